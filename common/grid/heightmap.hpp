@@ -15,6 +15,7 @@
 // Index (CellIndex: row, col) and Position (x, y in metres) never mix implicitly.
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <optional>
 
 #include "common/types.hpp"
@@ -23,6 +24,8 @@ namespace marsala::grid {
 
 /// Row-major storage of heights [m].
 using HeightMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+/// Row-major per-cell flags (1 = true, 0 = false), e.g. occupiable or navigable cells.
+using CellMask = Eigen::Matrix<std::uint8_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 /// Size and placement of a grid: rows, cols, lower-left corner [m], cell size [m/cell].
 struct GridGeometry {
