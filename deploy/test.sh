@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# The README's test command: installs what is missing, builds (Release) and runs every test with ctest.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+"$root/deploy/install-deps.sh"
+"$root/deploy/build.sh"
+cd "${MARSALA_BUILD_DIR:-$root/build}"
+ctest --output-on-failure -j"$(nproc)" --timeout 600
