@@ -1,12 +1,329 @@
 #include "common/cli/terrain_cli.hpp"
 
+// CLI11 2.1's pair conversion trips a false -Wmaybe-uninitialized at -O2; keep our own warnings on.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <CLI/CLI.hpp>
+#pragma GCC diagnostic pop
+
+#include <algorithm>
+#include <cstdint>
+#include <iomanip>
+#include <map>
 #include <ostream>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/error.hpp"
+#include "common/grid/heightmap.hpp"
+#include "common/processing/deposition.hpp"
+#include "common/processing/mars_processor.hpp"
+#include "common/processing/navigability_processor.hpp"
+#include "common/render/png_writer.hpp"
+#include "common/render/terrain_renderer.hpp"
+#include "common/terrain/asc_io.hpp"
+#include "common/terrain/generators.hpp"
+#include "common/terrain/geotiff_import.hpp"
+#include "common/terrain/resample.hpp"
+#include "common/terrain/terrain_stats.hpp"
 
 namespace marsala::cli {
+namespace {
 
-int run_terrain_cli(int, const char* const*, std::ostream&, std::ostream& err) {
-  err << "marsala-terrain: not implemented yet\n";
-  return 2;
+constexpr int kExitData = 1;
+constexpr int kExitUsage = 2;
+
+/// A usage error found after parsing (e.g. a bad --param); reported with exit code 2.
+class UsageError : public Error {
+ public:
+  explicit UsageError(const std::string& what) : Error(what) {}
+};
+
+bool has_tiff_extension(const std::string& path) {
+  std::string lower = path;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  auto ends_with = [&](const std::string& suffix) {
+    return lower.size() >= suffix.size() && lower.compare(lower.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  return ends_with(".tif") || ends_with(".tiff");
+}
+
+grid::Heightmap load_terrain(const std::string& path, bool fill_nodata) {
+  if (has_tiff_extension(path)) return terrain::read_geotiff(path, terrain::GeoTiffOptions{fill_nodata});
+  return terrain::read_asc(path, terrain::AscReadOptions{fill_nodata});
+}
+
+grid::Heightmap mask_as_heights(const grid::CellMask& mask, const grid::GridGeometry& geometry) {
+  return grid::Heightmap(geometry, mask.cast<double>().eval());
+}
+
+long long count(const grid::CellMask& mask) { return mask.cast<long long>().sum(); }
+
+std::string percent(long long part, long long whole) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(1) << (whole > 0 ? 100.0 * part / whole : 0.0) << "%";
+  return s.str();
+}
+
+/// Parses "key=value" pairs of --param into a map; a malformed pair is a usage error.
+std::map<std::string, double> parse_params(const std::vector<std::string>& pairs) {
+  std::map<std::string, double> params;
+  for (const std::string& pair : pairs) {
+    const auto eq = pair.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw UsageError("--param expects KEY=VALUE, got '" + pair + "'");
+    const std::string key = pair.substr(0, eq);
+    const std::string text = pair.substr(eq + 1);
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != text.size()) throw UsageError("--param " + key + ": '" + text + "' is not a number");
+    if (!params.emplace(key, value).second) throw UsageError("--param " + key + " is given twice");
+  }
+  return params;
+}
+
+std::string methods_help() {
+  std::ostringstream s;
+  s << "Methods and their --param keys:\n";
+  for (const std::string& name : terrain::generator_names()) {
+    s << "  " << name << "\n";
+    for (const std::string& line : terrain::generator_parameter_help(name)) s << "    " << line << "\n";
+  }
+  return s.str();
+}
+
+/// Adds --kappa/--eps/--delta with range checks to a subcommand.
+void add_navigability_options(CLI::App& cmd, NavigabilityParams& params, bool required) {
+  auto* kappa = cmd.add_option("--kappa", params.kappa, "maximum climbable slope, rise over run [m/m]")
+                    ->check(CLI::PositiveNumber);
+  auto* eps = cmd.add_option("--eps", params.eps_m, "largest discontinuity per body length [m]")
+                  ->check(CLI::NonNegativeNumber);
+  auto* delta = cmd.add_option("--delta", params.delta_m, "robot body length [m]")->check(CLI::PositiveNumber);
+  if (required) {
+    kappa->required();
+    eps->required();
+    delta->required();
+  } else {
+    kappa->capture_default_str();
+    eps->capture_default_str();
+    delta->capture_default_str();
+  }
+}
+
+CellIndex to_cell(const std::pair<int, int>& rc) { return CellIndex{rc.first, rc.second}; }
+
+void check_origin(const grid::Heightmap& map, CellIndex origin) {
+  if (!map.contains(origin))
+    throw InvalidArgument("origin cell (" + std::to_string(origin.row) + ", " + std::to_string(origin.col) +
+                          ") is off the " + std::to_string(map.rows()) + " x " + std::to_string(map.cols()) +
+                          " grid");
+}
+
+}  // namespace
+
+int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{"marsala-terrain: generate, import, inspect and render terrains; compute MARS and navigability.\n"
+               "Heights are metres; files are ESRI ASCII grids (.asc); GeoTIFF (.tif) is accepted as input.",
+               "marsala-terrain"};
+  app.require_subcommand(1);
+  app.set_help_all_flag("--help-all", "help for every subcommand");
+
+  // generate
+  terrain::GeneratorSpec spec;
+  std::string method;
+  std::string out_path;
+  std::vector<std::string> param_pairs;
+  auto* generate = app.add_subcommand("generate", "generate a seeded, deterministic terrain");
+  generate->add_option("--method", method, "generator name (see below)")->required();
+  generate->add_option("--seed", spec.seed, "random seed")->capture_default_str();
+  generate->add_option("--rows", spec.rows, "rows")->required()->check(CLI::Range(1, 1 << 16));
+  generate->add_option("--cols", spec.cols, "columns")->required()->check(CLI::Range(1, 1 << 16));
+  generate->add_option("--cell-size", spec.cell_size_m, "cell size [m]")->required()->check(CLI::PositiveNumber);
+  generate->add_option("--param", param_pairs, "method parameter KEY=VALUE (repeatable)");
+  generate->add_option("-o,--output", out_path, "output .asc")->required();
+  generate->footer(methods_help());
+
+  // import
+  std::string in_path;
+  std::vector<double> crop;
+  double target_cell_size = 0.0;
+  bool fill_nodata = false;
+  bool zero_base = false;
+  auto* import = app.add_subcommand("import", "import a GeoTIFF (or .asc) with optional crop and resampling");
+  import->add_option("input", in_path, "input .tif/.tiff or .asc")->required()->check(CLI::ExistingFile);
+  import->add_option("-o,--output", out_path, "output .asc")->required();
+  import->add_option("--crop", crop, "crop X0 Y0 W H [m], in the imported local frame (lower-left = 0, 0)")
+      ->expected(4);
+  import->add_option("--cell-size", target_cell_size, "resample bilinearly to this cell size [m]")
+      ->check(CLI::PositiveNumber);
+  import->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells from their valid neighbours instead of failing");
+  import->add_flag("--zero-base", zero_base, "shift heights so that the lowest cell is at 0 m");
+
+  // info
+  auto* info = app.add_subcommand("info", "print size, cell size, extent, height range and mean slope");
+  info->add_option("input", in_path, "input .asc or .tif")->required()->check(CLI::ExistingFile);
+  info->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
+
+  // mars
+  double kappa = 0.0;
+  bool write_gap = false;
+  auto* mars = app.add_subcommand("mars", "write the MARS bound P_kappa[h] (or, with --gap, the MARS gap)");
+  mars->add_option("input", in_path, "input .asc or .tif")->required()->check(CLI::ExistingFile);
+  mars->add_option("--kappa", kappa, "maximum climbable slope, rise over run [m/m]")
+      ->required()
+      ->check(CLI::PositiveNumber);
+  mars->add_option("-o,--output", out_path, "output .asc")->required();
+  mars->add_flag("--gap", write_gap, "write the gap P_kappa[h] - h instead of P_kappa[h]");
+
+  // navigable
+  NavigabilityParams nav_params;
+  std::pair<int, int> origin{0, 0};
+  bool write_occupiable = false;
+  auto* navigable = app.add_subcommand("navigable", "write 1 for navigable cells, 0 otherwise");
+  navigable->add_option("input", in_path, "input .asc or .tif")->required()->check(CLI::ExistingFile);
+  add_navigability_options(*navigable, nav_params, true);
+  auto* origin_option = navigable->add_option("--origin-cell", origin, "origin cell ROW COL");
+  navigable->add_option("-o,--output", out_path, "output .asc")->required();
+  navigable->add_flag("--occupiable", write_occupiable, "write occupiability instead (no origin needed)");
+
+  // render
+  std::vector<std::pair<int, int>> render_origins;
+  bool render_gap = false;
+  std::string title;
+  int max_size_px = 1024;
+  NavigabilityParams render_params;
+  auto* render = app.add_subcommand("render", "write a hillshaded, colour-mapped PNG with optional overlays");
+  render->add_option("input", in_path, "input .asc or .tif")->required()->check(CLI::ExistingFile);
+  render->add_option("-o,--output", out_path, "output .png")->required();
+  render->add_option("--navigable-from", render_origins, "overlay the region navigable from ROW COL (repeatable; give the input file first)");
+  render->add_flag("--gap", render_gap, "overlay the MARS gap at --kappa");
+  add_navigability_options(*render, render_params, false);
+  render->add_option("--title", title, "title drawn above the picture");
+  render->add_option("--max-size", max_size_px, "longest side of the terrain picture [px]")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  render->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    out << app.help();
+    return 0;
+  } catch (const CLI::CallForAllHelp&) {
+    out << app.help("", CLI::AppFormatMode::All);
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    // Subcommand --help arrives here too (as CallForHelp raised from the subcommand).
+    if (e.get_exit_code() == 0) {
+      for (const CLI::App* sub : app.get_subcommands()) out << sub->help();
+      if (app.get_subcommands().empty()) out << app.help();
+      return 0;
+    }
+    err << "marsala-terrain: " << e.what() << " (run with --help for usage)\n";
+    return kExitUsage;
+  }
+
+  try {
+    if (*generate) {
+      spec.params = parse_params(param_pairs);
+      grid::Heightmap map;
+      try {
+        map = terrain::generate_terrain(method, spec);
+      } catch (const InvalidArgument& e) {
+        throw UsageError(e.what());  // unknown method or parameter: the command line is wrong
+      }
+      terrain::write_asc(map, out_path);
+      out << "generated " << method << " " << map.rows() << " x " << map.cols() << " at " << map.cell_size_m()
+          << " m, heights " << map.min_height() << " .. " << map.max_height() << " m -> " << out_path << "\n";
+    } else if (*import) {
+      grid::Heightmap map = load_terrain(in_path, fill_nodata);
+      if (!crop.empty()) map = terrain::crop(map, crop[0], crop[1], crop[2], crop[3]);
+      if (target_cell_size > 0.0) map = terrain::resample_bilinear(map, target_cell_size);
+      if (zero_base) map.heights().array() -= map.min_height();
+      // The written grid starts its own local frame at (0, 0).
+      grid::GridGeometry local = map.geometry();
+      local.xll_m = 0.0;
+      local.yll_m = 0.0;
+      terrain::write_asc(grid::Heightmap(local, map.heights()), out_path);
+      out << "imported " << in_path << ": " << map.rows() << " x " << map.cols() << " at " << map.cell_size_m()
+          << " m -> " << out_path << "\n";
+    } else if (*info) {
+      const grid::Heightmap map = load_terrain(in_path, fill_nodata);
+      const terrain::TerrainStats s = terrain::compute_terrain_stats(map);
+      const auto& g = map.geometry();
+      out << std::setprecision(6) << "file        " << in_path << "\n"
+          << "size        " << s.rows << " rows x " << s.cols << " cols (" << map.size() << " cells)\n"
+          << "cell size   " << s.cell_size_m << " m\n"
+          << "extent      x " << g.xll_m << " .. " << g.xll_m + s.width_m << " m, y " << g.yll_m << " .. "
+          << g.yll_m + s.height_m << " m (" << s.width_m << " x " << s.height_m << " m)\n"
+          << "height      " << s.min_height_m << " .. " << s.max_height_m << " m (mean " << s.mean_height_m
+          << " m, relief " << s.max_height_m - s.min_height_m << " m)\n"
+          << "mean slope  " << s.mean_slope << " (rise over run; max " << s.max_slope << ")\n";
+    } else if (*mars) {
+      const grid::Heightmap map = load_terrain(in_path, false);
+      const processing::MarsProcessor processor(kappa);
+      const grid::Heightmap bound = processor.project(map);
+      grid::Heightmap gap(map.geometry(), (bound.heights() - map.heights()).eval());
+      terrain::write_asc(write_gap ? gap : bound, out_path);
+      out << "MARS at kappa " << kappa << ": gap volume " << processing::deposition_target_volume(gap)
+          << " m^3, largest gap " << gap.max_height() << " m -> " << out_path << "\n";
+    } else if (*navigable) {
+      const grid::Heightmap map = load_terrain(in_path, false);
+      const processing::NavigabilityProcessor processor(nav_params);
+      const grid::CellMask occupiable = processor.occupiable(map);
+      if (write_occupiable) {
+        terrain::write_asc(mask_as_heights(occupiable, map.geometry()), out_path);
+        out << "occupiable " << count(occupiable) << " of " << map.size() << " cells ("
+            << percent(count(occupiable), map.size()) << ") -> " << out_path << "\n";
+      } else {
+        if (origin_option->count() == 0) throw UsageError("navigable: --origin-cell ROW COL is required");
+        check_origin(map, to_cell(origin));
+        const grid::CellMask reach = processing::NavigabilityProcessor::navigable_from(occupiable, to_cell(origin));
+        terrain::write_asc(mask_as_heights(reach, map.geometry()), out_path);
+        out << "navigable from (" << origin.first << ", " << origin.second << "): " << count(reach) << " of "
+            << map.size() << " cells (" << percent(count(reach), map.size()) << "); occupiable "
+            << count(occupiable) << " -> " << out_path << "\n";
+        if (count(reach) == 0) out << "note: the origin cell is not occupiable, so nothing is navigable\n";
+      }
+    } else if (*render) {
+      const grid::Heightmap map = load_terrain(in_path, fill_nodata);
+      render::RenderOptions options;
+      options.title = title;
+      options.max_size_px = max_size_px;
+      if (!render_origins.empty()) {
+        const processing::NavigabilityProcessor processor(render_params);
+        const grid::CellMask occupiable = processor.occupiable(map);
+        grid::CellMask reach = grid::CellMask::Zero(map.rows(), map.cols());
+        for (const auto& rc : render_origins) {
+          const CellIndex origin_cell = to_cell(rc);
+          check_origin(map, origin_cell);
+          reach = reach.cwiseMax(processing::NavigabilityProcessor::navigable_from(occupiable, origin_cell));
+          options.markers.push_back(origin_cell);
+        }
+        options.navigable = reach;
+      }
+      if (render_gap) options.gap = processing::MarsProcessor(render_params.kappa).gap(map);
+      render::write_png(render::render_terrain(map, options), out_path);
+      out << "rendered " << map.rows() << " x " << map.cols() << " -> " << out_path << "\n";
+    }
+  } catch (const UsageError& e) {
+    err << "marsala-terrain: " << e.what() << " (run with --help for usage)\n";
+    return kExitUsage;
+  } catch (const Error& e) {
+    err << "marsala-terrain: " << e.what() << "\n";
+    return kExitData;
+  } catch (const std::bad_alloc&) {
+    err << "marsala-terrain: out of memory\n";
+    return kExitData;
+  }
+  return 0;
 }
 
 }  // namespace marsala::cli
