@@ -18,6 +18,7 @@
 
 #include "common/grid/heightmap.hpp"
 #include "common/processing/mars_processor.hpp"
+#include "common/terrain/generators.hpp"
 #include "tests/support/mars_brute_force.hpp"
 
 // ---- allocation counting (global operator new / delete) ------------------------------------
@@ -134,7 +135,17 @@ Heightmap make_roof(int n) {
   return h;
 }
 
-enum class Input { kTerrain, kFedBack, kCones, kPlane, kRoof, kSteepPlane };
+// The project's own generators at their default parameters (relief scales with the map: at 1024^2 of 0.1 m
+// cells the fractal spans about +-2.6 m).
+Heightmap make_generated(const char* method, int n) {
+  marsala::terrain::GeneratorSpec spec;
+  spec.rows = spec.cols = n;
+  spec.cell_size_m = kCellM;
+  spec.seed = 2024;
+  return marsala::terrain::generate_terrain(method, spec);
+}
+
+enum class Input { kTerrain, kFedBack, kCones, kPlane, kRoof, kSteepPlane, kMix, kFractal };
 
 const Heightmap& input(Input kind, int n) {
   static std::map<std::pair<int, int>, Heightmap> cache;
@@ -149,6 +160,8 @@ const Heightmap& input(Input kind, int n) {
     case Input::kPlane: h = make_plane(n, 1.0); break;
     case Input::kRoof: h = make_roof(n); break;
     case Input::kSteepPlane: h = make_plane(n, 1.001); break;
+    case Input::kMix: h = make_generated("mix", n); break;
+    case Input::kFractal: h = make_generated("fractal", n); break;
   }
   return cache.emplace(key, std::move(h)).first->second;
 }
@@ -185,6 +198,8 @@ void run_brute(benchmark::State& state, Input kind) {
 // Required cases: terrain at several sizes; adversarial (a) MARS output fed back, (b) cones of
 // slope exactly kappa with apexes anywhere, (c) a plane of slope exactly kappa at 30 degrees.
 void BM_MarsTerrain(benchmark::State& state) { run_fast(state, Input::kTerrain); }
+void BM_MarsGeneratedMix(benchmark::State& state) { run_fast(state, Input::kMix); }
+void BM_MarsGeneratedFractal(benchmark::State& state) { run_fast(state, Input::kFractal); }
 void BM_MarsFedBack(benchmark::State& state) { run_fast(state, Input::kFedBack); }
 void BM_MarsCones(benchmark::State& state) { run_fast(state, Input::kCones); }
 void BM_MarsPlane30(benchmark::State& state) { run_fast(state, Input::kPlane); }
@@ -199,6 +214,8 @@ void BM_BruteCones(benchmark::State& state) { run_brute(state, Input::kCones); }
 void BM_BrutePlane30(benchmark::State& state) { run_brute(state, Input::kPlane); }
 
 BENCHMARK(BM_MarsTerrain)->Arg(64)->Arg(128)->Arg(256)->Arg(1024)->Arg(2048)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MarsGeneratedMix)->Arg(1024)->Arg(2048)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MarsGeneratedFractal)->Arg(1024)->Arg(2048)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MarsFedBack)->Arg(64)->Arg(1024)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MarsCones)->Arg(64)->Arg(1024)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MarsPlane30)->Arg(64)->Arg(1024)->Unit(benchmark::kMillisecond);

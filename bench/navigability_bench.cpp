@@ -19,6 +19,7 @@
 
 #include "common/grid/heightmap.hpp"
 #include "common/processing/navigability_processor.hpp"
+#include "common/terrain/generators.hpp"
 #include "tests/support/navigability_brute_force.hpp"
 
 namespace {
@@ -102,6 +103,15 @@ Heightmap steep_ramp(int n, std::uint64_t) {
   return h;
 }
 
+/// The project's `mix` generator at its default parameters (fractal, hills, craters, cliffs).
+Heightmap generated_mix(int n, std::uint64_t seed) {
+  marsala::terrain::GeneratorSpec spec;
+  spec.rows = spec.cols = n;
+  spec.cell_size_m = kCellSizeM;
+  spec.seed = seed;
+  return marsala::terrain::generate_terrain("mix", spec);
+}
+
 using Generator = Heightmap (*)(int, std::uint64_t);
 
 const Heightmap& terrain(Generator make, int n) {
@@ -145,6 +155,8 @@ void run_brute(benchmark::State& state, Generator make) {
 void BM_OccupiableSmooth(benchmark::State& state) { run_fast(state, smooth_terrain); }
 void BM_OccupiableSmoothBruteForce(benchmark::State& state) { run_brute(state, smooth_terrain); }
 void BM_OccupiableRough(benchmark::State& state) { run_fast(state, rough_terrain); }
+void BM_OccupiableGeneratedMix(benchmark::State& state) { run_fast(state, generated_mix); }
+void BM_OccupiableGeneratedMixBruteForce(benchmark::State& state) { run_brute(state, generated_mix); }
 void BM_OccupiableRoughBruteForce(benchmark::State& state) { run_brute(state, rough_terrain); }
 void BM_OccupiableSteepRamp(benchmark::State& state) { run_fast(state, steep_ramp); }
 
@@ -207,6 +219,8 @@ void BM_PeakMemory(benchmark::State& state) {
 
 BENCHMARK(BM_OccupiableSmooth)->Arg(128)->Arg(256)->Arg(1024)->Arg(2048)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_OccupiableSmoothBruteForce)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_OccupiableGeneratedMix)->Arg(256)->Arg(1024)->Arg(2048)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_OccupiableGeneratedMixBruteForce)->Arg(256)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_OccupiableRough)->Arg(128)->Arg(256)->Arg(1024)->Arg(2048)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_OccupiableRoughBruteForce)->Arg(128)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_OccupiableSteepRamp)->Arg(1024)->Unit(benchmark::kMillisecond);

@@ -181,6 +181,7 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       ->check(CLI::PositiveNumber);
   mars->add_option("-o,--output", out_path, "output .asc")->required();
   mars->add_flag("--gap", write_gap, "write the gap P_kappa[h] - h instead of P_kappa[h]");
+  mars->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
 
   // navigable
   NavigabilityParams nav_params;
@@ -192,6 +193,7 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
   auto* origin_option = navigable->add_option("--origin-cell", origin, "origin cell ROW COL");
   navigable->add_option("-o,--output", out_path, "output .asc")->required();
   navigable->add_flag("--occupiable", write_occupiable, "write occupiability instead (no origin needed)");
+  navigable->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
 
   // render
   std::vector<std::pair<int, int>> render_origins;
@@ -267,7 +269,7 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
           << " m, relief " << s.max_height_m - s.min_height_m << " m)\n"
           << "mean slope  " << s.mean_slope << " (rise over run; max " << s.max_slope << ")\n";
     } else if (*mars) {
-      const grid::Heightmap map = load_terrain(in_path, false);
+      const grid::Heightmap map = load_terrain(in_path, fill_nodata);
       const processing::MarsProcessor processor(kappa);
       const grid::Heightmap bound = processor.project(map);
       grid::Heightmap gap(map.geometry(), (bound.heights() - map.heights()).eval());
@@ -275,7 +277,7 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       out << "MARS at kappa " << kappa << ": gap volume " << processing::deposition_target_volume(gap)
           << " m^3, largest gap " << gap.max_height() << " m -> " << out_path << "\n";
     } else if (*navigable) {
-      const grid::Heightmap map = load_terrain(in_path, false);
+      const grid::Heightmap map = load_terrain(in_path, fill_nodata);
       const processing::NavigabilityProcessor processor(nav_params);
       const grid::CellMask occupiable = processor.occupiable(map);
       if (write_occupiable) {
