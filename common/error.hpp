@@ -41,4 +41,10 @@ class IoError : public Error {
   explicit IoError(const std::string& what) : Error(what) {}
 };
 
+/// The publish/subscribe layer failed (participant, topic, reader or writer could not be made or used).
+class BusError : public Error {
+ public:
+  explicit BusError(const std::string& what) : Error(what) {}
+};
+
 }  // namespace marsala

@@ -1,0 +1,196 @@
+// The in-process backend: participants of one domain in one process share a hub per message type.
+// Same semantics as the DDS backends where tests rely on them: partitions isolate, delivery is reliable and
+// in order, transient-local writers replay their latest sample to late readers, and a writer that is
+// destroyed no longer counts as alive.
+
+#include <algorithm>
+#include <map>
+#include <mutex>
+#include <tuple>
+
+#include "common/bus/detail/backends.hpp"
+
+namespace marsala::bus::detail {
+namespace {
+
+template <typename T>
+class Hub;
+
+template <typename T>
+class InProcessReader final : public Reader<T> {
+ public:
+  InProcessReader(std::shared_ptr<Hub<T>> hub, EndpointOptions options) : hub_(std::move(hub)), options_(options) {}
+  ~InProcessReader() override { hub_->remove_reader(this); }
+
+  std::vector<T> take() override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<T> out;
+    out.swap(queue_);
+    return out;
+  }
+  int alive_writers() const override { return hub_->writers_in(options_.partition); }
+
+  void deliver(const T& sample) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      queue_.push_back(sample);
+    }
+    notify();
+  }
+  void notify() const {
+    if (options_.signal) options_.signal->notify();
+  }
+  const EndpointOptions& options() const { return options_; }
+
+ private:
+  std::shared_ptr<Hub<T>> hub_;
+  EndpointOptions options_;
+  std::mutex mutex_;
+  std::vector<T> queue_;
+};
+
+template <typename T>
+class InProcessWriter final : public Writer<T> {
+ public:
+  InProcessWriter(std::shared_ptr<Hub<T>> hub, EndpointOptions options) : hub_(std::move(hub)), options_(options) {}
+  ~InProcessWriter() override { hub_->remove_writer(this); }
+  void write(const T& sample) override { hub_->publish(this, sample); }
+  int matched_readers() const override { return hub_->readers_in(options_.partition); }
+  const EndpointOptions& options() const { return options_; }
+
+ private:
+  std::shared_ptr<Hub<T>> hub_;
+  EndpointOptions options_;
+};
+
+/// All endpoints of one message type in one domain.
+template <typename T>
+class Hub {
+ public:
+  void add_reader(InProcessReader<T>* reader) {
+    std::vector<T> replay;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      readers_.push_back(reader);
+      if (reader->options().durability == Durability::kTransientLocal)
+        for (const auto& [writer, latest] : latest_)
+          if (writer->options().partition == reader->options().partition) replay.push_back(latest);
+      notify_partition(reader->options().partition);
+    }
+    for (const T& sample : replay) reader->deliver(sample);
+  }
+  void remove_reader(InProcessReader<T>* reader) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    readers_.erase(std::remove(readers_.begin(), readers_.end(), reader), readers_.end());
+  }
+  void add_writer(InProcessWriter<T>* writer) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    writers_.push_back(writer);
+    notify_partition(writer->options().partition);
+  }
+  void remove_writer(InProcessWriter<T>* writer) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    writers_.erase(std::remove(writers_.begin(), writers_.end(), writer), writers_.end());
+    latest_.erase(writer);
+    notify_partition(writer->options().partition);
+  }
+  void publish(InProcessWriter<T>* writer, const T& sample) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (writer->options().durability == Durability::kTransientLocal) latest_[writer] = sample;
+    for (InProcessReader<T>* reader : readers_)
+      if (reader->options().partition == writer->options().partition) reader->deliver(sample);
+  }
+  int writers_in(const std::string& partition) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return static_cast<int>(std::count_if(writers_.begin(), writers_.end(),
+                                          [&](auto* w) { return w->options().partition == partition; }));
+  }
+  int readers_in(const std::string& partition) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return static_cast<int>(std::count_if(readers_.begin(), readers_.end(),
+                                          [&](auto* r) { return r->options().partition == partition; }));
+  }
+
+ private:
+  void notify_partition(const std::string& partition) const {
+    for (InProcessReader<T>* reader : readers_)
+      if (reader->options().partition == partition) reader->notify();
+  }
+
+  mutable std::mutex mutex_;
+  std::vector<InProcessReader<T>*> readers_;
+  std::vector<InProcessWriter<T>*> writers_;
+  std::map<InProcessWriter<T>*, T> latest_;
+};
+
+/// One hub per message type for one domain.
+struct Domain {
+  std::tuple<std::shared_ptr<Hub<AgentHello>>, std::shared_ptr<Hub<Admission>>, std::shared_ptr<Hub<SensorFrame>>,
+             std::shared_ptr<Hub<ActionRequest>>, std::shared_ptr<Hub<WorldStatus>>,
+             std::shared_ptr<Hub<WorldEvent>>>
+      hubs{std::make_shared<Hub<AgentHello>>(),    std::make_shared<Hub<Admission>>(),
+           std::make_shared<Hub<SensorFrame>>(),   std::make_shared<Hub<ActionRequest>>(),
+           std::make_shared<Hub<WorldStatus>>(),   std::make_shared<Hub<WorldEvent>>()};
+};
+
+std::shared_ptr<Domain> domain(int domain_id) {
+  static std::mutex mutex;
+  static std::map<int, std::weak_ptr<Domain>> domains;
+  std::lock_guard<std::mutex> lock(mutex);
+  std::shared_ptr<Domain> d = domains[domain_id].lock();
+  if (!d) {
+    d = std::make_shared<Domain>();
+    domains[domain_id] = d;
+  }
+  return d;
+}
+
+class InProcessParticipant final : public Participant {
+ public:
+  explicit InProcessParticipant(int domain_id) : domain_id_(domain_id), domain_(domain(domain_id)) {}
+  Vendor vendor() const override { return Vendor::kInProcess; }
+  int domain_id() const override { return domain_id_; }
+
+ protected:
+  template <typename T>
+  std::unique_ptr<Writer<T>> writer(const EndpointOptions& options) {
+    auto hub = std::get<std::shared_ptr<Hub<T>>>(domain_->hubs);
+    auto w = std::make_unique<InProcessWriter<T>>(hub, options);
+    hub->add_writer(w.get());
+    return w;
+  }
+  template <typename T>
+  std::unique_ptr<Reader<T>> reader(const EndpointOptions& options) {
+    auto hub = std::get<std::shared_ptr<Hub<T>>>(domain_->hubs);
+    auto r = std::make_unique<InProcessReader<T>>(hub, options);
+    hub->add_reader(r.get());
+    return r;
+  }
+
+  // clang-format off
+  std::unique_ptr<Writer<AgentHello>> make_writer(Tag<AgentHello>, const EndpointOptions& o) override { return writer<AgentHello>(o); }
+  std::unique_ptr<Writer<Admission>> make_writer(Tag<Admission>, const EndpointOptions& o) override { return writer<Admission>(o); }
+  std::unique_ptr<Writer<SensorFrame>> make_writer(Tag<SensorFrame>, const EndpointOptions& o) override { return writer<SensorFrame>(o); }
+  std::unique_ptr<Writer<ActionRequest>> make_writer(Tag<ActionRequest>, const EndpointOptions& o) override { return writer<ActionRequest>(o); }
+  std::unique_ptr<Writer<WorldStatus>> make_writer(Tag<WorldStatus>, const EndpointOptions& o) override { return writer<WorldStatus>(o); }
+  std::unique_ptr<Writer<WorldEvent>> make_writer(Tag<WorldEvent>, const EndpointOptions& o) override { return writer<WorldEvent>(o); }
+  std::unique_ptr<Reader<AgentHello>> make_reader(Tag<AgentHello>, const EndpointOptions& o) override { return reader<AgentHello>(o); }
+  std::unique_ptr<Reader<Admission>> make_reader(Tag<Admission>, const EndpointOptions& o) override { return reader<Admission>(o); }
+  std::unique_ptr<Reader<SensorFrame>> make_reader(Tag<SensorFrame>, const EndpointOptions& o) override { return reader<SensorFrame>(o); }
+  std::unique_ptr<Reader<ActionRequest>> make_reader(Tag<ActionRequest>, const EndpointOptions& o) override { return reader<ActionRequest>(o); }
+  std::unique_ptr<Reader<WorldStatus>> make_reader(Tag<WorldStatus>, const EndpointOptions& o) override { return reader<WorldStatus>(o); }
+  std::unique_ptr<Reader<WorldEvent>> make_reader(Tag<WorldEvent>, const EndpointOptions& o) override { return reader<WorldEvent>(o); }
+  // clang-format on
+
+ private:
+  int domain_id_;
+  std::shared_ptr<Domain> domain_;
+};
+
+}  // namespace
+
+std::unique_ptr<Participant> make_inprocess_participant(int domain_id) {
+  return std::make_unique<InProcessParticipant>(domain_id);
+}
+
+}  // namespace marsala::bus::detail
