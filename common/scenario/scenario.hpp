@@ -1,0 +1,83 @@
+#pragma once
+// A scenario as plain C++: terrain source, robot types, agent slots, goal, base station, clock settings.
+// Loaded from protobuf text format (schema idl/scenario.proto) by load_scenario(); protobuf types never leave
+// common/scenario.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "common/bus/messages.hpp"
+
+namespace marsala::scenario {
+
+/// Where the world's terrain comes from: a generator (common/terrain/generators.hpp) or a file.
+struct TerrainSource {
+  // Generated terrain (used when `file` is empty).
+  std::string method = "flat";               ///< generator name
+  int rows = 100;
+  int cols = 100;
+  double cell_size_m = 0.1;
+  std::uint64_t seed = 1;
+  std::map<std::string, double> params;      ///< generator parameters
+  // Or a terrain file (.asc or .tif), relative paths resolved against the scenario file's folder.
+  std::string file;
+  bool has_crop = false;
+  double crop_x0_m = 0.0, crop_y0_m = 0.0, crop_width_m = 0.0, crop_height_m = 0.0;
+  double resample_cell_size_m = 0.0;         ///< 0 = keep the file's cell size
+  bool zero_base = false;                    ///< shift so the lowest cell is at 0 m
+};
+
+/// A kind of robot: body parameters and the reactive behaviour that drives it.
+struct RobotType {
+  std::string name;                          ///< e.g. "husky"
+  std::string behaviour = "ramp_builder";    ///< reactive behaviour by name (agent registry)
+  bus::BodyParams body;
+};
+
+/// One agent of the team: agent id (slot index + 1), robot type, start and target [m].
+struct AgentSlot {
+  std::uint32_t id = 0;
+  std::string robot_type;                    ///< a RobotType name
+  double start_x_m = 0.0, start_y_m = 0.0;
+  double target_x_m = 0.0, target_y_m = 0.0;
+};
+
+/// Completion: every live agent inside [x0, x1] x [y0, y1] [m] standing at >= min_height_m.
+struct Goal {
+  double x0_m = 0.0, y0_m = 0.0, x1_m = 0.0, y1_m = 0.0;
+  double min_height_m = -1e9;
+};
+
+/// The base station: material is refilled only within radius of its centre.
+struct BaseStation {
+  double x_m = 0.0, y_m = 0.0, radius_m = 1.0;
+};
+
+/// A whole scenario.
+struct Scenario {
+  std::string name;
+  std::string source_path;                   ///< the file it was loaded from (for messages and relative paths)
+  TerrainSource terrain;
+  std::vector<RobotType> robot_types;
+  std::vector<AgentSlot> slots;              ///< slots[i].id == i + 1
+  Goal goal;
+  BaseStation base;
+  std::uint64_t max_steps = 5000;
+  double step_deadline_s = 10.0;
+  std::int32_t tile_size = 16;
+  std::uint64_t seed = 1;
+
+  /// The robot type of slot `id`; throws InvalidArgument when there is no such slot.
+  const RobotType& robot_for(std::uint32_t id) const;
+};
+
+/// Loads and validates a scenario (protobuf text format). Throws ParseError with file and line for syntax
+/// errors and unknown fields, InvalidArgument naming the field for bad values (non-positive sizes, unknown
+/// robot type or generator, slots outside the terrain, NaN).
+Scenario load_scenario(const std::string& path);
+/// Same from text; `source_name` names it in messages and anchors relative terrain paths.
+Scenario parse_scenario(const std::string& text, const std::string& source_name);
+
+}  // namespace marsala::scenario
