@@ -68,16 +68,13 @@ template <typename T>
 class Hub {
  public:
   void add_reader(InProcessReader<T>* reader) {
-    std::vector<T> replay;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      readers_.push_back(reader);
-      if (reader->options().durability == Durability::kTransientLocal)
-        for (const auto& [writer, latest] : latest_)
-          if (writer->options().partition == reader->options().partition) replay.push_back(latest);
-      notify_partition(reader->options().partition);
-    }
-    for (const T& sample : replay) reader->deliver(sample);
+    // The replay is delivered under the hub lock, so a concurrent publish cannot overtake it.
+    std::lock_guard<std::mutex> lock(mutex_);
+    readers_.push_back(reader);
+    if (reader->options().durability == Durability::kTransientLocal)
+      for (const auto& [writer, latest] : latest_)
+        if (writer->options().partition == reader->options().partition) reader->deliver(latest);
+    notify_partition(reader->options().partition);
   }
   void remove_reader(InProcessReader<T>* reader) {
     std::lock_guard<std::mutex> lock(mutex_);

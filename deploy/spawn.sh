@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# Runs a scenario as real processes: one marsala-world and N marsala-agent processes on a fresh DDS domain with the
+# loopback configuration, waits for the end, prints the summary, and stops every child it started on exit or Ctrl-C.
+#
+# Usage: deploy/spawn.sh --scenario FILE --agents N [--dds cyclone|fastdds] [--agent-dds cyclone|fastdds]
+#                        [--out DIR] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--quiet]
+#   --dds         vendor of every process (default cyclone); --agent-dds overrides it for the agents (mixed runs)
+#   --domain      DDS domain id (default: a free-looking one derived from the process id)
+#   --monitor     also run `marsala-monitor tail` in the foreground output
+#   --timeout     give up (and stop everything) after S seconds of wall time (default 1800)
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
+
+scenario="" agents="" dds="cyclone" agent_dds="" out="" domain="" monitor=0 max_steps="" timeout_s=1800 quiet=0
+usage() { sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; }
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --scenario) scenario="$2"; shift 2 ;;
+    --agents) agents="$2"; shift 2 ;;
+    --dds) dds="$2"; shift 2 ;;
+    --agent-dds) agent_dds="$2"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    --domain) domain="$2"; shift 2 ;;
+    --monitor) monitor=1; shift ;;
+    --max-steps) max_steps="$2"; shift 2 ;;
+    --timeout) timeout_s="$2"; shift 2 ;;
+    --quiet) quiet=1; shift ;;
+    -h|--help) usage; exit 0 ;;
+    *) echo "spawn.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
+  esac
+done
+[ -n "$scenario" ] || { echo "spawn.sh: --scenario FILE is required (try --help)" >&2; exit 2; }
+[ -f "$scenario" ] || { echo "spawn.sh: scenario file '$scenario' not found" >&2; exit 2; }
+[[ "$agents" =~ ^[0-9]+$ ]] && [ "$agents" -ge 1 ] || { echo "spawn.sh: --agents N (N >= 1) is required" >&2; exit 2; }
+for v in "$dds" "${agent_dds:-$dds}"; do
+  case "$v" in cyclone|fastdds) ;; *) echo "spawn.sh: --dds must be cyclone or fastdds, got '$v'" >&2; exit 2 ;; esac
+done
+agent_dds="${agent_dds:-$dds}"
+domain="${domain:-$(( ($$ % 200) + 20 ))}"
+out="${out:-$root/out/$(basename "${scenario%.*}")-$agents}"
+for b in marsala-world marsala-agent; do
+  [ -x "$bin/$b" ] || { echo "spawn.sh: $bin/$b not built (run deploy/build.sh)" >&2; exit 1; }
+done
+
+# Loopback only: DDS traffic never leaves this host's lo interface.
+export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-lo.xml"
+
+mkdir -p "$out/logs"
+pids=()
+cleanup() {
+  trap - EXIT INT TERM
+  for pid in "${pids[@]}"; do kill -TERM "$pid" 2>/dev/null || true; done
+  sleep 0.5
+  for pid in "${pids[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+}
+trap cleanup EXIT
+trap 'echo "spawn.sh: interrupted, stopping children" >&2; exit 130' INT TERM
+
+world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$domain" --out "$out")
+[ -n "$max_steps" ] && world_args+=(--max-steps "$max_steps")
+[ "$quiet" -eq 1 ] && world_args+=(--quiet)
+"$bin/marsala-world" "${world_args[@]}" >"$out/logs/world.log" 2>&1 &
+world_pid=$!
+pids+=("$world_pid")
+for id in $(seq 1 "$agents"); do
+  "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds "$agent_dds" --domain "$domain" \
+    >"$out/logs/agent-$id.log" 2>&1 &
+  pids+=("$!")
+done
+[ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain; logs in $out/logs"
+
+if [ "$monitor" -eq 1 ] && [ -x "$bin/marsala-monitor" ]; then
+  "$bin/marsala-monitor" tail --dds "$dds" --domain "$domain" &
+  pids+=("$!")
+fi
+
+# Wait for the world to finish, or give up after the timeout.
+start=$SECONDS
+while kill -0 "$world_pid" 2>/dev/null; do
+  if [ $((SECONDS - start)) -ge "$timeout_s" ]; then
+    echo "spawn.sh: no end after ${timeout_s}s, stopping the run" >&2
+    kill -TERM "$world_pid" 2>/dev/null || true
+    sleep 2
+  fi
+  sleep 0.2
+done
+world_rc=0
+wait "$world_pid" || world_rc=$?
+if [ "$world_rc" -ne 0 ]; then
+  echo "spawn.sh: marsala-world exited with $world_rc; last lines of its log:" >&2
+  tail -n 20 "$out/logs/world.log" >&2
+  exit "$world_rc"
+fi
+if [ -f "$out/summary.json" ]; then
+  [ "$quiet" -eq 1 ] || { echo "Summary ($out/summary.json):"; cat "$out/summary.json"; echo; }
+else
+  echo "spawn.sh: the world wrote no summary in $out" >&2
+  exit 1
+fi
+[ "$quiet" -eq 1 ] || { echo "Pictures:"; ls -1 "$out"/*.png 2>/dev/null | sed 's/^/  /'; }

@@ -1,0 +1,217 @@
+#include "monitor/follow.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <ostream>
+#include <set>
+#include <utility>
+#include <vector>
+
+namespace marsala::monitor {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Reader history: a slow terminal must not make tail skip steps; the world keeps only the latest (depth 1).
+constexpr std::int32_t kStatusDepth = 64;
+constexpr std::int32_t kEventDepth = 256;
+
+Clock::duration to_clock(std::chrono::duration<double> d) { return std::chrono::duration_cast<Clock::duration>(d); }
+
+std::string seconds_text(std::chrono::duration<double> d) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g s", d.count());
+  return text;
+}
+
+std::string where(const bus::Participant& participant) {
+  return "domain " + std::to_string(participant.domain_id()) + " (" + bus::to_string(participant.vendor()) + ")";
+}
+
+/// What one tail has printed so far, and the merge of statuses and events into one stream of lines.
+class TailPrinter {
+ public:
+  TailPrinter(const TailOptions& options, std::ostream& out, std::ostream& err)
+      : options_(options), run_id_(options.run_id), out_(out), err_(err) {}
+
+  /// Prints a batch in step order: each status after the events of its step and earlier (the world
+  /// publishes a step's events before its status; statuses are taken before events, so the events of a
+  /// taken status are in the batch). Stops at the final status and keeps the events after it; returns
+  /// whether a status of the followed run came.
+  bool print(const std::vector<bus::WorldStatus>& statuses, const std::vector<bus::WorldEvent>& events) {
+    bool got_status = false;
+    std::size_t next_event = 0;
+    for (const bus::WorldStatus& status : statuses) {
+      if (!follows(status)) continue;
+      got_status = true;
+      if (!status.running) {
+        final_ = status;
+        break;
+      }
+      while (next_event < events.size() && events[next_event].step <= status.step) print_event(events[next_event++]);
+      print_status(status);
+    }
+    for (; next_event < events.size(); ++next_event) {
+      if (final_)
+        late_events_.push_back(events[next_event]);
+      else
+        print_event(events[next_event]);
+    }
+    out_.flush();
+    return got_status;
+  }
+
+  const std::optional<bus::WorldStatus>& final_status() const { return final_; }
+  bool run_over_seen() const {
+    if (run_over_printed_) return true;
+    for (const bus::WorldEvent& e : late_events_)
+      if (e.kind == bus::EventKind::kRunOver) return true;
+    return false;
+  }
+  void add_late_events(const std::vector<bus::WorldEvent>& events) {
+    late_events_.insert(late_events_.end(), events.begin(), events.end());
+  }
+
+  /// The end of the run: its last events, its last step line, the summary.
+  void print_final() {
+    for (const bus::WorldEvent& e : late_events_) print_event(e);
+    late_events_.clear();
+    print_status(*final_);
+    out_ << format_run_summary(*final_) << '\n';
+    out_.flush();
+  }
+
+  void print_stopped() {
+    if (last_)
+      out_ << "tail stopped after step " << last_->step << " of run " << printable(last_->run_id) << '\n';
+    else
+      out_ << "tail stopped before any world status\n";
+    out_.flush();
+  }
+
+  std::string last_seen() const {
+    if (!last_) return "";
+    return " (last: step " + std::to_string(last_->step) + " of run " + printable(last_->run_id) + ")";
+  }
+
+ private:
+  bool follows(const bus::WorldStatus& status) {
+    if (run_id_.empty()) run_id_ = status.run_id;
+    if (status.run_id == run_id_) return true;
+    if (ignored_runs_.insert(status.run_id).second)
+      err_ << "marsala-monitor: ignoring run '" << printable(status.run_id) << "' (following '" << printable(run_id_)
+           << "')\n";
+    return false;
+  }
+
+  void print_status(const bus::WorldStatus& status) {
+    std::vector<std::uint32_t> ids;
+    for (const bus::AgentStatus& a : status.agents) ids.push_back(a.agent_id);
+    if (!last_ || ids != header_ids_) {
+      out_ << format_step_header(status, options_.format) << '\n';
+      header_ids_ = std::move(ids);
+    }
+    out_ << format_step_line(status, options_.format) << '\n';
+    last_ = status;
+  }
+
+  void print_event(const bus::WorldEvent& event) {
+    if (event.kind == bus::EventKind::kRunOver) run_over_printed_ = true;
+    out_ << format_event(event, options_.format) << '\n';
+  }
+
+  const TailOptions& options_;
+  std::string run_id_;
+  std::ostream& out_;
+  std::ostream& err_;
+  std::optional<bus::WorldStatus> last_;
+  std::optional<bus::WorldStatus> final_;
+  std::vector<std::uint32_t> header_ids_;
+  std::vector<bus::WorldEvent> late_events_;
+  std::set<std::string> ignored_runs_;
+  bool run_over_printed_ = false;
+};
+
+}  // namespace
+
+int run_tail(bus::Participant& participant, const TailOptions& options, const StopSource& stop, std::ostream& out,
+             std::ostream& err) {
+  const std::shared_ptr<bus::Signal>& signal = stop.signal();
+  auto statuses =
+      participant.create_reader<bus::WorldStatus>({"", signal, bus::Durability::kTransientLocal, kStatusDepth});
+  std::unique_ptr<bus::Reader<bus::WorldEvent>> events;
+  if (options.events)
+    events = participant.create_reader<bus::WorldEvent>({"", signal, bus::Durability::kVolatile, kEventDepth});
+  err << "marsala-monitor: tailing " << where(participant)
+      << (options.run_id.empty() ? "" : ", run " + printable(options.run_id)) << "; Ctrl-C stops" << std::endl;
+
+  TailPrinter printer(options, out, err);
+  std::optional<Clock::time_point> deadline;
+  if (options.timeout) deadline = Clock::now() + to_clock(*options.timeout);
+  for (;;) {
+    // Statuses before events: every event published before a taken status is then taken too.
+    std::vector<bus::WorldStatus> status_batch = statuses->take();
+    // In step order: a transient-local replay may be overtaken by a newer live sample.
+    std::stable_sort(status_batch.begin(), status_batch.end(),
+                     [](const auto& a, const auto& b) { return a.step < b.step; });
+    std::vector<bus::WorldEvent> event_batch = events ? events->take() : std::vector<bus::WorldEvent>{};
+    const bool got_status = printer.print(status_batch, event_batch);
+    if (printer.final_status()) break;
+    if (stop.stop_requested()) {  // after the take: what arrived before the stop is printed
+      printer.print_stopped();
+      return 0;
+    }
+    if (deadline && got_status) deadline = Clock::now() + to_clock(*options.timeout);
+    if (!deadline) {
+      signal->wait_for(std::chrono::hours(1));
+    } else if (Clock::now() < *deadline) {
+      signal->wait_until(*deadline);
+    } else {
+      err << "marsala-monitor: no world status on " << where(participant) << " for "
+          << seconds_text(*options.timeout) << printer.last_seen() << std::endl;
+      return 1;
+    }
+  }
+
+  // The run is over: the world may still be sending its last events (kRunOver comes last); wait briefly.
+  if (events) {
+    const Clock::time_point drain_until = Clock::now() + to_clock(options.drain);
+    while (!printer.run_over_seen() && !stop.stop_requested() && Clock::now() < drain_until) {
+      signal->wait_until(drain_until);
+      printer.add_late_events(events->take());
+    }
+  }
+  printer.print_final();
+  return 0;
+}
+
+int run_status(bus::Participant& participant, const StatusOptions& options, const StopSource& stop,
+               std::ostream& out, std::ostream& err) {
+  auto statuses = participant.create_reader<bus::WorldStatus>({"", stop.signal(), bus::Durability::kTransientLocal, 1});
+  const Clock::time_point deadline = Clock::now() + to_clock(options.timeout);
+  for (;;) {
+    const std::vector<bus::WorldStatus> batch = statuses->take();
+    if (!batch.empty()) {
+      // The newest (the last of the highest step): a transient-local replay may arrive after a live sample.
+      const bus::WorldStatus* latest = &batch.front();
+      for (const bus::WorldStatus& s : batch)
+        if (s.step >= latest->step) latest = &s;
+      for (const std::string& line : format_status_table(*latest)) out << line << '\n';
+      out.flush();
+      return 0;
+    }
+    if (stop.stop_requested()) {
+      err << "marsala-monitor: stopped before a world status arrived" << std::endl;
+      return 1;
+    }
+    if (Clock::now() >= deadline) {
+      err << "marsala-monitor: no world server on " << where(participant) << ": no world status within "
+          << seconds_text(options.timeout) << std::endl;
+      return 1;
+    }
+    stop.signal()->wait_until(deadline);
+  }
+}
+
+}  // namespace marsala::monitor

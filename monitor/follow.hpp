@@ -1,0 +1,42 @@
+#pragma once
+// The runtime of marsala-monitor: reads WorldStatus and WorldEvent from a participant and prints them.
+// It creates readers only (never a writer), so it joins and leaves a running system without disturbing it.
+// Statuses are read transient-local: a monitor that starts late sees the latest step at once.
+
+#include <chrono>
+#include <iosfwd>
+#include <optional>
+#include <string>
+
+#include "common/bus/bus.hpp"
+#include "monitor/format.hpp"
+#include "monitor/stop_source.hpp"
+
+namespace marsala::monitor {
+
+/// Options of `tail`.
+struct TailOptions {
+  std::string run_id;                                  ///< follow this run only; empty = the first run seen
+  bool events = false;                                 ///< also print one line per WorldEvent
+  std::optional<std::chrono::duration<double>> timeout;  ///< give up after this long without a status [s]; none = never
+  /// How long to wait for late events (up to kRunOver) once the final status arrived [s].
+  std::chrono::duration<double> drain = std::chrono::milliseconds(500);
+  FormatOptions format;
+};
+
+/// Options of `status`.
+struct StatusOptions {
+  std::chrono::duration<double> timeout = std::chrono::seconds(5);  ///< how long to wait for a world [s]
+};
+
+/// Prints one line per step (and per event) until the run ends (final summary, 0), `stop` is requested
+/// (0), or no status came for options.timeout (message on `err`, 1). Statuses of other runs are skipped.
+int run_tail(bus::Participant& participant, const TailOptions& options, const StopSource& stop, std::ostream& out,
+             std::ostream& err);
+
+/// Waits for the latest WorldStatus and prints the status table (0); no status within options.timeout or
+/// `stop` requested first: a message on `err` and 1.
+int run_status(bus::Participant& participant, const StatusOptions& options, const StopSource& stop,
+               std::ostream& out, std::ostream& err);
+
+}  // namespace marsala::monitor

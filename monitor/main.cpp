@@ -1,0 +1,18 @@
+// marsala-monitor: tail a running system (tail, status). Reads only; Ctrl-C ends it cleanly.
+#include <exception>
+#include <iostream>
+
+#include "monitor/monitor_cli.hpp"
+#include "monitor/signal_watcher.hpp"
+
+int main(int argc, char** argv) {
+  try {
+    marsala::monitor::StopSource stop;
+    // First, before any thread exists: SIGINT/SIGTERM become stop requests in every thread started later.
+    marsala::monitor::SignalWatcher watcher(stop);
+    return marsala::monitor::run_monitor_cli(argc, argv, std::cout, std::cerr, stop);
+  } catch (const std::exception& e) {
+    std::cerr << "marsala-monitor: " << e.what() << "\n";
+    return 1;
+  }
+}

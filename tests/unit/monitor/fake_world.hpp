@@ -1,0 +1,42 @@
+#pragma once
+// The world server's side of the bus for the monitor's tests: what the monitor reads, and a way to wait
+// (on a wake-up, not a sleep) until the monitor's readers have joined.
+
+#include <chrono>
+#include <memory>
+
+#include "common/bus/bus.hpp"
+
+namespace marsala::monitor::test_support {
+
+/// The world server's side of the bus: a transient-local status writer (depth 1) and an event writer,
+/// plus probes that wake the test when the monitor's readers join.
+class FakeWorld {
+ public:
+  explicit FakeWorld(int domain_id) : participant_(bus::make_participant({bus::Vendor::kInProcess, domain_id})) {
+    status_ = participant_->create_writer<bus::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
+    events_ = participant_->create_writer<bus::WorldEvent>({"", nullptr, bus::Durability::kVolatile, 256});
+    status_probe_ = participant_->create_reader<bus::WorldStatus>({"", probe_});
+    event_probe_ = participant_->create_reader<bus::WorldEvent>({"", probe_});
+  }
+
+  /// Waits (on the probes' wake-up, at most 5 s) until the monitor's readers joined.
+  bool wait_for_monitor(int status_readers, int event_readers) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    while (status_->matched_readers() < 1 + status_readers || events_->matched_readers() < 1 + event_readers)
+      if (!probe_->wait_until(deadline)) return false;
+    return true;
+  }
+  void publish(const bus::WorldStatus& s) { status_->write(s); }
+  void publish(const bus::WorldEvent& e) { events_->write(e); }
+
+ private:
+  std::unique_ptr<bus::Participant> participant_;
+  std::shared_ptr<bus::Signal> probe_ = std::make_shared<bus::Signal>();
+  std::unique_ptr<bus::Writer<bus::WorldStatus>> status_;
+  std::unique_ptr<bus::Writer<bus::WorldEvent>> events_;
+  std::unique_ptr<bus::Reader<bus::WorldStatus>> status_probe_;
+  std::unique_ptr<bus::Reader<bus::WorldEvent>> event_probe_;
+};
+
+}  // namespace marsala::monitor::test_support
