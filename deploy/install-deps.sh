@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev
   libtiff-dev libpng-dev zlib1g-dev
   libcli11-dev
+  libprotobuf-dev protobuf-compiler libspdlog-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
 )
 

@@ -1,0 +1,255 @@
+// Scenario files: protobuf text format (idl/scenario.proto) -> validated plain structs (scenario.hpp).
+#include <google/protobuf/io/tokenizer.h>
+#include <google/protobuf/text_format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "common/error.hpp"
+#include "common/scenario/body_check.hpp"
+#include "common/scenario/scenario.hpp"
+#include "common/scenario/terrain_builder.hpp"
+#include "common/terrain/generators.hpp"
+#include "idl/scenario.pb.h"
+
+namespace marsala::scenario {
+namespace {
+
+/// A text-format error that reads "FILE:LINE:COL: message" (1-based line and column).
+class TextFormatError : public ParseError {
+ public:
+  TextFormatError(const std::string& file, int line, int column, const std::string& message)
+      : ParseError(file, line, message),
+        text_(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + message) {}
+  const char* what() const noexcept override { return text_.c_str(); }
+
+ private:
+  std::string text_;
+};
+
+/// Keeps the first error the text-format parser reports.
+class FirstErrorCollector final : public google::protobuf::io::ErrorCollector {
+ public:
+  void AddError(int line, google::protobuf::io::ColumnNumber column, const std::string& message) override {
+    if (has_error_) return;
+    has_error_ = true;
+    line_ = line + 1;
+    column_ = column + 1;
+    message_ = message;
+  }
+  bool has_error() const { return has_error_; }
+  int line() const { return line_; }
+  int column() const { return column_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  bool has_error_ = false;
+  int line_ = 0;
+  int column_ = 0;
+  std::string message_;
+};
+
+std::string format(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+/// Validation of one scenario: each failure names the source and the field.
+class Validator {
+ public:
+  explicit Validator(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const std::string& field, const std::string& problem) const {
+    throw InvalidArgument("scenario " + source_ + ": " + field + ": " + problem);
+  }
+  double finite(const std::string& field, double v) const {
+    if (!std::isfinite(v) || std::abs(v) >= kMaxMagnitude) fail(field, format(v) + " must be finite and < 1e6 in magnitude");
+    return v;
+  }
+  double positive(const std::string& field, double v) const {
+    if (!(finite(field, v) > 0.0)) fail(field, format(v) + " must be > 0");
+    return v;
+  }
+
+ private:
+  std::string source_;
+};
+
+TerrainSource to_terrain(const proto::TerrainSource& p, const Validator& check) {
+  TerrainSource t;
+  const bool has_generator = !p.generator().empty();
+  const bool has_file = !p.file().empty();
+  if (has_generator == has_file) check.fail("terrain", "give exactly one of 'generator' and 'file'");
+  if (has_generator) {
+    const std::vector<std::string> names = terrain::generator_names();
+    if (std::find(names.begin(), names.end(), p.generator()) == names.end()) {
+      std::string valid;
+      for (const auto& n : names) valid += (valid.empty() ? "" : ", ") + n;
+      check.fail("terrain.generator", "unknown generator '" + p.generator() + "'; valid generators: " + valid);
+    }
+    t.method = p.generator();
+    if (p.has_rows()) t.rows = p.rows();
+    if (p.has_cols()) t.cols = p.cols();
+    if (t.rows <= 0) check.fail("terrain.rows", std::to_string(t.rows) + " must be > 0");
+    if (t.cols <= 0) check.fail("terrain.cols", std::to_string(t.cols) + " must be > 0");
+    if (p.has_cell_size_m()) t.cell_size_m = check.positive("terrain.cell_size_m", p.cell_size_m());
+    if (p.has_seed()) t.seed = p.seed();
+    for (const auto& [key, value] : p.params()) t.params[key] = check.finite("terrain.params['" + key + "']", value);
+    if (p.has_crop() || p.resample_cell_size_m() != 0.0 || p.zero_base())
+      check.fail("terrain", "crop, resample_cell_size_m and zero_base apply to a terrain file only");
+  } else {
+    if (p.has_rows() || p.has_cols() || p.has_cell_size_m() || p.has_seed() || !p.params().empty())
+      check.fail("terrain", "rows, cols, cell_size_m, seed and params apply to a generator only");
+    t.method.clear();
+    t.file = p.file();
+    if (p.has_crop()) {
+      t.has_crop = true;
+      t.crop_x0_m = check.finite("terrain.crop.x0_m", p.crop().x0_m());
+      t.crop_y0_m = check.finite("terrain.crop.y0_m", p.crop().y0_m());
+      t.crop_width_m = check.positive("terrain.crop.width_m", p.crop().width_m());
+      t.crop_height_m = check.positive("terrain.crop.height_m", p.crop().height_m());
+    }
+    t.resample_cell_size_m = check.finite("terrain.resample_cell_size_m", p.resample_cell_size_m());
+    if (t.resample_cell_size_m < 0.0) check.fail("terrain.resample_cell_size_m", "must be >= 0 (0 = keep)");
+    t.zero_base = p.zero_base();
+  }
+  return t;
+}
+
+bus::BodyParams to_body(const proto::Body& p) {
+  bus::BodyParams b;
+  if (p.has_kappa()) b.kappa = p.kappa();
+  if (p.has_delta_m()) b.delta_m = p.delta_m();
+  if (p.has_eps_m()) b.eps_m = p.eps_m();
+  if (p.has_max_step_m()) b.max_step_m = p.max_step_m();
+  if (p.has_max_deposit_m3()) b.max_deposit_m3 = p.max_deposit_m3();
+  if (p.has_material_capacity_m3()) b.material_capacity_m3 = p.material_capacity_m3();
+  if (p.has_reach_m()) b.reach_m = p.reach_m();
+  if (p.has_sensing_range_m()) b.sensing_range_m = p.sensing_range_m();
+  if (p.has_proximity_range_m()) b.proximity_range_m = p.proximity_range_m();
+  if (p.has_cube_size_m()) b.cube_size_m = p.cube_size_m();
+  return b;
+}
+
+bool valid_name(const std::string& name) {
+  if (name.empty()) return false;
+  for (char c : name)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) return false;
+  return true;
+}
+
+Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
+  const Validator check(source);
+  Scenario s;
+  s.source_path = source;
+  if (!valid_name(p.name())) check.fail("name", "'" + p.name() + "' must be non-empty letters, digits, '_', '-', '.'");
+  s.name = p.name();
+  if (!p.has_terrain()) check.fail("terrain", "missing");
+  s.terrain = to_terrain(p.terrain(), check);
+
+  if (p.robot_type_size() == 0) check.fail("robot_type", "at least one robot type is required");
+  for (int i = 0; i < p.robot_type_size(); ++i) {
+    const proto::RobotType& rp = p.robot_type(i);
+    const std::string field = "robot_type[" + std::to_string(i) + "]";
+    RobotType t;
+    if (rp.name().empty()) check.fail(field + ".name", "missing");
+    for (const RobotType& earlier : s.robot_types)
+      if (earlier.name == rp.name()) check.fail(field + ".name", "robot type '" + rp.name() + "' is defined twice");
+    t.name = rp.name();
+    if (rp.has_behaviour()) t.behaviour = rp.behaviour();
+    if (t.behaviour.empty()) check.fail(field + ".behaviour", "must not be empty");
+    t.body = to_body(rp.body());
+    const std::string problem = body_problem(t.body);
+    if (!problem.empty()) check.fail(field + ".body", problem);
+    s.robot_types.push_back(std::move(t));
+  }
+
+  if (p.agent_size() == 0) check.fail("agent", "at least one agent slot is required");
+  for (int i = 0; i < p.agent_size(); ++i) {
+    const proto::AgentSlot& ap = p.agent(i);
+    const std::uint32_t id = static_cast<std::uint32_t>(i) + 1;
+    const std::string field = "agent[" + std::to_string(i) + "] (agent " + std::to_string(id) + ")";
+    if (ap.has_id() && ap.id() != id)
+      check.fail(field + ".id", std::to_string(ap.id()) + " differs from its position in the file (" +
+                                    std::to_string(id) + ")");
+    AgentSlot slot;
+    slot.id = id;
+    slot.robot_type = ap.robot_type();
+    bool known = false;
+    std::string valid;
+    for (const RobotType& t : s.robot_types) {
+      known = known || t.name == slot.robot_type;
+      valid += (valid.empty() ? "" : ", ") + t.name;
+    }
+    if (!known) check.fail(field + ".robot_type", "unknown robot type '" + slot.robot_type + "'; valid: " + valid);
+    if (!ap.has_start()) check.fail(field + ".start", "missing");
+    if (!ap.has_target()) check.fail(field + ".target", "missing");
+    slot.start_x_m = check.finite(field + ".start.x_m", ap.start().x_m());
+    slot.start_y_m = check.finite(field + ".start.y_m", ap.start().y_m());
+    slot.target_x_m = check.finite(field + ".target.x_m", ap.target().x_m());
+    slot.target_y_m = check.finite(field + ".target.y_m", ap.target().y_m());
+    s.slots.push_back(slot);
+  }
+
+  if (!p.has_goal()) check.fail("goal", "missing");
+  s.goal.x0_m = check.finite("goal.x0_m", p.goal().x0_m());
+  s.goal.y0_m = check.finite("goal.y0_m", p.goal().y0_m());
+  s.goal.x1_m = check.finite("goal.x1_m", p.goal().x1_m());
+  s.goal.y1_m = check.finite("goal.y1_m", p.goal().y1_m());
+  if (!(s.goal.x0_m < s.goal.x1_m) || !(s.goal.y0_m < s.goal.y1_m))
+    check.fail("goal", "the rectangle needs x0_m < x1_m and y0_m < y1_m");
+  if (p.goal().has_min_height_m()) s.goal.min_height_m = check.finite("goal.min_height_m", p.goal().min_height_m());
+
+  if (p.has_base()) {
+    s.base.x_m = check.finite("base.x_m", p.base().x_m());
+    s.base.y_m = check.finite("base.y_m", p.base().y_m());
+    if (p.base().has_radius_m()) s.base.radius_m = check.positive("base.radius_m", p.base().radius_m());
+  }
+  if (p.has_max_steps()) s.max_steps = p.max_steps();
+  if (s.max_steps == 0) check.fail("max_steps", "must be >= 1");
+  if (p.has_step_deadline_s()) s.step_deadline_s = check.positive("step_deadline_s", p.step_deadline_s());
+  if (p.has_tile_size()) s.tile_size = p.tile_size();
+  if (s.tile_size < 1 || s.tile_size > 4096) check.fail("tile_size", std::to_string(s.tile_size) + " must be in 1..4096");
+  if (p.has_seed()) s.seed = p.seed();
+
+  // Generated terrains have a known extent: check placements now. File terrains are checked by build_terrain().
+  if (!s.terrain.method.empty()) {
+    grid::GridGeometry g;
+    g.rows = s.terrain.rows;
+    g.cols = s.terrain.cols;
+    g.cell_size_m = s.terrain.cell_size_m;
+    check_placement(s, g);
+  }
+  return s;
+}
+
+}  // namespace
+
+Scenario parse_scenario(const std::string& text, const std::string& source_name) {
+  proto::Scenario message;
+  google::protobuf::TextFormat::Parser parser;
+  FirstErrorCollector errors;
+  parser.RecordErrorsTo(&errors);
+  parser.AllowUnknownField(false);
+  if (!parser.ParseFromString(text, &message)) {
+    if (errors.has_error()) throw TextFormatError(source_name, errors.line(), errors.column(), errors.message());
+    throw ParseError(source_name, 0, "not a valid scenario (protobuf text format)");
+  }
+  return to_scenario(message, source_name);
+}
+
+Scenario load_scenario(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError("cannot open scenario file '" + path + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw IoError("cannot read scenario file '" + path + "'");
+  return parse_scenario(text.str(), path);
+}
+
+}  // namespace marsala::scenario

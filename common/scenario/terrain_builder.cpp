@@ -1,0 +1,97 @@
+#include "common/scenario/terrain_builder.hpp"
+
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+
+#include "common/error.hpp"
+#include "common/terrain/asc_io.hpp"
+#include "common/terrain/generators.hpp"
+#include "common/terrain/geotiff_import.hpp"
+#include "common/terrain/resample.hpp"
+
+namespace marsala::scenario {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string format(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+bool is_tiff(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".tif" || ext == ".tiff";
+}
+
+grid::Heightmap read_terrain_file(const Scenario& s) {
+  const std::string path = resolve_terrain_path(s);
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    throw IoError("scenario " + s.source_path + ": terrain.file '" + s.terrain.file + "' not found (looked for " +
+                  path + ")");
+  grid::Heightmap map = is_tiff(path) ? terrain::read_geotiff(path) : terrain::read_asc(path);
+  const TerrainSource& t = s.terrain;
+  if (t.has_crop) map = terrain::crop(map, t.crop_x0_m, t.crop_y0_m, t.crop_width_m, t.crop_height_m);
+  if (t.resample_cell_size_m > 0.0) map = terrain::resample_bilinear(map, t.resample_cell_size_m);
+  if (t.zero_base) map.heights().array() -= map.min_height();
+  return map;
+}
+
+}  // namespace
+
+std::string resolve_terrain_path(const Scenario& s) {
+  const fs::path file(s.terrain.file);
+  if (file.is_absolute()) return file.string();
+  return (fs::path(s.source_path).parent_path() / file).lexically_normal().string();
+}
+
+grid::Heightmap build_terrain(const Scenario& s) {
+  grid::Heightmap map;
+  try {
+    if (!s.terrain.file.empty()) {
+      map = read_terrain_file(s);
+    } else {
+      terrain::GeneratorSpec spec;
+      spec.rows = s.terrain.rows;
+      spec.cols = s.terrain.cols;
+      spec.cell_size_m = s.terrain.cell_size_m;
+      spec.seed = s.terrain.seed;
+      spec.params = s.terrain.params;
+      map = terrain::generate_terrain(s.terrain.method, spec);
+    }
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument("scenario " + s.source_path + ": terrain: " + e.what());
+  }
+  check_placement(s, map.geometry());
+  return map;
+}
+
+void check_placement(const Scenario& s, const grid::GridGeometry& g) {
+  const double x1 = g.xll_m + g.cols * g.cell_size_m;
+  const double y1 = g.yll_m + g.rows * g.cell_size_m;
+  const std::string extent = "[" + format(g.xll_m) + ", " + format(x1) + "] x [" + format(g.yll_m) + ", " +
+                             format(y1) + "] m";
+  const auto fail = [&](const std::string& field, const std::string& problem) {
+    throw InvalidArgument("scenario " + s.source_path + ": " + field + ": " + problem + " (terrain " + extent + ")");
+  };
+  const auto on_grid = [&](const std::string& field, double x, double y) {
+    if (!g.cell_at({x, y})) fail(field, "(" + format(x) + ", " + format(y) + ") is off the terrain");
+  };
+  for (std::size_t i = 0; i < s.slots.size(); ++i) {
+    const AgentSlot& slot = s.slots[i];
+    const std::string field = "agent[" + std::to_string(i) + "] (agent " + std::to_string(slot.id) + ")";
+    on_grid(field + ".start", slot.start_x_m, slot.start_y_m);
+    on_grid(field + ".target", slot.target_x_m, slot.target_y_m);
+  }
+  on_grid("base", s.base.x_m, s.base.y_m);
+  const Goal& goal = s.goal;
+  if (goal.x0_m < g.xll_m || goal.x1_m > x1 || goal.y0_m < g.yll_m || goal.y1_m > y1)
+    fail("goal", "[" + format(goal.x0_m) + ", " + format(goal.x1_m) + "] x [" + format(goal.y0_m) + ", " +
+                     format(goal.y1_m) + "] m is not inside the terrain");
+}
+
+}  // namespace marsala::scenario

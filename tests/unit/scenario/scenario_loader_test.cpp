@@ -1,0 +1,209 @@
+#include "common/scenario/scenario.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+
+#include "common/error.hpp"
+
+namespace marsala::scenario {
+namespace {
+
+std::string source_dir() {
+  const char* dir = std::getenv("MARSALA_SOURCE_DIR");
+  return dir ? dir : ".";
+}
+
+const char* const kMinimal = R"(
+name: "mini"
+terrain { generator: "flat" rows: 20 cols: 30 cell_size_m: 0.5 }
+robot_type { name: "bot" }
+agent { robot_type: "bot" start { x_m: 1 y_m: 1 } target { x_m: 10 y_m: 5 } }
+goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }
+)";
+
+/// kMinimal with `from` replaced by `to` (which must occur).
+std::string edit(const std::string& from, const std::string& to) {
+  std::string text = kMinimal;
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
+}
+
+/// The message of the InvalidArgument that parsing `text` throws (fails the test when none is thrown).
+std::string invalid(const std::string& text) {
+  try {
+    parse_scenario(text, "t.pbtxt");
+  } catch (const InvalidArgument& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InvalidArgument for\n" << text;
+  return {};
+}
+
+TEST(ScenarioLoader, TheRampScenarioLoadsWithEveryValue) {
+  const Scenario s = load_scenario(source_dir() + "/deploy/scenarios/ramp.pbtxt");
+  EXPECT_EQ(s.name, "ramp");
+  EXPECT_EQ(s.terrain.method, "platform");
+  EXPECT_EQ(s.terrain.rows, 200);
+  EXPECT_EQ(s.terrain.cols, 300);
+  EXPECT_EQ(s.terrain.cell_size_m, 0.1);
+  EXPECT_EQ(s.terrain.seed, 1u);
+  EXPECT_EQ(s.terrain.params.at("height"), 1.5);
+  EXPECT_EQ(s.terrain.params.at("centre_x"), 23.0);
+  EXPECT_TRUE(s.terrain.file.empty());
+  ASSERT_EQ(s.robot_types.size(), 1u);
+  const RobotType& husky = s.robot_types[0];
+  EXPECT_EQ(husky.name, "husky");
+  EXPECT_EQ(husky.behaviour, "ramp_builder");
+  EXPECT_EQ(husky.body.kappa, 0.3);
+  EXPECT_EQ(husky.body.delta_m, 1.0);
+  EXPECT_EQ(husky.body.eps_m, 0.05);
+  EXPECT_EQ(husky.body.max_step_m, 0.2);
+  EXPECT_EQ(husky.body.max_deposit_m3, 0.02);
+  EXPECT_EQ(husky.body.material_capacity_m3, 10.0);
+  EXPECT_EQ(husky.body.reach_m, 1.5);
+  EXPECT_EQ(husky.body.sensing_range_m, 4.0);
+  EXPECT_EQ(husky.body.proximity_range_m, 3.0);
+  EXPECT_EQ(husky.body.cube_size_m, 0.05);
+  ASSERT_EQ(s.slots.size(), 3u);
+  for (std::uint32_t id = 1; id <= 3; ++id) {
+    const AgentSlot& slot = s.slots[id - 1];
+    EXPECT_EQ(slot.id, id);
+    EXPECT_EQ(slot.robot_type, "husky");
+    EXPECT_EQ(slot.start_x_m, 5.05);
+    EXPECT_EQ(slot.target_x_m, 22.05);
+    EXPECT_EQ(slot.start_y_m, slot.target_y_m);  // straight ahead
+    EXPECT_EQ(&s.robot_for(id), &s.robot_types[0]);
+  }
+  EXPECT_NEAR(s.slots[1].start_y_m - s.slots[0].start_y_m, 3.0, 1e-12);  // spaced 3 m along the platform
+  EXPECT_EQ(s.goal.x0_m, 18.0);
+  EXPECT_EQ(s.goal.x1_m, 28.0);
+  EXPECT_EQ(s.goal.y0_m, 3.0);
+  EXPECT_EQ(s.goal.y1_m, 17.0);
+  EXPECT_EQ(s.goal.min_height_m, 1.4);
+  EXPECT_EQ(s.base.x_m, 3.05);
+  EXPECT_EQ(s.base.radius_m, 1.5);
+  EXPECT_EQ(s.max_steps, 4000u);
+  EXPECT_EQ(s.step_deadline_s, 10.0);
+  EXPECT_EQ(s.tile_size, 16);
+  EXPECT_EQ(s.seed, 1u);
+  EXPECT_THROW(s.robot_for(0), InvalidArgument);
+  EXPECT_THROW(s.robot_for(4), InvalidArgument);
+  // The kappa variants differ only in kappa and name.
+  for (const auto& [file, kappa] : {std::pair<const char*, double>{"ramp_k0.2.pbtxt", 0.2}, {"ramp_k0.5.pbtxt", 0.5}}) {
+    const Scenario v = load_scenario(source_dir() + "/deploy/scenarios/" + file);
+    EXPECT_EQ(v.robot_types[0].body.kappa, kappa);
+    EXPECT_EQ(v.robot_types[0].body.delta_m, 1.0);
+    EXPECT_EQ(v.slots.size(), 3u);
+  }
+}
+
+TEST(ScenarioLoader, DefaultsFillWhatIsLeftOut) {
+  const Scenario s = parse_scenario(kMinimal, "mini.pbtxt");
+  const bus::BodyParams defaults;
+  EXPECT_EQ(s.source_path, "mini.pbtxt");
+  EXPECT_EQ(s.robot_types[0].behaviour, "ramp_builder");
+  EXPECT_EQ(s.robot_types[0].body.kappa, defaults.kappa);
+  EXPECT_EQ(s.robot_types[0].body.reach_m, defaults.reach_m);
+  EXPECT_EQ(s.robot_types[0].body.material_capacity_m3, defaults.material_capacity_m3);
+  EXPECT_EQ(s.terrain.seed, 1u);
+  EXPECT_EQ(s.goal.min_height_m, -1e9);
+  EXPECT_EQ(s.base.radius_m, 1.0);
+  EXPECT_EQ(s.max_steps, 5000u);
+  EXPECT_EQ(s.step_deadline_s, 10.0);
+  EXPECT_EQ(s.tile_size, 16);
+  EXPECT_EQ(s.seed, 1u);
+  // Generator defaults: 100 x 100 cells of 0.1 m.
+  const Scenario d = parse_scenario(R"(
+name: "d"
+terrain { generator: "flat" }
+robot_type { name: "bot" }
+agent { robot_type: "bot" start { x_m: 1 y_m: 1 } target { x_m: 9.95 y_m: 9.95 } }
+goal { x0_m: 9 y0_m: 9 x1_m: 10 y1_m: 10 })", "d.pbtxt");
+  EXPECT_EQ(d.terrain.rows, 100);
+  EXPECT_EQ(d.terrain.cols, 100);
+  EXPECT_EQ(d.terrain.cell_size_m, 0.1);
+  // Heterogeneous teams: slots name different robot types.
+  const Scenario h = parse_scenario(std::string(kMinimal) + R"(
+robot_type { name: "digger" behaviour: "digger" body { kappa: 0.5 reach_m: 2 } }
+agent { id: 2 robot_type: "digger" start { x_m: 2 y_m: 2 } target { x_m: 3 y_m: 3 } })", "h.pbtxt");
+  EXPECT_EQ(h.robot_for(1).name, "bot");
+  EXPECT_EQ(h.robot_for(2).behaviour, "digger");
+  EXPECT_EQ(h.robot_for(2).body.kappa, 0.5);
+  EXPECT_EQ(h.robot_for(2).body.reach_m, 2.0);
+}
+
+TEST(ScenarioLoader, SyntaxErrorsNameFileLineAndColumn) {
+  try {
+    parse_scenario("name: \"x\"\n\nterrain { rows: 12 \n  cols: abc }\n", "broken.pbtxt");
+    FAIL() << "expected a ParseError";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("broken.pbtxt:4:", 0), 0u) << e.what();
+    EXPECT_EQ(e.line(), 4);
+    EXPECT_EQ(e.file(), "broken.pbtxt");
+  }
+  try {
+    parse_scenario(std::string(kMinimal) + "\nspeed: 3\n", "unknown.pbtxt");
+    FAIL() << "expected a ParseError";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("unknown.pbtxt:8:", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("speed"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(parse_scenario(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { wheels: 4 } }"), "t"),
+               ParseError);
+  EXPECT_THROW(parse_scenario(edit("name: \"mini\"", "name: \"mini\" name: \"again\""), "t"), ParseError);
+  EXPECT_THROW(load_scenario("/nonexistent/scenario.pbtxt"), IoError);
+}
+
+TEST(ScenarioLoader, BadValuesNameTheField) {
+  EXPECT_NE(invalid(edit("robot_type: \"bot\"", "robot_type: \"tank\"")).find("agent[0] (agent 1).robot_type: unknown robot type 'tank'; valid: bot"),
+            std::string::npos);
+  EXPECT_NE(invalid(edit("\"flat\"", "\"volcano\"")).find("terrain.generator: unknown generator 'volcano'; valid generators:"),
+            std::string::npos);
+  EXPECT_NE(invalid(edit("target { x_m: 10 y_m: 5 }", "target { x_m: 16 y_m: 5 }")).find("agent[0] (agent 1).target: (16, 5) is off the terrain"),
+            std::string::npos);
+  EXPECT_NE(invalid(edit("start { x_m: 1 y_m: 1 }", "start { x_m: 1 y_m: -0.1 }")).find(".start"), std::string::npos);
+  EXPECT_NE(invalid(edit("start { x_m: 1 y_m: 1 }", "start { x_m: nan y_m: 1 }")).find("start.x_m: nan must be finite"),
+            std::string::npos);
+  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { kappa: nan } }")).find("robot_type[0].body: kappa"),
+            std::string::npos);
+  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { reach_m: inf } }")).find("reach_m"),
+            std::string::npos);
+  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { delta_m: -1 } }")).find("delta_m = -1"),
+            std::string::npos);
+  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { max_step_m: 2e6 } }")).find("max_step_m"),
+            std::string::npos);
+  // Zero agents, no robot types.
+  const std::string no_agents = edit("agent { robot_type: \"bot\" start { x_m: 1 y_m: 1 } target { x_m: 10 y_m: 5 } }", "");
+  EXPECT_NE(invalid(no_agents).find("agent: at least one agent slot"), std::string::npos);
+  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "")).find("robot_type: at least one"), std::string::npos);
+  // Negative and zero sizes.
+  EXPECT_NE(invalid(edit("rows: 20", "rows: -20")).find("terrain.rows: -20 must be > 0"), std::string::npos);
+  EXPECT_NE(invalid(edit("cols: 30", "cols: 0")).find("terrain.cols: 0 must be > 0"), std::string::npos);
+  EXPECT_NE(invalid(edit("cell_size_m: 0.5", "cell_size_m: -0.5")).find("terrain.cell_size_m: -0.5 must be > 0"),
+            std::string::npos);
+  EXPECT_NE(invalid(std::string(kMinimal) + "tile_size: 0").find("tile_size"), std::string::npos);
+  EXPECT_NE(invalid(std::string(kMinimal) + "max_steps: 0").find("max_steps"), std::string::npos);
+  EXPECT_NE(invalid(std::string(kMinimal) + "step_deadline_s: -1").find("step_deadline_s"), std::string::npos);
+  EXPECT_NE(invalid(std::string(kMinimal) + "base { x_m: 1 y_m: 1 radius_m: 0 }").find("base.radius_m"), std::string::npos);
+  EXPECT_NE(invalid(std::string(kMinimal) + "base { x_m: 100 y_m: 1 }").find("base: (100, 1) is off the terrain"),
+            std::string::npos);
+  // Structure.
+  EXPECT_NE(invalid(edit("goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }", "goal { x0_m: 11 y0_m: 4 x1_m: 9 y1_m: 6 }")).find("goal"),
+            std::string::npos);
+  EXPECT_NE(invalid(edit("goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }", "goal { x0_m: 9 y0_m: 4 x1_m: 16 y1_m: 6 }")).find("not inside the terrain"),
+            std::string::npos);
+  EXPECT_NE(invalid(edit("goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }", "")).find("goal: missing"), std::string::npos);
+  EXPECT_NE(invalid(edit("name: \"mini\"", "name: \"a b\"")).find("name"), std::string::npos);
+  EXPECT_NE(invalid(edit("name: \"mini\"", "")).find("name"), std::string::npos);
+  EXPECT_NE(invalid(edit("generator: \"flat\"", "generator: \"flat\" file: \"x.asc\"")).find("exactly one"), std::string::npos);
+  EXPECT_NE(invalid(edit("robot_type: \"bot\"", "id: 2 robot_type: \"bot\"")).find("differs from its position"),
+            std::string::npos);
+  EXPECT_NE(invalid(std::string(kMinimal) + "robot_type { name: \"bot\" }").find("defined twice"), std::string::npos);
+  EXPECT_NE(invalid(edit(" target { x_m: 10 y_m: 5 }", "")).find("target: missing"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace marsala::scenario

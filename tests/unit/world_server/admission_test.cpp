@@ -1,0 +1,96 @@
+#include "world_server/admission.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "tests/unit/world_server/world_fixtures.hpp"
+#include "world_server/step.hpp"
+
+namespace marsala::world_server {
+namespace {
+
+using testing::flat_terrain;
+using testing::hello_for;
+using testing::small_scenario;
+
+class AdmissionTest : public ::testing::Test {
+ protected:
+  AdmissionTest() : state_(make_world_state(small_scenario(), flat_terrain(), 2)) {}
+  void expect_refused(const bus::AgentHello& h, const std::string& words, bool started = false) {
+    const AdmissionDecision d = decide_admission(state_, h, started);
+    EXPECT_FALSE(d.accepted) << "expected a refusal mentioning '" << words << "'";
+    EXPECT_NE(d.reason.find(words), std::string::npos) << d.reason;
+  }
+  WorldState state_;
+};
+
+TEST_F(AdmissionTest, AdmitsAMatchingHelloAndPlacesTheAgentAtItsStart) {
+  const bus::AgentHello h = hello_for(state_, 2, 77);
+  ASSERT_TRUE(decide_admission(state_, h, false).accepted);
+  EXPECT_TRUE(admit(state_, h));
+  const AgentRecord& a = state_.agent(2);
+  EXPECT_TRUE(a.admitted);
+  EXPECT_TRUE(a.alive);
+  EXPECT_EQ(a.session, 77u);
+  EXPECT_EQ(a.name, "tester-2");
+  EXPECT_EQ(a.x_m, 2.55);
+  EXPECT_EQ(a.y_m, 1.05);
+  EXPECT_EQ(a.material_m3, 0.05);
+  EXPECT_EQ(state_.live_ids(), std::vector<std::uint32_t>{2});
+  // A repeated hello of the same session is answered yes again and changes nothing.
+  EXPECT_TRUE(decide_admission(state_, h, true).accepted);
+  EXPECT_FALSE(admit(state_, h));
+
+  const bus::Admission m = admission_message(state_, h, {true, ""}, "small-d4");
+  EXPECT_EQ(m.agent_id, 2u);
+  EXPECT_EQ(m.session, 77u);
+  EXPECT_TRUE(m.accepted);
+  EXPECT_EQ(m.run_id, "small-d4");
+  EXPECT_EQ(m.rows, 40);
+  EXPECT_EQ(m.cols, 40);
+  EXPECT_EQ(m.cell_size_m, 0.1);
+  EXPECT_EQ(m.tile_size, 16);
+  EXPECT_EQ(m.start_x_m, 2.55);
+  EXPECT_EQ(m.target_x_m, 3.05);
+  EXPECT_EQ(m.target_y_m, 2.05);
+  EXPECT_EQ(m.base_x_m, 0.55);
+  EXPECT_EQ(m.base_radius_m, 0.5);
+}
+
+TEST_F(AdmissionTest, Refusals) {
+  bus::AgentHello h = hello_for(state_, 1, 5);
+  h.agent_id = 3;  // slot 3 exists in the scenario, but this run has two agents
+  expect_refused(h, "unknown agent id 3");
+  h.agent_id = 0;
+  expect_refused(h, "unknown agent id 0");
+
+  h = hello_for(state_, 1, 5);
+  h.body.kappa = 0.31;
+  expect_refused(h, "body differs from robot type 'tester'");
+  expect_refused(h, "kappa 0.31");
+  h = hello_for(state_, 1, 5);
+  h.body.cube_size_m = 0.1;
+  expect_refused(h, "cube_size_m");
+  h = hello_for(state_, 1, 5);
+  h.body.reach_m = std::numeric_limits<double>::quiet_NaN();
+  expect_refused(h, "invalid body: reach_m");
+  h = hello_for(state_, 1, 5);
+  h.body.max_step_m = 1e9;
+  expect_refused(h, "invalid body: max_step_m");
+
+  // Admitted with one session: another session of the same id is refused.
+  ASSERT_TRUE(admit(state_, hello_for(state_, 1, 5)));
+  expect_refused(hello_for(state_, 1, 6), "already admitted with another session");
+  // Not admitted before the start: refused once the run has started.
+  expect_refused(hello_for(state_, 2, 9), "already started", true);
+  // Dropped agents stay out.
+  drop_agent(state_, 1, "lost");
+  expect_refused(hello_for(state_, 1, 5), "was dropped");
+  const bus::Admission m = admission_message(state_, hello_for(state_, 1, 5), {false, "no"}, "r");
+  EXPECT_FALSE(m.accepted);
+  EXPECT_EQ(m.reason, "no");
+}
+
+}  // namespace
+}  // namespace marsala::world_server

@@ -1,0 +1,344 @@
+#include "world_server/arbiter.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "common/error.hpp"
+#include "common/processing/navigability_processor.hpp"
+#include "tests/unit/world_server/world_fixtures.hpp"
+
+namespace marsala::world_server {
+namespace {
+
+using testing::admitted_state;
+using testing::flat_terrain;
+using testing::kLayer;
+using testing::move_to;
+using testing::request_for;
+using testing::small_scenario;
+
+bus::Deposition dep(int row, int col, double h) { return {row, col, h}; }
+
+/// Row and column of the cell whose centre is (x, y) on the 40 x 40 test grid.
+CellIndex cell_of(double x, double y) { return {40 - 1 - static_cast<int>(std::floor(y / 0.1)), static_cast<int>(std::floor(x / 0.1))}; }
+
+class ArbiterTest : public ::testing::Test {
+ protected:
+  ArbiterTest() : scenario_(small_scenario()), state_(admitted_state(scenario_, flat_terrain(), 2)) {}
+  Verdict check(const bus::ActionRequest& r, std::uint32_t channel = 0) {
+    return validate_request(state_, channel == 0 ? r.agent_id : channel, r);
+  }
+  void expect_rejected(const bus::ActionRequest& r, const std::string& words, std::uint32_t channel = 0) {
+    const Verdict v = check(r, channel);
+    EXPECT_FALSE(v.accepted) << "expected a rejection mentioning '" << words << "'";
+    EXPECT_NE(v.reason.find(words), std::string::npos) << v.reason;
+  }
+  scenario::Scenario scenario_;
+  WorldState state_;
+};
+
+TEST_F(ArbiterTest, AcceptsAMoveWithDepositionsAndBooksThemExactly) {
+  bus::ActionRequest r = move_to(state_, 1, 1.25, 1.05);  // 0.2 m east
+  const CellIndex a = cell_of(1.25, 1.95), b = cell_of(0.45, 1.05);  // 0.9 m north, 0.8 m west of the new position
+  r.depositions = {dep(a.row, a.col, kLayer), dep(b.row, b.col, 2 * kLayer)};
+  const Verdict v = check(r);
+  ASSERT_TRUE(v.accepted) << v.reason;
+  EXPECT_EQ(v.volume_m3, kLayer * 0.1 * 0.1 + 2 * kLayer * 0.1 * 0.1);
+
+  std::vector<CellIndex> changed;
+  apply_request(state_, r, v, changed);
+  const AgentRecord& me = state_.agent(1);
+  EXPECT_EQ(me.x_m, 1.25);
+  EXPECT_EQ(me.y_m, 1.05);
+  EXPECT_EQ(me.z_m, 0.0);
+  EXPECT_EQ(state_.terrain(a), kLayer);
+  EXPECT_EQ(state_.terrain(b), 2 * kLayer);
+  EXPECT_DOUBLE_EQ(state_.terrain.heights().sum(), 3 * kLayer);  // nothing else moved
+  EXPECT_EQ(me.material_m3, 0.05 - v.volume_m3);
+  EXPECT_EQ(me.deposited_m3, v.volume_m3);
+  EXPECT_EQ(state_.deposited_volume_m3, v.volume_m3);
+  EXPECT_EQ(me.accepted, 1u);
+  ASSERT_EQ(changed.size(), 2u);
+  EXPECT_EQ(changed[0], a);
+  EXPECT_EQ(changed[1], b);
+}
+
+TEST_F(ArbiterTest, EnvelopeRules) {
+  // Spoofed id: agent 1's request on agent 2's partition.
+  expect_rejected(request_for(state_, 1), "arrived on the partition of agent 2", 2);
+  bus::ActionRequest r = request_for(state_, 1);
+  r.session += 1;
+  expect_rejected(r, "session");
+  r = request_for(state_, 1);
+  r.step = 1;
+  expect_rejected(r, "current step is 0");
+  state_.step = 5;
+  r.step = 4;
+  expect_rejected(r, "current step is 5");
+  r.step = 5;
+  EXPECT_TRUE(check(r).accepted);
+  // An agent of no slot, and one that was dropped.
+  r.agent_id = 7;
+  expect_rejected(r, "not admitted and alive");
+  state_.agent(2).alive = false;
+  r = request_for(state_, 2);
+  expect_rejected(r, "not admitted and alive");
+  // Slot 3 exists in the scenario but not in this two-agent run.
+  WorldState three = admitted_state(scenario_, flat_terrain(), 3);
+  three.agent(3).alive = false;
+  three.agent(3).admitted = false;
+  EXPECT_FALSE(validate_request(three, 3, request_for(three, 3)).accepted);
+}
+
+TEST_F(ArbiterTest, NonFiniteOrHugeValuesAreRejected) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  expect_rejected(move_to(state_, 1, nan, 1.05), "not finite");
+  expect_rejected(move_to(state_, 1, 1.05, inf), "not finite");
+  expect_rejected(move_to(state_, 1, 1e7, 1.05), "too large");
+  bus::ActionRequest r = request_for(state_, 1);
+  r.target_x_m = nan;  // checked even without a motion: every double must be sane
+  expect_rejected(r, "not finite");
+  r = request_for(state_, 1);
+  r.depositions = {dep(0, 0, inf)};
+  expect_rejected(r, "not finite");
+  r.depositions = {dep(0, 0, -nan)};
+  expect_rejected(r, "not finite");
+}
+
+TEST_F(ArbiterTest, MotionLongerThanTheStepIsRejectedTheStepItselfPasses) {
+  EXPECT_TRUE(check(move_to(state_, 1, 1.25, 1.05)).accepted);
+  // The diagonal of 0.2 m: (0.2 / sqrt 2) on both axes.
+  const double d = 0.2 / std::sqrt(2.0);
+  EXPECT_TRUE(check(move_to(state_, 1, 1.05 + d, 1.05 + d)).accepted);
+  expect_rejected(move_to(state_, 1, 1.05 + 0.2 + 1e-6, 1.05), "exceeds max_step_m");
+  expect_rejected(move_to(state_, 1, 1.35, 1.05), "exceeds max_step_m");
+}
+
+TEST_F(ArbiterTest, MotionOffTheGridIsRejected) {
+  state_.agent(1).x_m = 0.05;
+  state_.agent(1).y_m = 2.05;
+  expect_rejected(move_to(state_, 1, -0.1, 2.05), "off the grid");
+  state_.agent(1).x_m = 3.95;
+  expect_rejected(move_to(state_, 1, 4.05, 2.05), "off the grid");
+  EXPECT_TRUE(check(move_to(state_, 1, 3.99, 2.05)).accepted);
+}
+
+TEST_F(ArbiterTest, MotionOntoANonOccupiableCellIsRejected) {
+  // A 1 m cliff: every cell with x >= 3.0 m is at 1 m.
+  for (int r = 0; r < 40; ++r)
+    for (int c = 30; c < 40; ++c) state_.terrain(r, c) = 1.0;
+  state_.agent(1).x_m = 2.35;
+  state_.agent(1).y_m = 2.05;
+  // (2.55, 2.05): its ball (radius 0.5 m) reaches x = 3.05, a cell on the cliff 0.5 m from ground cells.
+  expect_rejected(move_to(state_, 1, 2.55, 2.05), "not occupiable");
+  // (2.45, 2.05): the ball stops at x = 2.95, all ground.
+  EXPECT_TRUE(check(move_to(state_, 1, 2.45, 2.05)).accepted);
+  EXPECT_TRUE(check(move_to(state_, 1, 2.15, 2.05)).accepted);
+}
+
+TEST_F(ArbiterTest, DepositionRules) {
+  const AgentRecord& me = state_.agent(1);  // at (1.05, 1.05); agent 2 at (2.55, 1.05)
+  bus::ActionRequest r = request_for(state_, 1);
+  const CellIndex fine = cell_of(1.05, 2.05);  // 1 m north: within reach 1.2, beyond delta/2 of everyone
+  r.depositions = {dep(fine.row, fine.col, kLayer)};
+  EXPECT_TRUE(check(r).accepted);
+
+  r.depositions = {dep(-1, 3, kLayer)};
+  expect_rejected(r, "off the grid");
+  r.depositions = {dep(fine.row, 40, kLayer)};
+  expect_rejected(r, "off the grid");
+  r.depositions = {dep(fine.row, fine.col, kLayer), dep(fine.row, fine.col, kLayer)};
+  expect_rejected(r, "listed twice");
+  r.depositions = {dep(fine.row, fine.col, 0.0)};
+  expect_rejected(r, "not in (0, 1] m");
+  r.depositions = {dep(fine.row, fine.col, -kLayer)};
+  expect_rejected(r, "not in (0, 1] m");
+  r.depositions = {dep(fine.row, fine.col, 81 * kLayer)};  // 1.0125 m: a whole multiple, but above 1 m
+  expect_rejected(r, "not in (0, 1] m");
+  r.depositions = {dep(fine.row, fine.col, 80 * kLayer)};  // exactly 1 m
+  EXPECT_TRUE(check(r).accepted);
+  r.depositions = {dep(fine.row, fine.col, 1.5 * kLayer)};
+  expect_rejected(r, "whole multiple");
+  r.depositions = {dep(fine.row, fine.col, 0.5 * kLayer)};
+  expect_rejected(r, "whole multiple");
+  r.depositions = {dep(fine.row, fine.col, kLayer * (1 + 2e-6))};
+  expect_rejected(r, "whole multiple");
+  r.depositions = {dep(fine.row, fine.col, kLayer * (1 + 5e-7))};  // within the 1e-6 tolerance
+  EXPECT_TRUE(check(r).accepted);
+
+  // Reach 1.2 m: 1.2 m north passes, 1.3 m does not.
+  const CellIndex at_reach = cell_of(1.05, 2.25), beyond = cell_of(1.05, 2.35);
+  r.depositions = {dep(at_reach.row, at_reach.col, kLayer)};
+  EXPECT_TRUE(check(r).accepted);
+  r.depositions = {dep(beyond.row, beyond.col, kLayer)};
+  expect_rejected(r, "beyond reach_m");
+  // Reach counts from the position after the motion.
+  bus::ActionRequest moved = move_to(state_, 1, 1.05, 1.25);
+  moved.depositions = {dep(beyond.row, beyond.col, kLayer)};
+  EXPECT_TRUE(check(moved).accepted);
+  EXPECT_EQ(me.y_m, 1.05);
+}
+
+TEST_F(ArbiterTest, DepositionUnderARobotIsRejected) {
+  bus::ActionRequest r = request_for(state_, 1);
+  // Under itself: 0.4 m away, and exactly delta/2 = 0.5 m away (the ball is inclusive).
+  CellIndex c = cell_of(1.45, 1.05);
+  r.depositions = {dep(c.row, c.col, kLayer)};
+  expect_rejected(r, "under agent 1");
+  c = cell_of(1.55, 1.05);
+  r.depositions = {dep(c.row, c.col, kLayer)};
+  expect_rejected(r, "under agent 1");
+  c = cell_of(1.65, 1.05);
+  r.depositions = {dep(c.row, c.col, kLayer)};
+  EXPECT_TRUE(check(r).accepted);
+  // Under agent 2 (at 2.55, 1.05): 0.5 m west of it is 1.0 m from agent 1, within reach.
+  c = cell_of(2.05, 1.05);
+  r.depositions = {dep(c.row, c.col, kLayer)};
+  expect_rejected(r, "under agent 2");
+  // Under its own new position: the cell it moves next to.
+  bus::ActionRequest moved = move_to(state_, 1, 1.05, 1.25);
+  c = cell_of(1.05, 1.65);  // 0.4 m from (1.05, 1.25), 0.6 m from (1.05, 1.05)
+  moved.depositions = {dep(c.row, c.col, kLayer)};
+  expect_rejected(moved, "under agent 1");
+  // A dropped robot is no longer in the world.
+  state_.agent(2).alive = false;
+  c = cell_of(2.05, 1.05);
+  r.depositions = {dep(c.row, c.col, kLayer)};
+  EXPECT_TRUE(check(r).accepted);
+}
+
+TEST_F(ArbiterTest, VolumeAboveTheThresholdOrTheMaterialIsRejected) {
+  bus::ActionRequest r = request_for(state_, 1);
+  const CellIndex a = cell_of(1.05, 2.05), b = cell_of(1.15, 2.05), c = cell_of(0.95, 2.05);
+  // 160 cubes = 160 * 1.25e-4 = 0.02 m^3: exactly the threshold.
+  r.depositions = {dep(a.row, a.col, 53 * kLayer), dep(b.row, b.col, 53 * kLayer), dep(c.row, c.col, 54 * kLayer)};
+  const Verdict at_threshold = check(r);
+  EXPECT_TRUE(at_threshold.accepted) << at_threshold.reason;
+  EXPECT_NEAR(at_threshold.volume_m3, 0.02, 1e-15);
+  r.depositions.back().height_m = 55 * kLayer;  // 161 cubes
+  expect_rejected(r, "exceeds max_deposit_m3");
+  // Material: 0.001 m^3 on board = 8 cubes.
+  state_.agent(1).material_m3 = 0.001;
+  r.depositions = {dep(a.row, a.col, 8 * kLayer)};
+  EXPECT_TRUE(check(r).accepted);
+  r.depositions = {dep(a.row, a.col, 9 * kLayer)};
+  expect_rejected(r, "exceeds the material on board");
+}
+
+TEST_F(ArbiterTest, RefillOnlyAtTheBase) {
+  bus::ActionRequest r = request_for(state_, 1);  // (1.05, 1.05) is 0.707 m from the base centre (0.55, 0.55)
+  r.refill = true;
+  expect_rejected(r, "from the base station");
+  r = move_to(state_, 1, 0.95, 0.95);  // 0.566 m: still outside the 0.5 m radius
+  r.refill = true;
+  expect_rejected(r, "from the base station");
+  state_.agent(1).x_m = 0.75;
+  state_.agent(1).y_m = 0.75;
+  state_.agent(1).material_m3 = 0.01;
+  r = move_to(state_, 1, 0.85, 0.85);  // 0.424 m from the centre
+  r.refill = true;
+  const CellIndex c = cell_of(0.85, 1.85);
+  r.depositions = {dep(c.row, c.col, 4 * kLayer)};
+  const Verdict v = check(r);
+  ASSERT_TRUE(v.accepted) << v.reason;
+  std::vector<CellIndex> changed;
+  apply_request(state_, r, v, changed);
+  EXPECT_EQ(state_.agent(1).material_m3, 0.05);  // deposited from what it had, then filled to capacity
+  EXPECT_EQ(state_.agent(1).deposited_m3, v.volume_m3);
+}
+
+TEST_F(ArbiterTest, AllOrNothing) {
+  bus::ActionRequest r = move_to(state_, 1, 1.25, 1.05);
+  const CellIndex good = cell_of(1.25, 2.05), bad = cell_of(1.25, 2.55);  // the second is 1.5 m away
+  r.depositions = {dep(good.row, good.col, kLayer), dep(bad.row, bad.col, kLayer)};
+  EXPECT_FALSE(check(r).accepted);
+  EXPECT_EQ(state_.terrain.heights().cwiseAbs().sum(), 0.0);
+  EXPECT_EQ(state_.agent(1).x_m, 1.05);
+}
+
+TEST(CellOccupiable, MatchesTheNavigabilityProcessorOnRoughTerrains) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 6; ++trial) {
+    grid::GridGeometry g;
+    g.rows = 18 + trial;
+    g.cols = 23 - trial;
+    g.cell_size_m = 0.1;
+    grid::Heightmap h(g, 0.0);
+    // Smooth noise below eps with sparse spikes: cells near a spike are not occupiable, the others are.
+    std::uniform_real_distribution<double> noise(0.0, 0.02), spike(0.0, 1.0);
+    for (long long i = 0; i < h.size(); ++i) h.data()[i] = noise(rng) + (spike(rng) < 0.03 ? 0.3 : 0.0);
+    const NavigabilityParams params{0.3, 0.4 + 0.15 * trial, 0.05};
+    const grid::CellMask want = processing::NavigabilityProcessor(params).occupiable(h);
+    int occupiable = 0;
+    for (int r = 0; r < h.rows(); ++r)
+      for (int c = 0; c < h.cols(); ++c) {
+        occupiable += want(r, c);
+        ASSERT_EQ(cell_occupiable(h, {r, c}, params, OccupancyMethod::kPairs), want(r, c) != 0)
+            << "trial " << trial << " cell " << r << ", " << c;
+        ASSERT_EQ(cell_occupiable(h, {r, c}, params, OccupancyMethod::kWindow), want(r, c) != 0);
+      }
+    // Both answers occur, so the comparison means something.
+    EXPECT_GT(occupiable, 0) << trial;
+    EXPECT_LT(occupiable, h.size()) << trial;
+  }
+}
+
+TEST(CellOccupiable, RampsExactlyAtKappaAreOccupiableOneLayerSteeperIsNot) {
+  grid::GridGeometry g;
+  g.rows = 20;
+  g.cols = 30;
+  g.cell_size_m = 0.1;
+  grid::Heightmap ramp(g, 0.0);
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c) ramp(r, c) = 0.3 * (c * 0.1);  // slope exactly kappa, steps of eps = 0
+  const NavigabilityParams params{0.3, 1.0, 0.0};
+  const grid::CellMask want = processing::NavigabilityProcessor(params).occupiable(ramp);
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c) {
+      EXPECT_TRUE(cell_occupiable(ramp, {r, c}, params));
+      EXPECT_EQ(want(r, c), 1);
+    }
+  grid::Heightmap steeper = ramp;
+  steeper(10, 15) += 0.0125;
+  const grid::CellMask want_steeper = processing::NavigabilityProcessor(params).occupiable(steeper);
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c)
+      ASSERT_EQ(cell_occupiable(steeper, {r, c}, params), want_steeper(r, c) != 0) << r << ", " << c;
+  EXPECT_FALSE(cell_occupiable(steeper, {10, 15}, params));
+  EXPECT_TRUE(cell_occupiable(steeper, {10, 2}, params));
+}
+
+TEST(CellOccupiable, BigBallsUseTheWindowAndAgree) {
+  grid::GridGeometry g;
+  g.rows = 70;
+  g.cols = 70;
+  g.cell_size_m = 0.1;
+  grid::Heightmap h(g, 0.0);
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c) h(r, c) = (r + c) % 7 == 0 ? 0.04 : 0.0;
+  h(5, 5) = 3.0;  // a pillar near a corner
+  const NavigabilityParams params{0.3, 6.0, 0.05};  // ball radius 30 cells: about 2800 cells
+  const grid::CellMask want = processing::NavigabilityProcessor(params).occupiable(h);
+  int occupiable = 0;
+  for (const CellIndex c : {CellIndex{35, 35}, CellIndex{5, 40}, CellIndex{60, 60}, CellIndex{20, 20}, CellIndex{5, 30}}) {
+    occupiable += want(c.row, c.col);
+    EXPECT_EQ(cell_occupiable(h, c, params), want(c.row, c.col) != 0);
+    EXPECT_EQ(cell_occupiable(h, c, params, OccupancyMethod::kPairs), want(c.row, c.col) != 0);
+  }
+  EXPECT_EQ(occupiable, 3);  // the two within 30 cells of the pillar are not
+}
+
+TEST(CellOccupiable, OffGridThrows) {
+  grid::GridGeometry g;
+  g.rows = 4;
+  g.cols = 4;
+  EXPECT_THROW(cell_occupiable(grid::Heightmap(g, 0.0), {4, 0}, {}), InvalidArgument);
+  EXPECT_THROW(cell_occupiable(grid::Heightmap(g, 0.0), {0, -1}, {}), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace marsala::world_server

@@ -1,0 +1,102 @@
+#include "world_server/world_cli.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "tests/unit/world_server/fake_agent.hpp"
+#include "tests/unit/world_server/world_fixtures.hpp"
+
+namespace marsala::world_server {
+namespace {
+
+namespace fs = std::filesystem;
+
+class WorldCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("marsala_world_cli_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string write(const std::string& name, const std::string& text) const {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p.string();
+  }
+  int run(std::vector<std::string> args) {
+    args.insert(args.begin(), "marsala-world");
+    std::vector<const char*> argv;
+    for (const auto& a : args) argv.push_back(a.c_str());
+    out_.str("");
+    err_.str("");
+    return run_world_cli(static_cast<int>(argv.size()), argv.data(), stop_, out_, err_);
+  }
+
+  fs::path dir_;
+  std::atomic<bool> stop_{false};
+  std::ostringstream out_, err_;
+};
+
+TEST_F(WorldCliTest, UsageErrorsExitWith2) {
+  EXPECT_EQ(run({}), 2);
+  EXPECT_NE(err_.str().find("--scenario is required"), std::string::npos) << err_.str();
+  const std::string ok = write("ok.pbtxt", testing::small_scenario_text());
+  EXPECT_EQ(run({"--scenario", ok, "--frobnicate"}), 2);
+  EXPECT_EQ(run({"--scenario", ok, "--agents", "0"}), 2);
+  EXPECT_EQ(run({"--scenario", ok, "--dds", "opensplice"}), 2);
+  EXPECT_EQ(run({"--scenario", ok, "--domain", "300"}), 2);
+  EXPECT_EQ(run({"--help"}), 0);
+  EXPECT_NE(out_.str().find("--admit-timeout"), std::string::npos);
+}
+
+TEST_F(WorldCliTest, BadScenariosExitWith1OnOneLineNamingFileAndLine) {
+  const std::string bad = write("bad.pbtxt", "name: \"x\"\nterrain { generator: \"flat\" }\nagent { robot_type: }\n");
+  EXPECT_EQ(run({"--scenario", bad}), 1);
+  const std::string message = err_.str();
+  EXPECT_EQ(message.rfind("marsala-world: error: " + bad + ":3:", 0), 0u) << message;
+  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1);
+  EXPECT_EQ(run({"--scenario", (dir_ / "missing.pbtxt").string()}), 1);
+  EXPECT_NE(err_.str().find("cannot open scenario file"), std::string::npos) << err_.str();
+  const std::string ok = write("ok.pbtxt", testing::small_scenario_text());
+  EXPECT_EQ(run({"--scenario", ok, "--agents", "5", "--dds", "inprocess"}), 1);
+  EXPECT_NE(err_.str().find("exceeds the 3 agent slots"), std::string::npos) << err_.str();
+  EXPECT_EQ(run({"--scenario", ok, "--dds", "inprocess", "--domain", "49", "--admit-timeout", "0.1", "--quiet",
+                 "--out", (dir_ / "none").string()}),
+            1);
+  EXPECT_NE(err_.str().find("no agent admitted"), std::string::npos) << err_.str();
+}
+
+TEST_F(WorldCliTest, ARunOverTheInProcessBusExitsWith0) {
+  const std::string scenario = write("small.pbtxt", testing::small_scenario_text());
+  const fs::path out = dir_ / "out";
+  int rc = -1;
+  std::thread world([&] {
+    rc = run({"--scenario", scenario, "--agents", "1", "--dds", "inprocess", "--domain", "48", "--out", out.string(),
+              "--quiet", "--max-steps", "3"});
+  });
+  testing::FakeAgentConfig c;
+  c.domain = 48;
+  c.id = 1;
+  c.session = 5;
+  c.body = testing::small_scenario().robot_for(1).body;
+  testing::FakeAgent agent(c);
+  world.join();
+  agent.join();
+  EXPECT_EQ(rc, 0) << err_.str();
+  EXPECT_NE(out_.str().find("run small-d48: max_steps after 3 steps, 1 agents"), std::string::npos) << out_.str();
+  for (const char* name : {"summary.json", "terrain_initial.asc", "terrain_final.asc", "final.png", "events.log"})
+    EXPECT_TRUE(fs::exists(out / name)) << name;
+}
+
+}  // namespace
+}  // namespace marsala::world_server

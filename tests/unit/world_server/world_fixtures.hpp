@@ -1,0 +1,93 @@
+#pragma once
+// Hand-made worlds for the world server's unit tests: a small scenario in text, states with admitted agents, and
+// requests with their envelope filled in.
+
+#include <string>
+
+#include "common/bus/messages.hpp"
+#include "common/grid/heightmap.hpp"
+#include "common/scenario/scenario.hpp"
+#include "world_server/admission.hpp"
+#include "world_server/world_state.hpp"
+
+namespace marsala::world_server::testing {
+
+/// The body every test robot has: layer of one cube on a 0.1 m cell = 0.05^3 / 0.01 = 0.0125 m, cube 1.25e-4 m^3.
+inline const char* const kTestRobotType = R"(
+robot_type {
+  name: "tester"
+  behaviour: "scripted"
+  body { kappa: 0.3 delta_m: 1.0 eps_m: 0.05 max_step_m: 0.2 max_deposit_m3: 0.02 material_capacity_m3: 0.05
+         reach_m: 1.2 sensing_range_m: 1.0 proximity_range_m: 1.5 cube_size_m: 0.05 }
+}
+)";
+
+/// A flat 40 x 40 grid of 0.1 m cells (4 x 4 m), three slots, base at (0.55, 0.55) r 0.5, goal [2.9, 3.2] x [1.9, 2.2].
+inline std::string small_scenario_text(const std::string& extra = "") {
+  return std::string(R"(
+name: "small"
+terrain { generator: "flat" rows: 40 cols: 40 cell_size_m: 0.1 }
+)") + kTestRobotType + R"(
+agent { robot_type: "tester" start { x_m: 1.05 y_m: 1.05 } target { x_m: 3.05 y_m: 2.05 } }
+agent { robot_type: "tester" start { x_m: 2.55 y_m: 1.05 } target { x_m: 3.05 y_m: 2.05 } }
+agent { robot_type: "tester" start { x_m: 1.05 y_m: 3.05 } target { x_m: 3.05 y_m: 2.05 } }
+goal { x0_m: 2.9 y0_m: 1.9 x1_m: 3.2 y1_m: 2.2 }
+base { x_m: 0.55 y_m: 0.55 radius_m: 0.5 }
+tile_size: 16
+)" + extra;
+}
+
+/// small_scenario_text() parsed.
+inline scenario::Scenario small_scenario(const std::string& extra = "") {
+  return scenario::parse_scenario(small_scenario_text(extra), "small.pbtxt");
+}
+
+/// A hello that matches slot `id` of `state`.
+inline bus::AgentHello hello_for(const WorldState& state, std::uint32_t id, std::uint64_t session) {
+  bus::AgentHello h;
+  h.agent_id = id;
+  h.session = session;
+  h.name = "tester-" + std::to_string(id);
+  h.behaviour = state.agent(id).behaviour;
+  h.body = state.agent(id).body;
+  return h;
+}
+
+/// A state on `terrain` with agents 1..agents admitted (session 1000 + id).
+inline WorldState admitted_state(const scenario::Scenario& s, grid::Heightmap terrain, std::uint32_t agents) {
+  WorldState state = make_world_state(s, std::move(terrain), agents);
+  for (std::uint32_t id = 1; id <= agents; ++id) admit(state, hello_for(state, id, 1000 + id));
+  return state;
+}
+
+/// A flat terrain of the small scenario's geometry.
+inline grid::Heightmap flat_terrain(double height = 0.0) {
+  grid::GridGeometry g;
+  g.rows = 40;
+  g.cols = 40;
+  g.cell_size_m = 0.1;
+  return grid::Heightmap(g, height);
+}
+
+/// A request of agent `id` for the state's current step, doing nothing yet.
+inline bus::ActionRequest request_for(const WorldState& state, std::uint32_t id) {
+  bus::ActionRequest r;
+  r.agent_id = id;
+  r.session = state.agent(id).session;
+  r.step = state.step;
+  return r;
+}
+
+/// A request that moves agent `id` to (x, y).
+inline bus::ActionRequest move_to(const WorldState& state, std::uint32_t id, double x, double y) {
+  bus::ActionRequest r = request_for(state, id);
+  r.move = true;
+  r.target_x_m = x;
+  r.target_y_m = y;
+  return r;
+}
+
+/// Cube layer of the test robot on 0.1 m cells [m].
+inline constexpr double kLayer = 0.05 * 0.05 * 0.05 / (0.1 * 0.1);
+
+}  // namespace marsala::world_server::testing

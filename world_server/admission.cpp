@@ -1,0 +1,105 @@
+#include "world_server/admission.hpp"
+
+#include <cstdio>
+
+#include "common/scenario/body_check.hpp"
+#include "world_server/completion.hpp"
+
+namespace marsala::world_server {
+namespace {
+
+constexpr std::size_t kMaxNameChars = 64;  // names are for display only
+
+std::string format(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+/// The first field in which `got` differs from `want`, as "kappa 0.2 != 0.3", or empty.
+std::string body_difference(const bus::BodyParams& got, const bus::BodyParams& want) {
+  const struct {
+    const char* name;
+    double got, want;
+  } fields[] = {{"kappa", got.kappa, want.kappa},
+                {"delta_m", got.delta_m, want.delta_m},
+                {"eps_m", got.eps_m, want.eps_m},
+                {"max_step_m", got.max_step_m, want.max_step_m},
+                {"max_deposit_m3", got.max_deposit_m3, want.max_deposit_m3},
+                {"material_capacity_m3", got.material_capacity_m3, want.material_capacity_m3},
+                {"reach_m", got.reach_m, want.reach_m},
+                {"sensing_range_m", got.sensing_range_m, want.sensing_range_m},
+                {"proximity_range_m", got.proximity_range_m, want.proximity_range_m},
+                {"cube_size_m", got.cube_size_m, want.cube_size_m}};
+  for (const auto& f : fields)
+    if (!(f.got == f.want)) return std::string(f.name) + " " + format(f.got) + " != " + format(f.want);
+  return {};
+}
+
+}  // namespace
+
+AdmissionDecision decide_admission(const WorldState& state, const bus::AgentHello& hello, bool run_started) {
+  const auto refuse = [](std::string reason) { return AdmissionDecision{false, std::move(reason)}; };
+  const std::string who = "agent " + std::to_string(hello.agent_id);
+  if (!state.has_agent(hello.agent_id))
+    return refuse("unknown agent id " + std::to_string(hello.agent_id) + ": this run has agents 1.." +
+                  std::to_string(state.agents.size()));
+  const AgentRecord& slot = state.agent(hello.agent_id);
+  const std::string problem = scenario::body_problem(hello.body);
+  if (!problem.empty()) return refuse(who + ": invalid body: " + problem);
+  const std::string difference = body_difference(hello.body, slot.body);
+  if (!difference.empty())
+    return refuse(who + ": body differs from robot type '" + slot.robot_type + "' of its slot: " + difference);
+  if (slot.dropped) return refuse(who + " was dropped from the run: " + slot.drop_reason);
+  if (slot.admitted) {
+    if (slot.session == hello.session) return {true, {}};
+    return refuse(who + " is already admitted with another session");
+  }
+  if (run_started) return refuse(who + ": the run has already started");
+  return {true, {}};
+}
+
+bool admit(WorldState& state, const bus::AgentHello& hello) {
+  AgentRecord& a = state.agent(hello.agent_id);
+  if (a.admitted) return false;
+  a.admitted = true;
+  a.alive = true;
+  a.session = hello.session;
+  a.name = hello.name.substr(0, kMaxNameChars);
+  a.x_m = a.start_x_m;
+  a.y_m = a.start_y_m;
+  a.z_m = height_under(state.terrain, a.x_m, a.y_m);
+  a.material_m3 = a.body.material_capacity_m3;
+  a.at_goal = at_goal(state, a);
+  return true;
+}
+
+bus::Admission admission_message(const WorldState& state, const bus::AgentHello& hello,
+                                 const AdmissionDecision& decision, const std::string& run_id) {
+  bus::Admission m;
+  m.agent_id = hello.agent_id;
+  m.session = hello.session;
+  m.accepted = decision.accepted;
+  m.reason = decision.reason;
+  m.run_id = run_id;
+  const grid::GridGeometry& g = state.terrain.geometry();
+  m.rows = g.rows;
+  m.cols = g.cols;
+  m.xll_m = g.xll_m;
+  m.yll_m = g.yll_m;
+  m.cell_size_m = g.cell_size_m;
+  m.tile_size = state.tile_size;
+  m.base_x_m = state.base.x_m;
+  m.base_y_m = state.base.y_m;
+  m.base_radius_m = state.base.radius_m;
+  if (state.has_agent(hello.agent_id)) {
+    const AgentRecord& a = state.agent(hello.agent_id);
+    m.start_x_m = a.start_x_m;
+    m.start_y_m = a.start_y_m;
+    m.target_x_m = a.target_x_m;
+    m.target_y_m = a.target_y_m;
+  }
+  return m;
+}
+
+}  // namespace marsala::world_server

@@ -1,0 +1,196 @@
+#include "world_server/arbiter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
+#include "common/error.hpp"
+#include "common/grid/iterators.hpp"
+#include "common/processing/navigability_processor.hpp"
+
+namespace marsala::world_server {
+namespace {
+
+namespace tol = arbiter_tolerance;
+
+// Balls above this many cells are checked by the processor on a window: the pair check is quadratic.
+constexpr std::size_t kMaxPairBallCells = 2000;
+
+std::string format(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+std::string cell_text(CellIndex c) { return "(" + std::to_string(c.row) + ", " + std::to_string(c.col) + ")"; }
+
+double distance(double ax, double ay, double bx, double by) {
+  const double dx = ax - bx, dy = ay - by;
+  return std::sqrt(dx * dx + dy * dy);
+}
+
+bool occupiable_by_pairs(const grid::Heightmap& h, CellIndex cell, const NavigabilityParams& p,
+                         const std::vector<CellIndex>& offsets) {
+  struct BallCell {
+    int dr, dc;
+    double height;
+  };
+  std::vector<BallCell> ball;
+  ball.reserve(offsets.size());
+  for (const CellIndex& o : offsets) {
+    const CellIndex c{cell.row + o.row, cell.col + o.col};
+    if (h.contains(c)) ball.push_back({o.row, o.col, h(c)});
+  }
+  const double cs = h.cell_size_m();
+  for (std::size_t a = 0; a < ball.size(); ++a)
+    for (std::size_t b = a + 1; b < ball.size(); ++b) {
+      const long long dr = ball[a].dr - ball[b].dr, dc = ball[a].dc - ball[b].dc;
+      // The expression NavigabilityProcessor's kernel uses, so that ties are decided identically.
+      const double threshold =
+          p.eps_m + p.kappa * (cs * std::sqrt(static_cast<double>(dr * dr + dc * dc))) + tolerance::kHeightM;
+      if (std::abs(ball[a].height - ball[b].height) > threshold) return false;
+    }
+  return true;
+}
+
+bool occupiable_by_window(const grid::Heightmap& h, CellIndex cell, const NavigabilityParams& p,
+                          const std::vector<CellIndex>& offsets) {
+  int reach = 0;
+  for (const CellIndex& o : offsets) reach = std::max({reach, std::abs(o.row), std::abs(o.col)});
+  const int r0 = std::max(0, cell.row - reach), c0 = std::max(0, cell.col - reach);
+  const int r1 = std::min(h.rows() - 1, cell.row + reach), c1 = std::min(h.cols() - 1, cell.col + reach);
+  // The ball of `cell` lies inside the window, so the window's edges clip nothing the definition keeps.
+  const grid::Heightmap window = h.window({r0, c0}, r1 - r0 + 1, c1 - c0 + 1);
+  return processing::NavigabilityProcessor(p).occupiable(window)(cell.row - r0, cell.col - c0) != 0;
+}
+
+}  // namespace
+
+double cube_layer_m(double cube_size_m, double cell_size_m) {
+  return cube_size_m * cube_size_m * cube_size_m / (cell_size_m * cell_size_m);
+}
+
+bool cell_occupiable(const grid::Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
+                     OccupancyMethod method) {
+  if (!terrain.contains(cell))
+    throw InvalidArgument("cell_occupiable: cell " + cell_text(cell) + " is off the " +
+                          std::to_string(terrain.rows()) + " x " + std::to_string(terrain.cols()) + " grid");
+  const std::vector<CellIndex> offsets = grid::disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m()));
+  if (method == OccupancyMethod::kAutomatic)
+    method = offsets.size() <= kMaxPairBallCells ? OccupancyMethod::kPairs : OccupancyMethod::kWindow;
+  return method == OccupancyMethod::kPairs ? occupiable_by_pairs(terrain, cell, params, offsets)
+                                           : occupiable_by_window(terrain, cell, params, offsets);
+}
+
+Verdict validate_request(const WorldState& state, std::uint32_t channel_id, const bus::ActionRequest& r) {
+  const auto reject = [](std::string reason) { return Verdict{false, std::move(reason), 0.0}; };
+
+  // 1. Envelope.
+  if (r.agent_id != channel_id)
+    return reject("agent_id " + std::to_string(r.agent_id) + " arrived on the partition of agent " +
+                  std::to_string(channel_id));
+  if (!state.has_agent(channel_id) || !state.agent(channel_id).alive)
+    return reject("agent " + std::to_string(channel_id) + " is not admitted and alive");
+  const AgentRecord& me = state.agent(channel_id);
+  if (r.session != me.session)
+    return reject("session " + std::to_string(r.session) + " does not match the admitted session");
+  if (r.step != state.step)
+    return reject("request for step " + std::to_string(r.step) + " but the current step is " +
+                  std::to_string(state.step));
+  const auto sane = [](double v) { return std::isfinite(v) && std::abs(v) < 1e6; };
+  if (!sane(r.target_x_m) || !sane(r.target_y_m))
+    return reject("target (" + format(r.target_x_m) + ", " + format(r.target_y_m) + ") is not finite or too large");
+  for (const bus::Deposition& d : r.depositions)
+    if (!sane(d.height_m)) return reject("deposition height " + format(d.height_m) + " m is not finite or too large");
+  const grid::Heightmap& terrain = state.terrain;
+  if (static_cast<long long>(r.depositions.size()) > terrain.size())
+    return reject(std::to_string(r.depositions.size()) + " depositions exceed the grid's cells");
+
+  // 2. Motion.
+  double x = me.x_m, y = me.y_m;
+  if (r.move) {
+    const double d = distance(r.target_x_m, r.target_y_m, x, y);
+    if (!(d <= me.body.max_step_m + tol::kLengthM))
+      return reject("motion of " + format(d) + " m exceeds max_step_m " + format(me.body.max_step_m));
+    const auto cell = terrain.cell_at({r.target_x_m, r.target_y_m});
+    if (!cell)
+      return reject("target (" + format(r.target_x_m) + ", " + format(r.target_y_m) + ") is off the grid");
+    if (!cell_occupiable(terrain, *cell, {me.body.kappa, me.body.delta_m, me.body.eps_m}))
+      return reject("target cell " + cell_text(*cell) + " is not occupiable for this body");
+    x = r.target_x_m;
+    y = r.target_y_m;
+  }
+
+  // 3. Depositions, from the position after the motion.
+  const double cs = terrain.cell_size_m();
+  const double layer = cube_layer_m(me.body.cube_size_m, cs);
+  std::vector<std::pair<int, int>> cells;
+  cells.reserve(r.depositions.size());
+  double volume = 0.0;
+  for (const bus::Deposition& d : r.depositions) {
+    const CellIndex c{d.row, d.col};
+    if (!terrain.contains(c)) return reject("deposition cell " + cell_text(c) + " is off the grid");
+    cells.emplace_back(d.row, d.col);
+    if (!(d.height_m > 0.0 && d.height_m <= tol::kMaxDepositionM + tol::kLengthM))
+      return reject("deposition height " + format(d.height_m) + " m at " + cell_text(c) + " is not in (0, 1] m");
+    const double layers = d.height_m / layer;
+    const double whole = std::round(layers);
+    if (!(whole >= 1.0 && std::abs(layers - whole) <= tol::kCubeMultiple))
+      return reject("deposition height " + format(d.height_m) + " m at " + cell_text(c) +
+                    " is not a whole multiple of the cube layer " + format(layer) + " m");
+    const Position centre = terrain.cell_center(c);
+    const double from_me = distance(centre.x, centre.y, x, y);
+    if (!(from_me <= me.body.reach_m + tol::kLengthM))
+      return reject("deposition cell " + cell_text(c) + " is " + format(from_me) + " m away, beyond reach_m " +
+                    format(me.body.reach_m));
+    for (const AgentRecord& other : state.agents) {
+      if (!other.alive) continue;
+      const bool self = other.id == me.id;
+      const double gap = distance(centre.x, centre.y, self ? x : other.x_m, self ? y : other.y_m);
+      if (gap <= 0.5 * other.body.delta_m + tol::kLengthM)
+        return reject("deposition cell " + cell_text(c) + " is under agent " + std::to_string(other.id));
+    }
+    volume += d.height_m * cs * cs;
+  }
+  std::sort(cells.begin(), cells.end());
+  const auto twice = std::adjacent_find(cells.begin(), cells.end());
+  if (twice != cells.end())
+    return reject("deposition cell " + cell_text({twice->first, twice->second}) + " is listed twice");
+  if (!(volume <= me.body.max_deposit_m3 + tol::kVolumeM3))
+    return reject("deposited volume " + format(volume) + " m^3 exceeds max_deposit_m3 " +
+                  format(me.body.max_deposit_m3));
+  if (!(volume <= me.material_m3 + tol::kVolumeM3))
+    return reject("deposited volume " + format(volume) + " m^3 exceeds the material on board " +
+                  format(me.material_m3) + " m^3");
+
+  // 4. Refill.
+  if (r.refill) {
+    const double to_base = distance(x, y, state.base.x_m, state.base.y_m);
+    if (!(to_base <= state.base.radius_m + tol::kLengthM))
+      return reject("refill requested " + format(to_base) + " m from the base station (radius " +
+                    format(state.base.radius_m) + " m)");
+  }
+  return Verdict{true, {}, volume};
+}
+
+void apply_request(WorldState& state, const bus::ActionRequest& r, const Verdict& verdict,
+                   std::vector<CellIndex>& changed_cells) {
+  AgentRecord& me = state.agent(r.agent_id);
+  if (r.move) {
+    me.x_m = r.target_x_m;
+    me.y_m = r.target_y_m;
+  }
+  for (const bus::Deposition& d : r.depositions) {
+    state.terrain(d.row, d.col) += d.height_m;
+    changed_cells.push_back({d.row, d.col});
+  }
+  me.z_m = height_under(state.terrain, me.x_m, me.y_m);
+  me.material_m3 = std::max(0.0, me.material_m3 - verdict.volume_m3);
+  if (r.refill) me.material_m3 = me.body.material_capacity_m3;
+  me.deposited_m3 += verdict.volume_m3;
+  state.deposited_volume_m3 += verdict.volume_m3;
+  ++me.accepted;
+}
+
+}  // namespace marsala::world_server

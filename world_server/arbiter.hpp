@@ -1,0 +1,57 @@
+#pragma once
+// The arbiter: validates one ActionRequest against the world state exactly as runtime_spec.md says (rules 1-4,
+// all-or-nothing) and applies accepted ones. Pure functions of their arguments.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/bus/messages.hpp"
+#include "common/grid/heightmap.hpp"
+#include "common/types.hpp"
+#include "world_server/world_state.hpp"
+
+namespace marsala::world_server {
+
+/// Tolerances of runtime_spec.md.
+namespace arbiter_tolerance {
+inline constexpr double kLengthM = 1e-9;       ///< added to length limits [m]
+inline constexpr double kVolumeM3 = 1e-12;     ///< added to volume limits [m^3]
+inline constexpr double kCubeMultiple = 1e-6;  ///< |h/q - round(h/q)| limit for a whole number of cube layers
+inline constexpr double kMaxDepositionM = 1.0; ///< tallest single deposition [m]
+}  // namespace arbiter_tolerance
+
+/// How cell_occupiable decides; every method gives the same answer (ARCHITECTURE.md definition).
+enum class OccupancyMethod {
+  kAutomatic,  ///< pairs for balls up to a few thousand cells, the processor window beyond
+  kPairs,      ///< every pair of the ball, with the processor's threshold expression
+  kWindow,     ///< NavigabilityProcessor on the window that holds the ball
+};
+
+/// True when on-grid `cell` is occupiable for `params` on `terrain`: every pair of cells within delta/2 of its centre
+/// (cells off the grid ignored) has |h(r) - h(q)| <= eps + kappa |r - q| + 1e-9 m. Throws InvalidArgument when the
+/// cell is off the grid.
+bool cell_occupiable(const grid::Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
+                     OccupancyMethod method = OccupancyMethod::kAutomatic);
+
+/// The arbiter's answer to one request.
+struct Verdict {
+  bool accepted = false;
+  std::string reason;        ///< why not, when rejected
+  double volume_m3 = 0.0;    ///< material the depositions place, when accepted [m^3]
+};
+
+/// Validates `request`, which arrived on the partition of agent `channel_id`, against `state` (runtime_spec.md rules
+/// 1-4: envelope, motion, depositions after the motion, refill). Duplicates and requests for other steps are
+/// apply_step's business; here a step other than state.step is a rejection.
+Verdict validate_request(const WorldState& state, std::uint32_t channel_id, const bus::ActionRequest& request);
+
+/// Applies a request validate_request accepted: position = target, depositions, material, refill, counts. Appends
+/// the changed cells to `changed_cells`.
+void apply_request(WorldState& state, const bus::ActionRequest& request, const Verdict& verdict,
+                   std::vector<CellIndex>& changed_cells);
+
+/// Thickness of one layer of cubes on a cell: cube_size^3 / cell_size^2 [m].
+double cube_layer_m(double cube_size_m, double cell_size_m);
+
+}  // namespace marsala::world_server

@@ -1,0 +1,58 @@
+#include "world_server/sensing_service.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "world_server/arbiter.hpp"
+
+namespace marsala::world_server {
+
+SensingService::SensingService(const WorldState& state)
+    : layout_(state.tiles()),
+      seen_(state.agents.size(), std::vector<std::uint64_t>(static_cast<std::size_t>(layout_.tile_count()), kNever)) {}
+
+void SensingService::forget(std::uint32_t id) {
+  if (id >= 1 && id <= seen_.size()) std::fill(seen_[id - 1].begin(), seen_[id - 1].end(), kNever);
+}
+
+bus::SensorFrame SensingService::frame_for(const WorldState& state, std::uint32_t id, bool run_over) {
+  const AgentRecord& me = state.agent(id);
+  bus::SensorFrame f;
+  f.agent_id = id;
+  f.step = state.step;
+  f.x_m = me.x_m;
+  f.y_m = me.y_m;
+  f.z_m = me.z_m;
+  f.material_m3 = me.material_m3;
+  f.last_result = me.last_result;
+  f.last_reason = me.last_reason;
+  f.run_over = run_over;
+
+  std::vector<std::uint64_t>& seen = seen_[id - 1];
+  const grid::Heightmap& terrain = state.terrain;
+  for (int index : layout_.tiles_in_square({me.x_m, me.y_m}, me.body.sensing_range_m)) {
+    const std::uint64_t version = state.tile_versions[static_cast<std::size_t>(index)];
+    if (seen[static_cast<std::size_t>(index)] == version) continue;
+    seen[static_cast<std::size_t>(index)] = version;
+    const Tile t = layout_.tile(index);
+    bus::TerrainTile tile;
+    tile.tile_row = t.tile_row;
+    tile.tile_col = t.tile_col;
+    tile.rows = t.rows;
+    tile.cols = t.cols;
+    tile.heights.reserve(static_cast<std::size_t>(t.rows) * t.cols);
+    for (int r = 0; r < t.rows; ++r)
+      for (int c = 0; c < t.cols; ++c) tile.heights.push_back(terrain(t.first_cell.row + r, t.first_cell.col + c));
+    f.tiles.push_back(std::move(tile));
+  }
+
+  for (const AgentRecord& other : state.agents) {
+    if (!other.alive || other.id == id) continue;
+    const double dx = other.x_m - me.x_m, dy = other.y_m - me.y_m;
+    if (std::sqrt(dx * dx + dy * dy) <= me.body.proximity_range_m + arbiter_tolerance::kLengthM)
+      f.neighbours.push_back({other.id, other.x_m, other.y_m, other.z_m});
+  }
+  return f;
+}
+
+}  // namespace marsala::world_server

@@ -1,0 +1,144 @@
+#include "world_server/step.hpp"
+
+#include <algorithm>
+
+#include "world_server/arbiter.hpp"
+#include "world_server/completion.hpp"
+
+namespace marsala::world_server {
+namespace {
+
+constexpr std::size_t kMaxStateChars = 64;  // behaviour state names are for display only
+
+bus::WorldEvent event(std::uint64_t step, std::uint32_t agent, bus::EventKind kind, std::string detail,
+                      double volume_m3 = 0.0) {
+  bus::WorldEvent e;
+  e.step = step;
+  e.agent_id = agent;
+  e.kind = kind;
+  e.volume_m3 = volume_m3;
+  e.detail = std::move(detail);
+  return e;
+}
+
+/// Applies the requests that arrived on one live agent's partition.
+void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const bus::ActionRequest*>& requests,
+                 std::vector<CellIndex>& changed_cells, StepOutcome& out) {
+  const std::uint64_t step = state.step;
+  const std::string who = "agent " + std::to_string(agent.id);
+  bool answered = false;
+  for (const bus::ActionRequest* r : requests) {
+    if (r->agent_id != agent.id || r->session != agent.session) {
+      // Forged or stale-session requests never take the agent's slot for the step: the real one still counts.
+      ++agent.rejected;
+      ++out.rejected;
+      out.events.push_back(event(step, agent.id, bus::EventKind::kRejected,
+                                 "request claiming agent " + std::to_string(r->agent_id) + " session " +
+                                     std::to_string(r->session) + " on agent " + std::to_string(agent.id) +
+                                     "'s partition rejected: not its admitted identity"));
+      continue;
+    }
+    if (r->step < step) {
+      out.notes.push_back(who + ": request for past step " + std::to_string(r->step) + " dropped");
+      continue;
+    }
+    if (r->step > step || answered) {
+      const std::string reason = r->step > step ? "request for future step " + std::to_string(r->step) + " rejected"
+                                                : "duplicate request for step " + std::to_string(step) +
+                                                      " rejected; the first stands";
+      ++agent.rejected;
+      ++out.rejected;
+      out.events.push_back(event(step, agent.id, bus::EventKind::kRejected, reason));
+      continue;
+    }
+    answered = true;
+    agent.state = r->state.substr(0, kMaxStateChars);
+    const Verdict verdict = validate_request(state, agent.id, *r);
+    if (verdict.accepted) {
+      apply_request(state, *r, verdict, changed_cells);
+      agent.last_result = bus::ActionResult::kAccepted;
+      agent.last_reason.clear();
+      ++out.accepted;
+      if (verdict.volume_m3 > 0.0)
+        out.events.push_back(event(step, agent.id, bus::EventKind::kDeposited,
+                                   std::to_string(r->depositions.size()) + " cells", verdict.volume_m3));
+    } else {
+      agent.last_result = bus::ActionResult::kRejected;
+      agent.last_reason = verdict.reason;
+      ++agent.rejected;
+      ++out.rejected;
+      out.events.push_back(event(step, agent.id, bus::EventKind::kRejected, verdict.reason));
+    }
+  }
+  if (answered) {
+    agent.consecutive_missed = 0;
+    return;
+  }
+  ++agent.missed;
+  ++agent.consecutive_missed;
+  ++out.missed;
+  agent.last_result = bus::ActionResult::kMissed;
+  agent.last_reason = "no request for step " + std::to_string(step) + " before the deadline";
+  out.events.push_back(event(step, agent.id, bus::EventKind::kMissed, agent.last_reason));
+  if (agent.consecutive_missed >= kMaxConsecutiveMisses) {
+    out.events.push_back(drop_agent(state, agent.id,
+                                    std::to_string(agent.consecutive_missed) + " consecutive missed deadlines"));
+    out.dropped.push_back(agent.id);
+  }
+}
+
+}  // namespace
+
+StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submissions) {
+  StepOutcome out;
+  out.step = state.step;
+  // Per partition, in arrival order; partitions in id order. The order across partitions never matters.
+  std::vector<std::vector<const bus::ActionRequest*>> by_agent(state.agents.size());
+  for (const Submission& s : submissions) {
+    if (!state.has_agent(s.channel_id) || !state.agent(s.channel_id).alive) {
+      out.notes.push_back("request on the partition of agent " + std::to_string(s.channel_id) +
+                          ", which is not in the run, ignored");
+      continue;
+    }
+    by_agent[s.channel_id - 1].push_back(&s.request);
+  }
+  std::vector<CellIndex> changed_cells;
+  for (AgentRecord& agent : state.agents)
+    if (agent.alive) apply_agent(state, agent, by_agent[agent.id - 1], changed_cells, out);
+
+  const TileLayout tiles = state.tiles();
+  for (const CellIndex& c : changed_cells) out.changed_tiles.push_back(tiles.index_of(c));
+  std::sort(out.changed_tiles.begin(), out.changed_tiles.end());
+  out.changed_tiles.erase(std::unique(out.changed_tiles.begin(), out.changed_tiles.end()), out.changed_tiles.end());
+  for (int t : out.changed_tiles) ++state.tile_versions[static_cast<std::size_t>(t)];
+
+  for (AgentRecord& agent : state.agents) {
+    if (!agent.admitted) continue;
+    agent.z_m = height_under(state.terrain, agent.x_m, agent.y_m);
+    if (!agent.alive) continue;
+    const bool reached = at_goal(state, agent);
+    if (reached && !agent.at_goal) out.events.push_back(event(state.step, agent.id, bus::EventKind::kAtGoal, ""));
+    agent.at_goal = reached;
+  }
+  out.completed = is_completed(state);
+  ++state.step;
+  return out;
+}
+
+StepOutcome apply_step(WorldState& state, const std::vector<bus::ActionRequest>& requests) {
+  std::vector<Submission> submissions;
+  submissions.reserve(requests.size());
+  for (const bus::ActionRequest& r : requests) submissions.push_back({r.agent_id, r});
+  return apply_step(state, submissions);
+}
+
+bus::WorldEvent drop_agent(WorldState& state, std::uint32_t id, const std::string& reason) {
+  AgentRecord& agent = state.agent(id);
+  agent.alive = false;
+  agent.dropped = true;
+  agent.at_goal = false;
+  agent.drop_reason = reason;
+  return event(state.step, id, bus::EventKind::kDropped, reason);
+}
+
+}  // namespace marsala::world_server

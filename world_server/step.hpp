@@ -1,0 +1,53 @@
+#pragma once
+// One lockstep step as a pure function of (state, requests): validate and apply in agent-id order, each request
+// against the state the previous ones left; count misses and drop agents after 3 consecutive ones; bump the
+// versions of changed tiles; update who is at the goal; advance the step. No clock, no IO: the runtime logs and
+// publishes what the outcome lists, so a recorded step can be replayed.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/bus/messages.hpp"
+#include "world_server/world_state.hpp"
+
+namespace marsala::world_server {
+
+/// Consecutive missed steps after which an agent is dropped from the run.
+inline constexpr std::uint32_t kMaxConsecutiveMisses = 3;
+
+/// A request as it arrived: the agent whose partition carried it, and the request.
+struct Submission {
+  std::uint32_t channel_id = 0;   ///< owner of the partition (reader) it came from
+  bus::ActionRequest request;
+};
+
+/// What happened in one step.
+struct StepOutcome {
+  std::uint64_t step = 0;                   ///< the step applied
+  std::vector<bus::WorldEvent> events;      ///< in agent-id order, as they happened
+  std::vector<std::string> notes;           ///< things to log that are not events (late requests dropped)
+  std::vector<int> changed_tiles;           ///< TileLayout indices whose heights changed, ascending
+  std::vector<std::uint32_t> dropped;       ///< agents dropped in this step (3 consecutive misses)
+  std::uint32_t accepted = 0;               ///< requests accepted
+  std::uint32_t rejected = 0;               ///< requests rejected (including duplicates and future steps)
+  std::uint32_t missed = 0;                 ///< live agents without a request for this step
+  bool completed = false;                   ///< is_completed() after the step
+};
+
+/// Applies step `state.step`. `submissions` may come in any order across agents; within one agent's partition they
+/// are taken in arrival order. Per live agent, in id order: requests for past steps are dropped (a note), for future
+/// steps rejected; the first for this step is validated and applied (or rejected), later ones are duplicates
+/// (rejected, the first stands); no request for this step is a miss (kMissed; dropped at 3 in a row). Submissions on
+/// the partition of an agent that is not live are ignored with a note. Then z of every agent, tile versions, at_goal
+/// (event kAtGoal when reached), completion; finally state.step += 1.
+StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submissions);
+
+/// Same, with each request taken as arriving on its own agent's partition (channel = request.agent_id).
+StepOutcome apply_step(WorldState& state, const std::vector<bus::ActionRequest>& requests);
+
+/// Removes a live agent from the run (e.g. its request writer lost liveliness): alive = false, dropped, reason.
+/// Returns the kDropped event; throws InvalidArgument when there is no such agent.
+bus::WorldEvent drop_agent(WorldState& state, std::uint32_t id, const std::string& reason);
+
+}  // namespace marsala::world_server

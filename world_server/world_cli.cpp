@@ -1,0 +1,70 @@
+#include "world_server/world_cli.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <ostream>
+
+#include "common/bus/bus.hpp"
+#include "common/error.hpp"
+#include "common/scenario/scenario.hpp"
+#include "common/scenario/terrain_builder.hpp"
+#include "world_server/world_runtime.hpp"
+
+namespace marsala::world_server {
+
+int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& stop, std::ostream& out,
+                  std::ostream& err) {
+  CLI::App app{"marsala-world: the authoritative world server. Loads a scenario, admits agents over DDS, runs the\n"
+               "lockstep (frames, requests, validation in agent-id order) and writes summary.json, terrain_initial.asc,\n"
+               "terrain_final.asc, final.png and events.log into --out. The run id (partition prefix) defaults to\n"
+               "<scenario name>-d<domain>.",
+               "marsala-world"};
+  std::string scenario_path, dds = "cyclone";
+  RuntimeOptions options;
+  int domain = 0;
+  bool quiet = false;
+  app.add_option("--scenario", scenario_path, "scenario file (protobuf text format)")->required();
+  app.add_option("--agents", options.agents, "agents to wait for, ids 1..N (default: every slot of the scenario)")
+      ->check(CLI::Range(1u, 100000u));
+  app.add_option("--dds", dds, "DDS vendor")->check(CLI::IsMember({"cyclone", "fastdds", "inprocess"}))
+      ->capture_default_str();
+  app.add_option("--domain", domain, "DDS domain id")->check(CLI::Range(0, 232))->capture_default_str();
+  app.add_option("--out", options.out_dir, "output folder")->capture_default_str();
+  app.add_option("--run-id", options.run_id, "run id, the prefix of every agent partition");
+  app.add_option("--admit-timeout", options.admit_timeout_s, "seconds to wait for all agents")
+      ->check(CLI::Range(0.0, 86400.0))->capture_default_str();
+  app.add_option("--max-steps", options.max_steps, "override the scenario's max_steps")->check(CLI::Range(1ull, 1ull << 40));
+  app.add_flag("--quiet", quiet, "log warnings and errors only");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) {
+      out << app.help();
+      return 0;
+    }
+    err << "marsala-world: " << e.what() << " (run with --help for usage)\n";
+    return 2;
+  }
+
+  spdlog::set_pattern("%H:%M:%S.%e %^%l%$ world: %v");
+  spdlog::set_level(quiet ? spdlog::level::warn : spdlog::level::info);
+  try {
+    const scenario::Scenario scenario = scenario::load_scenario(scenario_path);
+    grid::Heightmap terrain = scenario::build_terrain(scenario);
+    const auto participant = bus::make_participant({bus::vendor_from_string(dds), domain});
+    WorldRuntime runtime(scenario, std::move(terrain), options, *participant);
+    const RunResult result = runtime.run(stop);
+    out << "run " << runtime.run_id() << ": " << result.end_reason << " after " << result.steps << " steps, "
+        << result.admitted << " agents, terrain sha256 " << result.terrain_sha256 << "\n";
+  } catch (const Error& e) {
+    err << "marsala-world: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    err << "marsala-world: error: out of memory\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace marsala::world_server

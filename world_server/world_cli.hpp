@@ -1,0 +1,15 @@
+#pragma once
+// The marsala-world command line as a callable function, so tests can drive it in-process.
+
+#include <atomic>
+#include <iosfwd>
+
+namespace marsala::world_server {
+
+/// Runs marsala-world with argv until the run ends or `stop` becomes true; returns the exit code: 0 when the run
+/// finished (completed or not), 1 on errors (bad scenario: one line naming file and line; no agent admitted), 2 on
+/// usage errors. Help goes to `out`, errors to `err` as one line "marsala-world: error: <reason>".
+int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& stop, std::ostream& out,
+                  std::ostream& err);
+
+}  // namespace marsala::world_server

@@ -1,0 +1,383 @@
+#include "world_server/world_runtime.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "common/error.hpp"
+#include "world_server/admission.hpp"
+#include "world_server/completion.hpp"
+#include "world_server/run_outputs.hpp"
+#include "world_server/sensing_service.hpp"
+#include "world_server/sha256.hpp"
+#include "world_server/step.hpp"
+
+namespace marsala::world_server {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
+
+// Longest single wait, so that a stop request is seen promptly even when no sample arrives.
+constexpr auto kPollInterval = 100ms;
+// Between readiness checks once every agent is admitted (matching is not signalled to the world's writers).
+constexpr auto kReadyPollInterval = 5ms;
+// Progress lines at info level every this many steps.
+constexpr std::uint64_t kProgressEvery = 500;
+
+Clock::duration seconds(double s) { return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)); }
+
+std::string format_seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g s", s);
+  return buf;
+}
+
+double elapsed_s(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
+
+/// Writes a sample; a failing write is logged, never fatal: one agent's broken link must not stop the world.
+template <typename T>
+void write_logged(bus::Writer<T>& writer, const T& sample, const char* what) {
+  try {
+    writer.write(sample);
+  } catch (const std::exception& e) {
+    spdlog::error("cannot publish {}: {}", what, e.what());
+  }
+}
+
+}  // namespace
+
+std::string default_run_id(const std::string& scenario_name, int domain_id) {
+  return scenario_name + "-d" + std::to_string(domain_id);
+}
+
+void check_run_id(const std::string& run_id) {
+  const bool ok = !run_id.empty() && std::all_of(run_id.begin(), run_id.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+  });
+  if (!ok) throw InvalidArgument("run id '" + run_id + "' must be non-empty letters, digits, '_', '-', '.'");
+}
+
+/// The endpoints of one admitted agent.
+struct AgentLink {
+  std::unique_ptr<bus::Writer<bus::SensorFrame>> frames;
+  std::unique_ptr<bus::Reader<bus::ActionRequest>> requests;
+  bool writer_seen = false;  ///< its request writer has been alive at least once
+};
+
+struct WorldRuntime::Impl {
+  Impl(const scenario::Scenario& s, grid::Heightmap terrain, RuntimeOptions o, bus::Participant& p)
+      : scenario(s), options(std::move(o)), participant(p) {
+    const std::uint32_t agents = options.agents == 0 ? static_cast<std::uint32_t>(s.slots.size()) : options.agents;
+    if (agents > s.slots.size())
+      throw InvalidArgument("--agents " + std::to_string(agents) + " exceeds the " + std::to_string(s.slots.size()) +
+                            " agent slots of scenario '" + s.name + "'");
+    if (options.run_id.empty()) options.run_id = default_run_id(s.name, p.domain_id());
+    check_run_id(options.run_id);
+    if (!(options.admit_timeout_s >= 0.0) || !std::isfinite(options.admit_timeout_s))
+      throw InvalidArgument("admit timeout must be finite and >= 0 s");
+    if (options.max_steps == 0) options.max_steps = s.max_steps;
+    if (options.step_deadline_s == 0.0) options.step_deadline_s = s.step_deadline_s;
+    if (!(options.step_deadline_s > 0.0) || !std::isfinite(options.step_deadline_s))
+      throw InvalidArgument("step deadline must be finite and > 0 s");
+    state = make_world_state(s, std::move(terrain), agents);
+    sensing.emplace(state);
+    links.resize(agents);
+    last_rejection.resize(agents);
+  }
+
+  void open_endpoints() {
+    signal = std::make_shared<bus::Signal>();
+    hellos = participant.create_reader<bus::AgentHello>({"", signal, bus::Durability::kVolatile, 64});
+    admissions = participant.create_writer<bus::Admission>({"", nullptr, bus::Durability::kVolatile, 64});
+    status = participant.create_writer<bus::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
+    events = participant.create_writer<bus::WorldEvent>({"", nullptr, bus::Durability::kVolatile, 256});
+  }
+
+  void emit(const bus::WorldEvent& e) {
+    write_logged(*events, e, "a world event");
+    if (event_log) event_log->append(e);
+  }
+
+  void note(const std::string& text) {
+    spdlog::info("step {}: {}", state.step, text);
+    if (event_log) event_log->note(state.step, text);
+  }
+
+  bus::WorldEvent make_event(std::uint32_t agent, bus::EventKind kind, std::string detail) const {
+    bus::WorldEvent e;
+    e.step = state.step;
+    e.agent_id = agent;
+    e.kind = kind;
+    e.detail = std::move(detail);
+    return e;
+  }
+
+  /// Answers every pending hello; admits the accepted newcomers and opens their partition endpoints.
+  void service_hellos() {
+    for (const bus::AgentHello& hello : hellos->take()) {
+      const AdmissionDecision decision = decide_admission(state, hello, run_started);
+      if (decision.accepted && admit(state, hello)) {
+        const std::string partition = bus::partition_for(options.run_id, hello.agent_id);
+        AgentLink& link = links[hello.agent_id - 1];
+        link.frames = participant.create_writer<bus::SensorFrame>({partition, nullptr, bus::Durability::kVolatile, 64});
+        link.requests =
+            participant.create_reader<bus::ActionRequest>({partition, signal, bus::Durability::kVolatile, 64});
+        spdlog::info("admitted agent {} '{}' ({}) on partition {}", hello.agent_id, state.agent(hello.agent_id).name,
+                     state.agent(hello.agent_id).robot_type, partition);
+        emit(make_event(hello.agent_id, bus::EventKind::kAdmitted, state.agent(hello.agent_id).name));
+      } else if (!decision.accepted && refused.insert({hello.agent_id, hello.session}).second) {
+        // Agents repeat their hello: each (id, session) is logged and published once, answered every time.
+        spdlog::warn("refused agent {}: {}", hello.agent_id, decision.reason);
+        emit(make_event(hello.agent_id, bus::EventKind::kRefused, decision.reason));
+      }
+      write_logged(*admissions, admission_message(state, hello, decision, options.run_id), "an admission");
+    }
+  }
+
+  /// Drops every live agent whose request writer was alive and is no longer.
+  void check_liveliness() {
+    for (std::uint32_t id : state.live_ids()) {
+      AgentLink& link = links[id - 1];
+      if (link.requests->alive_writers() >= 1) {
+        link.writer_seen = true;
+      } else if (link.writer_seen) {
+        spdlog::warn("agent {} dropped: its request writer lost liveliness", id);
+        emit(drop_agent(state, id, "request writer lost liveliness"));
+      }
+    }
+  }
+
+  bool ready(std::uint32_t id) const {
+    const AgentLink& link = links[id - 1];
+    return link.frames->matched_readers() >= 1 && link.requests->alive_writers() >= 1;
+  }
+
+  void admit_agents(const std::atomic<bool>& stop) {
+    const Clock::time_point deadline = Clock::now() + seconds(options.admit_timeout_s);
+    const std::size_t expected = state.agents.size();
+    for (;;) {
+      service_hellos();
+      check_liveliness();
+      std::size_t admitted = 0;
+      bool all_ready = true;
+      for (const AgentRecord& a : state.agents) {
+        admitted += a.admitted ? 1 : 0;
+        if (a.alive && !ready(a.id)) all_ready = false;
+      }
+      if (admitted == expected && all_ready) return;
+      const Clock::time_point now = Clock::now();
+      if (stop || now >= deadline) break;
+      signal->wait_until(std::min(deadline, now + (admitted == expected ? kReadyPollInterval : kPollInterval)));
+    }
+    std::size_t admitted = 0, ready_count = 0;
+    for (const AgentRecord& a : state.agents) {
+      admitted += a.admitted ? 1 : 0;
+      ready_count += a.alive && ready(a.id) ? 1 : 0;
+    }
+    if (admitted == 0)
+      throw Error(stop ? "stopped before any agent was admitted"
+                       : "no agent admitted within the admit timeout of " + format_seconds(options.admit_timeout_s) +
+                             " (expected " + std::to_string(expected) + " on run '" + options.run_id + "')");
+    spdlog::warn("starting with {} of {} agents admitted, {} of them connected ({})", admitted, expected, ready_count,
+                 stop ? "stopped during admission" : "admit timeout");
+  }
+
+  void send_frame(std::uint32_t id, bool run_over) {
+    write_logged(*links[id - 1].frames, sensing->frame_for(state, id, run_over), "a sensor frame");
+  }
+
+  /// Requests of the current step's live agents until all answered, the deadline passes, or stop.
+  std::vector<Submission> collect(const std::atomic<bool>& stop) {
+    const Clock::time_point deadline = Clock::now() + seconds(options.step_deadline_s);
+    std::vector<Submission> submissions;
+    std::vector<bool> answered(state.agents.size(), false);
+    for (;;) {
+      service_hellos();
+      for (const AgentRecord& a : state.agents) {
+        if (!links[a.id - 1].requests) continue;
+        std::vector<bus::ActionRequest> received = links[a.id - 1].requests->take();
+        if (!a.alive) continue;  // a dropped agent's requests are read only to be discarded
+        for (bus::ActionRequest& r : received) {
+          // Only a request with the agent's own identity answers for it (a forged one must not close its slot).
+          if (r.step == state.step && r.agent_id == a.id && r.session == a.session) answered[a.id - 1] = true;
+          submissions.push_back({a.id, std::move(r)});
+        }
+      }
+      check_liveliness();
+      const std::vector<std::uint32_t> live = state.live_ids();
+      if (std::all_of(live.begin(), live.end(), [&](std::uint32_t id) { return answered[id - 1]; })) break;
+      const Clock::time_point now = Clock::now();
+      if (stop || now >= deadline) break;
+      signal->wait_until(std::min(deadline, now + kPollInterval));
+    }
+    return submissions;
+  }
+
+  void publish_status(bool running, bool completed, double wall_seconds) {
+    bus::WorldStatus s;
+    s.run_id = options.run_id;
+    s.scenario = scenario.name;
+    s.step = state.step;
+    s.wall_seconds = wall_seconds;
+    s.deposited_volume_m3 = state.deposited_volume_m3;
+    s.progress = progress(state);
+    s.running = running;
+    s.completed = completed;
+    for (const AgentRecord& a : state.agents) {
+      if (!a.admitted) continue;
+      bus::AgentStatus as;
+      as.agent_id = a.id;
+      as.name = a.name;
+      as.state = a.state;
+      as.x_m = a.x_m;
+      as.y_m = a.y_m;
+      as.z_m = a.z_m;
+      as.material_m3 = a.material_m3;
+      as.deposited_m3 = a.deposited_m3;
+      as.accepted = a.accepted;
+      as.rejected = a.rejected;
+      as.missed = a.missed;
+      as.alive = a.alive;
+      as.at_goal = a.alive && at_goal(state, a);
+      s.agents.push_back(std::move(as));
+    }
+    write_logged(*status, s, "the world status");
+  }
+
+  /// Logs a rejection at info level, or at debug level when it repeats the agent's previous one (a stuck agent would
+  /// otherwise fill the log; events.log keeps every one).
+  void log_rejection(const bus::WorldEvent& e) {
+    std::string& last = last_rejection[e.agent_id - 1];
+    if (e.detail == last) {
+      spdlog::debug("step {}: agent {} rejected again: {}", e.step, e.agent_id, e.detail);
+      return;
+    }
+    spdlog::info("step {}: agent {} rejected: {}", e.step, e.agent_id, e.detail);
+    last = e.detail;
+  }
+
+  /// Runs steps until an end condition; returns the end reason.
+  std::string lockstep(const std::atomic<bool>& stop, Clock::time_point start) {
+    for (;;) {
+      if (stop) return "signal";
+      if (is_completed(state)) return "completed";
+      if (state.step >= options.max_steps) return "max_steps";
+      const std::vector<std::uint32_t> live = state.live_ids();
+      if (live.empty()) return "no_live_agents";
+      for (std::uint32_t id : live) send_frame(id, false);
+      std::vector<Submission> submissions = collect(stop);
+      if (stop) return "signal";  // the interrupted step is not applied
+      const StepOutcome outcome = apply_step(state, submissions);
+      for (const std::string& text : outcome.notes) note(text);
+      for (const bus::WorldEvent& e : outcome.events) {
+        if (e.kind == bus::EventKind::kRejected)
+          log_rejection(e);
+        else if (e.kind == bus::EventKind::kMissed || e.kind == bus::EventKind::kDropped)
+          spdlog::warn("step {}: agent {} {}: {}", e.step, e.agent_id, bus::to_string(e.kind), e.detail);
+        else if (e.kind == bus::EventKind::kAtGoal)
+          spdlog::info("step {}: agent {} reached the goal", e.step, e.agent_id);
+        emit(e);
+      }
+      for (const AgentRecord& a : state.agents)
+        if (a.last_result != bus::ActionResult::kRejected) last_rejection[a.id - 1].clear();
+      // An agent dropped for missing its deadlines may only be slow or hung: tell it the run is over for it.
+      for (std::uint32_t id : outcome.dropped) send_frame(id, true);
+      publish_status(true, outcome.completed, elapsed_s(start));
+      if (state.step % kProgressEvery == 0)
+        spdlog::info("step {}: {} live agents, {:.6f} m3 deposited, progress {:.2f}", state.step, state.live_ids().size(),
+                     state.deposited_volume_m3, progress(state));
+    }
+  }
+
+  /// Waits until every agent told that the run is over has closed its request writer, or the linger time passes.
+  void linger(const std::vector<std::uint32_t>& ids) {
+    const Clock::time_point deadline = Clock::now() + seconds(options.linger_s);
+    for (;;) {
+      const bool gone = std::all_of(ids.begin(), ids.end(),
+                                    [&](std::uint32_t id) { return links[id - 1].requests->alive_writers() == 0; });
+      const Clock::time_point now = Clock::now();
+      if (gone || now >= deadline) return;
+      signal->wait_until(std::min(deadline, now + kPollInterval));
+    }
+  }
+
+  RunResult run(const std::atomic<bool>& stop) {
+    write_initial_outputs(options.out_dir, state.terrain);
+    event_log.emplace((std::filesystem::path(options.out_dir) / "events.log").string());
+    open_endpoints();
+    spdlog::info("run '{}': scenario '{}', {} x {} cells of {} m, waiting for {} agents (admit timeout {} s)",
+                 options.run_id, scenario.name, state.terrain.rows(), state.terrain.cols(),
+                 state.terrain.cell_size_m(), state.agents.size(), options.admit_timeout_s);
+    admit_agents(stop);
+    run_started = true;
+    const Clock::time_point start = Clock::now();
+    publish_status(true, false, 0.0);
+    const std::string end_reason = lockstep(stop, start);
+
+    RunResult result;
+    result.end_reason = end_reason;
+    result.completed = end_reason == "completed";
+    result.steps = state.step;
+    result.wall_seconds = elapsed_s(start);
+    const std::vector<std::uint32_t> live = state.live_ids();
+    for (std::uint32_t id : live) send_frame(id, true);
+    emit(make_event(0, bus::EventKind::kRunOver, end_reason));
+    publish_status(false, result.completed, result.wall_seconds);
+
+    RunInfo info;
+    info.scenario = scenario.name;
+    info.scenario_file = scenario.source_path;
+    info.run_id = options.run_id;
+    info.dds = bus::to_string(participant.vendor());
+    info.seed = scenario.seed;
+    info.completed = result.completed;
+    info.end_reason = end_reason;
+    info.wall_seconds = result.wall_seconds;
+    write_final_outputs(options.out_dir, state, info);
+    for (const AgentRecord& a : state.agents) result.admitted += a.admitted ? 1 : 0;
+    result.terrain_sha256 = terrain_sha256(state.terrain);
+    spdlog::info("run over ({}): {} steps in {:.3f} s, {:.6f} m3 deposited, terrain sha256 {}", end_reason,
+                 result.steps, result.wall_seconds, state.deposited_volume_m3, result.terrain_sha256);
+    linger(live);
+    return result;
+  }
+
+  scenario::Scenario scenario;
+  RuntimeOptions options;
+  bus::Participant& participant;
+  WorldState state;
+  std::optional<SensingService> sensing;
+  std::vector<AgentLink> links;  ///< [id - 1]
+  std::shared_ptr<bus::Signal> signal;
+  std::unique_ptr<bus::Reader<bus::AgentHello>> hellos;
+  std::unique_ptr<bus::Writer<bus::Admission>> admissions;
+  std::unique_ptr<bus::Writer<bus::WorldStatus>> status;
+  std::unique_ptr<bus::Writer<bus::WorldEvent>> events;
+  std::optional<EventLog> event_log;
+  std::vector<std::string> last_rejection;  ///< [id - 1]: the rejection reason last logged at info level
+  std::set<std::pair<std::uint32_t, std::uint64_t>> refused;  ///< (id, session) already reported as refused
+  bool run_started = false;
+};
+
+WorldRuntime::WorldRuntime(const scenario::Scenario& scenario, grid::Heightmap terrain, RuntimeOptions options,
+                           bus::Participant& participant)
+    : impl_(std::make_unique<Impl>(scenario, std::move(terrain), std::move(options), participant)) {}
+
+WorldRuntime::~WorldRuntime() = default;
+
+RunResult WorldRuntime::run(const std::atomic<bool>& stop) { return impl_->run(stop); }
+
+const WorldState& WorldRuntime::state() const { return impl_->state; }
+
+const std::string& WorldRuntime::run_id() const { return impl_->options.run_id; }
+
+}  // namespace marsala::world_server

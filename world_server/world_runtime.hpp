@@ -1,0 +1,76 @@
+#pragma once
+// The world server's runtime, the edge that owns the bus, the clock and the files: admission over the bus, the
+// lockstep loop with its deadline, liveliness and miss drops, WorldStatus and WorldEvents, final run_over frames
+// and the output folder. Everything it decides is delegated to the pure parts (admission, apply_step, sensing,
+// completion).
+//
+//   hello/admission on the default partition     -> per admitted agent: SensorFrame writer and ActionRequest reader
+//   on bus::partition_for(run_id, id)             -> step k: frames, wait for requests (deadline), apply_step, status
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "common/bus/bus.hpp"
+#include "common/grid/heightmap.hpp"
+#include "common/scenario/scenario.hpp"
+#include "world_server/world_state.hpp"
+
+namespace marsala::world_server {
+
+/// How to run.
+struct RuntimeOptions {
+  std::uint32_t agents = 0;         ///< expected agents, ids 1..agents; 0 = every slot of the scenario
+  std::string run_id;               ///< names the run's partitions; empty = default_run_id(scenario, domain)
+  double admit_timeout_s = 60.0;    ///< how long to wait for all agents before starting with those admitted [s]
+  std::uint64_t max_steps = 0;      ///< 0 = the scenario's max_steps
+  double step_deadline_s = 0.0;     ///< 0 = the scenario's step_deadline_s [s]
+  std::string out_dir = "out/run";  ///< summary.json, terrain_*.asc, final.png, events.log
+  double linger_s = 2.0;            ///< after the run_over frames, wait up to this long for agents to leave [s]
+};
+
+/// How a run ended.
+struct RunResult {
+  bool completed = false;
+  std::string end_reason;           ///< completed, max_steps, signal, no_live_agents
+  std::uint64_t steps = 0;          ///< steps applied
+  double wall_seconds = 0.0;        ///< from the first frame to the end [s]
+  std::uint32_t admitted = 0;
+  std::string terrain_sha256;       ///< of the final heights
+};
+
+/// The default run id: "<scenario name>-d<domain id>", so runs of one scenario on different domains never share
+/// partitions.
+std::string default_run_id(const std::string& scenario_name, int domain_id);
+
+/// Throws InvalidArgument unless `run_id` is non-empty letters, digits, '_', '-', '.' (no partition wildcards).
+void check_run_id(const std::string& run_id);
+
+/// One run of the world server on one participant.
+class WorldRuntime {
+ public:
+  /// Validates the options (agent count within the scenario's slots, run id, timeouts) and prepares the state;
+  /// throws InvalidArgument.
+  WorldRuntime(const scenario::Scenario& scenario, grid::Heightmap terrain, RuntimeOptions options,
+               bus::Participant& participant);
+  ~WorldRuntime();
+  WorldRuntime(const WorldRuntime&) = delete;
+  WorldRuntime& operator=(const WorldRuntime&) = delete;
+
+  /// Admits agents, runs the lockstep until completion, max_steps, no live agent or `stop`, sends run_over frames
+  /// and writes the outputs. Throws Error when no agent is admitted within the admit timeout (or before `stop`),
+  /// IoError when the outputs cannot be written.
+  RunResult run(const std::atomic<bool>& stop);
+
+  /// The world state (after run(): the final one).
+  const WorldState& state() const;
+  /// The run id in use.
+  const std::string& run_id() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace marsala::world_server

@@ -1,0 +1,62 @@
+#include "world_server/world_state.hpp"
+
+#include <limits>
+
+#include "common/error.hpp"
+
+namespace marsala::world_server {
+
+AgentRecord& WorldState::agent(std::uint32_t id) {
+  return const_cast<AgentRecord&>(static_cast<const WorldState&>(*this).agent(id));
+}
+
+const AgentRecord& WorldState::agent(std::uint32_t id) const {
+  if (!has_agent(id))
+    throw InvalidArgument("no agent " + std::to_string(id) + " in this run (agents 1.." +
+                          std::to_string(agents.size()) + ")");
+  return agents[id - 1];
+}
+
+std::vector<std::uint32_t> WorldState::live_ids() const {
+  std::vector<std::uint32_t> ids;
+  for (const AgentRecord& a : agents)
+    if (a.alive) ids.push_back(a.id);
+  return ids;
+}
+
+WorldState make_world_state(const scenario::Scenario& scenario, grid::Heightmap terrain, std::uint32_t agent_count) {
+  if (agent_count == 0 || agent_count > scenario.slots.size())
+    throw InvalidArgument("agent count " + std::to_string(agent_count) + " must be in 1.." +
+                          std::to_string(scenario.slots.size()) + " (the scenario's agent slots)");
+  WorldState s;
+  s.terrain = std::move(terrain);
+  s.goal = scenario.goal;
+  s.base = scenario.base;
+  s.tile_size = scenario.tile_size;
+  s.tile_versions.assign(static_cast<std::size_t>(s.tiles().tile_count()), 0);
+  for (std::uint32_t id = 1; id <= agent_count; ++id) {
+    const scenario::AgentSlot& slot = scenario.slots[id - 1];
+    const scenario::RobotType& type = scenario.robot_for(id);
+    AgentRecord a;
+    a.id = id;
+    a.robot_type = type.name;
+    a.behaviour = type.behaviour;
+    a.body = type.body;
+    a.start_x_m = slot.start_x_m;
+    a.start_y_m = slot.start_y_m;
+    a.target_x_m = slot.target_x_m;
+    a.target_y_m = slot.target_y_m;
+    a.x_m = slot.start_x_m;
+    a.y_m = slot.start_y_m;
+    a.z_m = height_under(s.terrain, a.x_m, a.y_m);
+    s.agents.push_back(std::move(a));
+  }
+  return s;
+}
+
+double height_under(const grid::Heightmap& terrain, double x_m, double y_m) {
+  const auto cell = terrain.cell_at({x_m, y_m});
+  return cell ? terrain(*cell) : std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace marsala::world_server

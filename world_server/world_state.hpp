@@ -1,0 +1,77 @@
+#pragma once
+// The world's authoritative state: terrain, agents, the step counter and per-tile change versions.
+// Plain data; the arbiter, apply_step, sensing and completion read and change it. No IO, no clock.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/bus/messages.hpp"
+#include "common/grid/heightmap.hpp"
+#include "common/scenario/scenario.hpp"
+#include "world_server/tile_layout.hpp"
+
+namespace marsala::world_server {
+
+/// One agent slot as the world sees it.
+struct AgentRecord {
+  std::uint32_t id = 0;                 ///< >= 1
+  std::string robot_type;               ///< from the scenario slot
+  std::string behaviour;                ///< from the scenario's robot type
+  bus::BodyParams body;                 ///< from the scenario's robot type: what the hello must declare
+  double start_x_m = 0.0, start_y_m = 0.0;    ///< [m]
+  double target_x_m = 0.0, target_y_m = 0.0;  ///< [m]
+
+  bool admitted = false;
+  bool alive = false;                   ///< admitted and not dropped: takes part in the lockstep
+  bool dropped = false;
+  std::string drop_reason;
+  std::uint64_t session = 0;            ///< from the admitted hello
+  std::string name;                     ///< from the admitted hello
+
+  double x_m = 0.0, y_m = 0.0;          ///< position [m]
+  double z_m = 0.0;                     ///< terrain height of the cell under the centre [m]
+  double material_m3 = 0.0;             ///< material on board [m^3]
+
+  std::uint32_t accepted = 0;           ///< requests accepted
+  std::uint32_t rejected = 0;           ///< requests rejected (duplicates and future steps included)
+  std::uint32_t missed = 0;             ///< steps without a request
+  std::uint32_t consecutive_missed = 0;
+  double deposited_m3 = 0.0;            ///< material placed [m^3]
+  bool at_goal = false;
+  std::string state;                    ///< the behaviour's state from its latest request
+
+  bus::ActionResult last_result = bus::ActionResult::kNone;  ///< for its next frame
+  std::string last_reason;
+};
+
+/// Everything the step function reads and changes.
+struct WorldState {
+  grid::Heightmap terrain;              ///< authoritative heights [m]
+  std::vector<AgentRecord> agents;      ///< agents[i].id == i + 1, one per expected agent
+  std::uint64_t step = 0;               ///< the step whose requests are awaited
+  scenario::Goal goal;
+  scenario::BaseStation base;
+  int tile_size = 16;                   ///< [cells]
+  std::vector<std::uint64_t> tile_versions;  ///< per tile (TileLayout index): bumped in every step that changes it
+  double deposited_volume_m3 = 0.0;     ///< total placed [m^3]
+
+  /// True when `id` names an agent slot of this run.
+  bool has_agent(std::uint32_t id) const { return id >= 1 && id <= agents.size(); }
+  /// The record of agent `id`; throws InvalidArgument when there is no such slot.
+  AgentRecord& agent(std::uint32_t id);
+  const AgentRecord& agent(std::uint32_t id) const;
+  /// Ids of the live agents, ascending.
+  std::vector<std::uint32_t> live_ids() const;
+  /// The tile layout of the terrain.
+  TileLayout tiles() const { return TileLayout(terrain.geometry(), tile_size); }
+};
+
+/// The initial state: `terrain`, the scenario's goal, base and tile size, and slots 1..agent_count (none admitted).
+/// Throws InvalidArgument when agent_count is 0 or exceeds the scenario's slots.
+WorldState make_world_state(const scenario::Scenario& scenario, grid::Heightmap terrain, std::uint32_t agent_count);
+
+/// Height of the cell under (x, y) [m], or NaN when off the grid.
+double height_under(const grid::Heightmap& terrain, double x_m, double y_m);
+
+}  // namespace marsala::world_server
