@@ -1,0 +1,40 @@
+#pragma once
+// What one robot knows about itself and its run once admitted: identity, body, the world grid and its target.
+// Everything an agent decides flows from this context and its own sensor frames.
+
+#include <cstdint>
+
+#include "common/bus/messages.hpp"
+#include "common/grid/heightmap.hpp"
+#include "common/types.hpp"
+
+namespace marsala::agent {
+
+/// The admitted agent: identity, body, the world's answer and team-wide margins.
+struct AgentContext {
+  std::uint32_t agent_id = 0;       ///< >= 1
+  std::uint64_t session = 0;        ///< echoed in every request
+  bus::BodyParams body;             ///< this robot's body, kinematics and capabilities
+  bus::Admission admission;         ///< world grid, tile size, start, target and base station
+  /// Depositions stay farther than this from a neighbour's reported centre [m]: the world rejects cells under any
+  /// robot, and a neighbour may move before its turn; default = delta/2 + max_step of this body (see
+  /// neighbour_keep_out_m()).
+  double neighbour_keep_out_m = 0.0;
+  std::uint64_t seed = 1;           ///< scenario seed; behaviours that randomise seed from seed + agent_id
+};
+
+/// The navigability parameters (kappa [m/m], delta [m], eps [m]) of a body.
+NavigabilityParams navigability_params(const bus::BodyParams& body);
+
+/// The world grid announced in an admission; throws InvalidArgument when its size or cell size is not positive.
+grid::GridGeometry world_geometry(const bus::Admission& admission);
+
+/// Keep-out around neighbours for a team whose largest body length is max_delta_m [m] and longest step
+/// max_step_m [m]: max_delta_m / 2 + max_step_m + 1e-6 [m].
+double neighbour_keep_out_m(double max_delta_m, double max_step_m);
+
+/// Height of one cube spread over a cell, q = cube^3 / cs^2 [m]: depositions are whole multiples of it; throws
+/// InvalidArgument unless cube size and cell size are finite and > 0.
+double cube_layer_m(const bus::BodyParams& body, double cell_size_m);
+
+}  // namespace marsala::agent

@@ -1,0 +1,139 @@
+#include "agent/deliberative/local_map_synthesizer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "common/error.hpp"
+#include "common/grid/iterators.hpp"
+
+namespace marsala::agent::deliberative {
+namespace {
+
+std::string describe(Position p) { return "(" + std::to_string(p.x) + ", " + std::to_string(p.y) + ") m"; }
+
+int clamp_int(double v, int lo, int hi) {
+  if (!(v >= lo)) return lo;  // also catches NaN
+  if (v > hi) return hi;
+  return static_cast<int>(v);
+}
+
+}  // namespace
+
+Window sensing_window(const grid::GridGeometry& world, Position robot, double range_m) {
+  if (!(range_m >= 0.0) || !std::isfinite(range_m))
+    throw InvalidArgument("sensing range must be finite and >= 0 m, got " + std::to_string(range_m));
+  if (!std::isfinite(robot.x) || !std::isfinite(robot.y) || !world.cell_at(robot))
+    throw InvalidArgument("local map: the robot at " + describe(robot) + " is off the grid");
+  const double cs = world.cell_size_m;
+  const int col_lo = clamp_int(std::floor((robot.x - range_m - world.xll_m) / cs), 0, world.cols - 1);
+  const int col_hi = clamp_int(std::floor((robot.x + range_m - world.xll_m) / cs), 0, world.cols - 1);
+  const int south_lo = clamp_int(std::floor((robot.y - range_m - world.yll_m) / cs), 0, world.rows - 1);
+  const int south_hi = clamp_int(std::floor((robot.y + range_m - world.yll_m) / cs), 0, world.rows - 1);
+  return {{world.rows - 1 - south_hi, col_lo}, south_hi - south_lo + 1, col_hi - col_lo + 1};
+}
+
+LocalMapSynthesizer::LocalMapSynthesizer(NavigabilityParams params, double sensing_range_m)
+    : mars_(params.kappa), navigability_(params), sensing_range_m_(sensing_range_m) {
+  if (!(sensing_range_m >= 0.0) || !std::isfinite(sensing_range_m))
+    throw InvalidArgument("local map synthesizer: sensing range must be finite and >= 0 m, got " +
+                          std::to_string(sensing_range_m));
+}
+
+LocalMap LocalMapSynthesizer::synthesize(const executive::MappingSystem& map, Position robot, Position target) const {
+  const Window w = sensing_window(map.geometry(), robot, sensing_range_m_);
+  LocalMap local;
+  local.world = map.geometry();
+  local.offset = w.top_left;
+  local.heights = map.heights().window(w.top_left, w.rows, w.cols);
+  local.known = map.known().block(w.top_left.row, w.top_left.col, w.rows, w.cols);
+
+  // Unknown cells take the lowest known height: they then never raise the MARS bound of a known cell.
+  const bool all_known = local.known.minCoeff() != 0;
+  if (!all_known) {
+    double lowest = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < w.rows; ++r)
+      for (int c = 0; c < w.cols; ++c)
+        if (local.known(r, c) != 0) lowest = std::min(lowest, local.heights(r, c));
+    if (!std::isfinite(lowest)) lowest = 0.0;
+    for (int r = 0; r < w.rows; ++r)
+      for (int c = 0; c < w.cols; ++c)
+        if (local.known(r, c) == 0) local.heights(r, c) = lowest;
+  }
+
+  local.gap = mars_.gap(local.heights);
+  local.occupiable = navigability_.occupiable(local.heights);
+  local.blind = grid::CellMask::Zero(w.rows, w.cols);
+  if (!all_known) {
+    // A ball that holds an unknown cell cannot be judged: treat its centre as not occupiable.
+    const auto ball = grid::disc_offsets(params().delta_m / (2.0 * local.geometry().cell_size_m));
+    for (int r = 0; r < w.rows; ++r)
+      for (int c = 0; c < w.cols; ++c) {
+        if (local.known(r, c) != 0) continue;
+        local.gap(r, c) = 0.0;
+        for (const CellIndex o : ball) {
+          const CellIndex p{r - o.row, c - o.col};
+          if (!local.contains(p)) continue;
+          local.blind(p.row, p.col) = 1;
+          local.occupiable(p.row, p.col) = 0;
+        }
+      }
+  }
+
+  local.robot = local.to_local(*map.geometry().cell_at(robot));
+  local.navigable = processing::NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
+  local.origin = local_origin(local, map.trajectory(), robot, sensing_range_m_);
+  const auto [goal, is_target] = local_goal(local, robot, target);
+  local.goal = goal;
+  local.goal_is_target = is_target;
+  return local;
+}
+
+std::optional<CellIndex> LocalMapSynthesizer::local_origin(const LocalMap& local,
+                                                           const std::vector<CellIndex>& trajectory, Position robot,
+                                                           double range_m) {
+  std::optional<CellIndex> best_navigable, best_occupiable;
+  double best_navigable_d = std::numeric_limits<double>::infinity();
+  double best_occupiable_d = std::numeric_limits<double>::infinity();
+  const bool has_navigable = local.navigable.rows() == local.rows() && local.navigable.cols() == local.cols();
+  for (const CellIndex global : trajectory) {
+    const CellIndex p = local.to_local(global);
+    if (!local.contains(p) || local.occupiable(p.row, p.col) == 0) continue;
+    const Position c = local.center(p);
+    const double d = std::min(range_m - std::abs(c.x - robot.x), range_m - std::abs(c.y - robot.y));
+    if (has_navigable && local.navigable(p.row, p.col) != 0) {
+      if (d < best_navigable_d) best_navigable_d = d, best_navigable = p;
+    } else if (d < best_occupiable_d) {
+      best_occupiable_d = d, best_occupiable = p;
+    }
+  }
+  return best_navigable ? best_navigable : best_occupiable;
+}
+
+std::pair<CellIndex, bool> LocalMapSynthesizer::local_goal(const LocalMap& local, Position robot, Position target) {
+  const grid::GridGeometry& g = local.geometry();
+  if (!std::isfinite(target.x) || !std::isfinite(target.y))
+    throw InvalidArgument("local map: the target " + describe(target) + " is not finite");
+  if (const auto cell = local.cell_at(target)) return {*cell, true};
+
+  // Clip the segment robot -> target to the rectangle of the window's cell centres.
+  const double cs = g.cell_size_m;
+  const double x_lo = g.xll_m + 0.5 * cs, x_hi = g.xll_m + (g.cols - 0.5) * cs;
+  const double y_lo = g.yll_m + 0.5 * cs, y_hi = g.yll_m + (g.rows - 0.5) * cs;
+  const Position s{std::clamp(robot.x, x_lo, x_hi), std::clamp(robot.y, y_lo, y_hi)};
+  const double dx = target.x - s.x, dy = target.y - s.y;
+  double t = 1.0;
+  if (dx > 0.0) t = std::min(t, (x_hi - s.x) / dx);
+  if (dx < 0.0) t = std::min(t, (x_lo - s.x) / dx);
+  if (dy > 0.0) t = std::min(t, (y_hi - s.y) / dy);
+  if (dy < 0.0) t = std::min(t, (y_lo - s.y) / dy);
+  t = std::max(t, 0.0);
+  const double ex = s.x + t * dx, ey = s.y + t * dy;
+  // The nearest cell centre to the exit point, kept inside the window.
+  const int col = std::clamp(static_cast<int>(std::lround((ex - g.xll_m) / cs - 0.5)), 0, g.cols - 1);
+  const int south = std::clamp(static_cast<int>(std::lround((ey - g.yll_m) / cs - 0.5)), 0, g.rows - 1);
+  return {{g.rows - 1 - south, col}, false};
+}
+
+}  // namespace marsala::agent::deliberative

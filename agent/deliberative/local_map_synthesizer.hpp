@@ -1,0 +1,101 @@
+#pragma once
+// Local map synthesizer (paper §III-A): the augmented local map around the robot. A window of the agent's own map
+// (the square sensing window [x - r, x + r] x [y - r, y + r] clipped to the grid), its MARS gap and navigability,
+// the local origin and the local goal. MARS and navigability are computed on the window alone, which keeps them
+// tractable and, by the local MARS bound, consistent with the global one.
+//
+//   +-------------------------------+   window (local indices, row 0 northmost)
+//   |  origin o                     |   o: the occupiable trajectory cell nearest the window boundary
+//   |                               |      (the sensing square's, unclipped by the grid)
+//   |     \__ trajectory            |   R: the robot's cell
+//   |         \__ R ------------- g |   g: where the straight line from R to the target leaves the window
+//   +-------------------------------+      (or the target cell when it lies inside)
+
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "agent/executive/mapping_system.hpp"
+#include "common/grid/heightmap.hpp"
+#include "common/processing/mars_processor.hpp"
+#include "common/processing/navigability_processor.hpp"
+#include "common/types.hpp"
+
+namespace marsala::agent::deliberative {
+
+/// The augmented local map: local heightmap, MARS gap, navigability, robot cell, local origin and local goal.
+/// All indices are local (row 0, col 0 = the window's top-left cell); `offset` maps them to the world grid.
+struct LocalMap {
+  grid::GridGeometry world;          ///< the world grid: positions map to cells through it, as the world maps them
+  CellIndex offset;                  ///< world index of the window's top-left cell
+  grid::Heightmap heights;           ///< the window [m], placed in the world frame; unknown cells hold the lowest known
+  grid::CellMask known;              ///< 1 where the agent's map knows the cell
+  grid::Heightmap gap;               ///< MARS gap P_kappa[h] - h of the window [m]; 0 on unknown cells
+  grid::CellMask blind;              ///< 1 where the cell's ball holds an unknown cell: it is never occupiable
+  grid::CellMask occupiable;         ///< occupiable cells; never a blind one
+  grid::CellMask navigable;          ///< occupiable cells 8-connected to the robot's cell
+  CellIndex robot;                   ///< the robot's cell
+  std::optional<CellIndex> origin;   ///< the local origin, when some trajectory cell in the window is occupiable
+  CellIndex goal;                    ///< the local goal
+  bool goal_is_target = false;       ///< true when the local goal is the target's own cell
+
+  /// The window's geometry (world placement, cell size [m]).
+  const grid::GridGeometry& geometry() const { return heights.geometry(); }
+  int rows() const { return heights.rows(); }
+  int cols() const { return heights.cols(); }
+  bool contains(CellIndex local) const { return heights.contains(local); }
+  CellIndex to_global(CellIndex local) const { return {local.row + offset.row, local.col + offset.col}; }
+  CellIndex to_local(CellIndex global) const { return {global.row - offset.row, global.col - offset.col}; }
+  /// Centre of a local cell in the world frame [m].
+  Position center(CellIndex local) const { return heights.cell_center(local); }
+  /// The local cell containing `p` [m] (mapped through the world grid), or nullopt when it is outside the window.
+  std::optional<CellIndex> cell_at(Position p) const {
+    const auto global = world.cell_at(p);
+    if (!global) return std::nullopt;
+    const CellIndex local = to_local(*global);
+    return contains(local) ? std::optional<CellIndex>(local) : std::nullopt;
+  }
+};
+
+/// Window of a world grid: top-left cell and size [cells].
+struct Window {
+  CellIndex top_left;
+  int rows = 0;
+  int cols = 0;
+};
+
+/// The cells whose squares meet [x - r, x + r] x [y - r, y + r] (r = range_m [m]), clipped to the grid; throws
+/// InvalidArgument when the robot is off the grid or the range is negative or not finite.
+Window sensing_window(const grid::GridGeometry& world, Position robot, double range_m);
+
+/// Builds augmented local maps for one robot.
+class LocalMapSynthesizer {
+ public:
+  /// params: the robot's kappa [m/m], delta [m], eps [m]; sensing_range_m: half-side of its sensing window [m].
+  /// Throws InvalidArgument on invalid parameters.
+  LocalMapSynthesizer(NavigabilityParams params, double sensing_range_m);
+
+  /// The augmented local map around `robot` [m] heading for `target` [m]; throws InvalidArgument when the robot is
+  /// off the grid.
+  LocalMap synthesize(const executive::MappingSystem& map, Position robot, Position target) const;
+
+  /// The local origin: among trajectory cells (world indices) inside the window, the one nearest the boundary of
+  /// the sensing square [x - r, x + r] x [y - r, y + r] around `robot` (r = range_m) that is navigable from the
+  /// robot, else the nearest that is occupiable; ties go to the oldest. The square, not the window clipped to the
+  /// grid: a world edge is no boundary of what the robot knows.
+  static std::optional<CellIndex> local_origin(const LocalMap& local, const std::vector<CellIndex>& trajectory,
+                                               Position robot, double range_m);
+  /// The local goal: the target's cell when it lies in the window, else the cell where the straight line from the
+  /// robot to the target leaves the window (the rectangle of the window's cell centres). Second: goal_is_target.
+  static std::pair<CellIndex, bool> local_goal(const LocalMap& local, Position robot, Position target);
+
+  const NavigabilityParams& params() const { return navigability_.params(); }
+  double sensing_range_m() const { return sensing_range_m_; }
+
+ private:
+  processing::MarsProcessor mars_;
+  processing::NavigabilityProcessor navigability_;
+  double sensing_range_m_;
+};
+
+}  // namespace marsala::agent::deliberative

@@ -1,0 +1,50 @@
+#include "agent/executive/action_manager.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "common/error.hpp"
+
+namespace marsala::agent::executive {
+namespace {
+
+double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+/// Below this a robot counts as standing on its cell's centre [m].
+constexpr double kCentredM = 1e-9;
+
+}  // namespace
+
+ActionManager::ActionManager(double max_step_m) : max_step_m_(max_step_m) {
+  if (!(max_step_m > 0.0) || !std::isfinite(max_step_m))
+    throw InvalidArgument("action manager: max step must be finite and > 0 m, got " + std::to_string(max_step_m));
+}
+
+const grid::CellMask& ActionManager::moves_mask(const deliberative::LocalMap& map) const {
+  return map.navigable(map.robot.row, map.robot.col) != 0 ? map.navigable : map.occupiable;
+}
+
+std::optional<Motion> ActionManager::advance(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
+                                             Position robot) const {
+  if (path.size() < 2) return std::nullopt;
+  const grid::CellMask& mask = moves_mask(map);
+  std::optional<Motion> best;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    const CellIndex cell = path[i];
+    if (!map.contains(cell) || mask(cell.row, cell.col) == 0) break;
+    const Position centre = map.center(cell);
+    const double d = distance(centre, robot);
+    if (d <= max_step_m_) best = Motion{cell, centre, i, d};
+  }
+  if (best) return best;
+  // The next cell is navigable but out of range from where the robot stands: first step onto its own centre.
+  const CellIndex next = path[1];
+  const Position own = map.center(path[0]);
+  const double d_own = distance(own, robot);
+  if (map.contains(next) && mask(next.row, next.col) != 0 && mask(path[0].row, path[0].col) != 0 &&
+      d_own > kCentredM && d_own <= max_step_m_)
+    return Motion{path[0], own, 0, d_own};
+  return std::nullopt;
+}
+
+}  // namespace marsala::agent::executive

@@ -1,0 +1,185 @@
+#include "agent/executive/deposition_manager.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "agent/agent_context.hpp"
+#include "common/error.hpp"
+#include "common/grid/iterators.hpp"
+
+namespace marsala::agent::executive {
+namespace {
+
+/// Margin kept inside the world's strict "more than delta/2 from every robot" rule [m].
+constexpr double kUnderRobotMarginM = 1e-6;
+
+double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+/// Ball offsets nearest first (then row-major), so each path cell's footprint is visited from its centre outwards.
+std::vector<CellIndex> sorted_ball(double radius_cells) {
+  std::vector<CellIndex> ball = grid::disc_offsets(radius_cells);
+  std::stable_sort(ball.begin(), ball.end(), [](CellIndex a, CellIndex b) {
+    return a.row * a.row + a.col * a.col < b.row * b.row + b.col * b.col;
+  });
+  return ball;
+}
+
+bool positive_finite(double v) { return v > 0.0 && std::isfinite(v); }
+
+long long cells2(CellIndex a, CellIndex b) {
+  const long long dr = a.row - b.row, dc = a.col - b.col;
+  return dr * dr + dc * dc;
+}
+
+}  // namespace
+
+bool DepositionManager::in_territory(const deliberative::LocalMap& map, CellIndex cell, Position centre,
+                                     const Neighbourhood& neighbours, std::optional<CellIndex> self_cell) const {
+  const CellIndex global = map.to_global(cell);
+  for (const bus::Neighbour& n : neighbours.others) {
+    const Position p{n.x_m, n.y_m};
+    if (distance(centre, p) <= params_.neighbour_keep_out_m) return false;
+    // Whole-cell distances: every robot computes them exactly alike, so territories never overlap.
+    const auto other = map.world.cell_at(p);
+    if (!self_cell || !other) continue;
+    const long long mine = cells2(global, *self_cell), theirs = cells2(global, *other);
+    if (theirs < mine || (theirs == mine && n.agent_id < neighbours.self_id)) return false;
+  }
+  return true;
+}
+
+DepositionParams deposition_params(const bus::BodyParams& body, double cell_size_m, double neighbour_keep_out_m) {
+  DepositionParams p;
+  p.navigability = navigability_params(body);
+  p.reach_m = body.reach_m;
+  p.max_deposit_m3 = body.max_deposit_m3;
+  p.cube_layer_m = cube_layer_m(body, cell_size_m);
+  p.neighbour_keep_out_m = neighbour_keep_out_m;
+  p.neighbour_step_m = body.max_step_m;
+  return p;
+}
+
+DepositionManager::DepositionManager(DepositionParams params)
+    : params_(params), navigability_(params.navigability) {
+  if (!positive_finite(params.reach_m) || !positive_finite(params.max_deposit_m3) ||
+      !positive_finite(params.cube_layer_m) || !positive_finite(params.max_height_m) ||
+      !(params.neighbour_keep_out_m >= 0.0) || !std::isfinite(params.neighbour_keep_out_m) ||
+      !(params.neighbour_step_m >= 0.0) || !std::isfinite(params.neighbour_step_m))
+    throw InvalidArgument("deposition manager: reach (" + std::to_string(params.reach_m) + " m), max deposit (" +
+                          std::to_string(params.max_deposit_m3) + " m^3), cube layer (" +
+                          std::to_string(params.cube_layer_m) + " m) and max height (" +
+                          std::to_string(params.max_height_m) +
+                          " m) must be finite and > 0, neighbour keep-out and step finite and >= 0");
+}
+
+std::vector<DepositionCandidate> DepositionManager::candidates(const deliberative::LocalMap& map,
+                                                               const std::vector<CellIndex>& path, Position robot,
+                                                               double material_m3,
+                                                               const Neighbourhood& neighbours) const {
+  std::vector<DepositionCandidate> out;
+  const double budget_m3 = std::min(params_.max_deposit_m3, std::max(material_m3, 0.0));
+  const double cs = map.geometry().cell_size_m;
+  const double area = cs * cs;
+  const double q = params_.cube_layer_m;
+  const double layer_volume = q * area;
+  const int max_layers = static_cast<int>(std::floor(params_.max_height_m / q + 1e-9));
+  const double clear_m = 0.5 * params_.navigability.delta_m + kUnderRobotMarginM;
+  const auto ball = sorted_ball(params_.navigability.delta_m / (2.0 * cs));
+  std::vector<std::uint8_t> seen(static_cast<std::size_t>(map.rows()) * map.cols(), 0);
+  const std::optional<CellIndex> self_cell = map.world.cell_at(neighbours.self);
+  double total_m3 = 0.0;
+  for (const CellIndex p : path) {
+    for (const CellIndex o : ball) {
+      const CellIndex cell{p.row + o.row, p.col + o.col};
+      if (!map.contains(cell)) continue;
+      std::uint8_t& s = seen[static_cast<std::size_t>(cell.row) * map.cols() + cell.col];
+      if (s) continue;
+      s = 1;
+      if (map.known(cell.row, cell.col) == 0) continue;
+      // Whole layers, rounded down: never above the local MARS height (1e-9 absorbs rounding in gaps that are
+      // exact multiples).
+      int layers = std::min(static_cast<int>(std::floor(map.gap(cell) / q + 1e-9)), max_layers);
+      if (layers < 1) continue;
+      const Position centre = map.center(cell);
+      const double d = distance(centre, robot);
+      if (d > params_.reach_m || d <= clear_m) continue;
+      if (!in_territory(map, cell, centre, neighbours, self_cell)) continue;
+      const int fit = static_cast<int>(std::floor((budget_m3 - total_m3) / layer_volume + 1e-9));
+      layers = std::min(layers, fit);
+      if (layers < 1) return out;
+      const double height = layers * q;
+      total_m3 += height * area;
+      out.push_back({cell, layers, height});
+    }
+  }
+  return out;
+}
+
+bool DepositionManager::keeps_way_back(const deliberative::LocalMap& map, Position robot,
+                                       const std::vector<DepositionCandidate>& depositions,
+                                       const Neighbourhood& neighbours) const {
+  const auto cell = map.cell_at(robot);
+  if (!cell) return false;
+  if (depositions.empty()) return true;
+  // Robots whose way back must survive: this one at its new position, then the neighbours in the window.
+  std::vector<CellIndex> robots{*cell};
+  const double cs = map.geometry().cell_size_m;
+  const auto step_disc = grid::disc_offsets(params_.neighbour_step_m / cs);
+  for (const bus::Neighbour& n : neighbours.others)
+    if (const auto c = map.cell_at({n.x_m, n.y_m}))
+      for (const CellIndex o : step_disc) {
+        const CellIndex p{c->row + o.row, c->col + o.col};
+        if (map.contains(p)) robots.push_back(p);
+      }
+  const bool has_origin = map.origin && map.occupiable(map.origin->row, map.origin->col) != 0;
+  const grid::CellMask before =
+      has_origin ? processing::NavigabilityProcessor::navigable_from(map.occupiable, *map.origin) : grid::CellMask();
+
+  grid::Heightmap after = map.heights;
+  for (const auto& d : depositions) after(d.cell) += d.height_m;
+  grid::CellMask occupiable = navigability_.occupiable(after);
+  for (int r = 0; r < map.rows(); ++r)
+    for (int c = 0; c < map.cols(); ++c)
+      if (map.blind(r, c) != 0) occupiable(r, c) = 0;
+  // This robot's own cell must stay occupiable if it was (the world checks only motion targets, but a robot on a
+  // cell it cannot occupy has no navigable move).
+  if (map.occupiable(cell->row, cell->col) != 0 && occupiable(cell->row, cell->col) == 0) return false;
+  if (!has_origin) return true;
+  const grid::CellMask reach = processing::NavigabilityProcessor::navigable_from(occupiable, *map.origin);
+  for (const CellIndex p : robots)
+    if (before(p.row, p.col) != 0 && reach(p.row, p.col) == 0) return false;
+  return true;
+}
+
+DepositionPlan DepositionManager::plan(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
+                                       Position robot, double material_m3,
+                                       const Neighbourhood& neighbours) const {
+  DepositionPlan plan;
+  std::vector<DepositionCandidate> chosen = candidates(map, path, robot, material_m3, neighbours);
+  plan.candidates = static_cast<int>(chosen.size());
+  if (!keeps_way_back(map, robot, chosen, neighbours)) {
+    // The longest prefix that keeps the way back (the empty one always does): binary search.
+    std::size_t good = 0, bad = chosen.size();
+    while (bad - good > 1) {
+      const std::size_t mid = good + (bad - good) / 2;
+      if (keeps_way_back(map, robot, {chosen.begin(), chosen.begin() + static_cast<std::ptrdiff_t>(mid)},
+                         neighbours))
+        good = mid;
+      else
+        bad = mid;
+    }
+    chosen.resize(good);
+    plan.dropped_for_way_back = plan.candidates - static_cast<int>(good);
+  }
+  const double area = map.geometry().cell_size_m * map.geometry().cell_size_m;
+  for (const auto& c : chosen) {
+    const CellIndex g = map.to_global(c.cell);
+    plan.depositions.push_back({g.row, g.col, c.height_m});
+    plan.volume_m3 += c.height_m * area;
+  }
+  return plan;
+}
+
+}  // namespace marsala::agent::executive

@@ -1,0 +1,92 @@
+#pragma once
+// Deposition manager (paper §III, executive layer): turns the MARS gap under a planned path's footprint into this
+// step's depositions. Cells go in path order (the footprint of the path cell nearest the robot first), each raised
+// towards its local MARS height P in whole cube layers q = cube^3 / cs^2, rounded down so that it never overshoots
+// P (rounding to nearest would let each built cell lift the bound of the next by up to q/2, and a ramp built cell
+// by cell would creep flatter and longer than kappa). Every rule the world checks is kept: reach, never under a
+// robot, at most 1 m per cell, total volume within the deposition threshold and the material on board. Finally
+// the depositions are simulated on the local map: the robot's (new) cell must stay occupiable and connected to
+// the local origin, and so must every neighbour in the window that was connected; depositions that would break
+// that are dropped.
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "agent/deliberative/local_map_synthesizer.hpp"
+#include "common/bus/messages.hpp"
+#include "common/processing/navigability_processor.hpp"
+#include "common/types.hpp"
+
+namespace marsala::agent::executive {
+
+/// The body's limits that bound a step's depositions.
+struct DepositionParams {
+  NavigabilityParams navigability;      ///< kappa [m/m], delta [m], eps [m]
+  double reach_m = 1.2;                 ///< manipulator reach from the robot's centre [m]
+  double max_deposit_m3 = 0.01;         ///< deposition threshold per step [m^3]
+  double cube_layer_m = 0.0125;         ///< q = cube^3 / cs^2: the height of one cube spread over a cell [m]
+  double max_height_m = 1.0;            ///< largest single deposition [m]
+  double neighbour_keep_out_m = 0.7;    ///< no deposition this close to a neighbour's centre [m]
+  double neighbour_step_m = 0.2;        ///< how far a neighbour may move this step [m]
+};
+
+/// The deposition parameters of a body on a grid of cell_size_m [m], with the team's keep-out [m].
+DepositionParams deposition_params(const bus::BodyParams& body, double cell_size_m, double neighbour_keep_out_m);
+
+/// The robots around this one at the start of the step, as its frame reports them.
+struct Neighbourhood {
+  std::uint32_t self_id = 0;             ///< this robot's agent id
+  Position self;                         ///< this robot's position at the start of the step [m]
+  std::vector<bus::Neighbour> others;    ///< the other robots within proximity range
+};
+
+/// One candidate deposition (local index).
+struct DepositionCandidate {
+  CellIndex cell;       ///< local index
+  int layers = 0;       ///< whole cube layers
+  double height_m = 0;  ///< layers * q [m]
+};
+
+/// This step's depositions.
+struct DepositionPlan {
+  std::vector<bus::Deposition> depositions;  ///< world indices, in path order
+  double volume_m3 = 0.0;                    ///< sum of height * cs^2 [m^3]
+  int candidates = 0;                        ///< candidates before the way-back check [count]
+  int dropped_for_way_back = 0;              ///< candidates dropped to keep the way back [count]
+};
+
+/// Chooses a step's depositions along a path.
+class DepositionManager {
+ public:
+  /// Throws InvalidArgument on non-positive or non-finite limits.
+  explicit DepositionManager(DepositionParams params);
+  const DepositionParams& params() const { return params_; }
+
+  /// The depositions the world would accept from a robot standing at `robot` [m] (after this step's motion) with
+  /// `material_m3` on board, without the way-back check; budget-limited. Cells nearer than the keep-out to a
+  /// neighbour are skipped, and so are cells outside this robot's territory: a cell belongs to the robot whose cell
+  /// (at the start of the step) is nearest in whole cells, ties to the lower id. Robots decide on the same frame
+  /// state, so two of them never fill the same cell in one step (each would fill it to the MARS height it saw).
+  std::vector<DepositionCandidate> candidates(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
+                                              Position robot, double material_m3,
+                                              const Neighbourhood& neighbours) const;
+  /// candidates() reduced to the longest prefix that keeps the way back (keeps_way_back()).
+  DepositionPlan plan(const deliberative::LocalMap& map, const std::vector<CellIndex>& path, Position robot,
+                      double material_m3, const Neighbourhood& neighbours) const;
+  /// True when the depositions, simulated on the local map, keep the robot's cell at `robot` [m] occupiable (if
+  /// it was) and keep every robot that was connected to the local origin connected to it: this one, and each
+  /// neighbour in the window wherever its own motion may take it this step (cells within neighbour_step_m). The
+  /// neighbours' own depositions of the same step are unknown here: robots closer than about a body length can
+  /// still wall each other in between them.
+  bool keeps_way_back(const deliberative::LocalMap& map, Position robot,
+                      const std::vector<DepositionCandidate>& depositions, const Neighbourhood& neighbours) const;
+
+ private:
+  bool in_territory(const deliberative::LocalMap& map, CellIndex cell, Position centre,
+                    const Neighbourhood& neighbours, std::optional<CellIndex> self_cell) const;
+  DepositionParams params_;
+  processing::NavigabilityProcessor navigability_;
+};
+
+}  // namespace marsala::agent::executive

@@ -1,0 +1,87 @@
+// marsala-agent: one robot of a MARSala run. Reads its body and behaviour from its slot of the scenario, says hello
+// to marsala-world over DDS, then answers every sensor frame with one action request until the run is over.
+// Exit codes: 0 run over (or stopped by a signal), 1 error (one line on stderr), 2 usage.
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <exception>
+#include <iostream>
+
+#include "agent/runtime/agent_runtime.hpp"
+#include "common/scenario/scenario.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop = true; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace marsala;
+  CLI::App app{"marsala-agent: one robot of a MARSala run (body and behaviour from its scenario slot)"};
+  std::string scenario_file, dds = "cyclone", log_level = "info";
+  std::uint32_t id = 0;
+  int domain = 0;
+  double admit_timeout_s = 60.0, world_timeout_s = 60.0;
+  app.add_option("--scenario", scenario_file, "scenario file (protobuf text format)")->required();
+  app.add_option("--id", id, "agent id: the scenario slot, 1..N")->required()->check(CLI::Range(1u, 1000000u));
+  app.add_option("--dds", dds, "DDS vendor")->check(CLI::IsMember({"cyclone", "fastdds", "inprocess"}));
+  app.add_option("--domain", domain, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error, off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+  app.add_option("--admit-timeout", admit_timeout_s, "give up when not admitted within this [s]")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--world-timeout", world_timeout_s, "give up when no frame comes for this long [s]")
+      ->check(CLI::PositiveNumber);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+
+  auto logger = spdlog::stderr_color_mt("marsala-agent");
+  spdlog::set_default_logger(logger);
+  spdlog::set_level(spdlog::level::from_str(log_level));
+  try {
+    const scenario::Scenario s = scenario::load_scenario(scenario_file);
+    const scenario::RobotType& type = s.robot_for(id);
+    // Keep-out around neighbours: the largest body and step of the whole team (bodies may differ per slot).
+    double max_delta = 0.0, max_step = 0.0;
+    for (const scenario::AgentSlot& slot : s.slots) {
+      max_delta = std::max(max_delta, s.robot_for(slot.id).body.delta_m);
+      max_step = std::max(max_step, s.robot_for(slot.id).body.max_step_m);
+    }
+    agent::runtime::RuntimeConfig config;
+    config.agent_id = id;
+    config.name = type.name + "-" + std::to_string(id);
+    config.behaviour = type.behaviour;
+    config.body = type.body;
+    config.neighbour_keep_out_m = agent::neighbour_keep_out_m(max_delta, max_step);
+    config.seed = s.seed;
+    config.admit_timeout = std::chrono::milliseconds(static_cast<long long>(admit_timeout_s * 1000.0));
+    config.world_timeout = std::chrono::milliseconds(static_cast<long long>(world_timeout_s * 1000.0));
+
+    const auto participant = bus::make_participant({bus::vendor_from_string(dds), domain});
+    agent::runtime::AgentRuntime agent(*participant, config);
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    const agent::runtime::RunResult result = agent.run(g_stop);
+    if (result.outcome == agent::runtime::RunOutcome::kRunOver) return 0;
+    if (result.outcome == agent::runtime::RunOutcome::kStopped) {
+      spdlog::info("agent {}: {}", id, result.message);
+      return 0;
+    }
+    std::cerr << "marsala-agent: agent " << id << ": " << result.message << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "marsala-agent: " << e.what() << "\n";
+    return 1;
+  }
+}

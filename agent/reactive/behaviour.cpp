@@ -1,0 +1,51 @@
+#include "agent/reactive/behaviour.hpp"
+
+#include <string>
+
+#include "agent/reactive/idle_behaviour.hpp"
+#include "agent/reactive/ramp_builder.hpp"
+#include "common/error.hpp"
+
+namespace marsala::agent::reactive {
+
+BehaviourRegistry make_behaviour_registry() { return BehaviourRegistry("behaviour"); }
+
+void register_builtins(BehaviourRegistry& registry) {
+  registry.add("idle", [](const AgentContext& c) { return std::make_unique<IdleBehaviour>(c); });
+  registry.add("ramp_builder", [](const AgentContext& c) { return std::make_unique<RampBuilder>(c); });
+}
+
+std::unique_ptr<Behaviour> make_behaviour(const std::string& name, const AgentContext& context) {
+  BehaviourRegistry registry = make_behaviour_registry();
+  register_builtins(registry);
+  return registry.make(name, context);
+}
+
+bus::ActionRequest empty_request(const AgentContext& context, const bus::SensorFrame& frame,
+                                 const std::string& state) {
+  bus::ActionRequest request;
+  request.agent_id = context.agent_id;
+  request.session = context.session;
+  request.step = frame.step;
+  request.state = state;
+  return request;
+}
+
+void check_admission(const AgentContext& context, const bus::Admission& admission) {
+  if (admission.agent_id != context.agent_id || admission.session != context.session || !admission.accepted)
+    throw InvalidArgument("admission for agent " + std::to_string(admission.agent_id) + " (session " +
+                          std::to_string(admission.session) + (admission.accepted ? "" : ", refused") +
+                          ") does not admit agent " + std::to_string(context.agent_id) + " (session " +
+                          std::to_string(context.session) + ")");
+  world_geometry(admission);
+  if (admission.tile_size < 1)
+    throw InvalidArgument("admission: tile size must be >= 1, got " + std::to_string(admission.tile_size));
+}
+
+void check_frame(const AgentContext& context, const bus::SensorFrame& frame) {
+  if (frame.agent_id != context.agent_id)
+    throw InvalidArgument("sensor frame for agent " + std::to_string(frame.agent_id) + " reached agent " +
+                          std::to_string(context.agent_id));
+}
+
+}  // namespace marsala::agent::reactive

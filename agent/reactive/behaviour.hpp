@@ -1,0 +1,53 @@
+#pragma once
+// Reactive layer (paper Fig. 1): a behaviour turns each sensor frame into one action request. Behaviours are
+// chosen by name from a registry filled by register_builtins(): "ramp_builder" builds a navigable ramp to its
+// target (paper §IV, Fig. 2), "idle" requests nothing (the lockstep benchmark's agent).
+//
+// decide() is the pure core: it depends only on the agent's context, its admission and the frames so far (no
+// clock, no unseeded randomness), so it is testable without DDS and a run is reproducible bit for bit.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "agent/agent_context.hpp"
+#include "agent/detail/registry.hpp"
+#include "common/bus/messages.hpp"
+
+namespace marsala::agent::reactive {
+
+/// One robot's behaviour state machine.
+class Behaviour {
+ public:
+  virtual ~Behaviour() = default;
+  /// The registry name of this behaviour.
+  virtual std::string name() const = 0;
+  /// The current state's name (sent in every request for the monitor).
+  virtual std::string state_name() const = 0;
+  /// The world admitted the agent: grid, start, target and base become known. Throws InvalidArgument when the
+  /// admission is for another agent or session, or its grid is invalid.
+  virtual void on_admission(const bus::Admission& admission) = 0;
+  /// The request for this frame (same step, this agent's id and session). Throws InvalidArgument before
+  /// admission, for another agent's frame, or for a frame whose tiles do not fit the grid. On a run_over frame
+  /// it returns an empty request and the behaviour is done.
+  virtual bus::ActionRequest decide(const bus::SensorFrame& frame) = 0;
+};
+
+/// Behaviours by name; each is made from the agent's context (admission still empty).
+using BehaviourRegistry = detail::Registry<Behaviour, const AgentContext&>;
+
+/// An empty registry whose messages speak of behaviours.
+BehaviourRegistry make_behaviour_registry();
+/// Registers the built-in behaviours: "idle", "ramp_builder".
+void register_builtins(BehaviourRegistry& registry);
+/// A built-in behaviour by name; throws InvalidArgument listing the valid names when unknown.
+std::unique_ptr<Behaviour> make_behaviour(const std::string& name, const AgentContext& context);
+
+/// An empty request answering `frame`: the envelope filled, no motion, no deposition, no refill.
+bus::ActionRequest empty_request(const AgentContext& context, const bus::SensorFrame& frame, const std::string& state);
+/// Checks an admission against the context (id, session, grid); throws InvalidArgument when it does not fit.
+void check_admission(const AgentContext& context, const bus::Admission& admission);
+/// Checks that a frame belongs to this agent; throws InvalidArgument otherwise.
+void check_frame(const AgentContext& context, const bus::SensorFrame& frame);
+
+}  // namespace marsala::agent::reactive

@@ -1,0 +1,21 @@
+#include "agent/reactive/idle_behaviour.hpp"
+
+#include "common/error.hpp"
+
+namespace marsala::agent::reactive {
+
+void IdleBehaviour::on_admission(const bus::Admission& admission) {
+  check_admission(context_, admission);
+  context_.admission = admission;
+  admitted_ = true;
+}
+
+bus::ActionRequest IdleBehaviour::decide(const bus::SensorFrame& frame) {
+  if (!admitted_) throw InvalidArgument("idle behaviour: frame for step " + std::to_string(frame.step) +
+                                        " before admission");
+  check_frame(context_, frame);
+  if (frame.run_over) done_ = true;
+  return empty_request(context_, frame, state_name());
+}
+
+}  // namespace marsala::agent::reactive

@@ -1,0 +1,286 @@
+#include "agent/reactive/ramp_builder.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "common/error.hpp"
+#include "common/processing/navigability_processor.hpp"
+
+namespace marsala::agent::reactive {
+namespace {
+
+constexpr RampState kStates[] = {RampState::kWaitAdmission, RampState::kSurvey,       RampState::kAdvance,
+                                 RampState::kBuild,         RampState::kRetreat,      RampState::kReturnToBase,
+                                 RampState::kAtGoal,        RampState::kDone};
+
+/// Kept inside the world's base radius so a refill is never rejected on a tie [m].
+constexpr double kBaseMarginM = 1e-6;
+
+double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+executive::Neighbourhood neighbourhood(const bus::SensorFrame& frame) {
+  return {frame.agent_id, {frame.x_m, frame.y_m}, frame.neighbours};
+}
+
+
+}  // namespace
+
+std::string to_string(RampState state) {
+  switch (state) {
+    case RampState::kWaitAdmission: return "wait_admission";
+    case RampState::kSurvey: return "survey";
+    case RampState::kAdvance: return "advance";
+    case RampState::kBuild: return "build";
+    case RampState::kRetreat: return "retreat";
+    case RampState::kReturnToBase: return "return_to_base";
+    case RampState::kAtGoal: return "at_goal";
+    case RampState::kDone: return "done";
+  }
+  return "unknown";
+}
+
+RampState ramp_state_from_string(const std::string& name) {
+  std::string valid;
+  for (RampState s : kStates) {
+    if (to_string(s) == name) return s;
+    valid += (valid.empty() ? "" : ", ") + to_string(s);
+  }
+  throw InvalidArgument("unknown ramp builder state '" + name + "'; valid: " + valid);
+}
+
+struct RampBuilder::Modules {
+  executive::MappingSystem map;
+  deliberative::LocalMapSynthesizer synthesizer;
+  deliberative::NavigablePathPlanner planner;  // deposition paths (eq. 4-5)
+  deliberative::NavigablePathPlanner router;   // shortest routes through navigable cells (alpha = 0)
+  executive::ActionManager actions;
+  executive::DepositionManager depositions;
+  double layer_volume_m3;                      // one cube [m^3]
+  int max_idle_retreat_moves;                  // retreat moves without work before trying to advance again
+};
+
+RampBuilder::RampBuilder(const AgentContext& context, RampBuilderOptions options)
+    : context_(context),
+      options_(std::move(options)),
+      goal_(deliberative::make_goal_synthesizer(options_.goal_synthesizer)) {
+  // Fail on an invalid body now rather than at admission.
+  (void)processing::NavigabilityProcessor(navigability_params(context_.body));
+}
+
+RampBuilder::~RampBuilder() = default;
+
+const executive::MappingSystem& RampBuilder::map() const {
+  if (!modules_) throw InvalidArgument("ramp builder: no map before admission");
+  return modules_->map;
+}
+
+void RampBuilder::on_admission(const bus::Admission& admission) {
+  check_admission(context_, admission);
+  context_.admission = admission;
+  const grid::GridGeometry world = world_geometry(admission);
+  const bus::BodyParams& body = context_.body;
+  deliberative::PlannerParams planner =
+      options_.planner ? *options_.planner : deliberative::default_planner_params(body, world.cell_size_m);
+  deliberative::PlannerParams router = planner;
+  router.alpha = 0.0;
+  router.beta = 1.0;
+  const double layer_m = cube_layer_m(body, world.cell_size_m);
+  modules_ = std::make_unique<Modules>(Modules{
+      executive::MappingSystem(world, admission.tile_size),
+      deliberative::LocalMapSynthesizer(navigability_params(body), body.sensing_range_m),
+      deliberative::NavigablePathPlanner(planner), deliberative::NavigablePathPlanner(router),
+      executive::ActionManager(body.max_step_m),
+      executive::DepositionManager(
+          executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m)),
+      layer_m * world.cell_size_m * world.cell_size_m,
+      static_cast<int>(std::ceil((body.reach_m + body.delta_m) / body.max_step_m)) + 1});
+  state_ = RampState::kSurvey;
+}
+
+bus::ActionRequest RampBuilder::decide(const bus::SensorFrame& frame) {
+  if (!modules_) throw InvalidArgument("ramp builder: frame for step " + std::to_string(frame.step) +
+                                       " before admission");
+  check_frame(context_, frame);
+  trace_ = DecisionTrace{};
+  trace_.before = state_;
+  bus::ActionRequest request = empty_request(context_, frame, "");
+  if (frame.run_over || state_ == RampState::kDone) {
+    state_ = RampState::kDone;
+  } else {
+    modules_->map.integrate(frame);
+    const Position robot{frame.x_m, frame.y_m};
+    const Position target = goal_->target(context_.admission, robot);
+    const deliberative::LocalMap local = modules_->synthesizer.synthesize(modules_->map, robot, target);
+    trace_.window_offset = local.offset;
+    trace_.local_goal = local.goal;
+    trace_.local_origin = local.origin;
+    trace_.navigable_cells = local.navigable.cast<long long>().sum();
+    if (state_ == RampState::kSurvey) state_ = RampState::kAdvance;
+
+    // At the goal: on the local goal's cell, which is the target's cell, or the nearest the robot can get to a
+    // target off the grid.
+    if (local.goal == local.robot) {
+      state_ = RampState::kAtGoal;
+    } else {
+      if (state_ == RampState::kAtGoal) state_ = RampState::kAdvance;
+      if (state_ != RampState::kReturnToBase && frame.material_m3 < modules_->layer_volume_m3)
+        state_ = RampState::kReturnToBase;
+      switch (state_) {
+        case RampState::kReturnToBase: return_step(local, frame, request); break;
+        case RampState::kRetreat: retreat_step(local, frame, request); break;
+        default: build_step(local, frame, request); break;
+      }
+    }
+  }
+  trace_.after = state_;
+  request.state = to_string(state_);
+  return request;
+}
+
+bool RampBuilder::plan_path(const deliberative::LocalMap& local) {
+  if (!trace_.planned) {
+    trace_.plan = modules_->planner.plan(local, local.robot, local.goal);
+    trace_.planned = true;
+  }
+  return trace_.plan.found;
+}
+
+void RampBuilder::move(const executive::Motion& motion, bus::ActionRequest& request) {
+  trace_.motion = motion;
+  request.move = true;
+  request.target_x_m = motion.target.x;
+  request.target_y_m = motion.target.y;
+}
+
+void RampBuilder::deposit(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position at,
+                          std::size_t from, bus::ActionRequest& request) {
+  // The path from where the robot will stand: the cells it leaves behind are its way back, not work.
+  const auto& path = trace_.plan.path;
+  const std::vector<CellIndex> ahead(path.begin() + static_cast<std::ptrdiff_t>(std::min(from, path.size())),
+                                     path.end());
+  trace_.deposition = modules_->depositions.plan(local, ahead, at, frame.material_m3, neighbourhood(frame));
+  request.depositions = trace_.deposition.depositions;
+}
+
+void RampBuilder::build_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame,
+                             bus::ActionRequest& request) {
+  const Position robot{frame.x_m, frame.y_m};
+  if (!plan_path(local)) return;  // no path through known cells: wait for the map to grow
+  if (const auto motion = modules_->actions.advance(local, trace_.plan.path, robot)) {
+    move(*motion, request);
+    deposit(local, frame, motion->target, motion->path_index, request);
+    state_ = RampState::kAdvance;
+    return;
+  }
+  deposit(local, frame, robot, 0, request);
+  if (!request.depositions.empty()) {
+    state_ = RampState::kBuild;
+    return;
+  }
+  state_ = RampState::kRetreat;
+  deposited_since_blocked_ = false;
+  idle_retreat_moves_ = 0;
+  retreat_step(local, frame, request);
+}
+
+void RampBuilder::retreat_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame,
+                               bus::ActionRequest& request) {
+  const Position robot{frame.x_m, frame.y_m};
+  if (!plan_path(local)) {
+    ++idle_retreat_moves_;
+    return;
+  }
+  const auto& path = trace_.plan.path;
+  deposit(local, frame, robot, 0, request);
+  if (!request.depositions.empty()) {
+    deposited_since_blocked_ = true;
+    idle_retreat_moves_ = 0;
+    return;
+  }
+  // Advance again only once something changed (or after a long idle retreat): advancing onto the cell just left
+  // without building would only block again.
+  if (deposited_since_blocked_ || idle_retreat_moves_ >= modules_->max_idle_retreat_moves) {
+    if (const auto motion = modules_->actions.advance(local, path, robot)) {
+      move(*motion, request);
+      deposit(local, frame, motion->target, motion->path_index, request);
+      state_ = RampState::kAdvance;
+      return;
+    }
+    deposited_since_blocked_ = false;
+  }
+  // Step back the way the robot came (towards the local origin, or the oldest navigable cell of its trajectory
+  // in the window when it stands on the origin) and fill what comes into reach: the gap where it stood.
+  ++idle_retreat_moves_;
+  std::optional<CellIndex> anchor;
+  if (local.origin && *local.origin != local.robot) anchor = local.origin;
+  if (!anchor) anchor = oldest_navigable_trajectory_cell(local);
+  if (!anchor) return;
+  const auto route = modules_->router.plan(local.gap, local.navigable, local.robot, *anchor);
+  if (!route.found) return;
+  const auto motion = modules_->actions.advance(local, route.path, robot);
+  if (!motion) return;
+  move(*motion, request);
+  deposit(local, frame, motion->target, 0, request);
+  if (!request.depositions.empty()) {
+    deposited_since_blocked_ = true;
+    idle_retreat_moves_ = 0;
+  }
+}
+
+std::optional<CellIndex> RampBuilder::oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const {
+  for (const CellIndex global : modules_->map.trajectory()) {
+    const CellIndex p = local.to_local(global);
+    if (local.contains(p) && p != local.robot && local.navigable(p.row, p.col) != 0) return p;
+  }
+  return std::nullopt;
+}
+
+void RampBuilder::return_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame,
+                              bus::ActionRequest& request) {
+  const Position robot{frame.x_m, frame.y_m};
+  const bus::Admission& a = context_.admission;
+  const Position base{a.base_x_m, a.base_y_m};
+  const double radius = a.base_radius_m - kBaseMarginM;
+  if (distance(robot, base) <= radius) {
+    request.refill = trace_.refill = true;
+    state_ = RampState::kAdvance;
+    return;
+  }
+  // Where to go: the navigable cell within the base radius nearest the robot; else the oldest navigable cell of
+  // the trajectory in the window (the way the robot came from the base); else the navigable cell nearest the base.
+  std::optional<CellIndex> goal;
+  double best = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      if (local.navigable(r, c) == 0) continue;
+      const Position centre = local.center({r, c});
+      if (distance(centre, base) > radius) continue;
+      const double d = distance(centre, robot);
+      if (d < best) best = d, goal = CellIndex{r, c};
+    }
+  if (!goal) goal = oldest_navigable_trajectory_cell(local);
+  if (!goal) {
+    best = distance(robot, base);
+    for (int r = 0; r < local.rows(); ++r)
+      for (int c = 0; c < local.cols(); ++c) {
+        const double d = distance(local.center({r, c}), base);
+        if (local.navigable(r, c) != 0 && d < best) best = d, goal = CellIndex{r, c};
+      }
+  }
+  if (!goal) return;
+  trace_.plan = modules_->router.plan(local.gap, local.navigable, local.robot, *goal);
+  trace_.planned = true;
+  if (!trace_.plan.found) return;
+  if (const auto motion = modules_->actions.advance(local, trace_.plan.path, robot)) {
+    move(*motion, request);
+    if (distance(motion->target, base) <= radius) {
+      request.refill = trace_.refill = true;
+      state_ = RampState::kAdvance;
+    }
+  }
+}
+
+}  // namespace marsala::agent::reactive

@@ -1,0 +1,120 @@
+#pragma once
+// "ramp_builder": the reactive state machine that builds a navigable ramp to the robot's target (paper §IV,
+// Fig. 2) with the deliberative and executive modules of paper Fig. 1.
+//
+// Each frame: the mapping system takes the frame's tiles; the local map synthesizer builds the augmented local
+// map; the navigable path planner plans a deposition path to the local goal; the action manager moves along it
+// as far as is navigable now; the deposition manager fills the path's MARS gap within reach.
+//
+// States and transitions (checked in this order on every frame):
+//   any            --run_over frame---------------------------------------------> kDone
+//   kWaitAdmission --on_admission()---------------------------------------------> kSurvey
+//   kSurvey        --first frame: the map is built, then as kAdvance on the same frame
+//   any            --robot on the local goal's cell (the target's cell, or the nearest cell to a target off
+//                    the grid)----------------------------------------------------> kAtGoal   (empty requests)
+//   kAtGoal        --robot off it--------------------------------------------> kAdvance
+//   any other      --material below one cube---------------------------------> kReturnToBase
+//   kReturnToBase  --retrace the trajectory through navigable cells; at the base: refill --> kAdvance
+//   kAdvance/kBuild: a motion along the path is possible -> move (and deposit ahead)       --> kAdvance
+//                    blocked, but depositions within reach                                   --> kBuild
+//                    blocked and nothing to deposit (the gap left is under the robot)        --> kRetreat
+//   kRetreat:        depositions within reach -> deposit in place                            --> kRetreat
+//                    after depositing (or after many idle retreat moves) and a motion along
+//                    the path is possible                                                    --> kAdvance
+//                    else step back the way it came (towards the local origin) and fill
+//                    what comes into reach                                                   --> kRetreat
+// Building thus runs from the top of the ramp down to its toe (the robot backs off to fill where it stood),
+// then the robot climbs, filling ahead of itself, until it reaches the target.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "agent/agent_context.hpp"
+#include "agent/deliberative/goal_synthesizer.hpp"
+#include "agent/deliberative/local_map_synthesizer.hpp"
+#include "agent/deliberative/navigable_path_planner.hpp"
+#include "agent/executive/action_manager.hpp"
+#include "agent/executive/deposition_manager.hpp"
+#include "agent/executive/mapping_system.hpp"
+#include "agent/reactive/behaviour.hpp"
+
+namespace marsala::agent::reactive {
+
+/// States of the ramp builder.
+enum class RampState : std::uint8_t {
+  kWaitAdmission = 0,
+  kSurvey = 1,
+  kAdvance = 2,
+  kBuild = 3,
+  kRetreat = 4,
+  kReturnToBase = 5,
+  kAtGoal = 6,
+  kDone = 7,
+};
+/// "wait_admission", "survey", "advance", "build", "retreat", "return_to_base", "at_goal", "done".
+std::string to_string(RampState state);
+/// The inverse of to_string; throws InvalidArgument listing the valid names.
+RampState ramp_state_from_string(const std::string& name);
+
+/// Options of the ramp builder.
+struct RampBuilderOptions {
+  std::string goal_synthesizer = "fixed_target";       ///< by name (deliberative::make_goal_synthesizer)
+  std::optional<deliberative::PlannerParams> planner;  ///< default: default_planner_params(body, cell size)
+};
+
+/// What the last decision saw and chose (for tests, logs and measurements).
+struct DecisionTrace {
+  RampState before = RampState::kWaitAdmission;
+  RampState after = RampState::kWaitAdmission;
+  CellIndex window_offset;                  ///< world index of the local map's top-left cell
+  CellIndex local_goal;                     ///< local index
+  std::optional<CellIndex> local_origin;    ///< local index
+  long long navigable_cells = 0;            ///< cells navigable from the robot in the local map [count]
+  bool planned = false;                     ///< a deposition path was planned
+  deliberative::PlannerResult plan;         ///< path in local indices
+  std::optional<executive::Motion> motion;  ///< local indices
+  executive::DepositionPlan deposition;
+  bool refill = false;
+};
+
+/// Builds a navigable ramp to its target; see the transition table above.
+class RampBuilder final : public Behaviour {
+ public:
+  /// Throws InvalidArgument for an unknown goal synthesizer or an invalid body.
+  explicit RampBuilder(const AgentContext& context, RampBuilderOptions options = {});
+  ~RampBuilder() override;
+
+  std::string name() const override { return "ramp_builder"; }
+  std::string state_name() const override { return to_string(state_); }
+  void on_admission(const bus::Admission& admission) override;
+  bus::ActionRequest decide(const bus::SensorFrame& frame) override;
+
+  RampState state() const { return state_; }
+  const DecisionTrace& last_trace() const { return trace_; }
+  /// The agent's own map (valid after admission).
+  const executive::MappingSystem& map() const;
+
+ private:
+  struct Modules;
+  void build_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, bus::ActionRequest& request);
+  void retreat_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, bus::ActionRequest& request);
+  void return_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, bus::ActionRequest& request);
+  bool plan_path(const deliberative::LocalMap& local);
+  std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
+  void deposit(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position at, std::size_t from,
+               bus::ActionRequest& request);
+  void move(const executive::Motion& motion, bus::ActionRequest& request);
+
+  AgentContext context_;
+  RampBuilderOptions options_;
+  std::unique_ptr<deliberative::GoalSynthesizer> goal_;
+  std::unique_ptr<Modules> modules_;  // made on admission, when the grid is known
+  RampState state_ = RampState::kWaitAdmission;
+  DecisionTrace trace_;
+  bool deposited_since_blocked_ = false;
+  int idle_retreat_moves_ = 0;
+};
+
+}  // namespace marsala::agent::reactive

@@ -1,0 +1,169 @@
+#include "agent/runtime/agent_runtime.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <random>
+
+#include "common/error.hpp"
+
+namespace marsala::agent::runtime {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+/// The longest a wait lasts before the stop flag is looked at again.
+constexpr std::chrono::milliseconds kStopPoll{100};
+
+}  // namespace
+
+std::string to_string(RunOutcome outcome) {
+  switch (outcome) {
+    case RunOutcome::kRunOver: return "run_over";
+    case RunOutcome::kStopped: return "stopped";
+    case RunOutcome::kRefused: return "refused";
+    case RunOutcome::kAdmitTimeout: return "admit_timeout";
+    case RunOutcome::kWorldTimeout: return "world_timeout";
+  }
+  return "unknown";
+}
+
+std::uint64_t random_session() {
+  std::random_device device;
+  std::uint64_t session = 0;
+  while (session == 0) session = (static_cast<std::uint64_t>(device()) << 32) ^ device();
+  return session;
+}
+
+AgentRuntime::AgentRuntime(bus::Participant& participant, RuntimeConfig config)
+    : participant_(participant), config_(std::move(config)) {
+  if (config_.agent_id == 0) throw InvalidArgument("agent id must be >= 1");
+  if (config_.hello_period.count() <= 0 || config_.admit_timeout.count() <= 0 || config_.world_timeout.count() <= 0)
+    throw InvalidArgument("agent " + std::to_string(config_.agent_id) +
+                          ": hello period and timeouts must be positive");
+  if (config_.session == 0) config_.session = random_session();
+  if (config_.name.empty()) config_.name = "agent-" + std::to_string(config_.agent_id);
+  AgentContext context;
+  context.agent_id = config_.agent_id;
+  context.session = config_.session;
+  context.body = config_.body;
+  context.neighbour_keep_out_m = config_.neighbour_keep_out_m > 0.0
+                                     ? config_.neighbour_keep_out_m
+                                     : neighbour_keep_out_m(config_.body.delta_m, config_.body.max_step_m);
+  context.seed = config_.seed;
+  behaviour_ = reactive::make_behaviour(config_.behaviour, context);
+}
+
+AgentRuntime::~AgentRuntime() = default;
+
+RunResult AgentRuntime::run(const std::atomic<bool>& stop) {
+  RunResult result;
+  bus::Admission admission;
+  if (admit(stop, result, admission)) lockstep(stop, admission, result);
+  result.final_state = behaviour_->state_name();
+  return result;
+}
+
+bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, bus::Admission& admission) {
+  auto signal = std::make_shared<bus::Signal>();
+  auto hellos = participant_.create_writer<bus::AgentHello>({"", nullptr, bus::Durability::kVolatile, 64});
+  auto admissions = participant_.create_reader<bus::Admission>({"", signal, bus::Durability::kVolatile, 64});
+  bus::AgentHello hello;
+  hello.agent_id = config_.agent_id;
+  hello.session = config_.session;
+  hello.name = config_.name;
+  hello.behaviour = config_.behaviour;
+  hello.body = config_.body;
+  spdlog::info("agent {} ({}, {}): saying hello, session {:016x}", config_.agent_id, config_.name,
+               config_.behaviour, config_.session);
+
+  const Clock::time_point deadline = Clock::now() + config_.admit_timeout;
+  Clock::time_point next_hello = Clock::now();
+  while (!stop.load()) {
+    const Clock::time_point now = Clock::now();
+    if (now >= deadline) {
+      result.outcome = RunOutcome::kAdmitTimeout;
+      result.message = fmt::format("not admitted within {} s (is marsala-world running on this DDS domain?)",
+                                   config_.admit_timeout.count() / 1000.0);
+      return false;
+    }
+    if (now >= next_hello) {
+      hellos->write(hello);
+      next_hello = now + config_.hello_period;
+    }
+    signal->wait_until(std::min({next_hello, deadline, now + kStopPoll}));
+    for (const bus::Admission& a : admissions->take()) {
+      if (a.agent_id != config_.agent_id || a.session != config_.session) continue;  // someone else's answer
+      if (!a.accepted) {
+        result.outcome = RunOutcome::kRefused;
+        result.message = "refused by the world: " + a.reason;
+        return false;
+      }
+      admission = a;
+      result.run_id = a.run_id;
+      behaviour_->on_admission(a);
+      spdlog::info("agent {}: admitted to run '{}' ({} x {} cells of {} m)", config_.agent_id, a.run_id, a.rows,
+                   a.cols, a.cell_size_m);
+      return true;
+    }
+  }
+  result.outcome = RunOutcome::kStopped;
+  result.message = "stopped before admission";
+  return false;
+}
+
+void AgentRuntime::lockstep(const std::atomic<bool>& stop, const bus::Admission& admission, RunResult& result) {
+  const std::string partition = bus::partition_for(admission.run_id, config_.agent_id);
+  auto signal = std::make_shared<bus::Signal>();
+  auto frames = participant_.create_reader<bus::SensorFrame>({partition, signal, bus::Durability::kVolatile, 64});
+  auto requests = participant_.create_writer<bus::ActionRequest>({partition, nullptr, bus::Durability::kVolatile, 64});
+  bool answered_any = false;
+  std::uint64_t last_answered = 0;
+  Clock::time_point deadline = Clock::now() + config_.world_timeout;
+  while (!stop.load()) {
+    const Clock::time_point now = Clock::now();
+    if (now >= deadline) {
+      result.outcome = RunOutcome::kWorldTimeout;
+      result.message = fmt::format("no sensor frame for {} s (last step {})", config_.world_timeout.count() / 1000.0,
+                                   result.last_step);
+      return;
+    }
+    signal->wait_until(std::min(deadline, now + kStopPoll));
+    for (const bus::SensorFrame& frame : frames->take()) {
+      if (frame.agent_id != config_.agent_id) {
+        spdlog::warn("agent {}: ignoring a frame addressed to agent {}", config_.agent_id, frame.agent_id);
+        continue;
+      }
+      ++result.frames;
+      result.last_step = frame.step;
+      deadline = Clock::now() + config_.world_timeout;
+      if (frame.last_result == bus::ActionResult::kRejected) {
+        ++result.rejected;
+        spdlog::warn("agent {}: request before step {} rejected: {}", config_.agent_id, frame.step,
+                     frame.last_reason);
+      }
+      if (frame.run_over) {
+        behaviour_->decide(frame);
+        result.outcome = RunOutcome::kRunOver;
+        result.message = "run over at step " + std::to_string(frame.step);
+        spdlog::info("agent {}: {} ({} requests, {} rejected)", config_.agent_id, result.message, result.requests,
+                     result.rejected);
+        return;
+      }
+      if (answered_any && frame.step <= last_answered) {
+        spdlog::warn("agent {}: ignoring a repeated frame for step {}", config_.agent_id, frame.step);
+        continue;
+      }
+      const std::string before = behaviour_->state_name();
+      requests->write(behaviour_->decide(frame));
+      ++result.requests;
+      answered_any = true;
+      last_answered = frame.step;
+      if (behaviour_->state_name() != before)
+        spdlog::debug("agent {}: step {}: {} -> {}", config_.agent_id, frame.step, before, behaviour_->state_name());
+    }
+  }
+  result.outcome = RunOutcome::kStopped;
+  result.message = "stopped at step " + std::to_string(result.last_step);
+}
+
+}  // namespace marsala::agent::runtime

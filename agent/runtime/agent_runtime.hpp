@@ -1,0 +1,82 @@
+#pragma once
+// The agent's edge (ARCHITECTURE.md): the bus participant, admission, and one ActionRequest per SensorFrame.
+//
+//   hello every hello_period on the default partition  ──▶  world
+//   admission (this id and session)                    ◀──  world      (refused: kRefused; none: kAdmitTimeout)
+//   frames on partition_for(run, id)                   ◀──  world      (none for world_timeout -> kWorldTimeout)
+//   one request per frame, same step                   ──▶  world      (run_over frame -> kRunOver)
+//
+// Single-threaded: the bus backends queue samples on their own threads and wake this one through a Signal; the
+// behaviour's decide() runs here, never in a backend callback.
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "agent/reactive/behaviour.hpp"
+#include "common/bus/bus.hpp"
+#include "common/bus/messages.hpp"
+
+namespace marsala::agent::runtime {
+
+/// Who the agent is and how patient it is.
+struct RuntimeConfig {
+  std::uint32_t agent_id = 0;                       ///< >= 1: the scenario slot
+  std::string name;                                 ///< human-readable, e.g. "husky-3"
+  std::string behaviour = "ramp_builder";           ///< reactive behaviour by name
+  bus::BodyParams body;                             ///< declared in the hello; the world checks it
+  std::uint64_t session = 0;                        ///< 0: a random one (random_session())
+  double neighbour_keep_out_m = 0.0;                ///< 0: delta/2 + max_step of this body [m]
+  std::uint64_t seed = 1;                           ///< scenario seed
+  std::chrono::milliseconds hello_period{200};      ///< between hellos until admitted
+  std::chrono::milliseconds admit_timeout{60000};   ///< give up when not admitted by then
+  std::chrono::milliseconds world_timeout{60000};   ///< give up when no frame comes for this long
+};
+
+/// Why run() returned.
+enum class RunOutcome { kRunOver, kStopped, kRefused, kAdmitTimeout, kWorldTimeout };
+/// "run_over", "stopped", "refused", "admit_timeout", "world_timeout".
+std::string to_string(RunOutcome outcome);
+
+/// What happened in a run.
+struct RunResult {
+  RunOutcome outcome = RunOutcome::kStopped;
+  std::string message;            ///< one line for the operator
+  std::string run_id;             ///< from the admission
+  std::uint64_t frames = 0;       ///< frames received [count]
+  std::uint64_t requests = 0;     ///< requests sent [count]
+  std::uint64_t rejected = 0;     ///< frames reporting the previous request rejected [count]
+  std::uint64_t last_step = 0;    ///< step of the last frame
+  std::string final_state;        ///< the behaviour's state at the end
+};
+
+/// A non-zero random session id (std::random_device): tells a restarted agent process apart.
+std::uint64_t random_session();
+
+/// One agent process: admission, then the lockstep loop.
+class AgentRuntime {
+ public:
+  /// Makes the behaviour at once, so an unknown name fails before any traffic (InvalidArgument listing the valid
+  /// names). Throws InvalidArgument when agent_id is 0 or a period or timeout is not positive.
+  AgentRuntime(bus::Participant& participant, RuntimeConfig config);
+  ~AgentRuntime();
+
+  /// Runs until the run is over, the world refuses, a timeout passes, or `stop` becomes true (checked at least
+  /// every 100 ms). Throws when the behaviour meets a broken contract (a malformed frame or admission) or the
+  /// bus fails.
+  RunResult run(const std::atomic<bool>& stop);
+
+  const RuntimeConfig& config() const { return config_; }
+
+ private:
+  bool admit(const std::atomic<bool>& stop, RunResult& result, bus::Admission& admission);
+  void lockstep(const std::atomic<bool>& stop, const bus::Admission& admission, RunResult& result);
+
+  bus::Participant& participant_;
+  RuntimeConfig config_;
+  std::unique_ptr<reactive::Behaviour> behaviour_;
+};
+
+}  // namespace marsala::agent::runtime

@@ -1,0 +1,91 @@
+#include "agent/executive/action_manager.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "agent_test_support.hpp"
+#include "common/error.hpp"
+
+namespace marsala::agent::executive {
+namespace {
+
+const grid::GridGeometry kGrid{15, 15, 0.0, 0.0, 0.1};
+const NavigabilityParams kNav{0.5, 0.4, 0.05};  // ball radius 2 cells
+
+deliberative::LocalMap flat_map(CellIndex robot) {
+  return test::make_local_map(grid::Heightmap(kGrid, 0.0), grid::Heightmap(kGrid, 0.0), kNav, robot, std::nullopt);
+}
+
+std::vector<CellIndex> line(CellIndex from, int d_row, int d_col, int n) {
+  std::vector<CellIndex> path;
+  for (int i = 0; i < n; ++i) path.push_back({from.row + i * d_row, from.col + i * d_col});
+  return path;
+}
+
+TEST(ActionManager, AdvancesToTheFarthestPathCellWithinTheStep) {
+  const ActionManager am(0.2);
+  const deliberative::LocalMap map = flat_map({7, 3});
+  const Position robot = kGrid.cell_center({7, 3});
+  // Straight east: 0.1 m per cell, 0.2 m reaches path[2] exactly.
+  auto m = am.advance(map, line({7, 3}, 0, 1, 8), robot);
+  ASSERT_TRUE(m.has_value());
+  EXPECT_EQ(m->cell, (CellIndex{7, 5}));
+  EXPECT_EQ(m->path_index, 2u);
+  EXPECT_NEAR(m->distance_m, 0.2, 1e-12);
+  EXPECT_EQ(m->target.x, kGrid.cell_center({7, 5}).x);  // the cell centre
+  EXPECT_EQ(m->target.y, kGrid.cell_center({7, 5}).y);
+  // Diagonal: path[1] is 0.141 m away, path[2] 0.283 m.
+  m = am.advance(map, line({7, 3}, -1, 1, 5), robot);
+  ASSERT_TRUE(m.has_value());
+  EXPECT_EQ(m->path_index, 1u);
+  // A longer step reaches further.
+  m = ActionManager(0.45).advance(map, line({7, 3}, 0, 1, 8), robot);
+  EXPECT_EQ(m->path_index, 4u);
+}
+
+TEST(ActionManager, StopsBeforeTheFirstCellThatIsNotNavigable) {
+  grid::Heightmap h(kGrid, 0.0);
+  h(7, 7) = 0.5;  // a post: cells within 2 cells of it are not occupiable, (7, 5) among them
+  const deliberative::LocalMap map = test::make_local_map(h, grid::Heightmap(kGrid, 0.0), kNav, {7, 3}, std::nullopt);
+  ASSERT_EQ(map.navigable(7, 4), 1);
+  ASSERT_EQ(map.navigable(7, 5), 0);
+  const ActionManager am(0.45);
+  const auto m = am.advance(map, line({7, 3}, 0, 1, 10), kGrid.cell_center({7, 3}));
+  ASSERT_TRUE(m.has_value());
+  EXPECT_EQ(m->cell, (CellIndex{7, 4}));
+  // Blocked at once: no motion.
+  EXPECT_FALSE(am.advance(map, line({7, 4}, 0, 1, 6), kGrid.cell_center({7, 4})).has_value());
+  // A one-cell path (the robot is at its goal): no motion.
+  EXPECT_FALSE(am.advance(map, {{7, 3}}, kGrid.cell_center({7, 3})).has_value());
+}
+
+TEST(ActionManager, CentresAnOffCentreRobotWhenTheNextCellIsOutOfRange) {
+  const deliberative::LocalMap map = flat_map({7, 3});
+  const Position off{kGrid.cell_center({7, 3}).x - 0.04, kGrid.cell_center({7, 3}).y};
+  // Step 0.1 m: path[1] lies 0.14 m away, the robot's own centre 0.04 m.
+  const auto m = ActionManager(0.1).advance(map, line({7, 3}, 0, 1, 5), off);
+  ASSERT_TRUE(m.has_value());
+  EXPECT_EQ(m->cell, (CellIndex{7, 3}));
+  EXPECT_EQ(m->path_index, 0u);
+  EXPECT_NEAR(m->distance_m, 0.04, 1e-12);
+  // On the centre already, the same step reaches path[1].
+  EXPECT_EQ(ActionManager(0.1).advance(map, line({7, 3}, 0, 1, 5), kGrid.cell_center({7, 3}))->path_index, 1u);
+}
+
+TEST(ActionManager, LeavesACellItCannotOccupyThroughOccupiableCells) {
+  grid::Heightmap h(kGrid, 0.0);
+  h(5, 3) = 0.3;  // within the robot's ball: its own cell (7, 3) is not occupiable
+  const deliberative::LocalMap map = test::make_local_map(h, grid::Heightmap(kGrid, 0.0), kNav, {7, 3}, std::nullopt);
+  ASSERT_EQ(map.occupiable(7, 3), 0);
+  ASSERT_EQ(map.navigable.cast<int>().sum(), 0);
+  // South, (8, 3) and (9, 3) are occupiable (their balls miss (5, 3)); (9, 3) is the farthest within 0.2 m.
+  const auto m = ActionManager(0.2).advance(map, line({7, 3}, 1, 0, 5), kGrid.cell_center({7, 3}));
+  ASSERT_TRUE(m.has_value());
+  EXPECT_EQ(m->cell, (CellIndex{9, 3}));
+  EXPECT_THROW(ActionManager(0.0), InvalidArgument);
+  EXPECT_THROW(ActionManager(std::nan("")), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace marsala::agent::executive

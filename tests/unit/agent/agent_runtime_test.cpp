@@ -1,0 +1,248 @@
+// The agent's runtime edge over the in-process bus, against a scripted world on a thread of the test.
+
+#include "agent/runtime/agent_runtime.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <future>
+#include <thread>
+
+#include "agent_test_support.hpp"
+#include "common/error.hpp"
+
+namespace marsala::agent::runtime {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+RuntimeConfig config(std::uint32_t id, const std::string& behaviour = "idle") {
+  RuntimeConfig c;
+  c.agent_id = id;
+  c.behaviour = behaviour;
+  c.body = test::husky();
+  c.hello_period = 20ms;
+  c.admit_timeout = 5s;
+  c.world_timeout = 5s;
+  return c;
+}
+
+bus::Admission admission_for(const bus::AgentHello& hello, const grid::Heightmap& h) {
+  bus::Admission a;
+  a.agent_id = hello.agent_id;
+  a.session = hello.session;
+  a.accepted = true;
+  a.run_id = "rt";
+  a.rows = h.rows();
+  a.cols = h.cols();
+  a.cell_size_m = h.cell_size_m();
+  a.tile_size = 16;
+  a.target_x_m = 2.55;
+  a.target_y_m = 1.05;
+  a.base_radius_m = 0.5;
+  return a;
+}
+
+/// A scripted world: waits for a hello from `id`, answers `answer(hello)`, then, if admitted, runs `steps` lockstep
+/// steps (frame, wait for the request) and a run_over frame. Returns the requests it received.
+struct ScriptedWorld {
+  bus::Participant& p;
+  std::uint32_t id;
+  std::uint64_t hellos_seen = 0;
+
+  bus::AgentHello wait_hello(bus::Reader<bus::AgentHello>& hellos, bus::Signal& signal) {
+    const auto deadline = Clock::now() + 5s;
+    while (Clock::now() < deadline) {
+      signal.wait_for(50ms);
+      for (const auto& h : hellos.take()) {
+        ++hellos_seen;
+        if (h.agent_id == id) return h;
+      }
+    }
+    throw Error("no hello from agent " + std::to_string(id));
+  }
+
+  std::vector<bus::ActionRequest> run(const std::function<bus::Admission(const bus::AgentHello&)>& answer,
+                                      int steps, bool send_frames = true) {
+    auto hello_signal = std::make_shared<bus::Signal>();
+    auto hellos = p.create_reader<bus::AgentHello>({"", hello_signal});
+    auto admissions = p.create_writer<bus::Admission>();
+    const bus::AgentHello hello = wait_hello(*hellos, *hello_signal);
+    const bus::Admission a = answer(hello);
+    const std::string partition = bus::partition_for(a.run_id, id);
+    auto signal = std::make_shared<bus::Signal>();
+    auto frames = p.create_writer<bus::SensorFrame>({partition, nullptr});
+    auto requests = p.create_reader<bus::ActionRequest>({partition, signal});
+    admissions->write(a);
+    std::vector<bus::ActionRequest> got;
+    if (!a.accepted || !send_frames) return got;
+    // Wait until the agent's endpoints exist (they are made on admission).
+    for (auto deadline = Clock::now() + 5s; frames->matched_readers() == 0 && Clock::now() < deadline;)
+      std::this_thread::sleep_for(1ms);
+    const grid::Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+    for (int step = 0; step <= steps; ++step) {
+      bus::SensorFrame f;
+      f.agent_id = id;
+      f.step = static_cast<std::uint64_t>(step);
+      f.x_m = 0.55 + 0.0;
+      f.y_m = 1.05;
+      f.material_m3 = 1.0;
+      f.run_over = step == steps;
+      if (step == 0)
+        for (int tr = 0; tr < 2; ++tr)
+          for (int tc = 0; tc < 3; ++tc) f.tiles.push_back(test::cut_tile(h, 16, tr, tc));
+      if (step == 2) {
+        f.last_result = bus::ActionResult::kRejected;
+        f.last_reason = "scripted rejection";
+      }
+      frames->write(f);
+      if (f.run_over) break;
+      const auto deadline = Clock::now() + 5s;
+      bool answered = false;
+      while (!answered && Clock::now() < deadline) {
+        signal->wait_for(50ms);
+        for (auto& q : requests->take()) {
+          answered = answered || q.step == f.step;
+          got.push_back(std::move(q));
+        }
+      }
+    }
+    return got;
+  }
+};
+
+TEST(AgentRuntime, HelloAdmissionLockstepAndRunOver) {
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, 101});
+  AgentRuntime agent(*participant, config(4, "ramp_builder"));
+  std::atomic<bool> stop{false};
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 101});
+  ScriptedWorld world{*world_participant, 4};
+  const grid::Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+  const auto requests = world.run([&](const bus::AgentHello& hello) { return admission_for(hello, h); }, 5);
+  const RunResult r = running.get();
+  EXPECT_EQ(r.outcome, RunOutcome::kRunOver) << r.message;
+  EXPECT_EQ(r.run_id, "rt");
+  EXPECT_EQ(r.frames, 6u);
+  EXPECT_EQ(r.requests, 5u);
+  EXPECT_EQ(r.rejected, 1u);
+  EXPECT_EQ(r.last_step, 5u);
+  EXPECT_EQ(r.final_state, "done");
+  ASSERT_EQ(requests.size(), 5u);
+  for (std::size_t i = 0; i < requests.size(); ++i) {
+    EXPECT_EQ(requests[i].step, i);
+    EXPECT_EQ(requests[i].agent_id, 4u);
+    EXPECT_EQ(requests[i].session, agent.config().session);
+    EXPECT_TRUE(requests[i].move);  // flat ground, target 2 m east: the ramp builder drives there
+  }
+  EXPECT_NE(agent.config().session, 0u);
+  EXPECT_EQ(agent.config().name, "agent-4");
+}
+
+TEST(AgentRuntime, RefusalEndsTheRunWithTheWorldsReason) {
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, 102});
+  AgentRuntime agent(*participant, config(2));
+  std::atomic<bool> stop{false};
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 102});
+  ScriptedWorld world{*world_participant, 2};
+  world.run(
+      [](const bus::AgentHello& hello) {
+        bus::Admission a;
+        a.agent_id = hello.agent_id;
+        a.session = hello.session;
+        a.accepted = false;
+        a.reason = "body differs from slot 2";
+        return a;
+      },
+      0);
+  const RunResult r = running.get();
+  EXPECT_EQ(r.outcome, RunOutcome::kRefused);
+  EXPECT_NE(r.message.find("body differs from slot 2"), std::string::npos) << r.message;
+  EXPECT_EQ(r.final_state, "wait_admission");
+}
+
+TEST(AgentRuntime, RepeatsHellosAndIgnoresOtherSessions) {
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, 103});
+  RuntimeConfig c = config(6);
+  c.session = 1234;
+  c.admit_timeout = 400ms;
+  AgentRuntime agent(*participant, c);
+  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 103});
+  auto signal = std::make_shared<bus::Signal>();
+  auto hellos = world_participant->create_reader<bus::AgentHello>({"", signal});
+  auto admissions = world_participant->create_writer<bus::Admission>();
+  std::atomic<bool> stop{false};
+  const auto t0 = Clock::now();
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  std::vector<bus::AgentHello> got;
+  while (Clock::now() - t0 < 300ms) {
+    signal->wait_for(20ms);
+    for (auto& h : hellos->take()) {
+      got.push_back(h);
+      bus::Admission a;  // accepted, but for another session of agent 6
+      a.agent_id = 6;
+      a.session = 999;
+      a.accepted = true;
+      a.run_id = "other";
+      admissions->write(a);
+    }
+  }
+  const RunResult r = running.get();
+  const double waited_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  EXPECT_EQ(r.outcome, RunOutcome::kAdmitTimeout);
+  EXPECT_GE(waited_s, 0.39);
+  EXPECT_GE(got.size(), 5u);  // every 20 ms for 300 ms (loosely: the machine is shared)
+  ASSERT_FALSE(got.empty());
+  EXPECT_EQ(got[0].agent_id, 6u);
+  EXPECT_EQ(got[0].session, 1234u);
+  EXPECT_EQ(got[0].behaviour, "idle");
+  EXPECT_EQ(got[0].body.reach_m, 1.5);
+}
+
+TEST(AgentRuntime, WorldSilenceAfterAdmissionTimesOut) {
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, 104});
+  RuntimeConfig c = config(1);
+  c.world_timeout = 300ms;
+  AgentRuntime agent(*participant, c);
+  std::atomic<bool> stop{false};
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 104});
+  ScriptedWorld world{*world_participant, 1};
+  const grid::Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+  world.run([&](const bus::AgentHello& hello) { return admission_for(hello, h); }, 0, false);
+  const RunResult r = running.get();
+  EXPECT_EQ(r.outcome, RunOutcome::kWorldTimeout);
+  EXPECT_EQ(r.frames, 0u);
+}
+
+TEST(AgentRuntime, StopsWhenAsked) {
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, 105});
+  AgentRuntime agent(*participant, config(1));
+  std::atomic<bool> stop{false};
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  std::this_thread::sleep_for(50ms);
+  stop = true;
+  const auto t0 = Clock::now();
+  const RunResult r = running.get();
+  EXPECT_EQ(r.outcome, RunOutcome::kStopped);
+  EXPECT_LT(Clock::now() - t0, 1s);
+}
+
+TEST(AgentRuntime, RejectsBadConfigurationBeforeAnyTraffic) {
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, 106});
+  EXPECT_THROW(AgentRuntime(*participant, config(0)), InvalidArgument);
+  EXPECT_THROW(AgentRuntime(*participant, config(1, "dancer")), InvalidArgument);
+  RuntimeConfig c = config(1);
+  c.world_timeout = 0ms;
+  EXPECT_THROW(AgentRuntime(*participant, c), InvalidArgument);
+  EXPECT_EQ(to_string(RunOutcome::kAdmitTimeout), "admit_timeout");
+  EXPECT_NE(random_session(), 0u);
+  EXPECT_NE(random_session(), random_session());
+}
+
+}  // namespace
+}  // namespace marsala::agent::runtime

@@ -1,0 +1,71 @@
+#pragma once
+// Helpers for agent unit tests: an agent map that knows a whole terrain, tiles cut from a terrain, bodies.
+
+#include <algorithm>
+#include <optional>
+
+#include "agent/deliberative/local_map_synthesizer.hpp"
+#include "agent/executive/mapping_system.hpp"
+#include "common/bus/messages.hpp"
+#include "common/grid/heightmap.hpp"
+#include "common/processing/navigability_processor.hpp"
+
+namespace marsala::agent::test {
+
+/// The tile (tr, tc) of `h` cut in tile_size tiles, as the world sends it.
+inline bus::TerrainTile cut_tile(const grid::Heightmap& h, int tile_size, int tr, int tc) {
+  bus::TerrainTile t;
+  t.tile_row = tr;
+  t.tile_col = tc;
+  t.rows = std::min(tile_size, h.rows() - tr * tile_size);
+  t.cols = std::min(tile_size, h.cols() - tc * tile_size);
+  for (int r = 0; r < t.rows; ++r)
+    for (int c = 0; c < t.cols; ++c) t.heights.push_back(h(tr * tile_size + r, tc * tile_size + c));
+  return t;
+}
+
+/// An agent map that has been sent every tile of `h`.
+inline executive::MappingSystem full_map(const grid::Heightmap& h, int tile_size = 16) {
+  executive::MappingSystem map(h.geometry(), tile_size);
+  for (int tr = 0; tr * tile_size < h.rows(); ++tr)
+    for (int tc = 0; tc * tile_size < h.cols(); ++tc) map.integrate_tile(cut_tile(h, tile_size, tr, tc));
+  return map;
+}
+
+/// A Husky-like body: delta 1 m, eps 5 cm, 20 cm steps, 0.02 m^3 per step, 1.5 m reach, 5 cm cubes.
+inline bus::BodyParams husky(double kappa = 0.5) {
+  bus::BodyParams b;
+  b.kappa = kappa;
+  b.delta_m = 1.0;
+  b.eps_m = 0.05;
+  b.max_step_m = 0.2;
+  b.max_deposit_m3 = 0.02;
+  b.material_capacity_m3 = 10.0;
+  b.reach_m = 1.5;
+  b.sensing_range_m = 4.0;
+  b.proximity_range_m = 3.0;
+  b.cube_size_m = 0.05;
+  return b;
+}
+
+/// A local map with hand-made heights and gap (all known, placed at the world's origin), masks from the
+/// navigability processor.
+inline deliberative::LocalMap make_local_map(const grid::Heightmap& heights, const grid::Heightmap& gap,
+                                             NavigabilityParams nav, CellIndex robot,
+                                             std::optional<CellIndex> origin) {
+  deliberative::LocalMap m;
+  m.world = heights.geometry();
+  m.offset = {0, 0};
+  m.heights = heights;
+  m.known = grid::CellMask::Ones(heights.rows(), heights.cols());
+  m.blind = grid::CellMask::Zero(heights.rows(), heights.cols());
+  m.gap = gap;
+  m.occupiable = processing::NavigabilityProcessor(nav).occupiable(heights);
+  m.navigable = processing::NavigabilityProcessor::navigable_from(m.occupiable, robot);
+  m.robot = robot;
+  m.origin = origin;
+  m.goal = robot;
+  return m;
+}
+
+}  // namespace marsala::agent::test

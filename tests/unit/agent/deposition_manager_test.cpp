@@ -1,0 +1,195 @@
+#include "agent/executive/deposition_manager.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+#include <utility>
+
+#include "agent_test_support.hpp"
+#include "common/error.hpp"
+#include "common/processing/navigability_processor.hpp"
+
+namespace marsala::agent::executive {
+namespace {
+
+using deliberative::LocalMap;
+
+constexpr double kCs = 0.1;
+constexpr double kQ = 0.0125;  // cube 0.05 m on 0.1 m cells: 0.05^3 / 0.01
+
+LocalMap make_map(const grid::Heightmap& heights, const grid::Heightmap& gap, NavigabilityParams nav, CellIndex robot,
+                  std::optional<CellIndex> origin) {
+  return test::make_local_map(heights, gap, nav, robot, origin);
+}
+
+DepositionParams params(double delta_m = 0.4, double max_deposit_m3 = 0.02) {
+  DepositionParams p;
+  p.navigability = {0.5, delta_m, 0.05};
+  p.reach_m = 1.5;
+  p.max_deposit_m3 = max_deposit_m3;
+  p.cube_layer_m = kQ;
+  p.max_height_m = 1.0;
+  p.neighbour_keep_out_m = 0.7;
+  p.neighbour_step_m = 0.2;
+  return p;
+}
+
+std::vector<CellIndex> row_path(int row, int from_col, int to_col) {
+  std::vector<CellIndex> path;
+  for (int c = from_col; from_col <= to_col ? c <= to_col : c >= to_col; c += from_col <= to_col ? 1 : -1)
+    path.push_back({row, c});
+  return path;
+}
+
+double dist(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+const grid::GridGeometry kGrid{21, 31, 0.0, 0.0, kCs};
+
+TEST(DepositionManager, RoundsDownToWholeCubeLayersAndCapsOneMetre) {
+  grid::Heightmap gap(kGrid, 0.0);
+  gap(10, 20) = 2.8 * kQ;          // -> 2 layers: never above P (nearest would overshoot)
+  gap(10, 21) = 3.0 * kQ;          // an exact multiple -> 3 layers
+  gap(10, 22) = 0.999999 * kQ;     // below one layer -> nothing
+  gap(10, 23) = 2.5;               // -> capped at 1 m (80 layers)
+  const LocalMap map = make_map(grid::Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, {{10, 0}});
+  const DepositionManager dm(params(0.4, 1.0));  // budget large enough for all of them
+  const Position robot = kGrid.cell_center({10, 10});
+  const auto c = dm.candidates(map, row_path(10, 10, 25), robot, 10.0, {1, robot, {}});
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_EQ(c[0].cell, (CellIndex{10, 20}));
+  EXPECT_EQ(c[0].layers, 2);
+  EXPECT_EQ(c[0].height_m, 2 * kQ);
+  EXPECT_EQ(c[1].layers, 3);
+  EXPECT_EQ(c[2].cell, (CellIndex{10, 23}));
+  EXPECT_EQ(c[2].layers, 80);
+  EXPECT_DOUBLE_EQ(c[2].height_m, 1.0);
+}
+
+TEST(DepositionManager, RespectsReachBudgetAndNeverDepositsUnderTheRobot) {
+  const grid::Heightmap gap(kGrid, 0.3);  // 24 layers everywhere
+  const LocalMap map = make_map(grid::Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, {{10, 0}});
+  const DepositionManager dm(params(0.4, 0.02));
+  // The robot moves to (10, 12) this step: reach and "under the robot" count from there.
+  const Position robot = kGrid.cell_center({10, 12});
+  const auto plan = dm.plan(map, row_path(10, 10, 30), robot, 10.0, {1, kGrid.cell_center({10, 10}), {}});
+  ASSERT_FALSE(plan.depositions.empty());
+  double volume = 0.0;
+  for (const auto& d : plan.depositions) {
+    const double r = dist(kGrid.cell_center({d.row, d.col}), robot);
+    EXPECT_GT(r, 0.2);   // delta / 2
+    EXPECT_LE(r, 1.5);   // reach
+    const double n = d.height_m / kQ;
+    EXPECT_NEAR(n, std::round(n), 1e-9);
+    volume += d.height_m * kCs * kCs;
+  }
+  // The budget is filled to the last whole layer: 0.02 m^3 = 160 layers of 1.25e-4 m^3.
+  EXPECT_NEAR(volume, 0.02, 1e-12);
+  EXPECT_LE(volume, 0.02 + 1e-12);
+  EXPECT_NEAR(plan.volume_m3, volume, 1e-15);
+  // Path order: the ball of path cell (10, 10) first, from its centre out. Its centre is 0.2 m from the robot
+  // (under it); of the four cells at one cell's distance, row-major, (9, 10) comes first and lies 0.224 m away.
+  EXPECT_EQ(plan.depositions.front().row, 9);
+  EXPECT_EQ(plan.depositions.front().col, 10);
+
+  // Material on board binds when it is below the threshold; none on board, no deposition.
+  const auto little = dm.plan(map, row_path(10, 10, 30), robot, 0.005, {1, robot, {}});
+  double v = 0.0;
+  for (const auto& d : little.depositions) v += d.height_m * kCs * kCs;
+  EXPECT_NEAR(v, 0.005, 1e-12);
+  EXPECT_LE(v, 0.005 + 1e-12);
+  EXPECT_TRUE(dm.plan(map, row_path(10, 10, 30), robot, 0.0, {1, robot, {}}).depositions.empty());
+  EXPECT_TRUE(dm.plan(map, row_path(10, 10, 30), robot, 1e-4, {1, robot, {}}).depositions.empty());  // < a cube
+}
+
+TEST(DepositionManager, NeighboursKeepOutAndTerritoriesDoNotOverlap) {
+  const grid::Heightmap gap(kGrid, 0.3);
+  const LocalMap map = make_map(grid::Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, std::nullopt);
+  DepositionParams p = params(0.4, 10.0);
+  p.neighbour_keep_out_m = 0.25;
+  const DepositionManager dm(p);
+  const Position a = kGrid.cell_center({10, 10}), b = kGrid.cell_center({10, 16});  // 0.6 m apart
+  const auto path = row_path(10, 0, 30);
+  const auto of_a = dm.candidates(map, path, a, 100.0, {1, a, {{2, b.x, b.y, 0.0}}});
+  const auto of_b = dm.candidates(map, path, b, 100.0, {2, b, {{1, a.x, a.y, 0.0}}});
+  ASSERT_FALSE(of_a.empty());
+  ASSERT_FALSE(of_b.empty());
+  std::set<std::pair<int, int>> cells_a;
+  bool a_has_tie = false;
+  for (const auto& c : of_a) {
+    cells_a.insert({c.cell.row, c.cell.col});
+    EXPECT_GT(dist(map.center(c.cell), b), 0.25);  // keep-out around the neighbour
+    EXPECT_LE(c.cell.col, 13);                     // its territory: cells nearer (10, 10) in whole cells
+    a_has_tie = a_has_tie || c.cell.col == 13;     // col 13 is as near to both: the lower id takes it
+  }
+  EXPECT_TRUE(a_has_tie);
+  for (const auto& c : of_b) {
+    EXPECT_EQ(cells_a.count({c.cell.row, c.cell.col}), 0u) << c.cell.row << ", " << c.cell.col;
+    EXPECT_GT(dist(map.center(c.cell), a), 0.25);
+    EXPECT_GE(c.cell.col, 14);
+  }
+}
+
+/// A corridor along row 10 (rows 8..12 at 0 m) between 2 m walls; with delta 0.4 m only row 10 is occupiable.
+grid::Heightmap corridor() {
+  grid::Heightmap h(kGrid, 2.0);
+  for (int r = 8; r <= 12; ++r)
+    for (int c = 0; c < kGrid.cols; ++c) h(r, c) = 0.0;
+  return h;
+}
+
+TEST(DepositionManager, KeepsTheRobotsWayBack) {
+  const grid::Heightmap h = corridor();
+  grid::Heightmap gap(kGrid, 0.0);
+  for (int c = 0; c < kGrid.cols; ++c) gap(10, c) = 0.3;
+  // The robot at (10, 20) plans west, through its own way back to the origin (10, 1).
+  const LocalMap map = make_map(h, gap, params().navigability, {10, 20}, {{10, 1}});
+  ASSERT_EQ(map.navigable(10, 1), 1);
+  const DepositionManager dm(params());
+  const Position robot = kGrid.cell_center({10, 20});
+  const auto path = row_path(10, 20, 0);
+  const auto all = dm.candidates(map, path, robot, 10.0, {1, robot, {}});
+  ASSERT_FALSE(all.empty());
+  EXPECT_FALSE(dm.keeps_way_back(map, robot, all, {1, robot, {}}));
+  const auto plan = dm.plan(map, path, robot, 10.0, {1, robot, {}});
+  EXPECT_TRUE(plan.depositions.empty());
+  EXPECT_EQ(plan.dropped_for_way_back, plan.candidates);
+  // Planning east instead (away from the origin) keeps everything.
+  const auto east = dm.plan(map, row_path(10, 20, 30), robot, 10.0, {1, robot, {}});
+  EXPECT_FALSE(east.depositions.empty());
+  EXPECT_EQ(east.dropped_for_way_back, 0);
+}
+
+TEST(DepositionManager, KeepsANeighboursWayBack) {
+  const grid::Heightmap h = corridor();
+  grid::Heightmap gap(kGrid, 0.0);
+  for (int c = 0; c < kGrid.cols; ++c) gap(10, c) = 0.3;
+  // This robot near the origin (10, 1) at (10, 2) builds east; a neighbour stands at (10, 20) further east.
+  const LocalMap map = make_map(h, gap, params().navigability, {10, 2}, {{10, 1}});
+  const DepositionManager dm(params());
+  const Position robot = kGrid.cell_center({10, 2}), other = kGrid.cell_center({10, 20});
+  const auto path = row_path(10, 2, 30);
+  const auto alone = dm.plan(map, path, robot, 10.0, {1, robot, {}});
+  EXPECT_FALSE(alone.depositions.empty());  // nobody to wall in
+  const auto with = dm.plan(map, path, robot, 10.0, {1, robot, {{2, other.x, other.y, 0.0}}});
+  EXPECT_TRUE(with.depositions.empty());    // every one of them would cut the neighbour off the origin
+  EXPECT_GT(with.dropped_for_way_back, 0);
+}
+
+TEST(DepositionManager, RejectsInvalidLimits) {
+  DepositionParams p = params();
+  p.reach_m = 0.0;
+  EXPECT_THROW(DepositionManager{p}, InvalidArgument);
+  p = params();
+  p.cube_layer_m = std::nan("");
+  EXPECT_THROW(DepositionManager{p}, InvalidArgument);
+  p = params();
+  p.neighbour_keep_out_m = -1.0;
+  EXPECT_THROW(DepositionManager{p}, InvalidArgument);
+  p = params();
+  p.navigability.kappa = 0.0;
+  EXPECT_THROW(DepositionManager{p}, InvalidArgument);
+}
+
+}  // namespace
+}  // namespace marsala::agent::executive

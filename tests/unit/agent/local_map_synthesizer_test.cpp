@@ -1,0 +1,157 @@
+#include "agent/deliberative/local_map_synthesizer.hpp"
+
+#include <gtest/gtest.h>
+
+#include "agent_test_support.hpp"
+#include "common/error.hpp"
+#include "tests/support/mars_brute_force.hpp"
+#include "tests/support/navigability_brute_force.hpp"
+
+namespace marsala::agent::deliberative {
+namespace {
+
+// 60 rows x 80 cols at 0.1 m, lower-left corner (0, 0): cell (r, c) has its centre at
+// x = 0.1 c + 0.05, y = 0.1 (59 - r) + 0.05.
+const grid::GridGeometry kWorld{60, 80, 0.0, 0.0, 0.1};
+const NavigabilityParams kBody{0.5, 0.4, 0.05};
+const Position kRobot{4.05, 2.95};  // cell (30, 40)
+
+TEST(SensingWindow, IsTheSquareClippedToTheGrid) {
+  // Square [3.05, 5.05] x [1.95, 3.95]: cols 30..50, rows 20..40 (hand-derived from the cell formula).
+  const Window w = sensing_window(kWorld, kRobot, 1.0);
+  EXPECT_EQ(w.top_left, (CellIndex{20, 30}));
+  EXPECT_EQ(w.rows, 21);
+  EXPECT_EQ(w.cols, 21);
+  // In the south-west corner: [-0.95, 1.05]^2 clipped to cols 0..10, rows 49..59.
+  const Window corner = sensing_window(kWorld, {0.05, 0.05}, 1.0);
+  EXPECT_EQ(corner.top_left, (CellIndex{49, 0}));
+  EXPECT_EQ(corner.rows, 11);
+  EXPECT_EQ(corner.cols, 11);
+  // A range wider than the grid: the whole grid.
+  const Window all = sensing_window(kWorld, kRobot, 100.0);
+  EXPECT_EQ(all.top_left, (CellIndex{0, 0}));
+  EXPECT_EQ(all.rows, 60);
+  EXPECT_EQ(all.cols, 80);
+  EXPECT_THROW(sensing_window(kWorld, {-0.01, 1.0}, 1.0), InvalidArgument);
+  EXPECT_THROW(sensing_window(kWorld, kRobot, -1.0), InvalidArgument);
+}
+
+grid::Heightmap bumpy_terrain() {
+  grid::Heightmap h(kWorld, 0.0);
+  for (int r = 0; r < h.rows(); ++r)
+    for (int c = 0; c < h.cols(); ++c) h(r, c) = 0.01 * ((r * 7 + c * 3) % 5);
+  for (int r = 25; r < 28; ++r)
+    for (int c = 44; c < 47; ++c) h(r, c) = 0.6;  // a block north-east of the robot
+  return h;
+}
+
+TEST(LocalMapSynthesizer, WindowGapAndNavigabilityMatchReferences) {
+  const grid::Heightmap h = bumpy_terrain();
+  executive::MappingSystem map = test::full_map(h);
+  map.record_pose(kRobot);
+  const LocalMapSynthesizer synthesizer(kBody, 1.0);
+  const LocalMap local = synthesizer.synthesize(map, kRobot, {4.55, 2.95});
+  EXPECT_EQ(local.offset, (CellIndex{20, 30}));
+  ASSERT_EQ(local.rows(), 21);
+  ASSERT_EQ(local.cols(), 21);
+  EXPECT_EQ(local.robot, (CellIndex{10, 10}));
+  EXPECT_EQ(local.to_global(local.robot), (CellIndex{30, 40}));
+  const grid::Heightmap expected = h.window({20, 30}, 21, 21);
+  EXPECT_TRUE(local.heights.heights() == expected.heights());
+  EXPECT_EQ(local.geometry(), expected.geometry());
+  // The gap and the masks against the brute-force references on the window alone.
+  const grid::Heightmap p = testing::mars_brute_force(expected, kBody.kappa);
+  for (int r = 0; r < 21; ++r)
+    for (int c = 0; c < 21; ++c) EXPECT_NEAR(local.gap(r, c), p(r, c) - expected(r, c), 1e-9);
+  EXPECT_TRUE(local.occupiable == testing::occupiable_brute_force(expected, kBody));
+  EXPECT_TRUE(local.navigable == testing::navigable_brute_force(expected, kBody, {10, 10}));
+  EXPECT_EQ(local.blind.cast<int>().sum(), 0);
+  // The block is not occupiable, so the navigable region has a hole.
+  EXPECT_EQ(local.occupiable(6, 15), 0);
+  EXPECT_GT(local.navigable.cast<int>().sum(), 300);
+}
+
+TEST(LocalMapSynthesizer, LocalGoalIsTheTargetInsideOrWhereTheLineLeaves) {
+  const executive::MappingSystem map = test::full_map(grid::Heightmap(kWorld, 0.0));
+  const LocalMapSynthesizer synthesizer(kBody, 1.0);
+  // Inside: the target's own cell (32, 45).
+  LocalMap local = synthesizer.synthesize(map, kRobot, {4.55, 2.75});
+  EXPECT_EQ(local.to_global(local.goal), (CellIndex{32, 45}));
+  EXPECT_TRUE(local.goal_is_target);
+  // Due east and off the grid: the line leaves at x = 5.05 on the robot's row -> (30, 50).
+  local = synthesizer.synthesize(map, kRobot, {10.0, 2.95});
+  EXPECT_EQ(local.to_global(local.goal), (CellIndex{30, 50}));
+  EXPECT_FALSE(local.goal_is_target);
+  // East-north-east: dx = 3, dy = 1.5 leaves the east side at t = 1/3, y = 3.45 -> row 59 - 34 = 25.
+  local = synthesizer.synthesize(map, kRobot, {7.05, 4.45});
+  EXPECT_EQ(local.to_global(local.goal), (CellIndex{25, 50}));
+  // Due south-west through the corner of the window: (40, 30).
+  local = synthesizer.synthesize(map, kRobot, {2.05, 0.95});
+  EXPECT_EQ(local.to_global(local.goal), (CellIndex{40, 30}));
+  // A target on a cell boundary maps through the world grid: x = 4.5 lies in col 45 for the world.
+  local = synthesizer.synthesize(map, kRobot, {4.5, 2.95});
+  EXPECT_EQ(local.to_global(local.goal), *kWorld.cell_at({4.5, 2.95}));
+}
+
+TEST(LocalMapSynthesizer, LocalOriginIsTheTrajectoryCellNearestTheBoundary) {
+  grid::Heightmap h(kWorld, 0.0);
+  executive::MappingSystem map = test::full_map(h);
+  // Came from the west along row 30 (cols 10 .. 40); in the window: cols 30 .. 40; col 30 lies on the square's
+  // west side (x = 3.05 = 4.05 - 1).
+  for (int c = 10; c <= 40; ++c) map.record_pose(kWorld.cell_center({30, c}));
+  const LocalMapSynthesizer synthesizer(kBody, 1.0);
+  LocalMap local = synthesizer.synthesize(map, kRobot, {7.0, 2.95});
+  ASSERT_TRUE(local.origin.has_value());
+  EXPECT_EQ(local.to_global(*local.origin), (CellIndex{30, 30}));
+
+  // A tie (the square's north side, row 20, is as near as its west side): the older cell wins.
+  executive::MappingSystem tie = test::full_map(h);
+  tie.record_pose(kWorld.cell_center({20, 40}));
+  tie.record_pose(kWorld.cell_center({30, 30}));
+  tie.record_pose(kRobot);
+  local = synthesizer.synthesize(tie, kRobot, {7.0, 2.95});
+  EXPECT_EQ(local.to_global(*local.origin), (CellIndex{20, 40}));
+
+  // A wall across row 30 at cols 33..34 (and rows 20..40) cuts cols 30..32 off: the nearest navigable cell wins.
+  for (int r = 0; r < 60; ++r)
+    for (int c = 33; c <= 34; ++c) h(r, c) = 2.0;
+  executive::MappingSystem walled = test::full_map(h);
+  for (int c = 10; c <= 40; ++c) walled.record_pose(kWorld.cell_center({30, c}));
+  local = synthesizer.synthesize(walled, kRobot, {7.0, 2.95});
+  ASSERT_TRUE(local.origin.has_value());
+  EXPECT_EQ(local.navigable(local.origin->row, local.origin->col), 1);
+  // Col 37 is the first east of the wall whose ball (radius 2 cells) holds no wall cell.
+  EXPECT_EQ(local.to_global(*local.origin), (CellIndex{30, 37}));
+}
+
+TEST(LocalMapSynthesizer, UnknownCellsAreNeverOccupiableNorTargets) {
+  const grid::Heightmap h(kWorld, 0.3);
+  executive::MappingSystem map(kWorld, 16);
+  // Only tile columns 2 and 3 (cols 32..63) of tile rows 1 and 2 (rows 16..47) are known.
+  for (int tr = 1; tr <= 2; ++tr)
+    for (int tc = 2; tc <= 3; ++tc) map.integrate_tile(test::cut_tile(h, 16, tr, tc));
+  map.record_pose(kRobot);
+  const LocalMapSynthesizer synthesizer(kBody, 1.0);
+  const LocalMap local = synthesizer.synthesize(map, kRobot, {7.0, 2.95});
+  // Window cols 30..50: cols 30, 31 unknown. Ball radius 2 cells: cols 30..33 are blind.
+  for (int r = 0; r < local.rows(); ++r) {
+    for (int c = 0; c < local.cols(); ++c) {
+      const bool known = local.to_global({r, c}).col >= 32;
+      EXPECT_EQ(local.known(r, c), known ? 1 : 0);
+      if (!known) {
+        EXPECT_EQ(local.gap(r, c), 0.0);
+      }
+      if (c <= 3) {
+        EXPECT_EQ(local.occupiable(r, c), 0) << r << ", " << c;
+      }
+    }
+  }
+  EXPECT_EQ(local.blind(10, 3), 1);
+  EXPECT_EQ(local.blind(10, 4), 0);
+  EXPECT_EQ(local.occupiable(10, 4), 1);
+  // Unknown cells take the lowest known height (0.3): no MARS gap appears on flat known ground.
+  EXPECT_EQ(local.gap.heights().maxCoeff(), 0.0);
+}
+
+}  // namespace
+}  // namespace marsala::agent::deliberative
