@@ -1,22 +1,36 @@
 #!/usr/bin/env bash
-# The README's main job. Until the distributed runtime lands it is the terrain demo: installs what is missing,
-# builds, generates a terrain, computes its MARS gap and navigability, writes pictures and prints a summary.
-# Usage: deploy/demo.sh [--out DIR] [--seed S]
+# The README's main job: installs what is missing, builds, and runs the ramp scenario (paper Fig. 2) as real
+# processes: one marsala-world and 3 marsala-agent processes over DDS (loopback only), then prints the summary and
+# the picture paths. With --terrain it runs the terrain demo instead (MARS gap and navigability of a generated site).
+# Usage: deploy/demo.sh [--agents N] [--dds cyclone|fastdds] [--out DIR] [--terrain [--seed S]]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="$root/out/demo"
 seed=7
+agents=3
+dds=cyclone
+mode=ramp
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out="$2"; shift 2 ;;
     --seed) seed="$2"; shift 2 ;;
-    -h|--help) sed -n '2,4p' "$0"; exit 0 ;;
+    --agents) agents="$2"; shift 2 ;;
+    --dds) dds="$2"; shift 2 ;;
+    --terrain) mode=terrain; shift ;;
+    -h|--help) sed -n '2,5p' "$0"; exit 0 ;;
     *) echo "demo.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
 
 "$root/deploy/install-deps.sh"
 "$root/deploy/build.sh"
+
+if [ "$mode" = ramp ]; then
+  echo "== The ramp scenario (paper Fig. 2): $agents robots build ramps to climb a 1.5 m platform"
+  exec "$root/deploy/spawn.sh" --scenario "$root/deploy/scenarios/ramp.pbtxt" --agents "$agents" --dds "$dds" \
+    --out "$out"
+fi
+
 terrain="${MARSALA_BUILD_DIR:-$root/build}/bin/marsala-terrain"
 mkdir -p "$out"
 

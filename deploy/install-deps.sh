@@ -8,8 +8,13 @@ packages=(
   libeigen3-dev
   libtiff-dev libpng-dev zlib1g-dev
   libcli11-dev
-  libprotobuf-dev protobuf-compiler libspdlog-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
+  # scenarios and run summaries (protobuf), logging
+  libprotobuf-dev protobuf-compiler libspdlog-dev
+  # common/bus: both DDS vendors (fastddsgen runs at build time)
+  cyclonedds-dev cyclonedds-tools libfastrtps-dev libfastcdr-dev fastddsgen
+  # multi-process tests run inside a private network namespace (unshare -n, ip link set lo up)
+  iproute2 util-linux
 )
 
 missing=()

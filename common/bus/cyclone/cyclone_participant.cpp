@@ -1,0 +1,304 @@
+// The Cyclone DDS backend (C API). One participant per bus::Participant; one publisher or subscriber per
+// endpoint, since the partition is a publisher/subscriber QoS; topics are created once per participant.
+// Readers take samples on Cyclone's listener thread, convert them and queue them (detail::ReaderQueue).
+
+#include <dds/dds.h>
+#include <spdlog/spdlog.h>
+
+#include <map>
+#include <mutex>
+#include <string>
+
+#include "common/bus/cyclone/cyclone_convert.hpp"
+#include "common/bus/detail/backends.hpp"
+#include "common/bus/detail/reader_queue.hpp"
+#include "common/bus/detail/topics.hpp"
+#include "common/error.hpp"
+
+namespace marsala::bus::detail {
+namespace {
+
+/// The C type and topic descriptor idlc generated for a bus message.
+template <typename T>
+struct CycloneType;
+template <>
+struct CycloneType<AgentHello> {
+  using Msg = marsala_wire_AgentHello;
+  static const dds_topic_descriptor_t* descriptor() { return &marsala_wire_AgentHello_desc; }
+};
+template <>
+struct CycloneType<Admission> {
+  using Msg = marsala_wire_Admission;
+  static const dds_topic_descriptor_t* descriptor() { return &marsala_wire_Admission_desc; }
+};
+template <>
+struct CycloneType<SensorFrame> {
+  using Msg = marsala_wire_SensorFrame;
+  static const dds_topic_descriptor_t* descriptor() { return &marsala_wire_SensorFrame_desc; }
+};
+template <>
+struct CycloneType<ActionRequest> {
+  using Msg = marsala_wire_ActionRequest;
+  static const dds_topic_descriptor_t* descriptor() { return &marsala_wire_ActionRequest_desc; }
+};
+template <>
+struct CycloneType<WorldStatus> {
+  using Msg = marsala_wire_WorldStatus;
+  static const dds_topic_descriptor_t* descriptor() { return &marsala_wire_WorldStatus_desc; }
+};
+template <>
+struct CycloneType<WorldEvent> {
+  using Msg = marsala_wire_WorldEvent;
+  static const dds_topic_descriptor_t* descriptor() { return &marsala_wire_WorldEvent_desc; }
+};
+
+std::string failure(const std::string& what, dds_return_t rc) {
+  return "Cyclone DDS: " + what + " failed: " + dds_strretcode(rc);
+}
+
+/// Owns a qos object for the duration of an endpoint's creation.
+class Qos {
+ public:
+  Qos() : qos_(dds_create_qos()) {}
+  ~Qos() { dds_delete_qos(qos_); }
+  Qos(const Qos&) = delete;
+  Qos& operator=(const Qos&) = delete;
+  dds_qos_t* get() const { return qos_; }
+
+ private:
+  dds_qos_t* qos_;
+};
+
+/// The DDS participant and its topics; shared by the bus::Participant and every endpoint it made, so the
+/// participant outlives its endpoints whatever order the caller destroys them in.
+class Context {
+ public:
+  explicit Context(int domain_id) : domain_id_(domain_id) {
+    participant_ = dds_create_participant(static_cast<dds_domainid_t>(domain_id), nullptr, nullptr);
+    if (participant_ < 0)
+      throw BusError(failure("creating a participant in domain " + std::to_string(domain_id), participant_));
+  }
+  ~Context() { dds_delete(participant_); }
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  dds_entity_t participant() const { return participant_; }
+  int domain_id() const { return domain_id_; }
+
+  /// The topic of message type T, created on first use.
+  template <typename T>
+  dds_entity_t topic() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const std::string name = TopicName<T>::value;
+    auto it = topics_.find(name);
+    if (it != topics_.end()) return it->second;
+    const dds_entity_t t = dds_create_topic(participant_, CycloneType<T>::descriptor(), name.c_str(), nullptr, nullptr);
+    if (t < 0) throw BusError(failure("creating topic " + name, t));
+    topics_.emplace(name, t);
+    return t;
+  }
+
+ private:
+  int domain_id_;
+  dds_entity_t participant_;
+  std::mutex mutex_;
+  std::map<std::string, dds_entity_t> topics_;
+};
+
+/// QoS shared by readers and writers: reliable, keep-last depth, transient-local on the wire (topics.hpp).
+void set_common_qos(dds_qos_t* qos, const EndpointOptions& options) {
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(kMaxBlocking.count()));
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, options.depth);
+  dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
+}
+
+/// Publisher/subscriber QoS: the endpoint's partition ("" = the default partition: no partition QoS at all).
+void set_partition(dds_qos_t* qos, const std::string& partition) {
+  if (!partition.empty()) dds_qset_partition1(qos, partition.c_str());
+}
+
+template <typename T>
+class CycloneWriter final : public Writer<T> {
+ public:
+  CycloneWriter(std::shared_ptr<Context> context, const EndpointOptions& options) : context_(std::move(context)) {
+    check_options(options);
+    const dds_entity_t topic = context_->template topic<T>();
+    Qos pub_qos;
+    set_partition(pub_qos.get(), options.partition);
+    publisher_ = dds_create_publisher(context_->participant(), pub_qos.get(), nullptr);
+    if (publisher_ < 0) throw BusError(failure("creating a publisher for " + label(options), publisher_));
+    Qos qos;
+    set_common_qos(qos.get(), options);
+    // Late joiners get the last `depth` samples of a transient-local writer, and only the latest of a volatile one
+    // (which its volatile readers drop).
+    const std::int32_t kept = options.durability == Durability::kTransientLocal ? options.depth : 1;
+    dds_qset_durability_service(qos.get(), 0, DDS_HISTORY_KEEP_LAST, kept, DDS_LENGTH_UNLIMITED,
+                                DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
+    dds_qset_liveliness(qos.get(), DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(kWriterLease.count()));
+    writer_ = dds_create_writer(publisher_, topic, qos.get(), nullptr);
+    if (writer_ < 0) {
+      dds_delete(publisher_);
+      throw BusError(failure("creating a writer for " + label(options), writer_));
+    }
+  }
+  // Deleting the publisher deletes its writer; Cyclone lingers briefly to deliver unacknowledged samples.
+  ~CycloneWriter() override { dds_delete(publisher_); }
+
+  void write(const T& sample) override {
+    cyclone::Storage storage;
+    const typename CycloneType<T>::Msg msg = cyclone::to_msg(sample, storage);
+    const dds_return_t rc = dds_write(writer_, &msg);
+    if (rc < 0) throw BusError(failure(std::string("writing ") + TopicName<T>::value, rc));
+  }
+
+  int matched_readers() const override {
+    dds_publication_matched_status_t status{};
+    if (dds_get_publication_matched_status(writer_, &status) < 0) return 0;
+    return static_cast<int>(status.current_count);
+  }
+
+ private:
+  static std::string label(const EndpointOptions& options) {
+    return std::string(TopicName<T>::value) + " in partition '" + options.partition + "'";
+  }
+
+  std::shared_ptr<Context> context_;
+  dds_entity_t publisher_ = 0;
+  dds_entity_t writer_ = 0;
+};
+
+template <typename T>
+class CycloneReader final : public Reader<T> {
+ public:
+  CycloneReader(std::shared_ptr<Context> context, const EndpointOptions& options)
+      : context_(std::move(context)), filter_(options.durability), queue_(options.signal) {
+    check_options(options);
+    const dds_entity_t topic = context_->template topic<T>();
+    Qos sub_qos;
+    set_partition(sub_qos.get(), options.partition);
+    subscriber_ = dds_create_subscriber(context_->participant(), sub_qos.get(), nullptr);
+    if (subscriber_ < 0)
+      throw BusError(failure(std::string("creating a subscriber for ") + TopicName<T>::value, subscriber_));
+    Qos qos;
+    set_common_qos(qos.get(), options);
+    dds_listener_t* listener = dds_create_listener(this);
+    dds_lset_data_available(listener, &CycloneReader::on_data_available);
+    dds_lset_liveliness_changed(listener, &CycloneReader::on_liveliness_changed);
+    dds_lset_subscription_matched(listener, &CycloneReader::on_subscription_matched);
+    reader_ = dds_create_reader(subscriber_, topic, qos.get(), listener);
+    dds_delete_listener(listener);
+    if (reader_ < 0) {
+      dds_delete(subscriber_);
+      throw BusError(failure(std::string("creating a reader for ") + TopicName<T>::value, reader_));
+    }
+  }
+  // Cyclone waits for a running listener callback to return before the reader is gone.
+  ~CycloneReader() override { dds_delete(subscriber_); }
+
+  std::vector<T> take() override { return queue_.take(); }
+
+  int alive_writers() const override {
+    dds_liveliness_changed_status_t status{};
+    if (dds_get_liveliness_changed_status(reader_, &status) < 0) return 0;
+    return static_cast<int>(status.alive_count);
+  }
+
+ private:
+  static constexpr std::uint32_t kBatch = 16;
+
+  /// Returns a loan of samples to the reader whatever happens while converting them.
+  struct Loan {
+    dds_entity_t reader;
+    void** samples;
+    std::int32_t count;
+    ~Loan() {
+      if (count > 0) dds_return_loan(reader, samples, count);
+    }
+  };
+
+  void drain(dds_entity_t reader) {
+    std::vector<T> received;
+    for (;;) {
+      void* samples[kBatch] = {};
+      dds_sample_info_t infos[kBatch];
+      const dds_return_t n = dds_take(reader, samples, infos, kBatch, kBatch);
+      if (n <= 0) break;
+      Loan loan{reader, samples, n};
+      for (dds_return_t i = 0; i < n; ++i)
+        if (infos[i].valid_data && filter_.passes(infos[i].source_timestamp))
+          received.push_back(cyclone::from_msg(*static_cast<const typename CycloneType<T>::Msg*>(samples[i])));
+    }
+    queue_.push(std::move(received));
+  }
+
+  // Listener callbacks: nothing may escape into Cyclone's thread.
+  static void on_data_available(dds_entity_t reader, void* arg) {
+    try {
+      static_cast<CycloneReader*>(arg)->drain(reader);
+    } catch (const std::exception& e) {
+      spdlog::error("bus (cyclone): dropping samples of {}: {}", TopicName<T>::value, e.what());
+    } catch (...) {
+      spdlog::error("bus (cyclone): dropping samples of {}: unknown error", TopicName<T>::value);
+    }
+  }
+  static void on_liveliness_changed(dds_entity_t, const dds_liveliness_changed_status_t, void* arg) { wake(arg); }
+  static void on_subscription_matched(dds_entity_t, const dds_subscription_matched_status_t, void* arg) { wake(arg); }
+  static void wake(void* arg) {
+    try {
+      static_cast<CycloneReader*>(arg)->queue_.notify();
+    } catch (...) {
+      spdlog::error("bus (cyclone): could not wake the reader of {}", TopicName<T>::value);
+    }
+  }
+
+  std::shared_ptr<Context> context_;
+  VolatileFilter filter_;
+  ReaderQueue<T> queue_;
+  dds_entity_t subscriber_ = 0;
+  dds_entity_t reader_ = 0;
+};
+
+class CycloneParticipant final : public Participant {
+ public:
+  explicit CycloneParticipant(int domain_id) : context_(std::make_shared<Context>(domain_id)) {
+    spdlog::debug("bus: Cyclone DDS participant in domain {}", domain_id);
+  }
+  Vendor vendor() const override { return Vendor::kCyclone; }
+  int domain_id() const override { return context_->domain_id(); }
+
+ protected:
+  template <typename T>
+  std::unique_ptr<Writer<T>> writer(const EndpointOptions& options) {
+    return std::make_unique<CycloneWriter<T>>(context_, options);
+  }
+  template <typename T>
+  std::unique_ptr<Reader<T>> reader(const EndpointOptions& options) {
+    return std::make_unique<CycloneReader<T>>(context_, options);
+  }
+
+  // clang-format off
+  std::unique_ptr<Writer<AgentHello>> make_writer(Tag<AgentHello>, const EndpointOptions& o) override { return writer<AgentHello>(o); }
+  std::unique_ptr<Writer<Admission>> make_writer(Tag<Admission>, const EndpointOptions& o) override { return writer<Admission>(o); }
+  std::unique_ptr<Writer<SensorFrame>> make_writer(Tag<SensorFrame>, const EndpointOptions& o) override { return writer<SensorFrame>(o); }
+  std::unique_ptr<Writer<ActionRequest>> make_writer(Tag<ActionRequest>, const EndpointOptions& o) override { return writer<ActionRequest>(o); }
+  std::unique_ptr<Writer<WorldStatus>> make_writer(Tag<WorldStatus>, const EndpointOptions& o) override { return writer<WorldStatus>(o); }
+  std::unique_ptr<Writer<WorldEvent>> make_writer(Tag<WorldEvent>, const EndpointOptions& o) override { return writer<WorldEvent>(o); }
+  std::unique_ptr<Reader<AgentHello>> make_reader(Tag<AgentHello>, const EndpointOptions& o) override { return reader<AgentHello>(o); }
+  std::unique_ptr<Reader<Admission>> make_reader(Tag<Admission>, const EndpointOptions& o) override { return reader<Admission>(o); }
+  std::unique_ptr<Reader<SensorFrame>> make_reader(Tag<SensorFrame>, const EndpointOptions& o) override { return reader<SensorFrame>(o); }
+  std::unique_ptr<Reader<ActionRequest>> make_reader(Tag<ActionRequest>, const EndpointOptions& o) override { return reader<ActionRequest>(o); }
+  std::unique_ptr<Reader<WorldStatus>> make_reader(Tag<WorldStatus>, const EndpointOptions& o) override { return reader<WorldStatus>(o); }
+  std::unique_ptr<Reader<WorldEvent>> make_reader(Tag<WorldEvent>, const EndpointOptions& o) override { return reader<WorldEvent>(o); }
+  // clang-format on
+
+ private:
+  std::shared_ptr<Context> context_;
+};
+
+}  // namespace
+
+std::unique_ptr<Participant> make_cyclone_participant(int domain_id) {
+  return std::make_unique<CycloneParticipant>(domain_id);
+}
+
+}  // namespace marsala::bus::detail

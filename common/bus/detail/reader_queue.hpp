@@ -1,0 +1,71 @@
+#pragma once
+// The part of a DDS reader both backends share: samples converted on the vendor's listener thread are queued
+// here until take(), and the endpoint's Signal is notified on data and on writer liveliness or match changes.
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <utility>
+#include <vector>
+
+#include "common/bus/bus.hpp"
+
+namespace marsala::bus::detail {
+
+/// Keeps a volatile reader volatile on transient-local writers (topics.hpp): passes only samples whose source
+/// timestamp [ns since the epoch, the writer's wall clock] is not before the reader's creation. Transient-local
+/// readers pass everything. Writers on other hosts need clocks in sync to well under a step.
+class VolatileFilter {
+ public:
+  explicit VolatileFilter(Durability durability)
+      : volatile_(durability == Durability::kVolatile),
+        created_ns_(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                        std::chrono::system_clock::now().time_since_epoch())
+                        .count()) {}
+  /// Whether a sample with this source timestamp [ns since the epoch] is delivered.
+  bool passes(std::int64_t source_timestamp_ns) const { return !volatile_ || source_timestamp_ns >= created_ns_; }
+
+ private:
+  bool volatile_;
+  std::int64_t created_ns_;
+};
+
+/// Thread-safe FIFO of received samples plus the reader's wake-up.
+template <typename T>
+class ReaderQueue {
+ public:
+  explicit ReaderQueue(std::shared_ptr<Signal> signal) : signal_(std::move(signal)) {}
+
+  /// Appends samples in arrival order and wakes the waiter (nothing to append = no wake-up).
+  void push(std::vector<T>&& samples) {
+    if (samples.empty()) return;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (queue_.empty()) {
+        queue_ = std::move(samples);
+      } else {
+        for (T& s : samples) queue_.push_back(std::move(s));
+      }
+    }
+    notify();
+  }
+  /// Everything queued since the last take.
+  std::vector<T> take() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<T> out;
+    out.swap(queue_);
+    return out;
+  }
+  /// Wakes the waiter (a writer came, went or changed liveliness).
+  void notify() const {
+    if (signal_) signal_->notify();
+  }
+
+ private:
+  std::shared_ptr<Signal> signal_;
+  std::mutex mutex_;
+  std::vector<T> queue_;
+};
+
+}  // namespace marsala::bus::detail

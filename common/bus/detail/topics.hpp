@@ -1,0 +1,67 @@
+#pragma once
+// What both DDS backends must agree on to talk to each other: topic names per message type and the QoS
+// constants of the wire contract (runtime_spec.md). Type names come from idl/marsala.idl
+// ("marsala::wire::<Type>") through each vendor's code generator.
+
+#include <chrono>
+#include <string>
+
+#include "common/bus/bus.hpp"
+#include "common/error.hpp"
+
+namespace marsala::bus::detail {
+
+/// The DDS topic that carries one message type (one topic per type).
+template <typename T>
+struct TopicName;
+template <>
+struct TopicName<AgentHello> {
+  static constexpr const char* value = "marsala_AgentHello";
+};
+template <>
+struct TopicName<Admission> {
+  static constexpr const char* value = "marsala_Admission";
+};
+template <>
+struct TopicName<SensorFrame> {
+  static constexpr const char* value = "marsala_SensorFrame";
+};
+template <>
+struct TopicName<ActionRequest> {
+  static constexpr const char* value = "marsala_ActionRequest";
+};
+template <>
+struct TopicName<WorldStatus> {
+  static constexpr const char* value = "marsala_WorldStatus";
+};
+template <>
+struct TopicName<WorldEvent> {
+  static constexpr const char* value = "marsala_WorldEvent";
+};
+
+// Durability on the wire. Every writer offers TRANSIENT_LOCAL and every Cyclone reader requests it; a reader the
+// caller asked to be volatile then drops samples written before it was created (source timestamp, see
+// VolatileFilter). Why: a volatile Cyclone reader starts a non-Cyclone writer's stream at the first heartbeat it
+// sees, so a Fast DDS writer's samples written while the Cyclone side is still connecting (the writer already
+// matched) are lost for good; as transient-local it asks for them again. A volatile Cyclone writer cannot serve a
+// transient-local reader, hence transient-local writers everywhere (Cyclone keeps 1 sample for late joiners then).
+
+/// AUTOMATIC liveliness lease of every writer: a reader sees a dead writer's process as not alive after this.
+inline constexpr std::chrono::milliseconds kWriterLease{1000};
+/// Lease by which Fast DDS readers judge a writer (>= kWriterLease for QoS compatibility). Longer than the writer
+/// lease because Cyclone asserts automatic liveliness only every 0.8 lease; Cyclone readers use the writer's lease.
+inline constexpr std::chrono::milliseconds kReaderLease{1500};
+/// How often a Fast DDS participant asserts its automatic writers (Cyclone derives it: 80 % of the lease).
+inline constexpr std::chrono::milliseconds kLivelinessAnnouncement{250};
+/// Heartbeat period of reliable Fast DDS writers: the delay before a lost sample is repaired (Cyclone adapts its own
+/// from 100 ms).
+inline constexpr std::chrono::milliseconds kHeartbeatPeriod{100};
+/// How long a reliable write may block when the writer's resend buffer is full.
+inline constexpr std::chrono::milliseconds kMaxBlocking{1000};
+
+/// Throws InvalidArgument for options no backend can honour (depth < 1).
+inline void check_options(const EndpointOptions& options) {
+  if (options.depth < 1) throw InvalidArgument("bus endpoint depth must be >= 1, got " + std::to_string(options.depth));
+}
+
+}  // namespace marsala::bus::detail

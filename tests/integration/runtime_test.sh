@@ -1,0 +1,115 @@
+#!/usr/bin/env bash
+# Multi-process integration tests of the runtime: real marsala-world and marsala-agent processes over DDS, each
+# test on its own domain with the loopback configs; ctest runs it inside run_isolated.sh (a private network
+# namespace with only lo, when permitted).
+#
+# Usage: runtime_test.sh CASE DOMAIN
+#   ramp1-cyclone | ramp1-fastdds | ramp3-cyclone | ramp3-fastdds   the ramp scenario with 1 or 3 agents
+#   mixed-cyclone-fastdds | mixed-fastdds-cyclone                    world on one vendor, agents on the other
+#   determinism                                                      2 Cyclone runs + 1 Fast DDS run: same sha256
+#   rogue                                                            a misbehaving agent is rejected, run completes
+#   kill                                                             SIGKILL one of 3 agents mid-run, others finish
+set -euo pipefail
+case_name="$1"
+domain="$2"
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
+scenario="$root/deploy/scenarios/ramp.pbtxt"
+
+work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-it-$case_name.XXXXXX")"
+trap 'rm -rf "$work"' EXIT
+
+fail() { echo "FAIL ($case_name): $*" >&2; exit 1; }
+field() {  # field NAME FILE: a scalar of summary.json
+  grep -o "\"$1\": *[^,}]*" "$2" | head -1 | sed 's/^[^:]*: *//; s/"//g'
+}
+run_spawn() {  # run_spawn OUT_NAME AGENTS DDS [AGENT_DDS]
+  local out="$work/$1"
+  "$root/deploy/spawn.sh" --scenario "$scenario" --agents "$2" --dds "$3" --agent-dds "${4:-$3}" \
+    --domain "$domain" --out "$out" --quiet --timeout 300 || fail "spawn.sh failed for $1 (logs: $out/logs)"
+  [ -f "$out/summary.json" ] || fail "no summary.json in $out"
+  echo "$out/summary.json"
+}
+expect_completed() {  # expect_completed SUMMARY AGENTS
+  [ "$(field completed "$1")" = "true" ] || { cat "$1"; fail "run did not complete"; }
+  [ "$(field agents "$1")" = "$2" ] || { cat "$1"; fail "expected $2 agents in the summary"; }
+}
+
+case "$case_name" in
+  ramp1-cyclone|ramp1-fastdds|ramp3-cyclone|ramp3-fastdds)
+    n="${case_name:4:1}"
+    vendor="${case_name#ramp?-}"
+    s=$(run_spawn run "$n" "$vendor")
+    expect_completed "$s" "$n"
+    echo "ok: $case_name completed in $(field steps "$s") steps, $(field wall_seconds "$s") s"
+    ;;
+  mixed-cyclone-fastdds|mixed-fastdds-cyclone)
+    world="$(echo "$case_name" | cut -d- -f2)"
+    agents="$(echo "$case_name" | cut -d- -f3)"
+    s=$(run_spawn run 3 "$world" "$agents")
+    expect_completed "$s" 3
+    echo "ok: world on $world, agents on $agents: completed in $(field steps "$s") steps"
+    ;;
+  determinism)
+    a=$(run_spawn a 3 cyclone)
+    b=$(run_spawn b 3 cyclone)
+    c=$(run_spawn c 3 fastdds)
+    for s in "$a" "$b" "$c"; do expect_completed "$s" 3; done
+    sha_a=$(field terrain_sha256 "$a"); sha_b=$(field terrain_sha256 "$b"); sha_c=$(field terrain_sha256 "$c")
+    [ -n "$sha_a" ] || fail "no terrain_sha256"
+    [ "$sha_a" = "$sha_b" ] || fail "two Cyclone runs differ: $sha_a vs $sha_b"
+    [ "$sha_a" = "$sha_c" ] || fail "Cyclone and Fast DDS runs differ: $sha_a vs $sha_c"
+    [ "$(field steps "$a")" = "$(field steps "$c")" ] || fail "step counts differ"
+    echo "ok: three runs, one terrain: $sha_a"
+    ;;
+  rogue)
+    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+    out="$work/rogue"
+    mkdir -p "$out/logs"
+    # A two-slot run: agent 1 is honest, agent 2 is the rogue.
+    "$bin/marsala-world" --scenario "$scenario" --agents 2 --dds cyclone --domain "$domain" --out "$out" \
+      >"$out/logs/world.log" 2>&1 &
+    world=$!
+    "$bin/marsala-agent" --scenario "$scenario" --id 1 --dds cyclone --domain "$domain" >"$out/logs/agent-1.log" 2>&1 &
+    agent=$!
+    "$bin/marsala-rogue-agent" "$scenario" 2 cyclone "$domain" >"$out/logs/rogue.log" 2>&1 || true
+    wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
+    wait "$agent" || true
+    s="$out/summary.json"
+    [ "$(field completed "$s")" = "true" ] || { cat "$s"; tail -30 "$out/logs/world.log"; fail "honest agent did not complete"; }
+    sent=$(grep -c "sending" "$out/logs/rogue.log" || true)
+    [ "$sent" -ge 8 ] || { cat "$out/logs/rogue.log"; fail "rogue sent only $sent attacks"; }
+    rejected=$(grep -ci "reject" "$out/logs/world.log" || true)
+    [ "$rejected" -ge 7 ] || { tail -40 "$out/logs/world.log"; fail "world logged only $rejected rejections"; }
+    echo "ok: $sent attacks, $rejected rejections logged, honest agent completed in $(field steps "$s") steps"
+    ;;
+  kill)
+    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+    out="$work/kill"
+    mkdir -p "$out/logs"
+    "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
+      >"$out/logs/world.log" 2>&1 &
+    world=$!
+    pids=()
+    for id in 1 2 3; do
+      "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" \
+        >"$out/logs/agent-$id.log" 2>&1 &
+      pids+=($!)
+    done
+    # Let the run get going, then kill agent 2 without warning.
+    for _ in $(seq 1 600); do grep -q "admitted agent 3" "$out/logs/world.log" 2>/dev/null && break; sleep 0.1; done
+    sleep 0.5  # the whole run takes about 2 s: agent 2 dies mid-run
+    kill -KILL "${pids[1]}"
+    wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
+    s="$out/summary.json"
+    [ "$(field completed "$s")" = "true" ] || { cat "$s"; tail -30 "$out/logs/world.log"; fail "survivors did not complete"; }
+    grep -q "lost liveliness" "$out/logs/world.log" || fail "world never noticed the killed agent via liveliness"
+    # Agent 2's entry: it took part before it died, and it was dropped.
+    entry2=$(tr -d '\n ' <"$s" | grep -o '{"agent_id":2,[^}]*}')
+    accepted2=$(echo "$entry2" | grep -o '"accepted":[0-9]*' | cut -d: -f2)
+    echo "$entry2" | grep -q '"dropped":true' || fail "agent 2 is not marked dropped: $entry2"
+    [ "${accepted2:-0}" -gt 0 ] || fail "agent 2 was killed before it took part (accepted $accepted2)"
+    echo "ok: agent 2 killed, dropped, the other two completed in $(field steps "$s") steps"
+    ;;
+  *) echo "unknown case '$case_name'" >&2; exit 2 ;;
+esac
