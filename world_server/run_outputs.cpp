@@ -38,6 +38,8 @@ std::string summary_json(const WorldState& state, const RunInfo& info) {
   s.set_end_reason(info.end_reason);
   s.set_steps(static_cast<std::uint32_t>(state.step));
   s.set_wall_seconds(info.wall_seconds);
+  s.set_step_wall_median_ms(info.step_wall_median_ms);
+  s.set_step_wall_p90_ms(info.step_wall_p90_ms);
   s.set_deposited_volume_m3(state.deposited_volume_m3);
   s.set_agents(static_cast<std::uint32_t>(state.agents.size()));
   std::uint32_t admitted = 0, missed = 0, rejected = 0;

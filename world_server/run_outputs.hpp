@@ -22,6 +22,8 @@ struct RunInfo {
   bool completed = false;
   std::string end_reason;      ///< completed, max_steps, signal, no_live_agents
   double wall_seconds = 0.0;   ///< [s]
+  double step_wall_median_ms = 0.0;  ///< median wall time of one lockstep step [ms]
+  double step_wall_p90_ms = 0.0;     ///< its 90th percentile [ms]
 };
 
 /// summary.json's text: every field present (zeros included); steps = state.step; terrain_sha256 of state.terrain.

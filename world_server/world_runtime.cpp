@@ -33,6 +33,14 @@ constexpr auto kReadyPollInterval = 5ms;
 // Progress lines at info level every this many steps.
 constexpr std::uint64_t kProgressEvery = 500;
 
+/// The q-quantile (nearest rank) of `values`; 0 when empty.
+double percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(values.size() - 1) + 0.5);
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
 Clock::duration seconds(double s) { return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)); }
 
 std::string format_seconds(double s) {
@@ -273,10 +281,12 @@ struct WorldRuntime::Impl {
       if (state.step >= options.max_steps) return "max_steps";
       const std::vector<std::uint32_t> live = state.live_ids();
       if (live.empty()) return "no_live_agents";
+      const Clock::time_point step_start = Clock::now();
       for (std::uint32_t id : live) send_frame(id, false);
       std::vector<Submission> submissions = collect(stop);
       if (stop) return "signal";  // the interrupted step is not applied
       const StepOutcome outcome = apply_step(state, submissions);
+      step_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - step_start).count());
       for (const std::string& text : outcome.notes) note(text);
       for (const bus::WorldEvent& e : outcome.events) {
         if (e.kind == bus::EventKind::kRejected)
@@ -342,6 +352,8 @@ struct WorldRuntime::Impl {
     info.completed = result.completed;
     info.end_reason = end_reason;
     info.wall_seconds = result.wall_seconds;
+    info.step_wall_median_ms = percentile(step_ms, 0.5);
+    info.step_wall_p90_ms = percentile(step_ms, 0.9);
     write_final_outputs(options.out_dir, state, info);
     for (const AgentRecord& a : state.agents) result.admitted += a.admitted ? 1 : 0;
     result.terrain_sha256 = terrain_sha256(state.terrain);
@@ -358,6 +370,7 @@ struct WorldRuntime::Impl {
   std::optional<SensingService> sensing;
   std::vector<AgentLink> links;  ///< [id - 1]
   std::shared_ptr<bus::Signal> signal;
+  std::vector<double> step_ms;  ///< wall time of each lockstep step [ms]
   std::unique_ptr<bus::Reader<bus::AgentHello>> hellos;
   std::unique_ptr<bus::Writer<bus::Admission>> admissions;
   std::unique_ptr<bus::Writer<bus::WorldStatus>> status;

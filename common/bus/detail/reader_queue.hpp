@@ -15,7 +15,8 @@ namespace marsala::bus::detail {
 
 /// Keeps a volatile reader volatile on transient-local writers (topics.hpp): passes only samples whose source
 /// timestamp [ns since the epoch, the writer's wall clock] is not before the reader's creation. Transient-local
-/// readers pass everything. Writers on other hosts need clocks in sync to well under a step.
+/// readers pass everything. Across hosts, a writer whose clock lags by d loses what it writes within d of the
+/// reader's creation: keep clocks synchronised.
 class VolatileFilter {
  public:
   explicit VolatileFilter(Durability durability)

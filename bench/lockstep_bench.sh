@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Lockstep benchmark: the wall time of one world step with 1, 4 and 12 idle agent processes (behaviour "idle": an
+# empty request per frame), beside the raw DDS round trip measured in the same run, as a ratio.
+# Reports the world's per-step median and 90th percentile (summary.json) over --steps steps.
+# Usage: bench/lockstep_bench.sh [--dds cyclone|fastdds] [--steps N] [--teams "1 4 12"]
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${MARSALA_BUILD_DIR:-$root/build}"
+dds=cyclone steps=2000 teams="1 4 12"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --dds) dds="$2"; shift 2 ;;
+    --steps) steps="$2"; shift 2 ;;
+    --teams) teams="$2"; shift 2 ;;
+    -h|--help) sed -n '2,5p' "$0"; exit 0 ;;
+    *) echo "lockstep_bench.sh: unknown argument '$1'" >&2; exit 2 ;;
+  esac
+done
+[ -x "$build/bin/marsala-world" ] || "$root/deploy/build.sh" >/dev/null
+work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-lockstep.XXXXXX")"
+trap 'rm -rf "$work"' EXIT
+
+# A flat 20 x 20 m site with 12 idle robots in a row; the goal is out of everyone's way, so the run lasts --steps.
+scenario="$work/idle.pbtxt"
+{
+  echo 'name: "idle" description: "lockstep benchmark: idle robots on flat ground"'
+  echo 'terrain { generator: "flat" rows: 200 cols: 200 cell_size_m: 0.1 seed: 1 }'
+  echo 'robot_type { name: "idler" behaviour: "idle" body { kappa: 0.3 delta_m: 1.0 eps_m: 0.05 max_step_m: 0.2'
+  echo '  max_deposit_m3: 0.02 material_capacity_m3: 1.0 reach_m: 1.5 sensing_range_m: 4.0 proximity_range_m: 3.0'
+  echo '  cube_size_m: 0.05 } }'
+  for id in $(seq 1 12); do
+    echo "agent { id: $id robot_type: \"idler\" start { x_m: $((id + 2)).05 y_m: 5.05 } target { x_m: 10.05 y_m: 15.05 } }"
+  done
+  echo 'goal { x0_m: 18 y0_m: 18 x1_m: 19 y1_m: 19 min_height_m: 0 }'
+  echo "base { x_m: 3.05 y_m: 3.05 radius_m: 1.0 } max_steps: $steps step_deadline_s: 10 tile_size: 16 seed: 1"
+} >"$scenario"
+
+export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-lo.xml"
+field() { grep -o "\"$1\": *[^,}]*" "$2" | head -1 | sed 's/^[^:]*: *//; s/"//g'; }
+
+raw_us=$("$build/bench/bus_pingpong_bench" --benchmark_filter="BM_BusPingPong/$dds/" --benchmark_repetitions=3 \
+  --benchmark_report_aggregates_only=true 2>/dev/null | grep median | grep -o 'p50_us=[0-9.]*' | head -1 | cut -d= -f2)
+echo "raw DDS round trip ($dds, median of p50): ${raw_us} us"
+printf '%-7s %-16s %-14s %-8s %s\n' agents "step median ms" "step p90 ms" ratio "idle agent RSS (MB)"
+for n in $teams; do
+  out="$work/run-$n"
+  "$root/deploy/spawn.sh" --scenario "$scenario" --agents "$n" --dds "$dds" --out "$out" --quiet --timeout 600 &
+  spawn=$!
+  rss=0  # largest agent resident set seen while the run lasts [kB]
+  while kill -0 "$spawn" 2>/dev/null; do
+    now=$( (ps -C marsala-agent -o rss= || true) | sort -n | tail -1)
+    [ -n "$now" ] && [ "$now" -gt "$rss" ] && rss=$now
+    sleep 0.05
+  done
+  wait "$spawn" || { echo "lockstep_bench.sh: the run with $n agents failed; world log:" >&2; tail -5 "$out/logs/world.log" >&2; exit 1; }
+  median=$(field step_wall_median_ms "$out/summary.json")
+  p90=$(field step_wall_p90_ms "$out/summary.json")
+  ratio=$(awk -v m="$median" -v r="$raw_us" 'BEGIN { if (r > 0) printf "%.1f", m * 1000 / r; else print "-" }')
+  printf '%-7s %-16.3f %-14.3f %-8s %s\n' "$n" "$median" "$p90" "$ratio" "$(awk -v k="${rss:-0}" 'BEGIN{printf "%.1f", k/1024}')"
+done
