@@ -9,6 +9,7 @@
 #   determinism                                                      2 Cyclone runs + 1 Fast DDS run: same sha256
 #   rogue                                                            a misbehaving agent is rejected, run completes
 #   kill                                                             SIGKILL one of 3 agents mid-run, others finish
+#   monitor                                                          marsala-monitor tail follows a run to its end
 set -euo pipefail
 case_name="$1"
 domain="$2"
@@ -110,6 +111,18 @@ case "$case_name" in
     echo "$entry2" | grep -q '"dropped":true' || fail "agent 2 is not marked dropped: $entry2"
     [ "${accepted2:-0}" -gt 0 ] || fail "agent 2 was killed before it took part (accepted $accepted2)"
     echo "ok: agent 2 killed, dropped, the other two completed in $(field steps "$s") steps"
+    ;;
+  monitor)
+    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+    "$bin/marsala-monitor" tail --dds cyclone --domain "$domain" --events --timeout 120 >"$work/tail.txt" 2>&1 &
+    monitor=$!
+    s=$(run_spawn run 3 cyclone)
+    wait "$monitor" || { cat "$work/tail.txt"; fail "monitor tail exited non-zero"; }
+    expect_completed "$s" 3
+    grep -q "completed at step $(field steps "$s")" "$work/tail.txt" || { cat "$work/tail.txt"; fail "no final line"; }
+    lines=$(wc -l <"$work/tail.txt")
+    [ "$lines" -ge 10 ] || { cat "$work/tail.txt"; fail "tail printed only $lines lines"; }
+    echo "ok: monitor followed the run ($lines lines) and saw it complete"
     ;;
   *) echo "unknown case '$case_name'" >&2; exit 2 ;;
 esac
