@@ -21,6 +21,7 @@
 #include <string>
 
 #include "common/bus/detail/backends.hpp"
+#include "common/bus/detail/participant_base.hpp"
 #include "common/bus/detail/reader_queue.hpp"
 #include "common/bus/detail/topics.hpp"
 #include "common/bus/fastdds/fastdds_convert.hpp"
@@ -271,7 +272,9 @@ class FastDdsReader final : public Reader<T> {
   dds::DataReader* reader_ = nullptr;
 };
 
-class FastDdsParticipant final : public Participant {
+class FastDdsParticipant final : public ParticipantBase<FastDdsParticipant> {
+  friend class ParticipantBase<FastDdsParticipant>;
+
  public:
   explicit FastDdsParticipant(int domain_id) : context_(std::make_shared<Context>(domain_id)) {
     spdlog::debug("bus: Fast DDS participant in domain {}", domain_id);
@@ -289,20 +292,6 @@ class FastDdsParticipant final : public Participant {
     return std::make_unique<FastDdsReader<T>>(context_, options);
   }
 
-  // clang-format off
-  std::unique_ptr<Writer<AgentHello>> make_writer(Tag<AgentHello>, const EndpointOptions& o) override { return writer<AgentHello>(o); }
-  std::unique_ptr<Writer<Admission>> make_writer(Tag<Admission>, const EndpointOptions& o) override { return writer<Admission>(o); }
-  std::unique_ptr<Writer<SensorFrame>> make_writer(Tag<SensorFrame>, const EndpointOptions& o) override { return writer<SensorFrame>(o); }
-  std::unique_ptr<Writer<ActionRequest>> make_writer(Tag<ActionRequest>, const EndpointOptions& o) override { return writer<ActionRequest>(o); }
-  std::unique_ptr<Writer<WorldStatus>> make_writer(Tag<WorldStatus>, const EndpointOptions& o) override { return writer<WorldStatus>(o); }
-  std::unique_ptr<Writer<WorldEvent>> make_writer(Tag<WorldEvent>, const EndpointOptions& o) override { return writer<WorldEvent>(o); }
-  std::unique_ptr<Reader<AgentHello>> make_reader(Tag<AgentHello>, const EndpointOptions& o) override { return reader<AgentHello>(o); }
-  std::unique_ptr<Reader<Admission>> make_reader(Tag<Admission>, const EndpointOptions& o) override { return reader<Admission>(o); }
-  std::unique_ptr<Reader<SensorFrame>> make_reader(Tag<SensorFrame>, const EndpointOptions& o) override { return reader<SensorFrame>(o); }
-  std::unique_ptr<Reader<ActionRequest>> make_reader(Tag<ActionRequest>, const EndpointOptions& o) override { return reader<ActionRequest>(o); }
-  std::unique_ptr<Reader<WorldStatus>> make_reader(Tag<WorldStatus>, const EndpointOptions& o) override { return reader<WorldStatus>(o); }
-  std::unique_ptr<Reader<WorldEvent>> make_reader(Tag<WorldEvent>, const EndpointOptions& o) override { return reader<WorldEvent>(o); }
-  // clang-format on
 
  private:
   std::shared_ptr<Context> context_;

@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "common/bus/detail/backends.hpp"
+#include "common/bus/detail/participant_base.hpp"
 
 namespace marsala::bus::detail {
 namespace {
@@ -142,7 +143,9 @@ std::shared_ptr<Domain> domain(int domain_id) {
   return d;
 }
 
-class InProcessParticipant final : public Participant {
+class InProcessParticipant final : public ParticipantBase<InProcessParticipant> {
+  friend class ParticipantBase<InProcessParticipant>;
+
  public:
   explicit InProcessParticipant(int domain_id) : domain_id_(domain_id), domain_(domain(domain_id)) {}
   Vendor vendor() const override { return Vendor::kInProcess; }
@@ -164,20 +167,6 @@ class InProcessParticipant final : public Participant {
     return r;
   }
 
-  // clang-format off
-  std::unique_ptr<Writer<AgentHello>> make_writer(Tag<AgentHello>, const EndpointOptions& o) override { return writer<AgentHello>(o); }
-  std::unique_ptr<Writer<Admission>> make_writer(Tag<Admission>, const EndpointOptions& o) override { return writer<Admission>(o); }
-  std::unique_ptr<Writer<SensorFrame>> make_writer(Tag<SensorFrame>, const EndpointOptions& o) override { return writer<SensorFrame>(o); }
-  std::unique_ptr<Writer<ActionRequest>> make_writer(Tag<ActionRequest>, const EndpointOptions& o) override { return writer<ActionRequest>(o); }
-  std::unique_ptr<Writer<WorldStatus>> make_writer(Tag<WorldStatus>, const EndpointOptions& o) override { return writer<WorldStatus>(o); }
-  std::unique_ptr<Writer<WorldEvent>> make_writer(Tag<WorldEvent>, const EndpointOptions& o) override { return writer<WorldEvent>(o); }
-  std::unique_ptr<Reader<AgentHello>> make_reader(Tag<AgentHello>, const EndpointOptions& o) override { return reader<AgentHello>(o); }
-  std::unique_ptr<Reader<Admission>> make_reader(Tag<Admission>, const EndpointOptions& o) override { return reader<Admission>(o); }
-  std::unique_ptr<Reader<SensorFrame>> make_reader(Tag<SensorFrame>, const EndpointOptions& o) override { return reader<SensorFrame>(o); }
-  std::unique_ptr<Reader<ActionRequest>> make_reader(Tag<ActionRequest>, const EndpointOptions& o) override { return reader<ActionRequest>(o); }
-  std::unique_ptr<Reader<WorldStatus>> make_reader(Tag<WorldStatus>, const EndpointOptions& o) override { return reader<WorldStatus>(o); }
-  std::unique_ptr<Reader<WorldEvent>> make_reader(Tag<WorldEvent>, const EndpointOptions& o) override { return reader<WorldEvent>(o); }
-  // clang-format on
 
  private:
   int domain_id_;
