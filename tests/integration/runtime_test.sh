@@ -97,9 +97,9 @@ case "$case_name" in
         >"$out/logs/agent-$id.log" 2>&1 &
       pids+=($!)
     done
-    # Let the run get going, then kill agent 2 without warning.
-    for _ in $(seq 1 600); do grep -q "admitted agent 3" "$out/logs/world.log" 2>/dev/null && break; sleep 0.1; done
-    sleep 0.5  # the whole run takes about 2 s: agent 2 dies mid-run
+    # Kill agent 2 without warning as soon as it has deposited (events.log is written live): mid-run for sure.
+    for _ in $(seq 1 3000); do grep -q "agent 2 deposited" "$out/events.log" 2>/dev/null && break; sleep 0.02; done
+    grep -q "agent 2 deposited" "$out/events.log" || fail "agent 2 never deposited (see $out/logs)"
     kill -KILL "${pids[1]}"
     wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
     s="$out/summary.json"
