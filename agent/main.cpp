@@ -5,7 +5,6 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
 #include <csignal>
@@ -13,6 +12,7 @@
 #include <iostream>
 
 #include "agent/runtime/agent_runtime.hpp"
+#include "common/cli/command_line.hpp"
 #include "common/scenario/scenario.hpp"
 
 namespace {
@@ -39,12 +39,8 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--world-timeout", world_timeout_s, "give up when no frame comes for this long [s]")
       ->check(CLI::PositiveNumber);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
+  if (const auto code = marsala::cli::parse_command_line(app, argc, argv, "marsala-agent", std::cout, std::cerr))
+    return *code;
 
   auto logger = spdlog::stderr_color_mt("marsala-agent");
   spdlog::set_default_logger(logger);

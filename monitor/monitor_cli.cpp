@@ -1,10 +1,7 @@
 #include "monitor/monitor_cli.hpp"
 
 // CLI11 2.1's option conversions trip a false -Wmaybe-uninitialized at -O2; keep our own warnings on.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <CLI/CLI.hpp>
-#pragma GCC diagnostic pop
+#include "common/cli/command_line.hpp"
 
 #include <exception>
 #include <new>
@@ -19,7 +16,6 @@ namespace marsala::monitor {
 namespace {
 
 constexpr int kExitError = 1;
-constexpr int kExitUsage = 2;
 
 constexpr const char* kTailLegend =
     "Columns: step; live agents/all; mat = material on board of the live agents [m3]; dep = volume deposited\n"
@@ -67,21 +63,7 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       ->check(CLI::Range(1e-3, 1e6))
       ->capture_default_str();
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp&) {
-    out << app.help();
-    return 0;
-  } catch (const CLI::ParseError& e) {
-    // Subcommand --help arrives here too (as CallForHelp raised from the subcommand).
-    if (e.get_exit_code() == 0) {
-      for (const CLI::App* sub : app.get_subcommands()) out << sub->help();
-      if (app.get_subcommands().empty()) out << app.help();
-      return 0;
-    }
-    err << "marsala-monitor: " << e.what() << " (run with --help for usage)\n";
-    return kExitUsage;
-  }
+  if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-monitor", out, err)) return *code;
 
   try {
     auto participant = bus::make_participant({bus::vendor_from_string(dds), domain});

@@ -2,10 +2,10 @@
 
 #include <spdlog/spdlog.h>
 
-#include <CLI/CLI.hpp>
 #include <ostream>
 
 #include "common/bus/bus.hpp"
+#include "common/cli/command_line.hpp"
 #include "common/error.hpp"
 #include "common/scenario/scenario.hpp"
 #include "common/scenario/terrain_builder.hpp"
@@ -36,16 +36,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       ->check(CLI::Range(0.0, 86400.0))->capture_default_str();
   app.add_option("--max-steps", options.max_steps, "override the scenario's max_steps")->check(CLI::Range(1ull, 1ull << 40));
   app.add_flag("--quiet", quiet, "log warnings and errors only");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) {
-      out << app.help();
-      return 0;
-    }
-    err << "marsala-world: " << e.what() << " (run with --help for usage)\n";
-    return 2;
-  }
+  if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-world", out, err)) return *code;
 
   spdlog::set_pattern("%H:%M:%S.%e %^%l%$ world: %v");
   spdlog::set_level(quiet ? spdlog::level::warn : spdlog::level::info);

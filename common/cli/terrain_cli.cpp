@@ -1,10 +1,5 @@
 #include "common/cli/terrain_cli.hpp"
 
-// CLI11 2.1's pair conversion trips a false -Wmaybe-uninitialized at -O2; keep our own warnings on.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <CLI/CLI.hpp>
-#pragma GCC diagnostic pop
 
 #include <algorithm>
 #include <cstdint>
@@ -16,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/cli/command_line.hpp"
 #include "common/error.hpp"
 #include "common/grid/heightmap.hpp"
 #include "common/processing/deposition.hpp"
@@ -33,7 +29,6 @@ namespace marsala::cli {
 namespace {
 
 constexpr int kExitData = 1;
-constexpr int kExitUsage = 2;
 
 /// A usage error found after parsing (e.g. a bad --param); reported with exit code 2.
 class UsageError : public Error {
@@ -213,24 +208,7 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       ->capture_default_str();
   render->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp&) {
-    out << app.help();
-    return 0;
-  } catch (const CLI::CallForAllHelp&) {
-    out << app.help("", CLI::AppFormatMode::All);
-    return 0;
-  } catch (const CLI::ParseError& e) {
-    // Subcommand --help arrives here too (as CallForHelp raised from the subcommand).
-    if (e.get_exit_code() == 0) {
-      for (const CLI::App* sub : app.get_subcommands()) out << sub->help();
-      if (app.get_subcommands().empty()) out << app.help();
-      return 0;
-    }
-    err << "marsala-terrain: " << e.what() << " (run with --help for usage)\n";
-    return kExitUsage;
-  }
+  if (const auto code = parse_command_line(app, argc, argv, "marsala-terrain", out, err)) return *code;
 
   try {
     if (*generate) {
