@@ -28,8 +28,7 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const 
   const std::string who = "agent " + std::to_string(agent.id);
   bool answered = false;
   for (const bus::ActionRequest* r : requests) {
-    if (r->agent_id != agent.id || r->session != agent.session) {
-      // Forged or stale-session requests never take the agent's slot for the step: the real one still counts.
+    if (!carries_identity_of(agent, *r)) {
       ++agent.rejected;
       ++out.rejected;
       out.events.push_back(event(step, agent.id, bus::EventKind::kRejected,

@@ -215,8 +215,7 @@ struct WorldRuntime::Impl {
         std::vector<bus::ActionRequest> received = links[a.id - 1].requests->take();
         if (!a.alive) continue;  // a dropped agent's requests are read only to be discarded
         for (bus::ActionRequest& r : received) {
-          // Only a request with the agent's own identity answers for it (a forged one must not close its slot).
-          if (r.step == state.step && r.agent_id == a.id && r.session == a.session) answered[a.id - 1] = true;
+          if (r.step == state.step && carries_identity_of(a, r)) answered[a.id - 1] = true;
           submissions.push_back({a.id, std::move(r)});
         }
       }

@@ -45,6 +45,12 @@ struct AgentRecord {
   std::string last_reason;
 };
 
+/// True when `r` carries the agent's admitted identity (id and session): only such a request can answer for it in a
+/// step. A request with another identity on its partition is forged or stale and never takes its slot.
+inline bool carries_identity_of(const AgentRecord& agent, const bus::ActionRequest& r) {
+  return r.agent_id == agent.id && r.session == agent.session;
+}
+
 /// Everything the step function reads and changes.
 struct WorldState {
   grid::Heightmap terrain;              ///< authoritative heights [m]
