@@ -20,6 +20,12 @@ grid::GridGeometry world_geometry(const bus::Admission& admission) {
   return {admission.rows, admission.cols, admission.xll_m, admission.yll_m, admission.cell_size_m};
 }
 
+NavigabilityParams construction_params(const AgentContext& context) {
+  const Task& t = context.task;
+  return {t.construction_kappa.value_or(context.body.kappa), t.construction_width_m.value_or(context.body.delta_m),
+          t.construction_eps_m.value_or(context.body.eps_m)};
+}
+
 double neighbour_keep_out_m(double max_delta_m, double max_step_m) { return 0.5 * max_delta_m + max_step_m + 1e-6; }
 
 double cube_layer_m(const bus::BodyParams& body, double cell_size_m) {

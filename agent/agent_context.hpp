@@ -3,12 +3,26 @@
 // Everything an agent decides flows from this context and its own sensor frames.
 
 #include <cstdint>
+#include <optional>
+#include <string>
 
 #include "common/bus/messages.hpp"
 #include "common/grid/heightmap.hpp"
+#include "common/processing/goal_vector_map.hpp"
 #include "common/types.hpp"
 
 namespace marsala::agent {
+
+/// What the robot builds and how it works with the team (scenario robot type; defaults: build for its own body).
+struct Task {
+  std::optional<double> construction_kappa;    ///< slope the structure must keep [m/m]; default body kappa
+  std::optional<double> construction_eps_m;    ///< discontinuity it may keep [m]; default body eps
+  std::optional<double> construction_width_m;  ///< diameter of the band filled along the path [m]; default delta
+  double separation_m = 2.0;                   ///< pipeline: distance kept behind the front neighbour [m]
+  double lane_offset_m = 0.5;                  ///< pipeline: lanes this far right of the way [m]
+  std::string goal_synthesizer = "fixed_target";                  ///< by name
+  std::optional<processing::GoalVectorMapSpec> goal_vector_map;   ///< for "goal_vector_map"
+};
 
 /// The admitted agent: identity, body, the world's answer and team-wide margins.
 struct AgentContext {
@@ -21,7 +35,11 @@ struct AgentContext {
   /// neighbour_keep_out_m()).
   double neighbour_keep_out_m = 0.0;
   std::uint64_t seed = 1;           ///< scenario seed; behaviours that randomise seed from seed + agent_id
+  Task task;                        ///< what it builds, with whom, towards which goals
 };
+
+/// The construction parameters of a context: the task's, falling back to the body's (kappa, width as delta, eps).
+NavigabilityParams construction_params(const AgentContext& context);
 
 /// The navigability parameters (kappa [m/m], delta [m], eps [m]) of a body.
 NavigabilityParams navigability_params(const bus::BodyParams& body);

@@ -61,6 +61,13 @@ int main(int argc, char** argv) {
     config.body = type.body;
     config.neighbour_keep_out_m = agent::neighbour_keep_out_m(max_delta, max_step);
     config.seed = s.seed;
+    config.task.construction_kappa = type.construction.kappa;
+    config.task.construction_eps_m = type.construction.eps_m;
+    config.task.construction_width_m = type.construction.width_m;
+    config.task.separation_m = type.pipeline.separation_m;
+    config.task.lane_offset_m = type.pipeline.lane_offset_m;
+    config.task.goal_synthesizer = type.goal_synthesizer;
+    if (s.has_goal_vector_map) config.task.goal_vector_map = s.goal_vector_map;
     config.admit_timeout = std::chrono::milliseconds(static_cast<long long>(admit_timeout_s * 1000.0));
     config.world_timeout = std::chrono::milliseconds(static_cast<long long>(world_timeout_s * 1000.0));
 

@@ -34,8 +34,9 @@ Window sensing_window(const grid::GridGeometry& world, Position robot, double ra
   return {{world.rows - 1 - south_hi, col_lo}, south_hi - south_lo + 1, col_hi - col_lo + 1};
 }
 
-LocalMapSynthesizer::LocalMapSynthesizer(NavigabilityParams params, double sensing_range_m)
-    : mars_(params.kappa), navigability_(params), sensing_range_m_(sensing_range_m) {
+LocalMapSynthesizer::LocalMapSynthesizer(NavigabilityParams params, double sensing_range_m,
+                                         std::optional<double> construction_kappa)
+    : mars_(construction_kappa.value_or(params.kappa)), navigability_(params), sensing_range_m_(sensing_range_m) {
   if (!(sensing_range_m >= 0.0) || !std::isfinite(sensing_range_m))
     throw InvalidArgument("local map synthesizer: sensing range must be finite and >= 0 m, got " +
                           std::to_string(sensing_range_m));

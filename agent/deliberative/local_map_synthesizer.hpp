@@ -30,7 +30,8 @@ struct LocalMap {
   CellIndex offset;                  ///< world index of the window's top-left cell
   grid::Heightmap heights;           ///< the window [m], placed in the world frame; unknown cells hold the lowest known
   grid::CellMask known;              ///< 1 where the agent's map knows the cell
-  grid::Heightmap gap;               ///< MARS gap P_kappa[h] - h of the window [m]; 0 on unknown cells
+  grid::Heightmap gap;               ///< MARS gap P_kappa[h] - h of the window at the construction kappa [m]; 0 on
+                                     ///< unknown cells
   grid::CellMask blind;              ///< 1 where the cell's ball holds an unknown cell: it is never occupiable
   grid::CellMask occupiable;         ///< occupiable cells; never a blind one
   grid::CellMask navigable;          ///< occupiable cells 8-connected to the robot's cell
@@ -71,9 +72,12 @@ Window sensing_window(const grid::GridGeometry& world, Position robot, double ra
 /// Builds augmented local maps for one robot.
 class LocalMapSynthesizer {
  public:
-  /// params: the robot's kappa [m/m], delta [m], eps [m]; sensing_range_m: half-side of its sensing window [m].
-  /// Throws InvalidArgument on invalid parameters.
-  LocalMapSynthesizer(NavigabilityParams params, double sensing_range_m);
+  /// params: the robot's kappa [m/m], delta [m], eps [m] (occupiable and navigable cells); sensing_range_m:
+  /// half-side of its sensing window [m]; construction_kappa: the slope of the MARS whose gap the robot fills [m/m]
+  /// (default: params.kappa; a payload's smaller kappa when it builds for one). Throws InvalidArgument on invalid
+  /// parameters.
+  LocalMapSynthesizer(NavigabilityParams params, double sensing_range_m,
+                      std::optional<double> construction_kappa = std::nullopt);
 
   /// The augmented local map around `robot` [m] heading for `target` [m]; throws InvalidArgument when the robot is
   /// off the grid.

@@ -50,9 +50,11 @@ bool DepositionManager::in_territory(const deliberative::LocalMap& map, CellInde
   return true;
 }
 
-DepositionParams deposition_params(const bus::BodyParams& body, double cell_size_m, double neighbour_keep_out_m) {
+DepositionParams deposition_params(const bus::BodyParams& body, double cell_size_m, double neighbour_keep_out_m,
+                                   std::optional<double> footprint_m) {
   DepositionParams p;
   p.navigability = navigability_params(body);
+  p.footprint_m = footprint_m.value_or(body.delta_m);
   p.reach_m = body.reach_m;
   p.max_deposit_m3 = body.max_deposit_m3;
   p.cube_layer_m = cube_layer_m(body, cell_size_m);
@@ -65,6 +67,7 @@ DepositionManager::DepositionManager(DepositionParams params)
     : params_(params), navigability_(params.navigability) {
   if (!positive_finite(params.reach_m) || !positive_finite(params.max_deposit_m3) ||
       !positive_finite(params.cube_layer_m) || !positive_finite(params.max_height_m) ||
+      !positive_finite(params.footprint_m) ||
       !(params.neighbour_keep_out_m >= 0.0) || !std::isfinite(params.neighbour_keep_out_m) ||
       !(params.neighbour_step_m >= 0.0) || !std::isfinite(params.neighbour_step_m))
     throw InvalidArgument("deposition manager: reach (" + std::to_string(params.reach_m) + " m), max deposit (" +
@@ -86,7 +89,7 @@ std::vector<DepositionCandidate> DepositionManager::candidates(const deliberativ
   const double layer_volume = q * area;
   const int max_layers = static_cast<int>(std::floor(params_.max_height_m / q + 1e-9));
   const double clear_m = 0.5 * params_.navigability.delta_m + kUnderRobotMarginM;
-  const auto ball = sorted_ball(params_.navigability.delta_m / (2.0 * cs));
+  const auto ball = sorted_ball(params_.footprint_m / (2.0 * cs));
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(map.rows()) * map.cols(), 0);
   const std::optional<CellIndex> self_cell = map.world.cell_at(neighbours.self);
   double total_m3 = 0.0;

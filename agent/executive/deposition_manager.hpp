@@ -22,7 +22,8 @@ namespace marsala::agent::executive {
 
 /// The body's limits that bound a step's depositions.
 struct DepositionParams {
-  NavigabilityParams navigability;      ///< kappa [m/m], delta [m], eps [m]
+  NavigabilityParams navigability;      ///< the robot's kappa [m/m], delta [m], eps [m]
+  double footprint_m = 1.0;             ///< diameter of the band filled around each path cell [m] (construction width)
   double reach_m = 1.2;                 ///< manipulator reach from the robot's centre [m]
   double max_deposit_m3 = 0.01;         ///< deposition threshold per step [m^3]
   double cube_layer_m = 0.0125;         ///< q = cube^3 / cs^2: the height of one cube spread over a cell [m]
@@ -31,8 +32,10 @@ struct DepositionParams {
   double neighbour_step_m = 0.2;        ///< how far a neighbour may move this step [m]
 };
 
-/// The deposition parameters of a body on a grid of cell_size_m [m], with the team's keep-out [m].
-DepositionParams deposition_params(const bus::BodyParams& body, double cell_size_m, double neighbour_keep_out_m);
+/// The deposition parameters of a body on a grid of cell_size_m [m], with the team's keep-out [m]; the footprint is
+/// footprint_m when given, else the body's delta.
+DepositionParams deposition_params(const bus::BodyParams& body, double cell_size_m, double neighbour_keep_out_m,
+                                   std::optional<double> footprint_m = std::nullopt);
 
 /// The robots around this one at the start of the step, as its frame reports them.
 struct Neighbourhood {

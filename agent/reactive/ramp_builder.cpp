@@ -64,10 +64,12 @@ struct RampBuilder::Modules {
 
 RampBuilder::RampBuilder(const AgentContext& context, RampBuilderOptions options)
     : context_(context),
-      options_(std::move(options)),
-      goal_(deliberative::make_goal_synthesizer(options_.goal_synthesizer)) {
-  // Fail on an invalid body now rather than at admission.
+      options_(std::move(options)) {
+  // Fail on an invalid body, construction or goal synthesizer name now rather than at admission.
   (void)processing::NavigabilityProcessor(navigability_params(context_.body));
+  (void)processing::NavigabilityProcessor(construction_params(context_));
+  if (!deliberative::is_goal_synthesizer(context_.task.goal_synthesizer))
+    (void)deliberative::make_goal_synthesizer(context_.task.goal_synthesizer, context_);  // throws, listing names
 }
 
 RampBuilder::~RampBuilder() = default;
@@ -82,21 +84,25 @@ void RampBuilder::on_admission(const bus::Admission& admission) {
   context_.admission = admission;
   const grid::GridGeometry world = world_geometry(admission);
   const bus::BodyParams& body = context_.body;
+  const NavigabilityParams build = construction_params(context_);
+  bus::BodyParams footprint = body;
+  footprint.delta_m = build.delta_m;
   deliberative::PlannerParams planner =
-      options_.planner ? *options_.planner : deliberative::default_planner_params(body, world.cell_size_m);
+      options_.planner ? *options_.planner : deliberative::default_planner_params(footprint, world.cell_size_m);
   deliberative::PlannerParams router = planner;
   router.alpha = 0.0;
   router.beta = 1.0;
   const double layer_m = cube_layer_m(body, world.cell_size_m);
   modules_ = std::make_unique<Modules>(Modules{
       executive::MappingSystem(world, admission.tile_size),
-      deliberative::LocalMapSynthesizer(navigability_params(body), body.sensing_range_m),
+      deliberative::LocalMapSynthesizer(navigability_params(body), body.sensing_range_m, build.kappa),
       deliberative::NavigablePathPlanner(planner), deliberative::NavigablePathPlanner(router),
       executive::ActionManager(body.max_step_m),
       executive::DepositionManager(
-          executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m)),
+          executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m, build.delta_m)),
       layer_m * world.cell_size_m * world.cell_size_m,
       static_cast<int>(std::ceil((body.reach_m + body.delta_m) / body.max_step_m)) + 1});
+  goal_ = deliberative::make_goal_synthesizer(context_.task.goal_synthesizer, context_);
   state_ = RampState::kSurvey;
 }
 
@@ -112,7 +118,8 @@ bus::ActionRequest RampBuilder::decide(const bus::SensorFrame& frame) {
   } else {
     modules_->map.integrate(frame);
     const Position robot{frame.x_m, frame.y_m};
-    const Position target = goal_->target(context_.admission, robot);
+    const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
+    const Position target = goal.value_or(robot);  // nothing left to build towards: stay
     const deliberative::LocalMap local = modules_->synthesizer.synthesize(modules_->map, robot, target);
     trace_.window_offset = local.offset;
     trace_.local_goal = local.goal;

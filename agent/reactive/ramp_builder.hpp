@@ -58,10 +58,10 @@ std::string to_string(RampState state);
 /// The inverse of to_string; throws InvalidArgument listing the valid names.
 RampState ramp_state_from_string(const std::string& name);
 
-/// Options of the ramp builder.
+/// Options of the ramp builder. The goal synthesizer is the context's task.goal_synthesizer; what it builds (MARS
+/// kappa, band width) is construction_params(context).
 struct RampBuilderOptions {
-  std::string goal_synthesizer = "fixed_target";       ///< by name (deliberative::make_goal_synthesizer)
-  std::optional<deliberative::PlannerParams> planner;  ///< default: default_planner_params(body, cell size)
+  std::optional<deliberative::PlannerParams> planner;  ///< default: default_planner_params for the construction width
 };
 
 /// What the last decision saw and chose (for tests, logs and measurements).
@@ -82,7 +82,7 @@ struct DecisionTrace {
 /// Builds a navigable ramp to its target; see the transition table above.
 class RampBuilder final : public Behaviour {
  public:
-  /// Throws InvalidArgument for an unknown goal synthesizer or an invalid body.
+  /// Throws InvalidArgument for an unknown goal synthesizer, an invalid body or construction.
   explicit RampBuilder(const AgentContext& context, RampBuilderOptions options = {});
   ~RampBuilder() override;
 

@@ -50,6 +50,7 @@ AgentRuntime::AgentRuntime(bus::Participant& participant, RuntimeConfig config)
                                      ? config_.neighbour_keep_out_m
                                      : neighbour_keep_out_m(config_.body.delta_m, config_.body.max_step_m);
   context.seed = config_.seed;
+  context.task = config_.task;
   behaviour_ = reactive::make_behaviour(config_.behaviour, context);
 }
 

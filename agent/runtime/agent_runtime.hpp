@@ -30,6 +30,7 @@ struct RuntimeConfig {
   std::uint64_t session = 0;                        ///< 0: a random one (random_session())
   double neighbour_keep_out_m = 0.0;                ///< 0: delta/2 + max_step of this body [m]
   std::uint64_t seed = 1;                           ///< scenario seed
+  Task task;                                        ///< what it builds and towards which goals
   std::chrono::milliseconds hello_period{200};      ///< between hellos until admitted
   std::chrono::milliseconds admit_timeout{60000};   ///< give up when not admitted by then
   std::chrono::milliseconds world_timeout{60000};   ///< give up when no frame comes for this long

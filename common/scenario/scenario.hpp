@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/bus/messages.hpp"
+#include "common/processing/goal_vector_map.hpp"
 
 namespace marsala::scenario {
 
@@ -29,11 +30,27 @@ struct TerrainSource {
   bool zero_base = false;                    ///< shift so the lowest cell is at 0 m
 };
 
-/// A kind of robot: body parameters and the reactive behaviour that drives it.
+/// What a robot builds: a structure navigable for kappa and eps, over a band width_m wide along its path.
+struct Construction {
+  double kappa = 0.3;                        ///< [m/m]
+  double eps_m = 0.05;                       ///< [m]
+  double width_m = 1.0;                      ///< [m]
+};
+
+/// The construction pipeline of the "path_builder" behaviour (paper §V-A, Fig. 4).
+struct Pipeline {
+  double separation_m = 2.0;                 ///< a follower keeps at least this far behind its front neighbour [m]
+  double lane_offset_m = 0.5;                ///< forward lane right of the path, backward lane left [m]
+};
+
+/// A kind of robot: body parameters, the reactive behaviour that drives it, and what it builds.
 struct RobotType {
   std::string name;                          ///< e.g. "husky"
   std::string behaviour = "ramp_builder";    ///< reactive behaviour by name (agent registry)
   bus::BodyParams body;
+  Construction construction;                 ///< defaults to the body's kappa, eps and delta
+  Pipeline pipeline;
+  std::string goal_synthesizer = "fixed_target";  ///< goal synthesizer by name (agent registry)
 };
 
 /// One agent of the team: agent id (slot index + 1), robot type, start and target [m].
@@ -50,6 +67,35 @@ struct Goal {
   double min_height_m = -1e9;
 };
 
+/// How the world decides that a run is complete.
+enum class CompletionKind : std::uint8_t {
+  kAgentsAtGoal = 0,   ///< every live agent inside the goal rectangle (Scenario::goal)
+  kPayloadPath = 1,    ///< a payload has a navigable path (Scenario::payload_path)
+  kLevelSite = 2,      ///< the site is level (Scenario::site)
+};
+/// "agents_at_goal", "payload_path", "level_site".
+std::string to_string(CompletionKind kind);
+
+/// A payload robot's navigable path from (from_x, from_y) to (to_x, to_y) [m] for kappa, delta, eps.
+struct PayloadPath {
+  double kappa = 0.2, delta_m = 2.0, eps_m = 0.05;
+  double from_x_m = 0.0, from_y_m = 0.0, to_x_m = 0.0, to_y_m = 0.0;
+  std::uint32_t check_every_steps = 10;
+};
+
+/// A level site: [x0, x1] x [y0, y1] [m], at least min_fraction of its cells occupiable (kappa, delta, eps) and
+/// connected.
+struct Site {
+  double x0_m = 0.0, y0_m = 0.0, x1_m = 0.0, y1_m = 0.0;
+  double kappa = 0.1, delta_m = 1.0, eps_m = 0.05;
+  double min_fraction = 1.0;
+  std::uint32_t check_every_steps = 10;
+};
+
+/// The goal vector map's specification (paper §V-B, Fig. 6), compiled by processing::GoalVectorMap.
+using GoalVectorMapSpec = processing::GoalVectorMapSpec;
+using processing::Heading;
+
 /// The base station: material is refilled only within radius of its centre.
 struct BaseStation {
   double x_m = 0.0, y_m = 0.0, radius_m = 1.0;
@@ -62,7 +108,13 @@ struct Scenario {
   TerrainSource terrain;
   std::vector<RobotType> robot_types;
   std::vector<AgentSlot> slots;              ///< slots[i].id == i + 1
-  Goal goal;
+  CompletionKind completion = CompletionKind::kAgentsAtGoal;
+  Goal goal;                                 ///< kAgentsAtGoal
+  PayloadPath payload_path;                  ///< kPayloadPath
+  Site site;                                 ///< kLevelSite
+  bool has_goal_vector_map = false;
+  GoalVectorMapSpec goal_vector_map;
+  double start_jitter_m = 0.0;               ///< the world moves each start by up to this much (seeded) [m]
   BaseStation base;
   std::uint64_t max_steps = 5000;
   double step_deadline_s = 10.0;

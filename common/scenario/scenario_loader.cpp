@@ -166,6 +166,27 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     t.body = to_body(rp.body());
     const std::string problem = body_problem(t.body);
     if (!problem.empty()) check.fail(field + ".body", problem);
+    const proto::Construction& cp = rp.construction();
+    t.construction.kappa = cp.has_kappa() ? check.positive(field + ".construction.kappa", cp.kappa()) : t.body.kappa;
+    t.construction.eps_m = cp.has_eps_m() ? check.finite(field + ".construction.eps_m", cp.eps_m()) : t.body.eps_m;
+    if (t.construction.eps_m < 0.0) check.fail(field + ".construction.eps_m", "must be >= 0");
+    t.construction.width_m =
+        cp.has_width_m() ? check.positive(field + ".construction.width_m", cp.width_m()) : t.body.delta_m;
+    if (t.construction.kappa > t.body.kappa)
+      check.fail(field + ".construction.kappa", format(t.construction.kappa) + " exceeds the body's kappa " +
+                                                    format(t.body.kappa) + ": the builder could not climb what it builds");
+    if (t.construction.width_m > 2.0 * t.body.reach_m + t.body.delta_m)
+      check.fail(field + ".construction.width_m", format(t.construction.width_m) + " is wider than the robot can reach " +
+                                                      "from its path (delta + 2 reach = " +
+                                                      format(2.0 * t.body.reach_m + t.body.delta_m) + " m)");
+    const proto::Pipeline& pp = rp.pipeline();
+    if (pp.has_separation_m()) t.pipeline.separation_m = check.positive(field + ".pipeline.separation_m", pp.separation_m());
+    if (pp.has_lane_offset_m()) t.pipeline.lane_offset_m = check.finite(field + ".pipeline.lane_offset_m", pp.lane_offset_m());
+    if (t.pipeline.lane_offset_m < 0.0) check.fail(field + ".pipeline.lane_offset_m", "must be >= 0");
+    if (rp.has_goal_synthesizer()) t.goal_synthesizer = rp.goal_synthesizer();
+    if (t.goal_synthesizer.empty()) check.fail(field + ".goal_synthesizer", "must not be empty");
+    if (t.goal_synthesizer == "goal_vector_map" && !p.has_goal_vector_map())
+      check.fail(field + ".goal_synthesizer", "'goal_vector_map' needs the scenario's goal_vector_map block");
     s.robot_types.push_back(std::move(t));
   }
 
@@ -196,14 +217,78 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     s.slots.push_back(slot);
   }
 
-  if (!p.has_goal()) check.fail("goal", "missing");
-  s.goal.x0_m = check.finite("goal.x0_m", p.goal().x0_m());
-  s.goal.y0_m = check.finite("goal.y0_m", p.goal().y0_m());
-  s.goal.x1_m = check.finite("goal.x1_m", p.goal().x1_m());
-  s.goal.y1_m = check.finite("goal.y1_m", p.goal().y1_m());
-  if (!(s.goal.x0_m < s.goal.x1_m) || !(s.goal.y0_m < s.goal.y1_m))
-    check.fail("goal", "the rectangle needs x0_m < x1_m and y0_m < y1_m");
-  if (p.goal().has_min_height_m()) s.goal.min_height_m = check.finite("goal.min_height_m", p.goal().min_height_m());
+  const int completions = (p.has_goal() ? 1 : 0) + (p.has_payload_path() ? 1 : 0) + (p.has_site() ? 1 : 0);
+  if (completions != 1) check.fail("goal", "give exactly one of 'goal', 'payload_path' and 'site' (how the run completes)");
+  if (p.has_goal()) {
+    s.completion = CompletionKind::kAgentsAtGoal;
+    s.goal.x0_m = check.finite("goal.x0_m", p.goal().x0_m());
+    s.goal.y0_m = check.finite("goal.y0_m", p.goal().y0_m());
+    s.goal.x1_m = check.finite("goal.x1_m", p.goal().x1_m());
+    s.goal.y1_m = check.finite("goal.y1_m", p.goal().y1_m());
+    if (!(s.goal.x0_m < s.goal.x1_m) || !(s.goal.y0_m < s.goal.y1_m))
+      check.fail("goal", "the rectangle needs x0_m < x1_m and y0_m < y1_m");
+    if (p.goal().has_min_height_m()) s.goal.min_height_m = check.finite("goal.min_height_m", p.goal().min_height_m());
+  }
+  if (p.has_payload_path()) {
+    s.completion = CompletionKind::kPayloadPath;
+    const proto::PayloadPath& pp = p.payload_path();
+    PayloadPath& path = s.payload_path;
+    const bus::BodyParams body = to_body(pp.body());
+    path.kappa = check.positive("payload_path.body.kappa", body.kappa);
+    path.delta_m = check.positive("payload_path.body.delta_m", body.delta_m);
+    path.eps_m = check.finite("payload_path.body.eps_m", body.eps_m);
+    if (path.eps_m < 0.0) check.fail("payload_path.body.eps_m", "must be >= 0");
+    if (!pp.has_from()) check.fail("payload_path.from", "missing");
+    if (!pp.has_to()) check.fail("payload_path.to", "missing");
+    path.from_x_m = check.finite("payload_path.from.x_m", pp.from().x_m());
+    path.from_y_m = check.finite("payload_path.from.y_m", pp.from().y_m());
+    path.to_x_m = check.finite("payload_path.to.x_m", pp.to().x_m());
+    path.to_y_m = check.finite("payload_path.to.y_m", pp.to().y_m());
+    if (pp.has_check_every_steps()) path.check_every_steps = pp.check_every_steps();
+    if (path.check_every_steps == 0) check.fail("payload_path.check_every_steps", "must be >= 1");
+  }
+  if (p.has_site()) {
+    s.completion = CompletionKind::kLevelSite;
+    const proto::Site& sp = p.site();
+    Site& site = s.site;
+    site.x0_m = check.finite("site.x0_m", sp.x0_m());
+    site.y0_m = check.finite("site.y0_m", sp.y0_m());
+    site.x1_m = check.finite("site.x1_m", sp.x1_m());
+    site.y1_m = check.finite("site.y1_m", sp.y1_m());
+    if (!(site.x0_m < site.x1_m) || !(site.y0_m < site.y1_m))
+      check.fail("site", "the rectangle needs x0_m < x1_m and y0_m < y1_m");
+    if (sp.has_kappa()) site.kappa = check.positive("site.kappa", sp.kappa());
+    if (sp.has_delta_m()) site.delta_m = check.positive("site.delta_m", sp.delta_m());
+    if (sp.has_eps_m()) site.eps_m = check.finite("site.eps_m", sp.eps_m());
+    if (site.eps_m < 0.0) check.fail("site.eps_m", "must be >= 0");
+    if (sp.has_min_fraction()) site.min_fraction = check.finite("site.min_fraction", sp.min_fraction());
+    if (!(site.min_fraction > 0.0 && site.min_fraction <= 1.0))
+      check.fail("site.min_fraction", format(site.min_fraction) + " must be in (0, 1]");
+    if (sp.has_check_every_steps()) site.check_every_steps = sp.check_every_steps();
+    if (site.check_every_steps == 0) check.fail("site.check_every_steps", "must be >= 1");
+  }
+  if (p.has_goal_vector_map()) {
+    const proto::GoalVectorMap& gp = p.goal_vector_map();
+    GoalVectorMapSpec& map = s.goal_vector_map;
+    s.has_goal_vector_map = true;
+    map.x0_m = check.finite("goal_vector_map.x0_m", gp.x0_m());
+    map.y0_m = check.finite("goal_vector_map.y0_m", gp.y0_m());
+    map.x1_m = check.finite("goal_vector_map.x1_m", gp.x1_m());
+    map.y1_m = check.finite("goal_vector_map.y1_m", gp.y1_m());
+    if (!(map.x0_m < map.x1_m) || !(map.y0_m < map.y1_m))
+      check.fail("goal_vector_map", "the rectangle needs x0_m < x1_m and y0_m < y1_m");
+    map.strip_width_m = check.positive("goal_vector_map.strip_width_m", gp.strip_width_m());
+    map.arrow_length_m = check.positive("goal_vector_map.arrow_length_m", gp.arrow_length_m());
+    if (gp.has_heading()) {
+      try {
+        map.heading = processing::heading_from_string(gp.heading());
+      } catch (const InvalidArgument& e) {
+        check.fail("goal_vector_map.heading", e.what());
+      }
+    }
+  }
+  if (p.has_start_jitter_m()) s.start_jitter_m = check.finite("start_jitter_m", p.start_jitter_m());
+  if (s.start_jitter_m < 0.0) check.fail("start_jitter_m", "must be >= 0");
 
   if (p.has_base()) {
     s.base.x_m = check.finite("base.x_m", p.base().x_m());
@@ -229,6 +314,15 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
 }
 
 }  // namespace
+
+std::string to_string(CompletionKind kind) {
+  switch (kind) {
+    case CompletionKind::kAgentsAtGoal: return "agents_at_goal";
+    case CompletionKind::kPayloadPath: return "payload_path";
+    case CompletionKind::kLevelSite: return "level_site";
+  }
+  return "unknown";
+}
 
 Scenario parse_scenario(const std::string& text, const std::string& source_name) {
   proto::Scenario message;

@@ -88,10 +88,23 @@ void check_placement(const Scenario& s, const grid::GridGeometry& g) {
     on_grid(field + ".target", slot.target_x_m, slot.target_y_m);
   }
   on_grid("base", s.base.x_m, s.base.y_m);
-  const Goal& goal = s.goal;
-  if (goal.x0_m < g.xll_m || goal.x1_m > x1 || goal.y0_m < g.yll_m || goal.y1_m > y1)
-    fail("goal", "[" + format(goal.x0_m) + ", " + format(goal.x1_m) + "] x [" + format(goal.y0_m) + ", " +
-                     format(goal.y1_m) + "] m is not inside the terrain");
+  const auto inside = [&](const std::string& field, double x0, double y0, double xa, double ya) {
+    if (x0 < g.xll_m || xa > x1 || y0 < g.yll_m || ya > y1)
+      fail(field, "[" + format(x0) + ", " + format(xa) + "] x [" + format(y0) + ", " + format(ya) +
+                      "] m is not inside the terrain");
+  };
+  switch (s.completion) {
+    case CompletionKind::kAgentsAtGoal: inside("goal", s.goal.x0_m, s.goal.y0_m, s.goal.x1_m, s.goal.y1_m); break;
+    case CompletionKind::kPayloadPath:
+      on_grid("payload_path.from", s.payload_path.from_x_m, s.payload_path.from_y_m);
+      on_grid("payload_path.to", s.payload_path.to_x_m, s.payload_path.to_y_m);
+      break;
+    case CompletionKind::kLevelSite: inside("site", s.site.x0_m, s.site.y0_m, s.site.x1_m, s.site.y1_m); break;
+  }
+  if (s.has_goal_vector_map) {
+    const GoalVectorMapSpec& m = s.goal_vector_map;
+    inside("goal_vector_map", m.x0_m, m.y0_m, m.x1_m, m.y1_m);
+  }
 }
 
 }  // namespace marsala::scenario

@@ -26,6 +26,7 @@ LocalMap make_map(const grid::Heightmap& heights, const grid::Heightmap& gap, Na
 DepositionParams params(double delta_m = 0.4, double max_deposit_m3 = 0.02) {
   DepositionParams p;
   p.navigability = {0.5, delta_m, 0.05};
+  p.footprint_m = delta_m;
   p.reach_m = 1.5;
   p.max_deposit_m3 = max_deposit_m3;
   p.cube_layer_m = kQ;

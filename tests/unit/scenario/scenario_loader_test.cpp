@@ -195,7 +195,8 @@ TEST(ScenarioLoader, BadValuesNameTheField) {
             std::string::npos);
   EXPECT_NE(invalid(edit("goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }", "goal { x0_m: 9 y0_m: 4 x1_m: 16 y1_m: 6 }")).find("not inside the terrain"),
             std::string::npos);
-  EXPECT_NE(invalid(edit("goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }", "")).find("goal: missing"), std::string::npos);
+  EXPECT_NE(invalid(edit("goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }", "")).find("goal: give exactly one of"),
+            std::string::npos);
   EXPECT_NE(invalid(edit("name: \"mini\"", "name: \"a b\"")).find("name"), std::string::npos);
   EXPECT_NE(invalid(edit("name: \"mini\"", "")).find("name"), std::string::npos);
   EXPECT_NE(invalid(edit("generator: \"flat\"", "generator: \"flat\" file: \"x.asc\"")).find("exactly one"), std::string::npos);
