@@ -1,5 +1,8 @@
 #include "agent/deliberative/goal_synthesizer.hpp"
 
+#include <cmath>
+#include <string>
+
 #include "common/error.hpp"
 
 namespace marsala::agent::deliberative {
@@ -15,8 +18,77 @@ GoalVectorMapSynthesizer::GoalVectorMapSynthesizer(const AgentContext& context)
            world_geometry(context.admission)),
       finished_(map_.arrows().size(), false) {}
 
-std::optional<Position> GoalVectorMapSynthesizer::target(const GoalQuery& /*query*/) {
-  throw InvalidArgument("goal_vector_map: not built yet");
+namespace {
+
+double distance2(Position a, Position b) {
+  const double dx = a.x - b.x;
+  const double dy = a.y - b.y;
+  return dx * dx + dy * dy;
+}
+
+// Within half a cell (Chebyshev) of p; the tolerance keeps a robot placed on a cell centre from missing it by a
+// rounding error.
+bool stands_on(Position robot, Position p, double cell_size_m) {
+  const double half = 0.5 * cell_size_m + 1e-9;
+  return std::abs(robot.x - p.x) <= half && std::abs(robot.y - p.y) <= half;
+}
+
+// A neighbour stands nearer to `tail` than the robot does (an equal distance counts when its id is lower): that
+// neighbour takes the tail.
+bool neighbour_takes(Position tail, const GoalQuery& query, std::uint32_t self_id) {
+  const double mine = distance2(query.robot, tail);
+  for (const bus::Neighbour& n : query.neighbours) {
+    if (n.agent_id == self_id) continue;
+    const double theirs = distance2({n.x_m, n.y_m}, tail);
+    if (theirs < mine || (theirs == mine && n.agent_id < self_id)) return true;
+  }
+  return false;
+}
+
+// The nearest unfinished tail that no neighbour takes. When neighbours take every unfinished tail the robot still
+// has work, so it takes the nearest unfinished one rather than stopping. nullopt when every arrow is finished.
+std::optional<std::size_t> pick_tail(const processing::GoalVectorMap& map, const std::vector<bool>& finished,
+                                     const GoalQuery& query, std::uint32_t self_id) {
+  std::vector<bool> excluded = finished;
+  for (std::size_t i = 0; i < excluded.size(); ++i)
+    if (!excluded[i] && neighbour_takes(map.arrows()[i].tail, query, self_id)) excluded[i] = true;
+  if (const std::optional<std::size_t> free = map.nearest_free_tail(query.robot, excluded)) return free;
+  return map.nearest_free_tail(query.robot, finished);
+}
+
+}  // namespace
+
+std::optional<Position> GoalVectorMapSynthesizer::target(const GoalQuery& query) {
+  if (!std::isfinite(query.robot.x) || !std::isfinite(query.robot.y))
+    throw InvalidArgument("goal synthesizer 'goal_vector_map' of agent " + std::to_string(self_id_) +
+                          ": the robot's position (" + std::to_string(query.robot.x) + ", " +
+                          std::to_string(query.robot.y) + ") m is not finite");
+  const std::vector<processing::GoalArrow>& arrows = map_.arrows();
+  // Every pass returns, reaches a tail (once per pick) or finishes an arrow, so the loop ends.
+  for (;;) {
+    // A tail still ahead is given up as soon as a neighbour stands nearer to it, with the same rule that picks
+    // tails: two robots that see each other never head for the same tail.
+    if (!current_ || (to_tail_ && !stands_on(query.robot, arrows[*current_].tail, cell_size_m_) &&
+                      neighbour_takes(arrows[*current_].tail, query, self_id_))) {
+      current_ = pick_tail(map_, finished_, query, self_id_);
+      to_tail_ = true;
+      if (!current_) return std::nullopt;
+    }
+    const processing::GoalArrow& arrow = arrows[*current_];
+    if (to_tail_) {
+      if (!stands_on(query.robot, arrow.tail, cell_size_m_)) return arrow.tail;
+      to_tail_ = false;
+    }
+    if (!stands_on(query.robot, arrow.head, cell_size_m_)) return arrow.head;
+    finished_[*current_] = true;
+    const std::optional<std::size_t> next = map_.next(*current_);
+    if (next && !finished_[*next]) {
+      current_ = next;  // its tail is where the robot stands
+      to_tail_ = false;
+    } else {
+      current_.reset();
+    }
+  }
 }
 
 GoalSynthesizerRegistry make_goal_synthesizer_registry() { return GoalSynthesizerRegistry("goal synthesizer"); }

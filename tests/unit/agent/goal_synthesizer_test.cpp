@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <utility>
+
 #include "common/error.hpp"
 
 namespace marsala::agent::deliberative {
@@ -38,6 +41,198 @@ TEST(GoalSynthesizer, RegistryListsValidNamesOnAnUnknownOne) {
   EXPECT_THROW(register_builtins(registry), InvalidArgument);  // registered twice
   EXPECT_THROW(registry.add("", [](const AgentContext& c) { return std::make_unique<FixedTarget>(c); }),
                InvalidArgument);
+}
+
+// World 12 x 12 cells of 1 m at the origin; site [2, 10] x [2, 6], strips 2 m, arrows 4 m east:
+//   arrow 0: (2.5, 3.5) -> (6.5, 3.5)   arrow 1: (6.5, 3.5) -> (9.5, 3.5)   (strip 0)
+//   arrow 2: (2.5, 5.5) -> (6.5, 5.5)   arrow 3: (6.5, 5.5) -> (9.5, 5.5)   (strip 1)
+AgentContext site_context(std::uint32_t id) {
+  AgentContext c;
+  c.agent_id = id;
+  c.admission.agent_id = id;
+  c.admission.rows = 12;
+  c.admission.cols = 12;
+  c.admission.cell_size_m = 1.0;
+  c.task.goal_synthesizer = "goal_vector_map";
+  processing::GoalVectorMapSpec spec;
+  spec.x0_m = 2.0;
+  spec.y0_m = 2.0;
+  spec.x1_m = 10.0;
+  spec.y1_m = 6.0;
+  spec.strip_width_m = 2.0;
+  spec.arrow_length_m = 4.0;
+  spec.heading = processing::Heading::kEast;
+  c.task.goal_vector_map = spec;
+  return c;
+}
+
+bus::Neighbour neighbour(std::uint32_t id, double x, double y) {
+  bus::Neighbour n;
+  n.agent_id = id;
+  n.x_m = x;
+  n.y_m = y;
+  return n;
+}
+
+// The target, which must exist, as a pair for EXPECT_EQ.
+std::pair<double, double> target_of(GoalVectorMapSynthesizer& goal, Position robot,
+                                    std::vector<bus::Neighbour> neighbours = {}) {
+  const std::optional<Position> t = goal.target({robot, std::move(neighbours)});
+  if (!t) ADD_FAILURE() << "no target from (" << robot.x << ", " << robot.y << ")";
+  return t ? std::make_pair(t->x, t->y) : std::make_pair(std::nan(""), std::nan(""));
+}
+
+using XY = std::pair<double, double>;
+
+TEST(GoalVectorMapSynthesizer, CompilesTheScenariosMap) {
+  const auto goal = make_goal_synthesizer("goal_vector_map", site_context(1));
+  EXPECT_EQ(goal->name(), "goal_vector_map");
+  const auto& gvm = dynamic_cast<const GoalVectorMapSynthesizer&>(*goal);
+  ASSERT_EQ(gvm.map().arrows().size(), 4u);
+  EXPECT_EQ(gvm.map().strips(), 2);
+  EXPECT_EQ(gvm.map().arrows()[3].tail.x, 6.5);
+  EXPECT_EQ(gvm.map().arrows()[3].tail.y, 5.5);
+  EXPECT_EQ(gvm.map().arrows()[3].head.x, 9.5);
+  EXPECT_FALSE(gvm.current_arrow().has_value());
+  EXPECT_EQ(gvm.finished(), std::vector<bool>(4, false));
+}
+
+// One robot through the whole table: nearest tail, tail -> head, head -> chained head, strip end -> nearest
+// unfinished tail, a next arrow it already finished -> nearest unfinished tail, all finished -> nullopt.
+TEST(GoalVectorMapSynthesizer, WalksTheArrowsAsTheTableSays) {
+  GoalVectorMapSynthesizer goal(site_context(1));
+  // Nearest tail from (0.5, 0.5): arrow 0 (squared distance 13; arrow 2: 29).
+  EXPECT_EQ(target_of(goal, {0.5, 0.5}), XY(2.5, 3.5));
+  EXPECT_EQ(goal.current_arrow(), std::optional<std::size_t>(0));
+  EXPECT_TRUE(goal.heading_for_tail());
+  // Just outside the tail's cell (0.51 m east of its centre): still the tail.
+  EXPECT_EQ(target_of(goal, {3.01, 3.5}), XY(2.5, 3.5));
+  // Within half a cell of the tail (Chebyshev): the head.
+  EXPECT_EQ(target_of(goal, {2.9, 3.1}), XY(6.5, 3.5));
+  EXPECT_FALSE(goal.heading_for_tail());
+  EXPECT_EQ(target_of(goal, {4.5, 3.5}), XY(6.5, 3.5));
+  // On the head: arrow 0 is finished, arrow 1 continues at once (its head).
+  EXPECT_EQ(target_of(goal, {6.5, 3.5}), XY(9.5, 3.5));
+  EXPECT_EQ(goal.current_arrow(), std::optional<std::size_t>(1));
+  EXPECT_FALSE(goal.heading_for_tail());
+  EXPECT_EQ(goal.finished(), (std::vector<bool>{true, false, false, false}));
+  // End of strip 0: the nearest unfinished tail is arrow 3's (squared distance 13; arrow 2's: 53).
+  EXPECT_EQ(target_of(goal, {9.5, 3.5}), XY(6.5, 5.5));
+  EXPECT_EQ(goal.current_arrow(), std::optional<std::size_t>(3));
+  EXPECT_TRUE(goal.heading_for_tail());
+  EXPECT_EQ(target_of(goal, {6.5, 5.5}), XY(9.5, 5.5));
+  // End of strip 1: arrow 2 is left.
+  EXPECT_EQ(target_of(goal, {9.5, 5.5}), XY(2.5, 5.5));
+  EXPECT_EQ(goal.current_arrow(), std::optional<std::size_t>(2));
+  EXPECT_EQ(target_of(goal, {2.5, 5.5}), XY(6.5, 5.5));
+  // Arrow 2's next arrow (3) is finished already: nothing is left.
+  EXPECT_FALSE(goal.target({{6.5, 5.5}, {}}).has_value());
+  EXPECT_EQ(goal.finished(), std::vector<bool>(4, true));
+  EXPECT_FALSE(goal.current_arrow().has_value());
+  EXPECT_FALSE(goal.target({{0.5, 0.5}, {}}).has_value());
+}
+
+TEST(GoalVectorMapSynthesizer, SkipsATailANeighbourIsNearerTo) {
+  // Alone at (0.5, 3.5): arrow 0's tail (squared distance 4).
+  {
+    GoalVectorMapSynthesizer goal(site_context(2));
+    EXPECT_EQ(target_of(goal, {0.5, 3.5}), XY(2.5, 3.5));
+  }
+  // A neighbour at (2.5, 2.5) is nearer to arrow 0's tail (1 < 4) but not to arrow 2's (9 > 8).
+  {
+    GoalVectorMapSynthesizer goal(site_context(2));
+    EXPECT_EQ(target_of(goal, {0.5, 3.5}, {neighbour(1, 2.5, 2.5)}), XY(2.5, 5.5));
+    EXPECT_EQ(goal.current_arrow(), std::optional<std::size_t>(2));
+  }
+  // A neighbour at (2.5, 1.5) is as near to arrow 0's tail (4 = 4): the lower id takes it.
+  {
+    GoalVectorMapSynthesizer goal(site_context(2));
+    EXPECT_EQ(target_of(goal, {0.5, 3.5}, {neighbour(1, 2.5, 1.5)}), XY(2.5, 5.5));
+  }
+  {
+    GoalVectorMapSynthesizer goal(site_context(2));
+    EXPECT_EQ(target_of(goal, {0.5, 3.5}, {neighbour(3, 2.5, 1.5)}), XY(2.5, 3.5));
+  }
+  // Its own id in the neighbour list is not a neighbour.
+  {
+    GoalVectorMapSynthesizer goal(site_context(2));
+    EXPECT_EQ(target_of(goal, {0.5, 3.5}, {neighbour(2, 2.5, 2.5)}), XY(2.5, 3.5));
+  }
+  // A neighbour at (4.5, 4.5) is nearer to every tail: the robot still has work and takes the nearest one.
+  {
+    GoalVectorMapSynthesizer goal(site_context(2));
+    EXPECT_EQ(target_of(goal, {0.5, 0.5}, {neighbour(1, 4.5, 4.5)}), XY(2.5, 3.5));
+  }
+}
+
+TEST(GoalVectorMapSynthesizer, GivesUpATailWhenANeighbourComesNearerAndKeepsTheNewOne) {
+  GoalVectorMapSynthesizer goal(site_context(1));
+  // From (0.5, 4.5) arrows 0 and 2 are equally near (5): the lower index.
+  EXPECT_EQ(target_of(goal, {0.5, 4.5}), XY(2.5, 3.5));
+  // A neighbour arrives next to arrow 0's tail (1.25 < 5); arrow 2's stays the robot's (9.25 > 5).
+  EXPECT_EQ(target_of(goal, {0.5, 4.5}, {neighbour(2, 3.0, 2.5)}), XY(2.5, 5.5));
+  EXPECT_EQ(goal.current_arrow(), std::optional<std::size_t>(2));
+  // The neighbour leaves: the robot keeps arrow 2 although arrow 0 ties and has the lower index.
+  EXPECT_EQ(target_of(goal, {0.5, 4.5}), XY(2.5, 5.5));
+  // On its tail, a neighbour nearby no longer matters: the head.
+  EXPECT_EQ(target_of(goal, {2.5, 5.5}, {neighbour(2, 2.6, 5.5)}), XY(6.5, 5.5));
+}
+
+// Two robots that see each other and jump onto their targets each frame: never the same tail at once, every arrow
+// finished by each, within 2 frames per arrow plus one; the same inputs give the same targets (no randomness).
+TEST(GoalVectorMapSynthesizer, TwoRobotsFinishEveryArrowDeterministically) {
+  const auto run = [](std::vector<std::pair<double, double>>& trace) {
+    GoalVectorMapSynthesizer a(site_context(1)), b(site_context(2));
+    Position pa{0.5, 0.5}, pb{0.5, 7.5};
+    bool a_done = false, b_done = false;
+    int frames = 0;
+    while ((!a_done || !b_done) && frames < 100) {
+      ++frames;
+      std::optional<Position> ta, tb;
+      if (!a_done) ta = a.target({pa, {neighbour(2, pb.x, pb.y)}});
+      if (!b_done) tb = b.target({pb, {neighbour(1, pa.x, pa.y)}});
+      if (ta && tb && a.heading_for_tail() && b.heading_for_tail()) {
+        EXPECT_NE(a.current_arrow(), b.current_arrow()) << "frame " << frames;
+      }
+      a_done = !ta;
+      b_done = !tb;
+      if (ta) pa = *ta;
+      if (tb) pb = *tb;
+      trace.emplace_back(pa.x, pa.y);
+      trace.emplace_back(pb.x, pb.y);
+    }
+    EXPECT_EQ(a.finished(), std::vector<bool>(4, true));
+    EXPECT_EQ(b.finished(), std::vector<bool>(4, true));
+    EXPECT_LE(frames, 2 * 4 + 1);
+  };
+  std::vector<std::pair<double, double>> first, second;
+  run(first);
+  run(second);
+  EXPECT_EQ(first, second);
+  // Robot 1 starts at arrow 0's tail, robot 2 (from the north) at arrow 2's.
+  ASSERT_GE(first.size(), 2u);
+  EXPECT_EQ(first[0], XY(2.5, 3.5));
+  EXPECT_EQ(first[1], XY(2.5, 5.5));
+}
+
+TEST(GoalVectorMapSynthesizer, RejectsAContextWithoutAUsableMap) {
+  AgentContext no_spec = site_context(1);
+  no_spec.task.goal_vector_map.reset();
+  try {
+    make_goal_synthesizer("goal_vector_map", no_spec);
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("goal_vector_map block"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(GoalVectorMapSynthesizer{no_spec}, InvalidArgument);
+  AgentContext outside = site_context(1);
+  outside.task.goal_vector_map->x1_m = 12.5;  // the world ends at x = 12
+  EXPECT_THROW(GoalVectorMapSynthesizer{outside}, InvalidArgument);
+  AgentContext no_grid = site_context(1);
+  no_grid.admission.cell_size_m = 0.0;
+  EXPECT_THROW(GoalVectorMapSynthesizer{no_grid}, InvalidArgument);
+  GoalVectorMapSynthesizer goal(site_context(1));
+  EXPECT_THROW(goal.target({{std::nan(""), 1.0}, {}}), InvalidArgument);
 }
 
 }  // namespace
