@@ -39,12 +39,20 @@ std::optional<Motion> ActionManager::advance(const deliberative::LocalMap& map, 
   if (best) return best;
   // The next cell is navigable but out of range from where the robot stands: first step onto its own centre.
   const CellIndex next = path[1];
+  if (!map.contains(next) || mask(next.row, next.col) == 0) return std::nullopt;
   const Position own = map.center(path[0]);
   const double d_own = distance(own, robot);
-  if (map.contains(next) && mask(next.row, next.col) != 0 && mask(path[0].row, path[0].col) != 0 &&
-      d_own > kCentredM && d_own <= max_step_m_)
+  if (mask(path[0].row, path[0].col) != 0 && d_own > kCentredM && d_own <= max_step_m_)
     return Motion{path[0], own, 0, d_own};
-  return std::nullopt;
+  // Centred, and the next cell's centre is farther than a step (a diagonal move when the step is shorter than a
+  // cell's diagonal): go max_step of the way towards it, provided that point lies in another cell it can move to.
+  const Position aim = map.center(next);
+  const double d_next = distance(aim, robot);
+  const double f = max_step_m_ * (1.0 - 1e-9) / d_next;
+  const Position partial{robot.x + (aim.x - robot.x) * f, robot.y + (aim.y - robot.y) * f};
+  const auto cell = map.cell_at(partial);
+  if (!cell || *cell == path[0] || mask(cell->row, cell->col) == 0) return std::nullopt;  // a new cell, or no motion
+  return Motion{*cell, partial, *cell == next ? std::size_t{1} : std::size_t{0}, distance(partial, robot)};
 }
 
 }  // namespace marsala::agent::executive

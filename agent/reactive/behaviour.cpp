@@ -13,6 +13,11 @@ BehaviourRegistry make_behaviour_registry() { return BehaviourRegistry("behaviou
 void register_builtins(BehaviourRegistry& registry) {
   registry.add("idle", [](const AgentContext& c) { return std::make_unique<IdleBehaviour>(c); });
   registry.add("ramp_builder", [](const AgentContext& c) { return std::make_unique<RampBuilder>(c); });
+  registry.add("path_builder", [](const AgentContext& c) {
+    RampBuilderOptions options;
+    options.pipeline = true;
+    return std::make_unique<RampBuilder>(c, options);
+  });
 }
 
 std::unique_ptr<Behaviour> make_behaviour(const std::string& name, const AgentContext& context) {

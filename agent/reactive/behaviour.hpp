@@ -1,7 +1,8 @@
 #pragma once
 // Reactive layer (paper Fig. 1): a behaviour turns each sensor frame into one action request. Behaviours are
 // chosen by name from a registry filled by register_builtins(): "ramp_builder" builds a navigable ramp to its
-// target (paper §IV, Fig. 2), "idle" requests nothing (the lockstep benchmark's agent).
+// target (paper §IV, Fig. 2), "path_builder" does so inside the construction pipeline (paper §V-A, Fig. 4), "idle"
+// requests nothing (the lockstep benchmark's agent).
 //
 // decide() is the pure core: it depends only on the agent's context, its admission and the frames so far (no
 // clock, no unseeded randomness), so it is testable without DDS and a run is reproducible bit for bit.
@@ -38,7 +39,7 @@ using BehaviourRegistry = detail::Registry<Behaviour, const AgentContext&>;
 
 /// An empty registry whose messages speak of behaviours.
 BehaviourRegistry make_behaviour_registry();
-/// Registers the built-in behaviours: "idle", "ramp_builder".
+/// Registers the built-in behaviours: "idle", "ramp_builder", "path_builder".
 void register_builtins(BehaviourRegistry& registry);
 /// A built-in behaviour by name; throws InvalidArgument listing the valid names when unknown.
 std::unique_ptr<Behaviour> make_behaviour(const std::string& name, const AgentContext& context);

@@ -14,7 +14,8 @@ namespace {
 
 constexpr RampState kStates[] = {RampState::kWaitAdmission, RampState::kSurvey,       RampState::kAdvance,
                                  RampState::kBuild,         RampState::kRetreat,      RampState::kReturnToBase,
-                                 RampState::kAtGoal,        RampState::kDone};
+                                 RampState::kAtGoal,        RampState::kDone,         RampState::kFollow,
+                                 RampState::kHold,          RampState::kBackOff};
 
 /// Kept inside the world's base radius so a refill is never rejected on a tie [m].
 constexpr double kBaseMarginM = 1e-6;
@@ -38,6 +39,9 @@ std::string to_string(RampState state) {
     case RampState::kReturnToBase: return "return_to_base";
     case RampState::kAtGoal: return "at_goal";
     case RampState::kDone: return "done";
+    case RampState::kFollow: return "follow";
+    case RampState::kHold: return "hold";
+    case RampState::kBackOff: return "back_off";
   }
   return "unknown";
 }
@@ -59,6 +63,7 @@ struct RampBuilder::Modules {
   executive::ActionManager actions;
   executive::DepositionManager depositions;
   double layer_volume_m3;                      // one cube [m^3]
+  double return_below_m3;                      // less material than this on board: back to the base [m^3]
   int max_idle_retreat_moves;                  // retreat moves without work before trying to advance again
 };
 
@@ -70,6 +75,13 @@ RampBuilder::RampBuilder(const AgentContext& context, RampBuilderOptions options
   (void)processing::NavigabilityProcessor(construction_params(context_));
   if (!deliberative::is_goal_synthesizer(context_.task.goal_synthesizer))
     (void)deliberative::make_goal_synthesizer(context_.task.goal_synthesizer, context_);  // throws, listing names
+  if (options_.pipeline) {
+    PipelineParams p;
+    p.separation_m = context_.task.separation_m;
+    p.back_off_margin_m = 0.25 * p.separation_m;
+    p.return_detect_m = 0.75 * p.separation_m;
+    pipeline_.emplace(p);
+  }
 }
 
 RampBuilder::~RampBuilder() = default;
@@ -101,6 +113,8 @@ void RampBuilder::on_admission(const bus::Admission& admission) {
       executive::DepositionManager(
           executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m, build.delta_m)),
       layer_m * world.cell_size_m * world.cell_size_m,
+      options_.pipeline ? std::min(body.max_deposit_m3, body.material_capacity_m3)
+                        : layer_m * world.cell_size_m * world.cell_size_m,
       static_cast<int>(std::ceil((body.reach_m + body.delta_m) / body.max_step_m)) + 1});
   goal_ = deliberative::make_goal_synthesizer(context_.task.goal_synthesizer, context_);
   state_ = RampState::kSurvey;
@@ -128,17 +142,23 @@ bus::ActionRequest RampBuilder::decide(const bus::SensorFrame& frame) {
     if (state_ == RampState::kSurvey) state_ = RampState::kAdvance;
 
     // At the goal: on the local goal's cell, which is the target's cell, or the nearest the robot can get to a
-    // target off the grid.
-    if (local.goal == local.robot) {
+    // target off the grid. In the pipeline the path has reached it: back to the base, to come again.
+    const bool at_goal = local.goal == local.robot;
+    if (pipeline_) pipeline_->observe(frame.neighbours, target);
+    if (at_goal && !pipeline_) {
       state_ = RampState::kAtGoal;
     } else {
       if (state_ == RampState::kAtGoal) state_ = RampState::kAdvance;
-      if (state_ != RampState::kReturnToBase && frame.material_m3 < modules_->layer_volume_m3)
+      if (state_ != RampState::kReturnToBase && (frame.material_m3 < modules_->return_below_m3 - 1e-12 || at_goal))
         state_ = RampState::kReturnToBase;
-      switch (state_) {
-        case RampState::kReturnToBase: return_step(local, frame, request); break;
-        case RampState::kRetreat: retreat_step(local, frame, request); break;
-        default: build_step(local, frame, request); break;
+      if (state_ == RampState::kReturnToBase) {
+        return_step(local, frame, request);
+      } else if (pipeline_) {
+        pipeline_step(local, frame, target, request);
+      } else if (state_ == RampState::kRetreat) {
+        retreat_step(local, frame, request);
+      } else {
+        build_step(local, frame, request);
       }
     }
   }
@@ -218,16 +238,9 @@ void RampBuilder::retreat_step(const deliberative::LocalMap& local, const bus::S
     }
     deposited_since_blocked_ = false;
   }
-  // Step back the way the robot came (towards the local origin, or the oldest navigable cell of its trajectory
-  // in the window when it stands on the origin) and fill what comes into reach: the gap where it stood.
+  // Step back the way the robot came and fill what comes into reach: the gap where it stood.
   ++idle_retreat_moves_;
-  std::optional<CellIndex> anchor;
-  if (local.origin && *local.origin != local.robot) anchor = local.origin;
-  if (!anchor) anchor = oldest_navigable_trajectory_cell(local);
-  if (!anchor) return;
-  const auto route = modules_->router.plan(local.gap, local.navigable, local.robot, *anchor);
-  if (!route.found) return;
-  const auto motion = modules_->actions.advance(local, route.path, robot);
+  const auto motion = step_back(local, robot);
   if (!motion) return;
   move(*motion, request);
   deposit(local, frame, motion->target, 0, request);
@@ -235,6 +248,69 @@ void RampBuilder::retreat_step(const deliberative::LocalMap& local, const bus::S
     deposited_since_blocked_ = true;
     idle_retreat_moves_ = 0;
   }
+}
+
+std::optional<executive::Motion> RampBuilder::step_back(const deliberative::LocalMap& local, Position robot) {
+  // Towards the local origin, or the oldest navigable cell of the trajectory in the window when the robot stands on
+  // the origin; with no way it came (it has not moved yet), to the navigable cell farthest from the local goal.
+  std::optional<CellIndex> anchor;
+  if (local.origin && *local.origin != local.robot) anchor = local.origin;
+  if (!anchor) anchor = oldest_navigable_trajectory_cell(local);
+  if (!anchor) anchor = farthest_navigable_from_goal(local);
+  if (!anchor) return std::nullopt;
+  const auto route = modules_->router.plan(local.gap, local.navigable, local.robot, *anchor);
+  if (!route.found) return std::nullopt;
+  return modules_->actions.advance(local, route.path, robot);
+}
+
+void RampBuilder::pipeline_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position target,
+                                bus::ActionRequest& request) {
+  const Position robot{frame.x_m, frame.y_m};
+  const PipelineRole role = pipeline_->role(robot, target);
+  trace_.role = role;
+  const auto front = pipeline_->front(robot, target);
+  switch (role) {
+    case PipelineRole::kActive:
+      if (state_ == RampState::kRetreat)
+        retreat_step(local, frame, request);
+      else
+        build_step(local, frame, request);
+      return;
+    case PipelineRole::kFollow: follow_step(local, frame, {front->x_m, front->y_m}, request); return;
+    case PipelineRole::kHold: state_ = RampState::kHold; return;
+    case PipelineRole::kBackOff: back_off_step(local, frame, {front->x_m, front->y_m}, request); return;
+  }
+}
+
+void RampBuilder::follow_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position front,
+                              bus::ActionRequest& request) {
+  const Position robot{frame.x_m, frame.y_m};
+  state_ = RampState::kHold;
+  if (!plan_path(local)) return;
+  const auto motion = modules_->actions.advance(local, trace_.plan.path, robot);
+  if (!motion || distance(motion->target, front) < pipeline_->params().separation_m) return;
+  move(*motion, request);
+  state_ = RampState::kFollow;
+}
+
+void RampBuilder::back_off_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position front,
+                                bus::ActionRequest& request) {
+  const Position robot{frame.x_m, frame.y_m};
+  state_ = RampState::kBackOff;
+  const auto motion = step_back(local, robot);
+  if (motion && distance(motion->target, front) > distance(robot, front)) move(*motion, request);
+}
+
+std::optional<CellIndex> RampBuilder::farthest_navigable_from_goal(const deliberative::LocalMap& local) {
+  std::optional<CellIndex> best;
+  double best_d = distance(local.center(local.robot), local.center(local.goal));
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      if (local.navigable(r, c) == 0) continue;
+      const double d = distance(local.center({r, c}), local.center(local.goal));
+      if (d > best_d) best_d = d, best = CellIndex{r, c};  // row-major: ties to the first
+    }
+  return best;
 }
 
 std::optional<CellIndex> RampBuilder::oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const {
@@ -256,8 +332,9 @@ void RampBuilder::return_step(const deliberative::LocalMap& local, const bus::Se
     state_ = RampState::kAdvance;
     return;
   }
-  // Where to go: the navigable cell within the base radius nearest the robot; else the oldest navigable cell of
-  // the trajectory in the window (the way the robot came from the base); else the navigable cell nearest the base.
+  // Where to go: the navigable cell within the base radius nearest the robot; else the navigable cell nearest the
+  // base when that is nearer than the robot by at least a cell; else the oldest navigable cell of the trajectory in
+  // the window (the way the robot came from the base).
   std::optional<CellIndex> goal;
   double best = std::numeric_limits<double>::infinity();
   for (int r = 0; r < local.rows(); ++r)
@@ -268,15 +345,15 @@ void RampBuilder::return_step(const deliberative::LocalMap& local, const bus::Se
       const double d = distance(centre, robot);
       if (d < best) best = d, goal = CellIndex{r, c};
     }
-  if (!goal) goal = oldest_navigable_trajectory_cell(local);
   if (!goal) {
-    best = distance(robot, base);
+    best = distance(robot, base) - local.geometry().cell_size_m;
     for (int r = 0; r < local.rows(); ++r)
       for (int c = 0; c < local.cols(); ++c) {
         const double d = distance(local.center({r, c}), base);
         if (local.navigable(r, c) != 0 && d < best) best = d, goal = CellIndex{r, c};
       }
   }
+  if (!goal) goal = oldest_navigable_trajectory_cell(local);
   if (!goal) return;
   trace_.plan = modules_->router.plan(local.gap, local.navigable, local.robot, *goal);
   trace_.planned = true;

@@ -25,6 +25,21 @@
 //                    what comes into reach                                                   --> kRetreat
 // Building thus runs from the top of the ramp down to its toe (the robot backs off to fill where it stood),
 // then the robot climbs, filling ahead of itself, until it reaches the target.
+//
+// "path_builder" is the same machine inside the construction pipeline (paper §V-A, Fig. 4; pipeline.hpp). It builds
+// for the task's construction parameters (e.g. a payload's kappa over a band wide enough for it and two lanes) and
+// changes these transitions:
+//   any but kReturnToBase --material below one deposition threshold (not enough for a deposition task)--> kReturnToBase
+//   any                   --robot on the target's cell: the path is there; go back, refill, come again----> kReturnToBase
+//   kReturnToBase         --at the base: refill -----------------------------------------------------------> kFollow
+//   otherwise, by the pipeline role of this frame:
+//     kActive  -> the ramp builder's kAdvance / kBuild / kRetreat (the front robot alone deposits)
+//     kFollow  -> advance along the planned path through navigable cells without depositing, never closer than
+//                 the separation to the front neighbour (else stand still) --------------------------------> kFollow / kHold
+//     kHold    -> stand still -------------------------------------------------------------------------------> kHold
+//     kBackOff -> step back the way it came, away from the front neighbour ----------------------------------> kBackOff
+// The forward motion keeps to the right of the straight line from base to target by lane_offset_m where it can,
+// the way back to the left: two lanes on a path wide enough for both.
 
 #include <cstdint>
 #include <memory>
@@ -39,6 +54,7 @@
 #include "agent/executive/deposition_manager.hpp"
 #include "agent/executive/mapping_system.hpp"
 #include "agent/reactive/behaviour.hpp"
+#include "agent/reactive/pipeline.hpp"
 
 namespace marsala::agent::reactive {
 
@@ -52,8 +68,12 @@ enum class RampState : std::uint8_t {
   kReturnToBase = 5,
   kAtGoal = 6,
   kDone = 7,
+  kFollow = 8,
+  kHold = 9,
+  kBackOff = 10,
 };
-/// "wait_admission", "survey", "advance", "build", "retreat", "return_to_base", "at_goal", "done".
+/// "wait_admission", "survey", "advance", "build", "retreat", "return_to_base", "at_goal", "done", "follow", "hold",
+/// "back_off".
 std::string to_string(RampState state);
 /// The inverse of to_string; throws InvalidArgument listing the valid names.
 RampState ramp_state_from_string(const std::string& name);
@@ -62,6 +82,7 @@ RampState ramp_state_from_string(const std::string& name);
 /// kappa, band width) is construction_params(context).
 struct RampBuilderOptions {
   std::optional<deliberative::PlannerParams> planner;  ///< default: default_planner_params for the construction width
+  bool pipeline = false;                               ///< true: "path_builder", the construction pipeline
 };
 
 /// What the last decision saw and chose (for tests, logs and measurements).
@@ -75,6 +96,7 @@ struct DecisionTrace {
   bool planned = false;                     ///< a deposition path was planned
   deliberative::PlannerResult plan;         ///< path in local indices
   std::optional<executive::Motion> motion;  ///< local indices
+  std::optional<PipelineRole> role;         ///< path_builder: the pipeline role of this frame
   executive::DepositionPlan deposition;
   bool refill = false;
 };
@@ -86,7 +108,7 @@ class RampBuilder final : public Behaviour {
   explicit RampBuilder(const AgentContext& context, RampBuilderOptions options = {});
   ~RampBuilder() override;
 
-  std::string name() const override { return "ramp_builder"; }
+  std::string name() const override { return options_.pipeline ? "path_builder" : "ramp_builder"; }
   std::string state_name() const override { return to_string(state_); }
   void on_admission(const bus::Admission& admission) override;
   bus::ActionRequest decide(const bus::SensorFrame& frame) override;
@@ -101,8 +123,16 @@ class RampBuilder final : public Behaviour {
   void build_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, bus::ActionRequest& request);
   void retreat_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, bus::ActionRequest& request);
   void return_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, bus::ActionRequest& request);
+  void pipeline_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position target,
+                     bus::ActionRequest& request);
+  void follow_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position front,
+                   bus::ActionRequest& request);
+  void back_off_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position front,
+                     bus::ActionRequest& request);
+  std::optional<executive::Motion> step_back(const deliberative::LocalMap& local, Position robot);
   bool plan_path(const deliberative::LocalMap& local);
   std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
+  static std::optional<CellIndex> farthest_navigable_from_goal(const deliberative::LocalMap& local);
   void deposit(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position at, std::size_t from,
                bus::ActionRequest& request);
   void move(const executive::Motion& motion, bus::ActionRequest& request);
@@ -111,6 +141,7 @@ class RampBuilder final : public Behaviour {
   RampBuilderOptions options_;
   std::unique_ptr<deliberative::GoalSynthesizer> goal_;
   std::unique_ptr<Modules> modules_;  // made on admission, when the grid is known
+  std::optional<PipelineTracker> pipeline_;  // path_builder only
   RampState state_ = RampState::kWaitAdmission;
   DecisionTrace trace_;
   bool deposited_since_blocked_ = false;

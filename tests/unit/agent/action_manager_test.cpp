@@ -44,6 +44,29 @@ TEST(ActionManager, AdvancesToTheFarthestPathCellWithinTheStep) {
   EXPECT_EQ(m->path_index, 4u);
 }
 
+TEST(ActionManager, AStepShorterThanTheDiagonalStillMovesDiagonally) {
+  // Step 0.1 m = one cell: the diagonal neighbour's centre (0.141 m) is out of reach, so the robot goes 0.1 m
+  // towards it; 0.1 / sqrt(2) = 0.0707 m along each axis passes the cell boundary (0.05 m) and lands in that cell.
+  const ActionManager am(0.1);
+  const deliberative::LocalMap map = flat_map({7, 3});
+  const Position robot = kGrid.cell_center({7, 3});
+  const auto m = am.advance(map, line({7, 3}, -1, 1, 5), robot);
+  ASSERT_TRUE(m.has_value());
+  EXPECT_EQ(m->cell, (CellIndex{6, 4}));
+  EXPECT_EQ(m->path_index, 1u);
+  EXPECT_LE(m->distance_m, 0.1);
+  EXPECT_NEAR(m->distance_m, 0.1, 1e-9);
+  EXPECT_NEAR(m->target.x - robot.x, 0.1 / std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(m->target.y - robot.y, 0.1 / std::sqrt(2.0), 1e-9);  // row 6 is north of row 7
+  // From that off-centre point the next motion centres it on (6, 4), 0.029 m per axis away.
+  const deliberative::LocalMap there = flat_map({6, 4});
+  const auto next = am.advance(there, line({6, 4}, -1, 1, 4), m->target);
+  ASSERT_TRUE(next.has_value());
+  EXPECT_LE(next->distance_m, 0.1);
+  // A step shorter than half a cell's diagonal lands in no new cell (nor does it reach the boundary): no motion.
+  EXPECT_FALSE(ActionManager(0.06).advance(map, line({7, 3}, -1, 1, 5), robot).has_value());
+}
+
 TEST(ActionManager, StopsBeforeTheFirstCellThatIsNotNavigable) {
   grid::Heightmap h(kGrid, 0.0);
   h(7, 7) = 0.5;  // a post: cells within 2 cells of it are not occupiable, (7, 5) among them

@@ -84,15 +84,16 @@ TEST(RampState, NamesRoundTrip) {
 
 TEST(BehaviourRegistry, MakesBuiltinsByNameAndListsThemOnAnUnknownOne) {
   EXPECT_EQ(make_behaviour("ramp_builder", context())->name(), "ramp_builder");
+  EXPECT_EQ(make_behaviour("path_builder", context())->name(), "path_builder");
   EXPECT_EQ(make_behaviour("idle", context())->name(), "idle");
   BehaviourRegistry registry = make_behaviour_registry();
   register_builtins(registry);
-  EXPECT_EQ(registry.names(), (std::vector<std::string>{"idle", "ramp_builder"}));
+  EXPECT_EQ(registry.names(), (std::vector<std::string>{"idle", "path_builder", "ramp_builder"}));
   try {
     make_behaviour("leveller", context());
     FAIL() << "expected InvalidArgument";
   } catch (const InvalidArgument& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown behaviour 'leveller'; valid: idle, ramp_builder"),
+    EXPECT_NE(std::string(e.what()).find("unknown behaviour 'leveller'; valid: idle, path_builder, ramp_builder"),
               std::string::npos)
         << e.what();
   }

@@ -1,0 +1,90 @@
+#include "agent/reactive/pipeline.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "common/error.hpp"
+
+namespace marsala::agent::reactive {
+namespace {
+
+double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
+Position where(const bus::Neighbour& n) { return {n.x_m, n.y_m}; }
+
+}  // namespace
+
+std::string to_string(PipelineRole role) {
+  switch (role) {
+    case PipelineRole::kActive: return "active";
+    case PipelineRole::kFollow: return "follow";
+    case PipelineRole::kHold: return "hold";
+    case PipelineRole::kBackOff: return "back_off";
+  }
+  return "unknown";
+}
+
+PipelineTracker::PipelineTracker(PipelineParams params) : params_(params) {
+  const auto finite = [](double v) { return std::isfinite(v); };
+  if (!finite(params.separation_m) || !(params.separation_m > 0.0) || !finite(params.back_off_margin_m) ||
+      !(params.back_off_margin_m >= 0.0) || !(params.back_off_margin_m < params.separation_m) ||
+      !finite(params.return_detect_m) || !(params.return_detect_m > 0.0))
+    throw InvalidArgument("pipeline: separation (" + std::to_string(params.separation_m) +
+                          " m) and return detection (" + std::to_string(params.return_detect_m) +
+                          " m) must be finite and > 0, the back-off margin (" +
+                          std::to_string(params.back_off_margin_m) + " m) in [0, separation)");
+}
+
+void PipelineTracker::observe(const std::vector<bus::Neighbour>& neighbours, Position target) {
+  std::map<std::uint32_t, Track> next;
+  for (const bus::Neighbour& n : neighbours) {
+    const double d = distance(where(n), target);
+    Track track;
+    const auto old = tracks_.find(n.agent_id);
+    if (old == tracks_.end()) {
+      track.extreme_m = d;
+    } else {
+      // Hysteresis both ways: `extreme` is the nearest distance to the target while approaching, the farthest while
+      // returning; a move of return_detect_m against it flips the direction.
+      track = old->second;
+      if (!track.returning) {
+        track.extreme_m = std::min(track.extreme_m, d);
+        if (d - track.extreme_m >= params_.return_detect_m) track.returning = true, track.extreme_m = d;
+      } else {
+        track.extreme_m = std::max(track.extreme_m, d);
+        if (track.extreme_m - d >= params_.return_detect_m) track.returning = false, track.extreme_m = d;
+      }
+    }
+    track.last = n;
+    next.emplace(n.agent_id, track);
+  }
+  tracks_ = std::move(next);
+}
+
+bool PipelineTracker::returning(std::uint32_t id) const {
+  const auto it = tracks_.find(id);
+  return it != tracks_.end() && it->second.returning;
+}
+
+std::optional<bus::Neighbour> PipelineTracker::front(Position self, Position target) const {
+  const double mine = distance(self, target);
+  std::optional<bus::Neighbour> best;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (const auto& [id, track] : tracks_) {
+    if (track.returning) continue;
+    if (!(distance(where(track.last), target) < mine - kAheadMarginM)) continue;
+    const double d = distance(where(track.last), self);
+    if (d < best_d) best_d = d, best = track.last;  // map order: ties to the lower id
+  }
+  return best;
+}
+
+PipelineRole PipelineTracker::role(Position self, Position target) const {
+  const auto f = front(self, target);
+  if (!f) return PipelineRole::kActive;
+  const double d = distance(where(*f), self);
+  if (d > params_.separation_m) return PipelineRole::kFollow;
+  if (d >= params_.separation_m - params_.back_off_margin_m) return PipelineRole::kHold;
+  return PipelineRole::kBackOff;
+}
+
+}  // namespace marsala::agent::reactive
