@@ -3,17 +3,18 @@
 # loopback configuration, waits for the end, prints the summary, and stops every child it started on exit or Ctrl-C.
 #
 # Usage: deploy/spawn.sh --scenario FILE --agents N [--dds cyclone|fastdds] [--agent-dds cyclone|fastdds]
-#                        [--out DIR] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--quiet]
+#                        [--out DIR] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N] [--quiet]
 #   --dds         vendor of every process (default cyclone); --agent-dds overrides it for the agents (mixed runs)
 #   --domain      DDS domain id (default: a free-looking one derived from the process id)
 #   --monitor     also run `marsala-monitor tail` in the foreground output
 #   --timeout     give up (and stop everything) after S seconds of wall time (default 1800)
+#   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
-scenario="" agents="" dds="cyclone" agent_dds="" out="" domain="" monitor=0 max_steps="" timeout_s=1800 quiet=0
-usage() { sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; }
+scenario="" agents="" dds="cyclone" agent_dds="" out="" domain="" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0
+usage() { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -25,6 +26,7 @@ while [ $# -gt 0 ]; do
     --monitor) monitor=1; shift ;;
     --max-steps) max_steps="$2"; shift 2 ;;
     --timeout) timeout_s="$2"; shift 2 ;;
+    --seed) seed="$2"; shift 2 ;;
     --quiet) quiet=1; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "spawn.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
@@ -36,6 +38,8 @@ done
 for v in "$dds" "${agent_dds:-$dds}"; do
   case "$v" in cyclone|fastdds) ;; *) echo "spawn.sh: --dds must be cyclone or fastdds, got '$v'" >&2; exit 2 ;; esac
 done
+[ -z "$seed" ] || [[ "$seed" =~ ^[0-9]+$ ]] ||
+  { echo "spawn.sh: --seed N needs a non-negative integer, got '$seed'" >&2; exit 2; }
 agent_dds="${agent_dds:-$dds}"
 domain="${domain:-$(( ($$ % 200) + 20 ))}"
 out="${out:-$root/out/$(basename "${scenario%.*}")-$agents}"
@@ -62,12 +66,15 @@ trap 'echo "spawn.sh: interrupted, stopping children" >&2; exit 130' INT TERM
 world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$domain" --out "$out")
 [ -n "$max_steps" ] && world_args+=(--max-steps "$max_steps")
 [ "$quiet" -eq 1 ] && world_args+=(--quiet)
+seed_args=()
+[ -n "$seed" ] && seed_args=(--seed "$seed")
+world_args+=("${seed_args[@]}")
 "$bin/marsala-world" "${world_args[@]}" >"$out/logs/world.log" 2>&1 &
 world_pid=$!
 pids+=("$world_pid")
 for id in $(seq 1 "$agents"); do
   "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds "$agent_dds" --domain "$domain" \
-    >"$out/logs/agent-$id.log" 2>&1 &
+    "${seed_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
   pids+=("$!")
 done
 [ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain; logs in $out/logs"
