@@ -10,6 +10,7 @@
 #include <csignal>
 #include <exception>
 #include <iostream>
+#include <optional>
 
 #include "agent/runtime/agent_runtime.hpp"
 #include "common/cli/command_line.hpp"
@@ -33,6 +34,8 @@ int main(int argc, char** argv) {
   app.add_option("--id", id, "agent id: the scenario slot, 1..N")->required()->check(CLI::Range(1u, 1000000u));
   app.add_option("--dds", dds, "DDS vendor")->check(CLI::IsMember({"cyclone", "fastdds", "inprocess"}));
   app.add_option("--domain", domain, "DDS domain id")->check(CLI::Range(0, 232));
+  std::optional<std::uint64_t> seed;
+  app.add_option("--seed", seed, "override the scenario's seed (marsala-world must get the same)");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
   app.add_option("--admit-timeout", admit_timeout_s, "give up when not admitted within this [s]")
@@ -60,7 +63,7 @@ int main(int argc, char** argv) {
     config.behaviour = type.behaviour;
     config.body = type.body;
     config.neighbour_keep_out_m = agent::neighbour_keep_out_m(max_delta, max_step);
-    config.seed = s.seed;
+    config.seed = seed.value_or(s.seed);
     config.task.construction_kappa = type.construction.kappa;
     config.task.construction_eps_m = type.construction.eps_m;
     config.task.construction_width_m = type.construction.width_m;

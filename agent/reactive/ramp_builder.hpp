@@ -38,8 +38,8 @@
 //                 the separation to the front neighbour (else stand still) --------------------------------> kFollow / kHold
 //     kHold    -> stand still -------------------------------------------------------------------------------> kHold
 //     kBackOff -> step back the way it came, away from the front neighbour ----------------------------------> kBackOff
-// The forward motion keeps to the right of the straight line from base to target by lane_offset_m where it can,
-// the way back to the left: two lanes on a path wide enough for both.
+// Lanes: the band is wide enough for two, but robots do not yet keep to one side (lane_offset_m is not used yet);
+// the world does not model collisions between robots, so a returning robot passes a follower on the same line.
 
 #include <cstdint>
 #include <memory>
