@@ -181,8 +181,12 @@ void apply_request(WorldState& state, const bus::ActionRequest& r, const Verdict
     me.x_m = r.target_x_m;
     me.y_m = r.target_y_m;
   }
+  if (!r.depositions.empty() &&
+      (state.depositor.rows() != state.terrain.rows() || state.depositor.cols() != state.terrain.cols()))
+    state.depositor = AgentIdGrid::Zero(state.terrain.rows(), state.terrain.cols());  // a state not made by make_world_state
   for (const bus::Deposition& d : r.depositions) {
     state.terrain(d.row, d.col) += d.height_m;
+    state.depositor(d.row, d.col) = r.agent_id;
     changed_cells.push_back({d.row, d.col});
   }
   me.z_m = height_under(state.terrain, me.x_m, me.y_m);

@@ -46,8 +46,8 @@ struct Verdict {
 /// apply_step's business; here a step other than state.step is a rejection.
 Verdict validate_request(const WorldState& state, std::uint32_t channel_id, const bus::ActionRequest& request);
 
-/// Applies a request validate_request accepted: position = target, depositions, material, refill, counts. Appends
-/// the changed cells to `changed_cells`.
+/// Applies a request validate_request accepted: position = target, depositions (each raised cell's depositor becomes
+/// the request's agent), material, refill, counts. Appends the changed cells to `changed_cells`.
 void apply_request(WorldState& state, const bus::ActionRequest& request, const Verdict& verdict,
                    std::vector<CellIndex>& changed_cells);
 

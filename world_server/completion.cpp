@@ -1,8 +1,56 @@
 #include "world_server/completion.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <string>
+#include <utility>
+
+#include "common/error.hpp"
+#include "common/processing/navigability_processor.hpp"
 #include "world_server/arbiter.hpp"
 
 namespace marsala::world_server {
+namespace {
+
+constexpr double kSqrt2 = 1.41421356237309504880;
+
+std::string format(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+CellIndex cell_of(const grid::Heightmap& terrain, double x_m, double y_m, const char* what) {
+  const auto cell = terrain.cell_at({x_m, y_m});
+  if (!cell)
+    throw InvalidArgument(std::string(what) + " (" + format(x_m) + ", " + format(y_m) + ") is off the " +
+                          std::to_string(terrain.rows()) + " x " + std::to_string(terrain.cols()) + " grid");
+  return *cell;
+}
+
+CellRect site_rect_or_throw(const grid::Heightmap& terrain, const scenario::Site& site) {
+  const CellRect rect = site_cells(terrain.geometry(), site);
+  if (rect.empty())
+    throw InvalidArgument("site [" + format(site.x0_m) + ", " + format(site.x1_m) + "] x [" + format(site.y0_m) +
+                          ", " + format(site.y1_m) + "] holds no cell centre of the grid");
+  return rect;
+}
+
+NavigabilityParams payload_params(const scenario::PayloadPath& p) { return {p.kappa, p.delta_m, p.eps_m}; }
+NavigabilityParams site_params(const scenario::Site& s) { return {s.kappa, s.delta_m, s.eps_m}; }
+
+void check_on_mask(const grid::CellMask& mask, CellIndex c, const char* what) {
+  if (c.row < 0 || c.col < 0 || c.row >= mask.rows() || c.col >= mask.cols())
+    throw InvalidArgument(std::string(what) + " cell (" + std::to_string(c.row) + ", " + std::to_string(c.col) +
+                          ") is off the " + std::to_string(mask.rows()) + " x " + std::to_string(mask.cols()) +
+                          " mask");
+}
+
+}  // namespace
 
 bool at_goal(const WorldState& state, const AgentRecord& agent) {
   constexpr double tol = arbiter_tolerance::kLengthM;
@@ -15,6 +63,7 @@ bool at_goal(const WorldState& state, const AgentRecord& agent) {
 }
 
 bool is_completed(const WorldState& state) {
+  if (state.completion != scenario::CompletionKind::kAgentsAtGoal) return state.check.met;
   bool any = false;
   for (const AgentRecord& a : state.agents) {
     if (!a.alive) continue;
@@ -25,6 +74,11 @@ bool is_completed(const WorldState& state) {
 }
 
 double progress(const WorldState& state) {
+  switch (state.completion) {
+    case scenario::CompletionKind::kPayloadPath: return state.check.met ? 1.0 : 0.0;
+    case scenario::CompletionKind::kLevelSite: return state.check.level_fraction;
+    case scenario::CompletionKind::kAgentsAtGoal: break;
+  }
   int live = 0, done = 0;
   for (const AgentRecord& a : state.agents) {
     if (!a.alive) continue;
@@ -32,6 +86,180 @@ double progress(const WorldState& state) {
     done += at_goal(state, a) ? 1 : 0;
   }
   return live == 0 ? 0.0 : static_cast<double>(done) / live;
+}
+
+void start_completion_check(WorldState& state) {
+  CompletionCheck& check = state.check;
+  check = {};
+  switch (state.completion) {
+    case scenario::CompletionKind::kAgentsAtGoal: return;
+    case scenario::CompletionKind::kPayloadPath: {
+      const scenario::PayloadPath& p = state.payload_path;
+      check.from = cell_of(state.terrain, p.from_x_m, p.from_y_m, "payload_path.from");
+      check.to = cell_of(state.terrain, p.to_x_m, p.to_y_m, "payload_path.to");
+      check.occupancy =
+          OccupancyCache(state.terrain, {{0, 0}, state.terrain.rows(), state.terrain.cols()}, payload_params(p));
+      break;
+    }
+    case scenario::CompletionKind::kLevelSite:
+      check.occupancy = OccupancyCache(state.terrain, site_rect_or_throw(state.terrain, state.site), site_params(state.site));
+      break;
+  }
+  evaluate_completion(state);
+}
+
+void evaluate_completion(WorldState& state) {
+  if (state.completion == scenario::CompletionKind::kAgentsAtGoal) return;
+  CompletionCheck& check = state.check;
+  check.occupancy.update(state.terrain);
+  const grid::CellMask& mask = check.occupancy.occupiable();
+  if (state.completion == scenario::CompletionKind::kPayloadPath) {
+    check.met = connected(mask, check.from, check.to);
+  } else {
+    check.level_fraction =
+        static_cast<double>(largest_component(mask)) / static_cast<double>(check.occupancy.area().size());
+    check.met = check.level_fraction >= state.site.min_fraction;
+  }
+  ++check.evaluations;
+}
+
+CellRect site_cells(const grid::GridGeometry& grid, const scenario::Site& site) {
+  constexpr double tol = arbiter_tolerance::kLengthM;
+  // Scanning every row and column decides each centre exactly as the definition says, with no rounding shortcut.
+  int r0 = grid.rows, r1 = -1, c0 = grid.cols, c1 = -1;
+  for (int r = 0; r < grid.rows; ++r) {
+    const double y = grid.cell_center({r, 0}).y;
+    if (y >= site.y0_m - tol && y <= site.y1_m + tol) r0 = std::min(r0, r), r1 = std::max(r1, r);
+  }
+  for (int c = 0; c < grid.cols; ++c) {
+    const double x = grid.cell_center({0, c}).x;
+    if (x >= site.x0_m - tol && x <= site.x1_m + tol) c0 = std::min(c0, c), c1 = std::max(c1, c);
+  }
+  if (r1 < 0 || c1 < 0) return {};
+  return {{r0, c0}, r1 - r0 + 1, c1 - c0 + 1};
+}
+
+long long largest_component(const grid::CellMask& mask) {
+  const int rows = static_cast<int>(mask.rows()), cols = static_cast<int>(mask.cols());
+  std::vector<std::uint8_t> seen(static_cast<std::size_t>(rows) * cols, 0);
+  std::vector<int> stack;
+  long long best = 0;
+  for (int start = 0; start < rows * cols; ++start) {
+    if (seen[start] || mask(start / cols, start % cols) == 0) continue;
+    long long size = 0;
+    seen[start] = 1;
+    stack.assign(1, start);
+    while (!stack.empty()) {
+      const int k = stack.back();
+      stack.pop_back();
+      ++size;
+      const int r = k / cols, c = k % cols;
+      for (int rr = std::max(0, r - 1); rr <= std::min(rows - 1, r + 1); ++rr)
+        for (int cc = std::max(0, c - 1); cc <= std::min(cols - 1, c + 1); ++cc) {
+          const int n = rr * cols + cc;
+          if (!seen[n] && mask(rr, cc) != 0) {
+            seen[n] = 1;
+            stack.push_back(n);
+          }
+        }
+    }
+    best = std::max(best, size);
+  }
+  return best;
+}
+
+bool connected(const grid::CellMask& passable, CellIndex from, CellIndex to) {
+  check_on_mask(passable, from, "connected: from");
+  check_on_mask(passable, to, "connected: to");
+  if (passable(from.row, from.col) == 0 || passable(to.row, to.col) == 0) return false;
+  const int rows = static_cast<int>(passable.rows()), cols = static_cast<int>(passable.cols());
+  const int goal = to.row * cols + to.col;
+  std::vector<std::uint8_t> seen(static_cast<std::size_t>(rows) * cols, 0);
+  std::vector<int> stack{from.row * cols + from.col};
+  seen[stack.back()] = 1;
+  while (!stack.empty()) {
+    const int k = stack.back();
+    stack.pop_back();
+    if (k == goal) return true;
+    const int r = k / cols, c = k % cols;
+    for (int rr = std::max(0, r - 1); rr <= std::min(rows - 1, r + 1); ++rr)
+      for (int cc = std::max(0, c - 1); cc <= std::min(cols - 1, c + 1); ++cc) {
+        const int n = rr * cols + cc;
+        if (!seen[n] && passable(rr, cc) != 0) {
+          seen[n] = 1;
+          stack.push_back(n);
+        }
+      }
+  }
+  return false;
+}
+
+bool payload_path_navigable(const grid::Heightmap& terrain, const scenario::PayloadPath& path) {
+  const CellIndex from = cell_of(terrain, path.from_x_m, path.from_y_m, "payload_path.from");
+  const CellIndex to = cell_of(terrain, path.to_x_m, path.to_y_m, "payload_path.to");
+  return connected(processing::NavigabilityProcessor(payload_params(path)).occupiable(terrain), from, to);
+}
+
+double site_level_fraction(const grid::Heightmap& terrain, const scenario::Site& site) {
+  const CellRect rect = site_rect_or_throw(terrain, site);
+  const grid::CellMask mask =
+      processing::NavigabilityProcessor(site_params(site)).occupiable(terrain.window(rect.first, rect.rows, rect.cols));
+  return static_cast<double>(largest_component(mask)) / static_cast<double>(rect.size());
+}
+
+std::optional<PayloadRoute> shortest_path(const grid::CellMask& passable, CellIndex from, CellIndex to,
+                                          double cell_size_m) {
+  check_on_mask(passable, from, "shortest_path: from");
+  check_on_mask(passable, to, "shortest_path: to");
+  if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m))
+    throw InvalidArgument("shortest_path: cell size " + format(cell_size_m) + " m must be finite and > 0");
+  if (passable(from.row, from.col) == 0 || passable(to.row, to.col) == 0) return std::nullopt;
+  const int rows = static_cast<int>(passable.rows()), cols = static_cast<int>(passable.cols());
+  const double side = cell_size_m, diagonal = cell_size_m * kSqrt2;
+  // A* with the octile distance, the exact 8-connected distance without obstacles: consistent, so the first time
+  // the goal leaves the queue its distance is the shortest. Queue ties go to the smaller cell index.
+  const auto heuristic = [&](int k) {
+    const int dr = std::abs(k / cols - to.row), dc = std::abs(k % cols - to.col);
+    return side * std::abs(dr - dc) + diagonal * std::min(dr, dc);
+  };
+  const int start = from.row * cols + from.col, goal = to.row * cols + to.col;
+  std::vector<double> distance(static_cast<std::size_t>(rows) * cols, std::numeric_limits<double>::infinity());
+  std::vector<int> parent(distance.size(), -1);
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+  distance[start] = 0.0;
+  open.push({heuristic(start), start});
+  while (!open.empty()) {
+    const auto [f, k] = open.top();
+    open.pop();
+    if (f != distance[k] + heuristic(k)) continue;  // superseded by a shorter distance
+    if (k == goal) break;
+    const int r = k / cols, c = k % cols;
+    for (int rr = std::max(0, r - 1); rr <= std::min(rows - 1, r + 1); ++rr)
+      for (int cc = std::max(0, c - 1); cc <= std::min(cols - 1, c + 1); ++cc) {
+        const int n = rr * cols + cc;
+        if (n == k || passable(rr, cc) == 0) continue;
+        const double d = distance[k] + (rr != r && cc != c ? diagonal : side);
+        if (d < distance[n]) {
+          distance[n] = d;
+          parent[n] = k;
+          open.push({d + heuristic(n), n});
+        }
+      }
+  }
+  if (!std::isfinite(distance[goal])) return std::nullopt;
+  PayloadRoute route;
+  route.length_m = distance[goal];
+  for (int k = goal; k != -1; k = parent[k]) route.cells.push_back({k / cols, k % cols});
+  std::reverse(route.cells.begin(), route.cells.end());
+  return route;
+}
+
+std::optional<PayloadRoute> payload_path(const grid::Heightmap& terrain, const scenario::PayloadPath& path) {
+  const CellIndex from = cell_of(terrain, path.from_x_m, path.from_y_m, "payload_path.from");
+  const CellIndex to = cell_of(terrain, path.to_x_m, path.to_y_m, "payload_path.to");
+  return shortest_path(processing::NavigabilityProcessor(payload_params(path)).occupiable(terrain), from, to,
+                       terrain.cell_size_m());
 }
 
 }  // namespace marsala::world_server

@@ -1,7 +1,20 @@
 #pragma once
-// Completion (runtime_spec.md): every live agent (at least one) stands inside the goal rectangle at a terrain height
-// of at least the goal's min_height_m, checked on the authoritative terrain.
+// Completion, checked on the authoritative terrain, in one of three kinds (scenario::CompletionKind):
+//   agents_at_goal  every live agent (at least one) stands inside the goal rectangle at >= the goal's min_height_m;
+//   payload_path    the payload (kappa, delta, eps of PayloadPath) has a navigable path from the cell of `from` to
+//                   the cell of `to`: 8-connected through occupiable cells of the whole grid (paper §V-A);
+//   level_site      the terrain cropped to the site (cells whose centres lie inside) has an 8-connected component
+//                   of cells occupiable for the site's kappa, delta, eps (balls cut at the crop's edge) covering at
+//                   least min_fraction of the crop's cells (paper §V-B).
+// The pure functions below decide each from a terrain; WorldState keeps an incremental check (CompletionCheck) that
+// apply_step evaluates on its schedule and is_completed reads.
 
+#include <optional>
+#include <vector>
+
+#include "common/grid/heightmap.hpp"
+#include "common/scenario/scenario.hpp"
+#include "common/types.hpp"
 #include "world_server/world_state.hpp"
 
 namespace marsala::world_server {
@@ -10,10 +23,56 @@ namespace marsala::world_server {
 /// goal.min_height_m - 1e-9 m.
 bool at_goal(const WorldState& state, const AgentRecord& agent);
 
-/// True when at least one agent is live and every live agent is at the goal.
+/// agents_at_goal: at least one agent is live and every live agent is at the goal. payload_path, level_site: the
+/// latest evaluation of the terrain check (state.check.met).
 bool is_completed(const WorldState& state);
 
-/// Fraction of the live agents at the goal [0, 1]; 0 when none is live.
+/// agents_at_goal: fraction of the live agents at the goal (0 when none is live); payload_path: 1 when the latest
+/// check found the path, else 0; level_site: the latest level fraction. In [0, 1].
 double progress(const WorldState& state);
+
+/// Sets up the terrain check of a payload_path or level_site state (its cache on the current terrain) and evaluates
+/// it once; nothing for agents_at_goal. Throws InvalidArgument when the payload's `from` or `to` is off the grid or
+/// the site holds no cell of the grid.
+void start_completion_check(WorldState& state);
+
+/// Evaluates the terrain check now: brings the cached occupiable mask up to date with the terrain changes recorded
+/// in it, then decides met (and the level fraction); counts the evaluation. Nothing for agents_at_goal.
+void evaluate_completion(WorldState& state);
+
+/// The site's cells: those whose centres lie in [x0, x1] x [y0, y1] (closed, 1e-9 m tolerance); empty when none.
+CellRect site_cells(const grid::GridGeometry& grid, const scenario::Site& site);
+
+/// Size of the largest 8-connected component of the mask's 1-cells [cells]; 0 when there is none.
+long long largest_component(const grid::CellMask& mask);
+
+/// True when `to` is 8-connected to `from` through 1-cells of `passable` (both must be 1). Throws InvalidArgument
+/// when either is off the mask.
+bool connected(const grid::CellMask& passable, CellIndex from, CellIndex to);
+
+/// True when the payload has a navigable path on `terrain` (whole grid): the cell of `to` is navigable from the cell
+/// of `from` for the payload's kappa, delta_m, eps_m. Throws InvalidArgument when `from` or `to` is off the grid.
+bool payload_path_navigable(const grid::Heightmap& terrain, const scenario::PayloadPath& path);
+
+/// The site's level fraction on `terrain`: largest 8-connected component of the crop's occupiable cells (balls cut
+/// at the crop's edge) / cells of the crop, in [0, 1]. Throws InvalidArgument when the site holds no cell of the grid.
+double site_level_fraction(const grid::Heightmap& terrain, const scenario::Site& site);
+
+/// A path of cells and its length.
+struct PayloadRoute {
+  std::vector<CellIndex> cells;  ///< from the first cell to the last, consecutive cells 8-adjacent
+  double length_m = 0.0;         ///< sum of the steps: cs for a side step, cs * sqrt(2) for a diagonal one [m]
+};
+
+/// A shortest 8-connected path through 1-cells of `passable` from `from` to `to` (Euclidean step costs: cs or
+/// cs * sqrt 2; among equally short paths a deterministic one), or nullopt when there is none (either end
+/// blocked or disconnected). Throws InvalidArgument when an end is off the mask or cell_size_m is not > 0.
+std::optional<PayloadRoute> shortest_path(const grid::CellMask& passable, CellIndex from, CellIndex to,
+                                          double cell_size_m);
+
+/// The payload's constructed path on `terrain`: a shortest path through cells occupiable for the payload (whole
+/// grid) from the cell of `from` to the cell of `to`, or nullopt when there is none. Throws InvalidArgument when
+/// `from` or `to` is off the grid.
+std::optional<PayloadRoute> payload_path(const grid::Heightmap& terrain, const scenario::PayloadPath& path);
 
 }  // namespace marsala::world_server

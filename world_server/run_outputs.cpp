@@ -25,9 +25,34 @@ void make_dir(const std::string& dir) {
 
 std::string path_in(const std::string& dir, const char* name) { return (fs::path(dir) / name).string(); }
 
-}  // namespace
+constexpr render::Rgb kWhite{255, 255, 255};
+constexpr render::Rgb kPathYellow{255, 214, 0};
+constexpr render::Rgb kFromRed{228, 26, 28};
+constexpr render::Rgb kToGreen{40, 190, 60};
+constexpr render::Rgb kArrowRed{220, 30, 30};
 
-std::string summary_json(const WorldState& state, const RunInfo& info) {
+/// What the end of a run reports about the terrain, computed once.
+struct FinalTerrainReport {
+  std::optional<PayloadRoute> route;  ///< payload_path only
+  double site_fraction = 0.0;         ///< level_site only
+};
+
+FinalTerrainReport final_terrain_report(const WorldState& state) {
+  FinalTerrainReport report;
+  if (state.completion == scenario::CompletionKind::kPayloadPath)
+    report.route = payload_path(state.terrain, state.payload_path);
+  if (state.completion == scenario::CompletionKind::kLevelSite)
+    report.site_fraction = site_level_fraction(state.terrain, state.site);
+  return report;
+}
+
+std::string format_number(const char* format, double v) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+std::string summary_text(const WorldState& state, const RunInfo& info, const FinalTerrainReport& report) {
   proto::RunSummary s;
   s.set_scenario(info.scenario);
   s.set_scenario_file(info.scenario_file);
@@ -71,6 +96,13 @@ std::string summary_json(const WorldState& state, const RunInfo& info) {
   s.set_rows(state.terrain.rows());
   s.set_cols(state.terrain.cols());
   s.set_cell_size_m(state.terrain.cell_size_m());
+  s.set_completion(scenario::to_string(state.completion));
+  s.set_idle_steps(static_cast<std::uint32_t>(state.idle_steps));
+  s.set_path_found(report.route.has_value());
+  s.set_path_length_m(report.route ? report.route->length_m : 0.0);
+  s.set_site_level_fraction(report.site_fraction);
+  s.set_completion_checks(state.check.evaluations);
+  s.set_start_jitter_m(info.start_jitter_m);
 
   google::protobuf::util::JsonPrintOptions options;
   options.add_whitespace = true;
@@ -82,6 +114,90 @@ std::string summary_json(const WorldState& state, const RunInfo& info) {
   return json;
 }
 
+}  // namespace
+
+std::string summary_json(const WorldState& state, const RunInfo& info) {
+  return summary_text(state, info, final_terrain_report(state));
+}
+
+render::RenderOptions final_picture_options(const WorldState& state, const RunInfo& info,
+                                            const std::optional<PayloadRoute>& route) {
+  render::RenderOptions o;
+  const grid::Heightmap& t = state.terrain;
+  if (state.depositor.rows() == t.rows() && state.depositor.cols() == t.cols() && state.depositor.maxCoeff() > 0)
+    o.labels = state.depositor;
+  o.circles.push_back({{state.base.x_m, state.base.y_m}, state.base.radius_m, kWhite, 0.0});
+  o.legend_entries.push_back({"base station", kWhite, render::LegendSwatch::kRing});
+  std::string outcome = info.completed ? "completed" : "not completed";
+  switch (state.completion) {
+    case scenario::CompletionKind::kAgentsAtGoal: {
+      const scenario::Goal& g = state.goal;
+      o.rectangles.push_back({{g.x0_m, g.y0_m}, {g.x1_m, g.y1_m}, kWhite, 0.0});
+      if (const auto cell = t.cell_at({0.5 * (g.x0_m + g.x1_m), 0.5 * (g.y0_m + g.y1_m)})) o.markers.push_back(*cell);
+      o.legend_entries.push_back({"goal", kWhite, render::LegendSwatch::kOutline});
+      break;
+    }
+    case scenario::CompletionKind::kPayloadPath: {
+      const scenario::PayloadPath& p = state.payload_path;
+      if (route) {
+        render::Polyline line;
+        line.colour = kPathYellow;
+        for (const CellIndex& c : route->cells) line.points.push_back(t.cell_center(c));
+        if (line.points.size() == 1) line.points.push_back(line.points.front());
+        o.polylines.push_back(std::move(line));
+        o.legend_entries.push_back(
+            {"payload path " + format_number("%.2f m", route->length_m), kPathYellow, render::LegendSwatch::kLine});
+        outcome += ", path " + format_number("%.2f m", route->length_m);
+      } else {
+        outcome += ", no payload path";
+      }
+      o.points.push_back({{p.from_x_m, p.from_y_m}, kFromRed, render::PointShape::kSquare, 0.0});
+      o.points.push_back({{p.to_x_m, p.to_y_m}, kToGreen, render::PointShape::kDiamond, 0.0});
+      o.legend_entries.push_back({"payload from", kFromRed, render::LegendSwatch::kSquare});
+      o.legend_entries.push_back({"payload to", kToGreen, render::LegendSwatch::kDiamond});
+      break;
+    }
+    case scenario::CompletionKind::kLevelSite: {
+      const scenario::Site& site = state.site;
+      o.rectangles.push_back({{site.x0_m, site.y0_m}, {site.x1_m, site.y1_m}, kWhite, 0.0});
+      o.legend_entries.push_back({"site", kWhite, render::LegendSwatch::kOutline});
+      outcome += ", level " + format_number("%.1f%%", 100.0 * state.check.level_fraction);
+      break;
+    }
+  }
+  // Agents: discs of their colour; the legend lists each colour once with the ids that share it.
+  std::vector<std::string> ids_of_colour(render::default_palette().size());
+  for (const AgentRecord& a : state.agents) {
+    if (!a.admitted) continue;
+    o.points.push_back({{a.x_m, a.y_m}, render::label_colour(a.id), render::PointShape::kDisc, 0.0});
+    std::string& ids = ids_of_colour[(a.id - 1) % ids_of_colour.size()];
+    ids += (ids.empty() ? "" : ", ") + std::to_string(a.id);
+  }
+  for (std::size_t k = 0; k < ids_of_colour.size(); ++k)
+    if (!ids_of_colour[k].empty())
+      o.legend_entries.push_back({(ids_of_colour[k].find(',') == std::string::npos ? "agent " : "agents ") +
+                                      ids_of_colour[k],
+                                  render::default_palette()[k], render::LegendSwatch::kDisc});
+  o.title = info.scenario + ": step " + std::to_string(state.step) + ", " + scenario::to_string(state.completion) +
+            " " + outcome;
+  return o;
+}
+
+render::RenderOptions goal_vector_map_picture_options(const WorldState& state, const RunInfo& info,
+                                                      const processing::GoalVectorMap& map) {
+  render::RenderOptions o;
+  const processing::GoalVectorMapSpec& spec = map.spec();
+  o.rectangles.push_back({{spec.x0_m, spec.y0_m}, {spec.x1_m, spec.y1_m}, kWhite, 0.0});
+  if (state.completion == scenario::CompletionKind::kLevelSite)
+    o.rectangles.push_back({{state.site.x0_m, state.site.y0_m}, {state.site.x1_m, state.site.y1_m}, kWhite, 0.0});
+  for (const processing::GoalArrow& a : map.arrows()) o.arrows.push_back({a.tail, a.head, kArrowRed, 0.0});
+  o.legend_entries.push_back({"tail -> head", kArrowRed, render::LegendSwatch::kArrow});
+  o.legend_entries.push_back({"site", kWhite, render::LegendSwatch::kOutline});
+  o.title = info.scenario + ": goal vector map, " + std::to_string(map.arrows().size()) + " arrows in " +
+            std::to_string(map.strips()) + " strips, heading " + processing::to_string(spec.heading);
+  return o;
+}
+
 void write_initial_outputs(const std::string& dir, const grid::Heightmap& terrain) {
   make_dir(dir);
   terrain::write_asc(terrain, path_in(dir, "terrain_initial.asc"));
@@ -91,20 +207,22 @@ void write_final_outputs(const std::string& dir, const WorldState& state, const 
   make_dir(dir);
   terrain::write_asc(state.terrain, path_in(dir, "terrain_final.asc"));
 
-  render::RenderOptions options;
-  for (const AgentRecord& a : state.agents)
-    if (a.admitted)
-      if (const auto cell = state.terrain.cell_at({a.x_m, a.y_m})) options.markers.push_back(*cell);
-  const Position goal_centre{0.5 * (state.goal.x0_m + state.goal.x1_m), 0.5 * (state.goal.y0_m + state.goal.y1_m)};
-  if (const auto cell = state.terrain.cell_at(goal_centre)) options.markers.push_back(*cell);
-  options.title = info.scenario + ": step " + std::to_string(state.step) + (info.completed ? ", completed" : "");
-  render::write_png(render::render_terrain(state.terrain, options), path_in(dir, "final.png"));
+  const FinalTerrainReport report = final_terrain_report(state);
+  render::write_png(render::render_terrain(state.terrain, final_picture_options(state, info, report.route)),
+                    path_in(dir, "final.png"));
 
   const std::string path = path_in(dir, "summary.json");
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << summary_json(state, info);
+  out << summary_text(state, info, report);
   out.close();
   if (!out) throw IoError("cannot write '" + path + "'");
+
+  if (info.goal_vector_map) {
+    const grid::Heightmap& initial = info.initial_terrain.size() > 0 ? info.initial_terrain : state.terrain;
+    const processing::GoalVectorMap map(*info.goal_vector_map, initial.geometry());
+    render::write_png(render::render_terrain(initial, goal_vector_map_picture_options(state, info, map)),
+                      path_in(dir, "goal_vector_map.png"));
+  }
 }
 
 std::string format_event(const bus::WorldEvent& e) {

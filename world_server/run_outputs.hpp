@@ -1,13 +1,25 @@
 #pragma once
 // What a run leaves in its output folder: summary.json (protobuf RunSummary as JSON, proto field names),
-// terrain_initial.asc, terrain_final.asc, final.png, and events.log (one text line per event). IO at the edge.
+// terrain_initial.asc, terrain_final.asc, final.png, goal_vector_map.png (scenarios with a goal vector map) and
+// events.log (one text line per event). IO at the edge.
+//
+// final.png: the hillshaded final terrain; every cell raised by a deposition tinted with its depositor's colour
+// (render::default_palette(): agent id k -> entry (k - 1) mod 12: 1 red, 2 blue, 3 green, 4 orange, 5 purple, 6 cyan,
+// 7 magenta, 8 lime, 9 brown, 10 pink, 11 teal, 12 lavender, then again from red); agents as discs of their colour;
+// the base station as a white circle of its radius; agents_at_goal: the goal rectangle outlined in white and its
+// centre crossed; payload_path: the constructed path as a yellow line, `from` as a red square, `to` as a green
+// diamond; level_site: the site outlined in white; a title with scenario, step and completion; a legend.
 
 #include <cstdint>
 #include <fstream>
+#include <optional>
 #include <string>
 
 #include "common/bus/messages.hpp"
 #include "common/grid/heightmap.hpp"
+#include "common/processing/goal_vector_map.hpp"
+#include "common/render/terrain_renderer.hpp"
+#include "world_server/completion.hpp"
 #include "world_server/world_state.hpp"
 
 namespace marsala::world_server {
@@ -24,15 +36,33 @@ struct RunInfo {
   double wall_seconds = 0.0;   ///< [s]
   double step_wall_median_ms = 0.0;  ///< median wall time of one lockstep step [ms]
   double step_wall_p90_ms = 0.0;     ///< its 90th percentile [ms]
+  double start_jitter_m = 0.0;       ///< the scenario's start jitter [m]
+  /// The scenario's goal vector map, drawn into goal_vector_map.png when set.
+  std::optional<processing::GoalVectorMapSpec> goal_vector_map;
+  grid::Heightmap initial_terrain;   ///< the terrain before the run (for goal_vector_map.png); empty = use the final
 };
 
-/// summary.json's text: every field present (zeros included); steps = state.step; terrain_sha256 of state.terrain.
+/// summary.json's text: every field present (zeros included); steps = state.step; terrain_sha256 of state.terrain;
+/// payload_path: path_found and path_length_m of payload_path() on state.terrain; level_site: site_level_fraction()
+/// on state.terrain.
 std::string summary_json(const WorldState& state, const RunInfo& info);
 
 /// Writes terrain_initial.asc into `dir` (created when missing); throws IoError.
 void write_initial_outputs(const std::string& dir, const grid::Heightmap& terrain);
 
-/// Writes summary.json, terrain_final.asc and final.png (agents and the goal centre marked) into `dir`; throws IoError.
+/// The options of final.png (see the top of this file) for the final state and the payload's constructed path.
+render::RenderOptions final_picture_options(const WorldState& state, const RunInfo& info,
+                                            const std::optional<PayloadRoute>& route);
+
+/// The options of goal_vector_map.png: the arrows of processing::GoalVectorMap(spec, grid).arrows() in red, the
+/// map's rectangle (and a level_site's site) outlined in white, a title with the arrow count.
+render::RenderOptions goal_vector_map_picture_options(const WorldState& state, const RunInfo& info,
+                                                      const processing::GoalVectorMap& map);
+
+/// Writes summary.json, terrain_final.asc, final.png and, when info.goal_vector_map is set, goal_vector_map.png (on
+/// info.initial_terrain, or the final terrain when that is empty) into `dir`; the payload's path is computed once.
+/// Throws IoError; a goal vector map that does not fit the grid throws InvalidArgument after the other files are
+/// written.
 void write_final_outputs(const std::string& dir, const WorldState& state, const RunInfo& info);
 
 /// One event as a log line: "step 12 agent 2 deposited 0.000125 m3: 1 cells".

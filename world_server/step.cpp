@@ -23,7 +23,7 @@ bus::WorldEvent event(std::uint64_t step, std::uint32_t agent, bus::EventKind ki
 
 /// Applies the requests that arrived on one live agent's partition.
 void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const bus::ActionRequest*>& requests,
-                 std::vector<CellIndex>& changed_cells, StepOutcome& out) {
+                 std::vector<CellIndex>& changed_cells, StepOutcome& out, bool& deposited) {
   const std::uint64_t step = state.step;
   const std::string who = "agent " + std::to_string(agent.id);
   bool answered = false;
@@ -55,6 +55,7 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const 
     const Verdict verdict = validate_request(state, agent.id, *r);
     if (verdict.accepted) {
       apply_request(state, *r, verdict, changed_cells);
+      deposited = deposited || !r->depositions.empty();
       agent.last_result = bus::ActionResult::kAccepted;
       agent.last_reason.clear();
       ++out.accepted;
@@ -102,8 +103,10 @@ StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submiss
     by_agent[s.channel_id - 1].push_back(&s.request);
   }
   std::vector<CellIndex> changed_cells;
+  bool deposited = false;
   for (AgentRecord& agent : state.agents)
-    if (agent.alive) apply_agent(state, agent, by_agent[agent.id - 1], changed_cells, out);
+    if (agent.alive) apply_agent(state, agent, by_agent[agent.id - 1], changed_cells, out, deposited);
+  if (!deposited) ++state.idle_steps;
 
   const TileLayout tiles = state.tiles();
   for (const CellIndex& c : changed_cells) out.changed_tiles.push_back(tiles.index_of(c));
@@ -118,6 +121,16 @@ StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submiss
     const bool reached = at_goal(state, agent);
     if (reached && !agent.at_goal) out.events.push_back(event(state.step, agent.id, bus::EventKind::kAtGoal, ""));
     agent.at_goal = reached;
+  }
+  if (state.completion != scenario::CompletionKind::kAgentsAtGoal) {
+    for (const CellIndex& c : changed_cells) state.check.occupancy.mark_changed(c);
+    const std::uint32_t every = state.completion == scenario::CompletionKind::kPayloadPath
+                                    ? state.payload_path.check_every_steps
+                                    : state.site.check_every_steps;
+    if ((state.step + 1) % std::max<std::uint32_t>(every, 1) == 0 && state.check.occupancy.has_changes()) {
+      evaluate_completion(state);
+      out.completion_checked = true;
+    }
   }
   out.completed = is_completed(state);
   ++state.step;

@@ -32,6 +32,7 @@ struct StepOutcome {
   std::uint32_t accepted = 0;               ///< requests accepted
   std::uint32_t rejected = 0;               ///< requests rejected (including duplicates and future steps)
   std::uint32_t missed = 0;                 ///< live agents without a request for this step
+  bool completion_checked = false;          ///< the payload/site check was evaluated in this step
   bool completed = false;                   ///< is_completed() after the step
 };
 
@@ -39,8 +40,11 @@ struct StepOutcome {
 /// are taken in arrival order. Per live agent, in id order: requests for past steps are dropped (a note), for future
 /// steps rejected; the first for this step is validated and applied (or rejected), later ones are duplicates
 /// (rejected, the first stands); no request for this step is a miss (kMissed; dropped at 3 in a row). Submissions on
-/// the partition of an agent that is not live are ignored with a note. Then z of every agent, tile versions, at_goal
-/// (event kAtGoal when reached), completion; finally state.step += 1.
+/// the partition of an agent that is not live are ignored with a note. A step in which no deposition is accepted
+/// counts in state.idle_steps. Then z of every agent, tile versions, at_goal (event kAtGoal when reached); for
+/// payload_path and level_site runs the changed cells are recorded in the completion check, which is evaluated when
+/// (step + 1) % check_every_steps == 0 and the terrain of its area changed since its previous evaluation; then
+/// completion; finally state.step += 1.
 StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submissions);
 
 /// Same, with each request taken as arriving on its own agent's partition (channel = request.agent_id).

@@ -17,8 +17,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
                   std::ostream& err) {
   CLI::App app{"marsala-world: the authoritative world server. Loads a scenario, admits agents over DDS, runs the\n"
                "lockstep (frames, requests, validation in agent-id order) and writes summary.json, terrain_initial.asc,\n"
-               "terrain_final.asc, final.png and events.log into --out. The run id (partition prefix) defaults to\n"
-               "<scenario name>-d<domain>.",
+               "terrain_final.asc, final.png, events.log (and goal_vector_map.png when the scenario has one) into --out.\n"
+               "The run id (partition prefix) defaults to <scenario name>-d<domain>.",
                "marsala-world"};
   std::string scenario_path, dds = "cyclone";
   RuntimeOptions options;
@@ -35,9 +35,13 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   app.add_option("--admit-timeout", options.admit_timeout_s, "seconds to wait for all agents")
       ->check(CLI::Range(0.0, 86400.0))->capture_default_str();
   app.add_option("--max-steps", options.max_steps, "override the scenario's max_steps")->check(CLI::Range(1ull, 1ull << 40));
+  std::uint64_t seed = 0;
+  const CLI::Option* seed_option =
+      app.add_option("--seed", seed, "override the scenario's seed (start jitter); summary.json reports the seed used");
   app.add_flag("--quiet", quiet, "log warnings and errors only");
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-world", out, err)) return *code;
 
+  if (seed_option->count() > 0) options.seed = seed;
   spdlog::set_pattern("%H:%M:%S.%e %^%l%$ world: %v");
   spdlog::set_level(quiet ? spdlog::level::warn : spdlog::level::info);
   try {

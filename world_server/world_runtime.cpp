@@ -84,6 +84,7 @@ struct AgentLink {
 struct WorldRuntime::Impl {
   Impl(const scenario::Scenario& s, grid::Heightmap terrain, RuntimeOptions o, bus::Participant& p)
       : scenario(s), options(std::move(o)), participant(p) {
+    if (options.seed) scenario.seed = *options.seed;
     const std::uint32_t agents = options.agents == 0 ? static_cast<std::uint32_t>(s.slots.size()) : options.agents;
     if (agents > s.slots.size())
       throw InvalidArgument("--agents " + std::to_string(agents) + " exceeds the " + std::to_string(s.slots.size()) +
@@ -96,7 +97,8 @@ struct WorldRuntime::Impl {
     if (options.step_deadline_s == 0.0) options.step_deadline_s = s.step_deadline_s;
     if (!(options.step_deadline_s > 0.0) || !std::isfinite(options.step_deadline_s))
       throw InvalidArgument("step deadline must be finite and > 0 s");
-    state = make_world_state(s, std::move(terrain), agents);
+    if (scenario.has_goal_vector_map) initial_terrain = terrain;
+    state = make_world_state(scenario, std::move(terrain), agents);
     sensing.emplace(state);
     links.resize(agents);
     last_rejection.resize(agents);
@@ -286,6 +288,10 @@ struct WorldRuntime::Impl {
       if (stop) return "signal";  // the interrupted step is not applied
       const StepOutcome outcome = apply_step(state, submissions);
       step_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - step_start).count());
+      if (outcome.completion_checked)
+        spdlog::debug("step {}: {} check: {} (level fraction {:.4f})", outcome.step,
+                      scenario::to_string(state.completion), state.check.met ? "met" : "not met",
+                      state.check.level_fraction);
       for (const std::string& text : outcome.notes) note(text);
       for (const bus::WorldEvent& e : outcome.events) {
         if (e.kind == bus::EventKind::kRejected)
@@ -307,6 +313,27 @@ struct WorldRuntime::Impl {
     }
   }
 
+  /// One line on how the run completes and where its terrain check stands at the start.
+  void log_completion() const {
+    switch (state.completion) {
+      case scenario::CompletionKind::kAgentsAtGoal:
+        spdlog::info("completion: agents_at_goal");
+        break;
+      case scenario::CompletionKind::kPayloadPath:
+        spdlog::info("completion: payload_path from ({}, {}) to ({}, {}), checked every {} steps: {}",
+                     state.payload_path.from_x_m, state.payload_path.from_y_m, state.payload_path.to_x_m,
+                     state.payload_path.to_y_m, state.payload_path.check_every_steps,
+                     state.check.met ? "already navigable" : "not navigable yet");
+        break;
+      case scenario::CompletionKind::kLevelSite:
+        spdlog::info("completion: level_site, checked every {} steps: level fraction {:.4f} of {:.4f} needed",
+                     state.site.check_every_steps, state.check.level_fraction, state.site.min_fraction);
+        break;
+    }
+    if (scenario.start_jitter_m > 0.0)
+      spdlog::info("starts jittered by up to {} m with seed {}", scenario.start_jitter_m, scenario.seed);
+  }
+
   /// Waits until every agent told that the run is over has closed its request writer, or the linger time passes.
   void linger(const std::vector<std::uint32_t>& ids) {
     const Clock::time_point deadline = Clock::now() + seconds(options.linger_s);
@@ -326,6 +353,7 @@ struct WorldRuntime::Impl {
     spdlog::info("run '{}': scenario '{}', {} x {} cells of {} m, waiting for {} agents (admit timeout {} s)",
                  options.run_id, scenario.name, state.terrain.rows(), state.terrain.cols(),
                  state.terrain.cell_size_m(), state.agents.size(), options.admit_timeout_s);
+    log_completion();
     admit_agents(stop);
     run_started = true;
     const Clock::time_point start = Clock::now();
@@ -348,6 +376,11 @@ struct WorldRuntime::Impl {
     info.run_id = options.run_id;
     info.dds = bus::to_string(participant.vendor());
     info.seed = scenario.seed;
+    info.start_jitter_m = scenario.start_jitter_m;
+    if (scenario.has_goal_vector_map) {
+      info.goal_vector_map = scenario.goal_vector_map;
+      info.initial_terrain = std::move(initial_terrain);
+    }
     info.completed = result.completed;
     info.end_reason = end_reason;
     info.wall_seconds = result.wall_seconds;
@@ -362,7 +395,7 @@ struct WorldRuntime::Impl {
     return result;
   }
 
-  scenario::Scenario scenario;
+  scenario::Scenario scenario;  ///< with the seed in use
   RuntimeOptions options;
   bus::Participant& participant;
   WorldState state;
@@ -370,6 +403,7 @@ struct WorldRuntime::Impl {
   std::vector<AgentLink> links;  ///< [id - 1]
   std::shared_ptr<bus::Signal> signal;
   std::vector<double> step_ms;  ///< wall time of each lockstep step [ms]
+  grid::Heightmap initial_terrain;  ///< kept for goal_vector_map.png only
   std::unique_ptr<bus::Reader<bus::AgentHello>> hellos;
   std::unique_ptr<bus::Writer<bus::Admission>> admissions;
   std::unique_ptr<bus::Writer<bus::WorldStatus>> status;

@@ -3,6 +3,8 @@
 #include <limits>
 
 #include "common/error.hpp"
+#include "world_server/completion.hpp"
+#include "world_server/start_jitter.hpp"
 
 namespace marsala::world_server {
 
@@ -34,6 +36,10 @@ WorldState make_world_state(const scenario::Scenario& scenario, grid::Heightmap 
   s.base = scenario.base;
   s.tile_size = scenario.tile_size;
   s.tile_versions.assign(static_cast<std::size_t>(s.tiles().tile_count()), 0);
+  s.depositor = AgentIdGrid::Zero(s.terrain.rows(), s.terrain.cols());
+  s.completion = scenario.completion;
+  s.payload_path = scenario.payload_path;
+  s.site = scenario.site;
   for (std::uint32_t id = 1; id <= agent_count; ++id) {
     const scenario::AgentSlot& slot = scenario.slots[id - 1];
     const scenario::RobotType& type = scenario.robot_for(id);
@@ -42,15 +48,17 @@ WorldState make_world_state(const scenario::Scenario& scenario, grid::Heightmap 
     a.robot_type = type.name;
     a.behaviour = type.behaviour;
     a.body = type.body;
-    a.start_x_m = slot.start_x_m;
-    a.start_y_m = slot.start_y_m;
+    const Position start = jittered_start(s.terrain, slot, type.body, scenario.start_jitter_m, scenario.seed);
+    a.start_x_m = start.x;
+    a.start_y_m = start.y;
     a.target_x_m = slot.target_x_m;
     a.target_y_m = slot.target_y_m;
-    a.x_m = slot.start_x_m;
-    a.y_m = slot.start_y_m;
+    a.x_m = start.x;
+    a.y_m = start.y;
     a.z_m = height_under(s.terrain, a.x_m, a.y_m);
     s.agents.push_back(std::move(a));
   }
+  start_completion_check(s);
   return s;
 }
 

@@ -9,6 +9,7 @@
 #include "common/bus/messages.hpp"
 #include "common/grid/heightmap.hpp"
 #include "common/scenario/scenario.hpp"
+#include "world_server/occupancy_cache.hpp"
 #include "world_server/tile_layout.hpp"
 
 namespace marsala::world_server {
@@ -51,6 +52,19 @@ inline bool carries_identity_of(const AgentRecord& agent, const bus::ActionReque
   return r.agent_id == agent.id && r.session == agent.session;
 }
 
+/// Per-cell agent ids, row-major like the terrain (0 = none).
+using AgentIdGrid = Eigen::Matrix<std::uint32_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+/// The terrain check of payload-path and level-site runs (completion.hpp): its cache and its latest answer.
+struct CompletionCheck {
+  OccupancyCache occupancy;        ///< payload: the whole grid for the payload's body; site: the site's cells
+  CellIndex from;                  ///< payload: the cells of `from` and `to`
+  CellIndex to;
+  bool met = false;                ///< the latest evaluation found the payload's path / a level site
+  double level_fraction = 0.0;     ///< site: the latest level fraction [0, 1]
+  std::uint32_t evaluations = 0;   ///< evaluations run, the initial one included
+};
+
 /// Everything the step function reads and changes.
 struct WorldState {
   grid::Heightmap terrain;              ///< authoritative heights [m]
@@ -61,6 +75,12 @@ struct WorldState {
   int tile_size = 16;                   ///< [cells]
   std::vector<std::uint64_t> tile_versions;  ///< per tile (TileLayout index): bumped in every step that changes it
   double deposited_volume_m3 = 0.0;     ///< total placed [m^3]
+  scenario::CompletionKind completion = scenario::CompletionKind::kAgentsAtGoal;
+  scenario::PayloadPath payload_path;   ///< kPayloadPath: the payload's body, from, to, schedule
+  scenario::Site site;                  ///< kLevelSite: the site, its parameters, schedule
+  CompletionCheck check;                ///< kPayloadPath and kLevelSite
+  AgentIdGrid depositor;                ///< per cell: the agent whose deposition last raised it (0 = never)
+  std::uint64_t idle_steps = 0;         ///< applied steps in which no deposition was accepted
 
   /// True when `id` names an agent slot of this run.
   bool has_agent(std::uint32_t id) const { return id >= 1 && id <= agents.size(); }
@@ -73,8 +93,11 @@ struct WorldState {
   TileLayout tiles() const { return TileLayout(terrain.geometry(), tile_size); }
 };
 
-/// The initial state: `terrain`, the scenario's goal, base and tile size, and slots 1..agent_count (none admitted).
-/// Throws InvalidArgument when agent_count is 0 or exceeds the scenario's slots.
+/// The initial state: `terrain`, the scenario's goal, base, tile size and completion (for kPayloadPath and kLevelSite
+/// evaluated once here, so a scenario complete from the start ends at once), and slots 1..agent_count (none
+/// admitted), each start moved by jittered_start() when the scenario's start_jitter_m > 0 (seeded by
+/// scenario.seed). Throws InvalidArgument when agent_count is 0 or exceeds the scenario's slots, when the payload's
+/// `from` or `to` is off the grid, or when the site holds no cell of the grid.
 WorldState make_world_state(const scenario::Scenario& scenario, grid::Heightmap terrain, std::uint32_t agent_count);
 
 /// Height of the cell under (x, y) [m], or NaN when off the grid.

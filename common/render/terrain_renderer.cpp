@@ -33,6 +33,13 @@ constexpr double kSunNorth = 0.5;
 // Vertical exaggeration of the shading only (colours use true heights): gentle 0.1-0.3 slopes stay readable.
 constexpr double kShadeExaggeration = 2.0;
 
+constexpr Rgb kHalo{30, 30, 30};
+
+// Twelve colours that stay apart from each other and from the terrain colour map's blues and sands when blended.
+const std::vector<Rgb> kPalette{{228, 26, 28},  {40, 100, 220},  {60, 170, 60},  {255, 127, 0},
+                                {150, 70, 170}, {0, 200, 220},   {235, 50, 190}, {170, 230, 40},
+                                {150, 85, 35},  {250, 160, 200}, {0, 120, 120},  {180, 160, 255}};
+
 std::string cell_name(int r, int c) { return "(" + std::to_string(r) + ", " + std::to_string(c) + ")"; }
 std::string size_name(long long r, long long c) { return std::to_string(r) + " x " + std::to_string(c); }
 
@@ -136,6 +143,161 @@ void validate(const grid::Heightmap& map, const RenderOptions& o) {
     if (!map.contains(m))
       throw InvalidArgument("render_terrain: marker " + cell_name(m.row, m.col) + " is off the " +
                             size_name(map.rows(), map.cols()) + " grid");
+  if (o.labels && (o.labels->rows() != map.rows() || o.labels->cols() != map.cols()))
+    throw InvalidArgument("render_terrain: label grid is " + size_name(o.labels->rows(), o.labels->cols()) +
+                          " but the heightmap is " + size_name(map.rows(), map.cols()));
+  if (!(o.label_alpha >= 0.0 && o.label_alpha <= 1.0))
+    throw InvalidArgument("render_terrain: label_alpha = " + std::to_string(o.label_alpha) + " is outside [0, 1]");
+  const auto check = [](bool ok, const std::string& what, std::size_t i) {
+    if (!ok) throw InvalidArgument("render_terrain: " + what + " " + std::to_string(i) + " has a non-finite or negative value");
+  };
+  const auto finite = [](Position p) { return std::isfinite(p.x) && std::isfinite(p.y); };
+  const auto width_ok = [](double w) { return std::isfinite(w) && w >= 0.0; };
+  for (std::size_t i = 0; i < o.polylines.size(); ++i) {
+    bool ok = width_ok(o.polylines[i].width_px);
+    for (const Position& p : o.polylines[i].points) ok = ok && finite(p);
+    check(ok, "polyline", i);
+  }
+  for (std::size_t i = 0; i < o.arrows.size(); ++i)
+    check(finite(o.arrows[i].tail) && finite(o.arrows[i].head) && width_ok(o.arrows[i].width_px), "arrow", i);
+  for (std::size_t i = 0; i < o.rectangles.size(); ++i)
+    check(finite(o.rectangles[i].a) && finite(o.rectangles[i].b) && width_ok(o.rectangles[i].width_px), "rectangle", i);
+  for (std::size_t i = 0; i < o.circles.size(); ++i)
+    check(finite(o.circles[i].centre) && width_ok(o.circles[i].radius_m) && width_ok(o.circles[i].width_px), "circle",
+          i);
+  for (std::size_t i = 0; i < o.points.size(); ++i)
+    check(finite(o.points[i].at) && width_ok(o.points[i].radius_px), "point", i);
+}
+
+/// Per display cell: the most frequent non-zero label of its block (ties: the smallest) and the labelled fraction.
+void block_labels(const CellLabels& labels, const Sampling& s, std::vector<std::uint32_t>& label,
+                  std::vector<double>& fraction) {
+  label.assign(static_cast<std::size_t>(s.rows) * s.cols, 0);
+  fraction.assign(label.size(), 0.0);
+  const int rows = static_cast<int>(labels.rows()), cols = static_cast<int>(labels.cols());
+  std::vector<std::uint32_t> seen;
+  for (int i = 0; i < s.rows; ++i)
+    for (int j = 0; j < s.cols; ++j) {
+      const int r1 = std::min(rows, (i + 1) * s.factor), c1 = std::min(cols, (j + 1) * s.factor);
+      seen.clear();
+      for (int r = i * s.factor; r < r1; ++r)
+        for (int c = j * s.factor; c < c1; ++c)
+          if (labels(r, c) != 0) seen.push_back(labels(r, c));
+      if (seen.empty()) continue;
+      std::sort(seen.begin(), seen.end());
+      std::uint32_t best = seen.front();
+      std::size_t best_run = 0;
+      for (std::size_t a = 0; a < seen.size();) {
+        std::size_t b = a;
+        while (b < seen.size() && seen[b] == seen[a]) ++b;
+        if (b - a > best_run) {
+          best_run = b - a;
+          best = seen[a];
+        }
+        a = b;
+      }
+      const std::size_t k = static_cast<std::size_t>(i) * s.cols + j;
+      label[k] = best;
+      fraction[k] = static_cast<double>(seen.size()) / ((r1 - i * s.factor) * (c1 - j * s.factor));
+    }
+}
+
+/// World [m] to continuous pixel coordinates of the terrain area.
+struct PixelMapper {
+  double x0, y_top, per_m;  // per_m = pixels per metre
+  double x(const Position& p) const { return (p.x - x0) * per_m; }
+  double y(const Position& p) const { return (y_top - p.y) * per_m; }
+};
+
+PixelMapper pixel_mapper(const grid::Heightmap& map, const Sampling& s) {
+  const grid::GridGeometry& g = map.geometry();
+  return {g.xll_m, g.yll_m + g.rows * g.cell_size_m, static_cast<double>(s.scale) / (s.factor * g.cell_size_m)};
+}
+
+double automatic(double width, double value) { return width > 0.0 ? width : value; }
+
+/// An arrow in pixel coordinates: the halo pass or the colour pass.
+void draw_arrow_px(Image& img, double tx, double ty, double hx, double hy, double w, Rgb colour, bool halo) {
+  const double dx = hx - tx, dy = hy - ty, length = std::sqrt(dx * dx + dy * dy);
+  if (!(length > 0.0)) return;
+  const double head = std::min(0.5 * length, 3.0 * w + 4.0), half = 0.6 * head;
+  const double ux = dx / length, uy = dy / length;
+  const double bx = hx - head * ux, by = hy - head * uy;  // middle of the head's base
+  const double lx = bx - half * uy, ly = by + half * ux, rx = bx + half * uy, ry = by - half * ux;
+  if (halo) {
+    detail::draw_segment(img, tx, ty, bx, by, w + 2.0, kHalo);
+    detail::draw_segment(img, hx, hy, lx, ly, 2.0, kHalo);
+    detail::draw_segment(img, lx, ly, rx, ry, 2.0, kHalo);
+    detail::draw_segment(img, rx, ry, hx, hy, 2.0, kHalo);
+    return;
+  }
+  detail::draw_segment(img, tx, ty, bx, by, w, colour);
+  detail::fill_triangle(img, hx, hy, lx, ly, rx, ry, colour);
+}
+
+void draw_arrow(Image& img, const PixelMapper& px, const Arrow& a, double auto_width, bool halo) {
+  draw_arrow_px(img, px.x(a.tail), px.y(a.tail), px.x(a.head), px.y(a.head), automatic(a.width_px, auto_width),
+                a.colour, halo);
+}
+
+void draw_point(Image& img, double x, double y, PointShape shape, double r, Rgb colour) {
+  switch (shape) {
+    case PointShape::kDisc:
+      detail::fill_disc(img, x, y, r, colour);
+      break;
+    case PointShape::kSquare: {
+      const int x0 = static_cast<int>(std::floor(x - r)), y0 = static_cast<int>(std::floor(y - r));
+      const int side = static_cast<int>(std::floor(x + r)) - x0 + 1;
+      detail::fill_rect(img, x0, y0, side, side, colour);
+      break;
+    }
+    case PointShape::kDiamond:
+      detail::fill_triangle(img, x - r, y, x, y - r, x + r, y, colour);
+      detail::fill_triangle(img, x - r, y, x, y + r, x + r, y, colour);
+      break;
+  }
+}
+
+/// Rectangles, circles, polylines and arrows, each kind with its halo under it.
+void draw_overlays(Image& img, const grid::Heightmap& map, const RenderOptions& o, const Sampling& s) {
+  const PixelMapper px = pixel_mapper(map, s);
+  const double longest = std::max(img.width, img.height);
+  const double thin = std::clamp(longest / 400.0, 1.0, 4.0);
+  const double line = std::clamp(longest / 200.0, 2.0, 8.0);
+  for (const RectangleOutline& r : o.rectangles) {
+    const double xa = px.x(r.a), ya = px.y(r.a), xb = px.x(r.b), yb = px.y(r.b);
+    const double w = automatic(r.width_px, thin);
+    for (const auto& [pass_w, colour] : {std::pair<double, Rgb>{w + 2.0, kHalo}, {w, r.colour}}) {
+      detail::draw_segment(img, xa, ya, xb, ya, pass_w, colour);
+      detail::draw_segment(img, xb, ya, xb, yb, pass_w, colour);
+      detail::draw_segment(img, xb, yb, xa, yb, pass_w, colour);
+      detail::draw_segment(img, xa, yb, xa, ya, pass_w, colour);
+    }
+  }
+  for (const CircleOutline& c : o.circles) {
+    const double w = automatic(c.width_px, thin), r = c.radius_m * px.per_m;
+    detail::draw_ring(img, px.x(c.centre), px.y(c.centre), r, w + 2.0, kHalo);
+    detail::draw_ring(img, px.x(c.centre), px.y(c.centre), r, w, c.colour);
+  }
+  for (bool halo : {true, false})
+    for (const Polyline& p : o.polylines) {
+      const double w = automatic(p.width_px, line);
+      for (std::size_t i = 1; i < p.points.size(); ++i)
+        detail::draw_segment(img, px.x(p.points[i - 1]), px.y(p.points[i - 1]), px.x(p.points[i]), px.y(p.points[i]),
+                             halo ? w + 2.0 : w, halo ? kHalo : p.colour);
+    }
+  for (bool halo : {true, false})
+    for (const Arrow& a : o.arrows) draw_arrow(img, px, a, thin, halo);
+}
+
+void draw_points(Image& img, const grid::Heightmap& map, const RenderOptions& o, const Sampling& s) {
+  const PixelMapper px = pixel_mapper(map, s);
+  const double auto_r = std::clamp(std::max(img.width, img.height) / 120.0, 3.0, 10.0);
+  for (const PointMark& p : o.points) {
+    const double r = automatic(p.radius_px, auto_r);
+    draw_point(img, px.x(p.at), px.y(p.at), p.shape, r + 1.5, kHalo);
+    draw_point(img, px.x(p.at), px.y(p.at), p.shape, r, p.colour);
+  }
 }
 
 /// The terrain area: colours, overlays and markers, one pixel per display pixel.
@@ -150,7 +312,9 @@ TerrainLayer draw_terrain(const grid::Heightmap& map, const RenderOptions& o, co
   TerrainLayer layer{{}, map.min_height(), map.max_height(), 0.0};
   const std::vector<double> heights = block_mean(map.heights(), s);
   const std::vector<double> light = hillshade(heights, s.rows, s.cols, map.cell_size_m() * s.factor);
-  std::vector<double> navigable, gap;
+  std::vector<double> navigable, gap, label_fraction;
+  std::vector<std::uint32_t> label;
+  if (o.labels) block_labels(*o.labels, s, label, label_fraction);
   if (o.navigable) navigable = block_mean(*o.navigable, s);
   if (o.gap) {
     gap = block_mean(o.gap->heights(), s);
@@ -166,6 +330,8 @@ TerrainLayer draw_terrain(const grid::Heightmap& map, const RenderOptions& o, co
       const std::size_t k = static_cast<std::size_t>(i) * s.cols + j;
       const double t = range > 0.0 ? (heights[k] - layer.min_height) / range : 0.5;
       Colour c = shade(detail::terrain_colour(t), light[k]);
+      if (!label.empty() && label[k] != 0)
+        c = detail::mix(c, detail::to_colour(label_colour(label[k], o.palette)), o.label_alpha * label_fraction[k]);
       if (!navigable.empty()) c = detail::mix(c, kNavigableTint, kNavigableAlpha * navigable[k]);
       if (!gap.empty() && layer.max_gap > 0.0 && gap[k] > kGapThresholdM)
         c = detail::mix(c, detail::heat_colour(gap[k] / layer.max_gap), kGapAlpha);
@@ -192,6 +358,8 @@ TerrainLayer draw_terrain(const grid::Heightmap& map, const RenderOptions& o, co
       }
   }
 
+  draw_overlays(layer.image, map, o, s);
+
   const int arm = std::max(3, longest / 64);
   const int thick = std::clamp(longest / 320, 1, 4);
   for (const CellIndex m : o.markers) {
@@ -203,6 +371,7 @@ TerrainLayer draw_terrain(const grid::Heightmap& map, const RenderOptions& o, co
     detail::fill_rect(layer.image, x - arm, y - lo, 2 * arm + 1, thick, kMarkerCore);
     detail::fill_rect(layer.image, x - lo, y - arm, thick, 2 * arm + 1, kMarkerCore);
   }
+  draw_points(layer.image, map, o, s);
   return layer;
 }
 
@@ -290,6 +459,44 @@ int draw_colour_bar(Image& img, int x, int y, int bar_w, int bar_h, const Colour
   return top - y + bar_h;
 }
 
+/// A legend entry's swatch in the side x side square at (x, y) [px].
+void draw_swatch(Image& img, int x, int y, int side, const LegendEntry& e) {
+  const double cx = x + 0.5 * side, cy = y + 0.5 * side, r = 0.5 * side;
+  const double w = std::max(2.0, side / 5.0);
+  switch (e.swatch) {
+    case LegendSwatch::kSquare:
+      detail::fill_rect(img, x, y, side, side, e.colour);
+      detail::draw_rect_outline(img, x, y, side, side, kFrame);
+      break;
+    case LegendSwatch::kDisc:
+      draw_point(img, cx, cy, PointShape::kDisc, r - 1.0, kHalo);
+      draw_point(img, cx, cy, PointShape::kDisc, r - 2.5, e.colour);
+      break;
+    case LegendSwatch::kDiamond:
+      draw_point(img, cx, cy, PointShape::kDiamond, r, kHalo);
+      draw_point(img, cx, cy, PointShape::kDiamond, r - 1.5, e.colour);
+      break;
+    case LegendSwatch::kLine:
+      detail::draw_segment(img, x + 1.0, cy, x + side - 1.0, cy, w + 2.0, kHalo);
+      detail::draw_segment(img, x + 1.0, cy, x + side - 1.0, cy, w, e.colour);
+      break;
+    case LegendSwatch::kRing:
+    case LegendSwatch::kOutline:
+      detail::fill_rect(img, x, y, side, side, detail::to_rgb(detail::terrain_colour(0.15)));
+      if (e.swatch == LegendSwatch::kRing) {
+        detail::draw_ring(img, cx, cy, r - 3.0, 2.0, e.colour);
+      } else {
+        detail::draw_rect_outline(img, x + 3, y + 3, side - 6, side - 6, e.colour);
+        detail::draw_rect_outline(img, x + 4, y + 4, side - 8, side - 8, e.colour);
+      }
+      break;
+    case LegendSwatch::kArrow:
+      for (bool halo : {true, false})
+        draw_arrow_px(img, x + 1.0, cy, x + side - 1.0, cy, std::max(1.0, side / 8.0), e.colour, halo);
+      break;
+  }
+}
+
 Image compose(const TerrainLayer& layer, const grid::Heightmap& map, const RenderOptions& o, const Sampling& s) {
   const int tw = layer.image.width, th = layer.image.height;
   const int font = std::clamp((std::max(tw, th) + 559) / 560, 1, 4);  // font pixel size [px]
@@ -305,6 +512,7 @@ Image compose(const TerrainLayer& layer, const grid::Heightmap& map, const Rende
   std::vector<std::string> keys;
   if (o.navigable) keys.push_back("navigable");
   if (!o.markers.empty()) keys.push_back(o.markers.size() > 1 ? "markers" : "marker");
+  for (const LegendEntry& e : o.legend_entries) keys.push_back(e.text);
   int panel_w = 0;
   for (const auto& b : bars) panel_w = std::max(panel_w, bar_w + bar_label_width(b, font));
   for (const auto& k : keys) panel_w = std::max(panel_w, bar_w + 6 * font + detail::text_width(k, font));
@@ -344,8 +552,12 @@ Image compose(const TerrainLayer& layer, const grid::Heightmap& map, const Rende
   int y = top;
   const int px = pad + left_w + 3 * pad;
   for (const auto& b : bars) y += draw_colour_bar(img, px, y, bar_w, bar_h, b, font) + 3 * pad;
-  for (const auto& k : keys) {
-    if (k == "navigable") {
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const std::string& k = keys[i];
+    const std::size_t builtin = keys.size() - o.legend_entries.size();
+    if (i >= builtin) {
+      draw_swatch(img, px, y, bar_w, o.legend_entries[i - builtin]);
+    } else if (k == "navigable") {
       const Colour base = detail::terrain_colour(0.5);
       detail::fill_rect(img, px, y, bar_w, bar_w, detail::to_rgb(detail::mix(base, kNavigableTint, kNavigableAlpha)));
       detail::draw_rect_outline(img, px, y, bar_w, bar_w, kNavigableOutline);
@@ -362,6 +574,13 @@ Image compose(const TerrainLayer& layer, const grid::Heightmap& map, const Rende
 }
 
 }  // namespace
+
+const std::vector<Rgb>& default_palette() { return kPalette; }
+
+Rgb label_colour(std::uint32_t label, const std::vector<Rgb>& palette) {
+  const std::vector<Rgb>& p = palette.empty() ? kPalette : palette;
+  return p[(label == 0 ? 0 : label - 1) % p.size()];
+}
 
 Image render_terrain(const grid::Heightmap& map, const RenderOptions& options) {
   validate(map, options);

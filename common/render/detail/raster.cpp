@@ -65,6 +65,57 @@ void blit(Image& dst, const Image& src, int x, int y) {
     for (int xx = 0; xx < src.width; ++xx) set_pixel(dst, x + xx, y + yy, get_pixel(src, xx, yy));
 }
 
+void draw_segment(Image& image, double x0, double y0, double x1, double y1, double width, Rgb colour) {
+  const double half = 0.5 * std::max(1.0, width);
+  const double dx = x1 - x0, dy = y1 - y0, length2 = dx * dx + dy * dy;
+  const int xa = std::max(0, static_cast<int>(std::floor(std::min(x0, x1) - half)));
+  const int xb = std::min(image.width - 1, static_cast<int>(std::ceil(std::max(x0, x1) + half)));
+  const int ya = std::max(0, static_cast<int>(std::floor(std::min(y0, y1) - half)));
+  const int yb = std::min(image.height - 1, static_cast<int>(std::ceil(std::max(y0, y1) + half)));
+  for (int y = ya; y <= yb; ++y)
+    for (int x = xa; x <= xb; ++x) {
+      const double px = x + 0.5 - x0, py = y + 0.5 - y0;
+      const double t = length2 > 0.0 ? std::clamp((px * dx + py * dy) / length2, 0.0, 1.0) : 0.0;
+      const double ex = px - t * dx, ey = py - t * dy;
+      if (ex * ex + ey * ey <= half * half) set_pixel(image, x, y, colour);
+    }
+}
+
+void fill_triangle(Image& image, double ax, double ay, double bx, double by, double cx, double cy, Rgb colour) {
+  const auto side = [](double ux, double uy, double vx, double vy, double px, double py) {
+    return (vx - ux) * (py - uy) - (vy - uy) * (px - ux);
+  };
+  const int xa = std::max(0, static_cast<int>(std::floor(std::min({ax, bx, cx}))));
+  const int xb = std::min(image.width - 1, static_cast<int>(std::ceil(std::max({ax, bx, cx}))));
+  const int ya = std::max(0, static_cast<int>(std::floor(std::min({ay, by, cy}))));
+  const int yb = std::min(image.height - 1, static_cast<int>(std::ceil(std::max({ay, by, cy}))));
+  for (int y = ya; y <= yb; ++y)
+    for (int x = xa; x <= xb; ++x) {
+      const double px = x + 0.5, py = y + 0.5;
+      const double s1 = side(ax, ay, bx, by, px, py), s2 = side(bx, by, cx, cy, px, py),
+                   s3 = side(cx, cy, ax, ay, px, py);
+      if ((s1 >= 0.0 && s2 >= 0.0 && s3 >= 0.0) || (s1 <= 0.0 && s2 <= 0.0 && s3 <= 0.0))
+        set_pixel(image, x, y, colour);
+    }
+}
+
+void fill_disc(Image& image, double cx, double cy, double radius, Rgb colour) {
+  draw_ring(image, cx, cy, 0.5 * radius, radius, colour);
+}
+
+void draw_ring(Image& image, double cx, double cy, double radius, double width, Rgb colour) {
+  const double half = 0.5 * width, outer = radius + half, inner = std::max(0.0, radius - half);
+  const int xa = std::max(0, static_cast<int>(std::floor(cx - outer)));
+  const int xb = std::min(image.width - 1, static_cast<int>(std::ceil(cx + outer)));
+  const int ya = std::max(0, static_cast<int>(std::floor(cy - outer)));
+  const int yb = std::min(image.height - 1, static_cast<int>(std::ceil(cy + outer)));
+  for (int y = ya; y <= yb; ++y)
+    for (int x = xa; x <= xb; ++x) {
+      const double px = x + 0.5 - cx, py = y + 0.5 - cy, d2 = px * px + py * py;
+      if (d2 <= outer * outer && d2 >= inner * inner) set_pixel(image, x, y, colour);
+    }
+}
+
 int text_width(const std::string& text, int scale) {
   if (text.empty()) return 0;
   return (static_cast<int>(text.size()) * kGlyphAdvance - 1) * scale;

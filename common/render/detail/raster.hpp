@@ -8,13 +8,8 @@
 
 namespace marsala::render::detail {
 
-/// An 8-bit sRGB colour.
-struct Rgb {
-  std::uint8_t r = 0;
-  std::uint8_t g = 0;
-  std::uint8_t b = 0;
-  friend bool operator==(Rgb a, Rgb b) { return a.r == b.r && a.g == b.g && a.b == b.b; }
-};
+/// An 8-bit sRGB colour (the public render::Rgb).
+using Rgb = render::Rgb;
 
 /// A colour with double channels on the 0..255 scale, for blending before rounding.
 struct Colour {
@@ -42,6 +37,16 @@ void fill_rect(Image& image, int x, int y, int w, int h, Rgb colour);
 void draw_rect_outline(Image& image, int x, int y, int w, int h, Rgb colour);
 /// Copies `src` into `dst` with its top-left at (x, y) [px], clipped.
 void blit(Image& dst, const Image& src, int x, int y);
+
+/// Paints every pixel whose centre (x + 0.5, y + 0.5) lies within width / 2 of the segment (x0, y0)-(x1, y1), in
+/// continuous pixel coordinates (a pixel covers [x, x + 1) x [y, y + 1)); width >= 1 [px].
+void draw_segment(Image& image, double x0, double y0, double x1, double y1, double width, Rgb colour);
+/// Paints every pixel whose centre lies inside the triangle (a, b, c) (either orientation, edges included).
+void fill_triangle(Image& image, double ax, double ay, double bx, double by, double cx, double cy, Rgb colour);
+/// Paints every pixel whose centre lies within `radius` of (cx, cy) [px].
+void fill_disc(Image& image, double cx, double cy, double radius, Rgb colour);
+/// Paints every pixel whose centre lies within width / 2 of the circle of `radius` around (cx, cy) [px].
+void draw_ring(Image& image, double cx, double cy, double radius, double width, Rgb colour);
 
 /// Width of `text` drawn at integer `scale` [px] (no trailing spacing).
 int text_width(const std::string& text, int scale);

@@ -98,5 +98,33 @@ TEST_F(WorldCliTest, ARunOverTheInProcessBusExitsWith0) {
     EXPECT_TRUE(fs::exists(out / name)) << name;
 }
 
+TEST_F(WorldCliTest, SeedOverridesTheScenariosAndIsReported) {
+  const std::string scenario = write("small.pbtxt", testing::small_scenario_text("seed: 5\nstart_jitter_m: 0.3\n"));
+  EXPECT_EQ(run({"--scenario", scenario, "--seed", "abc"}), 2);
+  EXPECT_NE(out_.str().size() + err_.str().size(), 0u);
+  const fs::path out = dir_ / "out";
+  int rc = -1;
+  std::thread world([&] {
+    rc = run({"--scenario", scenario, "--agents", "1", "--dds", "inprocess", "--domain", "52", "--out", out.string(),
+              "--quiet", "--max-steps", "2", "--seed", "77"});
+  });
+  testing::FakeAgentConfig c;
+  c.domain = 52;
+  c.id = 1;
+  c.session = 5;
+  c.body = testing::small_scenario().robot_for(1).body;
+  testing::FakeAgent agent(c);
+  world.join();
+  agent.join();
+  EXPECT_EQ(rc, 0) << err_.str();
+  std::ifstream in(out / "summary.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("\"seed\": \"77\""), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("\"start_jitter_m\": 0.3"), std::string::npos) << text.str();
+  EXPECT_EQ(run({"--help"}), 0);
+  EXPECT_NE(out_.str().find("--seed"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace marsala::world_server

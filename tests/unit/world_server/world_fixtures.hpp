@@ -22,8 +22,8 @@ robot_type {
 }
 )";
 
-/// A flat 40 x 40 grid of 0.1 m cells (4 x 4 m), three slots, base at (0.55, 0.55) r 0.5, goal [2.9, 3.2] x [1.9, 2.2].
-inline std::string small_scenario_text(const std::string& extra = "") {
+/// The small scenario with another completion block (`goal { ... }`, `payload_path { ... }` or `site { ... }`).
+inline std::string small_scenario_text_completing(const std::string& completion, const std::string& extra = "") {
   return std::string(R"(
 name: "small"
 terrain { generator: "flat" rows: 40 cols: 40 cell_size_m: 0.1 }
@@ -31,10 +31,30 @@ terrain { generator: "flat" rows: 40 cols: 40 cell_size_m: 0.1 }
 agent { robot_type: "tester" start { x_m: 1.05 y_m: 1.05 } target { x_m: 3.05 y_m: 2.05 } }
 agent { robot_type: "tester" start { x_m: 2.55 y_m: 1.05 } target { x_m: 3.05 y_m: 2.05 } }
 agent { robot_type: "tester" start { x_m: 1.05 y_m: 3.05 } target { x_m: 3.05 y_m: 2.05 } }
-goal { x0_m: 2.9 y0_m: 1.9 x1_m: 3.2 y1_m: 2.2 }
+)" + completion + R"(
 base { x_m: 0.55 y_m: 0.55 radius_m: 0.5 }
 tile_size: 16
 )" + extra;
+}
+
+/// A flat 40 x 40 grid of 0.1 m cells (4 x 4 m), three slots, base at (0.55, 0.55) r 0.5, goal [2.9, 3.2] x [1.9, 2.2].
+inline std::string small_scenario_text(const std::string& extra = "") {
+  return small_scenario_text_completing("goal { x0_m: 2.9 y0_m: 1.9 x1_m: 3.2 y1_m: 2.2 }", extra);
+}
+
+/// A payload path from the base (0.55, 0.55) to (3.05, 3.05) for a payload of kappa 0.2, delta 0.3 m, eps 0.05 m
+/// (its ball: the 3 x 3 cells around it), checked every `every` steps.
+inline std::string payload_block(int every = 3) {
+  return "payload_path { body { kappa: 0.2 delta_m: 0.3 eps_m: 0.05 } from { x_m: 0.55 y_m: 0.55 } "
+         "to { x_m: 3.05 y_m: 3.05 } check_every_steps: " +
+         std::to_string(every) + " }";
+}
+
+/// A level site [2.0, 3.0] x [2.0, 3.0] (the 10 x 10 cells rows 10..19, cols 20..29) for kappa 0.1, delta 0.3 m,
+/// eps 0.05 m, checked every `every` steps.
+inline std::string site_block(int every = 3, double min_fraction = 1.0) {
+  return "site { x0_m: 2.0 y0_m: 2.0 x1_m: 3.0 y1_m: 3.0 kappa: 0.1 delta_m: 0.3 eps_m: 0.05 min_fraction: " +
+         std::to_string(min_fraction) + " check_every_steps: " + std::to_string(every) + " }";
 }
 
 /// small_scenario_text() parsed.

@@ -300,6 +300,61 @@ TEST_F(RuntimeTest, MaxStepsEndsAnUnfinishedRun) {
   EXPECT_NE(read_text(out_ / "summary.json").find("\"completed\": false"), std::string::npos);
 }
 
+TEST_F(RuntimeTest, APayloadScenarioNavigableFromTheStartCompletesAtOnceWithTheSeedGiven) {
+  constexpr int kDomain = 50;
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, kDomain});
+  const scenario::Scenario payload =
+      scenario::parse_scenario(testing::small_scenario_text_completing(testing::payload_block()), "payload.pbtxt");
+  RuntimeOptions o = options(1, 10.0);
+  o.seed = 1234;
+  WorldRuntime runtime(payload, testing::flat_terrain(), o, *participant);
+  std::atomic<bool> stop{false};
+  RunResult result;
+  std::thread world([&] { result = runtime.run(stop); });
+  FakeAgent a1(agent(kDomain, 1));
+  world.join();
+  a1.join();
+  EXPECT_TRUE(result.completed);
+  EXPECT_EQ(result.end_reason, "completed");
+  EXPECT_EQ(result.steps, 0u);
+  auto late = participant->create_reader<bus::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
+  const auto latest = late->take();
+  ASSERT_EQ(latest.size(), 1u);
+  EXPECT_EQ(latest[0].progress, 1.0);
+  const std::string summary = read_text(out_ / "summary.json");
+  for (const char* field : {"\"completion\": \"payload_path\"", "\"path_found\": true", "\"seed\": \"1234\"",
+                            "\"completed\": true", "\"idle_steps\": 0"})
+    EXPECT_NE(summary.find(field), std::string::npos) << field << " not in\n" << summary;
+  EXPECT_NEAR(json_number(summary, "path_length_m"), 2.5 * std::sqrt(2.0), 1e-12);
+}
+
+TEST_F(RuntimeTest, ALevelSiteRunPublishesItsLevelFractionAsProgress) {
+  constexpr int kDomain = 51;
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, kDomain});
+  const scenario::Scenario site =
+      scenario::parse_scenario(testing::small_scenario_text_completing(testing::site_block()), "site.pbtxt");
+  grid::Heightmap terrain = testing::flat_terrain();
+  terrain(15, 25) = -0.1;  // spoils 9 of the site's 100 cells
+  RuntimeOptions o = options(1, 10.0);
+  o.max_steps = 4;
+  WorldRuntime runtime(site, terrain, o, *participant);
+  std::atomic<bool> stop{false};
+  RunResult result;
+  std::thread world([&] { result = runtime.run(stop); });
+  FakeAgent a1(agent(kDomain, 1));
+  world.join();
+  a1.join();
+  EXPECT_EQ(result.end_reason, "max_steps");
+  auto late = participant->create_reader<bus::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
+  const auto latest = late->take();
+  ASSERT_EQ(latest.size(), 1u);
+  EXPECT_DOUBLE_EQ(latest[0].progress, 0.91);
+  const std::string summary = read_text(out_ / "summary.json");
+  EXPECT_DOUBLE_EQ(json_number(summary, "site_level_fraction"), 0.91);
+  EXPECT_EQ(json_number(summary, "idle_steps"), 4.0);  // the walker never deposits
+  EXPECT_NE(summary.find("\"completion\": \"level_site\""), std::string::npos) << summary;
+}
+
 TEST_F(RuntimeTest, NoAgentWithinTheAdmitTimeoutIsAnError) {
   auto participant = bus::make_participant({bus::Vendor::kInProcess, 46});
   RuntimeOptions o = options(2, 1.0);
