@@ -9,7 +9,7 @@
 #include "common/error.hpp"
 #include "common/terrain/detail/det_math.hpp"
 #include "common/terrain/detail/noise.hpp"
-#include "common/terrain/detail/random.hpp"
+#include "common/random.hpp"
 
 namespace marsala::terrain {
 namespace {
@@ -218,7 +218,7 @@ HeightMatrix gaussian_hills(const Frame& f, const Params& p) {
   const int count = p.count("count");
   const double amplitude = p.get("amplitude");
   const double sigma = p.get("sigma");
-  detail::Rng rng(detail::derive_seed(f.seed, 0x68696c6c));
+  random::Rng rng(random::derive_seed(f.seed, 0x68696c6c));
   HeightMatrix h = HeightMatrix::Zero(f.rows, f.cols);
   std::vector<double> ex(f.cols), ey(f.rows);
   for (int k = 0; k < count; ++k) {
@@ -252,7 +252,7 @@ HeightMatrix fractal(const Frame& f, const Params& p) {
   if (wavelength < f.cs)
     throw InvalidArgument("terrain generator 'fractal': wavelength " + format_number(wavelength) +
                           " m is shorter than one cell (" + format_number(f.cs) + " m)");
-  HeightMatrix h = detail::gradient_fbm(f.rows, f.cols, f.cs, detail::derive_seed(f.seed, 0x6662), p.count("octaves"),
+  HeightMatrix h = detail::gradient_fbm(f.rows, f.cols, f.cs, random::derive_seed(f.seed, 0x6662), p.count("octaves"),
                                         p.get("persistence"), wavelength);
   const double lo = h.minCoeff();
   const double hi = h.maxCoeff();
@@ -273,7 +273,7 @@ HeightMatrix craters(const Frame& f, const Params& p) {
                           " m exceeds radius_max " + format_number(r_max) + " m");
   const double depth = p.get("depth");
   const double rim_height = p.get("rim_height");
-  detail::Rng rng(detail::derive_seed(f.seed, 0x63726174));
+  random::Rng rng(random::derive_seed(f.seed, 0x63726174));
   HeightMatrix h = HeightMatrix::Zero(f.rows, f.cols);
   for (int k = 0; k < count; ++k) {
     const double cx = rng.uniform(0.0, f.width_m);
@@ -314,7 +314,7 @@ HeightMatrix steps(const Frame& f, const Params& p) {
   const double uy = detail::det_cos_deg(p.get("azimuth"));
   const double half_span = 0.5 * (f.width_m * std::abs(ux) + f.depth_m * std::abs(uy));
   const double spacing = 2.0 * half_span / (count + 1);
-  detail::Rng rng(detail::derive_seed(f.seed, 0x73746570));
+  random::Rng rng(random::derive_seed(f.seed, 0x73746570));
   std::vector<double> base(count);
   std::vector<detail::ValueNoise1d> wave;
   for (int k = 0; k < count; ++k) {
@@ -346,17 +346,17 @@ HeightMatrix run(const std::string& method, const Frame& f, const ParamValues& g
 HeightMatrix mix(const Frame& f, const Params& p) {
   // Each component gets its own seed stream, so changing one count does not reshuffle the others.
   Frame sub = f;
-  sub.seed = detail::derive_seed(f.seed, 1);
+  sub.seed = random::derive_seed(f.seed, 1);
   HeightMatrix h = run("fractal", sub, {{"amplitude", p.get("fractal_amplitude")}});
-  sub.seed = detail::derive_seed(f.seed, 2);
+  sub.seed = random::derive_seed(f.seed, 2);
   h += run("gaussian_hills", sub, {{"count", p.get("hill_count")}, {"amplitude", p.get("hill_amplitude")}});
-  sub.seed = detail::derive_seed(f.seed, 3);
+  sub.seed = random::derive_seed(f.seed, 3);
   h += run("craters", sub,
            {{"count", p.get("crater_count")},
             {"depth", p.get("crater_depth")},
             {"rim_height", p.get("crater_depth") / 3.0}});
-  sub.seed = detail::derive_seed(f.seed, 4);
-  const double azimuth = std::floor(360.0 * detail::Rng(detail::derive_seed(f.seed, 5)).uniform());
+  sub.seed = random::derive_seed(f.seed, 4);
+  const double azimuth = std::floor(360.0 * random::Rng(random::derive_seed(f.seed, 5)).uniform());
   h += run("steps", sub,
            {{"count", p.get("step_count")}, {"step_height", p.get("step_height")}, {"azimuth", azimuth}});
   return h;

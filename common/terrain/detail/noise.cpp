@@ -5,10 +5,15 @@
 #include <vector>
 
 #include "common/terrain/detail/det_math.hpp"
-#include "common/terrain/detail/random.hpp"
+#include "common/random.hpp"
 
 namespace marsala::terrain::detail {
 namespace {
+
+using random::derive_seed;
+using random::hash2;
+using random::Rng;
+using random::to_unit;
 
 // Sixteen unit gradients, k * 22.5 degrees, as literals (no libm involved).
 constexpr double kC1 = 0.92387953251128674;  // cos 22.5

@@ -1,10 +1,11 @@
 #pragma once
-// Portable pseudo-random numbers for terrain generation: splitmix64 and exact conversions to doubles,
-// so that a seed gives the same numbers bit for bit with every compiler and standard library.
+// Portable pseudo-random numbers (terrain generators, seeded start positions): splitmix64 and exact conversions to
+// doubles, so that a seed gives the same numbers bit for bit with every compiler and standard library. Never the
+// standard library's distributions, whose results differ between implementations.
 
 #include <cstdint>
 
-namespace marsala::terrain::detail {
+namespace marsala::random {
 
 /// The splitmix64 finaliser: a bijective 64-bit mix with good avalanche.
 inline std::uint64_t mix64(std::uint64_t z) {
@@ -46,4 +47,4 @@ class Rng {
   std::uint64_t state_;
 };
 
-}  // namespace marsala::terrain::detail
+}  // namespace marsala::random
