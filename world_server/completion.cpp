@@ -171,27 +171,7 @@ long long largest_component(const grid::CellMask& mask) {
 bool connected(const grid::CellMask& passable, CellIndex from, CellIndex to) {
   check_on_mask(passable, from, "connected: from");
   check_on_mask(passable, to, "connected: to");
-  if (passable(from.row, from.col) == 0 || passable(to.row, to.col) == 0) return false;
-  const int rows = static_cast<int>(passable.rows()), cols = static_cast<int>(passable.cols());
-  const int goal = to.row * cols + to.col;
-  std::vector<std::uint8_t> seen(static_cast<std::size_t>(rows) * cols, 0);
-  std::vector<int> stack{from.row * cols + from.col};
-  seen[stack.back()] = 1;
-  while (!stack.empty()) {
-    const int k = stack.back();
-    stack.pop_back();
-    if (k == goal) return true;
-    const int r = k / cols, c = k % cols;
-    for (int rr = std::max(0, r - 1); rr <= std::min(rows - 1, r + 1); ++rr)
-      for (int cc = std::max(0, c - 1); cc <= std::min(cols - 1, c + 1); ++cc) {
-        const int n = rr * cols + cc;
-        if (!seen[n] && passable(rr, cc) != 0) {
-          seen[n] = 1;
-          stack.push_back(n);
-        }
-      }
-  }
-  return false;
+  return processing::NavigabilityProcessor::navigable_from(passable, from)(to.row, to.col) != 0;
 }
 
 bool payload_path_navigable(const grid::Heightmap& terrain, const scenario::PayloadPath& path) {
