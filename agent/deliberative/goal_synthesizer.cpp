@@ -104,10 +104,10 @@ std::unique_ptr<GoalSynthesizer> make_goal_synthesizer(const std::string& name, 
   return registry.make(name, context);
 }
 
-bool is_goal_synthesizer(const std::string& name) {
+void require_goal_synthesizer(const std::string& name) {
   GoalSynthesizerRegistry registry = make_goal_synthesizer_registry();
   register_builtins(registry);
-  return registry.contains(name);
+  registry.require(name);
 }
 
 }  // namespace marsala::agent::deliberative

@@ -92,7 +92,8 @@ void register_builtins(GoalSynthesizerRegistry& registry);
 /// A built-in goal synthesizer by name for an admitted context; throws InvalidArgument listing the valid names when
 /// unknown, or what the variant needs when the context lacks it.
 std::unique_ptr<GoalSynthesizer> make_goal_synthesizer(const std::string& name, const AgentContext& context);
-/// True when `name` is a built-in goal synthesizer.
-bool is_goal_synthesizer(const std::string& name);
+/// Throws InvalidArgument listing the valid names unless `name` is a built-in goal synthesizer (a check before
+/// admission, when the variant cannot be made yet).
+void require_goal_synthesizer(const std::string& name);
 
 }  // namespace marsala::agent::deliberative

@@ -27,15 +27,17 @@ class Registry {
       throw InvalidArgument(kind_ + " name '" + name + "' is empty or already registered");
     factories_.emplace(name, std::move(factory));
   }
+  /// Throws InvalidArgument listing the valid names when `name` is not registered.
+  void require(const std::string& name) const {
+    if (contains(name)) return;
+    std::string valid;
+    for (const auto& [n, f] : factories_) valid += (valid.empty() ? "" : ", ") + n;
+    throw InvalidArgument("unknown " + kind_ + " '" + name + "'; valid: " + (valid.empty() ? "(none)" : valid));
+  }
   /// Makes the named variant; throws InvalidArgument listing the valid names when it is unknown.
   std::unique_ptr<Product> make(const std::string& name, Args... args) const {
-    const auto it = factories_.find(name);
-    if (it == factories_.end()) {
-      std::string valid;
-      for (const auto& [n, f] : factories_) valid += (valid.empty() ? "" : ", ") + n;
-      throw InvalidArgument("unknown " + kind_ + " '" + name + "'; valid: " + (valid.empty() ? "(none)" : valid));
-    }
-    return it->second(std::forward<Args>(args)...);
+    require(name);
+    return factories_.at(name)(std::forward<Args>(args)...);
   }
   /// The registered names, sorted.
   std::vector<std::string> names() const {

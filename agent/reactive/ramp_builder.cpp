@@ -73,8 +73,7 @@ RampBuilder::RampBuilder(const AgentContext& context, RampBuilderOptions options
   // Fail on an invalid body, construction or goal synthesizer name now rather than at admission.
   (void)processing::NavigabilityProcessor(navigability_params(context_.body));
   (void)processing::NavigabilityProcessor(construction_params(context_));
-  if (!deliberative::is_goal_synthesizer(context_.task.goal_synthesizer))
-    (void)deliberative::make_goal_synthesizer(context_.task.goal_synthesizer, context_);  // throws, listing names
+  deliberative::require_goal_synthesizer(context_.task.goal_synthesizer);
   if (options_.pipeline) {
     PipelineParams p;
     p.separation_m = context_.task.separation_m;

@@ -38,6 +38,9 @@ TEST(GoalSynthesizer, RegistryListsValidNamesOnAnUnknownOne) {
     EXPECT_NE(what.find("unknown goal synthesizer 'spiral'"), std::string::npos) << what;
     EXPECT_NE(what.find("fixed_target"), std::string::npos) << what;
   }
+  // Before admission (no grid yet) a name is checked without making the variant.
+  EXPECT_NO_THROW(require_goal_synthesizer("goal_vector_map"));
+  EXPECT_THROW(require_goal_synthesizer("spiral"), InvalidArgument);
   EXPECT_THROW(register_builtins(registry), InvalidArgument);  // registered twice
   EXPECT_THROW(registry.add("", [](const AgentContext& c) { return std::make_unique<FixedTarget>(c); }),
                InvalidArgument);
