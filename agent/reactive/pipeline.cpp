@@ -78,13 +78,15 @@ std::optional<bus::Neighbour> PipelineTracker::front(Position self, Position tar
   return best;
 }
 
-PipelineRole PipelineTracker::role(Position self, Position target) const {
-  const auto f = front(self, target);
-  if (!f) return PipelineRole::kActive;
-  const double d = distance(where(*f), self);
-  if (d > params_.separation_m) return PipelineRole::kFollow;
-  if (d >= params_.separation_m - params_.back_off_margin_m) return PipelineRole::kHold;
-  return PipelineRole::kBackOff;
+PipelinePlace PipelineTracker::place(Position self, Position target) const {
+  PipelinePlace p;
+  p.front = front(self, target);
+  if (!p.front) return p;
+  const double d = distance(where(*p.front), self);
+  p.role = d > params_.separation_m                                    ? PipelineRole::kFollow
+           : d >= params_.separation_m - params_.back_off_margin_m ? PipelineRole::kHold
+                                                                    : PipelineRole::kBackOff;
+  return p;
 }
 
 }  // namespace marsala::agent::reactive

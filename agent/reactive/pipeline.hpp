@@ -33,6 +33,12 @@ enum class PipelineRole : std::uint8_t { kActive = 0, kFollow = 1, kHold = 2, kB
 /// "active", "follow", "hold", "back_off".
 std::string to_string(PipelineRole role);
 
+/// A robot's place in the pipeline: its role and the front neighbour that decided it (none when kActive).
+struct PipelinePlace {
+  PipelineRole role = PipelineRole::kActive;
+  std::optional<bus::Neighbour> front;
+};
+
 /// Distances of the pipeline rule.
 struct PipelineParams {
   double separation_m = 2.0;        ///< a follower keeps at least this far from its front neighbour [m]
@@ -57,8 +63,8 @@ class PipelineTracker {
   bool returning(std::uint32_t id) const;
   /// The front neighbour of a robot at `self` [m] (see the header), from the last observed frame.
   std::optional<bus::Neighbour> front(Position self, Position target) const;
-  /// The role of a robot at `self` [m], from the last observed frame.
-  PipelineRole role(Position self, Position target) const;
+  /// The role of a robot at `self` [m] and its front neighbour, from the last observed frame.
+  PipelinePlace place(Position self, Position target) const;
 
  private:
   struct Track {

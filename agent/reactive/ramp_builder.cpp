@@ -26,6 +26,20 @@ executive::Neighbourhood neighbourhood(const bus::SensorFrame& frame) {
   return {frame.agent_id, {frame.x_m, frame.y_m}, frame.neighbours};
 }
 
+/// The navigable cell of the window whose centre has the smallest score, if that is below `bound` (row-major order:
+/// ties to the first).
+template <typename Score>
+std::optional<CellIndex> best_navigable_cell(const deliberative::LocalMap& local, double bound, Score score) {
+  std::optional<CellIndex> best;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      if (local.navigable(r, c) == 0) continue;
+      const double s = score(local.center({r, c}));
+      if (s < bound) bound = s, best = CellIndex{r, c};
+    }
+  return best;
+}
+
 
 }  // namespace
 
@@ -62,7 +76,6 @@ struct RampBuilder::Modules {
   deliberative::NavigablePathPlanner router;   // shortest routes through navigable cells (alpha = 0)
   executive::ActionManager actions;
   executive::DepositionManager depositions;
-  double layer_volume_m3;                      // one cube [m^3]
   double return_below_m3;                      // less material than this on board: back to the base [m^3]
   int max_idle_retreat_moves;                  // retreat moves without work before trying to advance again
 };
@@ -111,9 +124,8 @@ void RampBuilder::on_admission(const bus::Admission& admission) {
       executive::ActionManager(body.max_step_m),
       executive::DepositionManager(
           executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m, build.delta_m)),
-      layer_m * world.cell_size_m * world.cell_size_m,
       options_.pipeline ? std::min(body.max_deposit_m3, body.material_capacity_m3)
-                        : layer_m * world.cell_size_m * world.cell_size_m,
+                        : layer_m * world.cell_size_m * world.cell_size_m,  // one cube
       static_cast<int>(std::ceil((body.reach_m + body.delta_m) / body.max_step_m)) + 1});
   goal_ = deliberative::make_goal_synthesizer(context_.task.goal_synthesizer, context_);
   state_ = RampState::kSurvey;
@@ -265,10 +277,10 @@ std::optional<executive::Motion> RampBuilder::step_back(const deliberative::Loca
 void RampBuilder::pipeline_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position target,
                                 bus::ActionRequest& request) {
   const Position robot{frame.x_m, frame.y_m};
-  const PipelineRole role = pipeline_->role(robot, target);
-  trace_.role = role;
-  const auto front = pipeline_->front(robot, target);
-  switch (role) {
+  const PipelinePlace place = pipeline_->place(robot, target);
+  trace_.role = place.role;
+  const auto& front = place.front;
+  switch (place.role) {
     case PipelineRole::kActive:
       if (state_ == RampState::kRetreat)
         retreat_step(local, frame, request);
@@ -301,15 +313,9 @@ void RampBuilder::back_off_step(const deliberative::LocalMap& local, const bus::
 }
 
 std::optional<CellIndex> RampBuilder::farthest_navigable_from_goal(const deliberative::LocalMap& local) {
-  std::optional<CellIndex> best;
-  double best_d = distance(local.center(local.robot), local.center(local.goal));
-  for (int r = 0; r < local.rows(); ++r)
-    for (int c = 0; c < local.cols(); ++c) {
-      if (local.navigable(r, c) == 0) continue;
-      const double d = distance(local.center({r, c}), local.center(local.goal));
-      if (d > best_d) best_d = d, best = CellIndex{r, c};  // row-major: ties to the first
-    }
-  return best;
+  const Position goal = local.center(local.goal);
+  return best_navigable_cell(local, -distance(local.center(local.robot), goal),
+                             [&](Position p) { return -distance(p, goal); });
 }
 
 std::optional<CellIndex> RampBuilder::oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const {
@@ -334,24 +340,13 @@ void RampBuilder::return_step(const deliberative::LocalMap& local, const bus::Se
   // Where to go: the navigable cell within the base radius nearest the robot; else the navigable cell nearest the
   // base when that is nearer than the robot by at least a cell; else the oldest navigable cell of the trajectory in
   // the window (the way the robot came from the base).
-  std::optional<CellIndex> goal;
-  double best = std::numeric_limits<double>::infinity();
-  for (int r = 0; r < local.rows(); ++r)
-    for (int c = 0; c < local.cols(); ++c) {
-      if (local.navigable(r, c) == 0) continue;
-      const Position centre = local.center({r, c});
-      if (distance(centre, base) > radius) continue;
-      const double d = distance(centre, robot);
-      if (d < best) best = d, goal = CellIndex{r, c};
-    }
-  if (!goal) {
-    best = distance(robot, base) - local.geometry().cell_size_m;
-    for (int r = 0; r < local.rows(); ++r)
-      for (int c = 0; c < local.cols(); ++c) {
-        const double d = distance(local.center({r, c}), base);
-        if (local.navigable(r, c) != 0 && d < best) best = d, goal = CellIndex{r, c};
-      }
-  }
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  std::optional<CellIndex> goal = best_navigable_cell(local, kNone, [&](Position p) {
+    return distance(p, base) <= radius ? distance(p, robot) : kNone;
+  });
+  if (!goal)
+    goal = best_navigable_cell(local, distance(robot, base) - local.geometry().cell_size_m,
+                               [&](Position p) { return distance(p, base); });
   if (!goal) goal = oldest_navigable_trajectory_cell(local);
   if (!goal) return;
   trace_.plan = modules_->router.plan(local.gap, local.navigable, local.robot, *goal);

@@ -25,9 +25,9 @@ PipelineParams params() {
 TEST(Pipeline, AloneOrWithNeighboursBehindTheRobotIsActive) {
   PipelineTracker t(params());
   t.observe({}, kTarget);
-  EXPECT_EQ(t.role({0.0, 50.0}, kTarget), PipelineRole::kActive);
+  EXPECT_EQ(t.place({0.0, 50.0}, kTarget).role, PipelineRole::kActive);
   t.observe({at(2, 0.0, 48.0), at(3, 0.5, 49.0)}, kTarget);  // both farther from the target
-  EXPECT_EQ(t.role({0.0, 50.0}, kTarget), PipelineRole::kActive);
+  EXPECT_EQ(t.place({0.0, 50.0}, kTarget).role, PipelineRole::kActive);
   EXPECT_FALSE(t.front({0.0, 50.0}, kTarget).has_value());
 }
 
@@ -47,7 +47,9 @@ TEST(Pipeline, RoleFollowsTheDistanceToTheFrontNeighbour) {
   for (const auto& c : cases) {
     PipelineTracker t(params());
     t.observe({at(7, 0.0, c.y)}, kTarget);
-    EXPECT_EQ(t.role(self, kTarget), c.role) << "neighbour at y = " << c.y << ": " << to_string(t.role(self, kTarget));
+    const PipelinePlace place = t.place(self, kTarget);
+    EXPECT_EQ(place.role, c.role) << "neighbour at y = " << c.y << ": " << to_string(place.role);
+    EXPECT_EQ(place.front.has_value(), c.role != PipelineRole::kActive);
   }
 }
 
@@ -64,22 +66,22 @@ TEST(Pipeline, ANeighbourMovingAwayFromTheTargetIsReturningAfterTheDetectionDist
   const Position self{1.0, 50.0};  // the neighbour drives the x = 0 line, this robot beside it
   // The front robot builds at y = 55, then turns back towards the base (y decreasing) on the other lane.
   t.observe({at(3, 0.0, 55.0)}, kTarget);
-  EXPECT_EQ(t.role(self, kTarget), PipelineRole::kFollow);
+  EXPECT_EQ(t.place(self, kTarget).role, PipelineRole::kFollow);
   t.observe({at(3, 0.0, 54.0)}, kTarget);  // 1 m back: a builder's short retreat, still the front
   EXPECT_FALSE(t.returning(3));
-  EXPECT_EQ(t.role(self, kTarget), PipelineRole::kFollow);
+  EXPECT_EQ(t.place(self, kTarget).role, PipelineRole::kFollow);
   t.observe({at(3, 0.0, 53.5)}, kTarget);  // 1.5 m back: returning
   EXPECT_TRUE(t.returning(3));
-  EXPECT_EQ(t.role(self, kTarget), PipelineRole::kActive);  // this robot is now the front of the pipeline
+  EXPECT_EQ(t.place(self, kTarget).role, PipelineRole::kActive);  // this robot is now the front of the pipeline
   t.observe({at(3, 0.0, 50.5)}, kTarget);  // passing by on the backward lane: no back-off
-  EXPECT_EQ(t.role(self, kTarget), PipelineRole::kActive);
+  EXPECT_EQ(t.place(self, kTarget).role, PipelineRole::kActive);
   // Refilled, it comes again: approaching by the detection distance from its farthest point rejoins it.
   t.observe({at(3, 0.0, 40.0)}, kTarget);
   t.observe({at(3, 0.0, 41.0)}, kTarget);
   EXPECT_TRUE(t.returning(3));
   t.observe({at(3, 0.0, 41.5)}, kTarget);
   EXPECT_FALSE(t.returning(3));
-  EXPECT_EQ(t.role(self, kTarget), PipelineRole::kActive);  // behind this robot now
+  EXPECT_EQ(t.place(self, kTarget).role, PipelineRole::kActive);  // behind this robot now
 }
 
 TEST(Pipeline, ANeighbourOutOfRangeIsForgotten) {
@@ -91,7 +93,7 @@ TEST(Pipeline, ANeighbourOutOfRangeIsForgotten) {
   EXPECT_FALSE(t.returning(3));
   t.observe({at(3, 0.0, 53.0)}, kTarget);  // seen again: starts fresh, ahead and not returning
   EXPECT_FALSE(t.returning(3));
-  EXPECT_EQ(t.role({0.0, 50.0}, kTarget), PipelineRole::kFollow);
+  EXPECT_EQ(t.place({0.0, 50.0}, kTarget).role, PipelineRole::kFollow);
 }
 
 TEST(Pipeline, BadParametersAreRejected) {
