@@ -11,20 +11,14 @@
 
 #include "common/error.hpp"
 #include "common/render/terrain_renderer.hpp"
+#include "render_test_support.hpp"
 
 namespace marsala::render {
 namespace {
 
-struct Pixel {
-  int r, g, b;
-  bool operator==(const Pixel& o) const { return r == o.r && g == o.g && b == o.b; }
-  bool operator!=(const Pixel& o) const { return !(*this == o); }
-};
-
-Pixel at(const Image& img, int x, int y) {
-  const std::size_t i = 3u * (static_cast<std::size_t>(y) * img.width + x);
-  return {img.rgb[i], img.rgb[i + 1], img.rgb[i + 2]};
-}
+using test::at;
+using test::Pixel;
+using test::plain;
 
 Pixel pixel(Rgb c) { return {c.r, c.g, c.b}; }
 
@@ -33,13 +27,6 @@ constexpr Pixel kHalo{30, 30, 30};
 /// A flat map (one colour everywhere, no shading), cs 0.5 m, lower-left at (10, 20) so that world and pixel
 /// coordinates differ.
 grid::Heightmap flat(int rows, int cols) { return grid::Heightmap(grid::GridGeometry{rows, cols, 10.0, 20.0, 0.5}, 1.0); }
-
-RenderOptions plain(int max_size_px) {
-  RenderOptions o;
-  o.legend = false;
-  o.max_size_px = max_size_px;
-  return o;
-}
 
 /// Expected blend of `base` towards `tint` by alpha, per channel, before rounding.
 void expect_blend(Pixel got, Pixel base, Pixel tint, double alpha, const char* what) {

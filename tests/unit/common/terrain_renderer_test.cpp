@@ -6,32 +6,17 @@
 #include <limits>
 
 #include "common/error.hpp"
+#include "render_test_support.hpp"
 
 namespace marsala::render {
 namespace {
 
-struct Pixel {
-  int r, g, b;
-  bool operator==(const Pixel& o) const { return r == o.r && g == o.g && b == o.b; }
-  bool operator!=(const Pixel& o) const { return !(*this == o); }
-  double luminance() const { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
-  double greenness() const { return g - 0.5 * (r + b); }
-};
-
-Pixel at(const Image& img, int x, int y) {
-  const std::size_t i = 3u * (static_cast<std::size_t>(y) * img.width + x);
-  return {img.rgb[i], img.rgb[i + 1], img.rgb[i + 2]};
-}
+using test::at;
+using test::Pixel;
+using test::plain;
 
 grid::Heightmap make_map(int rows, int cols, double cs = 0.5) {
   return grid::Heightmap(grid::GridGeometry{rows, cols, 0.0, 0.0, cs});
-}
-
-RenderOptions plain(int max_size_px) {
-  RenderOptions o;
-  o.legend = false;
-  o.max_size_px = max_size_px;
-  return o;
 }
 
 // An uneven but smooth test terrain.

@@ -75,6 +75,18 @@ class RuntimeTest : public ::testing::Test {
     return c;
   }
 
+  /// Runs `runtime` (on `domain`) with agent 1 walking until the run ends. The runtime outlives the call: its
+  /// transient-local status stays readable.
+  RunResult run_with_one_walker(WorldRuntime& runtime, int domain) const {
+    std::atomic<bool> stop{false};
+    RunResult result;
+    std::thread world([&] { result = runtime.run(stop); });
+    FakeAgent a1(agent(domain, 1));
+    world.join();
+    a1.join();
+    return result;
+  }
+
   /// Sends `hello` until the world answers it; returns the answer.
   static bus::Admission ask(int domain, const bus::AgentHello& hello) {
     auto participant = bus::make_participant({bus::Vendor::kInProcess, domain});
@@ -288,12 +300,7 @@ TEST_F(RuntimeTest, MaxStepsEndsAnUnfinishedRun) {
   RuntimeOptions o = options(1, 10.0);
   o.max_steps = 5;
   WorldRuntime runtime(scenario_, testing::flat_terrain(), o, *participant);
-  std::atomic<bool> stop{false};
-  RunResult result;
-  std::thread world([&] { result = runtime.run(stop); });
-  FakeAgent a1(agent(kDomain, 1));
-  world.join();
-  a1.join();
+  const RunResult result = run_with_one_walker(runtime, kDomain);
   EXPECT_EQ(result.end_reason, "max_steps");
   EXPECT_FALSE(result.completed);
   EXPECT_EQ(result.steps, 5u);
@@ -308,12 +315,7 @@ TEST_F(RuntimeTest, APayloadScenarioNavigableFromTheStartCompletesAtOnceWithTheS
   RuntimeOptions o = options(1, 10.0);
   o.seed = 1234;
   WorldRuntime runtime(payload, testing::flat_terrain(), o, *participant);
-  std::atomic<bool> stop{false};
-  RunResult result;
-  std::thread world([&] { result = runtime.run(stop); });
-  FakeAgent a1(agent(kDomain, 1));
-  world.join();
-  a1.join();
+  const RunResult result = run_with_one_walker(runtime, kDomain);
   EXPECT_TRUE(result.completed);
   EXPECT_EQ(result.end_reason, "completed");
   EXPECT_EQ(result.steps, 0u);
@@ -338,12 +340,7 @@ TEST_F(RuntimeTest, ALevelSiteRunPublishesItsLevelFractionAsProgress) {
   RuntimeOptions o = options(1, 10.0);
   o.max_steps = 4;
   WorldRuntime runtime(site, terrain, o, *participant);
-  std::atomic<bool> stop{false};
-  RunResult result;
-  std::thread world([&] { result = runtime.run(stop); });
-  FakeAgent a1(agent(kDomain, 1));
-  world.join();
-  a1.join();
+  const RunResult result = run_with_one_walker(runtime, kDomain);
   EXPECT_EQ(result.end_reason, "max_steps");
   auto late = participant->create_reader<bus::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
   const auto latest = late->take();
