@@ -2,6 +2,7 @@
 // Helpers for agent unit tests: an agent map that knows a whole terrain, tiles cut from a terrain, bodies.
 
 #include <algorithm>
+#include <cstdint>
 #include <optional>
 
 #include "agent/deliberative/local_map_synthesizer.hpp"
@@ -31,6 +32,9 @@ inline executive::MappingSystem full_map(const grid::Heightmap& h, int tile_size
     for (int tc = 0; tc * tile_size < h.cols(); ++tc) map.integrate_tile(cut_tile(h, tile_size, tr, tc));
   return map;
 }
+
+/// A neighbour as a frame reports it: agent `id` standing at (x, y) [m] (height 0).
+inline bus::Neighbour neighbour_at(std::uint32_t id, double x, double y) { return {id, x, y, 0.0}; }
 
 /// A Husky-like body: delta 1 m, eps 5 cm, 20 cm steps, 0.02 m^3 per step, 1.5 m reach, 5 cm cubes.
 inline bus::BodyParams husky(double kappa = 0.5) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <utility>
 
+#include "agent_test_support.hpp"
 #include "common/error.hpp"
 
 namespace marsala::agent::deliberative {
@@ -69,13 +70,7 @@ AgentContext site_context(std::uint32_t id) {
   return c;
 }
 
-bus::Neighbour neighbour(std::uint32_t id, double x, double y) {
-  bus::Neighbour n;
-  n.agent_id = id;
-  n.x_m = x;
-  n.y_m = y;
-  return n;
-}
+const auto neighbour = test::neighbour_at;
 
 // The target, which must exist, as a pair for EXPECT_EQ.
 std::pair<double, double> target_of(GoalVectorMapSynthesizer& goal, Position robot,

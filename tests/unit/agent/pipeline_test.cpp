@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "agent_test_support.hpp"
 #include "common/error.hpp"
 
 namespace marsala::agent::reactive {
@@ -12,7 +13,7 @@ namespace {
 // The target lies due north: a robot's distance to it is 100 - y for robots on the x = 0 line.
 constexpr Position kTarget{0.0, 100.0};
 
-bus::Neighbour at(std::uint32_t id, double x, double y) { return {id, x, y, 0.0}; }
+const auto at = test::neighbour_at;
 
 PipelineParams params() {
   PipelineParams p;
