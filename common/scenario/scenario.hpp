@@ -94,7 +94,6 @@ struct Site {
 
 /// The goal vector map's specification (paper §V-B, Fig. 6), compiled by processing::GoalVectorMap.
 using GoalVectorMapSpec = processing::GoalVectorMapSpec;
-using processing::Heading;
 
 /// The base station: material is refilled only within radius of its centre.
 struct BaseStation {
