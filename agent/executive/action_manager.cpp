@@ -26,8 +26,13 @@ const grid::CellMask& ActionManager::moves_mask(const deliberative::LocalMap& ma
 
 std::optional<Motion> ActionManager::advance(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
                                              Position robot) const {
-  if (path.size() < 2) return std::nullopt;
+  if (path.empty()) return std::nullopt;
   const grid::CellMask& mask = moves_mask(map);
+  const Position own = map.center(path[0]);
+  const double d_own = distance(own, robot);
+  const bool can_centre = mask(path[0].row, path[0].col) != 0 && d_own > kCentredM && d_own <= max_step_m_;
+  // A path that ends on the robot's own cell: arrive on its centre (a partial diagonal move leaves a robot off it).
+  if (path.size() == 1) return can_centre ? std::optional<Motion>(Motion{path[0], own, 0, d_own}) : std::nullopt;
   std::optional<Motion> best;
   for (std::size_t i = 1; i < path.size(); ++i) {
     const CellIndex cell = path[i];
@@ -40,10 +45,7 @@ std::optional<Motion> ActionManager::advance(const deliberative::LocalMap& map, 
   // The next cell is navigable but out of range from where the robot stands: first step onto its own centre.
   const CellIndex next = path[1];
   if (!map.contains(next) || mask(next.row, next.col) == 0) return std::nullopt;
-  const Position own = map.center(path[0]);
-  const double d_own = distance(own, robot);
-  if (mask(path[0].row, path[0].col) != 0 && d_own > kCentredM && d_own <= max_step_m_)
-    return Motion{path[0], own, 0, d_own};
+  if (can_centre) return Motion{path[0], own, 0, d_own};
   // Centred, and the next cell's centre is farther than a step (a diagonal move when the step is shorter than a
   // cell's diagonal): go max_step of the way towards it, provided that point lies in another cell it can move to.
   const Position aim = map.center(next);

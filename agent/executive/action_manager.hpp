@@ -29,10 +29,11 @@ class ActionManager {
 
   /// The farthest cell of `path` (path[0] = the robot's cell) reachable along the path through cells navigable
   /// now, with its centre within max_step of `robot` [m]; when the robot's own cell is not occupiable, occupiable
-  /// cells stand in for navigable ones (a way out). If only the robot's own cell centre is in range and the robot
-  /// is off it, the motion centres the robot; if the robot is centred and the next cell's centre is beyond a step (a
-  /// diagonal when the step is shorter than a cell's diagonal), it goes a step's length towards that centre, when
-  /// the point it reaches lies in another cell it may move to. nullopt when no progress is possible.
+  /// cells stand in for navigable ones (a way out). If the path is the robot's own cell alone, or only that cell's
+  /// centre is in range, and the robot is off the centre, the motion centres the robot; if the robot is centred and
+  /// the next cell's centre is beyond a step (a diagonal when the step is shorter than a cell's diagonal), it goes a
+  /// step's length towards that centre, when the point it reaches lies in another cell it may move to. nullopt when
+  /// no progress is possible.
   std::optional<Motion> advance(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
                                 Position robot) const;
 

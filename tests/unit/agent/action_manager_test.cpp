@@ -96,6 +96,22 @@ TEST(ActionManager, CentresAnOffCentreRobotWhenTheNextCellIsOutOfRange) {
   EXPECT_EQ(ActionManager(0.1).advance(map, line({7, 3}, 0, 1, 5), kGrid.cell_center({7, 3}))->path_index, 1u);
 }
 
+TEST(ActionManager, APathOfTheRobotsCellAloneCentresAnOffCentreRobot) {
+  // A route that ends where the robot stands (its goal is its own cell) after a partial diagonal move left it off
+  // the centre: the goal is the centre, e.g. a base station whose radius takes the centre but not the robot.
+  const deliberative::LocalMap map = flat_map({7, 3});
+  const Position centre = kGrid.cell_center({7, 3});
+  const auto m = ActionManager(0.1).advance(map, {{7, 3}}, {centre.x + 0.03, centre.y - 0.02});
+  ASSERT_TRUE(m.has_value());
+  EXPECT_EQ(m->cell, (CellIndex{7, 3}));
+  EXPECT_DOUBLE_EQ(m->target.x, centre.x);
+  EXPECT_DOUBLE_EQ(m->target.y, centre.y);
+  EXPECT_NEAR(m->distance_m, std::hypot(0.03, 0.02), 1e-12);
+  // Centred already, or the path empty: no motion.
+  EXPECT_FALSE(ActionManager(0.1).advance(map, {{7, 3}}, centre).has_value());
+  EXPECT_FALSE(ActionManager(0.1).advance(map, {}, centre).has_value());
+}
+
 TEST(ActionManager, LeavesACellItCannotOccupyThroughOccupiableCells) {
   grid::Heightmap h(kGrid, 0.0);
   h(5, 3) = 0.3;  // within the robot's ball: its own cell (7, 3) is not occupiable
