@@ -120,6 +120,16 @@ std::vector<DepositionCandidate> DepositionManager::candidates(const deliberativ
   return out;
 }
 
+namespace {
+
+bool reaches_border(const grid::CellMask& reach) {
+  const auto rows = reach.rows(), cols = reach.cols();
+  if (rows == 0 || cols == 0) return false;
+  return reach.row(0).any() || reach.row(rows - 1).any() || reach.col(0).any() || reach.col(cols - 1).any();
+}
+
+}  // namespace
+
 bool DepositionManager::keeps_way_back(const deliberative::LocalMap& map, Position robot,
                                        const std::vector<DepositionCandidate>& depositions,
                                        const Neighbourhood& neighbours) const {
@@ -149,6 +159,12 @@ bool DepositionManager::keeps_way_back(const deliberative::LocalMap& map, Positi
   // This robot's own cell must stay occupiable if it was (the world checks only motion targets, but a robot on a
   // cell it cannot occupy has no navigable move).
   if (map.occupiable(cell->row, cell->col) != 0 && occupiable(cell->row, cell->col) == 0) return false;
+  // And it must keep a way out of the window if it had one: near the start of its trajectory the local origin may
+  // be its own cell, and a ring of deposits around it would pass the origin test below.
+  if (map.occupiable(cell->row, cell->col) != 0 &&
+      reaches_border(processing::NavigabilityProcessor::navigable_from(map.occupiable, *cell)) &&
+      !reaches_border(processing::NavigabilityProcessor::navigable_from(occupiable, *cell)))
+    return false;
   if (!has_origin) return true;
   const grid::CellMask reach = processing::NavigabilityProcessor::navigable_from(occupiable, *map.origin);
   for (const CellIndex p : robots)

@@ -5,9 +5,9 @@
 // P (rounding to nearest would let each built cell lift the bound of the next by up to q/2, and a ramp built cell
 // by cell would creep flatter and longer than kappa). Every rule the world checks is kept: reach, never under a
 // robot, at most 1 m per cell, total volume within the deposition threshold and the material on board. Finally
-// the depositions are simulated on the local map: the robot's (new) cell must stay occupiable and connected to
-// the local origin, and so must every neighbour in the window that was connected; depositions that would break
-// that are dropped.
+// the depositions are simulated on the local map: the robot's (new) cell must stay occupiable, connected to the
+// window's border and to the local origin, and so must every neighbour in the window that was connected;
+// depositions that would break that are dropped.
 
 #include <cstdint>
 #include <optional>
@@ -78,7 +78,7 @@ class DepositionManager {
   DepositionPlan plan(const deliberative::LocalMap& map, const std::vector<CellIndex>& path, Position robot,
                       double material_m3, const Neighbourhood& neighbours) const;
   /// True when the depositions, simulated on the local map, keep the robot's cell at `robot` [m] occupiable (if
-  /// it was) and keep every robot that was connected to the local origin connected to it: this one, and each
+  /// it was), keep a navigable way from it to the window's border (if it had one), and keep every robot that was connected to the local origin connected to it: this one, and each
   /// neighbour in the window wherever its own motion may take it this step (cells within neighbour_step_m). The
   /// neighbours' own depositions of the same step are unknown here: robots closer than about a body length can
   /// still wall each other in between them.

@@ -161,6 +161,38 @@ TEST(DepositionManager, KeepsTheRobotsWayBack) {
   EXPECT_EQ(east.dropped_for_way_back, 0);
 }
 
+TEST(DepositionManager, NeverRingsInARobotWhoseOriginIsItsOwnCell) {
+  // A robot that has not moved yet: its local origin is its own cell, so the origin test alone is vacuous. The gap
+  // is a square ring three cells from it; filled whole, the ring's walls (0.3 m against eps 0.05 m) would leave it
+  // no way out of the window.
+  const grid::Heightmap flat(kGrid, 0.0);
+  const CellIndex centre{10, 15};
+  grid::Heightmap gap(kGrid, 0.0);
+  std::vector<CellIndex> ring;
+  for (int c = centre.col - 3; c <= centre.col + 3; ++c) ring.push_back({centre.row - 3, c});
+  for (int r = centre.row - 2; r <= centre.row + 3; ++r) ring.push_back({r, centre.col + 3});
+  for (int c = centre.col + 2; c >= centre.col - 3; --c) ring.push_back({centre.row + 3, c});
+  for (int r = centre.row + 2; r >= centre.row - 2; --r) ring.push_back({r, centre.col - 3});
+  for (const CellIndex p : ring) gap(p) = 0.3;
+  const DepositionParams p = params(0.4, 10.0);
+  const LocalMap map = make_map(flat, gap, p.navigability, centre, centre);
+  const DepositionManager dm(p);
+  const Position robot = kGrid.cell_center(centre);
+  const auto all = dm.candidates(map, ring, robot, 10.0, {1, robot, {}});
+  ASSERT_EQ(all.size(), ring.size());
+  EXPECT_FALSE(dm.keeps_way_back(map, robot, all, {1, robot, {}}));
+  const DepositionPlan plan = dm.plan(map, ring, robot, 10.0, {1, robot, {}});
+  EXPECT_GT(plan.depositions.size(), 0u);
+  EXPECT_LT(plan.depositions.size(), ring.size());
+  // Independent check: after the plan's depositions the robot still reaches the window's border.
+  grid::Heightmap after = flat;
+  for (const bus::Deposition& d : plan.depositions) after(CellIndex{d.row, d.col}) += d.height_m;
+  const grid::CellMask reach = processing::NavigabilityProcessor::navigable_from(
+      processing::NavigabilityProcessor(p.navigability).occupiable(after), centre);
+  EXPECT_TRUE(reach.row(0).any() || reach.row(kGrid.rows - 1).any() || reach.col(0).any() ||
+              reach.col(kGrid.cols - 1).any());
+}
+
 TEST(DepositionManager, KeepsANeighboursWayBack) {
   const grid::Heightmap h = corridor();
   grid::Heightmap gap(kGrid, 0.0);
