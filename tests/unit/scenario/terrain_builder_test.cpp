@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <iostream>
 #include <fstream>
 
 #include "common/error.hpp"
+#include "common/processing/goal_vector_map.hpp"
+#include "common/processing/navigability_processor.hpp"
 #include "common/terrain/asc_io.hpp"
 #include "common/terrain/generators.hpp"
 #include "common/terrain/resample.hpp"
@@ -136,6 +140,70 @@ TEST_F(TerrainBuilderTest, BadFileTerrainsAreClearErrors) {
     EXPECT_NE(std::string(e.what()).find("s.pbtxt: terrain: terrain generator 'flat': unknown parameter 'slope'"),
               std::string::npos)
         << e.what();
+  }
+}
+
+// Every scenario shipped in deploy/scenarios loads, builds its terrain and places its agents and base on it (the
+// scenarios that read ../shared/data are skipped when it is absent). The path scenarios keep their promise that
+// construction is needed: at the start the payload cannot reach the target from the base. The site scenario's goal
+// vector map compiles on its grid and the site is not level yet (some cell not occupiable at the site's kappa).
+TEST(DeployScenarios, EachBuildsItsTerrainAndNeedsConstruction) {
+  const char* dir = std::getenv("MARSALA_SOURCE_DIR");
+  const fs::path folder = fs::path(dir ? dir : ".") / "deploy" / "scenarios";
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(folder))
+    if (entry.path().extension() == ".pbtxt") files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 6u) << folder;
+  int built = 0, payload = 0, sites = 0;
+  std::vector<std::string> skipped;
+  for (const fs::path& file : files) {
+    SCOPED_TRACE(file.string());
+    const Scenario s = load_scenario(file.string());
+    grid::Heightmap h;
+    try {
+      h = build_terrain(s);
+    } catch (const IoError& e) {
+      ASSERT_FALSE(s.terrain.file.empty()) << e.what();
+      ASSERT_NE(s.terrain.file.find("shared/data/"), std::string::npos) << e.what();
+      skipped.push_back(file.filename().string());
+      continue;
+    }
+    ++built;
+    const auto cell = [&](double x, double y) {
+      const auto c = h.cell_at({x, y});
+      EXPECT_TRUE(c.has_value()) << "(" << x << ", " << y << ") is off the grid";
+      return c.value_or(CellIndex{0, 0});
+    };
+    if (s.completion == CompletionKind::kPayloadPath) {
+      ++payload;
+      const PayloadPath& p = s.payload_path;
+      const processing::NavigabilityProcessor nav({p.kappa, p.delta_m, p.eps_m});
+      const grid::CellMask occupiable = nav.occupiable(h);
+      const CellIndex from = cell(p.from_x_m, p.from_y_m), to = cell(p.to_x_m, p.to_y_m);
+      EXPECT_EQ(occupiable(from.row, from.col), 1) << "the payload cannot stand at its start";
+      EXPECT_EQ(processing::NavigabilityProcessor::navigable_from(occupiable, from)(to.row, to.col), 0)
+          << "the target is reachable without construction";
+    }
+    if (s.completion == CompletionKind::kLevelSite) {
+      ++sites;
+      ASSERT_TRUE(s.has_goal_vector_map);
+      const processing::GoalVectorMap map(s.goal_vector_map, h.geometry());
+      EXPECT_GE(static_cast<std::size_t>(map.strips()), 1u);
+      const CellIndex lo = cell(s.site.x0_m + 1e-6, s.site.y1_m - 1e-6), hi = cell(s.site.x1_m - 1e-6, s.site.y0_m + 1e-6);
+      const grid::Heightmap site = h.window(lo, hi.row - lo.row + 1, hi.col - lo.col + 1);
+      const grid::CellMask occupiable =
+          processing::NavigabilityProcessor({s.site.kappa, s.site.delta_m, s.site.eps_m}).occupiable(site);
+      EXPECT_LT(occupiable.cast<long long>().sum(), static_cast<long long>(site.rows()) * site.cols())
+          << "the site is level already";
+    }
+  }
+  EXPECT_GE(payload + static_cast<int>(skipped.size()), 2);  // path_gale (or skipped) and path_generated
+  EXPECT_GE(sites, 1);
+  if (!skipped.empty()) {
+    std::string names;
+    for (const std::string& n : skipped) names += " " + n;
+    std::cout << "[ SKIPPED  ] data under ../shared/data absent for:" << names << " (" << built << " built)\n";
   }
 }
 

@@ -1,0 +1,108 @@
+#!/usr/bin/env bash
+# The paper's scenarios (paper §V) small and fast, as real multi-process runs (marsala-world + marsala-agent over
+# DDS through deploy/spawn.sh, each case on its own domain with the loopback configs; ctest runs it inside
+# run_isolated.sh). Every outcome is checked again on the authoritative terrain the world wrote, with
+# marsala-terrain, independently of the world's own completion test.
+#
+# Usage: scenario_test.sh CASE DOMAIN
+#   path   tests/integration/scenarios/path_small.pbtxt, 3 path builders (Cyclone DDS): the payload (kappa 0.2,
+#          body 1.5 m) reaches the target on terrain_final.asc and did not on terrain_initial.asc; builders refilled
+#          (each carries 0.5 m^3); the summary's volume equals the terrain's change
+#   site   tests/integration/scenarios/site_small.pbtxt, 3 levellers on a goal vector map (Fast DDS): every cell of
+#          the site, cropped from terrain_final.asc, is occupiable at kappa 0.1 and all are connected; it was not
+#          so on terrain_initial.asc; goal_vector_map.png and final.png written
+set -euo pipefail
+case_name="$1"
+domain="$2"
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
+scenarios="$root/tests/integration/scenarios"
+
+work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-it-scenario-$case_name.XXXXXX")"
+trap 'rm -rf "$work"' EXIT
+
+fail() { echo "FAIL (scenario $case_name): $*" >&2; exit 1; }
+field() {  # field NAME FILE: the first scalar NAME of summary.json
+  grep -o "\"$1\": *[^,}]*" "$2" | head -1 | sed 's/^[^:]*: *//; s/"//g'
+}
+agent_fields() {  # agent_fields NAME FILE: NAME of every per_agent entry, one per line
+  grep -o "\"$1\": *[^,}]*" "$2" | sed 's/^[^:]*: *//; s/"//g'
+}
+run_spawn() {  # run_spawn SCENARIO AGENTS DDS: runs it into $work/run, prints the summary's path
+  local out="$work/run"
+  "$root/deploy/spawn.sh" --scenario "$1" --agents "$2" --dds "$3" --domain "$domain" --out "$out" --quiet \
+    --timeout 300 >&2 || fail "spawn.sh failed (logs: $out/logs)"
+  [ -f "$out/summary.json" ] || fail "no summary.json in $out"
+  echo "$out/summary.json"
+}
+expect_completed() {  # expect_completed SUMMARY AGENTS
+  [ "$(field completed "$1")" = "true" ] || { cat "$1"; fail "run did not complete"; }
+  [ "$(field end_reason "$1")" = "completed" ] || { cat "$1"; fail "end_reason is not 'completed'"; }
+  [ "$(field agents "$1")" = "$2" ] || { cat "$1"; fail "expected $2 agents in the summary"; }
+  [ "$(field rejected_requests "$1")" = "0" ] || { cat "$1"; fail "the world rejected requests"; }
+}
+asc_cell() {  # asc_cell FILE ROW COL: the value of one cell (row 0 = north)
+  awk -v r="$2" -v c="$3" 'NR == 7 + r { print $(c + 1); exit }' "$1"
+}
+is_png() { [ "$(head -c 8 "$1" | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ]; }
+
+case "$case_name" in
+  path)
+    s=$(run_spawn "$scenarios/path_small.pbtxt" 3 cyclone)
+    expect_completed "$s" 3
+    out="$(dirname "$s")"
+    [ "$(field path_found "$s")" = "true" ] || { cat "$s"; fail "summary: no payload path"; }
+    # The path joins base and target, 12 m apart: at least that long.
+    awk -v l="$(field path_length_m "$s")" 'BEGIN { exit !(l >= 12.0 && l < 30.0) }' ||
+      fail "payload path length $(field path_length_m "$s") m, expected [12, 30)"
+    # Base (6.125, 6.125) m -> cell row 47 - 24 = 23, col 24; target (18.125, 6.125) m -> row 23, col 72.
+    nav() {  # nav TERRAIN OUT: payload-navigable cells from the base
+      "$bin/marsala-terrain" navigable --kappa 0.2 --delta 1.5 --eps 0.05 --origin-cell 23 24 "$1" -o "$2" >/dev/null
+    }
+    nav "$out/terrain_initial.asc" "$work/nav_initial.asc"
+    nav "$out/terrain_final.asc" "$work/nav_final.asc"
+    [ "$(asc_cell "$work/nav_initial.asc" 23 72)" = "0" ] || fail "the target was navigable before any construction"
+    [ "$(asc_cell "$work/nav_final.asc" 23 72)" = "1" ] ||
+      fail "marsala-terrain finds no payload path to the target on terrain_final.asc"
+    # Material: 0.5 m^3 per trip; a builder that deposited more refilled at the base.
+    refilled=$(agent_fields deposited_m3 "$s" | awk '$1 > 0.5 + 1e-9 { n++ } END { print n + 0 }')
+    [ "$refilled" -ge 2 ] || { cat "$s"; fail "only $refilled builders deposited more than one load (0.5 m^3)"; }
+    # Conservation: the summary's volume is the terrain's change (cells of 0.25 m: 0.0625 m^2).
+    awk -v v="$(field deposited_volume_m3 "$s")" '
+      FNR <= 6 { next }
+      NR == FNR { for (i = 1; i <= NF; i++) h[FNR, i] = $i; next }
+      { for (i = 1; i <= NF; i++) { d = $i - h[FNR, i]; if (d < -1e-9) neg++; sum += d } }
+      END { sum *= 0.0625; if (neg || sum < v - 1e-6 || sum > v + 1e-6) { print "terrain change " sum " m^3, summary " v " m^3, " neg + 0 " cells lowered"; exit 1 } }
+    ' "$out/terrain_initial.asc" "$out/terrain_final.asc" || fail "deposited volume does not match the terrain"
+    is_png "$out/final.png" || fail "final.png missing or not a PNG"
+    echo "ok: path: payload path $(field path_length_m "$s") m after $(field steps "$s") steps," \
+      "$(field deposited_volume_m3 "$s") m^3; $refilled builders refilled"
+    ;;
+  site)
+    s=$(run_spawn "$scenarios/site_small.pbtxt" 3 fastdds)
+    expect_completed "$s" 3
+    out="$(dirname "$s")"
+    [ "$(field site_level_fraction "$s")" = "1" ] || { cat "$s"; fail "summary: site level fraction is not 1"; }
+    level() {  # level TERRAIN TAG: prints "occupiable navigable total" of the site [4, 12] x [3, 9] m
+      "$bin/marsala-terrain" import "$1" --crop 4 3 8 6 -o "$work/$2_site.asc" >/dev/null
+      local occ nav
+      occ=$("$bin/marsala-terrain" navigable --occupiable --kappa 0.1 --delta 1 --eps 0.05 "$work/$2_site.asc" \
+        -o "$work/$2_occ.asc")
+      nav=$("$bin/marsala-terrain" navigable --kappa 0.1 --delta 1 --eps 0.05 --origin-cell 12 16 \
+        "$work/$2_site.asc" -o "$work/$2_nav.asc")
+      # "occupiable N of M cells ..." and "navigable from (r, c): N of M cells ..."
+      echo "$(echo "$occ" | awk '{ print $2 }') $(echo "$nav" | awk '{ print $5 }') $(echo "$occ" | awk '{ print $4 }')"
+    }
+    read -r occ0 nav0 total0 <<<"$(level "$out/terrain_initial.asc" initial)"
+    read -r occ1 nav1 total1 <<<"$(level "$out/terrain_final.asc" final)"
+    [ "$total1" = 768 ] || fail "the cropped site has $total1 cells, expected 32 x 24 = 768"
+    [ "$occ0" -lt "$total0" ] || fail "the site was level before any construction"
+    [ "$occ1" = "$total1" ] || fail "$occ1 of $total1 site cells occupiable at kappa 0.1 on terrain_final.asc"
+    [ "$nav1" = "$total1" ] || fail "$nav1 of $total1 site cells connected at kappa 0.1 on terrain_final.asc"
+    is_png "$out/goal_vector_map.png" || fail "goal_vector_map.png missing or not a PNG"
+    is_png "$out/final.png" || fail "final.png missing or not a PNG"
+    echo "ok: site: level at kappa 0.1 after $(field steps "$s") steps ($occ0 of $total0 cells before)," \
+      "$(field deposited_volume_m3 "$s") m^3"
+    ;;
+  *) echo "usage: scenario_test.sh path|site DOMAIN" >&2; exit 2 ;;
+esac
