@@ -1,34 +1,60 @@
 #!/usr/bin/env bash
 # The README's main job: installs what is missing, builds, and runs the ramp scenario (paper Fig. 2) as real
 # processes: one marsala-world and 3 marsala-agent processes over DDS (loopback only), then prints the summary and
-# the picture paths. With --terrain it runs the terrain demo instead (MARS gap and navigability of a generated site).
-# Usage: deploy/demo.sh [--agents N] [--dds cyclone|fastdds] [--out DIR] [--terrain [--seed S]]
+# the picture paths. --scenario runs another scenario of deploy/scenarios the same way, e.g. path_generated (the
+# paper's path construction, 5 robots by default) or site_prep (site preparation, 11 robots). With --terrain it
+# runs the terrain demo instead (MARS gap and navigability of a generated site).
+# Usage: deploy/demo.sh [--scenario NAME|FILE] [--agents N] [--dds cyclone|fastdds] [--out DIR] [--terrain [--seed S]]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="$root/out/demo"
 seed=7
-agents=3
+agents=""
 dds=cyclone
-mode=ramp
+mode=scenario
+scenario=ramp
 while [ $# -gt 0 ]; do
   case "$1" in
-    --out) out="$2"; shift 2 ;;
-    --seed) seed="$2"; shift 2 ;;
-    --agents) agents="$2"; shift 2 ;;
-    --dds) dds="$2"; shift 2 ;;
+    --out|--seed|--agents|--dds|--scenario)
+      [ $# -ge 2 ] || { echo "demo.sh: $1 needs a value (try --help)" >&2; exit 2; }
+      case "$1" in
+        --out) out="$2" ;;
+        --seed) seed="$2" ;;
+        --agents) agents="$2" ;;
+        --dds) dds="$2" ;;
+        --scenario) scenario="$2" ;;
+      esac
+      shift 2 ;;
     --terrain) mode=terrain; shift ;;
-    -h|--help) sed -n '2,5p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
 
+if [ "$mode" = scenario ]; then
+  file="$scenario"
+  [ -f "$file" ] || file="$root/deploy/scenarios/$scenario.pbtxt"
+  if [ ! -f "$file" ]; then
+    names="$(cd "$root/deploy/scenarios" && ls *.pbtxt | sed 's/\.pbtxt$//' | tr '\n' ' ')"
+    echo "demo.sh: no scenario '$scenario' (a file, or one of: $names)" >&2
+    exit 2
+  fi
+fi
+
 "$root/deploy/install-deps.sh"
 "$root/deploy/build.sh"
 
-if [ "$mode" = ramp ]; then
-  echo "== The ramp scenario (paper Fig. 2): $agents robots build ramps to climb a 1.5 m platform"
-  exec "$root/deploy/spawn.sh" --scenario "$root/deploy/scenarios/ramp.pbtxt" --agents "$agents" --dds "$dds" \
-    --out "$out"
+if [ "$mode" = scenario ]; then
+  name="$(basename "$file" .pbtxt)"
+  case "$name" in
+    ramp*) default_agents=3; what="robots build ramps to climb a 1.5 m platform (paper Fig. 2)" ;;
+    path_*) default_agents=5; what="builders build a navigable path for a payload robot (paper §V-A)" ;;
+    site_*) default_agents=11; what="robots level a site for kappa 0.1 (paper §V-B)" ;;
+    *) default_agents="$(grep -c '^agent ' "$file")"; what="scenario $file" ;;
+  esac
+  agents="${agents:-$default_agents}"
+  echo "== $name: $agents $what"
+  exec "$root/deploy/spawn.sh" --scenario "$file" --agents "$agents" --dds "$dds" --out "$out"
 fi
 
 terrain="${MARSALA_BUILD_DIR:-$root/build}/bin/marsala-terrain"

@@ -136,7 +136,7 @@ struct WorldStatus {
   std::uint64_t step = 0;
   double wall_seconds = 0.0;
   double deposited_volume_m3 = 0.0;
-  double progress = 0.0;               ///< fraction of agents at their goal [0, 1]
+  double progress = 0.0;               ///< [0, 1]: agents at goal (fraction), payload path (0/1), site (level fraction)
   bool running = true;
   bool completed = false;
   std::vector<AgentStatus> agents;
