@@ -2,8 +2,11 @@
 
 #include <google/protobuf/util/json_util.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 #include "common/error.hpp"
 #include "common/render/png_writer.hpp"
@@ -51,6 +54,36 @@ std::string format_number(const char* format, double v) {
   std::snprintf(buf, sizeof buf, format, v);
   return buf;
 }
+
+// The zoom window's framing (run_outputs.hpp, zoom_window()).
+constexpr double kZoomMinMarginM = 3.0;
+constexpr double kZoomMarginFraction = 0.15;
+constexpr double kZoomMinSideM = 10.0;
+constexpr double kZoomMaxAreaFraction = 0.5;
+// Box edges that fall on cell edges up to rounding stay there instead of taking in one more cell.
+constexpr double kCellEdgeTolerance = 1e-9;
+
+/// An axis-aligned box in the world frame [m]; empty until something is added.
+struct WorldBox {
+  double x0 = std::numeric_limits<double>::infinity(), y0 = x0;
+  double x1 = -std::numeric_limits<double>::infinity(), y1 = x1;
+
+  bool empty() const { return !(x0 <= x1 && y0 <= y1); }
+  void add(double xa, double ya, double xb, double yb) {
+    x0 = std::min({x0, xa, xb});
+    x1 = std::max({x1, xa, xb});
+    y0 = std::min({y0, ya, yb});
+    y1 = std::max({y1, ya, yb});
+  }
+  void add(const grid::GridGeometry& g, CellIndex c) {
+    const Position p = g.cell_center(c);
+    const double half = 0.5 * g.cell_size_m;
+    add(p.x - half, p.y - half, p.x + half, p.y + half);
+  }
+};
+
+/// "140.25" (no trailing zeros, no rounding noise of the cell arithmetic).
+std::string format_metres(double v) { return format_number("%.10g", v); }
 
 std::string summary_text(const WorldState& state, const RunInfo& info, const FinalTerrainReport& report) {
   proto::RunSummary s;
@@ -120,12 +153,63 @@ std::string summary_json(const WorldState& state, const RunInfo& info) {
   return summary_text(state, info, final_terrain_report(state));
 }
 
+std::optional<CellRect> zoom_window(const WorldState& state, const std::optional<PayloadRoute>& route) {
+  const grid::GridGeometry& g = state.terrain.geometry();
+  if (g.size() <= 0) return std::nullopt;
+  WorldBox box;
+  if (state.depositor.rows() == g.rows && state.depositor.cols() == g.cols)
+    for (int r = 0; r < g.rows; ++r)
+      for (int c = 0; c < g.cols; ++c)
+        if (state.depositor(r, c) > 0) box.add(g, {r, c});
+  if (route)
+    for (const CellIndex& c : route->cells) box.add(g, c);
+  if (state.completion == scenario::CompletionKind::kPayloadPath) {
+    const scenario::PayloadPath& p = state.payload_path;
+    box.add(p.from_x_m, p.from_y_m, p.to_x_m, p.to_y_m);
+  }
+  if (state.completion == scenario::CompletionKind::kLevelSite)
+    box.add(state.site.x0_m, state.site.y0_m, state.site.x1_m, state.site.y1_m);
+  if (box.empty()) return std::nullopt;
+  const scenario::BaseStation& b = state.base;
+  box.add(b.x_m - b.radius_m, b.y_m - b.radius_m, b.x_m + b.radius_m, b.y_m + b.radius_m);
+
+  const double margin = std::max(kZoomMinMarginM, kZoomMarginFraction * std::max(box.x1 - box.x0, box.y1 - box.y0));
+  const double side = std::max(std::max(box.x1 - box.x0, box.y1 - box.y0) + 2.0 * margin, kZoomMinSideM);
+  const double cx = 0.5 * (box.x0 + box.x1), cy = 0.5 * (box.y0 + box.y1);
+  const double y_top = g.yll_m + g.rows * g.cell_size_m;
+  // Cell units: columns count east from xll, rows south from the top edge; rounded outwards, then clipped.
+  const auto lower = [&](double cells, int count) {
+    return static_cast<int>(std::clamp(std::floor(cells + kCellEdgeTolerance), 0.0, static_cast<double>(count)));
+  };
+  const auto upper = [&](double cells, int count) {
+    return static_cast<int>(std::clamp(std::ceil(cells - kCellEdgeTolerance), 0.0, static_cast<double>(count)));
+  };
+  const int c0 = lower((cx - 0.5 * side - g.xll_m) / g.cell_size_m, g.cols);
+  const int c1 = upper((cx + 0.5 * side - g.xll_m) / g.cell_size_m, g.cols);
+  const int r0 = lower((y_top - (cy + 0.5 * side)) / g.cell_size_m, g.rows);
+  const int r1 = upper((y_top - (cy - 0.5 * side)) / g.cell_size_m, g.rows);
+  const CellRect window{{r0, c0}, r1 - r0, c1 - c0};
+  if (window.empty() || window.size() > kZoomMaxAreaFraction * g.size()) return std::nullopt;
+  return window;
+}
+
 render::RenderOptions final_picture_options(const WorldState& state, const RunInfo& info,
-                                            const std::optional<PayloadRoute>& route) {
+                                            const std::optional<PayloadRoute>& route,
+                                            const std::optional<CellRect>& window) {
   render::RenderOptions o;
   const grid::Heightmap& t = state.terrain;
-  if (state.depositor.rows() == t.rows() && state.depositor.cols() == t.cols() && state.depositor.maxCoeff() > 0)
-    o.labels = state.depositor;
+  const CellRect area = window ? *window : CellRect{{0, 0}, t.rows(), t.cols()};
+  const CellIndex last{area.first.row + area.rows - 1, area.first.col + area.cols - 1};
+  if (area.empty() || !t.contains(area.first) || !t.contains(last))
+    throw InvalidArgument("final_picture_options: window of " + std::to_string(area.rows) + " x " +
+                          std::to_string(area.cols) + " cells at (" + std::to_string(area.first.row) + ", " +
+                          std::to_string(area.first.col) + ") leaves the " + std::to_string(t.rows()) + " x " +
+                          std::to_string(t.cols()) + " grid");
+  if (state.depositor.rows() == t.rows() && state.depositor.cols() == t.cols()) {
+    const render::CellLabels labels =
+        state.depositor.block(area.first.row, area.first.col, area.rows, area.cols);
+    if (labels.maxCoeff() > 0) o.labels = labels;
+  }
   o.circles.push_back({{state.base.x_m, state.base.y_m}, state.base.radius_m, kWhite, 0.0});
   o.legend_entries.push_back({"base station", kWhite, render::LegendSwatch::kRing});
   std::string outcome = info.completed ? "completed" : "not completed";
@@ -133,7 +217,8 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
     case scenario::CompletionKind::kAgentsAtGoal: {
       const scenario::Goal& g = state.goal;
       o.rectangles.push_back({{g.x0_m, g.y0_m}, {g.x1_m, g.y1_m}, kWhite, 0.0});
-      if (const auto cell = t.cell_at({0.5 * (g.x0_m + g.x1_m), 0.5 * (g.y0_m + g.y1_m)})) o.markers.push_back(*cell);
+      const auto cell = t.cell_at({0.5 * (g.x0_m + g.x1_m), 0.5 * (g.y0_m + g.y1_m)});
+      if (cell && area.contains(*cell)) o.markers.push_back({cell->row - area.first.row, cell->col - area.first.col});
       o.legend_entries.push_back({"goal", kWhite, render::LegendSwatch::kOutline});
       break;
     }
@@ -178,8 +263,16 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
       o.legend_entries.push_back({(ids_of_colour[k].find(',') == std::string::npos ? "agent " : "agents ") +
                                       ids_of_colour[k],
                                   render::default_palette()[k], render::LegendSwatch::kDisc});
-  o.title = info.scenario + ": step " + std::to_string(state.step) + ", " + scenario::to_string(state.completion) +
-            " " + outcome;
+  if (window) {
+    const double cs = t.cell_size_m();
+    const double x0 = t.geometry().xll_m + area.first.col * cs;
+    const double y1 = t.geometry().yll_m + (t.rows() - area.first.row) * cs;
+    o.title = info.scenario + ": close-up x " + format_metres(x0) + ".." + format_metres(x0 + area.cols * cs) +
+              " m, y " + format_metres(y1 - area.rows * cs) + ".." + format_metres(y1) + " m";
+  } else {
+    o.title = info.scenario + ": step " + std::to_string(state.step) + ", " + scenario::to_string(state.completion) +
+              " " + outcome;
+  }
   return o;
 }
 
@@ -210,6 +303,10 @@ void write_final_outputs(const std::string& dir, const WorldState& state, const 
   const FinalTerrainReport report = final_terrain_report(state);
   render::write_png(render::render_terrain(state.terrain, final_picture_options(state, info, report.route)),
                     path_in(dir, "final.png"));
+  if (const auto window = zoom_window(state, report.route))
+    render::write_png(render::render_terrain(state.terrain.window(window->first, window->rows, window->cols),
+                                             final_picture_options(state, info, report.route, window)),
+                      path_in(dir, "final_zoom.png"));
 
   const std::string path = path_in(dir, "summary.json");
   std::ofstream out(path, std::ios::binary | std::ios::trunc);

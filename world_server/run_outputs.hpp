@@ -1,7 +1,7 @@
 #pragma once
 // What a run leaves in its output folder: summary.json (protobuf RunSummary as JSON, proto field names),
-// terrain_initial.asc, terrain_final.asc, final.png, goal_vector_map.png (scenarios with a goal vector map) and
-// events.log (one text line per event). IO at the edge.
+// terrain_initial.asc, terrain_final.asc, final.png, final_zoom.png (when zoom_window() finds a close-up),
+// goal_vector_map.png (scenarios with a goal vector map) and events.log (one text line per event). IO at the edge.
 //
 // final.png: the hillshaded final terrain; every cell raised by a deposition tinted with its depositor's colour
 // (render::default_palette(): agent id k -> entry (k - 1) mod 12: 1 red, 2 blue, 3 green, 4 orange, 5 purple, 6 cyan,
@@ -9,6 +9,10 @@
 // the base station as a white circle of its radius; agents_at_goal: the goal rectangle outlined in white and its
 // centre crossed; payload_path: the constructed path as a yellow line, `from` as a red square, `to` as a green
 // diamond; level_site: the site outlined in white; a title with scenario, step and completion; a legend.
+//
+// final_zoom.png: the same picture of the zoom window only (what was built, the payload's path and ends, the site and
+// the base, with a margin), so that a 24 m path on a 160 m terrain fills the picture; titled
+// "<scenario>: close-up x X0..X1 m, y Y0..Y1 m". Not written when the window would hold more than half the terrain.
 
 #include <cstdint>
 #include <fstream>
@@ -20,6 +24,7 @@
 #include "common/processing/goal_vector_map.hpp"
 #include "common/render/terrain_renderer.hpp"
 #include "world_server/completion.hpp"
+#include "world_server/occupancy_cache.hpp"
 #include "world_server/world_state.hpp"
 
 namespace marsala::world_server {
@@ -50,17 +55,31 @@ std::string summary_json(const WorldState& state, const RunInfo& info);
 /// Writes terrain_initial.asc into `dir` (created when missing); throws IoError.
 void write_initial_outputs(const std::string& dir, const grid::Heightmap& terrain);
 
-/// The options of final.png (see the top of this file) for the final state and the payload's constructed path.
+/// The close-up of final_zoom.png, in whole cells of state.terrain: the bounding box of every cell a deposition raised
+/// (state.depositor > 0), the route's cells, payload_path's `from` and `to`, level_site's site and the base station's
+/// disc; widened by max(3 m, 15 % of the box's longer side) on each side, grown about its centre to a square at least
+/// 10 m a side, rounded outwards to whole cells and clipped to the grid. nullopt when there is nothing to frame (no
+/// deposit, no route, no payload ends, no site: the base alone is no subject) or when the window holds more than half
+/// of the terrain's cells (final.png shows it well enough then).
+std::optional<CellRect> zoom_window(const WorldState& state, const std::optional<PayloadRoute>& route);
+
+/// The options of final.png (see the top of this file) for the final state and the payload's constructed path; with
+/// `window`, those of final_zoom.png, to be drawn on state.terrain.window(window): labels and markers cropped to the
+/// window (a marker outside it dropped), the world-coordinate overlays unchanged (the crop keeps its cells' world
+/// positions; the renderer clips what lies off it), the close-up title. Throws InvalidArgument when the window is
+/// empty or leaves the grid.
 render::RenderOptions final_picture_options(const WorldState& state, const RunInfo& info,
-                                            const std::optional<PayloadRoute>& route);
+                                            const std::optional<PayloadRoute>& route,
+                                            const std::optional<CellRect>& window = std::nullopt);
 
 /// The options of goal_vector_map.png: the arrows of processing::GoalVectorMap(spec, grid).arrows() in red, the
 /// map's rectangle (and a level_site's site) outlined in white, a title with the arrow count.
 render::RenderOptions goal_vector_map_picture_options(const WorldState& state, const RunInfo& info,
                                                       const processing::GoalVectorMap& map);
 
-/// Writes summary.json, terrain_final.asc, final.png and, when info.goal_vector_map is set, goal_vector_map.png (on
-/// info.initial_terrain, or the final terrain when that is empty) into `dir`; the payload's path is computed once.
+/// Writes summary.json, terrain_final.asc, final.png, final_zoom.png when zoom_window() gives a window and, when
+/// info.goal_vector_map is set, goal_vector_map.png (on info.initial_terrain, or the final terrain when that is empty)
+/// into `dir`; the payload's path is computed once.
 /// Throws IoError; a goal vector map that does not fit the grid throws InvalidArgument after the other files are
 /// written.
 void write_final_outputs(const std::string& dir, const WorldState& state, const RunInfo& info);

@@ -17,7 +17,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
                   std::ostream& err) {
   CLI::App app{"marsala-world: the authoritative world server. Loads a scenario, admits agents over DDS, runs the\n"
                "lockstep (frames, requests, validation in agent-id order) and writes summary.json, terrain_initial.asc,\n"
-               "terrain_final.asc, final.png, events.log (and goal_vector_map.png when the scenario has one) into --out.\n"
+               "terrain_final.asc, final.png, events.log, final_zoom.png (a close-up of what was built, unless it would\n"
+               "cover more than half the terrain) and goal_vector_map.png (when the scenario has one) into --out.\n"
                "The run id (partition prefix) defaults to <scenario name>-d<domain>.",
                "marsala-world"};
   std::string scenario_path, dds = "cyclone";
