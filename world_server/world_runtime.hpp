@@ -27,7 +27,7 @@ struct RuntimeOptions {
   double admit_timeout_s = 60.0;    ///< how long to wait for all agents before starting with those admitted [s]
   std::uint64_t max_steps = 0;      ///< 0 = the scenario's max_steps
   double step_deadline_s = 0.0;     ///< 0 = the scenario's step_deadline_s [s]
-  std::string out_dir = "out/run";  ///< summary.json, terrain_*.asc, final.png, goal_vector_map.png, events.log
+  std::string out_dir = "out/run";  ///< summary.json, terrain_*.asc, final*.png, goal_vector_map.png, events.log
   double linger_s = 2.0;            ///< after the run_over frames, wait up to this long for agents to leave [s]
   std::optional<std::uint64_t> seed;  ///< overrides the scenario's seed (start jitter; reported in summary.json)
 };
