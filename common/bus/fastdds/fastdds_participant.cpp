@@ -1,7 +1,8 @@
 // The Fast DDS 2.9 backend. One DomainParticipant per bus::Participant (QoS from the default XML profile, e.g.
 // FASTRTPS_DEFAULT_PROFILES_FILE); one publisher or subscriber per endpoint, since the partition is a
 // publisher/subscriber QoS; types and topics are registered once per participant. Readers take samples on Fast
-// DDS's listener thread, convert them and queue them (detail::ReaderQueue).
+// DDS's listener thread, convert them and queue them (detail::ReaderQueue). Participants of one process talk over
+// loopback like participants of different processes (intraprocess delivery off, see configure_library()).
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -13,6 +14,8 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastrtps/attributes/LibrarySettingsAttributes.h>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -73,11 +76,32 @@ Duration_t duration(std::chrono::milliseconds ms) {
                     static_cast<std::uint32_t>(ms.count() % 1000) * 1000000u);
 }
 
+/// Turns Fast DDS's intraprocess delivery off, once, before the first participant of the process is created.
+/// With it on (the default), a participant hands its builtin traffic to another participant of the same process by a
+/// direct call on its own thread. Fast DDS 2.9 deadlocks there: each participant's event thread asserts the
+/// liveliness of its automatic writers holding its own discovery (PDP) mutex, and the direct call into the other
+/// participant's liveliness reader takes that participant's PDP mutex; two participants asserting at once wait for
+/// each other for good. Both then stop asserting (their idle writers are reported gone after the lease), stop
+/// receiving, and deleting one of their writers blocks forever on the stuck event thread. Off, every message goes
+/// through the loopback transport as between processes; a process with a single participant behaves the same.
+/// The XML profiles are loaded first so that a <library_settings> in them cannot switch it back on.
+void configure_library() {
+  static const bool configured = [] {
+    dds::DomainParticipantFactory::get_instance()->load_profiles();
+    eprosima::fastrtps::LibrarySettingsAttributes settings;
+    settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+    eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
+    return true;
+  }();
+  static_cast<void>(configured);
+}
+
 /// The DDS participant and its topics; shared by the bus::Participant and every endpoint it made, so the
 /// participant outlives its endpoints whatever order the caller destroys them in.
 class Context {
  public:
   explicit Context(int domain_id) : domain_id_(domain_id) {
+    configure_library();
     auto* factory = dds::DomainParticipantFactory::get_instance();
     participant_ = factory->create_participant(static_cast<dds::DomainId_t>(domain_id), dds::PARTICIPANT_QOS_DEFAULT);
     if (participant_ == nullptr)
