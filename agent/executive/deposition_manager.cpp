@@ -161,8 +161,11 @@ bool DepositionManager::keeps_way_back(const deliberative::LocalMap& map, Positi
   if (map.occupiable(cell->row, cell->col) != 0 && occupiable(cell->row, cell->col) == 0) return false;
   // And it must keep a way out of the window if it had one: near the start of its trajectory the local origin may
   // be its own cell, and a ring of deposits around it would pass the origin test below.
+  // (The reach before the depositions is the local map's own navigable mask when the robot stays on its cell.)
   if (map.occupiable(cell->row, cell->col) != 0 &&
-      reaches_border(processing::NavigabilityProcessor::navigable_from(map.occupiable, *cell)) &&
+      reaches_border(*cell == map.robot && map.navigable.size() == map.occupiable.size()
+                         ? map.navigable
+                         : processing::NavigabilityProcessor::navigable_from(map.occupiable, *cell)) &&
       !reaches_border(processing::NavigabilityProcessor::navigable_from(occupiable, *cell)))
     return false;
   if (!has_origin) return true;
