@@ -21,9 +21,7 @@ work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-it-$case_name.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 
 fail() { echo "FAIL ($case_name): $*" >&2; exit 1; }
-field() {  # field NAME FILE: a scalar of summary.json
-  grep -o "\"$1\": *[^,}]*" "$2" | head -1 | sed 's/^[^:]*: *//; s/"//g'
-}
+. "$root/tests/integration/lib.sh"  # field, is_png
 run_spawn() {  # run_spawn OUT_NAME AGENTS DDS [AGENT_DDS]
   local out="$work/$1"
   "$root/deploy/spawn.sh" --scenario "$scenario" --agents "$2" --dds "$3" --agent-dds "${4:-$3}" \

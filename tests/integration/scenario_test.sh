@@ -22,9 +22,7 @@ work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-it-scenario-$case_name.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 
 fail() { echo "FAIL (scenario $case_name): $*" >&2; exit 1; }
-field() {  # field NAME FILE: the first scalar NAME of summary.json
-  grep -o "\"$1\": *[^,}]*" "$2" | head -1 | sed 's/^[^:]*: *//; s/"//g'
-}
+. "$root/tests/integration/lib.sh"  # field, is_png
 agent_fields() {  # agent_fields NAME FILE: NAME of every per_agent entry, one per line
   grep -o "\"$1\": *[^,}]*" "$2" | sed 's/^[^:]*: *//; s/"//g'
 }
@@ -44,7 +42,6 @@ expect_completed() {  # expect_completed SUMMARY AGENTS
 asc_cell() {  # asc_cell FILE ROW COL: the value of one cell (row 0 = north)
   awk -v r="$2" -v c="$3" 'NR == 7 + r { print $(c + 1); exit }' "$1"
 }
-is_png() { [ "$(head -c 8 "$1" | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ]; }
 
 case "$case_name" in
   path)

@@ -16,13 +16,10 @@ work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-it-sweep.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 
 fail() { echo "FAIL (sweep): $*" >&2; exit 1; }
-field() {  # field NAME FILE: a scalar of summary.json
-  grep -o "\"$1\": *[^,}]*" "$2" | head -1 | sed 's/^[^:]*: *//; s/"//g'
-}
+. "$root/tests/integration/lib.sh"  # field, is_png
 csv_field() {  # csv_field CSV TEAM SEED COLUMN: one value of the row of (team, seed)
   awk -F, -v t="$2" -v s="$3" -v c="$4" 'NR > 1 && $1 == t && $2 == s { print $c }' "$1"
 }
-is_png() { [ "$(head -c 8 "$1" | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ]; }
 
 # --- 1. bad arguments: exit 2, a message that names the problem, nothing written --------------------------------
 expect_usage_error() {  # expect_usage_error PATTERN ARGS...
