@@ -6,10 +6,10 @@
 #include <optional>
 #include <string>
 
-#include "common/bus/messages.hpp"
-#include "common/grid/heightmap.hpp"
-#include "common/processing/goal_vector_map.hpp"
-#include "common/types.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/goal_vector_map.hpp"
+#include "marsala/core/types.hpp"
 
 namespace marsala::agent {
 
@@ -21,15 +21,15 @@ struct Task {
   double separation_m = 2.0;                   ///< pipeline: distance kept behind the front neighbour [m]
   double lane_offset_m = 0.5;                  ///< pipeline: lanes this far right of the way [m]
   std::string goal_synthesizer = "fixed_target";                  ///< by name
-  std::optional<processing::GoalVectorMapSpec> goal_vector_map;   ///< for "goal_vector_map"
+  std::optional<GoalVectorMapSpec> goal_vector_map;   ///< for "goal_vector_map"
 };
 
 /// The admitted agent: identity, body, the world's answer and team-wide margins.
 struct AgentContext {
   std::uint32_t agent_id = 0;       ///< >= 1
   std::uint64_t session = 0;        ///< echoed in every request
-  bus::BodyParams body;             ///< this robot's body, kinematics and capabilities
-  bus::Admission admission;         ///< world grid, tile size, start, target and base station
+  RobotBody body;             ///< this robot's body, kinematics and capabilities
+  protocol::Admission admission;         ///< world grid, tile size, start, target and base station
   /// Depositions stay farther than this from a neighbour's reported centre [m]: the world rejects cells under any
   /// robot, and a neighbour may move before its turn; default = delta/2 + max_step of this body (see
   /// neighbour_keep_out_m()).
@@ -41,18 +41,11 @@ struct AgentContext {
 /// The construction parameters of a context: the task's, falling back to the body's (kappa, width as delta, eps).
 NavigabilityParams construction_params(const AgentContext& context);
 
-/// The navigability parameters (kappa [m/m], delta [m], eps [m]) of a body.
-NavigabilityParams navigability_params(const bus::BodyParams& body);
-
 /// The world grid announced in an admission; throws InvalidArgument when its size or cell size is not positive.
-grid::GridGeometry world_geometry(const bus::Admission& admission);
+GridGeometry world_geometry(const protocol::Admission& admission);
 
 /// Keep-out around neighbours for a team whose largest body length is max_delta_m [m] and longest step
 /// max_step_m [m]: max_delta_m / 2 + max_step_m + 1e-6 [m].
 double neighbour_keep_out_m(double max_delta_m, double max_step_m);
-
-/// Height of one cube spread over a cell, q = cube^3 / cs^2 [m]: depositions are whole multiples of it; throws
-/// InvalidArgument unless cube size and cell size are finite and > 0.
-double cube_layer_m(const bus::BodyParams& body, double cell_size_m);
 
 }  // namespace marsala::agent

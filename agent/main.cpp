@@ -12,9 +12,9 @@
 #include <iostream>
 #include <optional>
 
-#include "agent/runtime/agent_runtime.hpp"
-#include "common/cli/command_line.hpp"
-#include "common/scenario/scenario.hpp"
+#include "marsala/agent/runtime/agent_runtime.hpp"
+#include "marsala/cli/command_line.hpp"
+#include "marsala/scenario/scenario.hpp"
 
 namespace {
 
@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
     // Keep-out around neighbours: the largest body and step of the whole team (bodies may differ per slot).
     double max_delta = 0.0, max_step = 0.0;
     for (const scenario::AgentSlot& slot : s.slots) {
-      max_delta = std::max(max_delta, s.robot_for(slot.id).body.delta_m);
+      max_delta = std::max(max_delta, s.robot_for(slot.id).body.navigability.delta_m);
       max_step = std::max(max_step, s.robot_for(slot.id).body.max_step_m);
     }
     agent::runtime::RuntimeConfig config;

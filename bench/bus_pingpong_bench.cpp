@@ -21,7 +21,7 @@
 #include <thread>
 #include <vector>
 
-#include "common/bus/bus.hpp"
+#include "marsala/bus/bus.hpp"
 
 namespace {
 

@@ -16,10 +16,10 @@
 #include <random>
 #include <vector>
 
-#include "common/grid/heightmap.hpp"
-#include "common/processing/mars_processor.hpp"
-#include "common/terrain/generators.hpp"
-#include "tests/support/mars_brute_force.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/mars_processor.hpp"
+#include "marsala/terrain/generators.hpp"
+#include "support/mars_brute_force.hpp"
 
 // ---- allocation counting (global operator new / delete) ------------------------------------
 
@@ -55,9 +55,9 @@ void operator delete[](void* p, std::size_t) noexcept { counted_free(p); }
 
 namespace {
 
-using marsala::grid::GridGeometry;
-using marsala::grid::Heightmap;
-using marsala::processing::MarsProcessor;
+using marsala::GridGeometry;
+using marsala::Heightmap;
+using marsala::MarsProcessor;
 
 constexpr double kCellM = 0.1;
 constexpr double kKappa = 0.3;

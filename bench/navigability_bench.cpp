@@ -17,17 +17,17 @@
 #include <string>
 #include <utility>
 
-#include "common/grid/heightmap.hpp"
-#include "common/processing/navigability_processor.hpp"
-#include "common/terrain/generators.hpp"
-#include "tests/support/navigability_brute_force.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/navigability_processor.hpp"
+#include "marsala/terrain/generators.hpp"
+#include "support/navigability_brute_force.hpp"
 
 namespace {
 
 using marsala::NavigabilityParams;
-using marsala::grid::GridGeometry;
-using marsala::grid::Heightmap;
-using marsala::processing::NavigabilityProcessor;
+using marsala::GridGeometry;
+using marsala::Heightmap;
+using marsala::NavigabilityProcessor;
 
 constexpr double kCellSizeM = 0.1;
 const NavigabilityParams kRobot{0.3, 1.0, 0.05};
@@ -121,7 +121,7 @@ const Heightmap& terrain(Generator make, int n) {
   return it->second;
 }
 
-double occupiable_fraction(const marsala::grid::CellMask& mask) {
+double occupiable_fraction(const marsala::CellMask& mask) {
   long long n = 0;
   for (Eigen::Index i = 0; i < mask.size(); ++i) n += mask.data()[i];
   return static_cast<double>(n) / static_cast<double>(mask.size());

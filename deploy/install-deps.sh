@@ -10,7 +10,7 @@ packages=(
   libcli11-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   # scenarios and run summaries (protobuf), logging
-  libprotobuf-dev protobuf-compiler libspdlog-dev
+  libprotobuf-dev protobuf-compiler libspdlog-dev libfmt-dev
   # common/bus: both DDS vendors (fastddsgen runs at build time)
   cyclonedds-dev cyclonedds-tools libfastrtps-dev libfastcdr-dev fastddsgen
   # multi-process tests run inside a private network namespace (unshare -n, ip link set lo up)

@@ -1,4 +1,4 @@
-#include "monitor/follow.hpp"
+#include "marsala/monitor/follow.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -39,10 +39,10 @@ class TailPrinter {
   /// publishes a step's events before its status; statuses are taken before events, so the events of a
   /// taken status are in the batch). Stops at the final status and keeps the events after it; returns
   /// whether a status of the followed run came.
-  bool print(const std::vector<bus::WorldStatus>& statuses, const std::vector<bus::WorldEvent>& events) {
+  bool print(const std::vector<protocol::WorldStatus>& statuses, const std::vector<protocol::WorldEvent>& events) {
     bool got_status = false;
     std::size_t next_event = 0;
-    for (const bus::WorldStatus& status : statuses) {
+    for (const protocol::WorldStatus& status : statuses) {
       if (!follows(status)) continue;
       got_status = true;
       if (!status.running) {
@@ -62,20 +62,20 @@ class TailPrinter {
     return got_status;
   }
 
-  const std::optional<bus::WorldStatus>& final_status() const { return final_; }
+  const std::optional<protocol::WorldStatus>& final_status() const { return final_; }
   bool run_over_seen() const {
     if (run_over_printed_) return true;
-    for (const bus::WorldEvent& e : late_events_)
-      if (e.kind == bus::EventKind::kRunOver) return true;
+    for (const protocol::WorldEvent& e : late_events_)
+      if (e.kind == protocol::EventKind::kRunOver) return true;
     return false;
   }
-  void add_late_events(const std::vector<bus::WorldEvent>& events) {
+  void add_late_events(const std::vector<protocol::WorldEvent>& events) {
     late_events_.insert(late_events_.end(), events.begin(), events.end());
   }
 
   /// The end of the run: its last events, its last step line, the summary.
   void print_final() {
-    for (const bus::WorldEvent& e : late_events_) print_event(e);
+    for (const protocol::WorldEvent& e : late_events_) print_event(e);
     late_events_.clear();
     print_status(*final_);
     out_ << format_run_summary(*final_) << '\n';
@@ -96,7 +96,7 @@ class TailPrinter {
   }
 
  private:
-  bool follows(const bus::WorldStatus& status) {
+  bool follows(const protocol::WorldStatus& status) {
     if (run_id_.empty()) run_id_ = status.run_id;
     if (status.run_id == run_id_) return true;
     if (ignored_runs_.insert(status.run_id).second)
@@ -105,9 +105,9 @@ class TailPrinter {
     return false;
   }
 
-  void print_status(const bus::WorldStatus& status) {
+  void print_status(const protocol::WorldStatus& status) {
     std::vector<std::uint32_t> ids;
-    for (const bus::AgentStatus& a : status.agents) ids.push_back(a.agent_id);
+    for (const protocol::AgentStatus& a : status.agents) ids.push_back(a.agent_id);
     if (!last_ || ids != header_ids_) {
       out_ << format_step_header(status, options_.format) << '\n';
       header_ids_ = std::move(ids);
@@ -116,8 +116,8 @@ class TailPrinter {
     last_ = status;
   }
 
-  void print_event(const bus::WorldEvent& event) {
-    if (event.kind == bus::EventKind::kRunOver) run_over_printed_ = true;
+  void print_event(const protocol::WorldEvent& event) {
+    if (event.kind == protocol::EventKind::kRunOver) run_over_printed_ = true;
     out_ << format_event(event, options_.format) << '\n';
   }
 
@@ -125,10 +125,10 @@ class TailPrinter {
   std::string run_id_;
   std::ostream& out_;
   std::ostream& err_;
-  std::optional<bus::WorldStatus> last_;
-  std::optional<bus::WorldStatus> final_;
+  std::optional<protocol::WorldStatus> last_;
+  std::optional<protocol::WorldStatus> final_;
   std::vector<std::uint32_t> header_ids_;
-  std::vector<bus::WorldEvent> late_events_;
+  std::vector<protocol::WorldEvent> late_events_;
   std::set<std::string> ignored_runs_;
   bool run_over_printed_ = false;
 };
@@ -139,10 +139,10 @@ int run_tail(bus::Participant& participant, const TailOptions& options, const St
              std::ostream& err) {
   const std::shared_ptr<bus::Signal>& signal = stop.signal();
   auto statuses =
-      participant.create_reader<bus::WorldStatus>({"", signal, bus::Durability::kTransientLocal, kStatusDepth});
-  std::unique_ptr<bus::Reader<bus::WorldEvent>> events;
+      participant.create_reader<protocol::WorldStatus>({"", signal, bus::Durability::kTransientLocal, kStatusDepth});
+  std::unique_ptr<bus::Reader<protocol::WorldEvent>> events;
   if (options.events)
-    events = participant.create_reader<bus::WorldEvent>({"", signal, bus::Durability::kVolatile, kEventDepth});
+    events = participant.create_reader<protocol::WorldEvent>({"", signal, bus::Durability::kVolatile, kEventDepth});
   err << "marsala-monitor: tailing " << where(participant)
       << (options.run_id.empty() ? "" : ", run " + printable(options.run_id)) << "; Ctrl-C stops" << std::endl;
 
@@ -151,11 +151,11 @@ int run_tail(bus::Participant& participant, const TailOptions& options, const St
   if (options.timeout) deadline = Clock::now() + to_clock(*options.timeout);
   for (;;) {
     // Statuses before events: every event published before a taken status is then taken too.
-    std::vector<bus::WorldStatus> status_batch = statuses->take();
+    std::vector<protocol::WorldStatus> status_batch = statuses->take();
     // In step order: a transient-local replay may be overtaken by a newer live sample.
     std::stable_sort(status_batch.begin(), status_batch.end(),
                      [](const auto& a, const auto& b) { return a.step < b.step; });
-    std::vector<bus::WorldEvent> event_batch = events ? events->take() : std::vector<bus::WorldEvent>{};
+    std::vector<protocol::WorldEvent> event_batch = events ? events->take() : std::vector<protocol::WorldEvent>{};
     const bool got_status = printer.print(status_batch, event_batch);
     if (printer.final_status()) break;
     if (stop.stop_requested()) {  // after the take: what arrived before the stop is printed
@@ -188,14 +188,14 @@ int run_tail(bus::Participant& participant, const TailOptions& options, const St
 
 int run_status(bus::Participant& participant, const StatusOptions& options, const StopSource& stop,
                std::ostream& out, std::ostream& err) {
-  auto statuses = participant.create_reader<bus::WorldStatus>({"", stop.signal(), bus::Durability::kTransientLocal, 1});
+  auto statuses = participant.create_reader<protocol::WorldStatus>({"", stop.signal(), bus::Durability::kTransientLocal, 1});
   const Clock::time_point deadline = Clock::now() + to_clock(options.timeout);
   for (;;) {
-    const std::vector<bus::WorldStatus> batch = statuses->take();
+    const std::vector<protocol::WorldStatus> batch = statuses->take();
     if (!batch.empty()) {
       // The newest (the last of the highest step): a transient-local replay may arrive after a live sample.
-      const bus::WorldStatus* latest = &batch.front();
-      for (const bus::WorldStatus& s : batch)
+      const protocol::WorldStatus* latest = &batch.front();
+      for (const protocol::WorldStatus& s : batch)
         if (s.step >= latest->step) latest = &s;
       for (const std::string& line : format_status_table(*latest)) out << line << '\n';
       out.flush();

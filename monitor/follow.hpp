@@ -8,9 +8,9 @@
 #include <optional>
 #include <string>
 
-#include "common/bus/bus.hpp"
-#include "monitor/format.hpp"
-#include "monitor/stop_source.hpp"
+#include "marsala/bus/bus.hpp"
+#include "marsala/monitor/format.hpp"
+#include "marsala/monitor/stop_source.hpp"
 
 namespace marsala::monitor {
 

@@ -1,4 +1,4 @@
-#include "monitor/format.hpp"
+#include "marsala/monitor/format.hpp"
 
 #include <algorithm>
 #include <cstdarg>
@@ -37,36 +37,36 @@ std::string cut(const std::string& text, int width) {
 }
 
 /// Agents in id order (the world sends them so; sorting keeps the columns stable whatever arrives).
-std::vector<const bus::AgentStatus*> by_id(const bus::WorldStatus& status) {
-  std::vector<const bus::AgentStatus*> agents;
-  for (const bus::AgentStatus& a : status.agents) agents.push_back(&a);
+std::vector<const protocol::AgentStatus*> by_id(const protocol::WorldStatus& status) {
+  std::vector<const protocol::AgentStatus*> agents;
+  for (const protocol::AgentStatus& a : status.agents) agents.push_back(&a);
   std::stable_sort(agents.begin(), agents.end(), [](auto* a, auto* b) { return a->agent_id < b->agent_id; });
   return agents;
 }
 
-std::size_t count_alive(const bus::WorldStatus& status) {
+std::size_t count_alive(const protocol::WorldStatus& status) {
   return static_cast<std::size_t>(
       std::count_if(status.agents.begin(), status.agents.end(), [](const auto& a) { return a.alive; }));
 }
 
-std::size_t count_at_goal(const bus::WorldStatus& status) {
+std::size_t count_at_goal(const protocol::WorldStatus& status) {
   return static_cast<std::size_t>(std::count_if(status.agents.begin(), status.agents.end(),
                                                 [](const auto& a) { return a.alive && a.at_goal; }));
 }
 
-std::string state_of(const bus::AgentStatus& agent) { return agent.state.empty() ? "?" : printable(agent.state); }
+std::string state_of(const protocol::AgentStatus& agent) { return agent.state.empty() ? "?" : printable(agent.state); }
 
 /// One agent's column text, at most `text_width` characters.
-std::string agent_column(const bus::AgentStatus& agent, int text_width) {
+std::string agent_column(const protocol::AgentStatus& agent, int text_width) {
   if (!agent.alive) return "--";
   if (agent.at_goal) return cut(state_of(agent), text_width - 1) + "*";
   return cut(state_of(agent), text_width);
 }
 
 /// "build 9, refill 3": live agents per state, most frequent first, ties by name.
-std::string states_summary(const bus::WorldStatus& status) {
+std::string states_summary(const protocol::WorldStatus& status) {
   std::map<std::string, int> counts;
-  for (const bus::AgentStatus& a : status.agents)
+  for (const protocol::AgentStatus& a : status.agents)
     if (a.alive) ++counts[state_of(a)];
   if (counts.empty()) return "no live agents";
   std::vector<std::pair<std::string, int>> sorted(counts.begin(), counts.end());
@@ -76,7 +76,7 @@ std::string states_summary(const bus::WorldStatus& status) {
   return text;
 }
 
-std::string run_outcome(const bus::WorldStatus& status) {
+std::string run_outcome(const protocol::WorldStatus& status) {
   if (status.running) return "running";
   return status.completed ? "completed" : "stopped";
 }
@@ -108,7 +108,7 @@ int agent_column_text_width(std::size_t agent_count, const FormatOptions& option
   return static_cast<int>(std::min<long long>(text, kMaxAgentColumnText));
 }
 
-std::string format_step_header(const bus::WorldStatus& status, const FormatOptions& options) {
+std::string format_step_header(const protocol::WorldStatus& status, const FormatOptions& options) {
   std::string line = printf_string("%6s %5s %7s %8s %4s |", "step", "live", "mat[m3]", "dep[m3]", "goal");
   const int text_width = agent_column_text_width(status.agents.size(), options);
   if (status.agents.empty()) {
@@ -116,14 +116,14 @@ std::string format_step_header(const bus::WorldStatus& status, const FormatOptio
   } else if (text_width == 0) {
     line += " live agents by state";
   } else {
-    for (const bus::AgentStatus* a : by_id(status)) line += " " + pad_right(std::to_string(a->agent_id), text_width);
+    for (const protocol::AgentStatus* a : by_id(status)) line += " " + pad_right(std::to_string(a->agent_id), text_width);
   }
   return fit_width(trim_right(line), options.width);
 }
 
-std::string format_step_line(const bus::WorldStatus& status, const FormatOptions& options) {
+std::string format_step_line(const protocol::WorldStatus& status, const FormatOptions& options) {
   double material_m3 = 0.0;
-  for (const bus::AgentStatus& a : status.agents)
+  for (const protocol::AgentStatus& a : status.agents)
     if (a.alive) material_m3 += a.material_m3;
   const std::string live = std::to_string(count_alive(status)) + "/" + std::to_string(status.agents.size());
   std::string line = printf_string("%6llu %5s %7.2f %8.3f %3.0f%% |", static_cast<unsigned long long>(status.step),
@@ -134,14 +134,14 @@ std::string format_step_line(const bus::WorldStatus& status, const FormatOptions
   } else if (text_width == 0) {
     line += " " + states_summary(status);
   } else {
-    for (const bus::AgentStatus* a : by_id(status)) line += " " + pad_right(agent_column(*a, text_width), text_width);
+    for (const protocol::AgentStatus* a : by_id(status)) line += " " + pad_right(agent_column(*a, text_width), text_width);
   }
   return fit_width(trim_right(line), options.width);
 }
 
-std::string format_run_summary(const bus::WorldStatus& status) {
+std::string format_run_summary(const protocol::WorldStatus& status) {
   unsigned long long accepted = 0, rejected = 0, missed = 0;
-  for (const bus::AgentStatus& a : status.agents) {
+  for (const protocol::AgentStatus& a : status.agents) {
     accepted += a.accepted;
     rejected += a.rejected;
     missed += a.missed;
@@ -154,20 +154,20 @@ std::string format_run_summary(const bus::WorldStatus& status) {
                        missed);
 }
 
-std::string format_event(const bus::WorldEvent& event, const FormatOptions& options) {
+std::string format_event(const protocol::WorldEvent& event, const FormatOptions& options) {
   const std::string who = event.agent_id == 0 ? "world" : "agent " + std::to_string(event.agent_id);
   const auto kind_value = static_cast<unsigned>(event.kind);
-  const std::string kind = kind_value <= static_cast<unsigned>(bus::EventKind::kRunOver)
-                               ? bus::to_string(event.kind)
+  const std::string kind = kind_value <= static_cast<unsigned>(protocol::EventKind::kRunOver)
+                               ? protocol::to_string(event.kind)
                                : "kind " + std::to_string(kind_value);
   std::string line = printf_string("%6llu > %-8s %-9s", static_cast<unsigned long long>(event.step), who.c_str(),
                                    kind.c_str());
-  if (event.kind == bus::EventKind::kDeposited) line += printf_string(" %.6g m3", event.volume_m3);
+  if (event.kind == protocol::EventKind::kDeposited) line += printf_string(" %.6g m3", event.volume_m3);
   if (!event.detail.empty()) line += " " + printable(event.detail);
   return fit_width(trim_right(line), options.width);
 }
 
-std::vector<std::string> format_status_table(const bus::WorldStatus& status) {
+std::vector<std::string> format_status_table(const protocol::WorldStatus& status) {
   std::vector<std::string> lines;
   lines.push_back(printf_string("run %s  scenario %s  step %llu  wall %.1f s  %s  progress %.1f%%  deposited %.4f m3",
                                 printable(status.run_id).c_str(), printable(status.scenario).c_str(),
@@ -178,7 +178,7 @@ std::vector<std::string> format_status_table(const bus::WorldStatus& status) {
                                            "alive", "goal")));
   double material_m3 = 0.0, deposited_m3 = 0.0;
   unsigned long long accepted = 0, rejected = 0, missed = 0;
-  for (const bus::AgentStatus* a : by_id(status)) {
+  for (const protocol::AgentStatus* a : by_id(status)) {
     lines.push_back(trim_right(printf_string(
         "%3u %-12s %-11s %8.2f %8.2f %7.3f %7.4f %7.4f %5u %4u %4u %-5s %-4s", static_cast<unsigned>(a->agent_id),
         cut(printable(a->name), 12).c_str(), cut(state_of(*a), 11).c_str(), a->x_m, a->y_m, a->z_m, a->material_m3,

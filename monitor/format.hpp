@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "common/bus/messages.hpp"
+#include "marsala/protocol/messages.hpp"
 
 namespace marsala::monitor {
 
@@ -40,15 +40,15 @@ inline constexpr int kMinAgentColumnText = 4;
 int agent_column_text_width(std::size_t agent_count, const FormatOptions& options = {});
 
 /// The tail view's column header for the agents of `status`.
-std::string format_step_header(const bus::WorldStatus& status, const FormatOptions& options = {});
+std::string format_step_header(const protocol::WorldStatus& status, const FormatOptions& options = {});
 /// The tail view's line for one step.
-std::string format_step_line(const bus::WorldStatus& status, const FormatOptions& options = {});
+std::string format_step_line(const protocol::WorldStatus& status, const FormatOptions& options = {});
 /// The line tail prints last, once the run has ended: outcome, agents, volume and request counts.
-std::string format_run_summary(const bus::WorldStatus& status);
+std::string format_run_summary(const protocol::WorldStatus& status);
 /// One line per world event: step, agent (or "world"), kind, volume when deposited, detail.
-std::string format_event(const bus::WorldEvent& event, const FormatOptions& options = {});
+std::string format_event(const protocol::WorldEvent& event, const FormatOptions& options = {});
 /// The status table: run line, column header, one row per agent in the order given, a totals row.
-std::vector<std::string> format_status_table(const bus::WorldStatus& status);
+std::vector<std::string> format_status_table(const protocol::WorldStatus& status);
 
 /// `text` with every byte outside printable ASCII replaced by '?'.
 std::string printable(const std::string& text);

@@ -2,8 +2,8 @@
 #include <exception>
 #include <iostream>
 
-#include "monitor/monitor_cli.hpp"
-#include "monitor/signal_watcher.hpp"
+#include "marsala/monitor/monitor_cli.hpp"
+#include "marsala/monitor/signal_watcher.hpp"
 
 int main(int argc, char** argv) {
   try {

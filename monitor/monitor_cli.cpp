@@ -1,16 +1,16 @@
-#include "monitor/monitor_cli.hpp"
+#include "marsala/monitor/monitor_cli.hpp"
 
 // CLI11 2.1's option conversions trip a false -Wmaybe-uninitialized at -O2; keep our own warnings on.
-#include "common/cli/command_line.hpp"
+#include "marsala/cli/command_line.hpp"
 
 #include <exception>
 #include <new>
 #include <ostream>
 #include <string>
 
-#include "common/bus/bus.hpp"
-#include "common/error.hpp"
-#include "monitor/follow.hpp"
+#include "marsala/bus/bus.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/monitor/follow.hpp"
 
 namespace marsala::monitor {
 namespace {

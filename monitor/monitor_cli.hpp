@@ -3,7 +3,7 @@
 
 #include <iosfwd>
 
-#include "monitor/stop_source.hpp"
+#include "marsala/monitor/stop_source.hpp"
 
 namespace marsala::monitor {
 

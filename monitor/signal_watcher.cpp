@@ -1,11 +1,11 @@
-#include "monitor/signal_watcher.hpp"
+#include "marsala/monitor/signal_watcher.hpp"
 
 #include <pthread.h>
 
 #include <csignal>
 #include <cstring>
 
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::monitor {
 namespace {

@@ -6,7 +6,7 @@
 #include <atomic>
 #include <thread>
 
-#include "monitor/stop_source.hpp"
+#include "marsala/monitor/stop_source.hpp"
 
 namespace marsala::monitor {
 

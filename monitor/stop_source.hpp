@@ -4,7 +4,7 @@
 #include <atomic>
 #include <memory>
 
-#include "common/bus/bus.hpp"
+#include "marsala/bus/bus.hpp"
 
 namespace marsala::monitor {
 

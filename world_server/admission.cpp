@@ -1,29 +1,24 @@
-#include "world_server/admission.hpp"
+#include "marsala/world_server/admission.hpp"
+#include "marsala/core/format.hpp"
 
 #include <cstdio>
 
-#include "common/scenario/body_check.hpp"
-#include "world_server/completion.hpp"
+#include "marsala/core/robot_body.hpp"
+#include "marsala/world_server/completion.hpp"
 
 namespace marsala::world_server {
 namespace {
 
 constexpr std::size_t kMaxNameChars = 64;  // names are for display only
 
-std::string format(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 /// The first field in which `got` differs from `want`, as "kappa 0.2 != 0.3", or empty.
-std::string body_difference(const bus::BodyParams& got, const bus::BodyParams& want) {
+std::string body_difference(const RobotBody& got, const RobotBody& want) {
   const struct {
     const char* name;
     double got, want;
-  } fields[] = {{"kappa", got.kappa, want.kappa},
-                {"delta_m", got.delta_m, want.delta_m},
-                {"eps_m", got.eps_m, want.eps_m},
+  } fields[] = {{"kappa", got.navigability.kappa, want.navigability.kappa},
+                {"delta_m", got.navigability.delta_m, want.navigability.delta_m},
+                {"eps_m", got.navigability.eps_m, want.navigability.eps_m},
                 {"max_step_m", got.max_step_m, want.max_step_m},
                 {"max_deposit_m3", got.max_deposit_m3, want.max_deposit_m3},
                 {"material_capacity_m3", got.material_capacity_m3, want.material_capacity_m3},
@@ -32,20 +27,20 @@ std::string body_difference(const bus::BodyParams& got, const bus::BodyParams& w
                 {"proximity_range_m", got.proximity_range_m, want.proximity_range_m},
                 {"cube_size_m", got.cube_size_m, want.cube_size_m}};
   for (const auto& f : fields)
-    if (!(f.got == f.want)) return std::string(f.name) + " " + format(f.got) + " != " + format(f.want);
+    if (!(f.got == f.want)) return std::string(f.name) + " " + fmt::format("{}", f.got) + " != " + fmt::format("{}", f.want);
   return {};
 }
 
 }  // namespace
 
-AdmissionDecision decide_admission(const WorldState& state, const bus::AgentHello& hello, bool run_started) {
+AdmissionDecision decide_admission(const WorldState& state, const protocol::AgentHello& hello, bool run_started) {
   const auto refuse = [](std::string reason) { return AdmissionDecision{false, std::move(reason)}; };
   const std::string who = "agent " + std::to_string(hello.agent_id);
   if (!state.has_agent(hello.agent_id))
     return refuse("unknown agent id " + std::to_string(hello.agent_id) + ": this run has agents 1.." +
                   std::to_string(state.agents.size()));
   const AgentRecord& slot = state.agent(hello.agent_id);
-  const std::string problem = scenario::body_problem(hello.body);
+  const std::string problem = body_problem(hello.body);
   if (!problem.empty()) return refuse(who + ": invalid body: " + problem);
   const std::string difference = body_difference(hello.body, slot.body);
   if (!difference.empty())
@@ -59,7 +54,7 @@ AdmissionDecision decide_admission(const WorldState& state, const bus::AgentHell
   return {true, {}};
 }
 
-bool admit(WorldState& state, const bus::AgentHello& hello) {
+bool admit(WorldState& state, const protocol::AgentHello& hello) {
   AgentRecord& a = state.agent(hello.agent_id);
   if (a.admitted) return false;
   a.admitted = true;
@@ -74,15 +69,15 @@ bool admit(WorldState& state, const bus::AgentHello& hello) {
   return true;
 }
 
-bus::Admission admission_message(const WorldState& state, const bus::AgentHello& hello,
+protocol::Admission admission_message(const WorldState& state, const protocol::AgentHello& hello,
                                  const AdmissionDecision& decision, const std::string& run_id) {
-  bus::Admission m;
+  protocol::Admission m;
   m.agent_id = hello.agent_id;
   m.session = hello.session;
   m.accepted = decision.accepted;
   m.reason = decision.reason;
   m.run_id = run_id;
-  const grid::GridGeometry& g = state.terrain.geometry();
+  const GridGeometry& g = state.terrain.geometry();
   m.rows = g.rows;
   m.cols = g.cols;
   m.xll_m = g.xll_m;

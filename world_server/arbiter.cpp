@@ -1,13 +1,14 @@
-#include "world_server/arbiter.hpp"
+#include "marsala/world_server/arbiter.hpp"
+#include "marsala/core/format.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <utility>
 
-#include "common/error.hpp"
-#include "common/grid/iterators.hpp"
-#include "common/processing/navigability_processor.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/iterators.hpp"
+#include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -17,20 +18,12 @@ namespace tol = arbiter_tolerance;
 // Balls above this many cells are checked by the processor on a window: the pair check is quadratic.
 constexpr std::size_t kMaxPairBallCells = 2000;
 
-std::string format(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
-
-std::string cell_text(CellIndex c) { return "(" + std::to_string(c.row) + ", " + std::to_string(c.col) + ")"; }
-
 double distance(double ax, double ay, double bx, double by) {
   const double dx = ax - bx, dy = ay - by;
   return std::sqrt(dx * dx + dy * dy);
 }
 
-bool occupiable_by_pairs(const grid::Heightmap& h, CellIndex cell, const NavigabilityParams& p,
+bool occupiable_by_pairs(const Heightmap& h, CellIndex cell, const NavigabilityParams& p,
                          const std::vector<CellIndex>& offsets) {
   struct BallCell {
     int dr, dc;
@@ -54,15 +47,15 @@ bool occupiable_by_pairs(const grid::Heightmap& h, CellIndex cell, const Navigab
   return true;
 }
 
-bool occupiable_by_window(const grid::Heightmap& h, CellIndex cell, const NavigabilityParams& p,
+bool occupiable_by_window(const Heightmap& h, CellIndex cell, const NavigabilityParams& p,
                           const std::vector<CellIndex>& offsets) {
   int reach = 0;
   for (const CellIndex& o : offsets) reach = std::max({reach, std::abs(o.row), std::abs(o.col)});
   const int r0 = std::max(0, cell.row - reach), c0 = std::max(0, cell.col - reach);
   const int r1 = std::min(h.rows() - 1, cell.row + reach), c1 = std::min(h.cols() - 1, cell.col + reach);
   // The ball of `cell` lies inside the window, so the window's edges clip nothing the definition keeps.
-  const grid::Heightmap window = h.window({r0, c0}, r1 - r0 + 1, c1 - c0 + 1);
-  return processing::NavigabilityProcessor(p).occupiable(window)(cell.row - r0, cell.col - c0) != 0;
+  const Heightmap window = h.window({r0, c0}, r1 - r0 + 1, c1 - c0 + 1);
+  return NavigabilityProcessor(p).occupiable(window)(cell.row - r0, cell.col - c0) != 0;
 }
 
 }  // namespace
@@ -71,19 +64,19 @@ double cube_layer_m(double cube_size_m, double cell_size_m) {
   return cube_size_m * cube_size_m * cube_size_m / (cell_size_m * cell_size_m);
 }
 
-bool cell_occupiable(const grid::Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
+bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
                      OccupancyMethod method) {
   if (!terrain.contains(cell))
-    throw InvalidArgument("cell_occupiable: cell " + cell_text(cell) + " is off the " +
+    throw InvalidArgument("cell_occupiable: cell " + fmt::format("{}", cell) + " is off the " +
                           std::to_string(terrain.rows()) + " x " + std::to_string(terrain.cols()) + " grid");
-  const std::vector<CellIndex> offsets = grid::disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m()));
+  const std::vector<CellIndex> offsets = disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m()));
   if (method == OccupancyMethod::kAutomatic)
     method = offsets.size() <= kMaxPairBallCells ? OccupancyMethod::kPairs : OccupancyMethod::kWindow;
   return method == OccupancyMethod::kPairs ? occupiable_by_pairs(terrain, cell, params, offsets)
                                            : occupiable_by_window(terrain, cell, params, offsets);
 }
 
-Verdict validate_request(const WorldState& state, std::uint32_t channel_id, const bus::ActionRequest& r) {
+Verdict validate_request(const WorldState& state, std::uint32_t channel_id, const protocol::ActionRequest& r) {
   const auto reject = [](std::string reason) { return Verdict{false, std::move(reason), 0.0}; };
 
   // 1. Envelope.
@@ -100,10 +93,10 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
                   std::to_string(state.step));
   const auto sane = [](double v) { return std::isfinite(v) && std::abs(v) < 1e6; };
   if (!sane(r.target_x_m) || !sane(r.target_y_m))
-    return reject("target (" + format(r.target_x_m) + ", " + format(r.target_y_m) + ") is not finite or too large");
-  for (const bus::Deposition& d : r.depositions)
-    if (!sane(d.height_m)) return reject("deposition height " + format(d.height_m) + " m is not finite or too large");
-  const grid::Heightmap& terrain = state.terrain;
+    return reject("target (" + fmt::format("{}", r.target_x_m) + ", " + fmt::format("{}", r.target_y_m) + ") is not finite or too large");
+  for (const protocol::Deposition& d : r.depositions)
+    if (!sane(d.height_m)) return reject("deposition height " + fmt::format("{}", d.height_m) + " m is not finite or too large");
+  const Heightmap& terrain = state.terrain;
   if (static_cast<long long>(r.depositions.size()) > terrain.size())
     return reject(std::to_string(r.depositions.size()) + " depositions exceed the grid's cells");
 
@@ -112,12 +105,12 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
   if (r.move) {
     const double d = distance(r.target_x_m, r.target_y_m, x, y);
     if (!(d <= me.body.max_step_m + tol::kLengthM))
-      return reject("motion of " + format(d) + " m exceeds max_step_m " + format(me.body.max_step_m));
+      return reject("motion of " + fmt::format("{}", d) + " m exceeds max_step_m " + fmt::format("{}", me.body.max_step_m));
     const auto cell = terrain.cell_at({r.target_x_m, r.target_y_m});
     if (!cell)
-      return reject("target (" + format(r.target_x_m) + ", " + format(r.target_y_m) + ") is off the grid");
-    if (!cell_occupiable(terrain, *cell, {me.body.kappa, me.body.delta_m, me.body.eps_m}))
-      return reject("target cell " + cell_text(*cell) + " is not occupiable for this body");
+      return reject("target (" + fmt::format("{}", r.target_x_m) + ", " + fmt::format("{}", r.target_y_m) + ") is off the grid");
+    if (!cell_occupiable(terrain, *cell, {me.body.navigability.kappa, me.body.navigability.delta_m, me.body.navigability.eps_m}))
+      return reject("target cell " + fmt::format("{}", *cell) + " is not occupiable for this body");
     x = r.target_x_m;
     y = r.target_y_m;
   }
@@ -128,53 +121,53 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
   std::vector<std::pair<int, int>> cells;
   cells.reserve(r.depositions.size());
   double volume = 0.0;
-  for (const bus::Deposition& d : r.depositions) {
+  for (const protocol::Deposition& d : r.depositions) {
     const CellIndex c{d.row, d.col};
-    if (!terrain.contains(c)) return reject("deposition cell " + cell_text(c) + " is off the grid");
+    if (!terrain.contains(c)) return reject("deposition cell " + fmt::format("{}", c) + " is off the grid");
     cells.emplace_back(d.row, d.col);
     if (!(d.height_m > 0.0 && d.height_m <= tol::kMaxDepositionM + tol::kLengthM))
-      return reject("deposition height " + format(d.height_m) + " m at " + cell_text(c) + " is not in (0, 1] m");
+      return reject("deposition height " + fmt::format("{}", d.height_m) + " m at " + fmt::format("{}", c) + " is not in (0, 1] m");
     const double layers = d.height_m / layer;
     const double whole = std::round(layers);
     if (!(whole >= 1.0 && std::abs(layers - whole) <= tol::kCubeMultiple))
-      return reject("deposition height " + format(d.height_m) + " m at " + cell_text(c) +
-                    " is not a whole multiple of the cube layer " + format(layer) + " m");
+      return reject("deposition height " + fmt::format("{}", d.height_m) + " m at " + fmt::format("{}", c) +
+                    " is not a whole multiple of the cube layer " + fmt::format("{}", layer) + " m");
     const Position centre = terrain.cell_center(c);
     const double from_me = distance(centre.x, centre.y, x, y);
     if (!(from_me <= me.body.reach_m + tol::kLengthM))
-      return reject("deposition cell " + cell_text(c) + " is " + format(from_me) + " m away, beyond reach_m " +
-                    format(me.body.reach_m));
+      return reject("deposition cell " + fmt::format("{}", c) + " is " + fmt::format("{}", from_me) + " m away, beyond reach_m " +
+                    fmt::format("{}", me.body.reach_m));
     for (const AgentRecord& other : state.agents) {
       if (!other.alive) continue;
       const bool self = other.id == me.id;
       const double gap = distance(centre.x, centre.y, self ? x : other.x_m, self ? y : other.y_m);
-      if (gap <= 0.5 * other.body.delta_m + tol::kLengthM)
-        return reject("deposition cell " + cell_text(c) + " is under agent " + std::to_string(other.id));
+      if (gap <= 0.5 * other.body.navigability.delta_m + tol::kLengthM)
+        return reject("deposition cell " + fmt::format("{}", c) + " is under agent " + std::to_string(other.id));
     }
     volume += d.height_m * cs * cs;
   }
   std::sort(cells.begin(), cells.end());
   const auto twice = std::adjacent_find(cells.begin(), cells.end());
   if (twice != cells.end())
-    return reject("deposition cell " + cell_text({twice->first, twice->second}) + " is listed twice");
+    return reject("deposition cell " + fmt::format("{}", CellIndex{twice->first, twice->second}) + " is listed twice");
   if (!(volume <= me.body.max_deposit_m3 + tol::kVolumeM3))
-    return reject("deposited volume " + format(volume) + " m^3 exceeds max_deposit_m3 " +
-                  format(me.body.max_deposit_m3));
+    return reject("deposited volume " + fmt::format("{}", volume) + " m^3 exceeds max_deposit_m3 " +
+                  fmt::format("{}", me.body.max_deposit_m3));
   if (!(volume <= me.material_m3 + tol::kVolumeM3))
-    return reject("deposited volume " + format(volume) + " m^3 exceeds the material on board " +
-                  format(me.material_m3) + " m^3");
+    return reject("deposited volume " + fmt::format("{}", volume) + " m^3 exceeds the material on board " +
+                  fmt::format("{}", me.material_m3) + " m^3");
 
   // 4. Refill.
   if (r.refill) {
     const double to_base = distance(x, y, state.base.x_m, state.base.y_m);
     if (!(to_base <= state.base.radius_m + tol::kLengthM))
-      return reject("refill requested " + format(to_base) + " m from the base station (radius " +
-                    format(state.base.radius_m) + " m)");
+      return reject("refill requested " + fmt::format("{}", to_base) + " m from the base station (radius " +
+                    fmt::format("{}", state.base.radius_m) + " m)");
   }
   return Verdict{true, {}, volume};
 }
 
-void apply_request(WorldState& state, const bus::ActionRequest& r, const Verdict& verdict,
+void apply_request(WorldState& state, const protocol::ActionRequest& r, const Verdict& verdict,
                    std::vector<CellIndex>& changed_cells) {
   AgentRecord& me = state.agent(r.agent_id);
   if (r.move) {
@@ -184,7 +177,7 @@ void apply_request(WorldState& state, const bus::ActionRequest& r, const Verdict
   if (!r.depositions.empty() &&
       (state.depositor.rows() != state.terrain.rows() || state.depositor.cols() != state.terrain.cols()))
     state.depositor = AgentIdGrid::Zero(state.terrain.rows(), state.terrain.cols());  // a state not made by make_world_state
-  for (const bus::Deposition& d : r.depositions) {
+  for (const protocol::Deposition& d : r.depositions) {
     state.terrain(d.row, d.col) += d.height_m;
     state.depositor(d.row, d.col) = r.agent_id;
     changed_cells.push_back({d.row, d.col});

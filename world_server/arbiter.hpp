@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "common/bus/messages.hpp"
-#include "common/grid/heightmap.hpp"
-#include "common/types.hpp"
-#include "world_server/world_state.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/types.hpp"
+#include "marsala/world_server/world_state.hpp"
 
 namespace marsala::world_server {
 
@@ -31,7 +31,7 @@ enum class OccupancyMethod {
 /// True when on-grid `cell` is occupiable for `params` on `terrain`: every pair of cells within delta/2 of its centre
 /// (cells off the grid ignored) has |h(r) - h(q)| <= eps + kappa |r - q| + 1e-9 m. Throws InvalidArgument when the
 /// cell is off the grid.
-bool cell_occupiable(const grid::Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
+bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
                      OccupancyMethod method = OccupancyMethod::kAutomatic);
 
 /// The arbiter's answer to one request.
@@ -44,11 +44,11 @@ struct Verdict {
 /// Validates `request`, which arrived on the partition of agent `channel_id`, against `state` (runtime_spec.md rules
 /// 1-4: envelope, motion, depositions after the motion, refill). Duplicates and requests for other steps are
 /// apply_step's business; here a step other than state.step is a rejection.
-Verdict validate_request(const WorldState& state, std::uint32_t channel_id, const bus::ActionRequest& request);
+Verdict validate_request(const WorldState& state, std::uint32_t channel_id, const protocol::ActionRequest& request);
 
 /// Applies a request validate_request accepted: position = target, depositions (each raised cell's depositor becomes
 /// the request's agent), material, refill, counts. Appends the changed cells to `changed_cells`.
-void apply_request(WorldState& state, const bus::ActionRequest& request, const Verdict& verdict,
+void apply_request(WorldState& state, const protocol::ActionRequest& request, const Verdict& verdict,
                    std::vector<CellIndex>& changed_cells);
 
 /// Thickness of one layer of cubes on a cell: cube_size^3 / cell_size^2 [m].

@@ -1,4 +1,5 @@
-#include "world_server/completion.hpp"
+#include "marsala/world_server/completion.hpp"
+#include "marsala/core/format.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,41 +10,35 @@
 #include <string>
 #include <utility>
 
-#include "common/error.hpp"
-#include "common/processing/navigability_processor.hpp"
-#include "world_server/arbiter.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/navigability_processor.hpp"
+#include "marsala/world_server/arbiter.hpp"
 
 namespace marsala::world_server {
 namespace {
 
 constexpr double kSqrt2 = 1.41421356237309504880;
 
-std::string format(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
-
-CellIndex cell_of(const grid::Heightmap& terrain, double x_m, double y_m, const char* what) {
+CellIndex cell_of(const Heightmap& terrain, double x_m, double y_m, const char* what) {
   const auto cell = terrain.cell_at({x_m, y_m});
   if (!cell)
-    throw InvalidArgument(std::string(what) + " (" + format(x_m) + ", " + format(y_m) + ") is off the " +
+    throw InvalidArgument(std::string(what) + " (" + fmt::format("{}", x_m) + ", " + fmt::format("{}", y_m) + ") is off the " +
                           std::to_string(terrain.rows()) + " x " + std::to_string(terrain.cols()) + " grid");
   return *cell;
 }
 
-CellRect site_rect_or_throw(const grid::Heightmap& terrain, const scenario::Site& site) {
+CellRect site_rect_or_throw(const Heightmap& terrain, const scenario::Site& site) {
   const CellRect rect = site_cells(terrain.geometry(), site);
   if (rect.empty())
-    throw InvalidArgument("site [" + format(site.x0_m) + ", " + format(site.x1_m) + "] x [" + format(site.y0_m) +
-                          ", " + format(site.y1_m) + "] holds no cell centre of the grid");
+    throw InvalidArgument("site [" + fmt::format("{}", site.x0_m) + ", " + fmt::format("{}", site.x1_m) + "] x [" + fmt::format("{}", site.y0_m) +
+                          ", " + fmt::format("{}", site.y1_m) + "] holds no cell centre of the grid");
   return rect;
 }
 
 NavigabilityParams payload_params(const scenario::PayloadPath& p) { return {p.kappa, p.delta_m, p.eps_m}; }
 NavigabilityParams site_params(const scenario::Site& s) { return {s.kappa, s.delta_m, s.eps_m}; }
 
-void check_on_mask(const grid::CellMask& mask, CellIndex c, const char* what) {
+void check_on_mask(const CellMask& mask, CellIndex c, const char* what) {
   if (c.row < 0 || c.col < 0 || c.row >= mask.rows() || c.col >= mask.cols())
     throw InvalidArgument(std::string(what) + " cell (" + std::to_string(c.row) + ", " + std::to_string(c.col) +
                           ") is off the " + std::to_string(mask.rows()) + " x " + std::to_string(mask.cols()) +
@@ -112,7 +107,7 @@ void evaluate_completion(WorldState& state) {
   if (state.completion == scenario::CompletionKind::kAgentsAtGoal) return;
   CompletionCheck& check = state.check;
   check.occupancy.update(state.terrain);
-  const grid::CellMask& mask = check.occupancy.occupiable();
+  const CellMask& mask = check.occupancy.occupiable();
   if (state.completion == scenario::CompletionKind::kPayloadPath) {
     check.met = connected(mask, check.from, check.to);
   } else {
@@ -123,7 +118,7 @@ void evaluate_completion(WorldState& state) {
   ++check.evaluations;
 }
 
-CellRect site_cells(const grid::GridGeometry& grid, const scenario::Site& site) {
+CellRect site_cells(const GridGeometry& grid, const scenario::Site& site) {
   constexpr double tol = arbiter_tolerance::kLengthM;
   // Scanning every row and column decides each centre exactly as the definition says, with no rounding shortcut.
   int r0 = grid.rows, r1 = -1, c0 = grid.cols, c1 = -1;
@@ -139,7 +134,7 @@ CellRect site_cells(const grid::GridGeometry& grid, const scenario::Site& site) 
   return {{r0, c0}, r1 - r0 + 1, c1 - c0 + 1};
 }
 
-long long largest_component(const grid::CellMask& mask) {
+long long largest_component(const CellMask& mask) {
   const int rows = static_cast<int>(mask.rows()), cols = static_cast<int>(mask.cols());
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(rows) * cols, 0);
   std::vector<int> stack;
@@ -168,31 +163,31 @@ long long largest_component(const grid::CellMask& mask) {
   return best;
 }
 
-bool connected(const grid::CellMask& passable, CellIndex from, CellIndex to) {
+bool connected(const CellMask& passable, CellIndex from, CellIndex to) {
   check_on_mask(passable, from, "connected: from");
   check_on_mask(passable, to, "connected: to");
-  return processing::NavigabilityProcessor::navigable_from(passable, from)(to.row, to.col) != 0;
+  return NavigabilityProcessor::navigable_from(passable, from)(to.row, to.col) != 0;
 }
 
-bool payload_path_navigable(const grid::Heightmap& terrain, const scenario::PayloadPath& path) {
+bool payload_path_navigable(const Heightmap& terrain, const scenario::PayloadPath& path) {
   const CellIndex from = cell_of(terrain, path.from_x_m, path.from_y_m, "payload_path.from");
   const CellIndex to = cell_of(terrain, path.to_x_m, path.to_y_m, "payload_path.to");
-  return connected(processing::NavigabilityProcessor(payload_params(path)).occupiable(terrain), from, to);
+  return connected(NavigabilityProcessor(payload_params(path)).occupiable(terrain), from, to);
 }
 
-double site_level_fraction(const grid::Heightmap& terrain, const scenario::Site& site) {
+double site_level_fraction(const Heightmap& terrain, const scenario::Site& site) {
   const CellRect rect = site_rect_or_throw(terrain, site);
-  const grid::CellMask mask =
-      processing::NavigabilityProcessor(site_params(site)).occupiable(terrain.window(rect.first, rect.rows, rect.cols));
+  const CellMask mask =
+      NavigabilityProcessor(site_params(site)).occupiable(terrain.window(rect.first, rect.rows, rect.cols));
   return static_cast<double>(largest_component(mask)) / static_cast<double>(rect.size());
 }
 
-std::optional<PayloadRoute> shortest_path(const grid::CellMask& passable, CellIndex from, CellIndex to,
+std::optional<PayloadRoute> shortest_path(const CellMask& passable, CellIndex from, CellIndex to,
                                           double cell_size_m) {
   check_on_mask(passable, from, "shortest_path: from");
   check_on_mask(passable, to, "shortest_path: to");
   if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m))
-    throw InvalidArgument("shortest_path: cell size " + format(cell_size_m) + " m must be finite and > 0");
+    throw InvalidArgument("shortest_path: cell size " + fmt::format("{}", cell_size_m) + " m must be finite and > 0");
   if (passable(from.row, from.col) == 0 || passable(to.row, to.col) == 0) return std::nullopt;
   const int rows = static_cast<int>(passable.rows()), cols = static_cast<int>(passable.cols());
   const double side = cell_size_m, diagonal = cell_size_m * kSqrt2;
@@ -235,10 +230,10 @@ std::optional<PayloadRoute> shortest_path(const grid::CellMask& passable, CellIn
   return route;
 }
 
-std::optional<PayloadRoute> payload_path(const grid::Heightmap& terrain, const scenario::PayloadPath& path) {
+std::optional<PayloadRoute> payload_path(const Heightmap& terrain, const scenario::PayloadPath& path) {
   const CellIndex from = cell_of(terrain, path.from_x_m, path.from_y_m, "payload_path.from");
   const CellIndex to = cell_of(terrain, path.to_x_m, path.to_y_m, "payload_path.to");
-  return shortest_path(processing::NavigabilityProcessor(payload_params(path)).occupiable(terrain), from, to,
+  return shortest_path(NavigabilityProcessor(payload_params(path)).occupiable(terrain), from, to,
                        terrain.cell_size_m());
 }
 

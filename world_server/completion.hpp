@@ -12,10 +12,10 @@
 #include <optional>
 #include <vector>
 
-#include "common/grid/heightmap.hpp"
-#include "common/scenario/scenario.hpp"
-#include "common/types.hpp"
-#include "world_server/world_state.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/scenario/scenario.hpp"
+#include "marsala/core/types.hpp"
+#include "marsala/world_server/world_state.hpp"
 
 namespace marsala::world_server {
 
@@ -41,22 +41,22 @@ void start_completion_check(WorldState& state);
 void evaluate_completion(WorldState& state);
 
 /// The site's cells: those whose centres lie in [x0, x1] x [y0, y1] (closed, 1e-9 m tolerance); empty when none.
-CellRect site_cells(const grid::GridGeometry& grid, const scenario::Site& site);
+CellRect site_cells(const GridGeometry& grid, const scenario::Site& site);
 
 /// Size of the largest 8-connected component of the mask's 1-cells [cells]; 0 when there is none.
-long long largest_component(const grid::CellMask& mask);
+long long largest_component(const CellMask& mask);
 
 /// True when `to` is 8-connected to `from` through 1-cells of `passable` (both must be 1). Throws InvalidArgument
 /// when either is off the mask.
-bool connected(const grid::CellMask& passable, CellIndex from, CellIndex to);
+bool connected(const CellMask& passable, CellIndex from, CellIndex to);
 
 /// True when the payload has a navigable path on `terrain` (whole grid): the cell of `to` is navigable from the cell
 /// of `from` for the payload's kappa, delta_m, eps_m. Throws InvalidArgument when `from` or `to` is off the grid.
-bool payload_path_navigable(const grid::Heightmap& terrain, const scenario::PayloadPath& path);
+bool payload_path_navigable(const Heightmap& terrain, const scenario::PayloadPath& path);
 
 /// The site's level fraction on `terrain`: largest 8-connected component of the crop's occupiable cells (balls cut
 /// at the crop's edge) / cells of the crop, in [0, 1]. Throws InvalidArgument when the site holds no cell of the grid.
-double site_level_fraction(const grid::Heightmap& terrain, const scenario::Site& site);
+double site_level_fraction(const Heightmap& terrain, const scenario::Site& site);
 
 /// A path of cells and its length.
 struct PayloadRoute {
@@ -67,12 +67,12 @@ struct PayloadRoute {
 /// A shortest 8-connected path through 1-cells of `passable` from `from` to `to` (Euclidean step costs: cs or
 /// cs * sqrt 2; among equally short paths a deterministic one), or nullopt when there is none (either end
 /// blocked or disconnected). Throws InvalidArgument when an end is off the mask or cell_size_m is not > 0.
-std::optional<PayloadRoute> shortest_path(const grid::CellMask& passable, CellIndex from, CellIndex to,
+std::optional<PayloadRoute> shortest_path(const CellMask& passable, CellIndex from, CellIndex to,
                                           double cell_size_m);
 
 /// The payload's constructed path on `terrain`: a shortest path through cells occupiable for the payload (whole
 /// grid) from the cell of `from` to the cell of `to`, or nullopt when there is none. Throws InvalidArgument when
 /// `from` or `to` is off the grid.
-std::optional<PayloadRoute> payload_path(const grid::Heightmap& terrain, const scenario::PayloadPath& path);
+std::optional<PayloadRoute> payload_path(const Heightmap& terrain, const scenario::PayloadPath& path);
 
 }  // namespace marsala::world_server

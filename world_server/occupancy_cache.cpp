@@ -1,13 +1,13 @@
-#include "world_server/occupancy_cache.hpp"
+#include "marsala/world_server/occupancy_cache.hpp"
 
 #include <algorithm>
 #include <cstdlib>
 #include <limits>
 #include <string>
 
-#include "common/error.hpp"
-#include "common/grid/iterators.hpp"
-#include "common/processing/navigability_processor.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/iterators.hpp"
+#include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -18,16 +18,16 @@ constexpr int kMaxInt = std::numeric_limits<int>::max();
 
 const OccupancyCache::Box OccupancyCache::kNoChange{kMaxInt, kMaxInt, -1, -1};
 
-OccupancyCache::OccupancyCache(const grid::Heightmap& terrain, CellRect area, NavigabilityParams params)
+OccupancyCache::OccupancyCache(const Heightmap& terrain, CellRect area, NavigabilityParams params)
     : area_(area), params_(params) {
-  const processing::NavigabilityProcessor processor(params);  // throws for invalid parameters
+  const NavigabilityProcessor processor(params);  // throws for invalid parameters
   if (area.empty() || !terrain.contains(area.first) ||
       !terrain.contains({area.first.row + area.rows - 1, area.first.col + area.cols - 1}))
     throw InvalidArgument("OccupancyCache: area of " + std::to_string(area.rows) + " x " + std::to_string(area.cols) +
                           " cells at (" + std::to_string(area.first.row) + ", " + std::to_string(area.first.col) +
                           ") is empty or leaves the " + std::to_string(terrain.rows()) + " x " +
                           std::to_string(terrain.cols()) + " grid");
-  for (const CellIndex& o : grid::disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m())))
+  for (const CellIndex& o : disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m())))
     reach_ = std::max({reach_, std::abs(o.row), std::abs(o.col)});
   block_rows_ = (area.rows + kBlockCells - 1) / kBlockCells;
   block_cols_ = (area.cols + kBlockCells - 1) / kBlockCells;
@@ -43,19 +43,19 @@ void OccupancyCache::mark_changed(CellIndex cell) {
   has_changes_ = true;
 }
 
-void OccupancyCache::recompute(const grid::Heightmap& terrain, const CellRect& t) {
+void OccupancyCache::recompute(const Heightmap& terrain, const CellRect& t) {
   // The window holds every cell of T's balls that the area holds (see the header).
   const int r0 = std::max(0, t.first.row - reach_), c0 = std::max(0, t.first.col - reach_);
   const int r1 = std::min(area_.rows, t.first.row + t.rows + reach_);
   const int c1 = std::min(area_.cols, t.first.col + t.cols + reach_);
-  const grid::Heightmap window =
+  const Heightmap window =
       terrain.window({area_.first.row + r0, area_.first.col + c0}, r1 - r0, c1 - c0);
-  const grid::CellMask part = processing::NavigabilityProcessor(params_).occupiable(window);
+  const CellMask part = NavigabilityProcessor(params_).occupiable(window);
   mask_.block(t.first.row, t.first.col, t.rows, t.cols) =
       part.block(t.first.row - r0, t.first.col - c0, t.rows, t.cols);
 }
 
-long long OccupancyCache::update(const grid::Heightmap& terrain) {
+long long OccupancyCache::update(const Heightmap& terrain) {
   if (!has_changes_) return 0;
   if (!terrain.contains({area_.first.row + area_.rows - 1, area_.first.col + area_.cols - 1}))
     throw InvalidArgument("OccupancyCache::update: the " + std::to_string(terrain.rows()) + " x " +

@@ -3,7 +3,7 @@
 // to date incrementally between completion checks. Pure data and computation: no IO, no threads.
 //
 // Why a windowed update gives the whole computation's answer: a cell's occupiability reads only the heights of the
-// cells in its ball B (radius delta / 2, reach R = max |dr|, |dc| of grid::disc_offsets), cut at the area's edge. So
+// cells in its ball B (radius delta / 2, reach R = max |dr|, |dc| of disc_offsets), cut at the area's edge. So
 // after cells change, only cells within R (Chebyshev) of a changed cell can change, and recomputing a rectangle T of
 // cells on the window W = (T dilated by R) clipped to the area sees, for every cell of T, exactly the ball it has in
 // the area (W's edges cut nothing the area keeps). Changes are recorded as the bounding box of the changed cells of
@@ -23,8 +23,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "common/grid/heightmap.hpp"
-#include "common/types.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/types.hpp"
 
 namespace marsala::world_server {
 
@@ -51,7 +51,7 @@ class OccupancyCache {
   OccupancyCache() = default;
   /// Computes the mask of `area` of `terrain` for `params` (NavigabilityProcessor on the area). Throws
   /// InvalidArgument when the area is empty or leaves the grid, or the parameters are invalid.
-  OccupancyCache(const grid::Heightmap& terrain, CellRect area, NavigabilityParams params);
+  OccupancyCache(const Heightmap& terrain, CellRect area, NavigabilityParams params);
 
   /// Records that terrain cell `cell` (grid coordinates) changed; cells outside the area change nothing in it.
   void mark_changed(CellIndex cell);
@@ -59,17 +59,17 @@ class OccupancyCache {
   bool has_changes() const { return has_changes_; }
   /// Brings the mask up to date with `terrain` (the grid it was built on), recomputing only the cells the recorded
   /// changes can affect; returns how many cells were recomputed (0 without changes).
-  long long update(const grid::Heightmap& terrain);
+  long long update(const Heightmap& terrain);
 
   /// 1 where the area's cell is occupiable; element (r, c) is grid cell (area.first.row + r, area.first.col + c).
-  const grid::CellMask& occupiable() const { return mask_; }
+  const CellMask& occupiable() const { return mask_; }
   const CellRect& area() const { return area_; }
   const NavigabilityParams& params() const { return params_; }
   /// Chebyshev reach of the ball [cells].
   int reach() const { return reach_; }
 
  private:
-  void recompute(const grid::Heightmap& terrain, const CellRect& target);
+  void recompute(const Heightmap& terrain, const CellRect& target);
 
   CellRect area_;
   NavigabilityParams params_;
@@ -84,7 +84,7 @@ class OccupancyCache {
   static const Box kNoChange;
   std::vector<Box> changed_;
   bool has_changes_ = false;
-  grid::CellMask mask_;
+  CellMask mask_;
 };
 
 }  // namespace marsala::world_server

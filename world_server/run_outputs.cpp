@@ -1,4 +1,4 @@
-#include "world_server/run_outputs.hpp"
+#include "marsala/world_server/run_outputs.hpp"
 
 #include <google/protobuf/util/json_util.h>
 
@@ -8,12 +8,12 @@
 #include <filesystem>
 #include <limits>
 
-#include "common/error.hpp"
-#include "common/render/png_writer.hpp"
-#include "common/render/terrain_renderer.hpp"
-#include "common/terrain/asc_io.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/render/png_writer.hpp"
+#include "marsala/render/terrain_renderer.hpp"
+#include "marsala/terrain/asc_io.hpp"
 #include "idl/run_summary.pb.h"
-#include "world_server/sha256.hpp"
+#include "marsala/world_server/sha256.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -75,7 +75,7 @@ struct WorldBox {
     y0 = std::min({y0, ya, yb});
     y1 = std::max({y1, ya, yb});
   }
-  void add(const grid::GridGeometry& g, CellIndex c) {
+  void add(const GridGeometry& g, CellIndex c) {
     const Position p = g.cell_center(c);
     const double half = 0.5 * g.cell_size_m;
     add(p.x - half, p.y - half, p.x + half, p.y + half);
@@ -154,7 +154,7 @@ std::string summary_json(const WorldState& state, const RunInfo& info) {
 }
 
 std::optional<CellRect> zoom_window(const WorldState& state, const std::optional<PayloadRoute>& route) {
-  const grid::GridGeometry& g = state.terrain.geometry();
+  const GridGeometry& g = state.terrain.geometry();
   if (g.size() <= 0) return std::nullopt;
   WorldBox box;
   if (state.depositor.rows() == g.rows && state.depositor.cols() == g.cols)
@@ -197,7 +197,7 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
                                             const std::optional<PayloadRoute>& route,
                                             const std::optional<CellRect>& window) {
   render::RenderOptions o;
-  const grid::Heightmap& t = state.terrain;
+  const Heightmap& t = state.terrain;
   const CellRect area = window ? *window : CellRect{{0, 0}, t.rows(), t.cols()};
   const CellIndex last{area.first.row + area.rows - 1, area.first.col + area.cols - 1};
   if (area.empty() || !t.contains(area.first) || !t.contains(last))
@@ -277,21 +277,21 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
 }
 
 render::RenderOptions goal_vector_map_picture_options(const WorldState& state, const RunInfo& info,
-                                                      const processing::GoalVectorMap& map) {
+                                                      const GoalVectorMap& map) {
   render::RenderOptions o;
-  const processing::GoalVectorMapSpec& spec = map.spec();
+  const GoalVectorMapSpec& spec = map.spec();
   o.rectangles.push_back({{spec.x0_m, spec.y0_m}, {spec.x1_m, spec.y1_m}, kWhite, 0.0});
   if (state.completion == scenario::CompletionKind::kLevelSite)
     o.rectangles.push_back({{state.site.x0_m, state.site.y0_m}, {state.site.x1_m, state.site.y1_m}, kWhite, 0.0});
-  for (const processing::GoalArrow& a : map.arrows()) o.arrows.push_back({a.tail, a.head, kArrowRed, 0.0});
+  for (const GoalArrow& a : map.arrows()) o.arrows.push_back({a.tail, a.head, kArrowRed, 0.0});
   o.legend_entries.push_back({"tail -> head", kArrowRed, render::LegendSwatch::kArrow});
   o.legend_entries.push_back({"site", kWhite, render::LegendSwatch::kOutline});
   o.title = info.scenario + ": goal vector map, " + std::to_string(map.arrows().size()) + " arrows in " +
-            std::to_string(map.strips()) + " strips, heading " + processing::to_string(spec.heading);
+            std::to_string(map.strips()) + " strips, heading " + to_string(spec.heading);
   return o;
 }
 
-void write_initial_outputs(const std::string& dir, const grid::Heightmap& terrain) {
+void write_initial_outputs(const std::string& dir, const Heightmap& terrain) {
   make_dir(dir);
   terrain::write_asc(terrain, path_in(dir, "terrain_initial.asc"));
 }
@@ -315,17 +315,17 @@ void write_final_outputs(const std::string& dir, const WorldState& state, const 
   if (!out) throw IoError("cannot write '" + path + "'");
 
   if (info.goal_vector_map) {
-    const grid::Heightmap& initial = info.initial_terrain.size() > 0 ? info.initial_terrain : state.terrain;
-    const processing::GoalVectorMap map(*info.goal_vector_map, initial.geometry());
+    const Heightmap& initial = info.initial_terrain.size() > 0 ? info.initial_terrain : state.terrain;
+    const GoalVectorMap map(*info.goal_vector_map, initial.geometry());
     render::write_png(render::render_terrain(initial, goal_vector_map_picture_options(state, info, map)),
                       path_in(dir, "goal_vector_map.png"));
   }
 }
 
-std::string format_event(const bus::WorldEvent& e) {
+std::string format_event(const protocol::WorldEvent& e) {
   std::string line = "step " + std::to_string(e.step) + " agent " + std::to_string(e.agent_id) + " " +
-                     bus::to_string(e.kind);
-  if (e.kind == bus::EventKind::kDeposited) {
+                     protocol::to_string(e.kind);
+  if (e.kind == protocol::EventKind::kDeposited) {
     char buf[40];
     std::snprintf(buf, sizeof buf, " %.9g m3", e.volume_m3);
     line += buf;
@@ -340,7 +340,7 @@ EventLog::EventLog(const std::string& path) : path_(path) {
   if (!out_) throw IoError("cannot write '" + path + "'");
 }
 
-void EventLog::append(const bus::WorldEvent& event) { out_ << format_event(event) << std::endl; }
+void EventLog::append(const protocol::WorldEvent& event) { out_ << format_event(event) << std::endl; }
 
 void EventLog::note(std::uint64_t step, const std::string& text) {
   out_ << "step " << step << " note: " << text << std::endl;

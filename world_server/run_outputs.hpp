@@ -19,13 +19,13 @@
 #include <optional>
 #include <string>
 
-#include "common/bus/messages.hpp"
-#include "common/grid/heightmap.hpp"
-#include "common/processing/goal_vector_map.hpp"
-#include "common/render/terrain_renderer.hpp"
-#include "world_server/completion.hpp"
-#include "world_server/occupancy_cache.hpp"
-#include "world_server/world_state.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/goal_vector_map.hpp"
+#include "marsala/render/terrain_renderer.hpp"
+#include "marsala/world_server/completion.hpp"
+#include "marsala/world_server/occupancy_cache.hpp"
+#include "marsala/world_server/world_state.hpp"
 
 namespace marsala::world_server {
 
@@ -43,8 +43,8 @@ struct RunInfo {
   double step_wall_p90_ms = 0.0;     ///< its 90th percentile [ms]
   double start_jitter_m = 0.0;       ///< the scenario's start jitter [m]
   /// The scenario's goal vector map, drawn into goal_vector_map.png when set.
-  std::optional<processing::GoalVectorMapSpec> goal_vector_map;
-  grid::Heightmap initial_terrain;   ///< the terrain before the run (for goal_vector_map.png); empty = use the final
+  std::optional<GoalVectorMapSpec> goal_vector_map;
+  Heightmap initial_terrain;   ///< the terrain before the run (for goal_vector_map.png); empty = use the final
 };
 
 /// summary.json's text: every field present (zeros included); steps = state.step; terrain_sha256 of state.terrain;
@@ -53,7 +53,7 @@ struct RunInfo {
 std::string summary_json(const WorldState& state, const RunInfo& info);
 
 /// Writes terrain_initial.asc into `dir` (created when missing); throws IoError.
-void write_initial_outputs(const std::string& dir, const grid::Heightmap& terrain);
+void write_initial_outputs(const std::string& dir, const Heightmap& terrain);
 
 /// The close-up of final_zoom.png, in whole cells of state.terrain: the bounding box of every cell a deposition raised
 /// (state.depositor > 0), the route's cells, payload_path's `from` and `to`, level_site's site and the base station's
@@ -72,10 +72,10 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
                                             const std::optional<PayloadRoute>& route,
                                             const std::optional<CellRect>& window = std::nullopt);
 
-/// The options of goal_vector_map.png: the arrows of processing::GoalVectorMap(spec, grid).arrows() in red, the
+/// The options of goal_vector_map.png: the arrows of GoalVectorMap(spec, grid).arrows() in red, the
 /// map's rectangle (and a level_site's site) outlined in white, a title with the arrow count.
 render::RenderOptions goal_vector_map_picture_options(const WorldState& state, const RunInfo& info,
-                                                      const processing::GoalVectorMap& map);
+                                                      const GoalVectorMap& map);
 
 /// Writes summary.json, terrain_final.asc, final.png, final_zoom.png when zoom_window() gives a window and, when
 /// info.goal_vector_map is set, goal_vector_map.png (on info.initial_terrain, or the final terrain when that is empty)
@@ -85,14 +85,14 @@ render::RenderOptions goal_vector_map_picture_options(const WorldState& state, c
 void write_final_outputs(const std::string& dir, const WorldState& state, const RunInfo& info);
 
 /// One event as a log line: "step 12 agent 2 deposited 0.000125 m3: 1 cells".
-std::string format_event(const bus::WorldEvent& event);
+std::string format_event(const protocol::WorldEvent& event);
 
 /// events.log: appends one line per event or note, flushed at once so that a crash keeps what happened.
 class EventLog {
  public:
   /// Creates (truncates) the file; throws IoError.
   explicit EventLog(const std::string& path);
-  void append(const bus::WorldEvent& event);
+  void append(const protocol::WorldEvent& event);
   /// A line that is not an event, e.g. "step 7 note: agent 2: request for past step 5 dropped".
   void note(std::uint64_t step, const std::string& text);
 

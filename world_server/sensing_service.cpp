@@ -1,9 +1,9 @@
-#include "world_server/sensing_service.hpp"
+#include "marsala/world_server/sensing_service.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "world_server/arbiter.hpp"
+#include "marsala/world_server/arbiter.hpp"
 
 namespace marsala::world_server {
 
@@ -15,9 +15,9 @@ void SensingService::forget(std::uint32_t id) {
   if (id >= 1 && id <= seen_.size()) std::fill(seen_[id - 1].begin(), seen_[id - 1].end(), kNever);
 }
 
-bus::SensorFrame SensingService::frame_for(const WorldState& state, std::uint32_t id, bool run_over) {
+protocol::SensorFrame SensingService::frame_for(const WorldState& state, std::uint32_t id, bool run_over) {
   const AgentRecord& me = state.agent(id);
-  bus::SensorFrame f;
+  protocol::SensorFrame f;
   f.agent_id = id;
   f.step = state.step;
   f.x_m = me.x_m;
@@ -29,13 +29,13 @@ bus::SensorFrame SensingService::frame_for(const WorldState& state, std::uint32_
   f.run_over = run_over;
 
   std::vector<std::uint64_t>& seen = seen_[id - 1];
-  const grid::Heightmap& terrain = state.terrain;
+  const Heightmap& terrain = state.terrain;
   for (int index : layout_.tiles_in_square({me.x_m, me.y_m}, me.body.sensing_range_m)) {
     const std::uint64_t version = state.tile_versions[static_cast<std::size_t>(index)];
     if (seen[static_cast<std::size_t>(index)] == version) continue;
     seen[static_cast<std::size_t>(index)] = version;
     const Tile t = layout_.tile(index);
-    bus::TerrainTile tile;
+    protocol::TerrainTile tile;
     tile.tile_row = t.tile_row;
     tile.tile_col = t.tile_col;
     tile.rows = t.rows;

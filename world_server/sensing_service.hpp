@@ -7,8 +7,8 @@
 #include <limits>
 #include <vector>
 
-#include "common/bus/messages.hpp"
-#include "world_server/world_state.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/world_server/world_state.hpp"
 
 namespace marsala::world_server {
 
@@ -21,7 +21,7 @@ class SensingService {
   /// The frame of agent `id` for state.step: pose, material, last result and reason, the tiles in range it has not
   /// seen in their current version (ascending tile index), neighbours within proximity_range_m (2D, +1e-9 m,
   /// ascending id), and `run_over`. Marks the sent tiles as seen. Throws InvalidArgument for an unknown id.
-  bus::SensorFrame frame_for(const WorldState& state, std::uint32_t id, bool run_over = false);
+  protocol::SensorFrame frame_for(const WorldState& state, std::uint32_t id, bool run_over = false);
 
   /// Forgets what agent `id` has seen, so its next frame carries every tile in range again.
   void forget(std::uint32_t id);

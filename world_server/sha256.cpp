@@ -1,4 +1,4 @@
-#include "world_server/sha256.hpp"
+#include "marsala/world_server/sha256.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -109,7 +109,7 @@ std::string sha256_hex(const void* data, std::size_t size) {
   return to_hex(hash.finish());
 }
 
-std::string terrain_sha256(const grid::Heightmap& terrain) {
+std::string terrain_sha256(const Heightmap& terrain) {
   Sha256 hash;
   std::uint8_t bytes[4096];
   std::size_t used = 0;

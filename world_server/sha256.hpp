@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string>
 
-#include "common/grid/heightmap.hpp"
+#include "marsala/core/heightmap.hpp"
 
 namespace marsala::world_server {
 
@@ -35,6 +35,6 @@ std::string to_hex(const std::array<std::uint8_t, 32>& digest);
 std::string sha256_hex(const void* data, std::size_t size);
 
 /// Hex SHA-256 of the heights as little-endian IEEE doubles, row-major (row 0 first).
-std::string terrain_sha256(const grid::Heightmap& terrain);
+std::string terrain_sha256(const Heightmap& terrain);
 
 }  // namespace marsala::world_server

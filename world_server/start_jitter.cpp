@@ -1,15 +1,15 @@
-#include "world_server/start_jitter.hpp"
+#include "marsala/world_server/start_jitter.hpp"
 
 #include <cmath>
 #include <string>
 
-#include "common/error.hpp"
-#include "common/random.hpp"
-#include "world_server/arbiter.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/random.hpp"
+#include "marsala/world_server/arbiter.hpp"
 
 namespace marsala::world_server {
 
-Position jittered_start(const grid::Heightmap& terrain, const scenario::AgentSlot& slot, const bus::BodyParams& body,
+Position jittered_start(const Heightmap& terrain, const scenario::AgentSlot& slot, const RobotBody& body,
                         double jitter_m, std::uint64_t seed) {
   if (!(jitter_m >= 0.0) || !std::isfinite(jitter_m))
     throw InvalidArgument("start jitter of agent " + std::to_string(slot.id) + " must be finite and >= 0 m");
@@ -17,7 +17,7 @@ Position jittered_start(const grid::Heightmap& terrain, const scenario::AgentSlo
   if (jitter_m == 0.0) return start;
   // Streams of different agents start at unrelated points of the generator's cycle.
   random::Rng rng(random::mix64(random::mix64(seed) + slot.id));
-  const NavigabilityParams params{body.kappa, body.delta_m, body.eps_m};
+  const NavigabilityParams params{body.navigability.kappa, body.navigability.delta_m, body.navigability.eps_m};
   for (int draw = 0; draw < kMaxJitterDraws; ++draw) {
     double dx = 0.0, dy = 0.0;
     do {  // uniform in the unit disc: 4 / pi tries on average

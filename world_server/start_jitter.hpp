@@ -4,10 +4,10 @@
 
 #include <cstdint>
 
-#include "common/bus/messages.hpp"
-#include "common/grid/heightmap.hpp"
-#include "common/scenario/scenario.hpp"
-#include "common/types.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/scenario/scenario.hpp"
+#include "marsala/core/types.hpp"
 
 namespace marsala::world_server {
 
@@ -16,7 +16,7 @@ namespace marsala::world_server {
 /// every platform draws the same points. A draw is kept when its cell is on the grid and occupiable for `body`
 /// (cell_occupiable); after 64 rejected draws, or when jitter_m is 0, the slot's start. Throws InvalidArgument
 /// when jitter_m is negative or not finite.
-Position jittered_start(const grid::Heightmap& terrain, const scenario::AgentSlot& slot, const bus::BodyParams& body,
+Position jittered_start(const Heightmap& terrain, const scenario::AgentSlot& slot, const RobotBody& body,
                         double jitter_m, std::uint64_t seed);
 
 /// Draws per agent before falling back to the slot's start.

@@ -1,18 +1,18 @@
-#include "world_server/step.hpp"
+#include "marsala/world_server/step.hpp"
 
 #include <algorithm>
 
-#include "world_server/arbiter.hpp"
-#include "world_server/completion.hpp"
+#include "marsala/world_server/arbiter.hpp"
+#include "marsala/world_server/completion.hpp"
 
 namespace marsala::world_server {
 namespace {
 
 constexpr std::size_t kMaxStateChars = 64;  // behaviour state names are for display only
 
-bus::WorldEvent event(std::uint64_t step, std::uint32_t agent, bus::EventKind kind, std::string detail,
+protocol::WorldEvent event(std::uint64_t step, std::uint32_t agent, protocol::EventKind kind, std::string detail,
                       double volume_m3 = 0.0) {
-  bus::WorldEvent e;
+  protocol::WorldEvent e;
   e.step = step;
   e.agent_id = agent;
   e.kind = kind;
@@ -22,16 +22,16 @@ bus::WorldEvent event(std::uint64_t step, std::uint32_t agent, bus::EventKind ki
 }
 
 /// Applies the requests that arrived on one live agent's partition.
-void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const bus::ActionRequest*>& requests,
+void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const protocol::ActionRequest*>& requests,
                  std::vector<CellIndex>& changed_cells, StepOutcome& out, bool& deposited) {
   const std::uint64_t step = state.step;
   const std::string who = "agent " + std::to_string(agent.id);
   bool answered = false;
-  for (const bus::ActionRequest* r : requests) {
+  for (const protocol::ActionRequest* r : requests) {
     if (!carries_identity_of(agent, *r)) {
       ++agent.rejected;
       ++out.rejected;
-      out.events.push_back(event(step, agent.id, bus::EventKind::kRejected,
+      out.events.push_back(event(step, agent.id, protocol::EventKind::kRejected,
                                  "request claiming agent " + std::to_string(r->agent_id) + " session " +
                                      std::to_string(r->session) + " on agent " + std::to_string(agent.id) +
                                      "'s partition rejected: not its admitted identity"));
@@ -47,7 +47,7 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const 
                                                       " rejected; the first stands";
       ++agent.rejected;
       ++out.rejected;
-      out.events.push_back(event(step, agent.id, bus::EventKind::kRejected, reason));
+      out.events.push_back(event(step, agent.id, protocol::EventKind::kRejected, reason));
       continue;
     }
     answered = true;
@@ -56,18 +56,18 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const 
     if (verdict.accepted) {
       apply_request(state, *r, verdict, changed_cells);
       deposited = deposited || !r->depositions.empty();
-      agent.last_result = bus::ActionResult::kAccepted;
+      agent.last_result = protocol::ActionResult::kAccepted;
       agent.last_reason.clear();
       ++out.accepted;
       if (verdict.volume_m3 > 0.0)
-        out.events.push_back(event(step, agent.id, bus::EventKind::kDeposited,
+        out.events.push_back(event(step, agent.id, protocol::EventKind::kDeposited,
                                    std::to_string(r->depositions.size()) + " cells", verdict.volume_m3));
     } else {
-      agent.last_result = bus::ActionResult::kRejected;
+      agent.last_result = protocol::ActionResult::kRejected;
       agent.last_reason = verdict.reason;
       ++agent.rejected;
       ++out.rejected;
-      out.events.push_back(event(step, agent.id, bus::EventKind::kRejected, verdict.reason));
+      out.events.push_back(event(step, agent.id, protocol::EventKind::kRejected, verdict.reason));
     }
   }
   if (answered) {
@@ -77,9 +77,9 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const 
   ++agent.missed;
   ++agent.consecutive_missed;
   ++out.missed;
-  agent.last_result = bus::ActionResult::kMissed;
+  agent.last_result = protocol::ActionResult::kMissed;
   agent.last_reason = "no request for step " + std::to_string(step) + " before the deadline";
-  out.events.push_back(event(step, agent.id, bus::EventKind::kMissed, agent.last_reason));
+  out.events.push_back(event(step, agent.id, protocol::EventKind::kMissed, agent.last_reason));
   if (agent.consecutive_missed >= kMaxConsecutiveMisses) {
     out.events.push_back(drop_agent(state, agent.id,
                                     std::to_string(agent.consecutive_missed) + " consecutive missed deadlines"));
@@ -93,7 +93,7 @@ StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submiss
   StepOutcome out;
   out.step = state.step;
   // Per partition, in arrival order; partitions in id order. The order across partitions never matters.
-  std::vector<std::vector<const bus::ActionRequest*>> by_agent(state.agents.size());
+  std::vector<std::vector<const protocol::ActionRequest*>> by_agent(state.agents.size());
   for (const Submission& s : submissions) {
     if (!state.has_agent(s.channel_id) || !state.agent(s.channel_id).alive) {
       out.notes.push_back("request on the partition of agent " + std::to_string(s.channel_id) +
@@ -119,7 +119,7 @@ StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submiss
     agent.z_m = height_under(state.terrain, agent.x_m, agent.y_m);
     if (!agent.alive) continue;
     const bool reached = at_goal(state, agent);
-    if (reached && !agent.at_goal) out.events.push_back(event(state.step, agent.id, bus::EventKind::kAtGoal, ""));
+    if (reached && !agent.at_goal) out.events.push_back(event(state.step, agent.id, protocol::EventKind::kAtGoal, ""));
     agent.at_goal = reached;
   }
   if (state.completion != scenario::CompletionKind::kAgentsAtGoal) {
@@ -137,20 +137,20 @@ StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submiss
   return out;
 }
 
-StepOutcome apply_step(WorldState& state, const std::vector<bus::ActionRequest>& requests) {
+StepOutcome apply_step(WorldState& state, const std::vector<protocol::ActionRequest>& requests) {
   std::vector<Submission> submissions;
   submissions.reserve(requests.size());
-  for (const bus::ActionRequest& r : requests) submissions.push_back({r.agent_id, r});
+  for (const protocol::ActionRequest& r : requests) submissions.push_back({r.agent_id, r});
   return apply_step(state, submissions);
 }
 
-bus::WorldEvent drop_agent(WorldState& state, std::uint32_t id, const std::string& reason) {
+protocol::WorldEvent drop_agent(WorldState& state, std::uint32_t id, const std::string& reason) {
   AgentRecord& agent = state.agent(id);
   agent.alive = false;
   agent.dropped = true;
   agent.at_goal = false;
   agent.drop_reason = reason;
-  return event(state.step, id, bus::EventKind::kDropped, reason);
+  return event(state.step, id, protocol::EventKind::kDropped, reason);
 }
 
 }  // namespace marsala::world_server

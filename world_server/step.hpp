@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "common/bus/messages.hpp"
-#include "world_server/world_state.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/world_server/world_state.hpp"
 
 namespace marsala::world_server {
 
@@ -19,13 +19,13 @@ inline constexpr std::uint32_t kMaxConsecutiveMisses = 3;
 /// A request as it arrived: the agent whose partition carried it, and the request.
 struct Submission {
   std::uint32_t channel_id = 0;   ///< owner of the partition (reader) it came from
-  bus::ActionRequest request;
+  protocol::ActionRequest request;
 };
 
 /// What happened in one step.
 struct StepOutcome {
   std::uint64_t step = 0;                   ///< the step applied
-  std::vector<bus::WorldEvent> events;      ///< in agent-id order, as they happened
+  std::vector<protocol::WorldEvent> events;      ///< in agent-id order, as they happened
   std::vector<std::string> notes;           ///< things to log that are not events (late requests dropped)
   std::vector<int> changed_tiles;           ///< TileLayout indices whose heights changed, ascending
   std::vector<std::uint32_t> dropped;       ///< agents dropped in this step (3 consecutive misses)
@@ -48,10 +48,10 @@ struct StepOutcome {
 StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submissions);
 
 /// Same, with each request taken as arriving on its own agent's partition (channel = request.agent_id).
-StepOutcome apply_step(WorldState& state, const std::vector<bus::ActionRequest>& requests);
+StepOutcome apply_step(WorldState& state, const std::vector<protocol::ActionRequest>& requests);
 
 /// Removes a live agent from the run (e.g. its request writer lost liveliness): alive = false, dropped, reason.
 /// Returns the kDropped event; throws InvalidArgument when there is no such agent.
-bus::WorldEvent drop_agent(WorldState& state, std::uint32_t id, const std::string& reason);
+protocol::WorldEvent drop_agent(WorldState& state, std::uint32_t id, const std::string& reason);
 
 }  // namespace marsala::world_server

@@ -1,14 +1,14 @@
-#include "world_server/tile_layout.hpp"
+#include "marsala/world_server/tile_layout.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::world_server {
 
-TileLayout::TileLayout(const grid::GridGeometry& grid, int tile_size) : grid_(grid), tile_size_(tile_size) {
+TileLayout::TileLayout(const GridGeometry& grid, int tile_size) : grid_(grid), tile_size_(tile_size) {
   if (grid.rows <= 0 || grid.cols <= 0) throw InvalidArgument("tile layout: the grid is empty");
   if (tile_size < 1) throw InvalidArgument("tile layout: tile_size must be >= 1, got " + std::to_string(tile_size));
   tile_rows_ = (grid.rows + tile_size - 1) / tile_size;

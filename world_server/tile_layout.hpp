@@ -11,8 +11,8 @@
 
 #include <vector>
 
-#include "common/grid/heightmap.hpp"
-#include "common/types.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/types.hpp"
 
 namespace marsala::world_server {
 
@@ -29,7 +29,7 @@ struct Tile {
 class TileLayout {
  public:
   /// Throws InvalidArgument for an empty grid or tile_size < 1.
-  TileLayout(const grid::GridGeometry& grid, int tile_size);
+  TileLayout(const GridGeometry& grid, int tile_size);
 
   int tile_size() const { return tile_size_; }
   int tile_rows() const { return tile_rows_; }
@@ -46,7 +46,7 @@ class TileLayout {
   std::vector<int> tiles_in_square(Position centre, double half_side_m) const;
 
  private:
-  grid::GridGeometry grid_;
+  GridGeometry grid_;
   int tile_size_;
   int tile_rows_;
   int tile_cols_;

@@ -1,15 +1,15 @@
-#include "world_server/world_cli.hpp"
+#include "marsala/world_server/world_cli.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <ostream>
 
-#include "common/bus/bus.hpp"
-#include "common/cli/command_line.hpp"
-#include "common/error.hpp"
-#include "common/scenario/scenario.hpp"
-#include "common/scenario/terrain_builder.hpp"
-#include "world_server/world_runtime.hpp"
+#include "marsala/bus/bus.hpp"
+#include "marsala/cli/command_line.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/scenario/scenario.hpp"
+#include "marsala/scenario/terrain_builder.hpp"
+#include "marsala/world_server/world_runtime.hpp"
 
 namespace marsala::world_server {
 
@@ -47,7 +47,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   spdlog::set_level(quiet ? spdlog::level::warn : spdlog::level::info);
   try {
     const scenario::Scenario scenario = scenario::load_scenario(scenario_path);
-    grid::Heightmap terrain = scenario::build_terrain(scenario);
+    Heightmap terrain = scenario::build_terrain(scenario);
     const auto participant = bus::make_participant({bus::vendor_from_string(dds), domain});
     WorldRuntime runtime(scenario, std::move(terrain), options, *participant);
     const RunResult result = runtime.run(stop);

@@ -1,4 +1,4 @@
-#include "world_server/world_runtime.hpp"
+#include "marsala/world_server/world_runtime.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -12,13 +12,13 @@
 #include <utility>
 #include <vector>
 
-#include "common/error.hpp"
-#include "world_server/admission.hpp"
-#include "world_server/completion.hpp"
-#include "world_server/run_outputs.hpp"
-#include "world_server/sensing_service.hpp"
-#include "world_server/sha256.hpp"
-#include "world_server/step.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/world_server/admission.hpp"
+#include "marsala/world_server/completion.hpp"
+#include "marsala/world_server/run_outputs.hpp"
+#include "marsala/world_server/sensing_service.hpp"
+#include "marsala/world_server/sha256.hpp"
+#include "marsala/world_server/step.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -76,13 +76,13 @@ void check_run_id(const std::string& run_id) {
 
 /// The endpoints of one admitted agent.
 struct AgentLink {
-  std::unique_ptr<bus::Writer<bus::SensorFrame>> frames;
-  std::unique_ptr<bus::Reader<bus::ActionRequest>> requests;
+  std::unique_ptr<bus::Writer<protocol::SensorFrame>> frames;
+  std::unique_ptr<bus::Reader<protocol::ActionRequest>> requests;
   bool writer_seen = false;  ///< its request writer has been alive at least once
 };
 
 struct WorldRuntime::Impl {
-  Impl(const scenario::Scenario& s, grid::Heightmap terrain, RuntimeOptions o, bus::Participant& p)
+  Impl(const scenario::Scenario& s, Heightmap terrain, RuntimeOptions o, bus::Participant& p)
       : scenario(s), options(std::move(o)), participant(p) {
     if (options.seed) scenario.seed = *options.seed;
     const std::uint32_t agents = options.agents == 0 ? static_cast<std::uint32_t>(s.slots.size()) : options.agents;
@@ -106,13 +106,13 @@ struct WorldRuntime::Impl {
 
   void open_endpoints() {
     signal = std::make_shared<bus::Signal>();
-    hellos = participant.create_reader<bus::AgentHello>({"", signal, bus::Durability::kVolatile, 64});
-    admissions = participant.create_writer<bus::Admission>({"", nullptr, bus::Durability::kVolatile, 64});
-    status = participant.create_writer<bus::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
-    events = participant.create_writer<bus::WorldEvent>({"", nullptr, bus::Durability::kVolatile, 256});
+    hellos = participant.create_reader<protocol::AgentHello>({"", signal, bus::Durability::kVolatile, 64});
+    admissions = participant.create_writer<protocol::Admission>({"", nullptr, bus::Durability::kVolatile, 64});
+    status = participant.create_writer<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
+    events = participant.create_writer<protocol::WorldEvent>({"", nullptr, bus::Durability::kVolatile, 256});
   }
 
-  void emit(const bus::WorldEvent& e) {
+  void emit(const protocol::WorldEvent& e) {
     write_logged(*events, e, "a world event");
     if (event_log) event_log->append(e);
   }
@@ -122,8 +122,8 @@ struct WorldRuntime::Impl {
     if (event_log) event_log->note(state.step, text);
   }
 
-  bus::WorldEvent make_event(std::uint32_t agent, bus::EventKind kind, std::string detail) const {
-    bus::WorldEvent e;
+  protocol::WorldEvent make_event(std::uint32_t agent, protocol::EventKind kind, std::string detail) const {
+    protocol::WorldEvent e;
     e.step = state.step;
     e.agent_id = agent;
     e.kind = kind;
@@ -133,21 +133,21 @@ struct WorldRuntime::Impl {
 
   /// Answers every pending hello; admits the accepted newcomers and opens their partition endpoints.
   void service_hellos() {
-    for (const bus::AgentHello& hello : hellos->take()) {
+    for (const protocol::AgentHello& hello : hellos->take()) {
       const AdmissionDecision decision = decide_admission(state, hello, run_started);
       if (decision.accepted && admit(state, hello)) {
-        const std::string partition = bus::partition_for(options.run_id, hello.agent_id);
+        const std::string partition = protocol::partition_for(options.run_id, hello.agent_id);
         AgentLink& link = links[hello.agent_id - 1];
-        link.frames = participant.create_writer<bus::SensorFrame>({partition, nullptr, bus::Durability::kVolatile, 64});
+        link.frames = participant.create_writer<protocol::SensorFrame>({partition, nullptr, bus::Durability::kVolatile, 64});
         link.requests =
-            participant.create_reader<bus::ActionRequest>({partition, signal, bus::Durability::kVolatile, 64});
+            participant.create_reader<protocol::ActionRequest>({partition, signal, bus::Durability::kVolatile, 64});
         spdlog::info("admitted agent {} '{}' ({}) on partition {}", hello.agent_id, state.agent(hello.agent_id).name,
                      state.agent(hello.agent_id).robot_type, partition);
-        emit(make_event(hello.agent_id, bus::EventKind::kAdmitted, state.agent(hello.agent_id).name));
+        emit(make_event(hello.agent_id, protocol::EventKind::kAdmitted, state.agent(hello.agent_id).name));
       } else if (!decision.accepted && refused.insert({hello.agent_id, hello.session}).second) {
         // Agents repeat their hello: each (id, session) is logged and published once, answered every time.
         spdlog::warn("refused agent {}: {}", hello.agent_id, decision.reason);
-        emit(make_event(hello.agent_id, bus::EventKind::kRefused, decision.reason));
+        emit(make_event(hello.agent_id, protocol::EventKind::kRefused, decision.reason));
       }
       write_logged(*admissions, admission_message(state, hello, decision, options.run_id), "an admission");
     }
@@ -214,9 +214,9 @@ struct WorldRuntime::Impl {
       service_hellos();
       for (const AgentRecord& a : state.agents) {
         if (!links[a.id - 1].requests) continue;
-        std::vector<bus::ActionRequest> received = links[a.id - 1].requests->take();
+        std::vector<protocol::ActionRequest> received = links[a.id - 1].requests->take();
         if (!a.alive) continue;  // a dropped agent's requests are read only to be discarded
-        for (bus::ActionRequest& r : received) {
+        for (protocol::ActionRequest& r : received) {
           if (r.step == state.step && carries_identity_of(a, r)) answered[a.id - 1] = true;
           submissions.push_back({a.id, std::move(r)});
         }
@@ -232,7 +232,7 @@ struct WorldRuntime::Impl {
   }
 
   void publish_status(bool running, bool completed, double wall_seconds) {
-    bus::WorldStatus s;
+    protocol::WorldStatus s;
     s.run_id = options.run_id;
     s.scenario = scenario.name;
     s.step = state.step;
@@ -243,7 +243,7 @@ struct WorldRuntime::Impl {
     s.completed = completed;
     for (const AgentRecord& a : state.agents) {
       if (!a.admitted) continue;
-      bus::AgentStatus as;
+      protocol::AgentStatus as;
       as.agent_id = a.id;
       as.name = a.name;
       as.state = a.state;
@@ -264,7 +264,7 @@ struct WorldRuntime::Impl {
 
   /// Logs a rejection at info level, or at debug level when it repeats the agent's previous one (a stuck agent would
   /// otherwise fill the log; events.log keeps every one).
-  void log_rejection(const bus::WorldEvent& e) {
+  void log_rejection(const protocol::WorldEvent& e) {
     std::string& last = last_rejection[e.agent_id - 1];
     if (e.detail == last) {
       spdlog::debug("step {}: agent {} rejected again: {}", e.step, e.agent_id, e.detail);
@@ -293,17 +293,17 @@ struct WorldRuntime::Impl {
                       scenario::to_string(state.completion), state.check.met ? "met" : "not met",
                       state.check.level_fraction);
       for (const std::string& text : outcome.notes) note(text);
-      for (const bus::WorldEvent& e : outcome.events) {
-        if (e.kind == bus::EventKind::kRejected)
+      for (const protocol::WorldEvent& e : outcome.events) {
+        if (e.kind == protocol::EventKind::kRejected)
           log_rejection(e);
-        else if (e.kind == bus::EventKind::kMissed || e.kind == bus::EventKind::kDropped)
-          spdlog::warn("step {}: agent {} {}: {}", e.step, e.agent_id, bus::to_string(e.kind), e.detail);
-        else if (e.kind == bus::EventKind::kAtGoal)
+        else if (e.kind == protocol::EventKind::kMissed || e.kind == protocol::EventKind::kDropped)
+          spdlog::warn("step {}: agent {} {}: {}", e.step, e.agent_id, protocol::to_string(e.kind), e.detail);
+        else if (e.kind == protocol::EventKind::kAtGoal)
           spdlog::info("step {}: agent {} reached the goal", e.step, e.agent_id);
         emit(e);
       }
       for (const AgentRecord& a : state.agents)
-        if (a.last_result != bus::ActionResult::kRejected) last_rejection[a.id - 1].clear();
+        if (a.last_result != protocol::ActionResult::kRejected) last_rejection[a.id - 1].clear();
       // An agent dropped for missing its deadlines may only be slow or hung: tell it the run is over for it.
       for (std::uint32_t id : outcome.dropped) send_frame(id, true);
       publish_status(true, outcome.completed, elapsed_s(start));
@@ -367,7 +367,7 @@ struct WorldRuntime::Impl {
     result.wall_seconds = elapsed_s(start);
     const std::vector<std::uint32_t> live = state.live_ids();
     for (std::uint32_t id : live) send_frame(id, true);
-    emit(make_event(0, bus::EventKind::kRunOver, end_reason));
+    emit(make_event(0, protocol::EventKind::kRunOver, end_reason));
     publish_status(false, result.completed, result.wall_seconds);
 
     RunInfo info;
@@ -403,18 +403,18 @@ struct WorldRuntime::Impl {
   std::vector<AgentLink> links;  ///< [id - 1]
   std::shared_ptr<bus::Signal> signal;
   std::vector<double> step_ms;  ///< wall time of each lockstep step [ms]
-  grid::Heightmap initial_terrain;  ///< kept for goal_vector_map.png only
-  std::unique_ptr<bus::Reader<bus::AgentHello>> hellos;
-  std::unique_ptr<bus::Writer<bus::Admission>> admissions;
-  std::unique_ptr<bus::Writer<bus::WorldStatus>> status;
-  std::unique_ptr<bus::Writer<bus::WorldEvent>> events;
+  Heightmap initial_terrain;  ///< kept for goal_vector_map.png only
+  std::unique_ptr<bus::Reader<protocol::AgentHello>> hellos;
+  std::unique_ptr<bus::Writer<protocol::Admission>> admissions;
+  std::unique_ptr<bus::Writer<protocol::WorldStatus>> status;
+  std::unique_ptr<bus::Writer<protocol::WorldEvent>> events;
   std::optional<EventLog> event_log;
   std::vector<std::string> last_rejection;  ///< [id - 1]: the rejection reason last logged at info level
   std::set<std::pair<std::uint32_t, std::uint64_t>> refused;  ///< (id, session) already reported as refused
   bool run_started = false;
 };
 
-WorldRuntime::WorldRuntime(const scenario::Scenario& scenario, grid::Heightmap terrain, RuntimeOptions options,
+WorldRuntime::WorldRuntime(const scenario::Scenario& scenario, Heightmap terrain, RuntimeOptions options,
                            bus::Participant& participant)
     : impl_(std::make_unique<Impl>(scenario, std::move(terrain), std::move(options), participant)) {}
 

@@ -5,7 +5,7 @@
 // completion).
 //
 //   hello/admission on the default partition     -> per admitted agent: SensorFrame writer and ActionRequest reader
-//   on bus::partition_for(run_id, id)             -> step k: frames, wait for requests (deadline), apply_step, status
+//   on protocol::partition_for(run_id, id)             -> step k: frames, wait for requests (deadline), apply_step, status
 
 #include <atomic>
 #include <cstdint>
@@ -13,10 +13,10 @@
 #include <optional>
 #include <string>
 
-#include "common/bus/bus.hpp"
-#include "common/grid/heightmap.hpp"
-#include "common/scenario/scenario.hpp"
-#include "world_server/world_state.hpp"
+#include "marsala/bus/bus.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/scenario/scenario.hpp"
+#include "marsala/world_server/world_state.hpp"
 
 namespace marsala::world_server {
 
@@ -54,7 +54,7 @@ class WorldRuntime {
  public:
   /// Validates the options (agent count within the scenario's slots, run id, timeouts) and prepares the state;
   /// throws InvalidArgument.
-  WorldRuntime(const scenario::Scenario& scenario, grid::Heightmap terrain, RuntimeOptions options,
+  WorldRuntime(const scenario::Scenario& scenario, Heightmap terrain, RuntimeOptions options,
                bus::Participant& participant);
   ~WorldRuntime();
   WorldRuntime(const WorldRuntime&) = delete;

@@ -1,10 +1,10 @@
-#include "world_server/world_state.hpp"
+#include "marsala/world_server/world_state.hpp"
 
 #include <limits>
 
-#include "common/error.hpp"
-#include "world_server/completion.hpp"
-#include "world_server/start_jitter.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/world_server/completion.hpp"
+#include "marsala/world_server/start_jitter.hpp"
 
 namespace marsala::world_server {
 
@@ -26,7 +26,7 @@ std::vector<std::uint32_t> WorldState::live_ids() const {
   return ids;
 }
 
-WorldState make_world_state(const scenario::Scenario& scenario, grid::Heightmap terrain, std::uint32_t agent_count) {
+WorldState make_world_state(const scenario::Scenario& scenario, Heightmap terrain, std::uint32_t agent_count) {
   if (agent_count == 0 || agent_count > scenario.slots.size())
     throw InvalidArgument("agent count " + std::to_string(agent_count) + " must be in 1.." +
                           std::to_string(scenario.slots.size()) + " (the scenario's agent slots)");
@@ -62,7 +62,7 @@ WorldState make_world_state(const scenario::Scenario& scenario, grid::Heightmap 
   return s;
 }
 
-double height_under(const grid::Heightmap& terrain, double x_m, double y_m) {
+double height_under(const Heightmap& terrain, double x_m, double y_m) {
   const auto cell = terrain.cell_at({x_m, y_m});
   return cell ? terrain(*cell) : std::numeric_limits<double>::quiet_NaN();
 }

@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "common/bus/messages.hpp"
-#include "common/grid/heightmap.hpp"
-#include "common/scenario/scenario.hpp"
-#include "world_server/occupancy_cache.hpp"
-#include "world_server/tile_layout.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/scenario/scenario.hpp"
+#include "marsala/world_server/occupancy_cache.hpp"
+#include "marsala/world_server/tile_layout.hpp"
 
 namespace marsala::world_server {
 
@@ -19,7 +19,7 @@ struct AgentRecord {
   std::uint32_t id = 0;                 ///< >= 1
   std::string robot_type;               ///< from the scenario slot
   std::string behaviour;                ///< from the scenario's robot type
-  bus::BodyParams body;                 ///< from the scenario's robot type: what the hello must declare
+  RobotBody body;                 ///< from the scenario's robot type: what the hello must declare
   double start_x_m = 0.0, start_y_m = 0.0;    ///< [m]
   double target_x_m = 0.0, target_y_m = 0.0;  ///< [m]
 
@@ -42,13 +42,13 @@ struct AgentRecord {
   bool at_goal = false;
   std::string state;                    ///< the behaviour's state from its latest request
 
-  bus::ActionResult last_result = bus::ActionResult::kNone;  ///< for its next frame
+  protocol::ActionResult last_result = protocol::ActionResult::kNone;  ///< for its next frame
   std::string last_reason;
 };
 
 /// True when `r` carries the agent's admitted identity (id and session): only such a request can answer for it in a
 /// step. A request with another identity on its partition is forged or stale and never takes its slot.
-inline bool carries_identity_of(const AgentRecord& agent, const bus::ActionRequest& r) {
+inline bool carries_identity_of(const AgentRecord& agent, const protocol::ActionRequest& r) {
   return r.agent_id == agent.id && r.session == agent.session;
 }
 
@@ -67,7 +67,7 @@ struct CompletionCheck {
 
 /// Everything the step function reads and changes.
 struct WorldState {
-  grid::Heightmap terrain;              ///< authoritative heights [m]
+  Heightmap terrain;              ///< authoritative heights [m]
   std::vector<AgentRecord> agents;      ///< agents[i].id == i + 1, one per expected agent
   std::uint64_t step = 0;               ///< the step whose requests are awaited
   scenario::Goal goal;
@@ -98,9 +98,9 @@ struct WorldState {
 /// admitted), each start moved by jittered_start() when the scenario's start_jitter_m > 0 (seeded by
 /// scenario.seed). Throws InvalidArgument when agent_count is 0 or exceeds the scenario's slots, when the payload's
 /// `from` or `to` is off the grid, or when the site holds no cell of the grid.
-WorldState make_world_state(const scenario::Scenario& scenario, grid::Heightmap terrain, std::uint32_t agent_count);
+WorldState make_world_state(const scenario::Scenario& scenario, Heightmap terrain, std::uint32_t agent_count);
 
 /// Height of the cell under (x, y) [m], or NaN when off the grid.
-double height_under(const grid::Heightmap& terrain, double x_m, double y_m);
+double height_under(const Heightmap& terrain, double x_m, double y_m);
 
 }  // namespace marsala::world_server

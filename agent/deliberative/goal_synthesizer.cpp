@@ -1,9 +1,9 @@
-#include "agent/deliberative/goal_synthesizer.hpp"
+#include "marsala/agent/deliberative/goal_synthesizer.hpp"
 
 #include <cmath>
 #include <string>
 
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::agent::deliberative {
 
@@ -37,7 +37,7 @@ bool stands_on(Position robot, Position p, double cell_size_m) {
 // neighbour takes the tail.
 bool neighbour_takes(Position tail, const GoalQuery& query, std::uint32_t self_id) {
   const double mine = distance2(query.robot, tail);
-  for (const bus::Neighbour& n : query.neighbours) {
+  for (const protocol::Neighbour& n : query.neighbours) {
     if (n.agent_id == self_id) continue;
     const double theirs = distance2({n.x_m, n.y_m}, tail);
     if (theirs < mine || (theirs == mine && n.agent_id < self_id)) return true;
@@ -47,7 +47,7 @@ bool neighbour_takes(Position tail, const GoalQuery& query, std::uint32_t self_i
 
 // The nearest unfinished tail that no neighbour takes. When neighbours take every unfinished tail the robot still
 // has work, so it takes the nearest unfinished one rather than stopping. nullopt when every arrow is finished.
-std::optional<std::size_t> pick_tail(const processing::GoalVectorMap& map, const std::vector<bool>& finished,
+std::optional<std::size_t> pick_tail(const GoalVectorMap& map, const std::vector<bool>& finished,
                                      const GoalQuery& query, std::uint32_t self_id) {
   std::vector<bool> excluded = finished;
   for (std::size_t i = 0; i < excluded.size(); ++i)
@@ -63,7 +63,7 @@ std::optional<Position> GoalVectorMapSynthesizer::target(const GoalQuery& query)
     throw InvalidArgument("goal synthesizer 'goal_vector_map' of agent " + std::to_string(self_id_) +
                           ": the robot's position (" + std::to_string(query.robot.x) + ", " +
                           std::to_string(query.robot.y) + ") m is not finite");
-  const std::vector<processing::GoalArrow>& arrows = map_.arrows();
+  const std::vector<GoalArrow>& arrows = map_.arrows();
   // Every pass returns, reaches a tail (once per pick) or finishes an arrow, so the loop ends.
   for (;;) {
     // A tail still ahead is given up as soon as a neighbour stands nearer to it, with the same rule that picks
@@ -74,7 +74,7 @@ std::optional<Position> GoalVectorMapSynthesizer::target(const GoalQuery& query)
       to_tail_ = true;
       if (!current_) return std::nullopt;
     }
-    const processing::GoalArrow& arrow = arrows[*current_];
+    const GoalArrow& arrow = arrows[*current_];
     if (to_tail_) {
       if (!stands_on(query.robot, arrow.tail, cell_size_m_)) return arrow.tail;
       to_tail_ = false;

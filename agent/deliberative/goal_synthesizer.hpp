@@ -13,18 +13,18 @@
 #include <string>
 #include <vector>
 
-#include "agent/agent_context.hpp"
-#include "agent/detail/registry.hpp"
-#include "common/bus/messages.hpp"
-#include "common/processing/goal_vector_map.hpp"
-#include "common/types.hpp"
+#include "marsala/agent/agent_context.hpp"
+#include "marsala/core/registry.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/core/goal_vector_map.hpp"
+#include "marsala/core/types.hpp"
 
 namespace marsala::agent::deliberative {
 
 /// What a goal synthesizer sees in one frame.
 struct GoalQuery {
   Position robot;                          ///< where the robot stands [m]
-  std::vector<bus::Neighbour> neighbours;  ///< robots within proximity range (from the frame)
+  std::vector<protocol::Neighbour> neighbours;  ///< robots within proximity range (from the frame)
 };
 
 /// Picks the target location [m] for the robot's current state.
@@ -65,7 +65,7 @@ class GoalVectorMapSynthesizer final : public GoalSynthesizer {
   std::string name() const override { return "goal_vector_map"; }
   std::optional<Position> target(const GoalQuery& query) override;
 
-  const processing::GoalVectorMap& map() const { return map_; }
+  const GoalVectorMap& map() const { return map_; }
   /// The arrow it is on, if any (index into map().arrows()).
   std::optional<std::size_t> current_arrow() const { return current_; }
   /// True while it heads for the current arrow's tail (false: for its head).
@@ -76,14 +76,14 @@ class GoalVectorMapSynthesizer final : public GoalSynthesizer {
  private:
   std::uint32_t self_id_;
   double cell_size_m_;
-  processing::GoalVectorMap map_;
+  GoalVectorMap map_;
   std::optional<std::size_t> current_;
   bool to_tail_ = true;
   std::vector<bool> finished_;
 };
 
 /// Goal synthesizers by name; each is made from the admitted agent's context.
-using GoalSynthesizerRegistry = detail::Registry<GoalSynthesizer, const AgentContext&>;
+using GoalSynthesizerRegistry = Registry<GoalSynthesizer, const AgentContext&>;
 
 /// An empty registry whose messages speak of goal synthesizers.
 GoalSynthesizerRegistry make_goal_synthesizer_registry();

@@ -1,12 +1,12 @@
-#include "agent/deliberative/local_map_synthesizer.hpp"
+#include "marsala/agent/deliberative/local_map_synthesizer.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include "common/error.hpp"
-#include "common/grid/iterators.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/iterators.hpp"
 
 namespace marsala::agent::deliberative {
 namespace {
@@ -21,7 +21,7 @@ int clamp_int(double v, int lo, int hi) {
 
 }  // namespace
 
-Window sensing_window(const grid::GridGeometry& world, Position robot, double range_m) {
+Window sensing_window(const GridGeometry& world, Position robot, double range_m) {
   if (!(range_m >= 0.0) || !std::isfinite(range_m))
     throw InvalidArgument("sensing range must be finite and >= 0 m, got " + std::to_string(range_m));
   if (!std::isfinite(robot.x) || !std::isfinite(robot.y) || !world.cell_at(robot))
@@ -65,10 +65,10 @@ LocalMap LocalMapSynthesizer::synthesize(const executive::MappingSystem& map, Po
 
   local.gap = mars_.gap(local.heights);
   local.occupiable = navigability_.occupiable(local.heights);
-  local.blind = grid::CellMask::Zero(w.rows, w.cols);
+  local.blind = CellMask::Zero(w.rows, w.cols);
   if (!all_known) {
     // A ball that holds an unknown cell cannot be judged: treat its centre as not occupiable.
-    const auto ball = grid::disc_offsets(params().delta_m / (2.0 * local.geometry().cell_size_m));
+    const auto ball = disc_offsets(params().delta_m / (2.0 * local.geometry().cell_size_m));
     for (int r = 0; r < w.rows; ++r)
       for (int c = 0; c < w.cols; ++c) {
         if (local.known(r, c) != 0) continue;
@@ -83,7 +83,7 @@ LocalMap LocalMapSynthesizer::synthesize(const executive::MappingSystem& map, Po
   }
 
   local.robot = local.to_local(*map.geometry().cell_at(robot));
-  local.navigable = processing::NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
+  local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
   local.origin = local_origin(local, map.trajectory(), robot, sensing_range_m_);
   const auto [goal, is_target] = local_goal(local, robot, target);
   local.goal = goal;
@@ -113,7 +113,7 @@ std::optional<CellIndex> LocalMapSynthesizer::local_origin(const LocalMap& local
 }
 
 std::pair<CellIndex, bool> LocalMapSynthesizer::local_goal(const LocalMap& local, Position robot, Position target) {
-  const grid::GridGeometry& g = local.geometry();
+  const GridGeometry& g = local.geometry();
   if (!std::isfinite(target.x) || !std::isfinite(target.y))
     throw InvalidArgument("local map: the target " + describe(target) + " is not finite");
   if (const auto cell = local.cell_at(target)) return {*cell, true};

@@ -15,33 +15,33 @@
 #include <utility>
 #include <vector>
 
-#include "agent/executive/mapping_system.hpp"
-#include "common/grid/heightmap.hpp"
-#include "common/processing/mars_processor.hpp"
-#include "common/processing/navigability_processor.hpp"
-#include "common/types.hpp"
+#include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/mars_processor.hpp"
+#include "marsala/core/navigability_processor.hpp"
+#include "marsala/core/types.hpp"
 
 namespace marsala::agent::deliberative {
 
 /// The augmented local map: local heightmap, MARS gap, navigability, robot cell, local origin and local goal.
 /// All indices are local (row 0, col 0 = the window's top-left cell); `offset` maps them to the world grid.
 struct LocalMap {
-  grid::GridGeometry world;          ///< the world grid: positions map to cells through it, as the world maps them
+  GridGeometry world;          ///< the world grid: positions map to cells through it, as the world maps them
   CellIndex offset;                  ///< world index of the window's top-left cell
-  grid::Heightmap heights;           ///< the window [m], placed in the world frame; unknown cells hold the lowest known
-  grid::CellMask known;              ///< 1 where the agent's map knows the cell
-  grid::Heightmap gap;               ///< MARS gap P_kappa[h] - h of the window at the construction kappa [m]; 0 on
+  Heightmap heights;           ///< the window [m], placed in the world frame; unknown cells hold the lowest known
+  CellMask known;              ///< 1 where the agent's map knows the cell
+  Heightmap gap;               ///< MARS gap P_kappa[h] - h of the window at the construction kappa [m]; 0 on
                                      ///< unknown cells
-  grid::CellMask blind;              ///< 1 where the cell's ball holds an unknown cell: it is never occupiable
-  grid::CellMask occupiable;         ///< occupiable cells; never a blind one
-  grid::CellMask navigable;          ///< occupiable cells 8-connected to the robot's cell
+  CellMask blind;              ///< 1 where the cell's ball holds an unknown cell: it is never occupiable
+  CellMask occupiable;         ///< occupiable cells; never a blind one
+  CellMask navigable;          ///< occupiable cells 8-connected to the robot's cell
   CellIndex robot;                   ///< the robot's cell
   std::optional<CellIndex> origin;   ///< the local origin, when some trajectory cell in the window is occupiable
   CellIndex goal;                    ///< the local goal
   bool goal_is_target = false;       ///< true when the local goal is the target's own cell
 
   /// The window's geometry (world placement, cell size [m]).
-  const grid::GridGeometry& geometry() const { return heights.geometry(); }
+  const GridGeometry& geometry() const { return heights.geometry(); }
   int rows() const { return heights.rows(); }
   int cols() const { return heights.cols(); }
   bool contains(CellIndex local) const { return heights.contains(local); }
@@ -67,7 +67,7 @@ struct Window {
 
 /// The cells whose squares meet [x - r, x + r] x [y - r, y + r] (r = range_m [m]), clipped to the grid; throws
 /// InvalidArgument when the robot is off the grid or the range is negative or not finite.
-Window sensing_window(const grid::GridGeometry& world, Position robot, double range_m);
+Window sensing_window(const GridGeometry& world, Position robot, double range_m);
 
 /// Builds augmented local maps for one robot.
 class LocalMapSynthesizer {
@@ -97,8 +97,8 @@ class LocalMapSynthesizer {
   double sensing_range_m() const { return sensing_range_m_; }
 
  private:
-  processing::MarsProcessor mars_;
-  processing::NavigabilityProcessor navigability_;
+  MarsProcessor mars_;
+  NavigabilityProcessor navigability_;
   double sensing_range_m_;
 };
 

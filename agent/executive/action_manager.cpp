@@ -1,9 +1,9 @@
-#include "agent/executive/action_manager.hpp"
+#include "marsala/agent/executive/action_manager.hpp"
 
 #include <cmath>
 #include <string>
 
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::agent::executive {
 namespace {
@@ -20,14 +20,14 @@ ActionManager::ActionManager(double max_step_m) : max_step_m_(max_step_m) {
     throw InvalidArgument("action manager: max step must be finite and > 0 m, got " + std::to_string(max_step_m));
 }
 
-const grid::CellMask& ActionManager::moves_mask(const deliberative::LocalMap& map) const {
+const CellMask& ActionManager::moves_mask(const deliberative::LocalMap& map) const {
   return map.navigable(map.robot.row, map.robot.col) != 0 ? map.navigable : map.occupiable;
 }
 
 std::optional<Motion> ActionManager::advance(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
                                              Position robot) const {
   if (path.empty()) return std::nullopt;
-  const grid::CellMask& mask = moves_mask(map);
+  const CellMask& mask = moves_mask(map);
   const Position own = map.center(path[0]);
   const double d_own = distance(own, robot);
   const bool can_centre = mask(path[0].row, path[0].col) != 0 && d_own > kCentredM && d_own <= max_step_m_;

@@ -7,8 +7,8 @@
 #include <optional>
 #include <vector>
 
-#include "agent/deliberative/local_map_synthesizer.hpp"
-#include "common/types.hpp"
+#include "marsala/agent/deliberative/local_map_synthesizer.hpp"
+#include "marsala/core/types.hpp"
 
 namespace marsala::agent::executive {
 
@@ -38,7 +38,7 @@ class ActionManager {
                                 Position robot) const;
 
  private:
-  const grid::CellMask& moves_mask(const deliberative::LocalMap& map) const;
+  const CellMask& moves_mask(const deliberative::LocalMap& map) const;
   double max_step_m_;
 };
 

@@ -1,13 +1,13 @@
-#include "agent/executive/deposition_manager.hpp"
+#include "marsala/agent/executive/deposition_manager.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include "agent/agent_context.hpp"
-#include "common/error.hpp"
-#include "common/grid/iterators.hpp"
+#include "marsala/agent/agent_context.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/iterators.hpp"
 
 namespace marsala::agent::executive {
 namespace {
@@ -19,7 +19,7 @@ double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y
 
 /// Ball offsets nearest first (then row-major), so each path cell's footprint is visited from its centre outwards.
 std::vector<CellIndex> sorted_ball(double radius_cells) {
-  std::vector<CellIndex> ball = grid::disc_offsets(radius_cells);
+  std::vector<CellIndex> ball = disc_offsets(radius_cells);
   std::stable_sort(ball.begin(), ball.end(), [](CellIndex a, CellIndex b) {
     return a.row * a.row + a.col * a.col < b.row * b.row + b.col * b.col;
   });
@@ -38,7 +38,7 @@ long long cells2(CellIndex a, CellIndex b) {
 bool DepositionManager::in_territory(const deliberative::LocalMap& map, CellIndex cell, Position centre,
                                      const Neighbourhood& neighbours, std::optional<CellIndex> self_cell) const {
   const CellIndex global = map.to_global(cell);
-  for (const bus::Neighbour& n : neighbours.others) {
+  for (const protocol::Neighbour& n : neighbours.others) {
     const Position p{n.x_m, n.y_m};
     if (distance(centre, p) <= params_.neighbour_keep_out_m) return false;
     // Whole-cell distances: every robot computes them exactly alike, so territories never overlap.
@@ -50,14 +50,14 @@ bool DepositionManager::in_territory(const deliberative::LocalMap& map, CellInde
   return true;
 }
 
-DepositionParams deposition_params(const bus::BodyParams& body, double cell_size_m, double neighbour_keep_out_m,
+DepositionParams deposition_params(const RobotBody& body, double cell_size_m, double neighbour_keep_out_m,
                                    std::optional<double> footprint_m) {
   DepositionParams p;
-  p.navigability = navigability_params(body);
-  p.footprint_m = footprint_m.value_or(body.delta_m);
+  p.navigability = body.navigability;
+  p.footprint_m = footprint_m.value_or(body.navigability.delta_m);
   p.reach_m = body.reach_m;
   p.max_deposit_m3 = body.max_deposit_m3;
-  p.cube_layer_m = cube_layer_m(body, cell_size_m);
+  p.cube_layer_m = cube_layer_m(body.cube_size_m, cell_size_m);
   p.neighbour_keep_out_m = neighbour_keep_out_m;
   p.neighbour_step_m = body.max_step_m;
   return p;
@@ -122,7 +122,7 @@ std::vector<DepositionCandidate> DepositionManager::candidates(const deliberativ
 
 namespace {
 
-bool reaches_border(const grid::CellMask& reach) {
+bool reaches_border(const CellMask& reach) {
   const auto rows = reach.rows(), cols = reach.cols();
   if (rows == 0 || cols == 0) return false;
   return reach.row(0).any() || reach.row(rows - 1).any() || reach.col(0).any() || reach.col(cols - 1).any();
@@ -139,20 +139,20 @@ bool DepositionManager::keeps_way_back(const deliberative::LocalMap& map, Positi
   // Robots whose way back must survive: this one at its new position, then the neighbours in the window.
   std::vector<CellIndex> robots{*cell};
   const double cs = map.geometry().cell_size_m;
-  const auto step_disc = grid::disc_offsets(params_.neighbour_step_m / cs);
-  for (const bus::Neighbour& n : neighbours.others)
+  const auto step_disc = disc_offsets(params_.neighbour_step_m / cs);
+  for (const protocol::Neighbour& n : neighbours.others)
     if (const auto c = map.cell_at({n.x_m, n.y_m}))
       for (const CellIndex o : step_disc) {
         const CellIndex p{c->row + o.row, c->col + o.col};
         if (map.contains(p)) robots.push_back(p);
       }
   const bool has_origin = map.origin && map.occupiable(map.origin->row, map.origin->col) != 0;
-  const grid::CellMask before =
-      has_origin ? processing::NavigabilityProcessor::navigable_from(map.occupiable, *map.origin) : grid::CellMask();
+  const CellMask before =
+      has_origin ? NavigabilityProcessor::navigable_from(map.occupiable, *map.origin) : CellMask();
 
-  grid::Heightmap after = map.heights;
+  Heightmap after = map.heights;
   for (const auto& d : depositions) after(d.cell) += d.height_m;
-  grid::CellMask occupiable = navigability_.occupiable(after);
+  CellMask occupiable = navigability_.occupiable(after);
   for (int r = 0; r < map.rows(); ++r)
     for (int c = 0; c < map.cols(); ++c)
       if (map.blind(r, c) != 0) occupiable(r, c) = 0;
@@ -165,11 +165,11 @@ bool DepositionManager::keeps_way_back(const deliberative::LocalMap& map, Positi
   if (map.occupiable(cell->row, cell->col) != 0 &&
       reaches_border(*cell == map.robot && map.navigable.size() == map.occupiable.size()
                          ? map.navigable
-                         : processing::NavigabilityProcessor::navigable_from(map.occupiable, *cell)) &&
-      !reaches_border(processing::NavigabilityProcessor::navigable_from(occupiable, *cell)))
+                         : NavigabilityProcessor::navigable_from(map.occupiable, *cell)) &&
+      !reaches_border(NavigabilityProcessor::navigable_from(occupiable, *cell)))
     return false;
   if (!has_origin) return true;
-  const grid::CellMask reach = processing::NavigabilityProcessor::navigable_from(occupiable, *map.origin);
+  const CellMask reach = NavigabilityProcessor::navigable_from(occupiable, *map.origin);
   for (const CellIndex p : robots)
     if (before(p.row, p.col) != 0 && reach(p.row, p.col) == 0) return false;
   return true;

@@ -13,10 +13,10 @@
 #include <optional>
 #include <vector>
 
-#include "agent/deliberative/local_map_synthesizer.hpp"
-#include "common/bus/messages.hpp"
-#include "common/processing/navigability_processor.hpp"
-#include "common/types.hpp"
+#include "marsala/agent/deliberative/local_map_synthesizer.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/core/navigability_processor.hpp"
+#include "marsala/core/types.hpp"
 
 namespace marsala::agent::executive {
 
@@ -34,14 +34,14 @@ struct DepositionParams {
 
 /// The deposition parameters of a body on a grid of cell_size_m [m], with the team's keep-out [m]; the footprint is
 /// footprint_m when given, else the body's delta.
-DepositionParams deposition_params(const bus::BodyParams& body, double cell_size_m, double neighbour_keep_out_m,
+DepositionParams deposition_params(const RobotBody& body, double cell_size_m, double neighbour_keep_out_m,
                                    std::optional<double> footprint_m = std::nullopt);
 
 /// The robots around this one at the start of the step, as its frame reports them.
 struct Neighbourhood {
   std::uint32_t self_id = 0;             ///< this robot's agent id
   Position self;                         ///< this robot's position at the start of the step [m]
-  std::vector<bus::Neighbour> others;    ///< the other robots within proximity range
+  std::vector<protocol::Neighbour> others;    ///< the other robots within proximity range
 };
 
 /// One candidate deposition (local index).
@@ -53,7 +53,7 @@ struct DepositionCandidate {
 
 /// This step's depositions.
 struct DepositionPlan {
-  std::vector<bus::Deposition> depositions;  ///< world indices, in path order
+  std::vector<protocol::Deposition> depositions;  ///< world indices, in path order
   double volume_m3 = 0.0;                    ///< sum of height * cs^2 [m^3]
   int candidates = 0;                        ///< candidates before the way-back check [count]
   int dropped_for_way_back = 0;              ///< candidates dropped to keep the way back [count]
@@ -89,7 +89,7 @@ class DepositionManager {
   bool in_territory(const deliberative::LocalMap& map, CellIndex cell, Position centre,
                     const Neighbourhood& neighbours, std::optional<CellIndex> self_cell) const;
   DepositionParams params_;
-  processing::NavigabilityProcessor navigability_;
+  NavigabilityProcessor navigability_;
 };
 
 }  // namespace marsala::agent::executive

@@ -1,33 +1,33 @@
-#include "agent/executive/mapping_system.hpp"
+#include "marsala/agent/executive/mapping_system.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::agent::executive {
 namespace {
 
-std::string describe(const bus::TerrainTile& t) {
+std::string describe(const protocol::TerrainTile& t) {
   return "tile (" + std::to_string(t.tile_row) + ", " + std::to_string(t.tile_col) + ") of " +
          std::to_string(t.rows) + " x " + std::to_string(t.cols) + " cells";
 }
 
 }  // namespace
 
-MappingSystem::MappingSystem(const grid::GridGeometry& world, int tile_size)
+MappingSystem::MappingSystem(const GridGeometry& world, int tile_size)
     : heights_(world, 0.0), tile_size_(tile_size) {
   if (tile_size < 1) throw InvalidArgument("mapping system: tile size must be >= 1, got " + std::to_string(tile_size));
-  known_ = grid::CellMask::Zero(world.rows, world.cols);
+  known_ = CellMask::Zero(world.rows, world.cols);
 }
 
-void MappingSystem::integrate(const bus::SensorFrame& frame) {
-  for (const bus::TerrainTile& tile : frame.tiles) integrate_tile(tile);
+void MappingSystem::integrate(const protocol::SensorFrame& frame) {
+  for (const protocol::TerrainTile& tile : frame.tiles) integrate_tile(tile);
   record_pose({frame.x_m, frame.y_m});
 }
 
-void MappingSystem::integrate_tile(const bus::TerrainTile& tile) {
+void MappingSystem::integrate_tile(const protocol::TerrainTile& tile) {
   const long long row0 = static_cast<long long>(tile.tile_row) * tile_size_;
   const long long col0 = static_cast<long long>(tile.tile_col) * tile_size_;
   const bool placed = tile.tile_row >= 0 && tile.tile_col >= 0 && row0 < heights_.rows() && col0 < heights_.cols();

@@ -5,9 +5,9 @@
 
 #include <vector>
 
-#include "common/bus/messages.hpp"
-#include "common/grid/heightmap.hpp"
-#include "common/types.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/types.hpp"
 
 namespace marsala::agent::executive {
 
@@ -16,33 +16,33 @@ class MappingSystem {
  public:
   /// An empty map of the world grid cut in tile_size x tile_size tiles; throws InvalidArgument on a bad geometry
   /// or tile_size < 1.
-  MappingSystem(const grid::GridGeometry& world, int tile_size);
+  MappingSystem(const GridGeometry& world, int tile_size);
 
   /// Writes the frame's tiles (heights copied bit for bit) and records its pose; throws InvalidArgument when a
   /// tile does not fit the grid or the pose is off the grid (a broken contract by the sender).
-  void integrate(const bus::SensorFrame& frame);
+  void integrate(const protocol::SensorFrame& frame);
   /// Writes one tile; throws InvalidArgument naming the tile when its place, size or heights are inconsistent.
-  void integrate_tile(const bus::TerrainTile& tile);
+  void integrate_tile(const protocol::TerrainTile& tile);
   /// Appends the cell under `pose` [m] to the trajectory (consecutive repeats are kept once); throws
   /// InvalidArgument when the pose is off the grid or not finite.
   void record_pose(Position pose);
 
   /// The map: known cells hold the world's heights [m], unknown cells 0.
-  const grid::Heightmap& heights() const { return heights_; }
+  const Heightmap& heights() const { return heights_; }
   /// 1 where the cell has been sensed at least once.
-  const grid::CellMask& known() const { return known_; }
+  const CellMask& known() const { return known_; }
   bool is_known(CellIndex cell) const { return heights_.contains(cell) && known_(cell.row, cell.col) != 0; }
   /// Number of known cells.
   long long known_cells() const { return known_count_; }
   /// Cells stood on, oldest first, consecutive repeats removed (global indices).
   const std::vector<CellIndex>& trajectory() const { return trajectory_; }
   /// The world grid.
-  const grid::GridGeometry& geometry() const { return heights_.geometry(); }
+  const GridGeometry& geometry() const { return heights_.geometry(); }
   int tile_size() const { return tile_size_; }
 
  private:
-  grid::Heightmap heights_;
-  grid::CellMask known_;
+  Heightmap heights_;
+  CellMask known_;
   long long known_count_ = 0;
   int tile_size_;
   std::vector<CellIndex> trajectory_;

@@ -1,10 +1,10 @@
-#include "agent/reactive/behaviour.hpp"
+#include "marsala/agent/reactive/behaviour.hpp"
 
 #include <string>
 
-#include "agent/reactive/idle_behaviour.hpp"
-#include "agent/reactive/ramp_builder.hpp"
-#include "common/error.hpp"
+#include "marsala/agent/reactive/idle_behaviour.hpp"
+#include "marsala/agent/reactive/ramp_builder.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::agent::reactive {
 
@@ -26,9 +26,9 @@ std::unique_ptr<Behaviour> make_behaviour(const std::string& name, const AgentCo
   return registry.make(name, context);
 }
 
-bus::ActionRequest empty_request(const AgentContext& context, const bus::SensorFrame& frame,
+protocol::ActionRequest empty_request(const AgentContext& context, const protocol::SensorFrame& frame,
                                  const std::string& state) {
-  bus::ActionRequest request;
+  protocol::ActionRequest request;
   request.agent_id = context.agent_id;
   request.session = context.session;
   request.step = frame.step;
@@ -36,7 +36,7 @@ bus::ActionRequest empty_request(const AgentContext& context, const bus::SensorF
   return request;
 }
 
-void check_admission(const AgentContext& context, const bus::Admission& admission) {
+void check_admission(const AgentContext& context, const protocol::Admission& admission) {
   if (admission.agent_id != context.agent_id || admission.session != context.session || !admission.accepted)
     throw InvalidArgument("admission for agent " + std::to_string(admission.agent_id) + " (session " +
                           std::to_string(admission.session) + (admission.accepted ? "" : ", refused") +
@@ -47,7 +47,7 @@ void check_admission(const AgentContext& context, const bus::Admission& admissio
     throw InvalidArgument("admission: tile size must be >= 1, got " + std::to_string(admission.tile_size));
 }
 
-void check_frame(const AgentContext& context, const bus::SensorFrame& frame) {
+void check_frame(const AgentContext& context, const protocol::SensorFrame& frame) {
   if (frame.agent_id != context.agent_id)
     throw InvalidArgument("sensor frame for agent " + std::to_string(frame.agent_id) + " reached agent " +
                           std::to_string(context.agent_id));

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "agent/agent_context.hpp"
-#include "agent/detail/registry.hpp"
-#include "common/bus/messages.hpp"
+#include "marsala/agent/agent_context.hpp"
+#include "marsala/core/registry.hpp"
+#include "marsala/protocol/messages.hpp"
 
 namespace marsala::agent::reactive {
 
@@ -27,15 +27,15 @@ class Behaviour {
   virtual std::string state_name() const = 0;
   /// The world admitted the agent: grid, start, target and base become known. Throws InvalidArgument when the
   /// admission is for another agent or session, or its grid is invalid.
-  virtual void on_admission(const bus::Admission& admission) = 0;
+  virtual void on_admission(const protocol::Admission& admission) = 0;
   /// The request for this frame (same step, this agent's id and session). Throws InvalidArgument before
   /// admission, for another agent's frame, or for a frame whose tiles do not fit the grid. On a run_over frame
   /// it returns an empty request and the behaviour is done.
-  virtual bus::ActionRequest decide(const bus::SensorFrame& frame) = 0;
+  virtual protocol::ActionRequest decide(const protocol::SensorFrame& frame) = 0;
 };
 
 /// Behaviours by name; each is made from the agent's context (admission still empty).
-using BehaviourRegistry = detail::Registry<Behaviour, const AgentContext&>;
+using BehaviourRegistry = Registry<Behaviour, const AgentContext&>;
 
 /// An empty registry whose messages speak of behaviours.
 BehaviourRegistry make_behaviour_registry();
@@ -45,10 +45,10 @@ void register_builtins(BehaviourRegistry& registry);
 std::unique_ptr<Behaviour> make_behaviour(const std::string& name, const AgentContext& context);
 
 /// An empty request answering `frame`: the envelope filled, no motion, no deposition, no refill.
-bus::ActionRequest empty_request(const AgentContext& context, const bus::SensorFrame& frame, const std::string& state);
+protocol::ActionRequest empty_request(const AgentContext& context, const protocol::SensorFrame& frame, const std::string& state);
 /// Checks an admission against the context (id, session, grid); throws InvalidArgument when it does not fit.
-void check_admission(const AgentContext& context, const bus::Admission& admission);
+void check_admission(const AgentContext& context, const protocol::Admission& admission);
 /// Checks that a frame belongs to this agent; throws InvalidArgument otherwise.
-void check_frame(const AgentContext& context, const bus::SensorFrame& frame);
+void check_frame(const AgentContext& context, const protocol::SensorFrame& frame);
 
 }  // namespace marsala::agent::reactive

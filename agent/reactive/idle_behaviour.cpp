@@ -1,16 +1,16 @@
-#include "agent/reactive/idle_behaviour.hpp"
+#include "marsala/agent/reactive/idle_behaviour.hpp"
 
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::agent::reactive {
 
-void IdleBehaviour::on_admission(const bus::Admission& admission) {
+void IdleBehaviour::on_admission(const protocol::Admission& admission) {
   check_admission(context_, admission);
   context_.admission = admission;
   admitted_ = true;
 }
 
-bus::ActionRequest IdleBehaviour::decide(const bus::SensorFrame& frame) {
+protocol::ActionRequest IdleBehaviour::decide(const protocol::SensorFrame& frame) {
   if (!admitted_) throw InvalidArgument("idle behaviour: frame for step " + std::to_string(frame.step) +
                                         " before admission");
   check_frame(context_, frame);

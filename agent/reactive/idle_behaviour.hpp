@@ -2,7 +2,7 @@
 // "idle": answers every frame with an empty request. The lockstep benchmark's agent: it measures the runtime's
 // round trip without any terrain work.
 
-#include "agent/reactive/behaviour.hpp"
+#include "marsala/agent/reactive/behaviour.hpp"
 
 namespace marsala::agent::reactive {
 
@@ -12,8 +12,8 @@ class IdleBehaviour final : public Behaviour {
   explicit IdleBehaviour(const AgentContext& context) : context_(context) {}
   std::string name() const override { return "idle"; }
   std::string state_name() const override { return done_ ? "done" : admitted_ ? "idle" : "wait_admission"; }
-  void on_admission(const bus::Admission& admission) override;
-  bus::ActionRequest decide(const bus::SensorFrame& frame) override;
+  void on_admission(const protocol::Admission& admission) override;
+  protocol::ActionRequest decide(const protocol::SensorFrame& frame) override;
 
  private:
   AgentContext context_;

@@ -1,4 +1,4 @@
-#include "agent/reactive/ramp_builder.hpp"
+#include "marsala/agent/reactive/ramp_builder.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,8 +6,8 @@
 #include <utility>
 #include <vector>
 
-#include "common/error.hpp"
-#include "common/processing/navigability_processor.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::agent::reactive {
 namespace {
@@ -22,7 +22,7 @@ constexpr double kBaseMarginM = 1e-6;
 
 double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
-executive::Neighbourhood neighbourhood(const bus::SensorFrame& frame) {
+executive::Neighbourhood neighbourhood(const protocol::SensorFrame& frame) {
   return {frame.agent_id, {frame.x_m, frame.y_m}, frame.neighbours};
 }
 
@@ -72,8 +72,8 @@ RampState ramp_state_from_string(const std::string& name) {
 struct RampBuilder::Modules {
   executive::MappingSystem map;
   deliberative::LocalMapSynthesizer synthesizer;
-  deliberative::NavigablePathPlanner planner;  // deposition paths (eq. 4-5)
-  deliberative::NavigablePathPlanner router;   // shortest routes through navigable cells (alpha = 0)
+  NavigablePathPlanner planner;  // deposition paths (eq. 4-5)
+  NavigablePathPlanner router;   // shortest routes through navigable cells (alpha = 0)
   executive::ActionManager actions;
   executive::DepositionManager depositions;
   double return_below_m3;                      // less material than this on board: back to the base [m^3]
@@ -84,8 +84,8 @@ RampBuilder::RampBuilder(const AgentContext& context, RampBuilderOptions options
     : context_(context),
       options_(std::move(options)) {
   // Fail on an invalid body, construction or goal synthesizer name now rather than at admission.
-  (void)processing::NavigabilityProcessor(navigability_params(context_.body));
-  (void)processing::NavigabilityProcessor(construction_params(context_));
+  (void)NavigabilityProcessor(context_.body.navigability);
+  (void)NavigabilityProcessor(construction_params(context_));
   deliberative::require_goal_synthesizer(context_.task.goal_synthesizer);
   if (options_.pipeline) {
     PipelineParams p;
@@ -103,41 +103,39 @@ const executive::MappingSystem& RampBuilder::map() const {
   return modules_->map;
 }
 
-void RampBuilder::on_admission(const bus::Admission& admission) {
+void RampBuilder::on_admission(const protocol::Admission& admission) {
   check_admission(context_, admission);
   context_.admission = admission;
-  const grid::GridGeometry world = world_geometry(admission);
-  const bus::BodyParams& body = context_.body;
+  const GridGeometry world = world_geometry(admission);
+  const RobotBody& body = context_.body;
   const NavigabilityParams build = construction_params(context_);
-  bus::BodyParams footprint = body;
-  footprint.delta_m = build.delta_m;
-  deliberative::PlannerParams planner =
-      options_.planner ? *options_.planner : deliberative::default_planner_params(footprint, world.cell_size_m);
-  deliberative::PlannerParams router = planner;
+  PlannerParams planner =
+      options_.planner ? *options_.planner : default_planner_params(build.delta_m, world.cell_size_m);
+  PlannerParams router = planner;
   router.alpha = 0.0;
   router.beta = 1.0;
-  const double layer_m = cube_layer_m(body, world.cell_size_m);
+  const double layer_m = cube_layer_m(body.cube_size_m, world.cell_size_m);
   modules_ = std::make_unique<Modules>(Modules{
       executive::MappingSystem(world, admission.tile_size),
-      deliberative::LocalMapSynthesizer(navigability_params(body), body.sensing_range_m, build.kappa),
-      deliberative::NavigablePathPlanner(planner), deliberative::NavigablePathPlanner(router),
+      deliberative::LocalMapSynthesizer(body.navigability, body.sensing_range_m, build.kappa),
+      NavigablePathPlanner(planner), NavigablePathPlanner(router),
       executive::ActionManager(body.max_step_m),
       executive::DepositionManager(
           executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m, build.delta_m)),
       options_.pipeline ? std::min(body.max_deposit_m3, body.material_capacity_m3)
                         : layer_m * world.cell_size_m * world.cell_size_m,  // one cube
-      static_cast<int>(std::ceil((body.reach_m + body.delta_m) / body.max_step_m)) + 1});
+      static_cast<int>(std::ceil((body.reach_m + body.navigability.delta_m) / body.max_step_m)) + 1});
   goal_ = deliberative::make_goal_synthesizer(context_.task.goal_synthesizer, context_);
   state_ = RampState::kSurvey;
 }
 
-bus::ActionRequest RampBuilder::decide(const bus::SensorFrame& frame) {
+protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) {
   if (!modules_) throw InvalidArgument("ramp builder: frame for step " + std::to_string(frame.step) +
                                        " before admission");
   check_frame(context_, frame);
   trace_ = DecisionTrace{};
   trace_.before = state_;
-  bus::ActionRequest request = empty_request(context_, frame, "");
+  protocol::ActionRequest request = empty_request(context_, frame, "");
   if (frame.run_over || state_ == RampState::kDone) {
     state_ = RampState::kDone;
   } else {
@@ -180,21 +178,21 @@ bus::ActionRequest RampBuilder::decide(const bus::SensorFrame& frame) {
 
 bool RampBuilder::plan_path(const deliberative::LocalMap& local) {
   if (!trace_.planned) {
-    trace_.plan = modules_->planner.plan(local, local.robot, local.goal);
+    trace_.plan = modules_->planner.plan(local.gap, local.known, local.robot, local.goal);
     trace_.planned = true;
   }
   return trace_.plan.found;
 }
 
-void RampBuilder::move(const executive::Motion& motion, bus::ActionRequest& request) {
+void RampBuilder::move(const executive::Motion& motion, protocol::ActionRequest& request) {
   trace_.motion = motion;
   request.move = true;
   request.target_x_m = motion.target.x;
   request.target_y_m = motion.target.y;
 }
 
-void RampBuilder::deposit(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position at,
-                          std::size_t from, bus::ActionRequest& request) {
+void RampBuilder::deposit(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position at,
+                          std::size_t from, protocol::ActionRequest& request) {
   // The path from where the robot will stand: the cells it leaves behind are its way back, not work.
   const auto& path = trace_.plan.path;
   const std::vector<CellIndex> ahead(path.begin() + static_cast<std::ptrdiff_t>(std::min(from, path.size())),
@@ -203,8 +201,8 @@ void RampBuilder::deposit(const deliberative::LocalMap& local, const bus::Sensor
   request.depositions = trace_.deposition.depositions;
 }
 
-void RampBuilder::build_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame,
-                             bus::ActionRequest& request) {
+void RampBuilder::build_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,
+                             protocol::ActionRequest& request) {
   const Position robot{frame.x_m, frame.y_m};
   if (!plan_path(local)) return;  // no path through known cells: wait for the map to grow
   if (const auto motion = modules_->actions.advance(local, trace_.plan.path, robot)) {
@@ -224,8 +222,8 @@ void RampBuilder::build_step(const deliberative::LocalMap& local, const bus::Sen
   retreat_step(local, frame, request);
 }
 
-void RampBuilder::retreat_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame,
-                               bus::ActionRequest& request) {
+void RampBuilder::retreat_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,
+                               protocol::ActionRequest& request) {
   const Position robot{frame.x_m, frame.y_m};
   if (!plan_path(local)) {
     ++idle_retreat_moves_;
@@ -274,8 +272,8 @@ std::optional<executive::Motion> RampBuilder::step_back(const deliberative::Loca
   return modules_->actions.advance(local, route.path, robot);
 }
 
-void RampBuilder::pipeline_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position target,
-                                bus::ActionRequest& request) {
+void RampBuilder::pipeline_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position target,
+                                protocol::ActionRequest& request) {
   const Position robot{frame.x_m, frame.y_m};
   const PipelinePlace place = pipeline_->place(robot, target);
   trace_.role = place.role;
@@ -293,8 +291,8 @@ void RampBuilder::pipeline_step(const deliberative::LocalMap& local, const bus::
   }
 }
 
-void RampBuilder::follow_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position front,
-                              bus::ActionRequest& request) {
+void RampBuilder::follow_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position front,
+                              protocol::ActionRequest& request) {
   const Position robot{frame.x_m, frame.y_m};
   state_ = RampState::kHold;
   if (!plan_path(local)) return;
@@ -304,8 +302,8 @@ void RampBuilder::follow_step(const deliberative::LocalMap& local, const bus::Se
   state_ = RampState::kFollow;
 }
 
-void RampBuilder::back_off_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position front,
-                                bus::ActionRequest& request) {
+void RampBuilder::back_off_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position front,
+                                protocol::ActionRequest& request) {
   const Position robot{frame.x_m, frame.y_m};
   state_ = RampState::kBackOff;
   const auto motion = step_back(local, robot);
@@ -326,10 +324,10 @@ std::optional<CellIndex> RampBuilder::oldest_navigable_trajectory_cell(const del
   return std::nullopt;
 }
 
-void RampBuilder::return_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame,
-                              bus::ActionRequest& request) {
+void RampBuilder::return_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,
+                              protocol::ActionRequest& request) {
   const Position robot{frame.x_m, frame.y_m};
-  const bus::Admission& a = context_.admission;
+  const protocol::Admission& a = context_.admission;
   const Position base{a.base_x_m, a.base_y_m};
   const double radius = a.base_radius_m - kBaseMarginM;
   if (distance(robot, base) <= radius) {

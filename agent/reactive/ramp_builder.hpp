@@ -46,15 +46,15 @@
 #include <optional>
 #include <string>
 
-#include "agent/agent_context.hpp"
-#include "agent/deliberative/goal_synthesizer.hpp"
-#include "agent/deliberative/local_map_synthesizer.hpp"
-#include "agent/deliberative/navigable_path_planner.hpp"
-#include "agent/executive/action_manager.hpp"
-#include "agent/executive/deposition_manager.hpp"
-#include "agent/executive/mapping_system.hpp"
-#include "agent/reactive/behaviour.hpp"
-#include "agent/reactive/pipeline.hpp"
+#include "marsala/agent/agent_context.hpp"
+#include "marsala/agent/deliberative/goal_synthesizer.hpp"
+#include "marsala/agent/deliberative/local_map_synthesizer.hpp"
+#include "marsala/core/navigable_path_planner.hpp"
+#include "marsala/agent/executive/action_manager.hpp"
+#include "marsala/agent/executive/deposition_manager.hpp"
+#include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/agent/reactive/behaviour.hpp"
+#include "marsala/agent/reactive/pipeline.hpp"
 
 namespace marsala::agent::reactive {
 
@@ -81,7 +81,7 @@ RampState ramp_state_from_string(const std::string& name);
 /// Options of the ramp builder. The goal synthesizer is the context's task.goal_synthesizer; what it builds (MARS
 /// kappa, band width) is construction_params(context).
 struct RampBuilderOptions {
-  std::optional<deliberative::PlannerParams> planner;  ///< default: default_planner_params for the construction width
+  std::optional<PlannerParams> planner;  ///< default: default_planner_params for the construction width
   bool pipeline = false;                               ///< true: "path_builder", the construction pipeline
 };
 
@@ -94,7 +94,7 @@ struct DecisionTrace {
   std::optional<CellIndex> local_origin;    ///< local index
   long long navigable_cells = 0;            ///< cells navigable from the robot in the local map [count]
   bool planned = false;                     ///< a deposition path was planned
-  deliberative::PlannerResult plan;         ///< path in local indices
+  PlannerResult plan;         ///< path in local indices
   std::optional<executive::Motion> motion;  ///< local indices
   std::optional<PipelineRole> role;         ///< path_builder: the pipeline role of this frame
   executive::DepositionPlan deposition;
@@ -110,8 +110,8 @@ class RampBuilder final : public Behaviour {
 
   std::string name() const override { return options_.pipeline ? "path_builder" : "ramp_builder"; }
   std::string state_name() const override { return to_string(state_); }
-  void on_admission(const bus::Admission& admission) override;
-  bus::ActionRequest decide(const bus::SensorFrame& frame) override;
+  void on_admission(const protocol::Admission& admission) override;
+  protocol::ActionRequest decide(const protocol::SensorFrame& frame) override;
 
   RampState state() const { return state_; }
   const DecisionTrace& last_trace() const { return trace_; }
@@ -120,22 +120,22 @@ class RampBuilder final : public Behaviour {
 
  private:
   struct Modules;
-  void build_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, bus::ActionRequest& request);
-  void retreat_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, bus::ActionRequest& request);
-  void return_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, bus::ActionRequest& request);
-  void pipeline_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position target,
-                     bus::ActionRequest& request);
-  void follow_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position front,
-                   bus::ActionRequest& request);
-  void back_off_step(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position front,
-                     bus::ActionRequest& request);
+  void build_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, protocol::ActionRequest& request);
+  void retreat_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, protocol::ActionRequest& request);
+  void return_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, protocol::ActionRequest& request);
+  void pipeline_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position target,
+                     protocol::ActionRequest& request);
+  void follow_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position front,
+                   protocol::ActionRequest& request);
+  void back_off_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position front,
+                     protocol::ActionRequest& request);
   std::optional<executive::Motion> step_back(const deliberative::LocalMap& local, Position robot);
   bool plan_path(const deliberative::LocalMap& local);
   std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
   static std::optional<CellIndex> farthest_navigable_from_goal(const deliberative::LocalMap& local);
-  void deposit(const deliberative::LocalMap& local, const bus::SensorFrame& frame, Position at, std::size_t from,
-               bus::ActionRequest& request);
-  void move(const executive::Motion& motion, bus::ActionRequest& request);
+  void deposit(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position at, std::size_t from,
+               protocol::ActionRequest& request);
+  void move(const executive::Motion& motion, protocol::ActionRequest& request);
 
   AgentContext context_;
   RampBuilderOptions options_;

@@ -1,11 +1,11 @@
-#include "agent/runtime/agent_runtime.hpp"
+#include "marsala/agent/runtime/agent_runtime.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <random>
 
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::agent::runtime {
 namespace {
@@ -48,7 +48,7 @@ AgentRuntime::AgentRuntime(bus::Participant& participant, RuntimeConfig config)
   context.body = config_.body;
   context.neighbour_keep_out_m = config_.neighbour_keep_out_m > 0.0
                                      ? config_.neighbour_keep_out_m
-                                     : neighbour_keep_out_m(config_.body.delta_m, config_.body.max_step_m);
+                                     : neighbour_keep_out_m(config_.body.navigability.delta_m, config_.body.max_step_m);
   context.seed = config_.seed;
   context.task = config_.task;
   behaviour_ = reactive::make_behaviour(config_.behaviour, context);
@@ -58,17 +58,17 @@ AgentRuntime::~AgentRuntime() = default;
 
 RunResult AgentRuntime::run(const std::atomic<bool>& stop) {
   RunResult result;
-  bus::Admission admission;
+  protocol::Admission admission;
   if (admit(stop, result, admission)) lockstep(stop, admission, result);
   result.final_state = behaviour_->state_name();
   return result;
 }
 
-bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, bus::Admission& admission) {
+bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, protocol::Admission& admission) {
   auto signal = std::make_shared<bus::Signal>();
-  auto hellos = participant_.create_writer<bus::AgentHello>({"", nullptr, bus::Durability::kVolatile, 64});
-  auto admissions = participant_.create_reader<bus::Admission>({"", signal, bus::Durability::kVolatile, 64});
-  bus::AgentHello hello;
+  auto hellos = participant_.create_writer<protocol::AgentHello>({"", nullptr, bus::Durability::kVolatile, 64});
+  auto admissions = participant_.create_reader<protocol::Admission>({"", signal, bus::Durability::kVolatile, 64});
+  protocol::AgentHello hello;
   hello.agent_id = config_.agent_id;
   hello.session = config_.session;
   hello.name = config_.name;
@@ -92,7 +92,7 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, bus::
       next_hello = now + config_.hello_period;
     }
     signal->wait_until(std::min({next_hello, deadline, now + kStopPoll}));
-    for (const bus::Admission& a : admissions->take()) {
+    for (const protocol::Admission& a : admissions->take()) {
       if (a.agent_id != config_.agent_id || a.session != config_.session) continue;  // someone else's answer
       if (!a.accepted) {
         result.outcome = RunOutcome::kRefused;
@@ -112,11 +112,11 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, bus::
   return false;
 }
 
-void AgentRuntime::lockstep(const std::atomic<bool>& stop, const bus::Admission& admission, RunResult& result) {
-  const std::string partition = bus::partition_for(admission.run_id, config_.agent_id);
+void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admission& admission, RunResult& result) {
+  const std::string partition = protocol::partition_for(admission.run_id, config_.agent_id);
   auto signal = std::make_shared<bus::Signal>();
-  auto frames = participant_.create_reader<bus::SensorFrame>({partition, signal, bus::Durability::kVolatile, 64});
-  auto requests = participant_.create_writer<bus::ActionRequest>({partition, nullptr, bus::Durability::kVolatile, 64});
+  auto frames = participant_.create_reader<protocol::SensorFrame>({partition, signal, bus::Durability::kVolatile, 64});
+  auto requests = participant_.create_writer<protocol::ActionRequest>({partition, nullptr, bus::Durability::kVolatile, 64});
   bool answered_any = false;
   std::uint64_t last_answered = 0;
   Clock::time_point deadline = Clock::now() + config_.world_timeout;
@@ -129,7 +129,7 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const bus::Admission&
       return;
     }
     signal->wait_until(std::min(deadline, now + kStopPoll));
-    for (const bus::SensorFrame& frame : frames->take()) {
+    for (const protocol::SensorFrame& frame : frames->take()) {
       if (frame.agent_id != config_.agent_id) {
         spdlog::warn("agent {}: ignoring a frame addressed to agent {}", config_.agent_id, frame.agent_id);
         continue;
@@ -137,7 +137,7 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const bus::Admission&
       ++result.frames;
       result.last_step = frame.step;
       deadline = Clock::now() + config_.world_timeout;
-      if (frame.last_result == bus::ActionResult::kRejected) {
+      if (frame.last_result == protocol::ActionResult::kRejected) {
         ++result.rejected;
         spdlog::warn("agent {}: request before step {} rejected: {}", config_.agent_id, frame.step,
                      frame.last_reason);

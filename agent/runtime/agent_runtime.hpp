@@ -15,9 +15,9 @@
 #include <memory>
 #include <string>
 
-#include "agent/reactive/behaviour.hpp"
-#include "common/bus/bus.hpp"
-#include "common/bus/messages.hpp"
+#include "marsala/agent/reactive/behaviour.hpp"
+#include "marsala/bus/bus.hpp"
+#include "marsala/protocol/messages.hpp"
 
 namespace marsala::agent::runtime {
 
@@ -26,7 +26,7 @@ struct RuntimeConfig {
   std::uint32_t agent_id = 0;                       ///< >= 1: the scenario slot
   std::string name;                                 ///< human-readable, e.g. "husky-3"
   std::string behaviour = "ramp_builder";           ///< reactive behaviour by name
-  bus::BodyParams body;                             ///< declared in the hello; the world checks it
+  RobotBody body;                             ///< declared in the hello; the world checks it
   std::uint64_t session = 0;                        ///< 0: a random one (random_session())
   double neighbour_keep_out_m = 0.0;                ///< 0: delta/2 + max_step of this body [m]
   std::uint64_t seed = 1;                           ///< scenario seed
@@ -72,8 +72,8 @@ class AgentRuntime {
   const RuntimeConfig& config() const { return config_; }
 
  private:
-  bool admit(const std::atomic<bool>& stop, RunResult& result, bus::Admission& admission);
-  void lockstep(const std::atomic<bool>& stop, const bus::Admission& admission, RunResult& result);
+  bool admit(const std::atomic<bool>& stop, RunResult& result, protocol::Admission& admission);
+  void lockstep(const std::atomic<bool>& stop, const protocol::Admission& admission, RunResult& result);
 
   bus::Participant& participant_;
   RuntimeConfig config_;

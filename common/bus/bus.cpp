@@ -1,7 +1,7 @@
-#include "common/bus/bus.hpp"
+#include "marsala/bus/bus.hpp"
 
-#include "common/bus/detail/backends.hpp"
-#include "common/error.hpp"
+#include "marsala/bus/detail/backends.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::bus {
 

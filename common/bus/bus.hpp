@@ -5,7 +5,7 @@
 //
 //   auto participant = bus::make_participant({bus::Vendor::kCyclone, domain_id});
 //   auto signal = std::make_shared<bus::Signal>();
-//   auto frames = participant->create_reader<bus::SensorFrame>({bus::partition_for(run, id), signal});
+//   auto frames = participant->create_reader<protocol::SensorFrame>({protocol::partition_for(run, id), signal});
 //   while (signal->wait_for(100ms)) for (auto& f : frames->take()) ...
 //
 // Threads: backends deliver on their own threads; readers queue samples and notify the endpoint's Signal.
@@ -19,9 +19,19 @@
 #include <string>
 #include <vector>
 
-#include "common/bus/messages.hpp"
+#include "marsala/protocol/messages.hpp"
+
+/// The message types the bus carries, in one place: X(Type) once for each protocol message that has its own topic.
+/// Participant's interface, each backend's endpoints and the topic names ("marsala_<Type>") are all made from it,
+/// so adding a message means adding it here, to idl/marsala.idl and to each backend's converter.
+#define MARSALA_BUS_MESSAGES(X) X(AgentHello) X(Admission) X(SensorFrame) X(ActionRequest) X(WorldStatus) X(WorldEvent)
 
 namespace marsala::bus {
+
+// The bus speaks of the protocol's messages by their own names.
+#define MARSALA_BUS_USING(T) using protocol::T;
+MARSALA_BUS_MESSAGES(MARSALA_BUS_USING)
+#undef MARSALA_BUS_USING
 
 /// The DDS implementation behind a participant.
 enum class Vendor { kCyclone, kFastDds, kInProcess };
@@ -100,18 +110,11 @@ class Participant {
   }
 
  protected:
-  virtual std::unique_ptr<Writer<AgentHello>> make_writer(Tag<AgentHello>, const EndpointOptions&) = 0;
-  virtual std::unique_ptr<Writer<Admission>> make_writer(Tag<Admission>, const EndpointOptions&) = 0;
-  virtual std::unique_ptr<Writer<SensorFrame>> make_writer(Tag<SensorFrame>, const EndpointOptions&) = 0;
-  virtual std::unique_ptr<Writer<ActionRequest>> make_writer(Tag<ActionRequest>, const EndpointOptions&) = 0;
-  virtual std::unique_ptr<Writer<WorldStatus>> make_writer(Tag<WorldStatus>, const EndpointOptions&) = 0;
-  virtual std::unique_ptr<Writer<WorldEvent>> make_writer(Tag<WorldEvent>, const EndpointOptions&) = 0;
-  virtual std::unique_ptr<Reader<AgentHello>> make_reader(Tag<AgentHello>, const EndpointOptions&) = 0;
-  virtual std::unique_ptr<Reader<Admission>> make_reader(Tag<Admission>, const EndpointOptions&) = 0;
-  virtual std::unique_ptr<Reader<SensorFrame>> make_reader(Tag<SensorFrame>, const EndpointOptions&) = 0;
-  virtual std::unique_ptr<Reader<ActionRequest>> make_reader(Tag<ActionRequest>, const EndpointOptions&) = 0;
-  virtual std::unique_ptr<Reader<WorldStatus>> make_reader(Tag<WorldStatus>, const EndpointOptions&) = 0;
-  virtual std::unique_ptr<Reader<WorldEvent>> make_reader(Tag<WorldEvent>, const EndpointOptions&) = 0;
+#define MARSALA_BUS_ENDPOINTS(T)                                                              \
+  virtual std::unique_ptr<Writer<T>> make_writer(Tag<T>, const EndpointOptions&) = 0; \
+  virtual std::unique_ptr<Reader<T>> make_reader(Tag<T>, const EndpointOptions&) = 0;
+  MARSALA_BUS_MESSAGES(MARSALA_BUS_ENDPOINTS)
+#undef MARSALA_BUS_ENDPOINTS
 };
 
 /// How to make a participant.

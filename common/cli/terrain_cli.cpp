@@ -1,4 +1,4 @@
-#include "common/cli/terrain_cli.hpp"
+#include "marsala/cli/terrain_cli.hpp"
 
 
 #include <algorithm>
@@ -11,19 +11,19 @@
 #include <utility>
 #include <vector>
 
-#include "common/cli/command_line.hpp"
-#include "common/error.hpp"
-#include "common/grid/heightmap.hpp"
-#include "common/processing/deposition.hpp"
-#include "common/processing/mars_processor.hpp"
-#include "common/processing/navigability_processor.hpp"
-#include "common/render/png_writer.hpp"
-#include "common/render/terrain_renderer.hpp"
-#include "common/terrain/asc_io.hpp"
-#include "common/terrain/generators.hpp"
-#include "common/terrain/geotiff_import.hpp"
-#include "common/terrain/resample.hpp"
-#include "common/terrain/terrain_stats.hpp"
+#include "marsala/cli/command_line.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/deposition.hpp"
+#include "marsala/core/mars_processor.hpp"
+#include "marsala/core/navigability_processor.hpp"
+#include "marsala/render/png_writer.hpp"
+#include "marsala/render/terrain_renderer.hpp"
+#include "marsala/terrain/asc_io.hpp"
+#include "marsala/terrain/generators.hpp"
+#include "marsala/terrain/geotiff_import.hpp"
+#include "marsala/terrain/resample.hpp"
+#include "marsala/terrain/terrain_stats.hpp"
 
 namespace marsala::cli {
 namespace {
@@ -45,16 +45,16 @@ bool has_tiff_extension(const std::string& path) {
   return ends_with(".tif") || ends_with(".tiff");
 }
 
-grid::Heightmap load_terrain(const std::string& path, bool fill_nodata) {
+Heightmap load_terrain(const std::string& path, bool fill_nodata) {
   if (has_tiff_extension(path)) return terrain::read_geotiff(path, terrain::GeoTiffOptions{fill_nodata});
   return terrain::read_asc(path, terrain::AscReadOptions{fill_nodata});
 }
 
-grid::Heightmap mask_as_heights(const grid::CellMask& mask, const grid::GridGeometry& geometry) {
-  return grid::Heightmap(geometry, mask.cast<double>().eval());
+Heightmap mask_as_heights(const CellMask& mask, const GridGeometry& geometry) {
+  return Heightmap(geometry, mask.cast<double>().eval());
 }
 
-long long count(const grid::CellMask& mask) { return mask.cast<long long>().sum(); }
+long long count(const CellMask& mask) { return mask.cast<long long>().sum(); }
 
 std::string percent(long long part, long long whole) {
   std::ostringstream s;
@@ -114,7 +114,7 @@ void add_navigability_options(CLI::App& cmd, NavigabilityParams& params, bool re
 
 CellIndex to_cell(const std::pair<int, int>& rc) { return CellIndex{rc.first, rc.second}; }
 
-void check_origin(const grid::Heightmap& map, CellIndex origin) {
+void check_origin(const Heightmap& map, CellIndex origin) {
   if (!map.contains(origin))
     throw InvalidArgument("origin cell (" + std::to_string(origin.row) + ", " + std::to_string(origin.col) +
                           ") is off the " + std::to_string(map.rows()) + " x " + std::to_string(map.cols()) +
@@ -213,7 +213,7 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
   try {
     if (*generate) {
       spec.params = parse_params(param_pairs);
-      grid::Heightmap map;
+      Heightmap map;
       try {
         map = terrain::generate_terrain(method, spec);
       } catch (const InvalidArgument& e) {
@@ -223,19 +223,19 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       out << "generated " << method << " " << map.rows() << " x " << map.cols() << " at " << map.cell_size_m()
           << " m, heights " << map.min_height() << " .. " << map.max_height() << " m -> " << out_path << "\n";
     } else if (*import) {
-      grid::Heightmap map = load_terrain(in_path, fill_nodata);
+      Heightmap map = load_terrain(in_path, fill_nodata);
       if (!crop.empty()) map = terrain::crop(map, crop[0], crop[1], crop[2], crop[3]);
       if (target_cell_size > 0.0) map = terrain::resample_bilinear(map, target_cell_size);
       if (zero_base) map.heights().array() -= map.min_height();
       // The written grid starts its own local frame at (0, 0).
-      grid::GridGeometry local = map.geometry();
+      GridGeometry local = map.geometry();
       local.xll_m = 0.0;
       local.yll_m = 0.0;
-      terrain::write_asc(grid::Heightmap(local, map.heights()), out_path);
+      terrain::write_asc(Heightmap(local, map.heights()), out_path);
       out << "imported " << in_path << ": " << map.rows() << " x " << map.cols() << " at " << map.cell_size_m()
           << " m -> " << out_path << "\n";
     } else if (*info) {
-      const grid::Heightmap map = load_terrain(in_path, fill_nodata);
+      const Heightmap map = load_terrain(in_path, fill_nodata);
       const terrain::TerrainStats s = terrain::compute_terrain_stats(map);
       const auto& g = map.geometry();
       out << std::setprecision(6) << "file        " << in_path << "\n"
@@ -247,17 +247,17 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
           << " m, relief " << s.max_height_m - s.min_height_m << " m)\n"
           << "mean slope  " << s.mean_slope << " (rise over run; max " << s.max_slope << ")\n";
     } else if (*mars) {
-      const grid::Heightmap map = load_terrain(in_path, fill_nodata);
-      const processing::MarsProcessor processor(kappa);
-      const grid::Heightmap bound = processor.project(map);
-      grid::Heightmap gap(map.geometry(), (bound.heights() - map.heights()).eval());
+      const Heightmap map = load_terrain(in_path, fill_nodata);
+      const MarsProcessor processor(kappa);
+      const Heightmap bound = processor.project(map);
+      Heightmap gap(map.geometry(), (bound.heights() - map.heights()).eval());
       terrain::write_asc(write_gap ? gap : bound, out_path);
-      out << "MARS at kappa " << kappa << ": gap volume " << processing::deposition_target_volume(gap)
+      out << "MARS at kappa " << kappa << ": gap volume " << deposition_target_volume(gap)
           << " m^3, largest gap " << gap.max_height() << " m -> " << out_path << "\n";
     } else if (*navigable) {
-      const grid::Heightmap map = load_terrain(in_path, fill_nodata);
-      const processing::NavigabilityProcessor processor(nav_params);
-      const grid::CellMask occupiable = processor.occupiable(map);
+      const Heightmap map = load_terrain(in_path, fill_nodata);
+      const NavigabilityProcessor processor(nav_params);
+      const CellMask occupiable = processor.occupiable(map);
       if (write_occupiable) {
         terrain::write_asc(mask_as_heights(occupiable, map.geometry()), out_path);
         out << "occupiable " << count(occupiable) << " of " << map.size() << " cells ("
@@ -265,7 +265,7 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       } else {
         if (origin_option->count() == 0) throw UsageError("navigable: --origin-cell ROW COL is required");
         check_origin(map, to_cell(origin));
-        const grid::CellMask reach = processing::NavigabilityProcessor::navigable_from(occupiable, to_cell(origin));
+        const CellMask reach = NavigabilityProcessor::navigable_from(occupiable, to_cell(origin));
         terrain::write_asc(mask_as_heights(reach, map.geometry()), out_path);
         out << "navigable from (" << origin.first << ", " << origin.second << "): " << count(reach) << " of "
             << map.size() << " cells (" << percent(count(reach), map.size()) << "); occupiable "
@@ -273,23 +273,23 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
         if (count(reach) == 0) out << "note: the origin cell is not occupiable, so nothing is navigable\n";
       }
     } else if (*render) {
-      const grid::Heightmap map = load_terrain(in_path, fill_nodata);
+      const Heightmap map = load_terrain(in_path, fill_nodata);
       render::RenderOptions options;
       options.title = title;
       options.max_size_px = max_size_px;
       if (!render_origins.empty()) {
-        const processing::NavigabilityProcessor processor(render_params);
-        const grid::CellMask occupiable = processor.occupiable(map);
-        grid::CellMask reach = grid::CellMask::Zero(map.rows(), map.cols());
+        const NavigabilityProcessor processor(render_params);
+        const CellMask occupiable = processor.occupiable(map);
+        CellMask reach = CellMask::Zero(map.rows(), map.cols());
         for (const auto& rc : render_origins) {
           const CellIndex origin_cell = to_cell(rc);
           check_origin(map, origin_cell);
-          reach = reach.cwiseMax(processing::NavigabilityProcessor::navigable_from(occupiable, origin_cell));
+          reach = reach.cwiseMax(NavigabilityProcessor::navigable_from(occupiable, origin_cell));
           options.markers.push_back(origin_cell);
         }
         options.navigable = reach;
       }
-      if (render_gap) options.gap = processing::MarsProcessor(render_params.kappa).gap(map);
+      if (render_gap) options.gap = MarsProcessor(render_params.kappa).gap(map);
       render::write_png(render::render_terrain(map, options), out_path);
       out << "rendered " << map.rows() << " x " << map.cols() << " -> " << out_path << "\n";
     }

@@ -1,10 +1,10 @@
-#include "common/render/png_writer.hpp"
+#include "marsala/render/png_writer.hpp"
 
 #include <png.h>
 
 #include <cstring>
 
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::render {
 

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "common/render/image.hpp"
+#include "marsala/render/image.hpp"
 
 namespace marsala::render {
 

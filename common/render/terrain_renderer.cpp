@@ -1,12 +1,12 @@
-#include "common/render/terrain_renderer.hpp"
+#include "marsala/render/terrain_renderer.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include "common/error.hpp"
-#include "common/render/detail/colormap.hpp"
-#include "common/render/detail/raster.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/render/detail/colormap.hpp"
+#include "marsala/render/detail/raster.hpp"
 
 namespace marsala::render {
 namespace {
@@ -117,7 +117,7 @@ Colour shade(Colour c, double light) {
   return detail::mix(scaled, {255.0, 255.0, 255.0}, std::min(1.0, 0.6 * (k - k_fit)));
 }
 
-void validate(const grid::Heightmap& map, const RenderOptions& o) {
+void validate(const Heightmap& map, const RenderOptions& o) {
   if (map.rows() <= 0 || map.cols() <= 0 || map.heights().size() != map.size())
     throw InvalidArgument("render_terrain: the heightmap is empty");
   for (int r = 0; r < map.rows(); ++r)
@@ -209,8 +209,8 @@ struct PixelMapper {
   double y(const Position& p) const { return (y_top - p.y) * per_m; }
 };
 
-PixelMapper pixel_mapper(const grid::Heightmap& map, const Sampling& s) {
-  const grid::GridGeometry& g = map.geometry();
+PixelMapper pixel_mapper(const Heightmap& map, const Sampling& s) {
+  const GridGeometry& g = map.geometry();
   return {g.xll_m, g.yll_m + g.rows * g.cell_size_m, static_cast<double>(s.scale) / (s.factor * g.cell_size_m)};
 }
 
@@ -259,7 +259,7 @@ void draw_point(Image& img, double x, double y, PointShape shape, double r, Rgb 
 }
 
 /// Rectangles, circles, polylines and arrows, each kind with its halo under it.
-void draw_overlays(Image& img, const grid::Heightmap& map, const RenderOptions& o, const Sampling& s) {
+void draw_overlays(Image& img, const Heightmap& map, const RenderOptions& o, const Sampling& s) {
   const PixelMapper px = pixel_mapper(map, s);
   const double longest = std::max(img.width, img.height);
   const double thin = std::clamp(longest / 400.0, 1.0, 4.0);
@@ -290,7 +290,7 @@ void draw_overlays(Image& img, const grid::Heightmap& map, const RenderOptions& 
     for (const Arrow& a : o.arrows) draw_arrow(img, px, a, thin, halo);
 }
 
-void draw_points(Image& img, const grid::Heightmap& map, const RenderOptions& o, const Sampling& s) {
+void draw_points(Image& img, const Heightmap& map, const RenderOptions& o, const Sampling& s) {
   const PixelMapper px = pixel_mapper(map, s);
   const double auto_r = std::clamp(std::max(img.width, img.height) / 120.0, 3.0, 10.0);
   for (const PointMark& p : o.points) {
@@ -308,7 +308,7 @@ struct TerrainLayer {
   double max_gap;  // 0 when there is no gap above the threshold
 };
 
-TerrainLayer draw_terrain(const grid::Heightmap& map, const RenderOptions& o, const Sampling& s) {
+TerrainLayer draw_terrain(const Heightmap& map, const RenderOptions& o, const Sampling& s) {
   TerrainLayer layer{{}, map.min_height(), map.max_height(), 0.0};
   const std::vector<double> heights = block_mean(map.heights(), s);
   const std::vector<double> light = hillshade(heights, s.rows, s.cols, map.cell_size_m() * s.factor);
@@ -497,7 +497,7 @@ void draw_swatch(Image& img, int x, int y, int side, const LegendEntry& e) {
   }
 }
 
-Image compose(const TerrainLayer& layer, const grid::Heightmap& map, const RenderOptions& o, const Sampling& s) {
+Image compose(const TerrainLayer& layer, const Heightmap& map, const RenderOptions& o, const Sampling& s) {
   const int tw = layer.image.width, th = layer.image.height;
   const int font = std::clamp((std::max(tw, th) + 559) / 560, 1, 4);  // font pixel size [px]
   const int title_font = font + 1;
@@ -582,7 +582,7 @@ Rgb label_colour(std::uint32_t label, const std::vector<Rgb>& palette) {
   return p[(label == 0 ? 0 : label - 1) % p.size()];
 }
 
-Image render_terrain(const grid::Heightmap& map, const RenderOptions& options) {
+Image render_terrain(const Heightmap& map, const RenderOptions& options) {
   validate(map, options);
   const Sampling s = choose_sampling(map.rows(), map.cols(), options.max_size_px);
   TerrainLayer layer = draw_terrain(map, options, s);

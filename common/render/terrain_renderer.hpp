@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "common/grid/heightmap.hpp"
-#include "common/render/image.hpp"
-#include "common/types.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/render/image.hpp"
+#include "marsala/core/types.hpp"
 
 namespace marsala::render {
 
@@ -89,8 +89,8 @@ struct LegendEntry {
 
 /// What to draw over the hillshaded, colour-mapped terrain.
 struct RenderOptions {
-  std::optional<grid::CellMask> navigable;   ///< tint navigable cells (translucent green), outline its border
-  std::optional<grid::Heightmap> gap;        ///< MARS gap [m]: a heat overlay where gap > 1e-9 m
+  std::optional<CellMask> navigable;   ///< tint navigable cells (translucent green), outline its border
+  std::optional<Heightmap> gap;        ///< MARS gap [m]: a heat overlay where gap > 1e-9 m
   std::vector<CellIndex> markers;            ///< e.g. navigability origins: drawn as crosses
   std::optional<CellLabels> labels;          ///< tint labelled cells with their palette colour (below the overlays)
   std::vector<Rgb> palette;                  ///< colours of labels 1, 2, ...; empty = default_palette()
@@ -111,6 +111,6 @@ struct RenderOptions {
 /// its labelled cells. Throws InvalidArgument for an empty map, a non-finite height or gap, an overlay or label grid
 /// of another size, a marker off the grid, a non-finite overlay coordinate, size or width, label_alpha outside
 /// [0, 1], or max_size_px outside [1, 16384].
-Image render_terrain(const grid::Heightmap& map, const RenderOptions& options = {});
+Image render_terrain(const Heightmap& map, const RenderOptions& options = {});
 
 }  // namespace marsala::render

@@ -1,6 +1,6 @@
-#include "common/scenario/scenario.hpp"
+#include "marsala/scenario/scenario.hpp"
 
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::scenario {
 

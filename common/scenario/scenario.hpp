@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "common/bus/messages.hpp"
-#include "common/processing/goal_vector_map.hpp"
+#include "marsala/core/robot_body.hpp"
+#include "marsala/core/goal_vector_map.hpp"
 
 namespace marsala::scenario {
 
@@ -47,7 +47,7 @@ struct Pipeline {
 struct RobotType {
   std::string name;                          ///< e.g. "husky"
   std::string behaviour = "ramp_builder";    ///< reactive behaviour by name (agent registry)
-  bus::BodyParams body;
+  RobotBody body;
   Construction construction;                 ///< defaults to the body's kappa, eps and delta
   Pipeline pipeline;
   std::string goal_synthesizer = "fixed_target";  ///< goal synthesizer by name (agent registry)
@@ -92,8 +92,6 @@ struct Site {
   std::uint32_t check_every_steps = 10;
 };
 
-/// The goal vector map's specification (paper §V-B, Fig. 6), compiled by processing::GoalVectorMap.
-using GoalVectorMapSpec = processing::GoalVectorMapSpec;
 
 /// The base station: material is refilled only within radius of its centre.
 struct BaseStation {

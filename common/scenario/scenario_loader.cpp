@@ -9,11 +9,12 @@
 #include <fstream>
 #include <sstream>
 
-#include "common/error.hpp"
-#include "common/scenario/body_check.hpp"
-#include "common/scenario/scenario.hpp"
-#include "common/scenario/terrain_builder.hpp"
-#include "common/terrain/generators.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
+#include "marsala/core/robot_body.hpp"
+#include "marsala/scenario/scenario.hpp"
+#include "marsala/scenario/terrain_builder.hpp"
+#include "marsala/terrain/generators.hpp"
 #include "idl/scenario.pb.h"
 
 namespace marsala::scenario {
@@ -53,12 +54,6 @@ class FirstErrorCollector final : public google::protobuf::io::ErrorCollector {
   std::string message_;
 };
 
-std::string format(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 /// Validation of one scenario: each failure names the source and the field.
 class Validator {
  public:
@@ -68,11 +63,11 @@ class Validator {
     throw InvalidArgument("scenario " + source_ + ": " + field + ": " + problem);
   }
   double finite(const std::string& field, double v) const {
-    if (!std::isfinite(v) || std::abs(v) >= kMaxMagnitude) fail(field, format(v) + " must be finite and < 1e6 in magnitude");
+    if (!std::isfinite(v) || std::abs(v) >= kMaxMagnitude) fail(field, fmt::format("{}", v) + " must be finite and < 1e6 in magnitude");
     return v;
   }
   double positive(const std::string& field, double v) const {
-    if (!(finite(field, v) > 0.0)) fail(field, format(v) + " must be > 0");
+    if (!(finite(field, v) > 0.0)) fail(field, fmt::format("{}", v) + " must be > 0");
     return v;
   }
 
@@ -121,11 +116,11 @@ TerrainSource to_terrain(const proto::TerrainSource& p, const Validator& check) 
   return t;
 }
 
-bus::BodyParams to_body(const proto::Body& p) {
-  bus::BodyParams b;
-  if (p.has_kappa()) b.kappa = p.kappa();
-  if (p.has_delta_m()) b.delta_m = p.delta_m();
-  if (p.has_eps_m()) b.eps_m = p.eps_m();
+RobotBody to_body(const proto::Body& p) {
+  RobotBody b;
+  if (p.has_kappa()) b.navigability.kappa = p.kappa();
+  if (p.has_delta_m()) b.navigability.delta_m = p.delta_m();
+  if (p.has_eps_m()) b.navigability.eps_m = p.eps_m();
   if (p.has_max_step_m()) b.max_step_m = p.max_step_m();
   if (p.has_max_deposit_m3()) b.max_deposit_m3 = p.max_deposit_m3();
   if (p.has_material_capacity_m3()) b.material_capacity_m3 = p.material_capacity_m3();
@@ -167,18 +162,18 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     const std::string problem = body_problem(t.body);
     if (!problem.empty()) check.fail(field + ".body", problem);
     const proto::Construction& cp = rp.construction();
-    t.construction.kappa = cp.has_kappa() ? check.positive(field + ".construction.kappa", cp.kappa()) : t.body.kappa;
-    t.construction.eps_m = cp.has_eps_m() ? check.finite(field + ".construction.eps_m", cp.eps_m()) : t.body.eps_m;
+    t.construction.kappa = cp.has_kappa() ? check.positive(field + ".construction.kappa", cp.kappa()) : t.body.navigability.kappa;
+    t.construction.eps_m = cp.has_eps_m() ? check.finite(field + ".construction.eps_m", cp.eps_m()) : t.body.navigability.eps_m;
     if (t.construction.eps_m < 0.0) check.fail(field + ".construction.eps_m", "must be >= 0");
     t.construction.width_m =
-        cp.has_width_m() ? check.positive(field + ".construction.width_m", cp.width_m()) : t.body.delta_m;
-    if (t.construction.kappa > t.body.kappa)
-      check.fail(field + ".construction.kappa", format(t.construction.kappa) + " exceeds the body's kappa " +
-                                                    format(t.body.kappa) + ": the builder could not climb what it builds");
-    if (t.construction.width_m > 2.0 * t.body.reach_m + t.body.delta_m)
-      check.fail(field + ".construction.width_m", format(t.construction.width_m) + " is wider than the robot can reach " +
+        cp.has_width_m() ? check.positive(field + ".construction.width_m", cp.width_m()) : t.body.navigability.delta_m;
+    if (t.construction.kappa > t.body.navigability.kappa)
+      check.fail(field + ".construction.kappa", fmt::format("{}", t.construction.kappa) + " exceeds the body's kappa " +
+                                                    fmt::format("{}", t.body.navigability.kappa) + ": the builder could not climb what it builds");
+    if (t.construction.width_m > 2.0 * t.body.reach_m + t.body.navigability.delta_m)
+      check.fail(field + ".construction.width_m", fmt::format("{}", t.construction.width_m) + " is wider than the robot can reach " +
                                                       "from its path (delta + 2 reach = " +
-                                                      format(2.0 * t.body.reach_m + t.body.delta_m) + " m)");
+                                                      fmt::format("{}", 2.0 * t.body.reach_m + t.body.navigability.delta_m) + " m)");
     const proto::Pipeline& pp = rp.pipeline();
     if (pp.has_separation_m()) t.pipeline.separation_m = check.positive(field + ".pipeline.separation_m", pp.separation_m());
     if (pp.has_lane_offset_m()) t.pipeline.lane_offset_m = check.finite(field + ".pipeline.lane_offset_m", pp.lane_offset_m());
@@ -233,11 +228,11 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     s.completion = CompletionKind::kPayloadPath;
     const proto::PayloadPath& pp = p.payload_path();
     PayloadPath& path = s.payload_path;
-    const bus::BodyParams body = to_body(pp.body());
-    path.kappa = check.positive("payload_path.body.kappa", body.kappa);
-    path.delta_m = check.positive("payload_path.body.delta_m", body.delta_m);
-    path.eps_m = check.finite("payload_path.body.eps_m", body.eps_m);
-    if (path.eps_m < 0.0) check.fail("payload_path.body.eps_m", "must be >= 0");
+    const RobotBody body = to_body(pp.body());
+    path.kappa = check.positive("payload_path.body.navigability.kappa", body.navigability.kappa);
+    path.delta_m = check.positive("payload_path.body.navigability.delta_m", body.navigability.delta_m);
+    path.eps_m = check.finite("payload_path.body.navigability.eps_m", body.navigability.eps_m);
+    if (path.eps_m < 0.0) check.fail("payload_path.body.navigability.eps_m", "must be >= 0");
     if (!pp.has_from()) check.fail("payload_path.from", "missing");
     if (!pp.has_to()) check.fail("payload_path.to", "missing");
     path.from_x_m = check.finite("payload_path.from.x_m", pp.from().x_m());
@@ -263,7 +258,7 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     if (site.eps_m < 0.0) check.fail("site.eps_m", "must be >= 0");
     if (sp.has_min_fraction()) site.min_fraction = check.finite("site.min_fraction", sp.min_fraction());
     if (!(site.min_fraction > 0.0 && site.min_fraction <= 1.0))
-      check.fail("site.min_fraction", format(site.min_fraction) + " must be in (0, 1]");
+      check.fail("site.min_fraction", fmt::format("{}", site.min_fraction) + " must be in (0, 1]");
     if (sp.has_check_every_steps()) site.check_every_steps = sp.check_every_steps();
     if (site.check_every_steps == 0) check.fail("site.check_every_steps", "must be >= 1");
   }
@@ -281,7 +276,7 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     map.arrow_length_m = check.positive("goal_vector_map.arrow_length_m", gp.arrow_length_m());
     if (gp.has_heading()) {
       try {
-        map.heading = processing::heading_from_string(gp.heading());
+        map.heading = heading_from_string(gp.heading());
       } catch (const InvalidArgument& e) {
         check.fail("goal_vector_map.heading", e.what());
       }
@@ -304,7 +299,7 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
 
   // Generated terrains have a known extent: check placements now. File terrains are checked by build_terrain().
   if (!s.terrain.method.empty()) {
-    grid::GridGeometry g;
+    GridGeometry g;
     g.rows = s.terrain.rows;
     g.cols = s.terrain.cols;
     g.cell_size_m = s.terrain.cell_size_m;

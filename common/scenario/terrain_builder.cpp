@@ -1,25 +1,20 @@
-#include "common/scenario/terrain_builder.hpp"
+#include "marsala/scenario/terrain_builder.hpp"
+#include "marsala/core/format.hpp"
 
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
 
-#include "common/error.hpp"
-#include "common/terrain/asc_io.hpp"
-#include "common/terrain/generators.hpp"
-#include "common/terrain/geotiff_import.hpp"
-#include "common/terrain/resample.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/terrain/asc_io.hpp"
+#include "marsala/terrain/generators.hpp"
+#include "marsala/terrain/geotiff_import.hpp"
+#include "marsala/terrain/resample.hpp"
 
 namespace marsala::scenario {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string format(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 bool is_tiff(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
@@ -27,13 +22,13 @@ bool is_tiff(const std::string& path) {
   return ext == ".tif" || ext == ".tiff";
 }
 
-grid::Heightmap read_terrain_file(const Scenario& s) {
+Heightmap read_terrain_file(const Scenario& s) {
   const std::string path = resolve_terrain_path(s);
   std::error_code ec;
   if (!fs::is_regular_file(path, ec))
     throw IoError("scenario " + s.source_path + ": terrain.file '" + s.terrain.file + "' not found (looked for " +
                   path + ")");
-  grid::Heightmap map = is_tiff(path) ? terrain::read_geotiff(path) : terrain::read_asc(path);
+  Heightmap map = is_tiff(path) ? terrain::read_geotiff(path) : terrain::read_asc(path);
   const TerrainSource& t = s.terrain;
   if (t.has_crop) map = terrain::crop(map, t.crop_x0_m, t.crop_y0_m, t.crop_width_m, t.crop_height_m);
   if (t.resample_cell_size_m > 0.0) map = terrain::resample_bilinear(map, t.resample_cell_size_m);
@@ -49,8 +44,8 @@ std::string resolve_terrain_path(const Scenario& s) {
   return (fs::path(s.source_path).parent_path() / file).lexically_normal().string();
 }
 
-grid::Heightmap build_terrain(const Scenario& s) {
-  grid::Heightmap map;
+Heightmap build_terrain(const Scenario& s) {
+  Heightmap map;
   try {
     if (!s.terrain.file.empty()) {
       map = read_terrain_file(s);
@@ -70,16 +65,16 @@ grid::Heightmap build_terrain(const Scenario& s) {
   return map;
 }
 
-void check_placement(const Scenario& s, const grid::GridGeometry& g) {
+void check_placement(const Scenario& s, const GridGeometry& g) {
   const double x1 = g.xll_m + g.cols * g.cell_size_m;
   const double y1 = g.yll_m + g.rows * g.cell_size_m;
-  const std::string extent = "[" + format(g.xll_m) + ", " + format(x1) + "] x [" + format(g.yll_m) + ", " +
-                             format(y1) + "] m";
+  const std::string extent = "[" + fmt::format("{}", g.xll_m) + ", " + fmt::format("{}", x1) + "] x [" + fmt::format("{}", g.yll_m) + ", " +
+                             fmt::format("{}", y1) + "] m";
   const auto fail = [&](const std::string& field, const std::string& problem) {
     throw InvalidArgument("scenario " + s.source_path + ": " + field + ": " + problem + " (terrain " + extent + ")");
   };
   const auto on_grid = [&](const std::string& field, double x, double y) {
-    if (!g.cell_at({x, y})) fail(field, "(" + format(x) + ", " + format(y) + ") is off the terrain");
+    if (!g.cell_at({x, y})) fail(field, "(" + fmt::format("{}", x) + ", " + fmt::format("{}", y) + ") is off the terrain");
   };
   for (std::size_t i = 0; i < s.slots.size(); ++i) {
     const AgentSlot& slot = s.slots[i];
@@ -90,7 +85,7 @@ void check_placement(const Scenario& s, const grid::GridGeometry& g) {
   on_grid("base", s.base.x_m, s.base.y_m);
   const auto inside = [&](const std::string& field, double x0, double y0, double xa, double ya) {
     if (x0 < g.xll_m || xa > x1 || y0 < g.yll_m || ya > y1)
-      fail(field, "[" + format(x0) + ", " + format(xa) + "] x [" + format(y0) + ", " + format(ya) +
+      fail(field, "[" + fmt::format("{}", x0) + ", " + fmt::format("{}", xa) + "] x [" + fmt::format("{}", y0) + ", " + fmt::format("{}", ya) +
                       "] m is not inside the terrain");
   };
   switch (s.completion) {

@@ -3,8 +3,8 @@
 
 #include <string>
 
-#include "common/grid/heightmap.hpp"
-#include "common/scenario/scenario.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/scenario/scenario.hpp"
 
 namespace marsala::scenario {
 
@@ -12,13 +12,13 @@ namespace marsala::scenario {
 /// resolved against the scenario file's folder), then cropped, resampled and shifted to a zero base as the scenario
 /// says. Then check_placement(). Throws IoError for a missing file, ParseError for a bad file, InvalidArgument for
 /// bad generator parameters or placements; every message names the scenario.
-grid::Heightmap build_terrain(const Scenario& scenario);
+Heightmap build_terrain(const Scenario& scenario);
 
 /// The scenario's terrain file resolved against the scenario file's folder (unchanged when absolute).
 std::string resolve_terrain_path(const Scenario& scenario);
 
 /// Throws InvalidArgument naming the field when a slot's start or target or the base centre lies off the grid, or
 /// the goal rectangle is not inside the grid's extent.
-void check_placement(const Scenario& scenario, const grid::GridGeometry& grid);
+void check_placement(const Scenario& scenario, const GridGeometry& grid);
 
 }  // namespace marsala::scenario

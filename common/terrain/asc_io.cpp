@@ -1,4 +1,4 @@
-#include "common/terrain/asc_io.hpp"
+#include "marsala/terrain/asc_io.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -17,7 +17,7 @@
 #include <system_error>
 #include <vector>
 
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::terrain {
 namespace {
@@ -106,7 +106,7 @@ class AscParser {
   AscParser(std::string_view text, const std::string& source, const AscReadOptions& options)
       : text_(text), source_(source), options_(options) {}
 
-  grid::Heightmap parse() {
+  Heightmap parse() {
     if (is_blank_text()) fail(1, "empty file: expected an ESRI ASCII grid header (ncols, nrows, ...)");
     std::string_view line;
     bool have_line = parse_header(line);
@@ -238,7 +238,7 @@ class AscParser {
       if (!header_[slot].seen) fail(line, std::string("missing header key '") + kNames[slot] + "' " + where);
   }
 
-  grid::Heightmap parse_data(bool have_line, std::string_view line) {
+  Heightmap parse_data(bool have_line, std::string_view line) {
     const int rows = static_cast<int>(header_[kNrows].value);
     const int cols = static_cast<int>(header_[kNcols].value);
     const double cell_size = header_[kCellsize].value;
@@ -301,13 +301,13 @@ class AscParser {
       fail(pending_blank_line != 0 ? pending_blank_line : line_no_ + 1,
            "too few data rows: got " + std::to_string(row) + ", expected " + std::to_string(rows) + " (nrows)");
 
-    grid::GridGeometry geometry;
+    GridGeometry geometry;
     geometry.rows = rows;
     geometry.cols = cols;
     geometry.cell_size_m = cell_size;
     geometry.xll_m = header_[kXll].value - (header_[kXll].is_center ? 0.5 * cell_size : 0.0);
     geometry.yll_m = header_[kYll].value - (header_[kYll].is_center ? 0.5 * cell_size : 0.0);
-    grid::Heightmap map(geometry, grid::HeightMatrix(Eigen::Map<const grid::HeightMatrix>(heights.data(), rows, cols)));
+    Heightmap map(geometry, HeightMatrix(Eigen::Map<const HeightMatrix>(heights.data(), rows, cols)));
     if (nodata_cells > 0) {
       if (nodata_cells == announced) fail(0, "every cell is NODATA; there is nothing to fill from");
       fill_nodata(map);
@@ -346,9 +346,9 @@ std::string read_stream(std::istream& in, const std::string& source_name) {
   return std::move(buffer).str();
 }
 
-void check_writable(const grid::Heightmap& map) {
+void check_writable(const Heightmap& map) {
   if (map.rows() <= 0 || map.cols() <= 0) throw InvalidArgument("write_asc: the heightmap is empty");
-  const grid::GridGeometry& g = map.geometry();
+  const GridGeometry& g = map.geometry();
   if (!std::isfinite(g.xll_m) || !std::isfinite(g.yll_m) || !std::isfinite(g.cell_size_m) || !(g.cell_size_m > 0))
     throw InvalidArgument("write_asc: the grid geometry must be finite with a positive cell size");
   for (int r = 0; r < map.rows(); ++r)
@@ -363,7 +363,7 @@ void check_writable(const grid::Heightmap& map) {
     }
 }
 
-void emit(const grid::Heightmap& map, std::ostream& out) {
+void emit(const Heightmap& map, std::ostream& out) {
   std::string buffer = "ncols " + std::to_string(map.cols()) + "\nnrows " + std::to_string(map.rows()) +
                        "\nxllcorner " + format_double(map.geometry().xll_m) + "\nyllcorner " +
                        format_double(map.geometry().yll_m) + "\ncellsize " + format_double(map.cell_size_m()) +
@@ -390,12 +390,12 @@ void emit(const grid::Heightmap& map, std::ostream& out) {
 
 }  // namespace
 
-grid::Heightmap parse_asc(std::istream& in, const std::string& source_name, const AscReadOptions& options) {
+Heightmap parse_asc(std::istream& in, const std::string& source_name, const AscReadOptions& options) {
   const std::string text = read_stream(in, source_name);
   return AscParser(text, source_name, options).parse();
 }
 
-grid::Heightmap read_asc(const std::string& path, const AscReadOptions& options) {
+Heightmap read_asc(const std::string& path, const AscReadOptions& options) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw IoError("cannot read '" + path + "': it is a directory");
   std::ifstream in(path, std::ios::binary);
@@ -410,13 +410,13 @@ grid::Heightmap read_asc(const std::string& path, const AscReadOptions& options)
   return AscParser(text, path, options).parse();
 }
 
-void write_asc(const grid::Heightmap& map, std::ostream& out) {
+void write_asc(const Heightmap& map, std::ostream& out) {
   check_writable(map);
   emit(map, out);
   if (!out) throw IoError("failed to write the ESRI ASCII grid to the output stream");
 }
 
-void write_asc(const grid::Heightmap& map, const std::string& path) {
+void write_asc(const Heightmap& map, const std::string& path) {
   check_writable(map);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw IoError("cannot open '" + path + "' for writing: " + std::strerror(errno));
@@ -425,7 +425,7 @@ void write_asc(const grid::Heightmap& map, const std::string& path) {
   if (!out) throw IoError("failed to write '" + path + "'");
 }
 
-void fill_nodata(grid::Heightmap& map) {
+void fill_nodata(Heightmap& map) {
   const int rows = map.rows();
   const int cols = map.cols();
   const long long cells = map.size();

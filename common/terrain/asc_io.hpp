@@ -16,7 +16,7 @@
 #include <iosfwd>
 #include <string>
 
-#include "common/grid/heightmap.hpp"
+#include "marsala/core/heightmap.hpp"
 
 namespace marsala::terrain {
 
@@ -26,24 +26,24 @@ struct AscReadOptions {
 };
 
 /// Reads an ESRI ASCII grid [m]; throws ParseError("file:line: problem") or IoError (cannot open/read).
-grid::Heightmap read_asc(const std::string& path, const AscReadOptions& options = {});
+Heightmap read_asc(const std::string& path, const AscReadOptions& options = {});
 
 /// Same as read_asc from a stream; `source_name` is used in messages.
-grid::Heightmap parse_asc(std::istream& in, const std::string& source_name, const AscReadOptions& options = {});
+Heightmap parse_asc(std::istream& in, const std::string& source_name, const AscReadOptions& options = {});
 
 /// Writes an ESRI ASCII grid with the shortest decimals that read back bit for bit (std::to_chars);
 /// NaN heights are written as NODATA_value -9999. Throws InvalidArgument for an empty map, a non-finite
 /// geometry, an infinite height or a finite height equal to -9999 [m] (it would read back as NODATA),
 /// checked before anything is written; throws IoError when the file cannot be written.
-void write_asc(const grid::Heightmap& map, const std::string& path);
+void write_asc(const Heightmap& map, const std::string& path);
 
 /// Same as write_asc(map, path) into a stream; throws IoError when the stream fails.
-void write_asc(const grid::Heightmap& map, std::ostream& out);
+void write_asc(const Heightmap& map, std::ostream& out);
 
 /// Fills NODATA cells (given as NaN) in place by onion peeling: layer by layer outwards from the valid data,
 /// each missing cell that touches a known cell (8-neighbourhood) takes the mean of its known 8-neighbours
 /// (cells filled in earlier layers count, cells of the same layer do not), so the result is deterministic
 /// and stays within [min, max] of the valid heights [m]. Throws InvalidArgument when no valid cell exists.
-void fill_nodata(grid::Heightmap& map);
+void fill_nodata(Heightmap& map);
 
 }  // namespace marsala::terrain

@@ -1,4 +1,5 @@
-#include "common/terrain/generators.hpp"
+#include "marsala/terrain/generators.hpp"
+#include "marsala/core/format.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,27 +7,20 @@
 #include <functional>
 #include <utility>
 
-#include "common/error.hpp"
-#include "common/terrain/detail/det_math.hpp"
-#include "common/terrain/detail/noise.hpp"
-#include "common/random.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/terrain/detail/det_math.hpp"
+#include "marsala/terrain/detail/noise.hpp"
+#include "marsala/core/random.hpp"
 
 namespace marsala::terrain {
 namespace {
 
-using grid::HeightMatrix;
 using ParamValues = std::map<std::string, double>;
 
 constexpr long long kMaxCells = 1LL << 28;
 constexpr double kMaxLength = 1e7;   // [m]
 constexpr double kMaxHeight = 1e4;   // [m]
 constexpr double kEdgeTol = 1e-9;    // [m], platform edges: west/south inclusive, east/north exclusive
-
-std::string format_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 std::string join(const std::vector<std::string>& items) {
   std::string out;
@@ -104,12 +98,12 @@ class GeneratorRegistry {
 // Default helpers: a fixed value, or a fraction of the map extent / width / depth.
 ParamDef param(std::string key, double fixed_default, double min, double max, bool integer, std::string meaning,
                std::string unit) {
-  return {std::move(key), format_number(fixed_default), [fixed_default](const Frame&) { return fixed_default; },
+  return {std::move(key), fmt::format("{}", fixed_default), [fixed_default](const Frame&) { return fixed_default; },
           min, max, integer, std::move(meaning), std::move(unit)};
 }
 
 ParamDef scaled_param(std::string key, double fraction, double min, double max, std::string meaning) {
-  return {std::move(key), format_number(100.0 * fraction) + "% of the map extent",
+  return {std::move(key), fmt::format("{}", 100.0 * fraction) + "% of the map extent",
           [fraction](const Frame& f) { return fraction * f.extent_m; }, min, max, false, std::move(meaning), "m"};
 }
 
@@ -133,12 +127,12 @@ ParamValues resolve(const std::string& method, const GeneratorEntry& entry, cons
       continue;
     }
     const double v = it->second;
-    const std::string range = "[" + format_number(d.min) + ", " + format_number(d.max) + "]";
+    const std::string range = "[" + fmt::format("{}", d.min) + ", " + fmt::format("{}", d.max) + "]";
     if (!(v >= d.min && v <= d.max))
-      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key + "' = " + format_number(v) +
+      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key + "' = " + fmt::format("{}", v) +
                             " is out of range " + range);
     if (d.integer && v != std::floor(v))
-      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key + "' = " + format_number(v) +
+      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key + "' = " + fmt::format("{}", v) +
                             " must be a whole number in " + range);
     out[d.key] = v;
   }
@@ -154,8 +148,8 @@ void check_spec(const std::string& method, const GeneratorSpec& spec) {
     throw InvalidArgument(where + "grid of " + std::to_string(spec.rows) + " x " + std::to_string(spec.cols) +
                           " cells exceeds the limit of " + std::to_string(kMaxCells) + " cells");
   if (!(spec.cell_size_m > 0.0 && spec.cell_size_m <= kMaxLength))
-    throw InvalidArgument(where + "cell size must be in (0, " + format_number(kMaxLength) + "] m, got " +
-                          format_number(spec.cell_size_m));
+    throw InvalidArgument(where + "cell size must be in (0, " + fmt::format("{}", kMaxLength) + "] m, got " +
+                          fmt::format("{}", spec.cell_size_m));
 }
 
 // Cell-centre coordinates with the lower-left corner at (0, 0) [m].
@@ -250,8 +244,8 @@ HeightMatrix fractal(const Frame& f, const Params& p) {
   const double amplitude = p.get("amplitude");
   const double wavelength = p.get("wavelength");
   if (wavelength < f.cs)
-    throw InvalidArgument("terrain generator 'fractal': wavelength " + format_number(wavelength) +
-                          " m is shorter than one cell (" + format_number(f.cs) + " m)");
+    throw InvalidArgument("terrain generator 'fractal': wavelength " + fmt::format("{}", wavelength) +
+                          " m is shorter than one cell (" + fmt::format("{}", f.cs) + " m)");
   HeightMatrix h = detail::gradient_fbm(f.rows, f.cols, f.cs, random::derive_seed(f.seed, 0x6662), p.count("octaves"),
                                         p.get("persistence"), wavelength);
   const double lo = h.minCoeff();
@@ -269,8 +263,8 @@ HeightMatrix craters(const Frame& f, const Params& p) {
   const double r_min = p.get("radius_min");
   const double r_max = p.get("radius_max");
   if (r_min > r_max)
-    throw InvalidArgument("terrain generator 'craters': radius_min " + format_number(r_min) +
-                          " m exceeds radius_max " + format_number(r_max) + " m");
+    throw InvalidArgument("terrain generator 'craters': radius_min " + fmt::format("{}", r_min) +
+                          " m exceeds radius_max " + fmt::format("{}", r_max) + " m");
   const double depth = p.get("depth");
   const double rim_height = p.get("rim_height");
   random::Rng rng(random::derive_seed(f.seed, 0x63726174));
@@ -444,12 +438,12 @@ const GeneratorRegistry& registry() {
 
 }  // namespace
 
-grid::Heightmap generate_terrain(const std::string& method, const GeneratorSpec& spec) {
+Heightmap generate_terrain(const std::string& method, const GeneratorSpec& spec) {
   const GeneratorEntry& entry = registry().find(method);
   check_spec(method, spec);
   const Frame frame = make_frame(spec);
   HeightMatrix h = entry.generate(frame, Params(resolve(method, entry, frame, spec.params)));
-  return grid::Heightmap(grid::GridGeometry{spec.rows, spec.cols, 0.0, 0.0, spec.cell_size_m}, std::move(h));
+  return Heightmap(GridGeometry{spec.rows, spec.cols, 0.0, 0.0, spec.cell_size_m}, std::move(h));
 }
 
 std::vector<std::string> generator_names() { return registry().names(); }
@@ -457,7 +451,7 @@ std::vector<std::string> generator_names() { return registry().names(); }
 std::vector<std::string> generator_parameter_help(const std::string& method) {
   std::vector<std::string> lines;
   for (const auto& d : registry().find(method).params) {
-    const std::string range = "[" + format_number(d.min) + ", " + format_number(d.max) + "]";
+    const std::string range = "[" + fmt::format("{}", d.min) + ", " + fmt::format("{}", d.max) + "]";
     lines.push_back(d.key + " (default " + d.default_text + "): " + d.meaning + "; valid " +
                     (d.integer ? "whole numbers in " : "") + range + " [" + d.unit + "]");
   }

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "common/grid/heightmap.hpp"
+#include "marsala/core/heightmap.hpp"
 
 namespace marsala::terrain {
 
@@ -37,7 +37,7 @@ struct GeneratorSpec {
 /// Generates a terrain by method name; throws InvalidArgument for an unknown method (listing the valid names), an
 /// unknown parameter key (listing the method's keys) or an out-of-range value (saying which and the range).
 /// Lower-left corner at (0, 0). Deterministic: same spec -> same heights bit for bit.
-grid::Heightmap generate_terrain(const std::string& method, const GeneratorSpec& spec);
+Heightmap generate_terrain(const std::string& method, const GeneratorSpec& spec);
 
 /// The registered method names, sorted.
 std::vector<std::string> generator_names();

@@ -1,4 +1,4 @@
-#include "common/terrain/geotiff_import.hpp"
+#include "marsala/terrain/geotiff_import.hpp"
 
 #include <tiffio.h>
 
@@ -17,8 +17,8 @@
 #include <system_error>
 #include <vector>
 
-#include "common/error.hpp"
-#include "common/terrain/asc_io.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/terrain/asc_io.hpp"
 
 namespace marsala::terrain {
 namespace {
@@ -92,16 +92,16 @@ class GeoTiffReader {
  public:
   GeoTiffReader(const std::string& path, const GeoTiffOptions& options) : path_(path), options_(options) {}
 
-  grid::Heightmap read() {
+  Heightmap read() {
     open();
     read_layout();
     const double cell_size = read_cell_size();
     read_nodata();
-    grid::GridGeometry geometry;
+    GridGeometry geometry;
     geometry.rows = static_cast<int>(height_);
     geometry.cols = static_cast<int>(width_);
     geometry.cell_size_m = cell_size;
-    grid::Heightmap map(geometry);
+    Heightmap map(geometry);
     if (TIFFIsTiled(tif_.get()))
       read_tiles(map.data());
     else
@@ -310,7 +310,7 @@ class GeoTiffReader {
   }
 
   // NODATA and NaN cells become NaN (then filled, if allowed); infinite samples are always an error.
-  void screen_cells(grid::Heightmap& map) const {
+  void screen_cells(Heightmap& map) const {
     long long missing = 0;
     double* h = map.data();
     const long long cells = map.size();
@@ -344,7 +344,7 @@ class GeoTiffReader {
 
 }  // namespace
 
-grid::Heightmap read_geotiff(const std::string& path, const GeoTiffOptions& options) {
+Heightmap read_geotiff(const std::string& path, const GeoTiffOptions& options) {
   return GeoTiffReader(path, options).read();
 }
 

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "common/grid/heightmap.hpp"
+#include "marsala/core/heightmap.hpp"
 
 namespace marsala::terrain {
 
@@ -19,6 +19,6 @@ struct GeoTiffOptions {
 /// error unless options.fill_nodata; infinite samples are always an error. Throws IoError when the file cannot
 /// be opened and ParseError naming the file and the problem (not a TIFF, unsupported sample format, several
 /// bands, non-square or rotated pixels, truncated data, ...).
-grid::Heightmap read_geotiff(const std::string& path, const GeoTiffOptions& options = {});
+Heightmap read_geotiff(const std::string& path, const GeoTiffOptions& options = {});
 
 }  // namespace marsala::terrain

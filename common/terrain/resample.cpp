@@ -1,11 +1,11 @@
-#include "common/terrain/resample.hpp"
+#include "marsala/terrain/resample.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::terrain {
 namespace {
@@ -56,13 +56,13 @@ Taps make_taps(int new_count, double ratio, int source_count) {
 
 }  // namespace
 
-grid::Heightmap crop(const grid::Heightmap& map, double x0_m, double y0_m, double width_m, double height_m) {
+Heightmap crop(const Heightmap& map, double x0_m, double y0_m, double width_m, double height_m) {
   if (!std::isfinite(x0_m) || !std::isfinite(y0_m) || !std::isfinite(width_m) || !std::isfinite(height_m))
     throw InvalidArgument("crop: the rectangle must be finite");
   if (!(width_m > 0.0) || !(height_m > 0.0))
     throw InvalidArgument("crop: width and height must be positive, got " + std::to_string(width_m) + " x " +
                           std::to_string(height_m) + " m");
-  const grid::GridGeometry& g = map.geometry();
+  const GridGeometry& g = map.geometry();
   const std::string rect = "[" + std::to_string(x0_m) + ", " + std::to_string(x0_m + width_m) + ") x [" +
                            std::to_string(y0_m) + ", " + std::to_string(y0_m + height_m) + ") m";
   int col_first = 0, col_last = 0, south_first = 0, south_last = 0;
@@ -75,11 +75,11 @@ grid::Heightmap crop(const grid::Heightmap& map, double x0_m, double y0_m, doubl
   return map.window({top_row, col_first}, south_last - south_first + 1, col_last - col_first + 1);
 }
 
-grid::Heightmap resample_bilinear(const grid::Heightmap& map, double cell_size_m) {
+Heightmap resample_bilinear(const Heightmap& map, double cell_size_m) {
   if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m))
     throw InvalidArgument("resample_bilinear: cell size must be positive and finite, got " +
                           std::to_string(cell_size_m) + " m");
-  const grid::GridGeometry& g = map.geometry();
+  const GridGeometry& g = map.geometry();
   if (g.rows <= 0 || g.cols <= 0) throw InvalidArgument("resample_bilinear: the heightmap is empty");
   const double cols_real = std::floor(g.cols * g.cell_size_m / cell_size_m + kCountTolerance);
   const double rows_real = std::floor(g.rows * g.cell_size_m / cell_size_m + kCountTolerance);
@@ -90,11 +90,11 @@ grid::Heightmap resample_bilinear(const grid::Heightmap& map, double cell_size_m
   if (cols_real * rows_real > kMaxCells)
     throw InvalidArgument("resample_bilinear: a cell of " + std::to_string(cell_size_m) + " m would give " +
                           std::to_string(cols_real) + " x " + std::to_string(rows_real) + " cells");
-  grid::GridGeometry out_geometry = g;
+  GridGeometry out_geometry = g;
   out_geometry.cols = static_cast<int>(cols_real);
   out_geometry.rows = static_cast<int>(rows_real);
   out_geometry.cell_size_m = cell_size_m;
-  grid::Heightmap out(out_geometry);
+  Heightmap out(out_geometry);
 
   // ratio == 1 when the size is unchanged, so the identity resampling is exact.
   const double ratio = cell_size_m / g.cell_size_m;

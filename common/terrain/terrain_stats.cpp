@@ -1,4 +1,4 @@
-#include "common/terrain/terrain_stats.hpp"
+#include "marsala/terrain/terrain_stats.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +17,7 @@ double derivative(Height height, int i, int n, double cs) {
 
 }  // namespace
 
-TerrainStats compute_terrain_stats(const grid::Heightmap& map) {
+TerrainStats compute_terrain_stats(const Heightmap& map) {
   TerrainStats s;
   s.rows = map.rows();
   s.cols = map.cols();

@@ -1,7 +1,7 @@
 #pragma once
 // Summary statistics of a terrain, as `marsala-terrain info` prints them.
 
-#include "common/grid/heightmap.hpp"
+#include "marsala/core/heightmap.hpp"
 
 namespace marsala::terrain {
 
@@ -20,6 +20,6 @@ struct TerrainStats {
 };
 
 /// Computes the statistics; slopes are 0 on a 1x1 grid.
-TerrainStats compute_terrain_stats(const grid::Heightmap& map);
+TerrainStats compute_terrain_stats(const Heightmap& map);
 
 }  // namespace marsala::terrain

@@ -15,9 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "common/bus/bus.hpp"
+#include "marsala/bus/bus.hpp"
 
 namespace marsala::bus {
+using namespace marsala::protocol;  // the messages under test
 namespace {
 
 using namespace std::chrono_literals;

@@ -23,14 +23,15 @@
 #include <string>
 #include <thread>
 
-#include "common/bus/bus.hpp"
-#include "common/error.hpp"
-#include "tests/integration/probe_frames.hpp"
+#include "marsala/bus/bus.hpp"
+#include "marsala/core/error.hpp"
+#include "probe_frames.hpp"
 
 namespace {
 
 using namespace std::chrono_literals;
 using namespace marsala::bus;
+using namespace marsala::protocol;
 using Clock = std::chrono::steady_clock;
 
 volatile std::sig_atomic_t g_stop = 0;

@@ -8,12 +8,13 @@
 #include <random>
 #include <string>
 
-#include "common/bus/messages.hpp"
+#include "marsala/protocol/messages.hpp"
 
 namespace marsala::probe {
+using namespace marsala::protocol;  // the messages under test
 
 /// Frame `step` with `tiles` full 16 x 16 tiles (about 2 KB each), neighbours and strings.
-inline bus::SensorFrame frame(std::uint64_t step, int tiles) {
+inline protocol::SensorFrame frame(std::uint64_t step, int tiles) {
   std::mt19937_64 rng(step * 7919 + 17);
   auto any_bits = [&] {
     const std::uint64_t b = rng();
@@ -21,17 +22,17 @@ inline bus::SensorFrame frame(std::uint64_t step, int tiles) {
     std::memcpy(&d, &b, sizeof d);
     return d;
   };
-  bus::SensorFrame f;
+  protocol::SensorFrame f;
   f.agent_id = 1;
   f.step = step;
   f.x_m = any_bits();
   f.y_m = any_bits();
   f.z_m = any_bits();
   f.material_m3 = any_bits();
-  f.last_result = static_cast<bus::ActionResult>(step % 4);
+  f.last_result = static_cast<protocol::ActionResult>(step % 4);
   f.last_reason = "step " + std::to_string(step) + " \xE2\x80\x94 r\xC3\xA9sultat";
   for (int t = 0; t < tiles; ++t) {
-    bus::TerrainTile tile{t / 8, t % 8, 16, 16, {}};
+    protocol::TerrainTile tile{t / 8, t % 8, 16, 16, {}};
     tile.heights.resize(256);
     for (double& h : tile.heights) h = any_bits();
     f.tiles.push_back(std::move(tile));
@@ -44,23 +45,23 @@ inline bus::SensorFrame frame(std::uint64_t step, int tiles) {
 inline bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 /// Every field equal, doubles bit for bit.
-inline bool same(const bus::SensorFrame& a, const bus::SensorFrame& b) {
+inline bool same(const protocol::SensorFrame& a, const protocol::SensorFrame& b) {
   if (a.agent_id != b.agent_id || a.step != b.step || !same_bits(a.x_m, b.x_m) || !same_bits(a.y_m, b.y_m) ||
       !same_bits(a.z_m, b.z_m) || !same_bits(a.material_m3, b.material_m3) || a.last_result != b.last_result ||
       a.last_reason != b.last_reason || a.run_over != b.run_over || a.tiles.size() != b.tiles.size() ||
       a.neighbours.size() != b.neighbours.size())
     return false;
   for (std::size_t i = 0; i < a.tiles.size(); ++i) {
-    const bus::TerrainTile& x = a.tiles[i];
-    const bus::TerrainTile& y = b.tiles[i];
+    const protocol::TerrainTile& x = a.tiles[i];
+    const protocol::TerrainTile& y = b.tiles[i];
     if (x.tile_row != y.tile_row || x.tile_col != y.tile_col || x.rows != y.rows || x.cols != y.cols ||
         x.heights.size() != y.heights.size() ||
         std::memcmp(x.heights.data(), y.heights.data(), x.heights.size() * sizeof(double)) != 0)
       return false;
   }
   for (std::size_t i = 0; i < a.neighbours.size(); ++i) {
-    const bus::Neighbour& x = a.neighbours[i];
-    const bus::Neighbour& y = b.neighbours[i];
+    const protocol::Neighbour& x = a.neighbours[i];
+    const protocol::Neighbour& y = b.neighbours[i];
     if (x.agent_id != y.agent_id || !same_bits(x.x_m, y.x_m) || !same_bits(x.y_m, y.y_m) || !same_bits(x.z_m, y.z_m))
       return false;
   }

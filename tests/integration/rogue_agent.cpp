@@ -10,9 +10,9 @@
 #include <random>
 #include <string>
 
-#include "common/bus/bus.hpp"
-#include "common/error.hpp"
-#include "common/scenario/scenario.hpp"
+#include "marsala/bus/bus.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/scenario/scenario.hpp"
 
 namespace {
 
@@ -21,9 +21,9 @@ using namespace std::chrono_literals;
 
 /// The bad request for the n-th step of the attack, built on a valid empty one; `spoof` is set when the request
 /// must go out on the victim's partition instead of the rogue's own.
-bus::ActionRequest attack(int n, const bus::ActionRequest& valid, const bus::SensorFrame& frame, double cell_m,
+protocol::ActionRequest attack(int n, const protocol::ActionRequest& valid, const protocol::SensorFrame& frame, double cell_m,
                           bool& spoof, std::string& what) {
-  bus::ActionRequest r = valid;
+  protocol::ActionRequest r = valid;
   spoof = false;
   switch (n) {
     case 0:
@@ -80,17 +80,17 @@ int run(int argc, char** argv) {
 
   auto participant = bus::make_participant({vendor, domain});
   auto signal = std::make_shared<bus::Signal>();
-  auto hello_writer = participant->create_writer<bus::AgentHello>();
-  auto admissions = participant->create_reader<bus::Admission>({"", signal});
+  auto hello_writer = participant->create_writer<protocol::AgentHello>();
+  auto admissions = participant->create_reader<protocol::Admission>({"", signal});
 
-  bus::AgentHello hello;
+  protocol::AgentHello hello;
   hello.agent_id = id;
   hello.session = std::random_device{}() | 1u;
   hello.name = "rogue";
   hello.behaviour = robot.behaviour;
   hello.body = robot.body;
 
-  bus::Admission admission;
+  protocol::Admission admission;
   const auto give_up = std::chrono::steady_clock::now() + 60s;
   while (!admission.accepted) {
     if (std::chrono::steady_clock::now() > give_up) throw Error("rogue: no admission within 60 s");
@@ -99,10 +99,10 @@ int run(int argc, char** argv) {
     for (const auto& a : admissions->take())
       if (a.agent_id == id && a.session == hello.session) admission = a;
   }
-  const std::string mine = bus::partition_for(admission.run_id, id);
-  auto frames = participant->create_reader<bus::SensorFrame>({mine, signal});
-  auto requests = participant->create_writer<bus::ActionRequest>({mine, nullptr});
-  auto victim = participant->create_writer<bus::ActionRequest>({bus::partition_for(admission.run_id, 1), nullptr});
+  const std::string mine = protocol::partition_for(admission.run_id, id);
+  auto frames = participant->create_reader<protocol::SensorFrame>({mine, signal});
+  auto requests = participant->create_writer<protocol::ActionRequest>({mine, nullptr});
+  auto victim = participant->create_writer<protocol::ActionRequest>({protocol::partition_for(admission.run_id, 1), nullptr});
 
   int attacks_sent = 0;
   constexpr int kAttacks = 8;
@@ -112,20 +112,20 @@ int run(int argc, char** argv) {
     for (const auto& frame : frames->take()) {
       if (frame.run_over) return 0;
       if (attacks_sent > 0)
-        std::cout << "rogue: step " << frame.step << " previous request " << bus::to_string(frame.last_result)
+        std::cout << "rogue: step " << frame.step << " previous request " << protocol::to_string(frame.last_result)
                   << (frame.last_reason.empty() ? "" : ": " + frame.last_reason) << std::endl;
       if (attacks_sent == kAttacks) {
         std::cout << "rogue: done, leaving" << std::endl;
         return 0;
       }
-      bus::ActionRequest valid;
+      protocol::ActionRequest valid;
       valid.agent_id = id;
       valid.session = hello.session;
       valid.step = frame.step;
       valid.state = "rogue";
       bool spoof = false;
       std::string what;
-      const bus::ActionRequest bad = attack(attacks_sent, valid, frame, admission.cell_size_m, spoof, what);
+      const protocol::ActionRequest bad = attack(attacks_sent, valid, frame, admission.cell_size_m, spoof, what);
       std::cout << "rogue: step " << frame.step << " sending " << what << std::endl;
       (spoof ? victim : requests)->write(bad);
       if (attacks_sent == kAttacks - 1) requests->write(bad);  // the duplicate goes out twice

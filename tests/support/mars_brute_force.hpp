@@ -4,14 +4,14 @@
 
 #include <cmath>
 
-#include "common/grid/heightmap.hpp"
-#include "common/types.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/types.hpp"
 
 namespace marsala::testing {
 
 /// P_kappa[h] [m] by visiting every pair of cells; distances between cell centres via std::hypot [m].
-inline grid::Heightmap mars_brute_force(const grid::Heightmap& h, double kappa) {
-  grid::Heightmap projected = h;
+inline Heightmap mars_brute_force(const Heightmap& h, double kappa) {
+  Heightmap projected = h;
   for (int pr = 0; pr < h.rows(); ++pr) {
     for (int pc = 0; pc < h.cols(); ++pc) {
       const Position p = h.cell_center({pr, pc});

@@ -8,21 +8,21 @@
 #include <queue>
 #include <vector>
 
-#include "common/grid/heightmap.hpp"
-#include "common/types.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/types.hpp"
 
 namespace marsala::testing {
 
 /// 1 where the cell is occupiable (paper eq. 1), from the definition: every pair of cells whose centres lie
 /// within delta/2 of the cell's centre passes |h(r) - h(q)| <= eps + kappa |r - q| + 1e-9 m.
-inline grid::CellMask occupiable_brute_force(const grid::Heightmap& h, NavigabilityParams params) {
-  const grid::GridGeometry& g = h.geometry();
+inline CellMask occupiable_brute_force(const Heightmap& h, NavigabilityParams params) {
+  const GridGeometry& g = h.geometry();
   const double cs = g.cell_size_m;
   const double radius_cells = params.delta_m / (2.0 * cs);
   const double ball_limit = radius_cells * radius_cells + tolerance::kBallCells2;  // [cells^2]
   const double reach = std::min(std::ceil(radius_cells) + 1.0, static_cast<double>(h.rows() + h.cols()));
   const int search = static_cast<int>(reach);
-  grid::CellMask out(h.rows(), h.cols());
+  CellMask out(h.rows(), h.cols());
   std::vector<CellIndex> ball;
   for (int pr = 0; pr < h.rows(); ++pr)
     for (int pc = 0; pc < h.cols(); ++pc) {
@@ -52,9 +52,9 @@ inline grid::CellMask occupiable_brute_force(const grid::Heightmap& h, Navigabil
 
 /// 1 where the cell is 8-connected to `origin` through occupiable cells (all 0 when the origin is not
 /// occupiable); `origin` must lie on the grid.
-inline grid::CellMask navigable_brute_force(const grid::Heightmap& h, NavigabilityParams params, CellIndex origin) {
-  const grid::CellMask occupiable = occupiable_brute_force(h, params);
-  grid::CellMask out = grid::CellMask::Zero(h.rows(), h.cols());
+inline CellMask navigable_brute_force(const Heightmap& h, NavigabilityParams params, CellIndex origin) {
+  const CellMask occupiable = occupiable_brute_force(h, params);
+  CellMask out = CellMask::Zero(h.rows(), h.cols());
   if (occupiable(origin.row, origin.col) == 0) return out;
   std::queue<CellIndex> queue;
   queue.push(origin);

@@ -1,9 +1,16 @@
-#include "common/bus/cyclone/cyclone_convert.hpp"
+#include "marsala/bus/cyclone/cyclone_convert.hpp"
 
 #include <string>
 #include <type_traits>
 
 namespace marsala::bus::cyclone {
+using protocol::ActionResult;
+using protocol::AgentStatus;
+using protocol::Deposition;
+using protocol::EventKind;
+using protocol::Neighbour;
+using protocol::TerrainTile;
+
 namespace {
 
 // The C types are only read by dds_write, so borrowing const data through non-const pointers is safe.
@@ -25,11 +32,11 @@ auto copy_seq(const Seq& seq) {
   return seq._length == 0 ? std::vector<Elem>() : std::vector<Elem>(seq._buffer, seq._buffer + seq._length);
 }
 
-marsala_wire_BodyParams to_msg(const BodyParams& in) {
+marsala_wire_BodyParams to_msg(const RobotBody& in) {
   marsala_wire_BodyParams out{};
-  out.kappa = in.kappa;
-  out.delta_m = in.delta_m;
-  out.eps_m = in.eps_m;
+  out.kappa = in.navigability.kappa;
+  out.delta_m = in.navigability.delta_m;
+  out.eps_m = in.navigability.eps_m;
   out.max_step_m = in.max_step_m;
   out.max_deposit_m3 = in.max_deposit_m3;
   out.material_capacity_m3 = in.material_capacity_m3;
@@ -40,11 +47,11 @@ marsala_wire_BodyParams to_msg(const BodyParams& in) {
   return out;
 }
 
-BodyParams from_msg(const marsala_wire_BodyParams& in) {
-  BodyParams out;
-  out.kappa = in.kappa;
-  out.delta_m = in.delta_m;
-  out.eps_m = in.eps_m;
+RobotBody from_msg(const marsala_wire_BodyParams& in) {
+  RobotBody out;
+  out.navigability.kappa = in.kappa;
+  out.navigability.delta_m = in.delta_m;
+  out.navigability.eps_m = in.eps_m;
   out.max_step_m = in.max_step_m;
   out.max_deposit_m3 = in.max_deposit_m3;
   out.material_capacity_m3 = in.material_capacity_m3;

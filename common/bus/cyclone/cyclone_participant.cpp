@@ -9,12 +9,12 @@
 #include <mutex>
 #include <string>
 
-#include "common/bus/cyclone/cyclone_convert.hpp"
-#include "common/bus/detail/backends.hpp"
-#include "common/bus/detail/participant_base.hpp"
-#include "common/bus/detail/reader_queue.hpp"
-#include "common/bus/detail/topics.hpp"
-#include "common/error.hpp"
+#include "marsala/bus/cyclone/cyclone_convert.hpp"
+#include "marsala/bus/detail/backends.hpp"
+#include "marsala/bus/detail/participant_base.hpp"
+#include "marsala/bus/detail/reader_queue.hpp"
+#include "marsala/bus/detail/topics.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::bus::detail {
 namespace {

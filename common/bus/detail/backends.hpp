@@ -3,7 +3,7 @@
 
 #include <memory>
 
-#include "common/bus/bus.hpp"
+#include "marsala/bus/bus.hpp"
 
 namespace marsala::bus::detail {
 

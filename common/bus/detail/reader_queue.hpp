@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "common/bus/bus.hpp"
+#include "marsala/bus/bus.hpp"
 
 namespace marsala::bus::detail {
 

@@ -1,43 +1,26 @@
 #pragma once
 // What both DDS backends must agree on to talk to each other: topic names per message type and the QoS
-// constants of the wire contract (runtime_spec.md). Type names come from idl/marsala.idl
+// constants of the wire contract (docs/runtime.md#topics). Type names come from idl/marsala.idl
 // ("marsala::wire::<Type>") through each vendor's code generator.
 
 #include <chrono>
 #include <string>
 
-#include "common/bus/bus.hpp"
-#include "common/error.hpp"
+#include "marsala/bus/bus.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::bus::detail {
 
 /// The DDS topic that carries one message type (one topic per type).
 template <typename T>
 struct TopicName;
-template <>
-struct TopicName<AgentHello> {
-  static constexpr const char* value = "marsala_AgentHello";
-};
-template <>
-struct TopicName<Admission> {
-  static constexpr const char* value = "marsala_Admission";
-};
-template <>
-struct TopicName<SensorFrame> {
-  static constexpr const char* value = "marsala_SensorFrame";
-};
-template <>
-struct TopicName<ActionRequest> {
-  static constexpr const char* value = "marsala_ActionRequest";
-};
-template <>
-struct TopicName<WorldStatus> {
-  static constexpr const char* value = "marsala_WorldStatus";
-};
-template <>
-struct TopicName<WorldEvent> {
-  static constexpr const char* value = "marsala_WorldEvent";
-};
+#define MARSALA_BUS_TOPIC(T)                      \
+  template <>                                     \
+  struct TopicName<T> {                           \
+    static constexpr const char* value = "marsala_" #T; \
+  };
+MARSALA_BUS_MESSAGES(MARSALA_BUS_TOPIC)
+#undef MARSALA_BUS_TOPIC
 
 // Durability on the wire. Every writer offers TRANSIENT_LOCAL and every Cyclone reader requests it; a reader the
 // caller asked to be volatile then drops samples written before it was created (source timestamp, see

@@ -1,13 +1,20 @@
-#include "common/bus/fastdds/fastdds_convert.hpp"
+#include "marsala/bus/fastdds/fastdds_convert.hpp"
 
 namespace marsala::bus::fastdds {
+using protocol::ActionResult;
+using protocol::AgentStatus;
+using protocol::Deposition;
+using protocol::EventKind;
+using protocol::Neighbour;
+using protocol::TerrainTile;
+
 namespace {
 
-wire::BodyParams to_msg(const BodyParams& in) {
+wire::BodyParams to_msg(const RobotBody& in) {
   wire::BodyParams out;
-  out.kappa(in.kappa);
-  out.delta_m(in.delta_m);
-  out.eps_m(in.eps_m);
+  out.kappa(in.navigability.kappa);
+  out.delta_m(in.navigability.delta_m);
+  out.eps_m(in.navigability.eps_m);
   out.max_step_m(in.max_step_m);
   out.max_deposit_m3(in.max_deposit_m3);
   out.material_capacity_m3(in.material_capacity_m3);
@@ -18,11 +25,11 @@ wire::BodyParams to_msg(const BodyParams& in) {
   return out;
 }
 
-BodyParams from_msg(const wire::BodyParams& in) {
-  BodyParams out;
-  out.kappa = in.kappa();
-  out.delta_m = in.delta_m();
-  out.eps_m = in.eps_m();
+RobotBody from_msg(const wire::BodyParams& in) {
+  RobotBody out;
+  out.navigability.kappa = in.kappa();
+  out.navigability.delta_m = in.delta_m();
+  out.navigability.eps_m = in.eps_m();
   out.max_step_m = in.max_step_m();
   out.max_deposit_m3 = in.max_deposit_m3();
   out.material_capacity_m3 = in.material_capacity_m3();

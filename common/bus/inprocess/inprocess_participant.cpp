@@ -8,8 +8,8 @@
 #include <mutex>
 #include <tuple>
 
-#include "common/bus/detail/backends.hpp"
-#include "common/bus/detail/participant_base.hpp"
+#include "marsala/bus/detail/backends.hpp"
+#include "marsala/bus/detail/participant_base.hpp"
 
 namespace marsala::bus::detail {
 namespace {

@@ -1,4 +1,4 @@
-#include "common/render/detail/bitmap_font.hpp"
+#include "marsala/render/detail/bitmap_font.hpp"
 
 #include <cstring>
 

@@ -1,4 +1,4 @@
-#include "common/render/detail/colormap.hpp"
+#include "marsala/render/detail/colormap.hpp"
 
 #include <algorithm>
 #include <cmath>

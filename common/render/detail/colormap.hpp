@@ -1,7 +1,7 @@
 #pragma once
 // Colour maps for terrain heights and overlays; lightness rises monotonically along each map.
 
-#include "common/render/detail/raster.hpp"
+#include "marsala/render/detail/raster.hpp"
 
 namespace marsala::render::detail {
 

@@ -1,9 +1,9 @@
-#include "common/render/detail/raster.hpp"
+#include "marsala/render/detail/raster.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "common/render/detail/bitmap_font.hpp"
+#include "marsala/render/detail/bitmap_font.hpp"
 
 namespace marsala::render::detail {
 namespace {

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string>
 
-#include "common/render/image.hpp"
+#include "marsala/render/image.hpp"
 
 namespace marsala::render::detail {
 

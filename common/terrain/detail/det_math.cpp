@@ -1,4 +1,4 @@
-#include "common/terrain/detail/det_math.hpp"
+#include "marsala/terrain/detail/det_math.hpp"
 
 #include <cmath>
 

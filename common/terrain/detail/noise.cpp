@@ -1,11 +1,11 @@
-#include "common/terrain/detail/noise.hpp"
+#include "marsala/terrain/detail/noise.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-#include "common/terrain/detail/det_math.hpp"
-#include "common/random.hpp"
+#include "marsala/terrain/detail/det_math.hpp"
+#include "marsala/core/random.hpp"
 
 namespace marsala::terrain::detail {
 namespace {
@@ -28,7 +28,7 @@ inline std::int64_t floor_to_int(double x) {
   return static_cast<double>(i) > x ? i - 1 : i;
 }
 
-void add_octave(grid::HeightMatrix& out, double cell_size_m, std::uint64_t seed, double wavelength_m,
+void add_octave(HeightMatrix& out, double cell_size_m, std::uint64_t seed, double wavelength_m,
                 double amplitude) {
   const int rows = static_cast<int>(out.rows());
   const int cols = static_cast<int>(out.cols());
@@ -92,9 +92,9 @@ void add_octave(grid::HeightMatrix& out, double cell_size_m, std::uint64_t seed,
 
 }  // namespace
 
-grid::HeightMatrix gradient_fbm(int rows, int cols, double cell_size_m, std::uint64_t seed, int octaves,
+HeightMatrix gradient_fbm(int rows, int cols, double cell_size_m, std::uint64_t seed, int octaves,
                                 double persistence, double base_wavelength_m) {
-  grid::HeightMatrix out = grid::HeightMatrix::Zero(rows, cols);
+  HeightMatrix out = HeightMatrix::Zero(rows, cols);
   double wavelength = base_wavelength_m;
   double amplitude = 1.0;
   for (int o = 0; o < octaves; ++o) {

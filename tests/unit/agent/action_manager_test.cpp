@@ -1,20 +1,20 @@
-#include "agent/executive/action_manager.hpp"
+#include "marsala/agent/executive/action_manager.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "agent_test_support.hpp"
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::agent::executive {
 namespace {
 
-const grid::GridGeometry kGrid{15, 15, 0.0, 0.0, 0.1};
+const GridGeometry kGrid{15, 15, 0.0, 0.0, 0.1};
 const NavigabilityParams kNav{0.5, 0.4, 0.05};  // ball radius 2 cells
 
 deliberative::LocalMap flat_map(CellIndex robot) {
-  return test::make_local_map(grid::Heightmap(kGrid, 0.0), grid::Heightmap(kGrid, 0.0), kNav, robot, std::nullopt);
+  return test::make_local_map(Heightmap(kGrid, 0.0), Heightmap(kGrid, 0.0), kNav, robot, std::nullopt);
 }
 
 std::vector<CellIndex> line(CellIndex from, int d_row, int d_col, int n) {
@@ -68,9 +68,9 @@ TEST(ActionManager, AStepShorterThanTheDiagonalStillMovesDiagonally) {
 }
 
 TEST(ActionManager, StopsBeforeTheFirstCellThatIsNotNavigable) {
-  grid::Heightmap h(kGrid, 0.0);
+  Heightmap h(kGrid, 0.0);
   h(7, 7) = 0.5;  // a post: cells within 2 cells of it are not occupiable, (7, 5) among them
-  const deliberative::LocalMap map = test::make_local_map(h, grid::Heightmap(kGrid, 0.0), kNav, {7, 3}, std::nullopt);
+  const deliberative::LocalMap map = test::make_local_map(h, Heightmap(kGrid, 0.0), kNav, {7, 3}, std::nullopt);
   ASSERT_EQ(map.navigable(7, 4), 1);
   ASSERT_EQ(map.navigable(7, 5), 0);
   const ActionManager am(0.45);
@@ -113,9 +113,9 @@ TEST(ActionManager, APathOfTheRobotsCellAloneCentresAnOffCentreRobot) {
 }
 
 TEST(ActionManager, LeavesACellItCannotOccupyThroughOccupiableCells) {
-  grid::Heightmap h(kGrid, 0.0);
+  Heightmap h(kGrid, 0.0);
   h(5, 3) = 0.3;  // within the robot's ball: its own cell (7, 3) is not occupiable
-  const deliberative::LocalMap map = test::make_local_map(h, grid::Heightmap(kGrid, 0.0), kNav, {7, 3}, std::nullopt);
+  const deliberative::LocalMap map = test::make_local_map(h, Heightmap(kGrid, 0.0), kNav, {7, 3}, std::nullopt);
   ASSERT_EQ(map.occupiable(7, 3), 0);
   ASSERT_EQ(map.navigable.cast<int>().sum(), 0);
   // South, (8, 3) and (9, 3) are occupiable (their balls miss (5, 3)); (9, 3) is the farthest within 0.2 m.

@@ -1,6 +1,6 @@
 // The agent's runtime edge over the in-process bus, against a scripted world on a thread of the test.
 
-#include "agent/runtime/agent_runtime.hpp"
+#include "marsala/agent/runtime/agent_runtime.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <thread>
 
 #include "agent_test_support.hpp"
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::agent::runtime {
 namespace {
@@ -30,8 +30,8 @@ RuntimeConfig config(std::uint32_t id, const std::string& behaviour = "idle") {
   return c;
 }
 
-bus::Admission admission_for(const bus::AgentHello& hello, const grid::Heightmap& h) {
-  bus::Admission a;
+protocol::Admission admission_for(const protocol::AgentHello& hello, const Heightmap& h) {
+  protocol::Admission a;
   a.agent_id = hello.agent_id;
   a.session = hello.session;
   a.accepted = true;
@@ -53,7 +53,7 @@ struct ScriptedWorld {
   std::uint32_t id;
   std::uint64_t hellos_seen = 0;
 
-  bus::AgentHello wait_hello(bus::Reader<bus::AgentHello>& hellos, bus::Signal& signal) {
+  protocol::AgentHello wait_hello(bus::Reader<protocol::AgentHello>& hellos, bus::Signal& signal) {
     const auto deadline = Clock::now() + 5s;
     while (Clock::now() < deadline) {
       signal.wait_for(50ms);
@@ -65,26 +65,26 @@ struct ScriptedWorld {
     throw Error("no hello from agent " + std::to_string(id));
   }
 
-  std::vector<bus::ActionRequest> run(const std::function<bus::Admission(const bus::AgentHello&)>& answer,
+  std::vector<protocol::ActionRequest> run(const std::function<protocol::Admission(const protocol::AgentHello&)>& answer,
                                       int steps, bool send_frames = true) {
     auto hello_signal = std::make_shared<bus::Signal>();
-    auto hellos = p.create_reader<bus::AgentHello>({"", hello_signal});
-    auto admissions = p.create_writer<bus::Admission>();
-    const bus::AgentHello hello = wait_hello(*hellos, *hello_signal);
-    const bus::Admission a = answer(hello);
-    const std::string partition = bus::partition_for(a.run_id, id);
+    auto hellos = p.create_reader<protocol::AgentHello>({"", hello_signal});
+    auto admissions = p.create_writer<protocol::Admission>();
+    const protocol::AgentHello hello = wait_hello(*hellos, *hello_signal);
+    const protocol::Admission a = answer(hello);
+    const std::string partition = protocol::partition_for(a.run_id, id);
     auto signal = std::make_shared<bus::Signal>();
-    auto frames = p.create_writer<bus::SensorFrame>({partition, nullptr});
-    auto requests = p.create_reader<bus::ActionRequest>({partition, signal});
+    auto frames = p.create_writer<protocol::SensorFrame>({partition, nullptr});
+    auto requests = p.create_reader<protocol::ActionRequest>({partition, signal});
     admissions->write(a);
-    std::vector<bus::ActionRequest> got;
+    std::vector<protocol::ActionRequest> got;
     if (!a.accepted || !send_frames) return got;
     // Wait until the agent's endpoints exist (they are made on admission).
     for (auto deadline = Clock::now() + 5s; frames->matched_readers() == 0 && Clock::now() < deadline;)
       std::this_thread::sleep_for(1ms);
-    const grid::Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+    const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
     for (int step = 0; step <= steps; ++step) {
-      bus::SensorFrame f;
+      protocol::SensorFrame f;
       f.agent_id = id;
       f.step = static_cast<std::uint64_t>(step);
       f.x_m = 0.55 + 0.0;
@@ -95,7 +95,7 @@ struct ScriptedWorld {
         for (int tr = 0; tr < 2; ++tr)
           for (int tc = 0; tc < 3; ++tc) f.tiles.push_back(test::cut_tile(h, 16, tr, tc));
       if (step == 2) {
-        f.last_result = bus::ActionResult::kRejected;
+        f.last_result = protocol::ActionResult::kRejected;
         f.last_reason = "scripted rejection";
       }
       frames->write(f);
@@ -121,8 +121,8 @@ TEST(AgentRuntime, HelloAdmissionLockstepAndRunOver) {
   auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
   auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 101});
   ScriptedWorld world{*world_participant, 4};
-  const grid::Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
-  const auto requests = world.run([&](const bus::AgentHello& hello) { return admission_for(hello, h); }, 5);
+  const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+  const auto requests = world.run([&](const protocol::AgentHello& hello) { return admission_for(hello, h); }, 5);
   const RunResult r = running.get();
   EXPECT_EQ(r.outcome, RunOutcome::kRunOver) << r.message;
   EXPECT_EQ(r.run_id, "rt");
@@ -150,8 +150,8 @@ TEST(AgentRuntime, RefusalEndsTheRunWithTheWorldsReason) {
   auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 102});
   ScriptedWorld world{*world_participant, 2};
   world.run(
-      [](const bus::AgentHello& hello) {
-        bus::Admission a;
+      [](const protocol::AgentHello& hello) {
+        protocol::Admission a;
         a.agent_id = hello.agent_id;
         a.session = hello.session;
         a.accepted = false;
@@ -173,17 +173,17 @@ TEST(AgentRuntime, RepeatsHellosAndIgnoresOtherSessions) {
   AgentRuntime agent(*participant, c);
   auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 103});
   auto signal = std::make_shared<bus::Signal>();
-  auto hellos = world_participant->create_reader<bus::AgentHello>({"", signal});
-  auto admissions = world_participant->create_writer<bus::Admission>();
+  auto hellos = world_participant->create_reader<protocol::AgentHello>({"", signal});
+  auto admissions = world_participant->create_writer<protocol::Admission>();
   std::atomic<bool> stop{false};
   const auto t0 = Clock::now();
   auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
-  std::vector<bus::AgentHello> got;
+  std::vector<protocol::AgentHello> got;
   while (Clock::now() - t0 < 300ms) {
     signal->wait_for(20ms);
     for (auto& h : hellos->take()) {
       got.push_back(h);
-      bus::Admission a;  // accepted, but for another session of agent 6
+      protocol::Admission a;  // accepted, but for another session of agent 6
       a.agent_id = 6;
       a.session = 999;
       a.accepted = true;
@@ -212,8 +212,8 @@ TEST(AgentRuntime, WorldSilenceAfterAdmissionTimesOut) {
   auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
   auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 104});
   ScriptedWorld world{*world_participant, 1};
-  const grid::Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
-  world.run([&](const bus::AgentHello& hello) { return admission_for(hello, h); }, 0, false);
+  const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+  world.run([&](const protocol::AgentHello& hello) { return admission_for(hello, h); }, 0, false);
   const RunResult r = running.get();
   EXPECT_EQ(r.outcome, RunOutcome::kWorldTimeout);
   EXPECT_EQ(r.frames, 0u);

@@ -5,17 +5,17 @@
 #include <cstdint>
 #include <optional>
 
-#include "agent/deliberative/local_map_synthesizer.hpp"
-#include "agent/executive/mapping_system.hpp"
-#include "common/bus/messages.hpp"
-#include "common/grid/heightmap.hpp"
-#include "common/processing/navigability_processor.hpp"
+#include "marsala/agent/deliberative/local_map_synthesizer.hpp"
+#include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::agent::test {
 
 /// The tile (tr, tc) of `h` cut in tile_size tiles, as the world sends it.
-inline bus::TerrainTile cut_tile(const grid::Heightmap& h, int tile_size, int tr, int tc) {
-  bus::TerrainTile t;
+inline protocol::TerrainTile cut_tile(const Heightmap& h, int tile_size, int tr, int tc) {
+  protocol::TerrainTile t;
   t.tile_row = tr;
   t.tile_col = tc;
   t.rows = std::min(tile_size, h.rows() - tr * tile_size);
@@ -26,7 +26,7 @@ inline bus::TerrainTile cut_tile(const grid::Heightmap& h, int tile_size, int tr
 }
 
 /// An agent map that has been sent every tile of `h`.
-inline executive::MappingSystem full_map(const grid::Heightmap& h, int tile_size = 16) {
+inline executive::MappingSystem full_map(const Heightmap& h, int tile_size = 16) {
   executive::MappingSystem map(h.geometry(), tile_size);
   for (int tr = 0; tr * tile_size < h.rows(); ++tr)
     for (int tc = 0; tc * tile_size < h.cols(); ++tc) map.integrate_tile(cut_tile(h, tile_size, tr, tc));
@@ -34,14 +34,14 @@ inline executive::MappingSystem full_map(const grid::Heightmap& h, int tile_size
 }
 
 /// A neighbour as a frame reports it: agent `id` standing at (x, y) [m] (height 0).
-inline bus::Neighbour neighbour_at(std::uint32_t id, double x, double y) { return {id, x, y, 0.0}; }
+inline protocol::Neighbour neighbour_at(std::uint32_t id, double x, double y) { return {id, x, y, 0.0}; }
 
 /// A Husky-like body: delta 1 m, eps 5 cm, 20 cm steps, 0.02 m^3 per step, 1.5 m reach, 5 cm cubes.
-inline bus::BodyParams husky(double kappa = 0.5) {
-  bus::BodyParams b;
-  b.kappa = kappa;
-  b.delta_m = 1.0;
-  b.eps_m = 0.05;
+inline RobotBody husky(double kappa = 0.5) {
+  RobotBody b;
+  b.navigability.kappa = kappa;
+  b.navigability.delta_m = 1.0;
+  b.navigability.eps_m = 0.05;
   b.max_step_m = 0.2;
   b.max_deposit_m3 = 0.02;
   b.material_capacity_m3 = 10.0;
@@ -54,18 +54,18 @@ inline bus::BodyParams husky(double kappa = 0.5) {
 
 /// A local map with hand-made heights and gap (all known, placed at the world's origin), masks from the
 /// navigability processor.
-inline deliberative::LocalMap make_local_map(const grid::Heightmap& heights, const grid::Heightmap& gap,
+inline deliberative::LocalMap make_local_map(const Heightmap& heights, const Heightmap& gap,
                                              NavigabilityParams nav, CellIndex robot,
                                              std::optional<CellIndex> origin) {
   deliberative::LocalMap m;
   m.world = heights.geometry();
   m.offset = {0, 0};
   m.heights = heights;
-  m.known = grid::CellMask::Ones(heights.rows(), heights.cols());
-  m.blind = grid::CellMask::Zero(heights.rows(), heights.cols());
+  m.known = CellMask::Ones(heights.rows(), heights.cols());
+  m.blind = CellMask::Zero(heights.rows(), heights.cols());
   m.gap = gap;
-  m.occupiable = processing::NavigabilityProcessor(nav).occupiable(heights);
-  m.navigable = processing::NavigabilityProcessor::navigable_from(m.occupiable, robot);
+  m.occupiable = NavigabilityProcessor(nav).occupiable(heights);
+  m.navigable = NavigabilityProcessor::navigable_from(m.occupiable, robot);
   m.robot = robot;
   m.origin = origin;
   m.goal = robot;

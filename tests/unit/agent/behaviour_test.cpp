@@ -5,35 +5,35 @@
 #include <set>
 #include <utility>
 
-#include "agent/reactive/behaviour.hpp"
-#include "agent/reactive/idle_behaviour.hpp"
-#include "agent/reactive/ramp_builder.hpp"
+#include "marsala/agent/reactive/behaviour.hpp"
+#include "marsala/agent/reactive/idle_behaviour.hpp"
+#include "marsala/agent/reactive/ramp_builder.hpp"
 #include "agent_test_support.hpp"
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 #include "mini_world.hpp"
 
 namespace marsala::agent::reactive {
 namespace {
 
 // A flat 6 x 10 m world at 0.1 m cells with a 1.5 m platform from x = 7 m eastwards.
-grid::Heightmap world_terrain() {
-  grid::Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
+Heightmap world_terrain() {
+  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
   for (int r = 0; r < h.rows(); ++r)
     for (int c = 70; c < h.cols(); ++c) h(r, c) = 1.5;
   return h;
 }
 
-AgentContext context(std::uint32_t id = 3, bus::BodyParams body = test::husky()) {
+AgentContext context(std::uint32_t id = 3, RobotBody body = test::husky()) {
   AgentContext c;
   c.agent_id = id;
   c.session = 77;
   c.body = body;
-  c.neighbour_keep_out_m = neighbour_keep_out_m(body.delta_m, body.max_step_m);
+  c.neighbour_keep_out_m = neighbour_keep_out_m(body.navigability.delta_m, body.max_step_m);
   return c;
 }
 
-bus::Admission admission(const AgentContext& c, Position target, Position base = {0.55, 3.05}) {
-  bus::Admission a;
+protocol::Admission admission(const AgentContext& c, Position target, Position base = {0.55, 3.05}) {
+  protocol::Admission a;
   a.agent_id = c.agent_id;
   a.session = c.session;
   a.accepted = true;
@@ -51,9 +51,9 @@ bus::Admission admission(const AgentContext& c, Position target, Position base =
 }
 
 /// A frame at `pose` carrying every tile of `h`.
-bus::SensorFrame frame(const AgentContext& c, std::uint64_t step, Position pose, double material_m3,
-                       const grid::Heightmap& h = world_terrain()) {
-  bus::SensorFrame f;
+protocol::SensorFrame frame(const AgentContext& c, std::uint64_t step, Position pose, double material_m3,
+                       const Heightmap& h = world_terrain()) {
+  protocol::SensorFrame f;
   f.agent_id = c.agent_id;
   f.step = step;
   f.x_m = pose.x;
@@ -97,8 +97,8 @@ TEST(BehaviourRegistry, MakesBuiltinsByNameAndListsThemOnAnUnknownOne) {
               std::string::npos)
         << e.what();
   }
-  bus::BodyParams bad = test::husky();
-  bad.kappa = -1.0;
+  RobotBody bad = test::husky();
+  bad.navigability.kappa = -1.0;
   EXPECT_THROW(make_behaviour("ramp_builder", context(3, bad)), InvalidArgument);
 }
 
@@ -109,7 +109,7 @@ TEST(IdleBehaviour, AnswersEveryFrameWithAnEmptyRequest) {
   EXPECT_THROW(idle.decide(frame(c, 0, {1.05, 3.05}, 1.0)), InvalidArgument);
   idle.on_admission(admission(c, {8.0, 3.0}));
   for (std::uint64_t step = 0; step < 3; ++step) {
-    const bus::ActionRequest q = idle.decide(frame(c, step, {1.05, 3.05}, 1.0));
+    const protocol::ActionRequest q = idle.decide(frame(c, step, {1.05, 3.05}, 1.0));
     EXPECT_EQ(q.agent_id, 3u);
     EXPECT_EQ(q.session, 77u);
     EXPECT_EQ(q.step, step);
@@ -118,7 +118,7 @@ TEST(IdleBehaviour, AnswersEveryFrameWithAnEmptyRequest) {
     EXPECT_TRUE(q.depositions.empty());
     EXPECT_EQ(q.state, "idle");
   }
-  bus::SensorFrame over = frame(c, 3, {1.05, 3.05}, 1.0);
+  protocol::SensorFrame over = frame(c, 3, {1.05, 3.05}, 1.0);
   over.run_over = true;
   EXPECT_EQ(idle.decide(over).state, "done");
 }
@@ -128,7 +128,7 @@ TEST(RampBuilder, AdmissionIsCheckedAndFramesBeforeItAreRefused) {
   RampBuilder rb(c);
   EXPECT_EQ(rb.state(), RampState::kWaitAdmission);
   EXPECT_THROW(rb.decide(frame(c, 0, {1.05, 3.05}, 1.0)), InvalidArgument);
-  bus::Admission other = admission(c, {8.0, 3.0});
+  protocol::Admission other = admission(c, {8.0, 3.0});
   other.agent_id = 4;
   EXPECT_THROW(rb.on_admission(other), InvalidArgument);
   other = admission(c, {8.0, 3.0});
@@ -143,7 +143,7 @@ TEST(RampBuilder, AdmissionIsCheckedAndFramesBeforeItAreRefused) {
   EXPECT_EQ(rb.state(), RampState::kWaitAdmission);
   rb.on_admission(admission(c, {8.0, 3.0}));
   EXPECT_EQ(rb.state(), RampState::kSurvey);
-  bus::SensorFrame stranger = frame(c, 0, {1.05, 3.05}, 1.0);
+  protocol::SensorFrame stranger = frame(c, 0, {1.05, 3.05}, 1.0);
   stranger.agent_id = 9;
   EXPECT_THROW(rb.decide(stranger), InvalidArgument);
 }
@@ -152,7 +152,7 @@ TEST(RampBuilder, SurveyThenAdvanceOnFlatGround) {
   const AgentContext c = context();
   RampBuilder rb(c);
   rb.on_admission(admission(c, {8.0, 3.0}));
-  const bus::ActionRequest q = rb.decide(frame(c, 5, {1.05, 3.05}, 1.0));
+  const protocol::ActionRequest q = rb.decide(frame(c, 5, {1.05, 3.05}, 1.0));
   EXPECT_EQ(rb.last_trace().before, RampState::kSurvey);
   EXPECT_EQ(rb.state(), RampState::kAdvance);
   EXPECT_EQ(q.state, "advance");
@@ -171,7 +171,7 @@ TEST(RampBuilder, SurveyStraightToAtGoalAndBackToAdvanceWhenMovedOff) {
   const AgentContext c = context();
   RampBuilder rb(c);
   rb.on_admission(admission(c, {8.02, 3.03}));  // inside cell (29, 80)
-  bus::ActionRequest q = rb.decide(frame(c, 0, {8.05, 3.05}, 1.0));
+  protocol::ActionRequest q = rb.decide(frame(c, 0, {8.05, 3.05}, 1.0));
   EXPECT_EQ(rb.state(), RampState::kAtGoal);
   EXPECT_FALSE(q.move);
   EXPECT_TRUE(q.depositions.empty());
@@ -188,7 +188,7 @@ TEST(RampBuilder, ReturnsToBaseWhenOutOfMaterialAndRefillsThere) {
   RampBuilder rb(c);
   rb.on_admission(admission(c, {8.0, 3.0}, {0.55, 3.05}));
   // Less than one cube (1.25e-4 m^3) on board, 1 m from the base: head west.
-  bus::ActionRequest q = rb.decide(frame(c, 0, {1.55, 3.05}, 1e-4));
+  protocol::ActionRequest q = rb.decide(frame(c, 0, {1.55, 3.05}, 1e-4));
   EXPECT_EQ(rb.state(), RampState::kReturnToBase);
   ASSERT_TRUE(q.move);
   EXPECT_LT(q.target_x_m, 1.55);
@@ -206,9 +206,9 @@ TEST(RampBuilder, RunOverEndsInDone) {
   RampBuilder rb(c);
   rb.on_admission(admission(c, {8.0, 3.0}));
   rb.decide(frame(c, 0, {1.05, 3.05}, 1.0));
-  bus::SensorFrame over = frame(c, 1, {1.25, 3.05}, 1.0);
+  protocol::SensorFrame over = frame(c, 1, {1.25, 3.05}, 1.0);
   over.run_over = true;
-  const bus::ActionRequest q = rb.decide(over);
+  const protocol::ActionRequest q = rb.decide(over);
   EXPECT_EQ(rb.state(), RampState::kDone);
   EXPECT_EQ(q.state, "done");
   EXPECT_FALSE(q.move);
@@ -218,13 +218,13 @@ TEST(RampBuilder, RunOverEndsInDone) {
 TEST(RampBuilder, BlockedWithNothingInReachRetreats) {
   // A body that can place material only in a ring it never reaches (reach = delta / 2): at the foot of the
   // platform it is blocked and has nothing to deposit, so it backs off the way it came.
-  bus::BodyParams body = test::husky();
+  RobotBody body = test::husky();
   body.reach_m = 0.5;
   const AgentContext c = context(3, body);
   RampBuilder rb(c);
   rb.on_admission(admission(c, {8.0, 3.05}));
   rb.decide(frame(c, 0, {5.95, 3.05}, 1.0));  // came from the west...
-  const bus::ActionRequest q = rb.decide(frame(c, 1, {6.45, 3.05}, 1.0));  // ... to the foot of the platform
+  const protocol::ActionRequest q = rb.decide(frame(c, 1, {6.45, 3.05}, 1.0));  // ... to the foot of the platform
   EXPECT_EQ(rb.last_trace().before, RampState::kAdvance);
   EXPECT_EQ(rb.state(), RampState::kRetreat);
   ASSERT_TRUE(q.move);
@@ -240,7 +240,7 @@ TEST(RampBuilder, ClimbingThePlatformExercisesTheBuildingTransitions) {
   rb.on_admission(world.admit(1, c.session, c.body, {1.05, 3.05}, {8.5, 3.05}));
   std::set<std::pair<RampState, RampState>> seen;
   for (int step = 0; step < 800 && rb.state() != RampState::kAtGoal; ++step) {
-    const bus::ActionRequest q = rb.decide(world.frame_for(1));
+    const protocol::ActionRequest q = rb.decide(world.frame_for(1));
     seen.insert({rb.last_trace().before, rb.last_trace().after});
     ASSERT_EQ(world.validate(q), "") << "step " << step << " in " << q.state;
     world.apply_step({q});

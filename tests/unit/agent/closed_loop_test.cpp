@@ -11,10 +11,10 @@
 #include <memory>
 #include <vector>
 
-#include "agent/reactive/ramp_builder.hpp"
-#include "common/processing/deposition.hpp"
-#include "common/processing/mars_processor.hpp"
-#include "common/processing/navigability_processor.hpp"
+#include "marsala/agent/reactive/ramp_builder.hpp"
+#include "marsala/core/deposition.hpp"
+#include "marsala/core/mars_processor.hpp"
+#include "marsala/core/navigability_processor.hpp"
 #include "mini_world.hpp"
 
 namespace marsala::agent {
@@ -26,19 +26,19 @@ using reactive::RampState;
 constexpr double kPlatformX = 8.0;   // west edge of the platform [m]
 constexpr double kPlatformH = 1.5;   // [m]
 
-grid::Heightmap platform_terrain() {
-  grid::Heightmap h({80, 120, 0.0, 0.0, 0.1}, 0.0);
+Heightmap platform_terrain() {
+  Heightmap h({80, 120, 0.0, 0.0, 0.1}, 0.0);
   for (int r = 0; r < h.rows(); ++r)
     for (int c = 0; c < h.cols(); ++c)
       if (h.cell_center({r, c}).x >= kPlatformX) h(r, c) = kPlatformH;
   return h;
 }
 
-bus::BodyParams husky(double kappa, double capacity_m3) {
-  bus::BodyParams b;
-  b.kappa = kappa;
-  b.delta_m = 1.0;
-  b.eps_m = 0.05;
+RobotBody husky(double kappa, double capacity_m3) {
+  RobotBody b;
+  b.navigability.kappa = kappa;
+  b.navigability.delta_m = 1.0;
+  b.navigability.eps_m = 0.05;
   b.max_step_m = 0.2;
   b.max_deposit_m3 = 0.02;
   b.material_capacity_m3 = capacity_m3;
@@ -53,7 +53,7 @@ struct LoopResult {
   bool all_on_top = false;
   int steps = 0;
   std::vector<int> steps_to_top;          // per robot, -1 if never
-  grid::Heightmap initial, final_terrain;
+  Heightmap initial, final_terrain;
   std::vector<std::vector<CellIndex>> trajectories;
   std::vector<Position> final_positions;
   double deposited_m3 = 0.0;
@@ -62,13 +62,13 @@ struct LoopResult {
   std::vector<std::string> states;        // last state per robot
 };
 
-bool on_top(const grid::Heightmap& h, Position p) {
+bool on_top(const Heightmap& h, Position p) {
   return p.x >= kPlatformX && h(*h.cell_at(p)) >= kPlatformH - 0.1;
 }
 
 /// Runs `starts.size()` ramp builders until all stand on the platform top or `max_steps` pass. Every request must
 /// be accepted by the mini world (ASSERTed inside).
-LoopResult run_loop(const bus::BodyParams& body, const std::vector<Position>& starts,
+LoopResult run_loop(const RobotBody& body, const std::vector<Position>& starts,
                     const std::vector<Position>& targets, int max_steps) {
   LoopResult out;
   test::MiniWorld world(platform_terrain(), 16, {1.0, 4.0}, 1.0);
@@ -79,7 +79,7 @@ LoopResult run_loop(const bus::BodyParams& body, const std::vector<Position>& st
     ctx.agent_id = static_cast<std::uint32_t>(i + 1);
     ctx.session = 1000 + i;
     ctx.body = body;
-    ctx.neighbour_keep_out_m = neighbour_keep_out_m(body.delta_m, body.max_step_m);
+    ctx.neighbour_keep_out_m = neighbour_keep_out_m(body.navigability.delta_m, body.max_step_m);
     agents.push_back(std::make_unique<RampBuilder>(ctx));
     agents.back()->on_admission(world.admit(ctx.agent_id, ctx.session, body, starts[i], targets[i]));
   }
@@ -87,12 +87,12 @@ LoopResult run_loop(const bus::BodyParams& body, const std::vector<Position>& st
   double total_ms = 0.0;
   int decisions = 0;
   for (int step = 0; step < max_steps; ++step) {
-    std::vector<bus::ActionRequest> requests;
+    std::vector<protocol::ActionRequest> requests;
     for (auto& agent : agents) {
       const std::uint32_t id = static_cast<std::uint32_t>(&agent - &agents[0] + 1);
-      const bus::SensorFrame frame = world.frame_for(id);
+      const protocol::SensorFrame frame = world.frame_for(id);
       const auto t0 = std::chrono::steady_clock::now();
-      bus::ActionRequest q = agent->decide(frame);
+      protocol::ActionRequest q = agent->decide(frame);
       const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       total_ms += ms;
       out.decide_ms_max = std::max(out.decide_ms_max, ms);
@@ -152,30 +152,30 @@ LoopResult run_loop(const bus::BodyParams& body, const std::vector<Position>& st
 
 /// Checks the outcome: all on top within the budget, each with a navigable way from its start cell, and reports
 /// the measurements.
-void check_and_report(const char* name, const bus::BodyParams& body, const std::vector<Position>& starts,
+void check_and_report(const char* name, const RobotBody& body, const std::vector<Position>& starts,
                       const LoopResult& r) {
   // Never above the MARS of the initial terrain: the robots only fill the gap (local MARS bounds are consistent
   // with the global one).
-  const grid::Heightmap bound = processing::MarsProcessor(body.kappa).project(r.initial);
+  const Heightmap bound = MarsProcessor(body.navigability.kappa).project(r.initial);
   const double over = (r.final_terrain.heights() - bound.heights()).maxCoeff();
   EXPECT_LE(over, 1e-9) << name << ": the terrain rose above P_kappa of the initial terrain";
   EXPECT_TRUE(r.all_on_top) << name << ": not every robot reached the platform top in " << r.steps << " steps";
   if (!r.all_on_top) return;
-  const processing::NavigabilityProcessor nav({body.kappa, body.delta_m, body.eps_m});
-  const grid::CellMask occ = nav.occupiable(r.final_terrain);
+  const NavigabilityProcessor nav({body.navigability.kappa, body.navigability.delta_m, body.navigability.eps_m});
+  const CellMask occ = nav.occupiable(r.final_terrain);
   for (std::size_t i = 0; i < starts.size(); ++i) {
     const CellIndex start = *r.final_terrain.cell_at(starts[i]);
     const CellIndex end = *r.final_terrain.cell_at(r.final_positions[i]);
-    EXPECT_EQ(processing::NavigabilityProcessor::navigable_from(occ, start)(end.row, end.col), 1)
+    EXPECT_EQ(NavigabilityProcessor::navigable_from(occ, start)(end.row, end.col), 1)
         << name << ": robot " << i + 1 << " has no navigable way back to its start";
     EXPECT_GE(r.final_terrain(end), kPlatformH - 1e-12);
   }
   // Deposited volume against the MARS target volume of the paths actually driven (global gap, initial terrain).
-  const grid::Heightmap gap = processing::MarsProcessor(body.kappa).gap(r.initial);
+  const Heightmap gap = MarsProcessor(body.navigability.kappa).gap(r.initial);
   std::vector<CellIndex> driven;
   for (const auto& t : r.trajectories) driven.insert(driven.end(), t.begin(), t.end());
-  const double target = processing::deposition_target_volume(
-      gap, processing::path_footprint(gap.geometry(), driven, body.delta_m));
+  const double target = deposition_target_volume(
+      gap, path_footprint(gap.geometry(), driven, body.navigability.delta_m));
   std::string tops;
   for (int s : r.steps_to_top) tops += std::to_string(s) + " ";
   std::printf("[closed loop] %s: steps to the top per robot: %s| run %d steps | deposited %.3f m^3 | MARS target "

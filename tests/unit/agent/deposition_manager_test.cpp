@@ -1,4 +1,4 @@
-#include "agent/executive/deposition_manager.hpp"
+#include "marsala/agent/executive/deposition_manager.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,8 +7,8 @@
 #include <utility>
 
 #include "agent_test_support.hpp"
-#include "common/error.hpp"
-#include "common/processing/navigability_processor.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::agent::executive {
 namespace {
@@ -18,7 +18,7 @@ using deliberative::LocalMap;
 constexpr double kCs = 0.1;
 constexpr double kQ = 0.0125;  // cube 0.05 m on 0.1 m cells: 0.05^3 / 0.01
 
-LocalMap make_map(const grid::Heightmap& heights, const grid::Heightmap& gap, NavigabilityParams nav, CellIndex robot,
+LocalMap make_map(const Heightmap& heights, const Heightmap& gap, NavigabilityParams nav, CellIndex robot,
                   std::optional<CellIndex> origin) {
   return test::make_local_map(heights, gap, nav, robot, origin);
 }
@@ -45,15 +45,15 @@ std::vector<CellIndex> row_path(int row, int from_col, int to_col) {
 
 double dist(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
-const grid::GridGeometry kGrid{21, 31, 0.0, 0.0, kCs};
+const GridGeometry kGrid{21, 31, 0.0, 0.0, kCs};
 
 TEST(DepositionManager, RoundsDownToWholeCubeLayersAndCapsOneMetre) {
-  grid::Heightmap gap(kGrid, 0.0);
+  Heightmap gap(kGrid, 0.0);
   gap(10, 20) = 2.8 * kQ;          // -> 2 layers: never above P (nearest would overshoot)
   gap(10, 21) = 3.0 * kQ;          // an exact multiple -> 3 layers
   gap(10, 22) = 0.999999 * kQ;     // below one layer -> nothing
   gap(10, 23) = 2.5;               // -> capped at 1 m (80 layers)
-  const LocalMap map = make_map(grid::Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, {{10, 0}});
+  const LocalMap map = make_map(Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, {{10, 0}});
   const DepositionManager dm(params(0.4, 1.0));  // budget large enough for all of them
   const Position robot = kGrid.cell_center({10, 10});
   const auto c = dm.candidates(map, row_path(10, 10, 25), robot, 10.0, {1, robot, {}});
@@ -68,8 +68,8 @@ TEST(DepositionManager, RoundsDownToWholeCubeLayersAndCapsOneMetre) {
 }
 
 TEST(DepositionManager, RespectsReachBudgetAndNeverDepositsUnderTheRobot) {
-  const grid::Heightmap gap(kGrid, 0.3);  // 24 layers everywhere
-  const LocalMap map = make_map(grid::Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, {{10, 0}});
+  const Heightmap gap(kGrid, 0.3);  // 24 layers everywhere
+  const LocalMap map = make_map(Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, {{10, 0}});
   const DepositionManager dm(params(0.4, 0.02));
   // The robot moves to (10, 12) this step: reach and "under the robot" count from there.
   const Position robot = kGrid.cell_center({10, 12});
@@ -104,8 +104,8 @@ TEST(DepositionManager, RespectsReachBudgetAndNeverDepositsUnderTheRobot) {
 }
 
 TEST(DepositionManager, NeighboursKeepOutAndTerritoriesDoNotOverlap) {
-  const grid::Heightmap gap(kGrid, 0.3);
-  const LocalMap map = make_map(grid::Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, std::nullopt);
+  const Heightmap gap(kGrid, 0.3);
+  const LocalMap map = make_map(Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, std::nullopt);
   DepositionParams p = params(0.4, 10.0);
   p.neighbour_keep_out_m = 0.25;
   const DepositionManager dm(p);
@@ -132,16 +132,16 @@ TEST(DepositionManager, NeighboursKeepOutAndTerritoriesDoNotOverlap) {
 }
 
 /// A corridor along row 10 (rows 8..12 at 0 m) between 2 m walls; with delta 0.4 m only row 10 is occupiable.
-grid::Heightmap corridor() {
-  grid::Heightmap h(kGrid, 2.0);
+Heightmap corridor() {
+  Heightmap h(kGrid, 2.0);
   for (int r = 8; r <= 12; ++r)
     for (int c = 0; c < kGrid.cols; ++c) h(r, c) = 0.0;
   return h;
 }
 
 TEST(DepositionManager, KeepsTheRobotsWayBack) {
-  const grid::Heightmap h = corridor();
-  grid::Heightmap gap(kGrid, 0.0);
+  const Heightmap h = corridor();
+  Heightmap gap(kGrid, 0.0);
   for (int c = 0; c < kGrid.cols; ++c) gap(10, c) = 0.3;
   // The robot at (10, 20) plans west, through its own way back to the origin (10, 1).
   const LocalMap map = make_map(h, gap, params().navigability, {10, 20}, {{10, 1}});
@@ -165,9 +165,9 @@ TEST(DepositionManager, NeverRingsInARobotWhoseOriginIsItsOwnCell) {
   // A robot that has not moved yet: its local origin is its own cell, so the origin test alone is vacuous. The gap
   // is a square ring three cells from it; filled whole, the ring's walls (0.3 m against eps 0.05 m) would leave it
   // no way out of the window.
-  const grid::Heightmap flat(kGrid, 0.0);
+  const Heightmap flat(kGrid, 0.0);
   const CellIndex centre{10, 15};
-  grid::Heightmap gap(kGrid, 0.0);
+  Heightmap gap(kGrid, 0.0);
   std::vector<CellIndex> ring;
   for (int c = centre.col - 3; c <= centre.col + 3; ++c) ring.push_back({centre.row - 3, c});
   for (int r = centre.row - 2; r <= centre.row + 3; ++r) ring.push_back({r, centre.col + 3});
@@ -185,17 +185,17 @@ TEST(DepositionManager, NeverRingsInARobotWhoseOriginIsItsOwnCell) {
   EXPECT_GT(plan.depositions.size(), 0u);
   EXPECT_LT(plan.depositions.size(), ring.size());
   // Independent check: after the plan's depositions the robot still reaches the window's border.
-  grid::Heightmap after = flat;
-  for (const bus::Deposition& d : plan.depositions) after(CellIndex{d.row, d.col}) += d.height_m;
-  const grid::CellMask reach = processing::NavigabilityProcessor::navigable_from(
-      processing::NavigabilityProcessor(p.navigability).occupiable(after), centre);
+  Heightmap after = flat;
+  for (const protocol::Deposition& d : plan.depositions) after(CellIndex{d.row, d.col}) += d.height_m;
+  const CellMask reach = NavigabilityProcessor::navigable_from(
+      NavigabilityProcessor(p.navigability).occupiable(after), centre);
   EXPECT_TRUE(reach.row(0).any() || reach.row(kGrid.rows - 1).any() || reach.col(0).any() ||
               reach.col(kGrid.cols - 1).any());
 }
 
 TEST(DepositionManager, KeepsANeighboursWayBack) {
-  const grid::Heightmap h = corridor();
-  grid::Heightmap gap(kGrid, 0.0);
+  const Heightmap h = corridor();
+  Heightmap gap(kGrid, 0.0);
   for (int c = 0; c < kGrid.cols; ++c) gap(10, c) = 0.3;
   // This robot near the origin (10, 1) at (10, 2) builds east; a neighbour stands at (10, 20) further east.
   const LocalMap map = make_map(h, gap, params().navigability, {10, 2}, {{10, 1}});

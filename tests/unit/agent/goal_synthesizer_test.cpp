@@ -1,4 +1,4 @@
-#include "agent/deliberative/goal_synthesizer.hpp"
+#include "marsala/agent/deliberative/goal_synthesizer.hpp"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <utility>
 
 #include "agent_test_support.hpp"
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::agent::deliberative {
 namespace {
@@ -58,14 +58,14 @@ AgentContext site_context(std::uint32_t id) {
   c.admission.cols = 12;
   c.admission.cell_size_m = 1.0;
   c.task.goal_synthesizer = "goal_vector_map";
-  processing::GoalVectorMapSpec spec;
+  GoalVectorMapSpec spec;
   spec.x0_m = 2.0;
   spec.y0_m = 2.0;
   spec.x1_m = 10.0;
   spec.y1_m = 6.0;
   spec.strip_width_m = 2.0;
   spec.arrow_length_m = 4.0;
-  spec.heading = processing::Heading::kEast;
+  spec.heading = Heading::kEast;
   c.task.goal_vector_map = spec;
   return c;
 }
@@ -74,7 +74,7 @@ const auto neighbour = test::neighbour_at;
 
 // The target, which must exist, as a pair for EXPECT_EQ.
 std::pair<double, double> target_of(GoalVectorMapSynthesizer& goal, Position robot,
-                                    std::vector<bus::Neighbour> neighbours = {}) {
+                                    std::vector<protocol::Neighbour> neighbours = {}) {
   const std::optional<Position> t = goal.target({robot, std::move(neighbours)});
   if (!t) ADD_FAILURE() << "no target from (" << robot.x << ", " << robot.y << ")";
   return t ? std::make_pair(t->x, t->y) : std::make_pair(std::nan(""), std::nan(""));

@@ -1,18 +1,18 @@
-#include "agent/deliberative/local_map_synthesizer.hpp"
+#include "marsala/agent/deliberative/local_map_synthesizer.hpp"
 
 #include <gtest/gtest.h>
 
 #include "agent_test_support.hpp"
-#include "common/error.hpp"
-#include "tests/support/mars_brute_force.hpp"
-#include "tests/support/navigability_brute_force.hpp"
+#include "marsala/core/error.hpp"
+#include "support/mars_brute_force.hpp"
+#include "support/navigability_brute_force.hpp"
 
 namespace marsala::agent::deliberative {
 namespace {
 
 // 60 rows x 80 cols at 0.1 m, lower-left corner (0, 0): cell (r, c) has its centre at
 // x = 0.1 c + 0.05, y = 0.1 (59 - r) + 0.05.
-const grid::GridGeometry kWorld{60, 80, 0.0, 0.0, 0.1};
+const GridGeometry kWorld{60, 80, 0.0, 0.0, 0.1};
 const NavigabilityParams kBody{0.5, 0.4, 0.05};
 const Position kRobot{4.05, 2.95};  // cell (30, 40)
 
@@ -36,8 +36,8 @@ TEST(SensingWindow, IsTheSquareClippedToTheGrid) {
   EXPECT_THROW(sensing_window(kWorld, kRobot, -1.0), InvalidArgument);
 }
 
-grid::Heightmap bumpy_terrain() {
-  grid::Heightmap h(kWorld, 0.0);
+Heightmap bumpy_terrain() {
+  Heightmap h(kWorld, 0.0);
   for (int r = 0; r < h.rows(); ++r)
     for (int c = 0; c < h.cols(); ++c) h(r, c) = 0.01 * ((r * 7 + c * 3) % 5);
   for (int r = 25; r < 28; ++r)
@@ -46,7 +46,7 @@ grid::Heightmap bumpy_terrain() {
 }
 
 TEST(LocalMapSynthesizer, WindowGapAndNavigabilityMatchReferences) {
-  const grid::Heightmap h = bumpy_terrain();
+  const Heightmap h = bumpy_terrain();
   executive::MappingSystem map = test::full_map(h);
   map.record_pose(kRobot);
   const LocalMapSynthesizer synthesizer(kBody, 1.0);
@@ -56,11 +56,11 @@ TEST(LocalMapSynthesizer, WindowGapAndNavigabilityMatchReferences) {
   ASSERT_EQ(local.cols(), 21);
   EXPECT_EQ(local.robot, (CellIndex{10, 10}));
   EXPECT_EQ(local.to_global(local.robot), (CellIndex{30, 40}));
-  const grid::Heightmap expected = h.window({20, 30}, 21, 21);
+  const Heightmap expected = h.window({20, 30}, 21, 21);
   EXPECT_TRUE(local.heights.heights() == expected.heights());
   EXPECT_EQ(local.geometry(), expected.geometry());
   // The gap and the masks against the brute-force references on the window alone.
-  const grid::Heightmap p = testing::mars_brute_force(expected, kBody.kappa);
+  const Heightmap p = testing::mars_brute_force(expected, kBody.kappa);
   for (int r = 0; r < 21; ++r)
     for (int c = 0; c < 21; ++c) EXPECT_NEAR(local.gap(r, c), p(r, c) - expected(r, c), 1e-9);
   EXPECT_TRUE(local.occupiable == testing::occupiable_brute_force(expected, kBody));
@@ -72,7 +72,7 @@ TEST(LocalMapSynthesizer, WindowGapAndNavigabilityMatchReferences) {
 }
 
 TEST(LocalMapSynthesizer, LocalGoalIsTheTargetInsideOrWhereTheLineLeaves) {
-  const executive::MappingSystem map = test::full_map(grid::Heightmap(kWorld, 0.0));
+  const executive::MappingSystem map = test::full_map(Heightmap(kWorld, 0.0));
   const LocalMapSynthesizer synthesizer(kBody, 1.0);
   // Inside: the target's own cell (32, 45).
   LocalMap local = synthesizer.synthesize(map, kRobot, {4.55, 2.75});
@@ -94,7 +94,7 @@ TEST(LocalMapSynthesizer, LocalGoalIsTheTargetInsideOrWhereTheLineLeaves) {
 }
 
 TEST(LocalMapSynthesizer, LocalOriginIsTheTrajectoryCellNearestTheBoundary) {
-  grid::Heightmap h(kWorld, 0.0);
+  Heightmap h(kWorld, 0.0);
   executive::MappingSystem map = test::full_map(h);
   // Came from the west along row 30 (cols 10 .. 40); in the window: cols 30 .. 40; col 30 lies on the square's
   // west side (x = 3.05 = 4.05 - 1).
@@ -125,7 +125,7 @@ TEST(LocalMapSynthesizer, LocalOriginIsTheTrajectoryCellNearestTheBoundary) {
 }
 
 TEST(LocalMapSynthesizer, UnknownCellsAreNeverOccupiableNorTargets) {
-  const grid::Heightmap h(kWorld, 0.3);
+  const Heightmap h(kWorld, 0.3);
   executive::MappingSystem map(kWorld, 16);
   // Only tile columns 2 and 3 (cols 32..63) of tile rows 1 and 2 (rows 16..47) are known.
   for (int tr = 1; tr <= 2; ++tr)

@@ -14,9 +14,9 @@
 #include <utility>
 #include <vector>
 
-#include "common/bus/messages.hpp"
-#include "common/grid/heightmap.hpp"
-#include "common/processing/navigability_processor.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::agent::test {
 
@@ -24,11 +24,11 @@ namespace marsala::agent::test {
 struct MiniRobot {
   std::uint32_t id = 0;
   std::uint64_t session = 0;
-  bus::BodyParams body;
+  RobotBody body;
   Position pos;
   Position target;
   double material_m3 = 0.0;
-  bus::ActionResult last_result = bus::ActionResult::kNone;
+  protocol::ActionResult last_result = protocol::ActionResult::kNone;
   std::string last_reason;
   std::map<std::pair<int, int>, std::uint64_t> tiles_seen;  // tile -> version last sent
   double deposited_m3 = 0.0;
@@ -38,20 +38,20 @@ struct MiniRobot {
 
 class MiniWorld {
  public:
-  MiniWorld(grid::Heightmap terrain, int tile_size, Position base, double base_radius_m)
+  MiniWorld(Heightmap terrain, int tile_size, Position base, double base_radius_m)
       : terrain_(std::move(terrain)), tile_size_(tile_size), base_(base), base_radius_m_(base_radius_m) {
     tile_rows_ = (terrain_.rows() + tile_size - 1) / tile_size;
     tile_cols_ = (terrain_.cols() + tile_size - 1) / tile_size;
     tile_version_.assign(static_cast<std::size_t>(tile_rows_) * tile_cols_, 1);
   }
 
-  const grid::Heightmap& terrain() const { return terrain_; }
+  const Heightmap& terrain() const { return terrain_; }
   std::uint64_t step() const { return step_; }
   const std::map<std::uint32_t, MiniRobot>& robots() const { return robots_; }
   const MiniRobot& robot(std::uint32_t id) const { return robots_.at(id); }
 
   /// Admits robot `id` at `start` heading for `target` with a full load.
-  bus::Admission admit(std::uint32_t id, std::uint64_t session, const bus::BodyParams& body, Position start,
+  protocol::Admission admit(std::uint32_t id, std::uint64_t session, const RobotBody& body, Position start,
                        Position target) {
     MiniRobot r;
     r.id = id;
@@ -61,7 +61,7 @@ class MiniWorld {
     r.target = target;
     r.material_m3 = body.material_capacity_m3;
     robots_[id] = r;
-    bus::Admission a;
+    protocol::Admission a;
     a.agent_id = id;
     a.session = session;
     a.accepted = true;
@@ -84,9 +84,9 @@ class MiniWorld {
 
   /// The frame of robot `id` for the current step: tiles meeting its sensing square that changed since it last
   /// got them, neighbours within proximity range.
-  bus::SensorFrame frame_for(std::uint32_t id, bool run_over = false) {
+  protocol::SensorFrame frame_for(std::uint32_t id, bool run_over = false) {
     MiniRobot& r = robots_.at(id);
-    bus::SensorFrame f;
+    protocol::SensorFrame f;
     f.agent_id = id;
     f.step = step_;
     f.x_m = r.pos.x;
@@ -109,7 +109,7 @@ class MiniWorld {
         auto& seen = r.tiles_seen[{tr, tc}];
         if (seen == v) continue;
         seen = v;
-        bus::TerrainTile t;
+        protocol::TerrainTile t;
         t.tile_row = tr;
         t.tile_col = tc;
         t.rows = std::min(tile_size_, g.rows - tr * tile_size_);
@@ -125,13 +125,13 @@ class MiniWorld {
   }
 
   /// Why the world would reject `q` in the current state ("" when it accepts it), per runtime_spec.md.
-  std::string validate(const bus::ActionRequest& q) const {
+  std::string validate(const protocol::ActionRequest& q) const {
     const auto it = robots_.find(q.agent_id);
     if (it == robots_.end()) return "unknown agent";
     const MiniRobot& r = it->second;
     if (q.session != r.session) return "wrong session";
     if (q.step != step_) return "wrong step";
-    const bus::BodyParams& b = r.body;
+    const RobotBody& b = r.body;
     const double cs = terrain_.cell_size_m();
     for (double v : {q.target_x_m, q.target_y_m})
       if (!std::isfinite(v) || std::abs(v) >= 1e6) return "bad number";
@@ -142,8 +142,8 @@ class MiniWorld {
       if (d > b.max_step_m + 1e-9) return "motion of " + num(d) + " m exceeds max_step";
       const auto cell = terrain_.cell_at(t);
       if (!cell) return "motion target off the grid";
-      const grid::CellMask occ =
-          processing::NavigabilityProcessor({b.kappa, b.delta_m, b.eps_m}).occupiable(terrain_);
+      const CellMask occ =
+          NavigabilityProcessor({b.navigability.kappa, b.navigability.delta_m, b.navigability.eps_m}).occupiable(terrain_);
       if (occ(cell->row, cell->col) == 0) return "motion target cell not occupiable";
       pos = t;
     }
@@ -162,7 +162,7 @@ class MiniWorld {
       if (std::hypot(centre.x - pos.x, centre.y - pos.y) > b.reach_m + 1e-9) return "deposition out of reach";
       for (const auto& [oid, o] : robots_) {
         const Position p = oid == q.agent_id ? pos : o.pos;
-        if (!(std::hypot(centre.x - p.x, centre.y - p.y) > o.body.delta_m / 2.0))
+        if (!(std::hypot(centre.x - p.x, centre.y - p.y) > o.body.navigability.delta_m / 2.0))
           return "deposition under robot " + std::to_string(oid);
       }
       volume += d.height_m * cs * cs;
@@ -176,14 +176,14 @@ class MiniWorld {
 
   /// Validates and applies the requests in id order, each against the state left by the previous ones; returns
   /// the reasons of rejected ones ("" for accepted), in the same order. Then advances the step.
-  std::vector<std::string> apply_step(std::vector<bus::ActionRequest> requests) {
+  std::vector<std::string> apply_step(std::vector<protocol::ActionRequest> requests) {
     std::sort(requests.begin(), requests.end(), [](const auto& a, const auto& b) { return a.agent_id < b.agent_id; });
     std::vector<std::string> reasons;
     for (const auto& q : requests) {
       MiniRobot& r = robots_.at(q.agent_id);
       const std::string why = validate(q);
       reasons.push_back(why);
-      r.last_result = why.empty() ? bus::ActionResult::kAccepted : bus::ActionResult::kRejected;
+      r.last_result = why.empty() ? protocol::ActionResult::kAccepted : protocol::ActionResult::kRejected;
       r.last_reason = why;
       if (!why.empty()) {
         ++r.rejected;
@@ -213,7 +213,7 @@ class MiniWorld {
     return s.str();
   }
 
-  grid::Heightmap terrain_;
+  Heightmap terrain_;
   int tile_size_;
   int tile_rows_ = 0, tile_cols_ = 0;
   std::vector<std::uint64_t> tile_version_;

@@ -1,11 +1,11 @@
-#include "agent/reactive/pipeline.hpp"
+#include "marsala/agent/reactive/pipeline.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "agent_test_support.hpp"
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::agent::reactive {
 namespace {

@@ -21,10 +21,11 @@
 #include <thread>
 #include <vector>
 
-#include "common/bus/bus.hpp"
-#include "common/error.hpp"
+#include "marsala/bus/bus.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::bus {
+using namespace marsala::protocol;  // the messages under test
 namespace {
 
 using namespace std::chrono_literals;
@@ -55,10 +56,10 @@ std::uint64_t bits(double d) {
 // Field-by-field comparisons, doubles bit for bit (NaN payloads and -0.0 included).
 #define EXPECT_SAME_DOUBLE(a, b) EXPECT_EQ(bits(a), bits(b)) << #a << " = " << (a) << " vs " << (b)
 
-void expect_same(const BodyParams& a, const BodyParams& b) {
-  EXPECT_SAME_DOUBLE(a.kappa, b.kappa);
-  EXPECT_SAME_DOUBLE(a.delta_m, b.delta_m);
-  EXPECT_SAME_DOUBLE(a.eps_m, b.eps_m);
+void expect_same(const RobotBody& a, const RobotBody& b) {
+  EXPECT_SAME_DOUBLE(a.navigability.kappa, b.navigability.kappa);
+  EXPECT_SAME_DOUBLE(a.navigability.delta_m, b.navigability.delta_m);
+  EXPECT_SAME_DOUBLE(a.navigability.eps_m, b.navigability.eps_m);
   EXPECT_SAME_DOUBLE(a.max_step_m, b.max_step_m);
   EXPECT_SAME_DOUBLE(a.max_deposit_m3, b.max_deposit_m3);
   EXPECT_SAME_DOUBLE(a.material_capacity_m3, b.material_capacity_m3);
@@ -197,8 +198,8 @@ class Filler {
   std::uint64_t u64() { return rng_() | 0x8000000000000001ull; }
   std::int32_t i32() { return -static_cast<std::int32_t>(rng_() % 100000) - 1; }
 
-  BodyParams body() {
-    return {real(), real(), real(), real(), real(), real(), real(), real(), real(), real()};
+  RobotBody body() {
+    return {{real(), real(), real()}, real(), real(), real(), real(), real(), real(), real()};
   }
   TerrainTile tile(int rows, int cols) {
     TerrainTile t{i32(), i32(), rows, cols, {}};

@@ -3,10 +3,11 @@
 #include <chrono>
 #include <thread>
 
-#include "common/bus/bus.hpp"
-#include "common/error.hpp"
+#include "marsala/bus/bus.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::bus {
+using namespace marsala::protocol;  // the messages under test
 namespace {
 
 using namespace std::chrono_literals;

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "monitor/format.hpp"
-#include "monitor/monitor_cli.hpp"
-#include "tests/unit/monitor/fake_world.hpp"
+#include "marsala/monitor/format.hpp"
+#include "marsala/monitor/monitor_cli.hpp"
+#include "unit/monitor/fake_world.hpp"
 
 extern char** environ;
 
@@ -43,13 +43,13 @@ Result run_cli(std::vector<std::string> args, const StopSource& stop = StopSourc
   return r;
 }
 
-bus::WorldStatus one_agent_status(std::uint64_t step, bool running) {
-  bus::WorldStatus s;
+protocol::WorldStatus one_agent_status(std::uint64_t step, bool running) {
+  protocol::WorldStatus s;
   s.run_id = "cli";
   s.scenario = "flat";
   s.step = step;
   s.running = running;
-  bus::AgentStatus a;
+  protocol::AgentStatus a;
   a.agent_id = 1;
   a.name = "solo";
   a.state = "build";
@@ -124,9 +124,9 @@ TEST(MonitorCli, TailFollowsARunToItsEnd) {
                     "--width", "60"});
   });
   ASSERT_TRUE(world.wait_for_monitor(1, 1));
-  bus::WorldEvent over;
+  protocol::WorldEvent over;
   over.step = 4;
-  over.kind = bus::EventKind::kRunOver;
+  over.kind = protocol::EventKind::kRunOver;
   over.detail = "max_steps reached";
   world.publish(one_agent_status(3, true));
   world.publish(over);

@@ -5,7 +5,7 @@
 #include <chrono>
 #include <memory>
 
-#include "common/bus/bus.hpp"
+#include "marsala/bus/bus.hpp"
 
 namespace marsala::monitor::test_support {
 
@@ -14,10 +14,10 @@ namespace marsala::monitor::test_support {
 class FakeWorld {
  public:
   explicit FakeWorld(int domain_id) : participant_(bus::make_participant({bus::Vendor::kInProcess, domain_id})) {
-    status_ = participant_->create_writer<bus::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
-    events_ = participant_->create_writer<bus::WorldEvent>({"", nullptr, bus::Durability::kVolatile, 256});
-    status_probe_ = participant_->create_reader<bus::WorldStatus>({"", probe_});
-    event_probe_ = participant_->create_reader<bus::WorldEvent>({"", probe_});
+    status_ = participant_->create_writer<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
+    events_ = participant_->create_writer<protocol::WorldEvent>({"", nullptr, bus::Durability::kVolatile, 256});
+    status_probe_ = participant_->create_reader<protocol::WorldStatus>({"", probe_});
+    event_probe_ = participant_->create_reader<protocol::WorldEvent>({"", probe_});
   }
 
   /// Waits (on the probes' wake-up, at most 5 s) until the monitor's readers joined.
@@ -27,16 +27,16 @@ class FakeWorld {
       if (!probe_->wait_until(deadline)) return false;
     return true;
   }
-  void publish(const bus::WorldStatus& s) { status_->write(s); }
-  void publish(const bus::WorldEvent& e) { events_->write(e); }
+  void publish(const protocol::WorldStatus& s) { status_->write(s); }
+  void publish(const protocol::WorldEvent& e) { events_->write(e); }
 
  private:
   std::unique_ptr<bus::Participant> participant_;
   std::shared_ptr<bus::Signal> probe_ = std::make_shared<bus::Signal>();
-  std::unique_ptr<bus::Writer<bus::WorldStatus>> status_;
-  std::unique_ptr<bus::Writer<bus::WorldEvent>> events_;
-  std::unique_ptr<bus::Reader<bus::WorldStatus>> status_probe_;
-  std::unique_ptr<bus::Reader<bus::WorldEvent>> event_probe_;
+  std::unique_ptr<bus::Writer<protocol::WorldStatus>> status_;
+  std::unique_ptr<bus::Writer<protocol::WorldEvent>> events_;
+  std::unique_ptr<bus::Reader<protocol::WorldStatus>> status_probe_;
+  std::unique_ptr<bus::Reader<protocol::WorldEvent>> event_probe_;
 };
 
 }  // namespace marsala::monitor::test_support

@@ -11,9 +11,9 @@
 #include <typeinfo>
 #include <vector>
 
-#include "common/error.hpp"
-#include "monitor/follow.hpp"
-#include "tests/unit/monitor/fake_world.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/monitor/follow.hpp"
+#include "unit/monitor/fake_world.hpp"
 
 namespace marsala::monitor {
 namespace {
@@ -23,14 +23,14 @@ using test_support::FakeWorld;
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-bus::WorldStatus status(const std::string& run_id, std::uint64_t step, std::vector<std::uint32_t> ids = {1, 2}) {
-  bus::WorldStatus s;
+protocol::WorldStatus status(const std::string& run_id, std::uint64_t step, std::vector<std::uint32_t> ids = {1, 2}) {
+  protocol::WorldStatus s;
   s.run_id = run_id;
   s.scenario = "ramp";
   s.step = step;
   s.deposited_volume_m3 = 0.000125 * static_cast<double>(step);
   for (std::uint32_t id : ids) {
-    bus::AgentStatus a;
+    protocol::AgentStatus a;
     a.agent_id = id;
     a.name = "builder-" + std::to_string(id);
     a.state = step % 2 == 0 ? "build" : "refill";
@@ -40,8 +40,8 @@ bus::WorldStatus status(const std::string& run_id, std::uint64_t step, std::vect
   return s;
 }
 
-bus::WorldStatus final_status(const std::string& run_id, std::uint64_t step) {
-  bus::WorldStatus s = status(run_id, step);
+protocol::WorldStatus final_status(const std::string& run_id, std::uint64_t step) {
+  protocol::WorldStatus s = status(run_id, step);
   s.running = false;
   s.completed = true;
   s.progress = 1.0;
@@ -49,13 +49,13 @@ bus::WorldStatus final_status(const std::string& run_id, std::uint64_t step) {
   return s;
 }
 
-bus::WorldEvent event(std::uint64_t step, std::uint32_t agent_id, bus::EventKind kind, const std::string& detail = "") {
-  bus::WorldEvent e;
+protocol::WorldEvent event(std::uint64_t step, std::uint32_t agent_id, protocol::EventKind kind, const std::string& detail = "") {
+  protocol::WorldEvent e;
   e.step = step;
   e.agent_id = agent_id;
   e.kind = kind;
   e.detail = detail;
-  if (kind == bus::EventKind::kDeposited) e.volume_m3 = 0.000125;
+  if (kind == protocol::EventKind::kDeposited) e.volume_m3 = 0.000125;
   return e;
 }
 
@@ -123,10 +123,10 @@ TEST(Tail, PrintsEachStepAndItsEventsThenEndsWithTheRun) {
   MonitorThread tail(61, tail_options(true));
   ASSERT_TRUE(world.wait_for_monitor(1, 1));
   // The world publishes a step's events before its status; kRunOver comes after the final status.
-  const auto e0 = event(0, 1, bus::EventKind::kAdmitted);
-  const auto e1 = event(1, 2, bus::EventKind::kDeposited, "1 cell");
-  const auto e2 = event(2, 1, bus::EventKind::kAtGoal);
-  const auto over = event(2, 0, bus::EventKind::kRunOver, "completed");
+  const auto e0 = event(0, 1, protocol::EventKind::kAdmitted);
+  const auto e1 = event(1, 2, protocol::EventKind::kDeposited, "1 cell");
+  const auto e2 = event(2, 1, protocol::EventKind::kAtGoal);
+  const auto over = event(2, 0, protocol::EventKind::kRunOver, "completed");
   const auto s0 = status("r1", 0), s1 = status("r1", 1), s2 = final_status("r1", 2);
   world.publish(e0);
   world.publish(s0);
@@ -151,7 +151,7 @@ TEST(Tail, ALateMonitorStartsAtTheLatestStatusAndSkipsEventsUnlessAsked) {
   world.publish(status("r2", 6));
   MonitorThread tail(62, tail_options(false));
   ASSERT_TRUE(world.wait_for_monitor(1, 0));
-  world.publish(event(6, 1, bus::EventKind::kDeposited));
+  world.publish(event(6, 1, protocol::EventKind::kDeposited));
   world.publish(final_status("r2", 7));
   const Result r = tail.join();
   EXPECT_EQ(r.exit_code, 0) << r.err;
@@ -166,7 +166,7 @@ TEST(Tail, HeaderAgainWhenTheTeamChangesAndNoRunOverEventIsNeeded) {
   MonitorThread tail(63, options);
   ASSERT_TRUE(world.wait_for_monitor(1, 1));
   const auto a = status("r3", 1, {1, 2, 3}), b = status("r3", 2, {1, 2, 3}), c = status("r3", 3, {1, 3});
-  bus::WorldStatus end = status("r3", 4, {1, 3});
+  protocol::WorldStatus end = status("r3", 4, {1, 3});
   end.running = false;
   for (const auto& s : {a, b, c, end}) world.publish(s);
   const Result r = tail.join();
@@ -181,7 +181,7 @@ TEST(Tail, WaitsBrieflyForTheEventsAfterTheFinalStatus) {
   MonitorThread tail(60, tail_options(true));  // drain: 0.5 s
   ASSERT_TRUE(world.wait_for_monitor(1, 1));
   const auto end = final_status("r0", 8);
-  const auto over = event(8, 0, bus::EventKind::kRunOver, "completed");
+  const auto over = event(8, 0, protocol::EventKind::kRunOver, "completed");
   world.publish(end);
   std::this_thread::sleep_for(100ms);  // the last event comes a little later
   world.publish(over);
@@ -326,18 +326,18 @@ class ReadOnlySpy final : public bus::Participant {
   }
 
   // clang-format off
-  std::unique_ptr<bus::Writer<bus::AgentHello>> make_writer(bus::Tag<bus::AgentHello>, const bus::EndpointOptions&) override { return refuse<bus::AgentHello>(); }
-  std::unique_ptr<bus::Writer<bus::Admission>> make_writer(bus::Tag<bus::Admission>, const bus::EndpointOptions&) override { return refuse<bus::Admission>(); }
-  std::unique_ptr<bus::Writer<bus::SensorFrame>> make_writer(bus::Tag<bus::SensorFrame>, const bus::EndpointOptions&) override { return refuse<bus::SensorFrame>(); }
-  std::unique_ptr<bus::Writer<bus::ActionRequest>> make_writer(bus::Tag<bus::ActionRequest>, const bus::EndpointOptions&) override { return refuse<bus::ActionRequest>(); }
-  std::unique_ptr<bus::Writer<bus::WorldStatus>> make_writer(bus::Tag<bus::WorldStatus>, const bus::EndpointOptions&) override { return refuse<bus::WorldStatus>(); }
-  std::unique_ptr<bus::Writer<bus::WorldEvent>> make_writer(bus::Tag<bus::WorldEvent>, const bus::EndpointOptions&) override { return refuse<bus::WorldEvent>(); }
-  std::unique_ptr<bus::Reader<bus::AgentHello>> make_reader(bus::Tag<bus::AgentHello>, const bus::EndpointOptions& o) override { return reader<bus::AgentHello>(o); }
-  std::unique_ptr<bus::Reader<bus::Admission>> make_reader(bus::Tag<bus::Admission>, const bus::EndpointOptions& o) override { return reader<bus::Admission>(o); }
-  std::unique_ptr<bus::Reader<bus::SensorFrame>> make_reader(bus::Tag<bus::SensorFrame>, const bus::EndpointOptions& o) override { return reader<bus::SensorFrame>(o); }
-  std::unique_ptr<bus::Reader<bus::ActionRequest>> make_reader(bus::Tag<bus::ActionRequest>, const bus::EndpointOptions& o) override { return reader<bus::ActionRequest>(o); }
-  std::unique_ptr<bus::Reader<bus::WorldStatus>> make_reader(bus::Tag<bus::WorldStatus>, const bus::EndpointOptions& o) override { return reader<bus::WorldStatus>(o); }
-  std::unique_ptr<bus::Reader<bus::WorldEvent>> make_reader(bus::Tag<bus::WorldEvent>, const bus::EndpointOptions& o) override { return reader<bus::WorldEvent>(o); }
+  std::unique_ptr<bus::Writer<protocol::AgentHello>> make_writer(bus::Tag<protocol::AgentHello>, const bus::EndpointOptions&) override { return refuse<protocol::AgentHello>(); }
+  std::unique_ptr<bus::Writer<protocol::Admission>> make_writer(bus::Tag<protocol::Admission>, const bus::EndpointOptions&) override { return refuse<protocol::Admission>(); }
+  std::unique_ptr<bus::Writer<protocol::SensorFrame>> make_writer(bus::Tag<protocol::SensorFrame>, const bus::EndpointOptions&) override { return refuse<protocol::SensorFrame>(); }
+  std::unique_ptr<bus::Writer<protocol::ActionRequest>> make_writer(bus::Tag<protocol::ActionRequest>, const bus::EndpointOptions&) override { return refuse<protocol::ActionRequest>(); }
+  std::unique_ptr<bus::Writer<protocol::WorldStatus>> make_writer(bus::Tag<protocol::WorldStatus>, const bus::EndpointOptions&) override { return refuse<protocol::WorldStatus>(); }
+  std::unique_ptr<bus::Writer<protocol::WorldEvent>> make_writer(bus::Tag<protocol::WorldEvent>, const bus::EndpointOptions&) override { return refuse<protocol::WorldEvent>(); }
+  std::unique_ptr<bus::Reader<protocol::AgentHello>> make_reader(bus::Tag<protocol::AgentHello>, const bus::EndpointOptions& o) override { return reader<protocol::AgentHello>(o); }
+  std::unique_ptr<bus::Reader<protocol::Admission>> make_reader(bus::Tag<protocol::Admission>, const bus::EndpointOptions& o) override { return reader<protocol::Admission>(o); }
+  std::unique_ptr<bus::Reader<protocol::SensorFrame>> make_reader(bus::Tag<protocol::SensorFrame>, const bus::EndpointOptions& o) override { return reader<protocol::SensorFrame>(o); }
+  std::unique_ptr<bus::Reader<protocol::ActionRequest>> make_reader(bus::Tag<protocol::ActionRequest>, const bus::EndpointOptions& o) override { return reader<protocol::ActionRequest>(o); }
+  std::unique_ptr<bus::Reader<protocol::WorldStatus>> make_reader(bus::Tag<protocol::WorldStatus>, const bus::EndpointOptions& o) override { return reader<protocol::WorldStatus>(o); }
+  std::unique_ptr<bus::Reader<protocol::WorldEvent>> make_reader(bus::Tag<protocol::WorldEvent>, const bus::EndpointOptions& o) override { return reader<protocol::WorldEvent>(o); }
   // clang-format on
 
  private:
@@ -356,7 +356,7 @@ TEST(Monitor, OnlyReadsWithTheContractsQos) {
   EXPECT_EQ(run_status(spy, StatusOptions{}, stop, out, err), 0) << err.str();
   EXPECT_EQ(spy.writers_requested, 0);
   ASSERT_EQ(spy.readers.size(), 3u);
-  const std::string status_type = typeid(bus::WorldStatus).name(), event_type = typeid(bus::WorldEvent).name();
+  const std::string status_type = typeid(protocol::WorldStatus).name(), event_type = typeid(protocol::WorldEvent).name();
   // tail: statuses transient-local (a late monitor sees the latest at once), events volatile.
   EXPECT_EQ(spy.readers[0].first, status_type);
   EXPECT_EQ(spy.readers[0].second.durability, bus::Durability::kTransientLocal);

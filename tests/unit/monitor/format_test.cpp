@@ -4,14 +4,14 @@
 #include <string>
 #include <vector>
 
-#include "monitor/format.hpp"
+#include "marsala/monitor/format.hpp"
 
 namespace marsala::monitor {
 namespace {
 
-bus::AgentStatus agent(std::uint32_t id, const std::string& state, double material_m3 = 1.0, bool alive = true,
+protocol::AgentStatus agent(std::uint32_t id, const std::string& state, double material_m3 = 1.0, bool alive = true,
                        bool at_goal = false) {
-  bus::AgentStatus a;
+  protocol::AgentStatus a;
   a.agent_id = id;
   a.name = "builder-" + std::to_string(id);
   a.state = state;
@@ -21,8 +21,8 @@ bus::AgentStatus agent(std::uint32_t id, const std::string& state, double materi
   return a;
 }
 
-bus::WorldStatus three_agents() {
-  bus::WorldStatus s;
+protocol::WorldStatus three_agents() {
+  protocol::WorldStatus s;
   s.run_id = "r7";
   s.scenario = "ramp";
   s.step = 42;
@@ -34,14 +34,14 @@ bus::WorldStatus three_agents() {
 }
 
 TEST(Format, StepHeaderAndLineWithFewAgents) {
-  const bus::WorldStatus s = three_agents();
+  const protocol::WorldStatus s = three_agents();
   EXPECT_EQ(format_step_header(s), "  step  live mat[m3]  dep[m3] goal | 1           2           3");
   // mat counts the live agents only (1.5 + 2.25); agent 2 at its goal, agent 3 dropped.
   EXPECT_EQ(format_step_line(s), "    42   2/3    3.75    0.125  33% | build       refill*     --");
 }
 
 TEST(Format, TwelveAgentsFitOneHundredColumns) {
-  bus::WorldStatus s;
+  protocol::WorldStatus s;
   s.step = 7;
   s.progress = 1.0 / 12.0;
   for (std::uint32_t id = 1; id <= 12; ++id) s.agents.push_back(agent(id, "build"));
@@ -58,7 +58,7 @@ TEST(Format, TwelveAgentsFitOneHundredColumns) {
 }
 
 TEST(Format, BeyondTwelveAgentsCountsLiveAgentsPerState) {
-  bus::WorldStatus s;
+  protocol::WorldStatus s;
   s.step = 3;
   s.deposited_volume_m3 = 2.5;
   for (std::uint32_t id = 1; id <= 13; ++id) {
@@ -76,7 +76,7 @@ TEST(Format, BeyondTwelveAgentsCountsLiveAgentsPerState) {
 }
 
 TEST(Format, LongLinesEndInEllipsisAtTheWidth) {
-  bus::WorldStatus s;
+  protocol::WorldStatus s;
   for (std::uint32_t id = 1; id <= 40; ++id) s.agents.push_back(agent(id, "state_number_" + std::to_string(id)));
   const std::string line = format_step_line(s);
   EXPECT_EQ(line.size(), 100u);
@@ -89,16 +89,16 @@ TEST(Format, LongLinesEndInEllipsisAtTheWidth) {
 }
 
 TEST(Format, NoAgents) {
-  bus::WorldStatus s;
+  protocol::WorldStatus s;
   EXPECT_EQ(format_step_header(s), "  step  live mat[m3]  dep[m3] goal | no agents");
   EXPECT_EQ(format_step_line(s), "     0   0/0    0.00    0.000   0% | no agents");
 }
 
 TEST(Format, EventLines) {
-  bus::WorldEvent e;
+  protocol::WorldEvent e;
   e.step = 42;
   e.agent_id = 3;
-  e.kind = bus::EventKind::kDeposited;
+  e.kind = protocol::EventKind::kDeposited;
   e.volume_m3 = 0.000125;
   e.detail = "5 cells";
   EXPECT_EQ(format_event(e), "    42 > agent 3  deposited 0.000125 m3 5 cells");
@@ -106,48 +106,48 @@ TEST(Format, EventLines) {
   e = {};
   e.step = 7;
   e.agent_id = 12;
-  e.kind = bus::EventKind::kRejected;
+  e.kind = protocol::EventKind::kRejected;
   e.detail = "target 0.31 m away > max_step 0.2 m";
   EXPECT_EQ(format_event(e), "     7 > agent 12 rejected  target 0.31 m away > max_step 0.2 m");
 
   e = {};
   e.step = 100;
-  e.kind = bus::EventKind::kRunOver;
+  e.kind = protocol::EventKind::kRunOver;
   e.detail = "completed";
   EXPECT_EQ(format_event(e), "   100 > world    run_over  completed");
 
   e = {};
   e.agent_id = 1;
-  e.kind = bus::EventKind::kAdmitted;
+  e.kind = protocol::EventKind::kAdmitted;
   EXPECT_EQ(format_event(e), "     0 > agent 1  admitted");
 
   e = {};
   e.step = 1;
   e.agent_id = 2;
-  e.kind = static_cast<bus::EventKind>(42);  // a kind this monitor does not know yet
+  e.kind = static_cast<protocol::EventKind>(42);  // a kind this monitor does not know yet
   e.detail = "x";
   EXPECT_EQ(format_event(e), "     1 > agent 2  kind 42   x");
 }
 
 TEST(Format, TextFromTheWireCannotDriveTheTerminal) {
-  bus::WorldEvent e;
+  protocol::WorldEvent e;
   e.step = 5;
   e.agent_id = 4;
-  e.kind = bus::EventKind::kRefused;
+  e.kind = protocol::EventKind::kRefused;
   e.detail = "bad\x1b[2Jname\n\xc3\xa9";
   EXPECT_EQ(format_event(e), "     5 > agent 4  refused   bad?[2Jname???");
 
-  bus::WorldStatus s;
+  protocol::WorldStatus s;
   s.agents = {agent(1, "evil\r\tstate")};
   EXPECT_EQ(format_step_line(s), "     0   1/1    1.00    0.000   0% | evil??state");
   EXPECT_EQ(printable(std::string("a\0b", 3)), "a?b");
 }
 
 TEST(Format, LongEventDetailIsCut) {
-  bus::WorldEvent e;
+  protocol::WorldEvent e;
   e.step = 9;
   e.agent_id = 1;
-  e.kind = bus::EventKind::kRejected;
+  e.kind = protocol::EventKind::kRejected;
   e.detail = std::string(200, 'r');
   const std::string line = format_event(e);
   EXPECT_EQ(line, "     9 > agent 1  rejected  " + std::string(69, 'r') + "...");
@@ -155,7 +155,7 @@ TEST(Format, LongEventDetailIsCut) {
 }
 
 TEST(Format, RunSummary) {
-  bus::WorldStatus s = three_agents();
+  protocol::WorldStatus s = three_agents();
   s.step = 1234;
   s.wall_seconds = 12.34;
   s.deposited_volume_m3 = 1.25;
@@ -174,21 +174,21 @@ TEST(Format, RunSummary) {
 }
 
 TEST(Format, StatusTable) {
-  bus::WorldStatus s;
+  protocol::WorldStatus s;
   s.run_id = "r7";
   s.scenario = "ramp";
   s.step = 42;
   s.wall_seconds = 3.5;
   s.progress = 0.5;
   s.deposited_volume_m3 = 0.625;
-  bus::AgentStatus a = agent(1, "build", 1.25);
+  protocol::AgentStatus a = agent(1, "build", 1.25);
   a.x_m = 2.5;
   a.y_m = 3.75;
   a.z_m = 0.25;
   a.deposited_m3 = 0.125;
   a.accepted = 40;
   a.rejected = 1;
-  bus::AgentStatus b = agent(2, "navigate_to_site", 0.0, false);
+  protocol::AgentStatus b = agent(2, "navigate_to_site", 0.0, false);
   b.name = "a-very-long-name-x";
   b.x_m = -10.5;
   b.z_m = 1.5;

@@ -1,11 +1,11 @@
-#include "common/scenario/scenario.hpp"
+#include "marsala/scenario/scenario.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <string>
 
-#include "common/error.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala::scenario {
 namespace {
@@ -57,9 +57,9 @@ TEST(ScenarioLoader, TheRampScenarioLoadsWithEveryValue) {
   const RobotType& husky = s.robot_types[0];
   EXPECT_EQ(husky.name, "husky");
   EXPECT_EQ(husky.behaviour, "ramp_builder");
-  EXPECT_EQ(husky.body.kappa, 0.3);
-  EXPECT_EQ(husky.body.delta_m, 1.0);
-  EXPECT_EQ(husky.body.eps_m, 0.05);
+  EXPECT_EQ(husky.body.navigability.kappa, 0.3);
+  EXPECT_EQ(husky.body.navigability.delta_m, 1.0);
+  EXPECT_EQ(husky.body.navigability.eps_m, 0.05);
   EXPECT_EQ(husky.body.max_step_m, 0.2);
   EXPECT_EQ(husky.body.max_deposit_m3, 0.02);
   EXPECT_EQ(husky.body.material_capacity_m3, 10.0);
@@ -94,18 +94,18 @@ TEST(ScenarioLoader, TheRampScenarioLoadsWithEveryValue) {
   // The kappa variants differ only in kappa and name.
   for (const auto& [file, kappa] : {std::pair<const char*, double>{"ramp_k0.2.pbtxt", 0.2}, {"ramp_k0.5.pbtxt", 0.5}}) {
     const Scenario v = load_scenario(source_dir() + "/deploy/scenarios/" + file);
-    EXPECT_EQ(v.robot_types[0].body.kappa, kappa);
-    EXPECT_EQ(v.robot_types[0].body.delta_m, 1.0);
+    EXPECT_EQ(v.robot_types[0].body.navigability.kappa, kappa);
+    EXPECT_EQ(v.robot_types[0].body.navigability.delta_m, 1.0);
     EXPECT_EQ(v.slots.size(), 3u);
   }
 }
 
 TEST(ScenarioLoader, DefaultsFillWhatIsLeftOut) {
   const Scenario s = parse_scenario(kMinimal, "mini.pbtxt");
-  const bus::BodyParams defaults;
+  const RobotBody defaults;
   EXPECT_EQ(s.source_path, "mini.pbtxt");
   EXPECT_EQ(s.robot_types[0].behaviour, "ramp_builder");
-  EXPECT_EQ(s.robot_types[0].body.kappa, defaults.kappa);
+  EXPECT_EQ(s.robot_types[0].body.navigability.kappa, defaults.navigability.kappa);
   EXPECT_EQ(s.robot_types[0].body.reach_m, defaults.reach_m);
   EXPECT_EQ(s.robot_types[0].body.material_capacity_m3, defaults.material_capacity_m3);
   EXPECT_EQ(s.terrain.seed, 1u);
@@ -131,7 +131,7 @@ robot_type { name: "digger" behaviour: "digger" body { kappa: 0.5 reach_m: 2 } }
 agent { id: 2 robot_type: "digger" start { x_m: 2 y_m: 2 } target { x_m: 3 y_m: 3 } })", "h.pbtxt");
   EXPECT_EQ(h.robot_for(1).name, "bot");
   EXPECT_EQ(h.robot_for(2).behaviour, "digger");
-  EXPECT_EQ(h.robot_for(2).body.kappa, 0.5);
+  EXPECT_EQ(h.robot_for(2).body.navigability.kappa, 0.5);
   EXPECT_EQ(h.robot_for(2).body.reach_m, 2.0);
 }
 

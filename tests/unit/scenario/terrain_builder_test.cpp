@@ -1,4 +1,4 @@
-#include "common/scenario/terrain_builder.hpp"
+#include "marsala/scenario/terrain_builder.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -8,12 +8,12 @@
 #include <iostream>
 #include <fstream>
 
-#include "common/error.hpp"
-#include "common/processing/goal_vector_map.hpp"
-#include "common/processing/navigability_processor.hpp"
-#include "common/terrain/asc_io.hpp"
-#include "common/terrain/generators.hpp"
-#include "common/terrain/resample.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/goal_vector_map.hpp"
+#include "marsala/core/navigability_processor.hpp"
+#include "marsala/terrain/asc_io.hpp"
+#include "marsala/terrain/generators.hpp"
+#include "marsala/terrain/resample.hpp"
 
 namespace marsala::scenario {
 namespace {
@@ -48,14 +48,14 @@ class TerrainBuilderTest : public ::testing::Test {
 TEST_F(TerrainBuilderTest, GeneratedTerrainIsTheGeneratorsOutputBitForBit) {
   const Scenario s = scenario(R"(terrain { generator: "gaussian_hills" rows: 30 cols: 40 cell_size_m: 0.1 seed: 9
                                            params { key: "count" value: 3 } })");
-  const grid::Heightmap built = build_terrain(s);
+  const Heightmap built = build_terrain(s);
   terrain::GeneratorSpec spec;
   spec.rows = 30;
   spec.cols = 40;
   spec.cell_size_m = 0.1;
   spec.seed = 9;
   spec.params = {{"count", 3.0}};
-  const grid::Heightmap want = terrain::generate_terrain("gaussian_hills", spec);
+  const Heightmap want = terrain::generate_terrain("gaussian_hills", spec);
   ASSERT_EQ(built.geometry(), want.geometry());
   EXPECT_TRUE(built.heights() == want.heights());
   EXPECT_GT(built.max_height(), 0.0);
@@ -64,7 +64,7 @@ TEST_F(TerrainBuilderTest, GeneratedTerrainIsTheGeneratorsOutputBitForBit) {
 TEST_F(TerrainBuilderTest, TheRampPlatformStandsWhereTheScenarioSays) {
   const char* dir = std::getenv("MARSALA_SOURCE_DIR");
   const Scenario s = load_scenario(std::string(dir ? dir : ".") + "/deploy/scenarios/ramp.pbtxt");
-  const grid::Heightmap h = build_terrain(s);
+  const Heightmap h = build_terrain(s);
   EXPECT_EQ(h.rows(), 200);
   EXPECT_EQ(h.cols(), 300);
   // Platform x in [18, 28), y in [3, 17): cell centres 18.05 .. 27.95 and 3.05 .. 16.95.
@@ -83,27 +83,27 @@ TEST_F(TerrainBuilderTest, TheRampPlatformStandsWhereTheScenarioSays) {
 }
 
 TEST_F(TerrainBuilderTest, FileTerrainRelativeToTheScenarioWithCropResampleAndZeroBase) {
-  grid::GridGeometry g;
+  GridGeometry g;
   g.rows = 12;
   g.cols = 16;
   g.xll_m = 0.0;
   g.yll_m = 0.0;
   g.cell_size_m = 0.5;
-  grid::Heightmap source(g, 0.0);
+  Heightmap source(g, 0.0);
   for (int r = 0; r < g.rows; ++r)
     for (int c = 0; c < g.cols; ++c) source(r, c) = 100.0 + 0.25 * c - 0.5 * r;
   terrain::write_asc(source, (dir_ / "maps" / "site.asc").string());
 
   const Scenario plain = scenario(R"(terrain { file: "maps/site.asc" })");
   EXPECT_EQ(resolve_terrain_path(plain), (dir_ / "maps" / "site.asc").string());
-  const grid::Heightmap same = build_terrain(plain);
+  const Heightmap same = build_terrain(plain);
   EXPECT_TRUE(same.heights() == source.heights());
 
   const Scenario edited = scenario(R"(terrain { file: "maps/site.asc" crop { x0_m: 0.5 y0_m: 0.5 width_m: 6 height_m: 4 }
                                                 resample_cell_size_m: 0.25 zero_base: true })");
-  grid::Heightmap want = terrain::resample_bilinear(terrain::crop(source, 0.5, 0.5, 6, 4), 0.25);
+  Heightmap want = terrain::resample_bilinear(terrain::crop(source, 0.5, 0.5, 6, 4), 0.25);
   want.heights().array() -= want.min_height();
-  const grid::Heightmap got = build_terrain(edited);
+  const Heightmap got = build_terrain(edited);
   ASSERT_EQ(got.geometry(), want.geometry());
   EXPECT_TRUE(got.heights() == want.heights());
   EXPECT_EQ(got.min_height(), 0.0);
@@ -120,11 +120,11 @@ TEST_F(TerrainBuilderTest, BadFileTerrainsAreClearErrors) {
   std::ofstream(dir_ / "maps" / "broken.asc") << "ncols 2\nnrows 2\n";
   EXPECT_THROW(build_terrain(scenario(R"(terrain { file: "maps/broken.asc" })")), ParseError);
   // A file too small for the agent slots: (2, 2) lies off a 1.5 x 1.5 m grid.
-  grid::GridGeometry g;
+  GridGeometry g;
   g.rows = 3;
   g.cols = 3;
   g.cell_size_m = 0.5;
-  terrain::write_asc(grid::Heightmap(g, 0.0), (dir_ / "maps" / "tiny.asc").string());
+  terrain::write_asc(Heightmap(g, 0.0), (dir_ / "maps" / "tiny.asc").string());
   try {
     build_terrain(scenario(R"(terrain { file: "maps/tiny.asc" })"));
     FAIL() << "expected an InvalidArgument";
@@ -160,7 +160,7 @@ TEST(DeployScenarios, EachBuildsItsTerrainAndNeedsConstruction) {
   for (const fs::path& file : files) {
     SCOPED_TRACE(file.string());
     const Scenario s = load_scenario(file.string());
-    grid::Heightmap h;
+    Heightmap h;
     try {
       h = build_terrain(s);
     } catch (const IoError& e) {
@@ -178,22 +178,22 @@ TEST(DeployScenarios, EachBuildsItsTerrainAndNeedsConstruction) {
     if (s.completion == CompletionKind::kPayloadPath) {
       ++payload;
       const PayloadPath& p = s.payload_path;
-      const processing::NavigabilityProcessor nav({p.kappa, p.delta_m, p.eps_m});
-      const grid::CellMask occupiable = nav.occupiable(h);
+      const NavigabilityProcessor nav({p.kappa, p.delta_m, p.eps_m});
+      const CellMask occupiable = nav.occupiable(h);
       const CellIndex from = cell(p.from_x_m, p.from_y_m), to = cell(p.to_x_m, p.to_y_m);
       EXPECT_EQ(occupiable(from.row, from.col), 1) << "the payload cannot stand at its start";
-      EXPECT_EQ(processing::NavigabilityProcessor::navigable_from(occupiable, from)(to.row, to.col), 0)
+      EXPECT_EQ(NavigabilityProcessor::navigable_from(occupiable, from)(to.row, to.col), 0)
           << "the target is reachable without construction";
     }
     if (s.completion == CompletionKind::kLevelSite) {
       ++sites;
       ASSERT_TRUE(s.has_goal_vector_map);
-      const processing::GoalVectorMap map(s.goal_vector_map, h.geometry());
+      const GoalVectorMap map(s.goal_vector_map, h.geometry());
       EXPECT_GE(static_cast<std::size_t>(map.strips()), 1u);
       const CellIndex lo = cell(s.site.x0_m + 1e-6, s.site.y1_m - 1e-6), hi = cell(s.site.x1_m - 1e-6, s.site.y0_m + 1e-6);
-      const grid::Heightmap site = h.window(lo, hi.row - lo.row + 1, hi.col - lo.col + 1);
-      const grid::CellMask occupiable =
-          processing::NavigabilityProcessor({s.site.kappa, s.site.delta_m, s.site.eps_m}).occupiable(site);
+      const Heightmap site = h.window(lo, hi.row - lo.row + 1, hi.col - lo.col + 1);
+      const CellMask occupiable =
+          NavigabilityProcessor({s.site.kappa, s.site.delta_m, s.site.eps_m}).occupiable(site);
       EXPECT_LT(occupiable.cast<long long>().sum(), static_cast<long long>(site.rows()) * site.cols())
           << "the site is level already";
     }

@@ -1,11 +1,11 @@
-#include "world_server/admission.hpp"
+#include "marsala/world_server/admission.hpp"
 
 #include <gtest/gtest.h>
 
 #include <limits>
 
-#include "tests/unit/world_server/world_fixtures.hpp"
-#include "world_server/step.hpp"
+#include "unit/world_server/world_fixtures.hpp"
+#include "marsala/world_server/step.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -17,7 +17,7 @@ using testing::small_scenario;
 class AdmissionTest : public ::testing::Test {
  protected:
   AdmissionTest() : state_(make_world_state(small_scenario(), flat_terrain(), 2)) {}
-  void expect_refused(const bus::AgentHello& h, const std::string& words, bool started = false) {
+  void expect_refused(const protocol::AgentHello& h, const std::string& words, bool started = false) {
     const AdmissionDecision d = decide_admission(state_, h, started);
     EXPECT_FALSE(d.accepted) << "expected a refusal mentioning '" << words << "'";
     EXPECT_NE(d.reason.find(words), std::string::npos) << d.reason;
@@ -26,7 +26,7 @@ class AdmissionTest : public ::testing::Test {
 };
 
 TEST_F(AdmissionTest, AdmitsAMatchingHelloAndPlacesTheAgentAtItsStart) {
-  const bus::AgentHello h = hello_for(state_, 2, 77);
+  const protocol::AgentHello h = hello_for(state_, 2, 77);
   ASSERT_TRUE(decide_admission(state_, h, false).accepted);
   EXPECT_TRUE(admit(state_, h));
   const AgentRecord& a = state_.agent(2);
@@ -42,7 +42,7 @@ TEST_F(AdmissionTest, AdmitsAMatchingHelloAndPlacesTheAgentAtItsStart) {
   EXPECT_TRUE(decide_admission(state_, h, true).accepted);
   EXPECT_FALSE(admit(state_, h));
 
-  const bus::Admission m = admission_message(state_, h, {true, ""}, "small-d4");
+  const protocol::Admission m = admission_message(state_, h, {true, ""}, "small-d4");
   EXPECT_EQ(m.agent_id, 2u);
   EXPECT_EQ(m.session, 77u);
   EXPECT_TRUE(m.accepted);
@@ -59,14 +59,14 @@ TEST_F(AdmissionTest, AdmitsAMatchingHelloAndPlacesTheAgentAtItsStart) {
 }
 
 TEST_F(AdmissionTest, Refusals) {
-  bus::AgentHello h = hello_for(state_, 1, 5);
+  protocol::AgentHello h = hello_for(state_, 1, 5);
   h.agent_id = 3;  // slot 3 exists in the scenario, but this run has two agents
   expect_refused(h, "unknown agent id 3");
   h.agent_id = 0;
   expect_refused(h, "unknown agent id 0");
 
   h = hello_for(state_, 1, 5);
-  h.body.kappa = 0.31;
+  h.body.navigability.kappa = 0.31;
   expect_refused(h, "body differs from robot type 'tester'");
   expect_refused(h, "kappa 0.31");
   h = hello_for(state_, 1, 5);
@@ -87,7 +87,7 @@ TEST_F(AdmissionTest, Refusals) {
   // Dropped agents stay out.
   drop_agent(state_, 1, "lost");
   expect_refused(hello_for(state_, 1, 5), "was dropped");
-  const bus::Admission m = admission_message(state_, hello_for(state_, 1, 5), {false, "no"}, "r");
+  const protocol::Admission m = admission_message(state_, hello_for(state_, 1, 5), {false, "no"}, "r");
   EXPECT_FALSE(m.accepted);
   EXPECT_EQ(m.reason, "no");
 }

@@ -1,4 +1,4 @@
-#include "world_server/arbiter.hpp"
+#include "marsala/world_server/arbiter.hpp"
 
 #include <gtest/gtest.h>
 
@@ -6,9 +6,9 @@
 #include <limits>
 #include <random>
 
-#include "common/error.hpp"
-#include "common/processing/navigability_processor.hpp"
-#include "tests/unit/world_server/world_fixtures.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/navigability_processor.hpp"
+#include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -20,7 +20,7 @@ using testing::move_to;
 using testing::request_for;
 using testing::small_scenario;
 
-bus::Deposition dep(int row, int col, double h) { return {row, col, h}; }
+protocol::Deposition dep(int row, int col, double h) { return {row, col, h}; }
 
 /// Row and column of the cell whose centre is (x, y) on the 40 x 40 test grid.
 CellIndex cell_of(double x, double y) { return {40 - 1 - static_cast<int>(std::floor(y / 0.1)), static_cast<int>(std::floor(x / 0.1))}; }
@@ -28,10 +28,10 @@ CellIndex cell_of(double x, double y) { return {40 - 1 - static_cast<int>(std::f
 class ArbiterTest : public ::testing::Test {
  protected:
   ArbiterTest() : scenario_(small_scenario()), state_(admitted_state(scenario_, flat_terrain(), 2)) {}
-  Verdict check(const bus::ActionRequest& r, std::uint32_t channel = 0) {
+  Verdict check(const protocol::ActionRequest& r, std::uint32_t channel = 0) {
     return validate_request(state_, channel == 0 ? r.agent_id : channel, r);
   }
-  void expect_rejected(const bus::ActionRequest& r, const std::string& words, std::uint32_t channel = 0) {
+  void expect_rejected(const protocol::ActionRequest& r, const std::string& words, std::uint32_t channel = 0) {
     const Verdict v = check(r, channel);
     EXPECT_FALSE(v.accepted) << "expected a rejection mentioning '" << words << "'";
     EXPECT_NE(v.reason.find(words), std::string::npos) << v.reason;
@@ -41,7 +41,7 @@ class ArbiterTest : public ::testing::Test {
 };
 
 TEST_F(ArbiterTest, AcceptsAMoveWithDepositionsAndBooksThemExactly) {
-  bus::ActionRequest r = move_to(state_, 1, 1.25, 1.05);  // 0.2 m east
+  protocol::ActionRequest r = move_to(state_, 1, 1.25, 1.05);  // 0.2 m east
   const CellIndex a = cell_of(1.25, 1.95), b = cell_of(0.45, 1.05);  // 0.9 m north, 0.8 m west of the new position
   r.depositions = {dep(a.row, a.col, kLayer), dep(b.row, b.col, 2 * kLayer)};
   const Verdict v = check(r);
@@ -69,7 +69,7 @@ TEST_F(ArbiterTest, AcceptsAMoveWithDepositionsAndBooksThemExactly) {
 TEST_F(ArbiterTest, EnvelopeRules) {
   // Spoofed id: agent 1's request on agent 2's partition.
   expect_rejected(request_for(state_, 1), "arrived on the partition of agent 2", 2);
-  bus::ActionRequest r = request_for(state_, 1);
+  protocol::ActionRequest r = request_for(state_, 1);
   r.session += 1;
   expect_rejected(r, "session");
   r = request_for(state_, 1);
@@ -99,7 +99,7 @@ TEST_F(ArbiterTest, NonFiniteOrHugeValuesAreRejected) {
   expect_rejected(move_to(state_, 1, nan, 1.05), "not finite");
   expect_rejected(move_to(state_, 1, 1.05, inf), "not finite");
   expect_rejected(move_to(state_, 1, 1e7, 1.05), "too large");
-  bus::ActionRequest r = request_for(state_, 1);
+  protocol::ActionRequest r = request_for(state_, 1);
   r.target_x_m = nan;  // checked even without a motion: every double must be sane
   expect_rejected(r, "not finite");
   r = request_for(state_, 1);
@@ -142,7 +142,7 @@ TEST_F(ArbiterTest, MotionOntoANonOccupiableCellIsRejected) {
 
 TEST_F(ArbiterTest, DepositionRules) {
   const AgentRecord& me = state_.agent(1);  // at (1.05, 1.05); agent 2 at (2.55, 1.05)
-  bus::ActionRequest r = request_for(state_, 1);
+  protocol::ActionRequest r = request_for(state_, 1);
   const CellIndex fine = cell_of(1.05, 2.05);  // 1 m north: within reach 1.2, beyond delta/2 of everyone
   r.depositions = {dep(fine.row, fine.col, kLayer)};
   EXPECT_TRUE(check(r).accepted);
@@ -177,14 +177,14 @@ TEST_F(ArbiterTest, DepositionRules) {
   r.depositions = {dep(beyond.row, beyond.col, kLayer)};
   expect_rejected(r, "beyond reach_m");
   // Reach counts from the position after the motion.
-  bus::ActionRequest moved = move_to(state_, 1, 1.05, 1.25);
+  protocol::ActionRequest moved = move_to(state_, 1, 1.05, 1.25);
   moved.depositions = {dep(beyond.row, beyond.col, kLayer)};
   EXPECT_TRUE(check(moved).accepted);
   EXPECT_EQ(me.y_m, 1.05);
 }
 
 TEST_F(ArbiterTest, DepositionUnderARobotIsRejected) {
-  bus::ActionRequest r = request_for(state_, 1);
+  protocol::ActionRequest r = request_for(state_, 1);
   // Under itself: 0.4 m away, and exactly delta/2 = 0.5 m away (the ball is inclusive).
   CellIndex c = cell_of(1.45, 1.05);
   r.depositions = {dep(c.row, c.col, kLayer)};
@@ -200,7 +200,7 @@ TEST_F(ArbiterTest, DepositionUnderARobotIsRejected) {
   r.depositions = {dep(c.row, c.col, kLayer)};
   expect_rejected(r, "under agent 2");
   // Under its own new position: the cell it moves next to.
-  bus::ActionRequest moved = move_to(state_, 1, 1.05, 1.25);
+  protocol::ActionRequest moved = move_to(state_, 1, 1.05, 1.25);
   c = cell_of(1.05, 1.65);  // 0.4 m from (1.05, 1.25), 0.6 m from (1.05, 1.05)
   moved.depositions = {dep(c.row, c.col, kLayer)};
   expect_rejected(moved, "under agent 1");
@@ -212,7 +212,7 @@ TEST_F(ArbiterTest, DepositionUnderARobotIsRejected) {
 }
 
 TEST_F(ArbiterTest, VolumeAboveTheThresholdOrTheMaterialIsRejected) {
-  bus::ActionRequest r = request_for(state_, 1);
+  protocol::ActionRequest r = request_for(state_, 1);
   const CellIndex a = cell_of(1.05, 2.05), b = cell_of(1.15, 2.05), c = cell_of(0.95, 2.05);
   // 160 cubes = 160 * 1.25e-4 = 0.02 m^3: exactly the threshold.
   r.depositions = {dep(a.row, a.col, 53 * kLayer), dep(b.row, b.col, 53 * kLayer), dep(c.row, c.col, 54 * kLayer)};
@@ -230,7 +230,7 @@ TEST_F(ArbiterTest, VolumeAboveTheThresholdOrTheMaterialIsRejected) {
 }
 
 TEST_F(ArbiterTest, RefillOnlyAtTheBase) {
-  bus::ActionRequest r = request_for(state_, 1);  // (1.05, 1.05) is 0.707 m from the base centre (0.55, 0.55)
+  protocol::ActionRequest r = request_for(state_, 1);  // (1.05, 1.05) is 0.707 m from the base centre (0.55, 0.55)
   r.refill = true;
   expect_rejected(r, "from the base station");
   r = move_to(state_, 1, 0.95, 0.95);  // 0.566 m: still outside the 0.5 m radius
@@ -252,7 +252,7 @@ TEST_F(ArbiterTest, RefillOnlyAtTheBase) {
 }
 
 TEST_F(ArbiterTest, AllOrNothing) {
-  bus::ActionRequest r = move_to(state_, 1, 1.25, 1.05);
+  protocol::ActionRequest r = move_to(state_, 1, 1.25, 1.05);
   const CellIndex good = cell_of(1.25, 2.05), bad = cell_of(1.25, 2.55);  // the second is 1.5 m away
   r.depositions = {dep(good.row, good.col, kLayer), dep(bad.row, bad.col, kLayer)};
   EXPECT_FALSE(check(r).accepted);
@@ -263,16 +263,16 @@ TEST_F(ArbiterTest, AllOrNothing) {
 TEST(CellOccupiable, MatchesTheNavigabilityProcessorOnRoughTerrains) {
   std::mt19937_64 rng(7);
   for (int trial = 0; trial < 6; ++trial) {
-    grid::GridGeometry g;
+    GridGeometry g;
     g.rows = 18 + trial;
     g.cols = 23 - trial;
     g.cell_size_m = 0.1;
-    grid::Heightmap h(g, 0.0);
+    Heightmap h(g, 0.0);
     // Smooth noise below eps with sparse spikes: cells near a spike are not occupiable, the others are.
     std::uniform_real_distribution<double> noise(0.0, 0.02), spike(0.0, 1.0);
     for (long long i = 0; i < h.size(); ++i) h.data()[i] = noise(rng) + (spike(rng) < 0.03 ? 0.3 : 0.0);
     const NavigabilityParams params{0.3, 0.4 + 0.15 * trial, 0.05};
-    const grid::CellMask want = processing::NavigabilityProcessor(params).occupiable(h);
+    const CellMask want = NavigabilityProcessor(params).occupiable(h);
     int occupiable = 0;
     for (int r = 0; r < h.rows(); ++r)
       for (int c = 0; c < h.cols(); ++c) {
@@ -288,23 +288,23 @@ TEST(CellOccupiable, MatchesTheNavigabilityProcessorOnRoughTerrains) {
 }
 
 TEST(CellOccupiable, RampsExactlyAtKappaAreOccupiableOneLayerSteeperIsNot) {
-  grid::GridGeometry g;
+  GridGeometry g;
   g.rows = 20;
   g.cols = 30;
   g.cell_size_m = 0.1;
-  grid::Heightmap ramp(g, 0.0);
+  Heightmap ramp(g, 0.0);
   for (int r = 0; r < g.rows; ++r)
     for (int c = 0; c < g.cols; ++c) ramp(r, c) = 0.3 * (c * 0.1);  // slope exactly kappa, steps of eps = 0
   const NavigabilityParams params{0.3, 1.0, 0.0};
-  const grid::CellMask want = processing::NavigabilityProcessor(params).occupiable(ramp);
+  const CellMask want = NavigabilityProcessor(params).occupiable(ramp);
   for (int r = 0; r < g.rows; ++r)
     for (int c = 0; c < g.cols; ++c) {
       EXPECT_TRUE(cell_occupiable(ramp, {r, c}, params));
       EXPECT_EQ(want(r, c), 1);
     }
-  grid::Heightmap steeper = ramp;
+  Heightmap steeper = ramp;
   steeper(10, 15) += 0.0125;
-  const grid::CellMask want_steeper = processing::NavigabilityProcessor(params).occupiable(steeper);
+  const CellMask want_steeper = NavigabilityProcessor(params).occupiable(steeper);
   for (int r = 0; r < g.rows; ++r)
     for (int c = 0; c < g.cols; ++c)
       ASSERT_EQ(cell_occupiable(steeper, {r, c}, params), want_steeper(r, c) != 0) << r << ", " << c;
@@ -313,16 +313,16 @@ TEST(CellOccupiable, RampsExactlyAtKappaAreOccupiableOneLayerSteeperIsNot) {
 }
 
 TEST(CellOccupiable, BigBallsUseTheWindowAndAgree) {
-  grid::GridGeometry g;
+  GridGeometry g;
   g.rows = 70;
   g.cols = 70;
   g.cell_size_m = 0.1;
-  grid::Heightmap h(g, 0.0);
+  Heightmap h(g, 0.0);
   for (int r = 0; r < g.rows; ++r)
     for (int c = 0; c < g.cols; ++c) h(r, c) = (r + c) % 7 == 0 ? 0.04 : 0.0;
   h(5, 5) = 3.0;  // a pillar near a corner
   const NavigabilityParams params{0.3, 6.0, 0.05};  // ball radius 30 cells: about 2800 cells
-  const grid::CellMask want = processing::NavigabilityProcessor(params).occupiable(h);
+  const CellMask want = NavigabilityProcessor(params).occupiable(h);
   int occupiable = 0;
   for (const CellIndex c : {CellIndex{35, 35}, CellIndex{5, 40}, CellIndex{60, 60}, CellIndex{20, 20}, CellIndex{5, 30}}) {
     occupiable += want(c.row, c.col);
@@ -333,11 +333,11 @@ TEST(CellOccupiable, BigBallsUseTheWindowAndAgree) {
 }
 
 TEST(CellOccupiable, OffGridThrows) {
-  grid::GridGeometry g;
+  GridGeometry g;
   g.rows = 4;
   g.cols = 4;
-  EXPECT_THROW(cell_occupiable(grid::Heightmap(g, 0.0), {4, 0}, {}), InvalidArgument);
-  EXPECT_THROW(cell_occupiable(grid::Heightmap(g, 0.0), {0, -1}, {}), InvalidArgument);
+  EXPECT_THROW(cell_occupiable(Heightmap(g, 0.0), {4, 0}, {}), InvalidArgument);
+  EXPECT_THROW(cell_occupiable(Heightmap(g, 0.0), {0, -1}, {}), InvalidArgument);
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 // the definitions (tests/support: every pair of every ball; here: Bellman-Ford distances, union-find components)
 // on small seeded grids, and golden values worked out by hand.
 
-#include "world_server/completion.hpp"
+#include "marsala/world_server/completion.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 #include <numeric>
 #include <random>
 
-#include "common/error.hpp"
-#include "tests/support/navigability_brute_force.hpp"
+#include "marsala/core/error.hpp"
+#include "support/navigability_brute_force.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -20,8 +20,8 @@ namespace {
 constexpr double kSqrt2 = 1.4142135623730951;
 
 /// Flat ground with a few raised blocks and millimetre noise: occupiable regions separated by walls.
-grid::Heightmap blocky(std::mt19937& rng, int rows, int cols, double cs = 0.1) {
-  grid::Heightmap h(grid::GridGeometry{rows, cols, 0.0, 0.0, cs});
+Heightmap blocky(std::mt19937& rng, int rows, int cols, double cs = 0.1) {
+  Heightmap h(GridGeometry{rows, cols, 0.0, 0.0, cs});
   std::uniform_int_distribution<int> row(0, rows - 1), col(0, cols - 1), size(1, 5), count(1, 5);
   std::uniform_real_distribution<double> rise(0.05, 0.3), noise(0.0, 0.004);
   const int blocks = count(rng);
@@ -37,7 +37,7 @@ grid::Heightmap blocky(std::mt19937& rng, int rows, int cols, double cs = 0.1) {
 }
 
 /// Shortest 8-connected distances from `from` over 1-cells by Bellman-Ford relaxation until nothing changes.
-std::vector<double> distances_brute_force(const grid::CellMask& m, CellIndex from, double cs) {
+std::vector<double> distances_brute_force(const CellMask& m, CellIndex from, double cs) {
   const int rows = static_cast<int>(m.rows()), cols = static_cast<int>(m.cols());
   std::vector<double> d(static_cast<std::size_t>(rows) * cols, std::numeric_limits<double>::infinity());
   if (m(from.row, from.col) == 0) return d;
@@ -63,7 +63,7 @@ std::vector<double> distances_brute_force(const grid::CellMask& m, CellIndex fro
 }
 
 /// Largest 8-connected component by union-find.
-long long largest_component_brute_force(const grid::CellMask& m) {
+long long largest_component_brute_force(const CellMask& m) {
   const int rows = static_cast<int>(m.rows()), cols = static_cast<int>(m.cols());
   std::vector<int> parent(static_cast<std::size_t>(rows) * cols);
   std::iota(parent.begin(), parent.end(), 0);
@@ -117,7 +117,7 @@ TEST(PayloadPath, NavigabilityAndShortestPathsMatchBruteForce) {
   int found = 0, missing = 0;
   for (int trial = 0; trial < 150; ++trial) {
     const int rows = 8 + trial % 7, cols = 9 + trial % 5;
-    const grid::Heightmap h = blocky(rng, rows, cols);
+    const Heightmap h = blocky(rng, rows, cols);
     const Position from{unit(rng) * cols * 0.1, unit(rng) * rows * 0.1}, to{unit(rng) * cols * 0.1, unit(rng) * rows * 0.1};
     const scenario::PayloadPath p = payload(0.3, delta(rng), 0.03, from, to);
     const NavigabilityParams params{p.kappa, p.delta_m, p.eps_m};
@@ -132,7 +132,7 @@ TEST(PayloadPath, NavigabilityAndShortestPathsMatchBruteForce) {
       continue;
     }
     ++found;
-    const grid::CellMask occupiable = testing::occupiable_brute_force(h, params);
+    const CellMask occupiable = testing::occupiable_brute_force(h, params);
     const std::vector<double> d = distances_brute_force(occupiable, a, 0.1);
     EXPECT_NEAR(route->length_m, d[b.row * cols + b.col], 1e-9) << "trial " << trial;
     ASSERT_FALSE(route->cells.empty());
@@ -156,7 +156,7 @@ TEST(PayloadPath, NavigabilityAndShortestPathsMatchBruteForce) {
 
 TEST(PayloadPath, GoldenLengths) {
   // Flat 40 x 40 at 0.1 m: straight along a row, and along the diagonal.
-  const grid::Heightmap flat(grid::GridGeometry{40, 40, 0.0, 0.0, 0.1});
+  const Heightmap flat(GridGeometry{40, 40, 0.0, 0.0, 0.1});
   const auto straight = payload_path(flat, payload(0.2, 2.0, 0.05, {0.55, 0.55}, {3.05, 0.55}));
   ASSERT_TRUE(straight);
   EXPECT_NEAR(straight->length_m, 2.5, 1e-12);
@@ -172,7 +172,7 @@ TEST(PayloadPath, GoldenLengths) {
 
   // A wall in column 2 open only at row 4 (cs 1 m): from (0, 0) to (0, 4) through (4, 2), each half 2 side steps
   // and 2 diagonal ones: 4 + 4 sqrt 2.
-  grid::CellMask m = grid::CellMask::Ones(5, 5);
+  CellMask m = CellMask::Ones(5, 5);
   for (int r = 0; r < 4; ++r) m(r, 2) = 0;
   const auto around = shortest_path(m, {0, 0}, {0, 4}, 1.0);
   ASSERT_TRUE(around);
@@ -186,7 +186,7 @@ TEST(PayloadPath, GoldenLengths) {
 
   // A 0.1 m deep, one cell wide trench across the grid stops a payload of eps 0.05 (and kappa 0.2): its ball of
   // 3 x 3 cells would hold a 0.1 m step between neighbours (> 0.05 + 0.02).
-  grid::Heightmap trench = flat;
+  Heightmap trench = flat;
   for (int r = 0; r < 40; ++r) trench(r, 20) = -0.1;
   const scenario::PayloadPath across = payload(0.2, 0.3, 0.05, {0.55, 0.55}, {3.05, 0.55});
   EXPECT_FALSE(payload_path_navigable(trench, across));
@@ -196,17 +196,17 @@ TEST(PayloadPath, GoldenLengths) {
 }
 
 TEST(PayloadPath, EndsOffTheGridAreErrors) {
-  const grid::Heightmap flat(grid::GridGeometry{10, 10, 0.0, 0.0, 0.1});
+  const Heightmap flat(GridGeometry{10, 10, 0.0, 0.0, 0.1});
   EXPECT_THROW(payload_path_navigable(flat, payload(0.2, 0.3, 0.05, {-0.1, 0.5}, {0.5, 0.5})), InvalidArgument);
   EXPECT_THROW(payload_path(flat, payload(0.2, 0.3, 0.05, {0.5, 0.5}, {0.5, 1.0})), InvalidArgument);
-  grid::CellMask m = grid::CellMask::Ones(3, 3);
+  CellMask m = CellMask::Ones(3, 3);
   EXPECT_THROW(shortest_path(m, {0, 0}, {3, 0}, 1.0), InvalidArgument);
   EXPECT_THROW(shortest_path(m, {0, 0}, {1, 1}, 0.0), InvalidArgument);
   EXPECT_THROW(connected(m, {-1, 0}, {1, 1}), InvalidArgument);
 }
 
 TEST(LevelSite, SiteCellsAreThoseWhoseCentresLieInside) {
-  const grid::GridGeometry g{40, 40, 0.0, 0.0, 0.1};
+  const GridGeometry g{40, 40, 0.0, 0.0, 0.1};
   // Centres x = 0.05 + 0.1 c in [1.0, 2.0]: c = 10..19; y = (39.5 - r) 0.1 in [0.5, 1.5]: r = 25..34.
   CellRect r = site_cells(g, site(1.0, 0.5, 2.0, 1.5));
   EXPECT_EQ(r.first, (CellIndex{25, 10}));
@@ -229,7 +229,7 @@ TEST(LevelSite, SiteCellsAreThoseWhoseCentresLieInside) {
 TEST(LevelSite, GoldenFractions) {
   // Flat 40 x 40 at 0.1 m; site rows 10..19 x cols 20..29 (100 cells); delta 0.3 m: the ball is the 3 x 3 cells
   // around a cell. A 0.1 m hole spoils every cell whose ball holds it (0.1 > eps 0.05 + kappa 0.1 * 0.1 m).
-  grid::Heightmap h(grid::GridGeometry{40, 40, 0.0, 0.0, 0.1});
+  Heightmap h(GridGeometry{40, 40, 0.0, 0.0, 0.1});
   const scenario::Site s = site(2.0, 2.0, 3.0, 3.0);
   EXPECT_EQ(site_level_fraction(h, s), 1.0);
   h(15, 25) = -0.1;  // inside: its 3 x 3 neighbourhood is lost
@@ -250,7 +250,7 @@ TEST(LevelSite, FractionsMatchBruteForce) {
   std::uniform_real_distribution<double> unit(0.0, 1.0), delta(0.2, 0.5);
   for (int trial = 0; trial < 120; ++trial) {
     const int rows = 10 + trial % 6, cols = 8 + trial % 7;
-    const grid::Heightmap h = blocky(rng, rows, cols);
+    const Heightmap h = blocky(rng, rows, cols);
     // Random rectangles, some reaching past the grid's edges.
     double x0 = unit(rng) * cols * 0.12 - 0.1, x1 = unit(rng) * cols * 0.12 - 0.1;
     double y0 = unit(rng) * rows * 0.12 - 0.1, y1 = unit(rng) * rows * 0.12 - 0.1;
@@ -269,8 +269,8 @@ TEST(LevelSite, FractionsMatchBruteForce) {
       EXPECT_THROW(site_level_fraction(h, s), InvalidArgument) << "trial " << trial;
       continue;
     }
-    const grid::Heightmap crop = h.window({r0, c0}, r1 - r0 + 1, c1 - c0 + 1);
-    const grid::CellMask occupiable = testing::occupiable_brute_force(crop, {s.kappa, s.delta_m, s.eps_m});
+    const Heightmap crop = h.window({r0, c0}, r1 - r0 + 1, c1 - c0 + 1);
+    const CellMask occupiable = testing::occupiable_brute_force(crop, {s.kappa, s.delta_m, s.eps_m});
     const double expected =
         static_cast<double>(largest_component_brute_force(occupiable)) / static_cast<double>(crop.size());
     EXPECT_DOUBLE_EQ(site_level_fraction(h, s), expected) << "trial " << trial;

@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "common/bus/bus.hpp"
+#include "marsala/bus/bus.hpp"
 
 namespace marsala::world_server::testing {
 
@@ -26,7 +26,7 @@ struct FakeAgentConfig {
   int domain = 0;
   std::uint32_t id = 1;
   std::uint64_t session = 1;
-  bus::BodyParams body;
+  RobotBody body;
   FakeMode mode = FakeMode::kWalker;
   std::uint64_t quit_at_step = 0;
   bool deposit_first = false;   ///< at step 0, also deposit two cube layers on the cell centred at (0.55, 1.95)
@@ -44,7 +44,7 @@ class FakeAgent {
     if (thread_.joinable()) thread_.join();
   }
   /// Frames received so far (copy; safe while running).
-  std::vector<bus::SensorFrame> frames() const {
+  std::vector<protocol::SensorFrame> frames() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return frames_;
   }
@@ -58,20 +58,20 @@ class FakeAgent {
     const auto give_up = std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.timeout_s);
     auto participant = bus::make_participant({bus::Vendor::kInProcess, config_.domain});
     auto signal = std::make_shared<bus::Signal>();
-    auto hellos = participant->create_writer<bus::AgentHello>();
-    auto admissions = participant->create_reader<bus::Admission>({"", signal});
-    bus::AgentHello hello;
+    auto hellos = participant->create_writer<protocol::AgentHello>();
+    auto admissions = participant->create_reader<protocol::Admission>({"", signal});
+    protocol::AgentHello hello;
     hello.agent_id = config_.id;
     hello.session = config_.session;
     hello.name = "fake-" + std::to_string(config_.id);
     hello.behaviour = "scripted";
     hello.body = config_.body;
-    bus::Admission admission;
+    protocol::Admission admission;
     while (!admitted_ && refusal_.empty()) {
       if (stop_ || std::chrono::steady_clock::now() > give_up) return;
       hellos->write(hello);
       signal->wait_for(20ms);
-      for (const bus::Admission& a : admissions->take()) {
+      for (const protocol::Admission& a : admissions->take()) {
         if (a.agent_id != config_.id || a.session != config_.session) continue;
         if (a.accepted) {
           admission = a;
@@ -82,12 +82,12 @@ class FakeAgent {
       }
     }
     if (!admitted_) return;
-    const std::string partition = bus::partition_for(admission.run_id, config_.id);
-    auto frames = participant->create_reader<bus::SensorFrame>({partition, signal});
-    auto requests = participant->create_writer<bus::ActionRequest>({partition, nullptr});
+    const std::string partition = protocol::partition_for(admission.run_id, config_.id);
+    auto frames = participant->create_reader<protocol::SensorFrame>({partition, signal});
+    auto requests = participant->create_writer<protocol::ActionRequest>({partition, nullptr});
     while (!stop_ && std::chrono::steady_clock::now() < give_up) {
       signal->wait_for(20ms);
-      for (const bus::SensorFrame& f : frames->take()) {
+      for (const protocol::SensorFrame& f : frames->take()) {
         {
           std::lock_guard<std::mutex> lock(mutex_);
           frames_.push_back(f);
@@ -100,8 +100,8 @@ class FakeAgent {
     }
   }
 
-  bus::ActionRequest decide(const bus::SensorFrame& f, const bus::Admission& a) const {
-    bus::ActionRequest r;
+  protocol::ActionRequest decide(const protocol::SensorFrame& f, const protocol::Admission& a) const {
+    protocol::ActionRequest r;
     r.agent_id = config_.id;
     r.session = config_.session;
     r.step = f.step;
@@ -128,7 +128,7 @@ class FakeAgent {
   std::atomic<bool> admitted_{false};
   std::string refusal_;
   mutable std::mutex mutex_;
-  std::vector<bus::SensorFrame> frames_;
+  std::vector<protocol::SensorFrame> frames_;
   std::thread thread_;
 };
 

@@ -2,7 +2,7 @@
 // (balls cut at the area's edge), for balls smaller and larger than a change block; and the cost of one payload and
 // one site check of apply_step on a 640 x 640 grid (printed; run in Release for the numbers).
 
-#include "world_server/occupancy_cache.hpp"
+#include "marsala/world_server/occupancy_cache.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,31 +11,31 @@
 #include <cstdio>
 #include <random>
 
-#include "common/error.hpp"
-#include "common/processing/navigability_processor.hpp"
-#include "common/scenario/terrain_builder.hpp"
-#include "tests/unit/world_server/world_fixtures.hpp"
-#include "world_server/completion.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/navigability_processor.hpp"
+#include "marsala/scenario/terrain_builder.hpp"
+#include "unit/world_server/world_fixtures.hpp"
+#include "marsala/world_server/completion.hpp"
 
 namespace marsala::world_server {
 namespace {
 
-grid::Heightmap rough(std::mt19937& rng, int rows, int cols, double cs) {
-  grid::Heightmap h(grid::GridGeometry{rows, cols, 0.0, 0.0, cs});
+Heightmap rough(std::mt19937& rng, int rows, int cols, double cs) {
+  Heightmap h(GridGeometry{rows, cols, 0.0, 0.0, cs});
   std::uniform_real_distribution<double> noise(0.0, 0.01);
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < cols; ++c) h(r, c) = 0.02 * std::sin(0.3 * r) * std::cos(0.2 * c) + noise(rng);
   return h;
 }
 
-grid::CellMask full(const grid::Heightmap& h, const CellRect& a, NavigabilityParams p) {
-  return processing::NavigabilityProcessor(p).occupiable(h.window(a.first, a.rows, a.cols));
+CellMask full(const Heightmap& h, const CellRect& a, NavigabilityParams p) {
+  return NavigabilityProcessor(p).occupiable(h.window(a.first, a.rows, a.cols));
 }
 
 TEST(OccupancyCache, IncrementalUpdatesEqualTheWholeComputation) {
   std::mt19937 rng(3);
   for (const double delta : {0.3, 1.0, 2.5, 4.1}) {  // reach 1, 5, 12 and 20 cells (one more than a block)
-    grid::Heightmap h = rough(rng, 90, 75, 0.1);
+    Heightmap h = rough(rng, 90, 75, 0.1);
     const NavigabilityParams p{0.3, delta, 0.03};
     for (const CellRect area : {CellRect{{0, 0}, 90, 75}, CellRect{{17, 9}, 50, 41}}) {
       OccupancyCache cache(h, area, p);
@@ -70,7 +70,7 @@ TEST(OccupancyCache, IncrementalUpdatesEqualTheWholeComputation) {
 
 TEST(OccupancyCache, OnlyCellsNearChangesAreRecomputedAndOutsideChangesAreIgnored) {
   std::mt19937 rng(8);
-  grid::Heightmap h = rough(rng, 160, 160, 0.1);
+  Heightmap h = rough(rng, 160, 160, 0.1);
   const NavigabilityParams p{0.3, 1.0, 0.03};
   OccupancyCache cache(h, {{40, 40}, 80, 80}, p);
   EXPECT_EQ(cache.reach(), 5);
@@ -87,14 +87,14 @@ TEST(OccupancyCache, OnlyCellsNearChangesAreRecomputedAndOutsideChangesAreIgnore
 }
 
 TEST(OccupancyCache, BadAreasAreErrors) {
-  const grid::Heightmap h(grid::GridGeometry{20, 20, 0.0, 0.0, 0.1});
+  const Heightmap h(GridGeometry{20, 20, 0.0, 0.0, 0.1});
   EXPECT_THROW(OccupancyCache(h, {{0, 0}, 0, 5}, {}), InvalidArgument);
   EXPECT_THROW(OccupancyCache(h, {{15, 0}, 6, 5}, {}), InvalidArgument);
   EXPECT_THROW(OccupancyCache(h, {{-1, 0}, 6, 5}, {}), InvalidArgument);
   EXPECT_THROW(OccupancyCache(h, {{0, 0}, 5, 5}, {0.3, -1.0, 0.05}), InvalidArgument);
   OccupancyCache cache(h, {{0, 0}, 20, 20}, {});
   cache.mark_changed({3, 3});
-  EXPECT_THROW(cache.update(grid::Heightmap(grid::GridGeometry{10, 10, 0.0, 0.0, 0.1})), InvalidArgument);
+  EXPECT_THROW(cache.update(Heightmap(GridGeometry{10, 10, 0.0, 0.0, 0.1})), InvalidArgument);
 }
 
 double ms_since(std::chrono::steady_clock::time_point t) {

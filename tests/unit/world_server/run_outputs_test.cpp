@@ -3,7 +3,7 @@
 // (zoom_window()) against hand-derived rectangles, its options (labels and markers cropped, world overlays unchanged,
 // title), and the written picture read back with libpng and checked by pixels against final.png.
 
-#include "world_server/run_outputs.hpp"
+#include "marsala/world_server/run_outputs.hpp"
 
 #include <gtest/gtest.h>
 #include <png.h>
@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "common/error.hpp"
-#include "tests/unit/world_server/world_fixtures.hpp"
-#include "world_server/completion.hpp"
-#include "world_server/step.hpp"
+#include "marsala/core/error.hpp"
+#include "unit/world_server/world_fixtures.hpp"
+#include "marsala/world_server/completion.hpp"
+#include "marsala/world_server/step.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -65,10 +65,10 @@ bool has_legend(const render::RenderOptions& o, const std::string& text, render:
 
 /// Agent 1 deposits one layer on cell (29, 18), then one idle step.
 void deposit_then_idle(WorldState& s) {
-  bus::ActionRequest r = request_for(s, 1);
+  protocol::ActionRequest r = request_for(s, 1);
   r.depositions.push_back({29, 18, kLayer});
-  apply_step(s, std::vector<bus::ActionRequest>{r});
-  apply_step(s, std::vector<bus::ActionRequest>{request_for(s, 1)});
+  apply_step(s, std::vector<protocol::ActionRequest>{r});
+  apply_step(s, std::vector<protocol::ActionRequest>{request_for(s, 1)});
 }
 
 TEST(RunSummary, PayloadRunsReportThePathAndIdleSteps) {
@@ -93,7 +93,7 @@ TEST(RunSummary, PayloadRunsReportThePathAndIdleSteps) {
 }
 
 TEST(RunSummary, SiteRunsReportTheLevelFractionOthersTheirKind) {
-  grid::Heightmap terrain = flat_terrain();
+  Heightmap terrain = flat_terrain();
   terrain(15, 25) = -0.1;
   const WorldState site = admitted_state(scenario_with(site_block()), terrain, 1);
   const std::string json = summary_json(site, info_for("small", false));
@@ -204,7 +204,7 @@ TEST_F(OutputFiles, GoalVectorMapPictureOnlyWhenTheScenarioHasOne) {
   for (const char* name : {"summary.json", "terrain_final.asc", "final.png"}) EXPECT_TRUE(fs::exists(dir_ / name));
   EXPECT_FALSE(fs::exists(dir_ / "goal_vector_map.png"));
 
-  processing::GoalVectorMapSpec spec;
+  GoalVectorMapSpec spec;
   spec.x0_m = 2.0;
   spec.y0_m = 2.0;
   spec.x1_m = 3.0;
@@ -216,7 +216,7 @@ TEST_F(OutputFiles, GoalVectorMapPictureOnlyWhenTheScenarioHasOne) {
   write_final_outputs(dir_.string(), s, info);
   EXPECT_GT(fs::file_size(dir_ / "goal_vector_map.png"), 500u);
 
-  const processing::GoalVectorMap map(spec, s.terrain.geometry());
+  const GoalVectorMap map(spec, s.terrain.geometry());
   const render::RenderOptions o = goal_vector_map_picture_options(s, info, map);
   EXPECT_EQ(o.arrows.size(), map.arrows().size());
   for (std::size_t k = 0; k < map.arrows().size(); ++k) {
@@ -233,7 +233,7 @@ TEST_F(OutputFiles, GoalVectorMapPictureOnlyWhenTheScenarioHasOne) {
 /// agents, the base station at (bx, by) with radius br.
 WorldState flat_state(int rows, int cols, double cs, double xll, double yll, double bx, double by, double br) {
   WorldState s;
-  s.terrain = grid::Heightmap(grid::GridGeometry{rows, cols, xll, yll, cs}, 0.0);
+  s.terrain = Heightmap(GridGeometry{rows, cols, xll, yll, cs}, 0.0);
   s.depositor = AgentIdGrid::Zero(rows, cols);
   s.base = {bx, by, br};
   return s;
@@ -275,7 +275,7 @@ TEST(ZoomWindow, CornerDepositsAreFramedWithTheMarginAndClippedAtTheGridEdge) {
   const auto w = zoom_window(s, std::nullopt);
   expect_window(w, {0, 84}, 16, 16);
   // The crop keeps world coordinates: x in [42, 50], y in [42, 50].
-  const grid::Heightmap crop = s.terrain.window(w->first, w->rows, w->cols);
+  const Heightmap crop = s.terrain.window(w->first, w->rows, w->cols);
   EXPECT_EQ(crop.geometry().xll_m, 42.0);
   EXPECT_EQ(crop.geometry().yll_m, 42.0);
   EXPECT_EQ(crop.cell_center({0, 0}).x, s.terrain.cell_center({0, 84}).x);

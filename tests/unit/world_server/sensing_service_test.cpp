@@ -1,4 +1,4 @@
-#include "world_server/sensing_service.hpp"
+#include "marsala/world_server/sensing_service.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,9 +7,9 @@
 #include <set>
 #include <utility>
 
-#include "common/error.hpp"
-#include "tests/unit/world_server/world_fixtures.hpp"
-#include "world_server/step.hpp"
+#include "marsala/core/error.hpp"
+#include "unit/world_server/world_fixtures.hpp"
+#include "marsala/world_server/step.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -21,11 +21,11 @@ using testing::small_scenario;
 /// A 50 x 70 grid of 0.1 m cells (7 x 5 m) with distinct random heights; tiles of 16: 4 x 5 tiles, the last tile
 /// row 2 cells high and the last tile column 6 cells wide.
 WorldState sensing_state() {
-  grid::GridGeometry g;
+  GridGeometry g;
   g.rows = 50;
   g.cols = 70;
   g.cell_size_m = 0.1;
-  grid::Heightmap h(g, 0.0);
+  Heightmap h(g, 0.0);
   std::mt19937_64 rng(3);
   for (long long i = 0; i < h.size(); ++i) h.data()[i] = std::uniform_real_distribution<double>(0.0, 0.01)(rng);
   WorldState w = make_world_state(small_scenario(), h, 3);
@@ -39,13 +39,13 @@ WorldState sensing_state() {
   return w;
 }
 
-std::set<std::pair<int, int>> tile_ids(const bus::SensorFrame& f) {
+std::set<std::pair<int, int>> tile_ids(const protocol::SensorFrame& f) {
   std::set<std::pair<int, int>> out;
   for (const auto& t : f.tiles) out.insert({t.tile_row, t.tile_col});
   return out;
 }
 
-void expect_heights_match(const WorldState& w, const bus::TerrainTile& t) {
+void expect_heights_match(const WorldState& w, const protocol::TerrainTile& t) {
   ASSERT_EQ(t.heights.size(), static_cast<std::size_t>(t.rows) * t.cols);
   for (int r = 0; r < t.rows; ++r)
     for (int c = 0; c < t.cols; ++c)
@@ -55,7 +55,7 @@ void expect_heights_match(const WorldState& w, const bus::TerrainTile& t) {
 TEST(SensingService, FirstFrameCarriesEveryTileInRangeWithEdgeTilesSmaller) {
   WorldState w = sensing_state();
   SensingService sensing(w);
-  const bus::SensorFrame f = sensing.frame_for(w, 1);
+  const protocol::SensorFrame f = sensing.frame_for(w, 1);
   // Tile columns 3 [4.8, 6.4] and 4 [6.4, 7.0] m; tile rows 2 [0.2, 1.8] and 3 [0, 0.2] m.
   EXPECT_EQ(tile_ids(f), (std::set<std::pair<int, int>>{{2, 3}, {2, 4}, {3, 3}, {3, 4}}));
   for (const auto& t : f.tiles) {
@@ -69,7 +69,7 @@ TEST(SensingService, FirstFrameCarriesEveryTileInRangeWithEdgeTilesSmaller) {
   EXPECT_EQ(f.y_m, 0.35);
   EXPECT_EQ(f.z_m, w.agent(1).z_m);
   EXPECT_EQ(f.material_m3, 0.05);
-  EXPECT_EQ(f.last_result, bus::ActionResult::kNone);
+  EXPECT_EQ(f.last_result, protocol::ActionResult::kNone);
   EXPECT_FALSE(f.run_over);
   EXPECT_TRUE(sensing.frame_for(w, 1, true).run_over);
 }
@@ -81,20 +81,20 @@ TEST(SensingService, LaterFramesCarryOnlyChangedOrNewTiles) {
   EXPECT_TRUE(sensing.frame_for(w, 1).tiles.empty());
 
   // Agent 1 deposits 1 m west of itself: cell (46, 56), tile (2, 3).
-  bus::ActionRequest r = request_for(w, 1);
+  protocol::ActionRequest r = request_for(w, 1);
   r.depositions = {{46, 56, kLayer}};
   const double before = w.terrain(46, 56);
-  apply_step(w, std::vector<bus::ActionRequest>{r, request_for(w, 2), request_for(w, 3)});
+  apply_step(w, std::vector<protocol::ActionRequest>{r, request_for(w, 2), request_for(w, 3)});
   ASSERT_EQ(w.terrain(46, 56), before + kLayer);
-  const bus::SensorFrame f = sensing.frame_for(w, 1);
+  const protocol::SensorFrame f = sensing.frame_for(w, 1);
   EXPECT_EQ(f.step, 1u);
-  EXPECT_EQ(f.last_result, bus::ActionResult::kAccepted);
+  EXPECT_EQ(f.last_result, protocol::ActionResult::kAccepted);
   ASSERT_EQ(tile_ids(f), (std::set<std::pair<int, int>>{{2, 3}}));
   expect_heights_match(w, f.tiles[0]);
   EXPECT_TRUE(sensing.frame_for(w, 1).tiles.empty());
 
   // Agent 3 never got a frame: everything in its range, the changed tile included.
-  const bus::SensorFrame first_of_3 = sensing.frame_for(w, 3);  // square [4.0, 6.0] x [-0.65, 1.35]
+  const protocol::SensorFrame first_of_3 = sensing.frame_for(w, 3);  // square [4.0, 6.0] x [-0.65, 1.35]
   EXPECT_EQ(tile_ids(first_of_3), (std::set<std::pair<int, int>>{{2, 2}, {2, 3}, {3, 2}, {3, 3}}));
 
   // Moving north: only the tiles it has not seen.
@@ -107,7 +107,7 @@ TEST(SensingService, LaterFramesCarryOnlyChangedOrNewTiles) {
 TEST(SensingService, NeighboursWithinProximityRangeOnly) {
   WorldState w = sensing_state();
   SensingService sensing(w);
-  bus::SensorFrame f = sensing.frame_for(w, 1);
+  protocol::SensorFrame f = sensing.frame_for(w, 1);
   ASSERT_EQ(f.neighbours.size(), 1u);  // agent 2 at exactly 1.5 m; agent 3 at 1.65 m is out
   EXPECT_EQ(f.neighbours[0].agent_id, 2u);
   EXPECT_EQ(f.neighbours[0].x_m, 6.65);
@@ -128,7 +128,7 @@ TEST(SensingService, NeighboursWithinProximityRangeOnly) {
 }
 
 TEST(TileLayout, SizesAndSquaresAgreeWithABruteForceReference) {
-  grid::GridGeometry g;
+  GridGeometry g;
   g.rows = 37;
   g.cols = 53;
   g.xll_m = -2.0;

@@ -1,4 +1,4 @@
-#include "world_server/sha256.hpp"
+#include "marsala/world_server/sha256.hpp"
 
 #include <gtest/gtest.h>
 
@@ -38,10 +38,10 @@ TEST(Sha256, IncrementalUpdatesInAnyChunkingGiveTheSameDigest) {
 }
 
 TEST(Sha256, TerrainDigestIsOfLittleEndianDoublesRowMajor) {
-  grid::GridGeometry g;
+  GridGeometry g;
   g.rows = 2;
   g.cols = 3;
-  grid::Heightmap h(g, 0.0);
+  Heightmap h(g, 0.0);
   const double values[6] = {1.0, -2.5, 0.1, 1e-300, 3.0, 1.5};
   for (int i = 0; i < 6; ++i) h.data()[i] = values[i];
   std::vector<unsigned char> bytes;
@@ -56,11 +56,11 @@ TEST(Sha256, TerrainDigestIsOfLittleEndianDoublesRowMajor) {
   h(1, 2) = std::nextafter(1.5, 2.0);
   EXPECT_NE(terrain_sha256(h), sha256_hex(bytes.data(), bytes.size()));
   // One zero-height cell: eight zero bytes.
-  grid::GridGeometry one;
+  GridGeometry one;
   one.rows = 1;
   one.cols = 1;
   const unsigned char zeros[8] = {};
-  EXPECT_EQ(terrain_sha256(grid::Heightmap(one, 0.0)), sha256_hex(zeros, 8));
+  EXPECT_EQ(terrain_sha256(Heightmap(one, 0.0)), sha256_hex(zeros, 8));
   EXPECT_EQ(sha256_hex(zeros, 8), "af5570f5a1810b7af78caf4bc70a660f0df51e42baf91d4de5b2328de0e83dfc");
 }
 

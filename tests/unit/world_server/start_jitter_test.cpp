@@ -1,16 +1,16 @@
 // Start jitter: seeded, deterministic, uniform in the disc, only onto occupiable cells, the slot's start as the
 // fallback; make_world_state and the admission use the jittered start.
 
-#include "world_server/start_jitter.hpp"
+#include "marsala/world_server/start_jitter.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "common/error.hpp"
-#include "tests/support/navigability_brute_force.hpp"
-#include "tests/unit/world_server/world_fixtures.hpp"
-#include "world_server/admission.hpp"
+#include "marsala/core/error.hpp"
+#include "support/navigability_brute_force.hpp"
+#include "unit/world_server/world_fixtures.hpp"
+#include "marsala/world_server/admission.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -23,16 +23,16 @@ scenario::AgentSlot slot(std::uint32_t id, double x, double y) {
   return s;
 }
 
-bus::BodyParams body() {
-  bus::BodyParams b;
-  b.kappa = 0.3;
-  b.delta_m = 0.5;
-  b.eps_m = 0.05;
+RobotBody body() {
+  RobotBody b;
+  b.navigability.kappa = 0.3;
+  b.navigability.delta_m = 0.5;
+  b.navigability.eps_m = 0.05;
   return b;
 }
 
 TEST(StartJitter, SameSeedSameStartsOtherSeedsOrIdsOtherStarts) {
-  const grid::Heightmap flat(grid::GridGeometry{60, 60, 0.0, 0.0, 0.1});
+  const Heightmap flat(GridGeometry{60, 60, 0.0, 0.0, 0.1});
   const Position a = jittered_start(flat, slot(1, 3.0, 3.0), body(), 1.0, 42);
   const Position b = jittered_start(flat, slot(1, 3.0, 3.0), body(), 1.0, 42);
   EXPECT_EQ(a.x, b.x);
@@ -50,7 +50,7 @@ TEST(StartJitter, SameSeedSameStartsOtherSeedsOrIdsOtherStarts) {
 TEST(StartJitter, OffsetsAreUniformInTheDisc) {
   // On flat ground every draw is kept: the first point of each stream. Uniform in the disc of radius R: mean offset
   // near 0, half the points within R / sqrt 2, a quarter in each quadrant.
-  const grid::Heightmap flat(grid::GridGeometry{100, 100, 0.0, 0.0, 0.1});
+  const Heightmap flat(GridGeometry{100, 100, 0.0, 0.0, 0.1});
   constexpr int kAgents = 4000;
   constexpr double kRadius = 2.0;
   double sx = 0.0, sy = 0.0;
@@ -74,10 +74,10 @@ TEST(StartJitter, OffsetsAreUniformInTheDisc) {
 TEST(StartJitter, OnlyOccupiableCellsOnTheGridAreChosen) {
   // A 1 m tall block covers x > 3 m: cells within delta/2 = 0.25 m of its edge and the block's top near the edge
   // are not occupiable; the top far from the edge is. Starts at the edge, jittered by 1 m.
-  grid::Heightmap h(grid::GridGeometry{60, 60, 0.0, 0.0, 0.1});
+  Heightmap h(GridGeometry{60, 60, 0.0, 0.0, 0.1});
   for (int r = 0; r < 60; ++r)
     for (int c = 30; c < 60; ++c) h(r, c) = 1.0;
-  const grid::CellMask occupiable = marsala::testing::occupiable_brute_force(h, {0.3, 0.5, 0.05});
+  const CellMask occupiable = marsala::testing::occupiable_brute_force(h, {0.3, 0.5, 0.05});
   int moved = 0;
   for (std::uint32_t id = 1; id <= 300; ++id) {
     const Position p = jittered_start(h, slot(id, 3.0, 3.0), body(), 1.0, 99);
@@ -94,7 +94,7 @@ TEST(StartJitter, OnlyOccupiableCellsOnTheGridAreChosen) {
 
 TEST(StartJitter, WithNoOccupiableCellInReachTheSlotsStartStays) {
   // A checkerboard of 0 and 1 m: no cell is occupiable, so every draw fails.
-  grid::Heightmap h(grid::GridGeometry{40, 40, 0.0, 0.0, 0.1});
+  Heightmap h(GridGeometry{40, 40, 0.0, 0.0, 0.1});
   for (int r = 0; r < 40; ++r)
     for (int c = 0; c < 40; ++c) h(r, c) = (r + c) % 2;
   const Position p = jittered_start(h, slot(3, 2.0, 2.0), body(), 0.8, 1);
@@ -122,9 +122,9 @@ TEST(StartJitter, TheWorldStateAndTheAdmissionUseTheJitteredStart) {
   jittered.seed = 18;
   WorldState t = make_world_state(jittered, testing::flat_terrain(), 3);
   EXPECT_NE(t.agent(1).start_x_m, s.agent(1).start_x_m);
-  const bus::AgentHello hello = testing::hello_for(t, 2, 77);
+  const protocol::AgentHello hello = testing::hello_for(t, 2, 77);
   admit(t, hello);
-  const bus::Admission m = admission_message(t, hello, decide_admission(t, hello, false), "run");
+  const protocol::Admission m = admission_message(t, hello, decide_admission(t, hello, false), "run");
   EXPECT_EQ(m.start_x_m, t.agent(2).start_x_m);
   EXPECT_EQ(m.start_y_m, t.agent(2).start_y_m);
   EXPECT_EQ(t.agent(2).x_m, t.agent(2).start_x_m);

@@ -5,10 +5,10 @@
 
 #include <cmath>
 
-#include "common/error.hpp"
-#include "tests/unit/world_server/world_fixtures.hpp"
-#include "world_server/completion.hpp"
-#include "world_server/step.hpp"
+#include "marsala/core/error.hpp"
+#include "unit/world_server/world_fixtures.hpp"
+#include "marsala/world_server/completion.hpp"
+#include "marsala/world_server/step.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -25,8 +25,8 @@ scenario::Scenario scenario_with(const std::string& completion) {
   return scenario::parse_scenario(small_scenario_text_completing(completion), "small.pbtxt");
 }
 
-bus::ActionRequest deposit(const WorldState& s, std::uint32_t id, CellIndex cell, double height_m) {
-  bus::ActionRequest r = request_for(s, id);
+protocol::ActionRequest deposit(const WorldState& s, std::uint32_t id, CellIndex cell, double height_m) {
+  protocol::ActionRequest r = request_for(s, id);
   r.depositions.push_back({cell.row, cell.col, height_m});
   return r;
 }
@@ -34,7 +34,7 @@ bus::ActionRequest deposit(const WorldState& s, std::uint32_t id, CellIndex cell
 /// Steps with every live agent idle (requests that do nothing).
 void idle_steps(WorldState& s, int n) {
   for (int i = 0; i < n; ++i) {
-    std::vector<bus::ActionRequest> requests;
+    std::vector<protocol::ActionRequest> requests;
     for (std::uint32_t id : s.live_ids()) requests.push_back(request_for(s, id));
     apply_step(s, requests);
   }
@@ -53,7 +53,7 @@ TEST(PayloadCompletion, AnAlreadyNavigablePayloadIsCompleteFromTheStart) {
 
 TEST(PayloadCompletion, TheCheckRunsOnItsScheduleOnlyAfterChanges) {
   // A 0.1 m hole under `to` (row 9, col 30) spoils it for the payload (ball 3 x 3, eps 0.05, kappa 0.2).
-  grid::Heightmap terrain = flat_terrain();
+  Heightmap terrain = flat_terrain();
   const CellIndex hole{9, 30};
   terrain(hole) = -8 * kLayer;
   WorldState s = admitted_state(scenario_with(payload_block(3)), terrain, 2);
@@ -64,8 +64,8 @@ TEST(PayloadCompletion, TheCheckRunsOnItsScheduleOnlyAfterChanges) {
   s.agent(1).y_m = 3.05;
 
   // Step 0 fills the hole; no check at steps 0 and 1, the check at step 2 finds the path.
-  StepOutcome o = apply_step(s, std::vector<bus::ActionRequest>{deposit(s, 1, hole, 8 * kLayer), request_for(s, 2)});
-  ASSERT_EQ(s.agent(1).last_result, bus::ActionResult::kAccepted) << s.agent(1).last_reason;
+  StepOutcome o = apply_step(s, std::vector<protocol::ActionRequest>{deposit(s, 1, hole, 8 * kLayer), request_for(s, 2)});
+  ASSERT_EQ(s.agent(1).last_result, protocol::ActionResult::kAccepted) << s.agent(1).last_reason;
   EXPECT_EQ(s.terrain(hole), 0.0);
   EXPECT_FALSE(o.completion_checked);
   EXPECT_FALSE(o.completed);
@@ -73,7 +73,7 @@ TEST(PayloadCompletion, TheCheckRunsOnItsScheduleOnlyAfterChanges) {
   idle_steps(s, 1);
   EXPECT_FALSE(is_completed(s));
   EXPECT_EQ(s.check.evaluations, 1u);
-  o = apply_step(s, std::vector<bus::ActionRequest>{request_for(s, 1), request_for(s, 2)});
+  o = apply_step(s, std::vector<protocol::ActionRequest>{request_for(s, 1), request_for(s, 2)});
   EXPECT_EQ(o.step, 2u);
   EXPECT_TRUE(o.completion_checked);
   EXPECT_TRUE(o.completed);
@@ -96,7 +96,7 @@ TEST(PayloadCompletion, EndsOffTheGridAreRefusedWhenTheStateIsMade) {
 
 TEST(SiteCompletion, LevelFractionIsProgressAndCompletesWhenLevel) {
   // Site rows 10..19 x cols 20..29; a 0.1 m hole at (15, 25) spoils its 3 x 3 neighbourhood: 91 of 100 cells.
-  grid::Heightmap terrain = flat_terrain();
+  Heightmap terrain = flat_terrain();
   const CellIndex hole{15, 25};
   terrain(hole) = -8 * kLayer;
   WorldState s = admitted_state(scenario_with(site_block(2)), terrain, 1);
@@ -108,19 +108,19 @@ TEST(SiteCompletion, LevelFractionIsProgressAndCompletesWhenLevel) {
   // A deposition outside the site (cell (30, 18), 0.81 m from the agent) is no change for its check.
   s.agent(1).x_m = 1.05;
   s.agent(1).y_m = 1.05;
-  apply_step(s, std::vector<bus::ActionRequest>{deposit(s, 1, {30, 18}, kLayer)});
-  StepOutcome o = apply_step(s, std::vector<bus::ActionRequest>{request_for(s, 1)});
+  apply_step(s, std::vector<protocol::ActionRequest>{deposit(s, 1, {30, 18}, kLayer)});
+  StepOutcome o = apply_step(s, std::vector<protocol::ActionRequest>{request_for(s, 1)});
   EXPECT_FALSE(o.completion_checked);
   EXPECT_EQ(s.check.evaluations, 1u);
 
   // Filling the hole at step 2 (not a check step), the check at step 3 sees a level site.
   s.agent(1).x_m = 2.55;
   s.agent(1).y_m = 1.65;  // 0.9 m south of the hole
-  o = apply_step(s, std::vector<bus::ActionRequest>{deposit(s, 1, hole, 8 * kLayer)});
-  ASSERT_EQ(s.agent(1).last_result, bus::ActionResult::kAccepted) << s.agent(1).last_reason;
+  o = apply_step(s, std::vector<protocol::ActionRequest>{deposit(s, 1, hole, 8 * kLayer)});
+  ASSERT_EQ(s.agent(1).last_result, protocol::ActionResult::kAccepted) << s.agent(1).last_reason;
   EXPECT_FALSE(o.completion_checked);
   EXPECT_DOUBLE_EQ(progress(s), 0.91);
-  o = apply_step(s, std::vector<bus::ActionRequest>{request_for(s, 1)});
+  o = apply_step(s, std::vector<protocol::ActionRequest>{request_for(s, 1)});
   EXPECT_TRUE(o.completion_checked);
   EXPECT_TRUE(o.completed);
   EXPECT_EQ(s.check.level_fraction, 1.0);
@@ -128,7 +128,7 @@ TEST(SiteCompletion, LevelFractionIsProgressAndCompletesWhenLevel) {
 }
 
 TEST(SiteCompletion, MinFractionBelowOneAcceptsAPartlyLevelSite) {
-  grid::Heightmap terrain = flat_terrain();
+  Heightmap terrain = flat_terrain();
   terrain(15, 25) = -0.1;
   EXPECT_TRUE(is_completed(admitted_state(scenario_with(site_block(2, 0.9)), terrain, 1)));
   EXPECT_FALSE(is_completed(admitted_state(scenario_with(site_block(2, 0.92)), terrain, 1)));
@@ -140,21 +140,21 @@ TEST(Depositors, EachCellRemembersWhoRaisedItLastAndIdleStepsAreCounted) {
   ASSERT_EQ(s.depositor.rows(), 40);
   EXPECT_EQ(s.depositor.maxCoeff(), 0u);
   const CellIndex shared{29, 18};  // (1.85, 1.05): 0.8 m from agent 1, 0.7 m from agent 2
-  apply_step(s, std::vector<bus::ActionRequest>{deposit(s, 1, shared, kLayer), request_for(s, 2)});
+  apply_step(s, std::vector<protocol::ActionRequest>{deposit(s, 1, shared, kLayer), request_for(s, 2)});
   EXPECT_EQ(s.depositor(shared.row, shared.col), 1u);
   EXPECT_EQ(s.idle_steps, 0u);
-  apply_step(s, std::vector<bus::ActionRequest>{request_for(s, 1), request_for(s, 2)});
+  apply_step(s, std::vector<protocol::ActionRequest>{request_for(s, 1), request_for(s, 2)});
   EXPECT_EQ(s.idle_steps, 1u);
-  apply_step(s, std::vector<bus::ActionRequest>{request_for(s, 1), deposit(s, 2, shared, kLayer)});
+  apply_step(s, std::vector<protocol::ActionRequest>{request_for(s, 1), deposit(s, 2, shared, kLayer)});
   EXPECT_EQ(s.depositor(shared.row, shared.col), 2u);
   EXPECT_EQ(s.idle_steps, 1u);
   // A rejected deposition (not a whole cube layer) raises nothing: the step is idle, the cell keeps its depositor.
-  apply_step(s, std::vector<bus::ActionRequest>{deposit(s, 1, shared, 0.5 * kLayer), request_for(s, 2)});
-  EXPECT_EQ(s.agent(1).last_result, bus::ActionResult::kRejected);
+  apply_step(s, std::vector<protocol::ActionRequest>{deposit(s, 1, shared, 0.5 * kLayer), request_for(s, 2)});
+  EXPECT_EQ(s.agent(1).last_result, protocol::ActionResult::kRejected);
   EXPECT_EQ(s.depositor(shared.row, shared.col), 2u);
   EXPECT_EQ(s.idle_steps, 2u);
   // A step where every agent missed is idle too.
-  apply_step(s, std::vector<bus::ActionRequest>{});
+  apply_step(s, std::vector<protocol::ActionRequest>{});
   EXPECT_EQ(s.idle_steps, 3u);
   // Only deposited cells have a depositor.
   EXPECT_EQ((s.depositor.array() != 0).count(), 1);

@@ -1,4 +1,4 @@
-#include "world_server/step.hpp"
+#include "marsala/world_server/step.hpp"
 
 #include <gtest/gtest.h>
 
@@ -6,10 +6,10 @@
 #include <cmath>
 #include <random>
 
-#include "common/error.hpp"
-#include "tests/unit/world_server/world_fixtures.hpp"
-#include "world_server/completion.hpp"
-#include "world_server/sha256.hpp"
+#include "marsala/core/error.hpp"
+#include "unit/world_server/world_fixtures.hpp"
+#include "marsala/world_server/completion.hpp"
+#include "marsala/world_server/sha256.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -25,13 +25,13 @@ CellIndex cell_of(double x, double y) {
   return {40 - 1 - static_cast<int>(std::floor(y / 0.1)), static_cast<int>(std::floor(x / 0.1))};
 }
 
-bus::ActionRequest with_deposition(bus::ActionRequest r, double x, double y, double h) {
+protocol::ActionRequest with_deposition(protocol::ActionRequest r, double x, double y, double h) {
   const CellIndex c = cell_of(x, y);
   r.depositions.push_back({c.row, c.col, h});
   return r;
 }
 
-int count(const StepOutcome& o, bus::EventKind kind) {
+int count(const StepOutcome& o, protocol::EventKind kind) {
   return static_cast<int>(std::count_if(o.events.begin(), o.events.end(), [&](const auto& e) { return e.kind == kind; }));
 }
 
@@ -39,15 +39,15 @@ TEST(ApplyStep, IdOrderDecidesConflictsWhateverTheArrivalOrder) {
   // Agent 1 moves next to the cell agent 2 deposits on: processed first, its new position wins.
   const scenario::Scenario s = small_scenario();
   WorldState base = admitted_state(s, flat_terrain(), 2);  // agent 1 at (1.05, 1.05), agent 2 at (2.55, 1.05)
-  const bus::ActionRequest one = move_to(base, 1, 1.25, 1.05);
-  const bus::ActionRequest two = with_deposition(request_for(base, 2), 1.65, 1.05, kLayer);  // 0.4 m from (1.25, 1.05)
+  const protocol::ActionRequest one = move_to(base, 1, 1.25, 1.05);
+  const protocol::ActionRequest two = with_deposition(request_for(base, 2), 1.65, 1.05, kLayer);  // 0.4 m from (1.25, 1.05)
 
   WorldState a = base, b = base;
-  const StepOutcome oa = apply_step(a, std::vector<bus::ActionRequest>{one, two});
-  const StepOutcome ob = apply_step(b, std::vector<bus::ActionRequest>{two, one});
+  const StepOutcome oa = apply_step(a, std::vector<protocol::ActionRequest>{one, two});
+  const StepOutcome ob = apply_step(b, std::vector<protocol::ActionRequest>{two, one});
   for (const WorldState* w : {&a, &b}) {
     EXPECT_EQ(w->agent(1).x_m, 1.25);
-    EXPECT_EQ(w->agent(2).last_result, bus::ActionResult::kRejected);
+    EXPECT_EQ(w->agent(2).last_result, protocol::ActionResult::kRejected);
     EXPECT_NE(w->agent(2).last_reason.find("under agent 1"), std::string::npos) << w->agent(2).last_reason;
     EXPECT_EQ(w->terrain.heights().cwiseAbs().maxCoeff(), 0.0);
     EXPECT_EQ(w->step, 1u);
@@ -59,7 +59,7 @@ TEST(ApplyStep, IdOrderDecidesConflictsWhateverTheArrivalOrder) {
 
   // Alone (no motion of agent 1), agent 2's deposition is fine: the conflict above came from the order.
   WorldState c = base;
-  apply_step(c, std::vector<bus::ActionRequest>{two});
+  apply_step(c, std::vector<protocol::ActionRequest>{two});
   EXPECT_EQ(c.terrain(cell_of(1.65, 1.05)), kLayer);
 }
 
@@ -69,14 +69,14 @@ TEST(ApplyStep, ADepositionOfALowerIdCanBlockAMotionOfAHigherId) {
   base.agent(2).x_m = 2.45;
   base.agent(2).y_m = 1.15;
   // A 1 m column at (2.05, 1.55): 1.118 m from agent 1, 0.566 m from agent 2, 0.424 m from agent 2's target.
-  const bus::ActionRequest column = with_deposition(request_for(base, 1), 2.05, 1.55, 80 * kLayer);
-  const bus::ActionRequest step_in = move_to(base, 2, 2.35, 1.25);
-  for (const auto& order : {std::vector<bus::ActionRequest>{column, step_in}, std::vector<bus::ActionRequest>{step_in, column}}) {
+  const protocol::ActionRequest column = with_deposition(request_for(base, 1), 2.05, 1.55, 80 * kLayer);
+  const protocol::ActionRequest step_in = move_to(base, 2, 2.35, 1.25);
+  for (const auto& order : {std::vector<protocol::ActionRequest>{column, step_in}, std::vector<protocol::ActionRequest>{step_in, column}}) {
     WorldState w = base;
     apply_step(w, order);
-    EXPECT_EQ(w.agent(1).last_result, bus::ActionResult::kAccepted);
+    EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kAccepted);
     EXPECT_EQ(w.terrain(cell_of(2.05, 1.55)), 80 * kLayer);
-    EXPECT_EQ(w.agent(2).last_result, bus::ActionResult::kRejected);
+    EXPECT_EQ(w.agent(2).last_result, protocol::ActionResult::kRejected);
     EXPECT_NE(w.agent(2).last_reason.find("not occupiable"), std::string::npos) << w.agent(2).last_reason;
     EXPECT_EQ(w.agent(2).x_m, 2.45);
   }
@@ -92,7 +92,7 @@ TEST(ApplyStep, ArrivalOrderAcrossAgentsNeverChangesTheResult) {
     for (std::uint32_t id = 1; id <= 3; ++id) {
       const AgentRecord& a = in_order.agent(id);
       const double angle = std::uniform_real_distribution<double>(0.0, 6.283185307179586)(rng);
-      bus::ActionRequest r = move_to(in_order, id, a.x_m + 0.19 * std::cos(angle), a.y_m + 0.19 * std::sin(angle));
+      protocol::ActionRequest r = move_to(in_order, id, a.x_m + 0.19 * std::cos(angle), a.y_m + 0.19 * std::sin(angle));
       // Two depositions 0.7-1.1 m away, some of which collide with other robots or cells of other agents.
       for (int k = 0; k < 2; ++k) {
         const double d = std::uniform_real_distribution<double>(0.7, 1.1)(rng);
@@ -120,32 +120,32 @@ TEST(ApplyStep, ArrivalOrderAcrossAgentsNeverChangesTheResult) {
 TEST(ApplyStep, DuplicatesPastAndFutureRequests) {
   const scenario::Scenario s = small_scenario();
   WorldState w = admitted_state(s, flat_terrain(), 2);
-  apply_step(w, std::vector<bus::ActionRequest>{request_for(w, 1), request_for(w, 2)});
+  apply_step(w, std::vector<protocol::ActionRequest>{request_for(w, 1), request_for(w, 2)});
   ASSERT_EQ(w.step, 1u);
 
-  bus::ActionRequest past = request_for(w, 1);
+  protocol::ActionRequest past = request_for(w, 1);
   past.step = 0;
-  const bus::ActionRequest first = move_to(w, 1, 1.25, 1.05);
-  const bus::ActionRequest second = move_to(w, 1, 0.85, 1.05);
-  bus::ActionRequest future = request_for(w, 1);
+  const protocol::ActionRequest first = move_to(w, 1, 1.25, 1.05);
+  const protocol::ActionRequest second = move_to(w, 1, 0.85, 1.05);
+  protocol::ActionRequest future = request_for(w, 1);
   future.step = 2;
-  bus::ActionRequest future_of_2 = request_for(w, 2);
+  protocol::ActionRequest future_of_2 = request_for(w, 2);
   future_of_2.step = 2;
   const StepOutcome o = apply_step(w, std::vector<Submission>{{1, past}, {1, first}, {2, future_of_2}, {1, second}, {1, future}});
 
   EXPECT_EQ(w.agent(1).x_m, 1.25);  // the first stands
-  EXPECT_EQ(w.agent(1).last_result, bus::ActionResult::kAccepted);
+  EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kAccepted);
   EXPECT_EQ(w.agent(1).accepted, 2u);
   EXPECT_EQ(w.agent(1).rejected, 2u);  // the duplicate and the future one
   EXPECT_EQ(w.agent(1).missed, 0u);
   EXPECT_EQ(w.agent(2).rejected, 1u);
   EXPECT_EQ(w.agent(2).missed, 1u);  // a request for another step does not answer this one
-  EXPECT_EQ(w.agent(2).last_result, bus::ActionResult::kMissed);
+  EXPECT_EQ(w.agent(2).last_result, protocol::ActionResult::kMissed);
   EXPECT_EQ(o.accepted, 1u);
   EXPECT_EQ(o.rejected, 3u);
   EXPECT_EQ(o.missed, 1u);
-  EXPECT_EQ(count(o, bus::EventKind::kRejected), 3);
-  EXPECT_EQ(count(o, bus::EventKind::kMissed), 1);
+  EXPECT_EQ(count(o, protocol::EventKind::kRejected), 3);
+  EXPECT_EQ(count(o, protocol::EventKind::kMissed), 1);
   ASSERT_EQ(o.notes.size(), 1u);
   EXPECT_NE(o.notes[0].find("past step 0"), std::string::npos);
 }
@@ -155,14 +155,14 @@ TEST(ApplyStep, AForgedRequestOnAnAgentsPartitionDoesNotTakeItsSlot) {
   WorldState w = admitted_state(s, flat_terrain(), 2);
   // Another process writes on agent 1's partition first: once claiming agent 1 with a wrong session, once
   // claiming agent 2. Agent 1's own request, arriving after them, must still be the one that counts.
-  bus::ActionRequest forged = move_to(w, 1, 0.85, 1.05);
+  protocol::ActionRequest forged = move_to(w, 1, 0.85, 1.05);
   forged.session += 1;
-  bus::ActionRequest claims_2 = request_for(w, 2);
-  const bus::ActionRequest real = move_to(w, 1, 1.25, 1.05);
+  protocol::ActionRequest claims_2 = request_for(w, 2);
+  const protocol::ActionRequest real = move_to(w, 1, 1.25, 1.05);
   const StepOutcome o = apply_step(
       w, std::vector<Submission>{{1, forged}, {1, claims_2}, {1, real}, {2, request_for(w, 2)}});
   EXPECT_EQ(w.agent(1).x_m, 1.25);
-  EXPECT_EQ(w.agent(1).last_result, bus::ActionResult::kAccepted);
+  EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kAccepted);
   EXPECT_EQ(w.agent(1).missed, 0u);
   EXPECT_EQ(w.agent(1).rejected, 2u);
   EXPECT_EQ(w.agent(2).accepted, 1u);
@@ -175,17 +175,17 @@ TEST(ApplyStep, ARejectedRequestChangesNothingAndIsReportedInTheNextFrame) {
   const scenario::Scenario s = small_scenario();
   WorldState w = admitted_state(s, flat_terrain(), 1);
   const std::string before = terrain_sha256(w.terrain);
-  bus::ActionRequest r = with_deposition(move_to(w, 1, 1.25, 1.05), 1.25, 2.05, kLayer);
+  protocol::ActionRequest r = with_deposition(move_to(w, 1, 1.25, 1.05), 1.25, 2.05, kLayer);
   r = with_deposition(r, 1.25, 2.55, kLayer);  // 1.5 m away: out of reach, so nothing of it happens
-  const StepOutcome o = apply_step(w, std::vector<bus::ActionRequest>{r});
+  const StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{r});
   EXPECT_EQ(terrain_sha256(w.terrain), before);
   EXPECT_EQ(w.agent(1).x_m, 1.05);
   EXPECT_EQ(w.agent(1).material_m3, 0.05);
-  EXPECT_EQ(w.agent(1).last_result, bus::ActionResult::kRejected);
+  EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kRejected);
   EXPECT_NE(w.agent(1).last_reason.find("beyond reach_m"), std::string::npos);
   EXPECT_TRUE(o.changed_tiles.empty());
-  apply_step(w, std::vector<bus::ActionRequest>{request_for(w, 1)});
-  EXPECT_EQ(w.agent(1).last_result, bus::ActionResult::kAccepted);
+  apply_step(w, std::vector<protocol::ActionRequest>{request_for(w, 1)});
+  EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kAccepted);
   EXPECT_TRUE(w.agent(1).last_reason.empty());
 }
 
@@ -193,24 +193,24 @@ TEST(ApplyStep, ThreeConsecutiveMissesDropAnAgent) {
   const scenario::Scenario s = small_scenario();
   WorldState w = admitted_state(s, flat_terrain(), 2);
   // Two misses, an answer, two misses: never three in a row.
-  for (int k = 0; k < 2; ++k) apply_step(w, std::vector<bus::ActionRequest>{request_for(w, 1)});
-  apply_step(w, std::vector<bus::ActionRequest>{request_for(w, 1), request_for(w, 2)});
+  for (int k = 0; k < 2; ++k) apply_step(w, std::vector<protocol::ActionRequest>{request_for(w, 1)});
+  apply_step(w, std::vector<protocol::ActionRequest>{request_for(w, 1), request_for(w, 2)});
   for (int k = 0; k < 2; ++k) {
-    const StepOutcome o = apply_step(w, std::vector<bus::ActionRequest>{request_for(w, 1)});
+    const StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{request_for(w, 1)});
     EXPECT_TRUE(o.dropped.empty());
   }
   EXPECT_EQ(w.agent(2).missed, 4u);
   EXPECT_TRUE(w.agent(2).alive);
-  const StepOutcome third = apply_step(w, std::vector<bus::ActionRequest>{request_for(w, 1)});
+  const StepOutcome third = apply_step(w, std::vector<protocol::ActionRequest>{request_for(w, 1)});
   EXPECT_EQ(third.dropped, std::vector<std::uint32_t>{2});
-  EXPECT_EQ(count(third, bus::EventKind::kDropped), 1);
+  EXPECT_EQ(count(third, protocol::EventKind::kDropped), 1);
   EXPECT_FALSE(w.agent(2).alive);
   EXPECT_TRUE(w.agent(2).dropped);
   EXPECT_NE(w.agent(2).drop_reason.find("3 consecutive missed"), std::string::npos);
   EXPECT_EQ(w.live_ids(), std::vector<std::uint32_t>{1});
   // Later requests on its partition are ignored, and it is no longer expected.
-  bus::ActionRequest late = request_for(w, 2);
-  const StepOutcome after = apply_step(w, std::vector<bus::ActionRequest>{request_for(w, 1), late});
+  protocol::ActionRequest late = request_for(w, 2);
+  const StepOutcome after = apply_step(w, std::vector<protocol::ActionRequest>{request_for(w, 1), late});
   EXPECT_EQ(after.missed, 0u);
   EXPECT_EQ(after.accepted, 1u);
   ASSERT_EQ(after.notes.size(), 1u);
@@ -223,10 +223,10 @@ TEST(ApplyStep, OnlyChangedTilesGetANewVersion) {
   WorldState w = admitted_state(s, flat_terrain(), 1);
   ASSERT_EQ(w.tile_versions.size(), 9u);
   // (1.05, 2.05) is cell (19, 10): tile (1, 0).
-  const StepOutcome o = apply_step(w, std::vector<bus::ActionRequest>{with_deposition(request_for(w, 1), 1.05, 2.05, kLayer)});
+  const StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{with_deposition(request_for(w, 1), 1.05, 2.05, kLayer)});
   EXPECT_EQ(o.changed_tiles, std::vector<int>{3});
   EXPECT_EQ(w.tile_versions, (std::vector<std::uint64_t>{0, 0, 0, 1, 0, 0, 0, 0, 0}));
-  ASSERT_EQ(count(o, bus::EventKind::kDeposited), 1);
+  ASSERT_EQ(count(o, protocol::EventKind::kDeposited), 1);
   EXPECT_EQ(o.events[0].volume_m3, kLayer * 0.1 * 0.1);
 }
 
@@ -238,13 +238,13 @@ TEST(ApplyStep, ReachingTheGoalCompletesTheRun) {
   w.agent(2).x_m = 3.05;
   w.agent(2).y_m = 2.25;
   EXPECT_FALSE(is_completed(w));
-  StepOutcome o = apply_step(w, std::vector<bus::ActionRequest>{move_to(w, 1, 3.05, 2.05), request_for(w, 2)});
-  EXPECT_EQ(count(o, bus::EventKind::kAtGoal), 1);
+  StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{move_to(w, 1, 3.05, 2.05), request_for(w, 2)});
+  EXPECT_EQ(count(o, protocol::EventKind::kAtGoal), 1);
   EXPECT_TRUE(w.agent(1).at_goal);
   EXPECT_FALSE(o.completed);
   EXPECT_DOUBLE_EQ(progress(w), 0.5);
-  o = apply_step(w, std::vector<bus::ActionRequest>{request_for(w, 1), move_to(w, 2, 3.05, 2.15)});
-  EXPECT_EQ(count(o, bus::EventKind::kAtGoal), 1);  // agent 1 is not reported twice
+  o = apply_step(w, std::vector<protocol::ActionRequest>{request_for(w, 1), move_to(w, 2, 3.05, 2.15)});
+  EXPECT_EQ(count(o, protocol::EventKind::kAtGoal), 1);  // agent 1 is not reported twice
   EXPECT_TRUE(o.completed);
   EXPECT_DOUBLE_EQ(progress(w), 1.0);
   // A height condition: the flat ground at 0 m is not high enough for 0.5 m.

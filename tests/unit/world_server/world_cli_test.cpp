@@ -1,4 +1,4 @@
-#include "world_server/world_cli.hpp"
+#include "marsala/world_server/world_cli.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -10,8 +10,8 @@
 #include <thread>
 #include <vector>
 
-#include "tests/unit/world_server/fake_agent.hpp"
-#include "tests/unit/world_server/world_fixtures.hpp"
+#include "unit/world_server/fake_agent.hpp"
+#include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
 namespace {

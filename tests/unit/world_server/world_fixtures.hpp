@@ -4,11 +4,11 @@
 
 #include <string>
 
-#include "common/bus/messages.hpp"
-#include "common/grid/heightmap.hpp"
-#include "common/scenario/scenario.hpp"
-#include "world_server/admission.hpp"
-#include "world_server/world_state.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/scenario/scenario.hpp"
+#include "marsala/world_server/admission.hpp"
+#include "marsala/world_server/world_state.hpp"
 
 namespace marsala::world_server::testing {
 
@@ -63,8 +63,8 @@ inline scenario::Scenario small_scenario(const std::string& extra = "") {
 }
 
 /// A hello that matches slot `id` of `state`.
-inline bus::AgentHello hello_for(const WorldState& state, std::uint32_t id, std::uint64_t session) {
-  bus::AgentHello h;
+inline protocol::AgentHello hello_for(const WorldState& state, std::uint32_t id, std::uint64_t session) {
+  protocol::AgentHello h;
   h.agent_id = id;
   h.session = session;
   h.name = "tester-" + std::to_string(id);
@@ -74,24 +74,24 @@ inline bus::AgentHello hello_for(const WorldState& state, std::uint32_t id, std:
 }
 
 /// A state on `terrain` with agents 1..agents admitted (session 1000 + id).
-inline WorldState admitted_state(const scenario::Scenario& s, grid::Heightmap terrain, std::uint32_t agents) {
+inline WorldState admitted_state(const scenario::Scenario& s, Heightmap terrain, std::uint32_t agents) {
   WorldState state = make_world_state(s, std::move(terrain), agents);
   for (std::uint32_t id = 1; id <= agents; ++id) admit(state, hello_for(state, id, 1000 + id));
   return state;
 }
 
 /// A flat terrain of the small scenario's geometry.
-inline grid::Heightmap flat_terrain(double height = 0.0) {
-  grid::GridGeometry g;
+inline Heightmap flat_terrain(double height = 0.0) {
+  GridGeometry g;
   g.rows = 40;
   g.cols = 40;
   g.cell_size_m = 0.1;
-  return grid::Heightmap(g, height);
+  return Heightmap(g, height);
 }
 
 /// A request of agent `id` for the state's current step, doing nothing yet.
-inline bus::ActionRequest request_for(const WorldState& state, std::uint32_t id) {
-  bus::ActionRequest r;
+inline protocol::ActionRequest request_for(const WorldState& state, std::uint32_t id) {
+  protocol::ActionRequest r;
   r.agent_id = id;
   r.session = state.agent(id).session;
   r.step = state.step;
@@ -99,8 +99,8 @@ inline bus::ActionRequest request_for(const WorldState& state, std::uint32_t id)
 }
 
 /// A request that moves agent `id` to (x, y).
-inline bus::ActionRequest move_to(const WorldState& state, std::uint32_t id, double x, double y) {
-  bus::ActionRequest r = request_for(state, id);
+inline protocol::ActionRequest move_to(const WorldState& state, std::uint32_t id, double x, double y) {
+  protocol::ActionRequest r = request_for(state, id);
   r.move = true;
   r.target_x_m = x;
   r.target_y_m = y;

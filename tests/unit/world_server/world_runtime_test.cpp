@@ -1,4 +1,4 @@
-#include "world_server/world_runtime.hpp"
+#include "marsala/world_server/world_runtime.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,11 +11,11 @@
 #include <thread>
 #include <unistd.h>
 
-#include "common/error.hpp"
-#include "common/terrain/asc_io.hpp"
-#include "tests/unit/world_server/fake_agent.hpp"
-#include "tests/unit/world_server/world_fixtures.hpp"
-#include "world_server/sha256.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/terrain/asc_io.hpp"
+#include "unit/world_server/fake_agent.hpp"
+#include "unit/world_server/world_fixtures.hpp"
+#include "marsala/world_server/sha256.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -88,15 +88,15 @@ class RuntimeTest : public ::testing::Test {
   }
 
   /// Sends `hello` until the world answers it; returns the answer.
-  static bus::Admission ask(int domain, const bus::AgentHello& hello) {
+  static protocol::Admission ask(int domain, const protocol::AgentHello& hello) {
     auto participant = bus::make_participant({bus::Vendor::kInProcess, domain});
     auto signal = std::make_shared<bus::Signal>();
-    auto writer = participant->create_writer<bus::AgentHello>();
-    auto reader = participant->create_reader<bus::Admission>({"", signal});
+    auto writer = participant->create_writer<protocol::AgentHello>();
+    auto reader = participant->create_reader<protocol::Admission>({"", signal});
     for (int attempt = 0; attempt < 500; ++attempt) {
       writer->write(hello);
       signal->wait_for(20ms);
-      for (const bus::Admission& a : reader->take())
+      for (const protocol::Admission& a : reader->take())
         if (a.agent_id == hello.agent_id && a.session == hello.session) return a;
     }
     ADD_FAILURE() << "no answer to the hello of agent " << hello.agent_id;
@@ -111,8 +111,8 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   constexpr int kDomain = 41;
   auto participant = bus::make_participant({bus::Vendor::kInProcess, kDomain});
   auto monitor_signal = std::make_shared<bus::Signal>();
-  auto statuses = participant->create_reader<bus::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
-  auto events = participant->create_reader<bus::WorldEvent>({"", nullptr, bus::Durability::kVolatile, 256});
+  auto statuses = participant->create_reader<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
+  auto events = participant->create_reader<protocol::WorldEvent>({"", nullptr, bus::Durability::kVolatile, 256});
   WorldRuntime runtime(scenario_, testing::flat_terrain(), options(2, 10.0), *participant);
   EXPECT_EQ(runtime.run_id(), "small-d41");
   std::atomic<bool> stop{false};
@@ -120,15 +120,15 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   std::thread world([&] { result = runtime.run(stop); });
 
   // Refusals: slot 3 is not part of a two-agent run; agent 1 with another body.
-  bus::AgentHello intruder;
+  protocol::AgentHello intruder;
   intruder.agent_id = 3;
   intruder.session = 9;
   intruder.body = scenario_.robot_for(3).body;
-  bus::Admission answer = ask(kDomain, intruder);
+  protocol::Admission answer = ask(kDomain, intruder);
   EXPECT_FALSE(answer.accepted);
   EXPECT_NE(answer.reason.find("unknown agent id 3"), std::string::npos) << answer.reason;
   intruder.agent_id = 1;
-  intruder.body.delta_m = 0.5;
+  intruder.body.navigability.delta_m = 0.5;
   answer = ask(kDomain, intruder);
   EXPECT_FALSE(answer.accepted);
   EXPECT_NE(answer.reason.find("body differs"), std::string::npos) << answer.reason;
@@ -159,11 +159,11 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
     ASSERT_EQ(frames.size(), kStepsToGoal + 1);
     for (std::uint64_t k = 0; k < frames.size(); ++k) EXPECT_EQ(frames[k].step, k);
     EXPECT_TRUE(frames.back().run_over);
-    EXPECT_EQ(frames.back().last_result, bus::ActionResult::kAccepted);
+    EXPECT_EQ(frames.back().last_result, protocol::ActionResult::kAccepted);
   }
 
   // The latest status, as a late monitor sees it.
-  auto late = participant->create_reader<bus::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
+  auto late = participant->create_reader<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
   const auto latest = late->take();
   ASSERT_EQ(latest.size(), 1u);
   EXPECT_FALSE(latest[0].running);
@@ -174,11 +174,11 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   EXPECT_EQ(latest[0].agents[0].state, "walking");
   EXPECT_EQ(statuses->take().size(), kStepsToGoal + 2);  // before step 0, after each step, the final one
   int admitted = 0, refused = 0, deposited = 0, run_over = 0;
-  for (const bus::WorldEvent& e : events->take()) {
-    admitted += e.kind == bus::EventKind::kAdmitted;
-    refused += e.kind == bus::EventKind::kRefused;
-    deposited += e.kind == bus::EventKind::kDeposited;
-    run_over += e.kind == bus::EventKind::kRunOver;
+  for (const protocol::WorldEvent& e : events->take()) {
+    admitted += e.kind == protocol::EventKind::kAdmitted;
+    refused += e.kind == protocol::EventKind::kRefused;
+    deposited += e.kind == protocol::EventKind::kDeposited;
+    run_over += e.kind == protocol::EventKind::kRunOver;
   }
   EXPECT_EQ(admitted, 2);
   EXPECT_EQ(refused, 2);
@@ -198,7 +198,7 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   EXPECT_EQ(json_number(summary, "deposited_volume_m3"), s.deposited_volume_m3);  // printed to round-trip
   EXPECT_EQ(json_number(summary, "deposited_m3"), s.agent(1).deposited_m3);
   EXPECT_GT(json_number(summary, "wall_seconds"), 0.0);
-  const grid::Heightmap final_terrain = terrain::read_asc((out_ / "terrain_final.asc").string());
+  const Heightmap final_terrain = terrain::read_asc((out_ / "terrain_final.asc").string());
   EXPECT_EQ(terrain_sha256(final_terrain), terrain_sha256(s.terrain));
   EXPECT_EQ(terrain::read_asc((out_ / "terrain_initial.asc").string()).max_height(), 0.0);
   EXPECT_GT(fs::file_size(out_ / "final.png"), 1000u);
@@ -231,7 +231,7 @@ TEST_F(RuntimeTest, AnAgentThatMissesThreeDeadlinesIsDroppedTheOthersContinue) {
   // The dropped agent was told the run is over for it, right after its third miss.
   const auto frames = a2.frames();
   ASSERT_EQ(frames.size(), 4u);
-  EXPECT_EQ(frames[1].last_result, bus::ActionResult::kMissed);
+  EXPECT_EQ(frames[1].last_result, protocol::ActionResult::kMissed);
   EXPECT_TRUE(frames.back().run_over);
   EXPECT_EQ(frames.back().step, 3u);
   const std::string summary = read_text(out_ / "summary.json");
@@ -319,7 +319,7 @@ TEST_F(RuntimeTest, APayloadScenarioNavigableFromTheStartCompletesAtOnceWithTheS
   EXPECT_TRUE(result.completed);
   EXPECT_EQ(result.end_reason, "completed");
   EXPECT_EQ(result.steps, 0u);
-  auto late = participant->create_reader<bus::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
+  auto late = participant->create_reader<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
   const auto latest = late->take();
   ASSERT_EQ(latest.size(), 1u);
   EXPECT_EQ(latest[0].progress, 1.0);
@@ -335,14 +335,14 @@ TEST_F(RuntimeTest, ALevelSiteRunPublishesItsLevelFractionAsProgress) {
   auto participant = bus::make_participant({bus::Vendor::kInProcess, kDomain});
   const scenario::Scenario site =
       scenario::parse_scenario(testing::small_scenario_text_completing(testing::site_block()), "site.pbtxt");
-  grid::Heightmap terrain = testing::flat_terrain();
+  Heightmap terrain = testing::flat_terrain();
   terrain(15, 25) = -0.1;  // spoils 9 of the site's 100 cells
   RuntimeOptions o = options(1, 10.0);
   o.max_steps = 4;
   WorldRuntime runtime(site, terrain, o, *participant);
   const RunResult result = run_with_one_walker(runtime, kDomain);
   EXPECT_EQ(result.end_reason, "max_steps");
-  auto late = participant->create_reader<bus::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
+  auto late = participant->create_reader<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
   const auto latest = late->take();
   ASSERT_EQ(latest.size(), 1u);
   EXPECT_DOUBLE_EQ(latest[0].progress, 0.91);

@@ -1,0 +1,59 @@
+#include "marsala/core/deposition.hpp"
+#include "marsala/core/format.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "marsala/core/error.hpp"
+#include "marsala/core/iterators.hpp"
+
+namespace marsala {
+namespace {
+
+double checked_gap(const Heightmap& gap, CellIndex i) {
+  if (!gap.contains(i)) throw InvalidArgument("deposition target cell " + fmt::format("{}", i) + " is off the grid");
+  const double g = gap(i);
+  if (!(g >= 0.0) || !std::isfinite(g))
+    throw InvalidArgument("MARS gap at cell " + fmt::format("{}", i) + " is " + std::to_string(g) +
+                          "; a gap is finite and >= 0");
+  return g;
+}
+
+}  // namespace
+
+double deposition_target_volume(const Heightmap& gap, const std::vector<CellIndex>& cells) {
+  CellMask footprint = CellMask::Zero(gap.rows(), gap.cols());
+  for (const CellIndex i : cells) {
+    checked_gap(gap, i);
+    footprint(i.row, i.col) = 1;
+  }
+  return deposition_target_volume(gap, footprint);
+}
+
+double deposition_target_volume(const Heightmap& gap, const CellMask& footprint) {
+  if (footprint.rows() != gap.rows() || footprint.cols() != gap.cols())
+    throw InvalidArgument("footprint mask is " + std::to_string(footprint.rows()) + " x " +
+                          std::to_string(footprint.cols()) + " but the gap grid is " + std::to_string(gap.rows()) +
+                          " x " + std::to_string(gap.cols()));
+  double sum_m = 0.0;
+  for (SubmapIterator it(gap.geometry(), {0, 0}, gap.rows(), gap.cols()); !it.is_past_end(); ++it)
+    if (footprint((*it).row, (*it).col) != 0) sum_m += checked_gap(gap, *it);
+  return sum_m * gap.cell_size_m() * gap.cell_size_m();
+}
+
+double deposition_target_volume(const Heightmap& gap) {
+  return deposition_target_volume(gap, CellMask::Ones(gap.rows(), gap.cols()));
+}
+
+CellMask path_footprint(const GridGeometry& grid, const std::vector<CellIndex>& path, double delta_m) {
+  if (!(delta_m > 0.0) || !std::isfinite(delta_m))
+    throw InvalidArgument("body length delta must be finite and > 0, got " + std::to_string(delta_m));
+  CellMask footprint = CellMask::Zero(grid.rows, grid.cols);
+  for (const CellIndex p : path) {
+    if (!grid.contains(p)) throw InvalidArgument("path cell " + fmt::format("{}", p) + " is off the grid");
+    for (DiscIterator it(grid, p, delta_m / 2.0); !it.is_past_end(); ++it) footprint((*it).row, (*it).col) = 1;
+  }
+  return footprint;
+}
+
+}  // namespace marsala

@@ -1,0 +1,162 @@
+#include "marsala/core/detail/mars_seed.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace marsala::detail {
+namespace {
+
+// Raster propagation (two sweeps, as in 8SSEDT) of each cell's best *foreign* source: the best
+// other cell found so far, even while it stays below the cell's own height. Passing foreign
+// sources through cells that are their own maximum lets a far source reach the cells it wins at
+// behind them (e.g. on a plane slightly steeper than kappa, where no neighbour ever wins).
+class ForeignSourcePropagation {
+ public:
+  // value[i] receives the best foreign value [m], src[i] the foreign source (-1: none).
+  ForeignSourcePropagation(const Problem& pb, double* value, std::int32_t* src)
+      : pb_(pb),
+        value_(value),
+        src_(src),
+        inv_cols_(1.0 / pb.cols),
+        drop_side_(pb.kcs * std::sqrt(1.0)),
+        drop_diagonal_(pb.kcs * std::sqrt(2.0)) {}
+
+  void run() {
+    const int rows = pb_.rows, cols = pb_.cols;
+    std::fill(src_, src_ + static_cast<std::int64_t>(rows) * cols, -1);
+    std::fill(value_, value_ + static_cast<std::int64_t>(rows) * cols, -kInf);
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < cols; ++c) {
+        if (c > 0) take(r, c, 0, -1);
+        if (r > 0) {
+          if (c > 0) take(r, c, -1, -1);
+          take(r, c, -1, 0);
+          if (c + 1 < cols) take(r, c, -1, 1);
+        }
+      }
+      for (int c = cols - 2; c >= 0; --c) take(r, c, 0, 1);
+    }
+    for (int r = rows - 1; r >= 0; --r) {
+      for (int c = cols - 1; c >= 0; --c) {
+        if (c + 1 < cols) take(r, c, 0, 1);
+        if (r + 1 < rows) {
+          if (c + 1 < cols) take(r, c, 1, 1);
+          take(r, c, 1, 0);
+          if (c > 0) take(r, c, 1, -1);
+        }
+      }
+      for (int c = 1; c < cols; ++c) take(r, c, 0, -1);
+    }
+  }
+
+ private:
+  // Offers neighbour (r + dr, c + dc) itself and its foreign source to cell (r, c).
+  void take(int r, int c, int dr, int dc) {
+    const std::int64_t i = static_cast<std::int64_t>(r) * pb_.cols + c;
+    const std::int64_t n = i + static_cast<std::int64_t>(dr) * pb_.cols + dc;
+    if (n != src_[i]) {
+      // Same bits as cone_value(h, kcs, 1) and cone_value(h, kcs, 2).
+      const double v = pb_.h[n] - (dr != 0 && dc != 0 ? drop_diagonal_ : drop_side_);
+      if (v > value_[i]) {
+        value_[i] = v;
+        src_[i] = static_cast<std::int32_t>(n);
+      }
+    }
+    const std::int32_t s = src_[n];
+    if (s < 0 || s == i || s == src_[i]) return;
+    const int sr = row_of(s, inv_cols_);
+    const long long er = r - sr, ec = c - (s - static_cast<std::int64_t>(sr) * pb_.cols);
+    const double v = cone_value(pb_.h[s], pb_.kcs, er * er + ec * ec);
+    if (v > value_[i]) {
+      value_[i] = v;
+      src_[i] = s;
+    }
+  }
+
+  const Problem& pb_;
+  double* value_;
+  std::int32_t* src_;
+  double inv_cols_;
+  double drop_side_, drop_diagonal_;
+};
+
+// Makes every dropped cell point straight at a surviving source that dominates it within tol,
+// re-checked directly against the root of its pointer chain, so that tolerances never add up
+// along a chain; a cell failing the direct check survives. Pointers always climb in height
+// (tol < kcs), so chains end.
+void resolve_chains(const Problem& pb, std::int32_t* src) {
+  const double inv_cols = 1.0 / pb.cols;
+  const std::int64_t n = static_cast<std::int64_t>(pb.rows) * pb.cols;
+  auto resolved = [&](std::int64_t i) { return src[i] == i || src[src[i]] == src[i]; };
+  std::vector<std::int32_t> chain;
+  for (std::int64_t start = 0; start < n; ++start) {
+    if (resolved(start)) continue;
+    chain.clear();
+    for (std::int64_t i = start; !resolved(i); i = src[i]) chain.push_back(static_cast<std::int32_t>(i));
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      const std::int32_t q = *it;
+      const std::int32_t root = src[src[q]];  // src[q] is resolved: a survivor or points at one
+      const int qr = row_of(q, inv_cols), rr = row_of(root, inv_cols);
+      const long long dr = qr - rr;
+      const long long dc = (q - static_cast<std::int64_t>(qr) * pb.cols) - (root - static_cast<std::int64_t>(rr) * pb.cols);
+      src[q] = cone_value(pb.h[root], pb.kcs, dr * dr + dc * dc) >= pb.h[q] - pb.tol ? root : q;
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<std::uint64_t> seed_lower_bound(const Problem& pb, double* lower) {
+  const std::int64_t n = static_cast<std::int64_t>(pb.rows) * pb.cols;
+  std::vector<std::int32_t> src(static_cast<std::size_t>(n));
+  ForeignSourcePropagation(pb, lower, src.data()).run();
+  for (std::int64_t i = 0; i < n; ++i) {
+    if (src[i] < 0 || lower[i] < pb.h[i] - pb.tol) src[i] = static_cast<std::int32_t>(i);
+    lower[i] = std::max(lower[i], pb.h[i]);
+  }
+  resolve_chains(pb, src.data());
+  const int leaf_cols = (pb.cols + kBlock - 1) / kBlock, leaf_rows = (pb.rows + kBlock - 1) / kBlock;
+  std::vector<std::uint64_t> masks(static_cast<std::size_t>(leaf_rows) * leaf_cols, 0);
+  for (int r = 0; r < pb.rows; ++r)
+    for (int c = 0; c < pb.cols; ++c) {
+      const std::int64_t i = static_cast<std::int64_t>(r) * pb.cols + c;
+      if (src[i] == i)
+        masks[static_cast<std::size_t>(r / kBlock) * leaf_cols + c / kBlock] |= std::uint64_t{1}
+                                                                               << ((r % kBlock) * kBlock + c % kBlock);
+    }
+  return masks;
+}
+
+void apply_local_sources(const Problem& pb, double* lower) {
+  struct Offset {
+    int dr, dc;
+    double drop;
+  };
+  std::vector<Offset> offsets;
+  int radius = 0;
+  while ((radius + 1) * (radius + 1) <= kLocalRadius2) ++radius;
+  for (int dr = -radius; dr <= radius; ++dr)
+    for (int dc = -radius; dc <= radius; ++dc) {
+      const long long d2 = static_cast<long long>(dr) * dr + static_cast<long long>(dc) * dc;
+      if (d2 > 0 && d2 <= kLocalRadius2) offsets.push_back({dr, dc, pb.kcs * std::sqrt(static_cast<double>(d2))});
+    }
+  const int cols = pb.cols;
+  for (int r = 0; r < pb.rows; ++r) {
+    double* out = lower + static_cast<std::int64_t>(r) * cols;
+    for (const Offset& o : offsets) {
+      const int sr = r + o.dr;
+      if (sr < 0 || sr >= pb.rows) continue;
+      const double* in = pb.h + static_cast<std::int64_t>(sr) * cols;
+      const int c_begin = std::max(0, -o.dc), c_end = std::min(cols, cols - o.dc);
+      const double drop = o.drop;
+      const int dc = o.dc;
+      // Same bits as cone_value(); written as a plain max so that it vectorises.
+      for (int c = c_begin; c < c_end; ++c) {
+        const double v = in[c + dc] - drop;
+        out[c] = out[c] < v ? v : out[c];
+      }
+    }
+  }
+}
+
+}  // namespace marsala::detail

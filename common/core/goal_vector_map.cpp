@@ -1,0 +1,191 @@
+#include "marsala/core/goal_vector_map.hpp"
+#include "marsala/core/format.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "marsala/core/error.hpp"
+
+namespace marsala {
+namespace {
+
+// Lengths computed from user metres (x1 - x0, k * L) carry rounding; comparisons against one cell or the grid's
+// extent forgive this much [m].
+constexpr double kTolM = 1e-9;
+
+[[noreturn]] void fail(const std::string& problem) { throw InvalidArgument("goal vector map: " + problem); }
+
+void check_finite(const char* field, double v) {
+  if (!std::isfinite(v)) fail(std::string(field) + " is " + fmt::format("{}", v) + ", not a finite number");
+}
+
+bool along_x(Heading h) { return h == Heading::kEast || h == Heading::kWest; }
+bool forward(Heading h) { return h == Heading::kEast || h == Heading::kNorth; }
+
+// Pieces of n units of `size` covering `extent`, the last one possibly shorter: ceil(extent / size), at least 1;
+// a quotient a rounding error above an integer does not open an extra, empty piece.
+int pieces(double extent, double size) {
+  return std::max(1, static_cast<int>(std::ceil(extent / size - kTolM)));
+}
+
+}  // namespace
+
+std::string to_string(Heading heading) {
+  switch (heading) {
+    case Heading::kEast: return "east";
+    case Heading::kWest: return "west";
+    case Heading::kNorth: return "north";
+    case Heading::kSouth: return "south";
+  }
+  return "unknown";
+}
+
+Heading heading_from_string(const std::string& name) {
+  for (Heading h : {Heading::kEast, Heading::kWest, Heading::kNorth, Heading::kSouth})
+    if (to_string(h) == name) return h;
+  throw InvalidArgument("unknown heading '" + name + "'; valid: east, west, north, south");
+}
+
+GoalVectorMap::GoalVectorMap(const GoalVectorMapSpec& spec, const GridGeometry& grid) : spec_(spec) {
+  check_finite("x0_m", spec.x0_m);
+  check_finite("y0_m", spec.y0_m);
+  check_finite("x1_m", spec.x1_m);
+  check_finite("y1_m", spec.y1_m);
+  check_finite("strip_width_m", spec.strip_width_m);
+  check_finite("arrow_length_m", spec.arrow_length_m);
+  const double cs = grid.cell_size_m;
+  if (grid.rows <= 0 || grid.cols <= 0 || !std::isfinite(cs) || !(cs > 0.0) || !std::isfinite(grid.xll_m) ||
+      !std::isfinite(grid.yll_m))
+    fail("the grid " + std::to_string(grid.rows) + " x " + std::to_string(grid.cols) + " with cell size " +
+         fmt::format("{}", cs) + " m is not a valid grid");
+  const std::string rect = "[" + fmt::format("{}", spec.x0_m) + ", " + fmt::format("{}", spec.x1_m) + "] x [" + fmt::format("{}", spec.y0_m) + ", " +
+                           fmt::format("{}", spec.y1_m) + "] m";
+  if (!(spec.x0_m < spec.x1_m) || !(spec.y0_m < spec.y1_m))
+    fail("the rectangle " + rect + " is empty (needs x0_m < x1_m and y0_m < y1_m)");
+  const double gx1 = grid.xll_m + grid.cols * cs;
+  const double gy1 = grid.yll_m + grid.rows * cs;
+  if (spec.x0_m < grid.xll_m - kTolM || spec.x1_m > gx1 + kTolM || spec.y0_m < grid.yll_m - kTolM ||
+      spec.y1_m > gy1 + kTolM)
+    fail("the rectangle " + rect + " is not inside the grid [" + fmt::format("{}", grid.xll_m) + ", " + fmt::format("{}", gx1) + "] x [" +
+         fmt::format("{}", grid.yll_m) + ", " + fmt::format("{}", gy1) + "] m");
+  if (!(spec.strip_width_m > 0.0)) fail("strip_width_m is " + fmt::format("{}", spec.strip_width_m) + ", must be > 0");
+  if (!(spec.arrow_length_m > 0.0)) fail("arrow_length_m is " + fmt::format("{}", spec.arrow_length_m) + ", must be > 0");
+  if (spec.strip_width_m < cs - kTolM)
+    fail("strip_width_m " + fmt::format("{}", spec.strip_width_m) + " m is narrower than one cell (" + fmt::format("{}", cs) + " m)");
+  if (spec.arrow_length_m < cs - kTolM)
+    fail("arrow_length_m " + fmt::format("{}", spec.arrow_length_m) + " m is shorter than one cell (" + fmt::format("{}", cs) + " m)");
+
+  const Heading heading = spec.heading;
+  const bool ax = along_x(heading);
+  const bool fwd = forward(heading);
+  const double across_lo = ax ? spec.y0_m : spec.x0_m;
+  const double across_hi = ax ? spec.y1_m : spec.x1_m;
+  const double along_lo = ax ? spec.x0_m : spec.y0_m;
+  const double along_hi = ax ? spec.x1_m : spec.y1_m;
+  const double w = spec.strip_width_m;
+  const double len = spec.arrow_length_m;
+
+  // Snaps a point to the centre of its cell; points on the far (high-coordinate) edges would fall into the cell
+  // beyond, so they move half a cell inwards first. Clamping only absorbs the tolerance of the inside check.
+  const auto snap = [&](double x, double y) {
+    if (x >= spec.x1_m) x = spec.x1_m - 0.5 * cs;
+    if (y >= spec.y1_m) y = spec.y1_m - 0.5 * cs;
+    const int col = std::clamp(static_cast<int>(std::floor((x - grid.xll_m) / cs)), 0, grid.cols - 1);
+    const int row_from_south = std::clamp(static_cast<int>(std::floor((y - grid.yll_m) / cs)), 0, grid.rows - 1);
+    return grid.cell_center({grid.rows - 1 - row_from_south, col});
+  };
+  // Coordinate along the heading of a snapped point, and across it.
+  const auto along_of = [&](Position p) { return ax ? p.x : p.y; };
+  const auto across_of = [&](Position p) { return ax ? p.y : p.x; };
+  const auto point = [&](double along, double across) { return ax ? snap(along, across) : snap(across, along); };
+
+  // Strip centre lines across the heading, strip 0 at the low side; the last band may be narrower, but not
+  // narrower than a cell (its centre line would leave the rectangle or share a cell with its neighbour's).
+  strips_ = pieces(across_hi - across_lo, w);
+  const double last_band_lo = across_lo + (strips_ - 1) * w;
+  if (across_hi - last_band_lo < cs - kTolM)
+    fail("strip " + std::to_string(strips_ - 1) + " of " + std::to_string(strips_) + " is only " +
+         fmt::format("{}", across_hi - last_band_lo) + " m wide, narrower than one cell (" + fmt::format("{}", cs) +
+         " m): the site is " + fmt::format("{}", across_hi - across_lo) + " m across heading " + to_string(heading) +
+         " with strip_width_m " + fmt::format("{}", w) + " m");
+  std::vector<double> lines(static_cast<std::size_t>(strips_));
+  for (int i = 0; i < strips_; ++i) {
+    const double lo = across_lo + i * w;
+    const double hi = i + 1 < strips_ ? across_lo + (i + 1) * w : across_hi;
+    lines[static_cast<std::size_t>(i)] = across_of(point(fwd ? along_lo : along_hi, 0.5 * (lo + hi)));
+  }
+
+  // Cut points along the heading: the upwind edge, every arrow length, the downwind edge (set exactly, not as
+  // lo + extent, so the far-edge rule sees it).
+  const double extent = along_hi - along_lo;
+  const int n = pieces(extent, len);
+  const auto travelled = [&](int k) { return k == n ? extent : k * len; };  // from the upwind edge [m]
+  const auto cut = [&](int k) {
+    if (k == 0) return fwd ? along_lo : along_hi;
+    if (k == n) return fwd ? along_hi : along_lo;
+    return fwd ? along_lo + k * len : along_hi - k * len;
+  };
+  std::vector<double> snapped(static_cast<std::size_t>(n) + 1);
+  for (int k = 0; k <= n; ++k) snapped[static_cast<std::size_t>(k)] = along_of(point(cut(k), lines[0]));
+  // Signed advance along the heading between two snapped cut points [m].
+  const auto advance = [&](int a, int b) {
+    const double d = snapped[static_cast<std::size_t>(b)] - snapped[static_cast<std::size_t>(a)];
+    return fwd ? d : -d;
+  };
+  // Snapping moves a point by up to half a cell, so an arrow that is one cell long on paper can shrink to nothing
+  // (or point backwards at the far edge). Cut points that would make an arrow shorter than one cell are dropped,
+  // which merges that arrow into its neighbour; the remainder at the downwind edge is merged into the previous
+  // arrow when it is shorter than one cell on paper or after snapping.
+  std::vector<int> kept{0};
+  for (int k = 1; k < n; ++k)
+    if (advance(kept.back(), k) >= cs - kTolM) kept.push_back(k);
+  while (kept.size() > 1 &&
+         (travelled(n) - travelled(kept.back()) < cs - kTolM || advance(kept.back(), n) < cs - kTolM))
+    kept.pop_back();
+  if (advance(kept.back(), n) < cs - kTolM)
+    fail("the site is only " + fmt::format("{}", extent) + " m long along heading " + to_string(heading) +
+         ": its upwind and downwind cells are less than one cell (" + fmt::format("{}", cs) + " m) apart");
+  kept.push_back(n);
+
+  arrows_.reserve(static_cast<std::size_t>(strips_) * (kept.size() - 1));
+  for (int i = 0; i < strips_; ++i) {
+    const double across = lines[static_cast<std::size_t>(i)];
+    for (std::size_t j = 0; j + 1 < kept.size(); ++j) {
+      GoalArrow a;
+      a.tail = point(cut(kept[j]), across);
+      a.head = point(cut(kept[j + 1]), across);
+      a.strip = i;
+      a.index = static_cast<int>(j);
+      arrows_.push_back(a);
+    }
+  }
+}
+
+std::optional<std::size_t> GoalVectorMap::nearest_free_tail(Position p, const std::vector<bool>& excluded) const {
+  if (!std::isfinite(p.x) || !std::isfinite(p.y))
+    fail("nearest_free_tail from (" + fmt::format("{}", p.x) + ", " + fmt::format("{}", p.y) + ") m: not a finite position");
+  std::optional<std::size_t> best;
+  double best_d2 = 0.0;
+  for (std::size_t i = 0; i < arrows_.size(); ++i) {
+    if (i < excluded.size() && excluded[i]) continue;
+    const double dx = arrows_[i].tail.x - p.x;
+    const double dy = arrows_[i].tail.y - p.y;
+    const double d2 = dx * dx + dy * dy;
+    if (!best || d2 < best_d2) {
+      best = i;
+      best_d2 = d2;
+    }
+  }
+  return best;
+}
+
+std::optional<std::size_t> GoalVectorMap::next(std::size_t i) const {
+  if (i >= arrows_.size())
+    fail("arrow " + std::to_string(i) + " is out of range (the map has " + std::to_string(arrows_.size()) +
+         " arrows)");
+  if (i + 1 < arrows_.size() && arrows_[i + 1].strip == arrows_[i].strip) return i + 1;
+  return std::nullopt;
+}
+
+}  // namespace marsala

@@ -1,0 +1,72 @@
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/format.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "marsala/core/error.hpp"
+
+namespace marsala {
+namespace {
+
+void check_geometry(const GridGeometry& g) {
+  if (g.rows <= 0 || g.cols <= 0)
+    throw InvalidArgument("grid size must be positive, got " + std::to_string(g.rows) + " x " +
+                          std::to_string(g.cols));
+  if (!(g.cell_size_m > 0.0) || !std::isfinite(g.cell_size_m))
+    throw InvalidArgument("cell size must be a positive finite number of metres, got " +
+                          std::to_string(g.cell_size_m));
+  if (!std::isfinite(g.xll_m) || !std::isfinite(g.yll_m))
+    throw InvalidArgument("grid corner must be finite");
+}
+
+}  // namespace
+
+std::optional<CellIndex> GridGeometry::cell_at(Position p) const {
+  const double col = std::floor((p.x - xll_m) / cell_size_m);
+  const double row_from_south = std::floor((p.y - yll_m) / cell_size_m);
+  if (!(col >= 0 && col < cols && row_from_south >= 0 && row_from_south < rows)) return std::nullopt;
+  return CellIndex{rows - 1 - static_cast<int>(row_from_south), static_cast<int>(col)};
+}
+
+Heightmap::Heightmap(GridGeometry geometry, double fill) : geometry_(geometry) {
+  check_geometry(geometry_);
+  heights_.setConstant(geometry_.rows, geometry_.cols, fill);
+}
+
+Heightmap::Heightmap(GridGeometry geometry, HeightMatrix heights)
+    : geometry_(geometry), heights_(std::move(heights)) {
+  geometry_.rows = static_cast<int>(heights_.rows());
+  geometry_.cols = static_cast<int>(heights_.cols());
+  check_geometry(geometry_);
+}
+
+double Heightmap::at(CellIndex i) const {
+  if (!contains(i))
+    throw InvalidArgument("cell " + fmt::format("{}", i) + " is off the " + std::to_string(rows()) + " x " +
+                          std::to_string(cols()) + " grid");
+  return heights_(i.row, i.col);
+}
+
+double& Heightmap::at(CellIndex i) {
+  if (!contains(i))
+    throw InvalidArgument("cell " + fmt::format("{}", i) + " is off the " + std::to_string(rows()) + " x " +
+                          std::to_string(cols()) + " grid");
+  return heights_(i.row, i.col);
+}
+
+Heightmap Heightmap::window(CellIndex top_left, int rows, int cols) const {
+  const CellIndex bottom_right{top_left.row + rows - 1, top_left.col + cols - 1};
+  if (rows <= 0 || cols <= 0 || !contains(top_left) || !contains(bottom_right))
+    throw InvalidArgument("window " + std::to_string(rows) + " x " + std::to_string(cols) + " at " +
+                          fmt::format("{}", top_left) + " leaves the " + std::to_string(this->rows()) + " x " +
+                          std::to_string(this->cols()) + " grid");
+  GridGeometry g = geometry_;
+  g.rows = rows;
+  g.cols = cols;
+  g.xll_m = geometry_.xll_m + top_left.col * geometry_.cell_size_m;
+  g.yll_m = geometry_.yll_m + (geometry_.rows - 1 - bottom_right.row) * geometry_.cell_size_m;
+  return Heightmap(g, HeightMatrix(heights_.block(top_left.row, top_left.col, rows, cols)));
+}
+
+}  // namespace marsala

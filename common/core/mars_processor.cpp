@@ -1,0 +1,68 @@
+#include "marsala/core/mars_processor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "marsala/core/error.hpp"
+#include "marsala/core/detail/mars_common.hpp"
+#include "marsala/core/detail/mars_search.hpp"
+#include "marsala/core/detail/mars_seed.hpp"
+#include "marsala/core/detail/mars_source_tree.hpp"
+
+namespace marsala {
+namespace {
+
+constexpr double kAbsoluteTolM = 1e-10;  // tie tolerance [m] ...
+constexpr double kRelativeTol = 1e-15;   // ... grown with the magnitudes of heights and drops
+
+}  // namespace
+
+MarsProcessor::MarsProcessor(double kappa) : kappa_(kappa) {
+  if (!std::isfinite(kappa) || !(kappa > 0.0))
+    throw InvalidArgument("MarsProcessor: kappa must be finite and > 0, got " + std::to_string(kappa));
+}
+
+Heightmap MarsProcessor::project(const Heightmap& h) const {
+  Heightmap out = h;
+  const int rows = h.rows(), cols = h.cols();
+  if (rows <= 0 || cols <= 0) return out;
+  if (h.size() >= std::numeric_limits<std::int32_t>::max())
+    throw InvalidArgument("MarsProcessor: a grid of " + std::to_string(h.size()) + " cells is too large");
+  double max_abs = 0.0;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const double v = h(r, c);
+      if (!std::isfinite(v))
+        throw InvalidArgument("MarsProcessor: height at cell (row " + std::to_string(r) + ", col " +
+                              std::to_string(c) + ") is not finite");
+      max_abs = std::max(max_abs, std::abs(v));
+    }
+  detail::Problem pb;
+  pb.h = h.data();
+  pb.rows = rows;
+  pb.cols = cols;
+  pb.kcs = kappa_ * h.cell_size_m();
+  const double longest_drop = pb.kcs * std::hypot(static_cast<double>(rows), static_cast<double>(cols));
+  pb.tol = std::max(kAbsoluteTolM, kRelativeTol * (max_abs + longest_drop));
+  // Pointer chains of dominated cells must climb (by kcs - tol per step) to end.
+  pb.tol = std::min(pb.tol, 0.25 * pb.kcs);
+
+  double* lower = out.data();
+  std::vector<std::uint64_t> sources = detail::seed_lower_bound(pb, lower);
+  detail::apply_local_sources(pb, lower);
+  const detail::SourceTree tree(pb, std::move(sources));
+  detail::search_sources(pb, tree, lower);
+  return out;
+}
+
+Heightmap MarsProcessor::gap(const Heightmap& h) const {
+  Heightmap g = project(h);
+  g.heights() -= h.heights();
+  return g;
+}
+
+}  // namespace marsala

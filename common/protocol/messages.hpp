@@ -1,0 +1,163 @@
+#pragma once
+// The wire contract as plain C++ structs: what agents, the world server and the monitor exchange.
+// They are built from the core's vocabulary (RobotBody); idl/marsala.idl mirrors them field for field (all @final)
+// and the DDS backends in common/bus convert between the two, so no other code ever sees a vendor type. The rules
+// that give each message its meaning are docs/runtime.md.
+//
+// Units: positions and lengths [m] in the world frame of ARCHITECTURE.md (x east, y north), heights [m],
+// volumes [m^3], slopes rise over run [m/m]. Steps count lockstep ticks from 0.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "marsala/core/robot_body.hpp"
+
+namespace marsala::protocol {
+
+/// Agent -> world, repeated until admitted: who I am and what my body can do.
+struct AgentHello {
+  std::uint32_t agent_id = 0;   ///< unique in the run, >= 1
+  std::uint64_t session = 0;    ///< random per process start, so a restarted agent is told apart
+  std::string name;             ///< human-readable, e.g. "builder-3"
+  std::string behaviour;        ///< reactive behaviour name, e.g. "ramp_builder"
+  RobotBody body;                ///< declared body; admitted only if equal to its slot's robot type
+};
+
+/// World -> agent: the answer to a hello, with what the agent needs to build its own map.
+struct Admission {
+  std::uint32_t agent_id = 0;
+  std::uint64_t session = 0;     ///< echoes the hello's session
+  bool accepted = false;
+  std::string reason;            ///< why not, when rejected
+  std::string run_id;            ///< names the run; endpoints of this agent use partition partition_for(run, id)
+  std::int32_t rows = 0;         ///< world grid size [cells]
+  std::int32_t cols = 0;
+  double xll_m = 0.0;            ///< world grid lower-left corner [m]
+  double yll_m = 0.0;
+  double cell_size_m = 0.0;      ///< [m/cell]
+  std::int32_t tile_size = 16;   ///< terrain tiles are tile_size x tile_size cells (smaller at the grid edge)
+  double start_x_m = 0.0;        ///< where the agent starts [m]
+  double start_y_m = 0.0;
+  double target_x_m = 0.0;       ///< the goal of the scenario for this agent [m]
+  double target_y_m = 0.0;
+  double base_x_m = 0.0;         ///< base station centre: material is refilled only there [m]
+  double base_y_m = 0.0;
+  double base_radius_m = 0.0;
+};
+
+/// A tile of the authoritative terrain: heights of cells [tile_row * tile_size, ...) x [tile_col * tile_size, ...).
+struct TerrainTile {
+  std::int32_t tile_row = 0;
+  std::int32_t tile_col = 0;
+  std::int32_t rows = 0;               ///< cells in this tile (tile_size, or fewer at the grid edge)
+  std::int32_t cols = 0;
+  std::vector<double> heights;         ///< rows * cols heights [m], row-major, row 0 northmost
+};
+
+/// Another robot within proximity range.
+struct Neighbour {
+  std::uint32_t agent_id = 0;
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double z_m = 0.0;
+};
+
+/// Outcome of an agent's previous request, reported in its next frame.
+enum class ActionResult : std::uint8_t { kNone = 0, kAccepted = 1, kRejected = 2, kMissed = 3 };
+
+/// World -> one agent (its own partition only): what its sensors see at the start of `step`.
+struct SensorFrame {
+  std::uint32_t agent_id = 0;
+  std::uint64_t step = 0;
+  double x_m = 0.0;                    ///< pose: the world's record of where the robot stands [m]
+  double y_m = 0.0;
+  double z_m = 0.0;                    ///< terrain height under the robot's centre [m]
+  double material_m3 = 0.0;            ///< material on board [m^3]
+  ActionResult last_result = ActionResult::kNone;
+  std::string last_reason;             ///< why the previous request was rejected, if it was
+  std::vector<TerrainTile> tiles;      ///< tiles in sensing range that changed since this agent last got them
+  std::vector<Neighbour> neighbours;   ///< robots within proximity range
+  bool run_over = false;               ///< the run has ended: the agent should exit
+};
+
+/// Raise one cell by `height_m` (> 0): additive construction only.
+struct Deposition {
+  std::int32_t row = 0;
+  std::int32_t col = 0;
+  double height_m = 0.0;
+};
+
+/// Agent -> world (its own partition only): what it wants to do in `step`.
+struct ActionRequest {
+  std::uint32_t agent_id = 0;
+  std::uint64_t session = 0;
+  std::uint64_t step = 0;
+  bool move = false;                   ///< move to (target_x_m, target_y_m) this step
+  double target_x_m = 0.0;
+  double target_y_m = 0.0;
+  std::vector<Deposition> depositions; ///< applied after the motion, within reach of the new position
+  bool refill = false;                 ///< top up material (only at the base station)
+  std::string state;                   ///< the behaviour's state name, for the monitor
+};
+
+/// One agent as the world sees it, for status and the monitor.
+struct AgentStatus {
+  std::uint32_t agent_id = 0;
+  std::string name;
+  std::string state;
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double z_m = 0.0;
+  double material_m3 = 0.0;
+  double deposited_m3 = 0.0;
+  std::uint32_t accepted = 0;          ///< requests accepted
+  std::uint32_t rejected = 0;          ///< requests rejected
+  std::uint32_t missed = 0;            ///< steps whose deadline passed without its request
+  bool alive = true;
+  bool at_goal = false;
+};
+
+/// World -> everyone, once per step (transient-local, so a late monitor sees the latest at once).
+struct WorldStatus {
+  std::string run_id;
+  std::string scenario;
+  std::uint64_t step = 0;
+  double wall_seconds = 0.0;
+  double deposited_volume_m3 = 0.0;
+  double progress = 0.0;               ///< [0, 1]: agents at goal (fraction), payload path (0/1), site (level fraction)
+  bool running = true;
+  bool completed = false;
+  std::vector<AgentStatus> agents;
+};
+
+/// Kinds of world events, for the event stream and the monitor.
+enum class EventKind : std::uint8_t {
+  kAdmitted = 0,
+  kRefused = 1,
+  kRejected = 2,
+  kDeposited = 3,
+  kMissed = 4,
+  kDropped = 5,
+  kAtGoal = 6,
+  kRunOver = 7,
+};
+
+/// World -> everyone: something happened.
+struct WorldEvent {
+  std::uint64_t step = 0;
+  std::uint32_t agent_id = 0;          ///< 0 when not about one agent
+  EventKind kind = EventKind::kAdmitted;
+  double volume_m3 = 0.0;              ///< for kDeposited
+  std::string detail;
+};
+
+/// The partition that carries one agent's frames and requests in one run: "<run_id>/agent-<id>".
+std::string partition_for(const std::string& run_id, std::uint32_t agent_id);
+
+/// Names of the enums, for logs and the monitor; from_string throws InvalidArgument listing valid names.
+std::string to_string(ActionResult r);
+std::string to_string(EventKind k);
+EventKind event_kind_from_string(const std::string& name);
+
+}  // namespace marsala::protocol

@@ -1,0 +1,124 @@
+#include "marsala/render/png_writer.hpp"
+
+#include <gtest/gtest.h>
+#include <png.h>
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "marsala/core/error.hpp"
+#include "marsala/render/terrain_renderer.hpp"
+
+namespace marsala::render {
+namespace {
+
+std::string temp_path(const std::string& name) { return ::testing::TempDir() + "/marsala_png_writer_" + name; }
+
+// Reads a PNG back with libpng (independent of the writer) as 8-bit RGB.
+Image read_png(const std::string& path) {
+  png_image png;
+  std::memset(&png, 0, sizeof png);
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&png, path.c_str())) {
+    ADD_FAILURE() << "cannot read " << path << ": " << png.message;
+    return {};
+  }
+  png.format = PNG_FORMAT_RGB;
+  Image image;
+  image.width = static_cast<int>(png.width);
+  image.height = static_cast<int>(png.height);
+  image.rgb.resize(PNG_IMAGE_SIZE(png));
+  if (!png_image_finish_read(&png, nullptr, image.rgb.data(), 0, nullptr)) {
+    ADD_FAILURE() << "cannot decode " << path << ": " << png.message;
+    png_image_free(&png);
+    return {};
+  }
+  return image;
+}
+
+Image pattern(int width, int height) {
+  Image image{width, height, std::vector<std::uint8_t>(3u * width * height)};
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = 3u * (y * width + x);
+      image.rgb[i] = static_cast<std::uint8_t>(40 * x + 1);
+      image.rgb[i + 1] = static_cast<std::uint8_t>(90 * y + 2);
+      image.rgb[i + 2] = static_cast<std::uint8_t>(7 * (x + y) + 200);
+    }
+  return image;
+}
+
+TEST(PngWriter, RoundTripKeepsSizeAndEveryPixel) {
+  const Image image = pattern(3, 2);
+  const std::string path = temp_path("pattern.png");
+  write_png(image, path);
+  const Image back = read_png(path);
+  ASSERT_EQ(back.width, 3);
+  ASSERT_EQ(back.height, 2);
+  EXPECT_EQ(back.rgb, image.rgb);
+  // Spot checks by hand: pixel (x = 2, y = 1) is (81, 92, 221); (0, 0) is (1, 2, 200).
+  EXPECT_EQ(back.rgb[3 * (1 * 3 + 2) + 0], 81);
+  EXPECT_EQ(back.rgb[3 * (1 * 3 + 2) + 1], 92);
+  EXPECT_EQ(back.rgb[3 * (1 * 3 + 2) + 2], 221);
+  EXPECT_EQ(back.rgb[0], 1);
+  EXPECT_EQ(back.rgb[1], 2);
+  EXPECT_EQ(back.rgb[2], 200);
+}
+
+TEST(PngWriter, FileStartsWithThePngSignature) {
+  const std::string path = temp_path("signature.png");
+  write_png(pattern(1, 1), path);
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  ASSERT_NE(f, nullptr);
+  unsigned char head[8] = {};
+  EXPECT_EQ(std::fread(head, 1, 8, f), 8u);
+  std::fclose(f);
+  const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  EXPECT_EQ(std::memcmp(head, signature, 8), 0);
+}
+
+TEST(PngWriter, RenderedTerrainRoundTrips) {
+  Heightmap map(GridGeometry{9, 13, 0.0, 0.0, 0.5});
+  for (int r = 0; r < 9; ++r)
+    for (int c = 0; c < 13; ++c) map(r, c) = 0.1 * r * c - 0.3 * c;
+  const Image image = render_terrain(map);
+  const std::string path = temp_path("terrain.png");
+  write_png(image, path);
+  const Image back = read_png(path);
+  EXPECT_EQ(back.width, image.width);
+  EXPECT_EQ(back.height, image.height);
+  EXPECT_EQ(back.rgb, image.rgb);
+}
+
+TEST(PngWriter, OverwritesAnExistingFile) {
+  const std::string path = temp_path("overwrite.png");
+  write_png(pattern(4, 4), path);
+  write_png(pattern(2, 5), path);
+  const Image back = read_png(path);
+  EXPECT_EQ(back.width, 2);
+  EXPECT_EQ(back.height, 5);
+}
+
+TEST(PngWriter, UnwritablePathThrowsIoErrorNamingIt) {
+  const std::string path = ::testing::TempDir() + "/no_such_directory_for_marsala/x.png";
+  try {
+    write_png(pattern(2, 2), path);
+    FAIL() << "no exception";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+}
+
+TEST(PngWriter, MalformedImagesAreRejected) {
+  EXPECT_THROW(write_png(Image{}, temp_path("empty.png")), InvalidArgument);
+  Image short_buffer = pattern(3, 3);
+  short_buffer.rgb.pop_back();
+  EXPECT_THROW(write_png(short_buffer, temp_path("short.png")), InvalidArgument);
+  Image negative{-2, 3, {}};
+  EXPECT_THROW(write_png(negative, temp_path("negative.png")), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace marsala::render
