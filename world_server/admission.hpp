@@ -1,5 +1,5 @@
 #pragma once
-// Admission of agents (runtime_spec.md "Scenario and lifecycle"): pure decisions on hellos, and the Admission
+// Admission of agents (docs/runtime.md#admission): pure decisions on hellos, and the Admission
 // message that answers each one.
 
 #include <string>

@@ -1,5 +1,5 @@
 #pragma once
-// The arbiter: validates one ActionRequest against the world state exactly as runtime_spec.md says (rules 1-4,
+// The arbiter: validates one ActionRequest against the world state exactly as docs/runtime.md#validation says (rules 1-4,
 // all-or-nothing) and applies accepted ones. Pure functions of their arguments.
 
 #include <cstdint>
@@ -13,7 +13,7 @@
 
 namespace marsala::world_server {
 
-/// Tolerances of runtime_spec.md.
+/// Tolerances of docs/runtime.md#tolerances.
 namespace arbiter_tolerance {
 inline constexpr double kLengthM = 1e-9;       ///< added to length limits [m]
 inline constexpr double kVolumeM3 = 1e-12;     ///< added to volume limits [m^3]
@@ -41,7 +41,7 @@ struct Verdict {
   double volume_m3 = 0.0;    ///< material the depositions place, when accepted [m^3]
 };
 
-/// Validates `request`, which arrived on the partition of agent `channel_id`, against `state` (runtime_spec.md rules
+/// Validates `request`, which arrived on the partition of agent `channel_id`, against `state` (docs/runtime.md#validation, rules
 /// 1-4: envelope, motion, depositions after the motion, refill). Duplicates and requests for other steps are
 /// apply_step's business; here a step other than state.step is a rejection.
 Verdict validate_request(const WorldState& state, std::uint32_t channel_id, const protocol::ActionRequest& request);

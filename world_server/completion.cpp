@@ -12,12 +12,11 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/navigability_processor.hpp"
+#include "marsala/core/navigable_path_planner.hpp"
 #include "marsala/world_server/arbiter.hpp"
 
 namespace marsala::world_server {
 namespace {
-
-constexpr double kSqrt2 = 1.41421356237309504880;
 
 CellIndex cell_of(const Heightmap& terrain, double x_m, double y_m, const char* what) {
   const auto cell = terrain.cell_at({x_m, y_m});
@@ -187,47 +186,15 @@ std::optional<PayloadRoute> shortest_path(const CellMask& passable, CellIndex fr
   check_on_mask(passable, from, "shortest_path: from");
   check_on_mask(passable, to, "shortest_path: to");
   if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m))
-    throw InvalidArgument("shortest_path: cell size " + fmt::format("{}", cell_size_m) + " m must be finite and > 0");
-  if (passable(from.row, from.col) == 0 || passable(to.row, to.col) == 0) return std::nullopt;
-  const int rows = static_cast<int>(passable.rows()), cols = static_cast<int>(passable.cols());
-  const double side = cell_size_m, diagonal = cell_size_m * kSqrt2;
-  // A* with the octile distance, the exact 8-connected distance without obstacles: consistent, so the first time
-  // the goal leaves the queue its distance is the shortest. Queue ties go to the smaller cell index.
-  const auto heuristic = [&](int k) {
-    const int dr = std::abs(k / cols - to.row), dc = std::abs(k % cols - to.col);
-    return side * std::abs(dr - dc) + diagonal * std::min(dr, dc);
-  };
-  const int start = from.row * cols + from.col, goal = to.row * cols + to.col;
-  std::vector<double> distance(static_cast<std::size_t>(rows) * cols, std::numeric_limits<double>::infinity());
-  std::vector<int> parent(distance.size(), -1);
-  using Entry = std::pair<double, int>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
-  distance[start] = 0.0;
-  open.push({heuristic(start), start});
-  while (!open.empty()) {
-    const auto [f, k] = open.top();
-    open.pop();
-    if (f != distance[k] + heuristic(k)) continue;  // superseded by a shorter distance
-    if (k == goal) break;
-    const int r = k / cols, c = k % cols;
-    for (int rr = std::max(0, r - 1); rr <= std::min(rows - 1, r + 1); ++rr)
-      for (int cc = std::max(0, c - 1); cc <= std::min(cols - 1, c + 1); ++cc) {
-        const int n = rr * cols + cc;
-        if (n == k || passable(rr, cc) == 0) continue;
-        const double d = distance[k] + (rr != r && cc != c ? diagonal : side);
-        if (d < distance[n]) {
-          distance[n] = d;
-          parent[n] = k;
-          open.push({d + heuristic(n), n});
-        }
-      }
-  }
-  if (!std::isfinite(distance[goal])) return std::nullopt;
-  PayloadRoute route;
-  route.length_m = distance[goal];
-  for (int k = goal; k != -1; k = parent[k]) route.cells.push_back({k / cols, k % cols});
-  std::reverse(route.cells.begin(), route.cells.end());
-  return route;
+    throw InvalidArgument(fmt::format("shortest_path: cell size {} m must be finite and > 0", cell_size_m));
+  // The agents' planner with no construction cost (alpha = 0) on a zero gap: a shortest 8-connected path, found by
+  // the one A* of the project. delta_m only sizes the (unused) footprint: one cell.
+  const NavigablePathPlanner planner({0.0, 1.0, cell_size_m});
+  const GridGeometry geometry{static_cast<int>(passable.rows()), static_cast<int>(passable.cols()), 0.0, 0.0,
+                              cell_size_m};
+  const PlannerResult found = planner.plan(Heightmap(geometry, 0.0), passable, from, to);
+  if (!found.found) return std::nullopt;
+  return PayloadRoute{found.path, found.length_m};
 }
 
 std::optional<PayloadRoute> payload_path(const Heightmap& terrain, const scenario::PayloadPath& path) {

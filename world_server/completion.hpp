@@ -64,9 +64,9 @@ struct PayloadRoute {
   double length_m = 0.0;         ///< sum of the steps: cs for a side step, cs * sqrt(2) for a diagonal one [m]
 };
 
-/// A shortest 8-connected path through 1-cells of `passable` from `from` to `to` (Euclidean step costs: cs or
-/// cs * sqrt 2; among equally short paths a deterministic one), or nullopt when there is none (either end
-/// blocked or disconnected). Throws InvalidArgument when an end is off the mask or cell_size_m is not > 0.
+/// A shortest 8-connected path through 1-cells of `passable` from `from` to `to`, found by the core's
+/// NavigablePathPlanner with alpha = 0 (Euclidean step costs: cs or cs * sqrt 2; among equally short paths a
+/// deterministic one), or nullopt when there is none (either end blocked or disconnected). Throws InvalidArgument when an end is off the mask or cell_size_m is not > 0.
 std::optional<PayloadRoute> shortest_path(const CellMask& passable, CellIndex from, CellIndex to,
                                           double cell_size_m);
 

@@ -1,6 +1,6 @@
 // Closed loop without the world server: ramp builders drive a mini world (tests/unit/agent/mini_world.hpp) on the
 // paper's platform scenario (Fig. 2) at a small size: 12 x 8 m at 0.1 m, a 1.5 m platform on the east side.
-// Every request is checked against runtime_spec.md's rules before it is applied; the robots must end on the
+// Every request is checked against the rules of docs/runtime.md#validation before it is applied; the robots must end on the
 // platform top with a navigable way from their start, within a step budget.
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 #pragma once
-// A small stand-in for the world server, written from runtime_spec.md alone (not from the agent's code): the
+// A small stand-in for the world server, written from docs/runtime.md alone (not from the agent's code): the
 // authoritative terrain, admission, sensor frames (tiles in range that changed since the agent last got them,
 // neighbours in range) and the validation rules of an ActionRequest. Closed-loop agent tests drive real
 // behaviours with it and check that every request they make is one the world accepts.
@@ -124,7 +124,7 @@ class MiniWorld {
     return f;
   }
 
-  /// Why the world would reject `q` in the current state ("" when it accepts it), per runtime_spec.md.
+  /// Why the world would reject `q` in the current state ("" when it accepts it), per docs/runtime.md#validation.
   std::string validate(const protocol::ActionRequest& q) const {
     const auto it = robots_.find(q.agent_id);
     if (it == robots_.end()) return "unknown agent";
