@@ -6,9 +6,9 @@
 #include <optional>
 #include <string>
 
-#include "marsala/protocol/messages.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/goal_vector_map.hpp"
+#include "marsala/core/robot_body.hpp"
 #include "marsala/core/types.hpp"
 
 namespace marsala::agent {
@@ -24,12 +24,23 @@ struct Task {
   std::optional<GoalVectorMapSpec> goal_vector_map;   ///< for "goal_vector_map"
 };
 
+/// Where the world placed this agent, read from its admission by the reactive layer (assignment_from): the layers
+/// below never see the wire message.
+struct Assignment {
+  GridGeometry world;           ///< the world grid (rows, cols, lower-left corner [m], cell size [m/cell])
+  int tile_size = 16;           ///< the terrain arrives in tiles of tile_size x tile_size cells
+  Position start;               ///< where the robot starts [m]
+  Position target;              ///< the scenario's goal for this agent [m]
+  Position base;                ///< base station centre: material is refilled only near it [m]
+  double base_radius_m = 0.0;   ///< [m]
+};
+
 /// The admitted agent: identity, body, the world's answer and team-wide margins.
 struct AgentContext {
   std::uint32_t agent_id = 0;       ///< >= 1
   std::uint64_t session = 0;        ///< echoed in every request
-  RobotBody body;             ///< this robot's body, kinematics and capabilities
-  protocol::Admission admission;         ///< world grid, tile size, start, target and base station
+  RobotBody body;                   ///< this robot's body, kinematics and capabilities
+  Assignment assignment;            ///< world grid, tile size, start, target and base station (once admitted)
   /// Depositions stay farther than this from a neighbour's reported centre [m]: the world rejects cells under any
   /// robot, and a neighbour may move before its turn; default = delta/2 + max_step of this body (see
   /// neighbour_keep_out_m()).
@@ -40,9 +51,6 @@ struct AgentContext {
 
 /// The construction parameters of a context: the task's, falling back to the body's (kappa, width as delta, eps).
 NavigabilityParams construction_params(const AgentContext& context);
-
-/// The world grid announced in an admission; throws InvalidArgument when its size or cell size is not positive.
-GridGeometry world_geometry(const protocol::Admission& admission);
 
 /// Keep-out around neighbours for a team whose largest body length is max_delta_m [m] and longest step
 /// max_step_m [m]: max_delta_m / 2 + max_step_m + 1e-6 [m].

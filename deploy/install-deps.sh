@@ -4,9 +4,9 @@
 set -euo pipefail
 
 packages=(
-  cmake make g++ pkg-config
+  cmake make g++ pkg-config python3
   libeigen3-dev
-  libtiff-dev libpng-dev zlib1g-dev
+  libtiff-dev libpng-dev zlib1g-dev libssl-dev
   libcli11-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   # scenarios and run summaries (protobuf), logging

@@ -94,7 +94,7 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
   const auto sane = [](double v) { return std::isfinite(v) && std::abs(v) < 1e6; };
   if (!sane(r.target_x_m) || !sane(r.target_y_m))
     return reject("target (" + fmt::format("{}", r.target_x_m) + ", " + fmt::format("{}", r.target_y_m) + ") is not finite or too large");
-  for (const protocol::Deposition& d : r.depositions)
+  for (const Deposition& d : r.depositions)
     if (!sane(d.height_m)) return reject("deposition height " + fmt::format("{}", d.height_m) + " m is not finite or too large");
   const Heightmap& terrain = state.terrain;
   if (static_cast<long long>(r.depositions.size()) > terrain.size())
@@ -121,7 +121,7 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
   std::vector<std::pair<int, int>> cells;
   cells.reserve(r.depositions.size());
   double volume = 0.0;
-  for (const protocol::Deposition& d : r.depositions) {
+  for (const Deposition& d : r.depositions) {
     const CellIndex c{d.row, d.col};
     if (!terrain.contains(c)) return reject("deposition cell " + fmt::format("{}", c) + " is off the grid");
     cells.emplace_back(d.row, d.col);
@@ -177,7 +177,7 @@ void apply_request(WorldState& state, const protocol::ActionRequest& r, const Ve
   if (!r.depositions.empty() &&
       (state.depositor.rows() != state.terrain.rows() || state.depositor.cols() != state.terrain.cols()))
     state.depositor = AgentIdGrid::Zero(state.terrain.rows(), state.terrain.cols());  // a state not made by make_world_state
-  for (const protocol::Deposition& d : r.depositions) {
+  for (const Deposition& d : r.depositions) {
     state.terrain(d.row, d.col) += d.height_m;
     state.depositor(d.row, d.col) = r.agent_id;
     changed_cells.push_back({d.row, d.col});

@@ -93,7 +93,7 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_seed(info.seed);
   s.set_dds(info.dds);
   s.set_completed(info.completed);
-  s.set_end_reason(info.end_reason);
+  s.set_end_reason(to_string(info.end_reason));
   s.set_steps(static_cast<std::uint32_t>(state.step));
   s.set_wall_seconds(info.wall_seconds);
   s.set_step_wall_median_ms(info.step_wall_median_ms);

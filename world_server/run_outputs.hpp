@@ -23,6 +23,7 @@
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/goal_vector_map.hpp"
 #include "marsala/render/terrain_renderer.hpp"
+#include "marsala/world_server/end_reason.hpp"
 #include "marsala/world_server/completion.hpp"
 #include "marsala/world_server/occupancy_cache.hpp"
 #include "marsala/world_server/world_state.hpp"
@@ -37,7 +38,7 @@ struct RunInfo {
   std::string dds;             ///< cyclone, fastdds or inprocess
   std::uint64_t seed = 0;
   bool completed = false;
-  std::string end_reason;      ///< completed, max_steps, signal, no_live_agents
+  EndReason end_reason = EndReason::kSignal;  ///< why the run ended
   double wall_seconds = 0.0;   ///< [s]
   double step_wall_median_ms = 0.0;  ///< median wall time of one lockstep step [ms]
   double step_wall_p90_ms = 0.0;     ///< its 90th percentile [ms]

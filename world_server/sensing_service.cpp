@@ -35,7 +35,7 @@ protocol::SensorFrame SensingService::frame_for(const WorldState& state, std::ui
     if (seen[static_cast<std::size_t>(index)] == version) continue;
     seen[static_cast<std::size_t>(index)] = version;
     const Tile t = layout_.tile(index);
-    protocol::TerrainTile tile;
+    TerrainTile tile;
     tile.tile_row = t.tile_row;
     tile.tile_col = t.tile_col;
     tile.rows = t.rows;

@@ -1,31 +1,33 @@
 #pragma once
-// SHA-256 (FIPS 180-4), for fingerprints of terrains: two runs that end with the same heights bit for bit print the
-// same digest.
+// SHA-256 fingerprints of terrains (OpenSSL's libcrypto): two runs that end with the same heights bit for bit print
+// the same digest.
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "marsala/core/heightmap.hpp"
 
 namespace marsala::world_server {
 
-/// Incremental SHA-256.
+/// Incremental SHA-256 (FIPS 180-4).
 class Sha256 {
  public:
+  /// Throws IoError when libcrypto cannot set up a digest.
   Sha256();
+  ~Sha256();
+  Sha256(const Sha256&) = delete;
+  Sha256& operator=(const Sha256&) = delete;
   /// Appends `size` bytes.
   void update(const void* data, std::size_t size);
   /// The digest of everything appended; the object is spent afterwards.
   std::array<std::uint8_t, 32> finish();
 
  private:
-  void block(const std::uint8_t* p);
-  std::array<std::uint32_t, 8> h_;
-  std::array<std::uint8_t, 64> buffer_{};
-  std::size_t buffered_ = 0;
-  std::uint64_t total_bytes_ = 0;
+  struct Context;
+  std::unique_ptr<Context> context_;
 };
 
 /// Lowercase hex of a digest (64 characters).

@@ -51,7 +51,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
     const auto participant = bus::make_participant({bus::vendor_from_string(dds), domain});
     WorldRuntime runtime(scenario, std::move(terrain), options, *participant);
     const RunResult result = runtime.run(stop);
-    out << "run " << runtime.run_id() << ": " << result.end_reason << " after " << result.steps << " steps, "
+    out << "run " << runtime.run_id() << ": " << to_string(result.end_reason) << " after " << result.steps << " steps, "
         << result.admitted << " agents, terrain sha256 " << result.terrain_sha256 << "\n";
   } catch (const Error& e) {
     err << "marsala-world: error: " << e.what() << "\n";

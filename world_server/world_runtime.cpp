@@ -275,17 +275,17 @@ struct WorldRuntime::Impl {
   }
 
   /// Runs steps until an end condition; returns the end reason.
-  std::string lockstep(const std::atomic<bool>& stop, Clock::time_point start) {
+  EndReason lockstep(const std::atomic<bool>& stop, Clock::time_point start) {
     for (;;) {
-      if (stop) return "signal";
-      if (is_completed(state)) return "completed";
-      if (state.step >= options.max_steps) return "max_steps";
+      if (stop) return EndReason::kSignal;
+      if (is_completed(state)) return EndReason::kCompleted;
+      if (state.step >= options.max_steps) return EndReason::kMaxSteps;
       const std::vector<std::uint32_t> live = state.live_ids();
-      if (live.empty()) return "no_live_agents";
+      if (live.empty()) return EndReason::kNoLiveAgents;
       const Clock::time_point step_start = Clock::now();
       for (std::uint32_t id : live) send_frame(id, false);
       std::vector<Submission> submissions = collect(stop);
-      if (stop) return "signal";  // the interrupted step is not applied
+      if (stop) return EndReason::kSignal;  // the interrupted step is not applied
       const StepOutcome outcome = apply_step(state, submissions);
       step_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - step_start).count());
       if (outcome.completion_checked)
@@ -358,16 +358,16 @@ struct WorldRuntime::Impl {
     run_started = true;
     const Clock::time_point start = Clock::now();
     publish_status(true, false, 0.0);
-    const std::string end_reason = lockstep(stop, start);
+    const EndReason end_reason = lockstep(stop, start);
 
     RunResult result;
     result.end_reason = end_reason;
-    result.completed = end_reason == "completed";
+    result.completed = end_reason == EndReason::kCompleted;
     result.steps = state.step;
     result.wall_seconds = elapsed_s(start);
     const std::vector<std::uint32_t> live = state.live_ids();
     for (std::uint32_t id : live) send_frame(id, true);
-    emit(make_event(0, protocol::EventKind::kRunOver, end_reason));
+    emit(make_event(0, protocol::EventKind::kRunOver, to_string(end_reason)));
     publish_status(false, result.completed, result.wall_seconds);
 
     RunInfo info;
@@ -389,7 +389,7 @@ struct WorldRuntime::Impl {
     write_final_outputs(options.out_dir, state, info);
     for (const AgentRecord& a : state.agents) result.admitted += a.admitted ? 1 : 0;
     result.terrain_sha256 = terrain_sha256(state.terrain);
-    spdlog::info("run over ({}): {} steps in {:.3f} s, {:.6f} m3 deposited, terrain sha256 {}", end_reason,
+    spdlog::info("run over ({}): {} steps in {:.3f} s, {:.6f} m3 deposited, terrain sha256 {}", to_string(end_reason),
                  result.steps, result.wall_seconds, state.deposited_volume_m3, result.terrain_sha256);
     linger(live);
     return result;

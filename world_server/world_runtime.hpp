@@ -14,8 +14,10 @@
 #include <string>
 
 #include "marsala/bus/bus.hpp"
+#include "marsala/world_server/end_reason.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/scenario/scenario.hpp"
+#include "marsala/world_server/end_reason.hpp"
 #include "marsala/world_server/world_state.hpp"
 
 namespace marsala::world_server {
@@ -35,7 +37,7 @@ struct RuntimeOptions {
 /// How a run ended.
 struct RunResult {
   bool completed = false;
-  std::string end_reason;           ///< completed, max_steps, signal, no_live_agents
+  EndReason end_reason = EndReason::kSignal;  ///< why the run ended
   std::uint64_t steps = 0;          ///< steps applied
   double wall_seconds = 0.0;        ///< from the first frame to the end [s]
   std::uint32_t admitted = 0;

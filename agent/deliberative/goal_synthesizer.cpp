@@ -11,11 +11,11 @@ std::optional<Position> FixedTarget::target(const GoalQuery& /*query*/) { return
 
 GoalVectorMapSynthesizer::GoalVectorMapSynthesizer(const AgentContext& context)
     : self_id_(context.agent_id),
-      cell_size_m_(world_geometry(context.admission).cell_size_m),
+      cell_size_m_(context.assignment.world.cell_size_m),
       map_(context.task.goal_vector_map ? *context.task.goal_vector_map
                                         : throw InvalidArgument("goal synthesizer 'goal_vector_map' needs the "
                                                                 "scenario's goal_vector_map block"),
-           world_geometry(context.admission)),
+           context.assignment.world),
       finished_(map_.arrows().size(), false) {}
 
 namespace {
@@ -37,7 +37,7 @@ bool stands_on(Position robot, Position p, double cell_size_m) {
 // neighbour takes the tail.
 bool neighbour_takes(Position tail, const GoalQuery& query, std::uint32_t self_id) {
   const double mine = distance2(query.robot, tail);
-  for (const protocol::Neighbour& n : query.neighbours) {
+  for (const Neighbour& n : query.neighbours) {
     if (n.agent_id == self_id) continue;
     const double theirs = distance2({n.x_m, n.y_m}, tail);
     if (theirs < mine || (theirs == mine && n.agent_id < self_id)) return true;

@@ -15,7 +15,6 @@
 
 #include "marsala/agent/agent_context.hpp"
 #include "marsala/core/registry.hpp"
-#include "marsala/protocol/messages.hpp"
 #include "marsala/core/goal_vector_map.hpp"
 #include "marsala/core/types.hpp"
 
@@ -24,7 +23,7 @@ namespace marsala::agent::deliberative {
 /// What a goal synthesizer sees in one frame.
 struct GoalQuery {
   Position robot;                          ///< where the robot stands [m]
-  std::vector<protocol::Neighbour> neighbours;  ///< robots within proximity range (from the frame)
+  std::vector<Neighbour> neighbours;  ///< robots within proximity range (from the frame)
 };
 
 /// Picks the target location [m] for the robot's current state.
@@ -40,7 +39,7 @@ class GoalSynthesizer {
 /// The admission's target_x/y, wherever the robot is.
 class FixedTarget final : public GoalSynthesizer {
  public:
-  explicit FixedTarget(const AgentContext& context) : target_{context.admission.target_x_m, context.admission.target_y_m} {}
+  explicit FixedTarget(const AgentContext& context) : target_{context.assignment.target} {}
   std::string name() const override { return "fixed_target"; }
   std::optional<Position> target(const GoalQuery& query) override;
 

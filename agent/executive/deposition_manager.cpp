@@ -38,7 +38,7 @@ long long cells2(CellIndex a, CellIndex b) {
 bool DepositionManager::in_territory(const deliberative::LocalMap& map, CellIndex cell, Position centre,
                                      const Neighbourhood& neighbours, std::optional<CellIndex> self_cell) const {
   const CellIndex global = map.to_global(cell);
-  for (const protocol::Neighbour& n : neighbours.others) {
+  for (const Neighbour& n : neighbours.others) {
     const Position p{n.x_m, n.y_m};
     if (distance(centre, p) <= params_.neighbour_keep_out_m) return false;
     // Whole-cell distances: every robot computes them exactly alike, so territories never overlap.
@@ -140,7 +140,7 @@ bool DepositionManager::keeps_way_back(const deliberative::LocalMap& map, Positi
   std::vector<CellIndex> robots{*cell};
   const double cs = map.geometry().cell_size_m;
   const auto step_disc = disc_offsets(params_.neighbour_step_m / cs);
-  for (const protocol::Neighbour& n : neighbours.others)
+  for (const Neighbour& n : neighbours.others)
     if (const auto c = map.cell_at({n.x_m, n.y_m}))
       for (const CellIndex o : step_disc) {
         const CellIndex p{c->row + o.row, c->col + o.col};

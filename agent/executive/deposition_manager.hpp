@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "marsala/agent/deliberative/local_map_synthesizer.hpp"
-#include "marsala/protocol/messages.hpp"
+#include "marsala/core/robot_body.hpp"
 #include "marsala/core/navigability_processor.hpp"
 #include "marsala/core/types.hpp"
 
@@ -41,7 +41,7 @@ DepositionParams deposition_params(const RobotBody& body, double cell_size_m, do
 struct Neighbourhood {
   std::uint32_t self_id = 0;             ///< this robot's agent id
   Position self;                         ///< this robot's position at the start of the step [m]
-  std::vector<protocol::Neighbour> others;    ///< the other robots within proximity range
+  std::vector<Neighbour> others;    ///< the other robots within proximity range
 };
 
 /// One candidate deposition (local index).
@@ -53,7 +53,7 @@ struct DepositionCandidate {
 
 /// This step's depositions.
 struct DepositionPlan {
-  std::vector<protocol::Deposition> depositions;  ///< world indices, in path order
+  std::vector<Deposition> depositions;  ///< world indices, in path order
   double volume_m3 = 0.0;                    ///< sum of height * cs^2 [m^3]
   int candidates = 0;                        ///< candidates before the way-back check [count]
   int dropped_for_way_back = 0;              ///< candidates dropped to keep the way back [count]

@@ -9,7 +9,7 @@
 namespace marsala::agent::executive {
 namespace {
 
-std::string describe(const protocol::TerrainTile& t) {
+std::string describe(const TerrainTile& t) {
   return "tile (" + std::to_string(t.tile_row) + ", " + std::to_string(t.tile_col) + ") of " +
          std::to_string(t.rows) + " x " + std::to_string(t.cols) + " cells";
 }
@@ -22,12 +22,12 @@ MappingSystem::MappingSystem(const GridGeometry& world, int tile_size)
   known_ = CellMask::Zero(world.rows, world.cols);
 }
 
-void MappingSystem::integrate(const protocol::SensorFrame& frame) {
-  for (const protocol::TerrainTile& tile : frame.tiles) integrate_tile(tile);
-  record_pose({frame.x_m, frame.y_m});
+void MappingSystem::integrate(const std::vector<TerrainTile>& tiles, Position pose) {
+  for (const TerrainTile& tile : tiles) integrate_tile(tile);
+  record_pose(pose);
 }
 
-void MappingSystem::integrate_tile(const protocol::TerrainTile& tile) {
+void MappingSystem::integrate_tile(const TerrainTile& tile) {
   const long long row0 = static_cast<long long>(tile.tile_row) * tile_size_;
   const long long col0 = static_cast<long long>(tile.tile_col) * tile_size_;
   const bool placed = tile.tile_row >= 0 && tile.tile_col >= 0 && row0 < heights_.rows() && col0 < heights_.cols();

@@ -5,7 +5,6 @@
 
 #include <vector>
 
-#include "marsala/protocol/messages.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/types.hpp"
 
@@ -18,11 +17,11 @@ class MappingSystem {
   /// or tile_size < 1.
   MappingSystem(const GridGeometry& world, int tile_size);
 
-  /// Writes the frame's tiles (heights copied bit for bit) and records its pose; throws InvalidArgument when a
-  /// tile does not fit the grid or the pose is off the grid (a broken contract by the sender).
-  void integrate(const protocol::SensorFrame& frame);
+  /// Writes one sensing's tiles (heights copied bit for bit) and records the pose it was taken from [m]; throws
+  /// InvalidArgument when a tile does not fit the grid or the pose is off the grid (a broken contract by the sender).
+  void integrate(const std::vector<TerrainTile>& tiles, Position pose);
   /// Writes one tile; throws InvalidArgument naming the tile when its place, size or heights are inconsistent.
-  void integrate_tile(const protocol::TerrainTile& tile);
+  void integrate_tile(const TerrainTile& tile);
   /// Appends the cell under `pose` [m] to the trajectory (consecutive repeats are kept once); throws
   /// InvalidArgument when the pose is off the grid or not finite.
   void record_pose(Position pose);

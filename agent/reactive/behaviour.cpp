@@ -1,10 +1,12 @@
 #include "marsala/agent/reactive/behaviour.hpp"
 
+#include <cmath>
 #include <string>
 
 #include "marsala/agent/reactive/idle_behaviour.hpp"
 #include "marsala/agent/reactive/ramp_builder.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 
 namespace marsala::agent::reactive {
 
@@ -36,15 +38,24 @@ protocol::ActionRequest empty_request(const AgentContext& context, const protoco
   return request;
 }
 
-void check_admission(const AgentContext& context, const protocol::Admission& admission) {
+Assignment assignment_from(const AgentContext& context, const protocol::Admission& admission) {
   if (admission.agent_id != context.agent_id || admission.session != context.session || !admission.accepted)
     throw InvalidArgument("admission for agent " + std::to_string(admission.agent_id) + " (session " +
                           std::to_string(admission.session) + (admission.accepted ? "" : ", refused") +
                           ") does not admit agent " + std::to_string(context.agent_id) + " (session " +
                           std::to_string(context.session) + ")");
-  world_geometry(admission);
+  if (admission.rows <= 0 || admission.cols <= 0 || !(admission.cell_size_m > 0.0) ||
+      !std::isfinite(admission.cell_size_m) || !std::isfinite(admission.xll_m) || !std::isfinite(admission.yll_m))
+    throw InvalidArgument(fmt::format("admission: world grid {} x {} with cell size {} m is not a valid grid",
+                                      admission.rows, admission.cols, admission.cell_size_m));
   if (admission.tile_size < 1)
     throw InvalidArgument("admission: tile size must be >= 1, got " + std::to_string(admission.tile_size));
+  return {{admission.rows, admission.cols, admission.xll_m, admission.yll_m, admission.cell_size_m},
+          admission.tile_size,
+          {admission.start_x_m, admission.start_y_m},
+          {admission.target_x_m, admission.target_y_m},
+          {admission.base_x_m, admission.base_y_m},
+          admission.base_radius_m};
 }
 
 void check_frame(const AgentContext& context, const protocol::SensorFrame& frame) {

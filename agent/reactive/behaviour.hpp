@@ -46,8 +46,9 @@ std::unique_ptr<Behaviour> make_behaviour(const std::string& name, const AgentCo
 
 /// An empty request answering `frame`: the envelope filled, no motion, no deposition, no refill.
 protocol::ActionRequest empty_request(const AgentContext& context, const protocol::SensorFrame& frame, const std::string& state);
-/// Checks an admission against the context (id, session, grid); throws InvalidArgument when it does not fit.
-void check_admission(const AgentContext& context, const protocol::Admission& admission);
+/// The assignment an admission gives `context`'s agent; throws InvalidArgument when the admission is not for it (id,
+/// session, refused) or its grid or tile size is not valid.
+Assignment assignment_from(const AgentContext& context, const protocol::Admission& admission);
 /// Checks that a frame belongs to this agent; throws InvalidArgument otherwise.
 void check_frame(const AgentContext& context, const protocol::SensorFrame& frame);
 

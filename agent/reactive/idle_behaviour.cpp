@@ -5,8 +5,7 @@
 namespace marsala::agent::reactive {
 
 void IdleBehaviour::on_admission(const protocol::Admission& admission) {
-  check_admission(context_, admission);
-  context_.admission = admission;
+  context_.assignment = assignment_from(context_, admission);
   admitted_ = true;
 }
 

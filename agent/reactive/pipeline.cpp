@@ -9,7 +9,7 @@ namespace marsala::agent::reactive {
 namespace {
 
 double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
-Position where(const protocol::Neighbour& n) { return {n.x_m, n.y_m}; }
+Position where(const Neighbour& n) { return {n.x_m, n.y_m}; }
 
 }  // namespace
 
@@ -34,9 +34,9 @@ PipelineTracker::PipelineTracker(PipelineParams params) : params_(params) {
                           std::to_string(params.back_off_margin_m) + " m) in [0, separation)");
 }
 
-void PipelineTracker::observe(const std::vector<protocol::Neighbour>& neighbours, Position target) {
+void PipelineTracker::observe(const std::vector<Neighbour>& neighbours, Position target) {
   std::map<std::uint32_t, Track> next;
-  for (const protocol::Neighbour& n : neighbours) {
+  for (const Neighbour& n : neighbours) {
     const double d = distance(where(n), target);
     Track track;
     const auto old = tracks_.find(n.agent_id);
@@ -65,9 +65,9 @@ bool PipelineTracker::returning(std::uint32_t id) const {
   return it != tracks_.end() && it->second.returning;
 }
 
-std::optional<protocol::Neighbour> PipelineTracker::front(Position self, Position target) const {
+std::optional<Neighbour> PipelineTracker::front(Position self, Position target) const {
   const double mine = distance(self, target);
-  std::optional<protocol::Neighbour> best;
+  std::optional<Neighbour> best;
   double best_d = std::numeric_limits<double>::infinity();
   for (const auto& [id, track] : tracks_) {
     if (track.returning) continue;

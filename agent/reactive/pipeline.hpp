@@ -36,7 +36,7 @@ std::string to_string(PipelineRole role);
 /// A robot's place in the pipeline: its role and the front neighbour that decided it (none when kActive).
 struct PipelinePlace {
   PipelineRole role = PipelineRole::kActive;
-  std::optional<protocol::Neighbour> front;
+  std::optional<Neighbour> front;
 };
 
 /// Distances of the pipeline rule.
@@ -58,17 +58,17 @@ class PipelineTracker {
   const PipelineParams& params() const { return params_; }
 
   /// Takes one frame's neighbours (robots within proximity range), with `target` [m] the pipeline's target.
-  void observe(const std::vector<protocol::Neighbour>& neighbours, Position target);
+  void observe(const std::vector<Neighbour>& neighbours, Position target);
   /// True when neighbour `id` is currently seen and counted as returning.
   bool returning(std::uint32_t id) const;
   /// The front neighbour of a robot at `self` [m] (see the header), from the last observed frame.
-  std::optional<protocol::Neighbour> front(Position self, Position target) const;
+  std::optional<Neighbour> front(Position self, Position target) const;
   /// The role of a robot at `self` [m] and its front neighbour, from the last observed frame.
   PipelinePlace place(Position self, Position target) const;
 
  private:
   struct Track {
-    protocol::Neighbour last;
+    Neighbour last;
     double extreme_m = 0.0;  ///< nearest distance to the target while approaching, farthest while returning [m]
     bool returning = false;
   };

@@ -104,9 +104,8 @@ const executive::MappingSystem& RampBuilder::map() const {
 }
 
 void RampBuilder::on_admission(const protocol::Admission& admission) {
-  check_admission(context_, admission);
-  context_.admission = admission;
-  const GridGeometry world = world_geometry(admission);
+  context_.assignment = assignment_from(context_, admission);
+  const GridGeometry world = context_.assignment.world;
   const RobotBody& body = context_.body;
   const NavigabilityParams build = construction_params(context_);
   PlannerParams planner =
@@ -116,7 +115,7 @@ void RampBuilder::on_admission(const protocol::Admission& admission) {
   router.beta = 1.0;
   const double layer_m = cube_layer_m(body.cube_size_m, world.cell_size_m);
   modules_ = std::make_unique<Modules>(Modules{
-      executive::MappingSystem(world, admission.tile_size),
+      executive::MappingSystem(world, context_.assignment.tile_size),
       deliberative::LocalMapSynthesizer(body.navigability, body.sensing_range_m, build.kappa),
       NavigablePathPlanner(planner), NavigablePathPlanner(router),
       executive::ActionManager(body.max_step_m),
@@ -139,7 +138,7 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
   if (frame.run_over || state_ == RampState::kDone) {
     state_ = RampState::kDone;
   } else {
-    modules_->map.integrate(frame);
+    modules_->map.integrate(frame.tiles, {frame.x_m, frame.y_m});
     const Position robot{frame.x_m, frame.y_m};
     const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
     const Position target = goal.value_or(robot);  // nothing left to build towards: stay
@@ -327,9 +326,8 @@ std::optional<CellIndex> RampBuilder::oldest_navigable_trajectory_cell(const del
 void RampBuilder::return_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,
                               protocol::ActionRequest& request) {
   const Position robot{frame.x_m, frame.y_m};
-  const protocol::Admission& a = context_.admission;
-  const Position base{a.base_x_m, a.base_y_m};
-  const double radius = a.base_radius_m - kBaseMarginM;
+  const Position base = context_.assignment.base;
+  const double radius = context_.assignment.base_radius_m - kBaseMarginM;
   if (distance(robot, base) <= radius) {
     request.refill = trace_.refill = true;
     state_ = RampState::kAdvance;

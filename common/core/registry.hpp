@@ -1,6 +1,6 @@
 #pragma once
-// A registry of variants by name (behaviours, goal synthesizers): filled explicitly by register_builtins(), an
-// unknown name is an error that lists the valid ones.
+// The one registry of variants by name (terrain generators, behaviours, goal synthesizers, ...): filled explicitly
+// by each family's register_builtins(); an unknown name is an error that lists the valid ones.
 
 #include <functional>
 #include <map>
@@ -13,43 +13,54 @@
 
 namespace marsala {
 
-/// Factories of `Product` by name; `kind` names the variant family in messages ("behaviour", ...).
-template <typename Product, typename... Args>
-class Registry {
+/// Entries of type `Entry` by name; `kind` names the family in messages ("behaviour", "terrain generator", ...).
+template <typename Entry>
+class NamedRegistry {
  public:
-  using Factory = std::function<std::unique_ptr<Product>(Args...)>;
+  explicit NamedRegistry(std::string kind) : kind_(std::move(kind)) {}
 
-  explicit Registry(std::string kind) : kind_(std::move(kind)) {}
-
-  /// Registers a factory; throws InvalidArgument when the name is empty or taken.
-  void add(const std::string& name, Factory factory) {
-    if (name.empty() || factories_.count(name) != 0)
+  /// Registers an entry; throws InvalidArgument when the name is empty or taken.
+  void add(const std::string& name, Entry entry) {
+    if (name.empty() || entries_.count(name) != 0)
       throw InvalidArgument(kind_ + " name '" + name + "' is empty or already registered");
-    factories_.emplace(name, std::move(factory));
+    entries_.emplace(name, std::move(entry));
   }
-  /// Throws InvalidArgument listing the valid names when `name` is not registered.
+  /// Throws InvalidArgument "unknown <kind> 'name'; valid: a, b" when `name` is not registered.
   void require(const std::string& name) const {
     if (contains(name)) return;
     std::string valid;
-    for (const auto& [n, f] : factories_) valid += (valid.empty() ? "" : ", ") + n;
+    for (const auto& [n, e] : entries_) valid += (valid.empty() ? "" : ", ") + n;
     throw InvalidArgument("unknown " + kind_ + " '" + name + "'; valid: " + (valid.empty() ? "(none)" : valid));
   }
-  /// Makes the named variant; throws InvalidArgument listing the valid names when it is unknown.
-  std::unique_ptr<Product> make(const std::string& name, Args... args) const {
+  /// The entry named `name`; throws as require() when it is unknown.
+  const Entry& find(const std::string& name) const {
     require(name);
-    return factories_.at(name)(std::forward<Args>(args)...);
+    return entries_.at(name);
   }
   /// The registered names, sorted.
   std::vector<std::string> names() const {
     std::vector<std::string> out;
-    for (const auto& [n, f] : factories_) out.push_back(n);
+    for (const auto& [n, e] : entries_) out.push_back(n);
     return out;
   }
-  bool contains(const std::string& name) const { return factories_.count(name) != 0; }
+  bool contains(const std::string& name) const { return entries_.count(name) != 0; }
 
  private:
   std::string kind_;
-  std::map<std::string, Factory> factories_;
+  std::map<std::string, Entry> entries_;
+};
+
+/// Factories of `Product` by name, made from `Args`.
+template <typename Product, typename... Args>
+class Registry : public NamedRegistry<std::function<std::unique_ptr<Product>(Args...)>> {
+ public:
+  using Factory = std::function<std::unique_ptr<Product>(Args...)>;
+  using NamedRegistry<Factory>::NamedRegistry;
+
+  /// Makes the named variant; throws InvalidArgument listing the valid names when it is unknown.
+  std::unique_ptr<Product> make(const std::string& name, Args... args) const {
+    return this->find(name)(std::forward<Args>(args)...);
+  }
 };
 
 }  // namespace marsala

@@ -2,6 +2,7 @@
 // Vocabulary types shared by every layer, in the paper's language.
 
 #include <cstdint>
+#include <vector>
 
 namespace marsala {
 
@@ -28,6 +29,30 @@ struct NavigabilityParams {
     return a.kappa == b.kappa && a.delta_m == b.delta_m && a.eps_m == b.eps_m;
   }
   friend bool operator!=(const NavigabilityParams& a, const NavigabilityParams& b) { return !(a == b); }
+};
+
+/// A tile of the authoritative terrain, as a robot's terrain sensing delivers it: heights of cells [tile_row * tile_size, ...) x [tile_col * tile_size, ...).
+struct TerrainTile {
+  std::int32_t tile_row = 0;
+  std::int32_t tile_col = 0;
+  std::int32_t rows = 0;               ///< cells in this tile (tile_size, or fewer at the grid edge)
+  std::int32_t cols = 0;
+  std::vector<double> heights;         ///< rows * cols heights [m], row-major, row 0 northmost
+};
+
+/// Another robot within proximity range, as proximity sensing reports it.
+struct Neighbour {
+  std::uint32_t agent_id = 0;
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double z_m = 0.0;
+};
+
+/// Raise one cell by `height_m` (> 0): additive construction only.
+struct Deposition {
+  std::int32_t row = 0;
+  std::int32_t col = 0;
+  double height_m = 0.0;
 };
 
 /// Fixed tolerances every implementation shares (ARCHITECTURE.md, grid conventions).

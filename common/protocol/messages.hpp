@@ -15,6 +15,11 @@
 
 namespace marsala::protocol {
 
+// Core vocabulary the messages carry as it is.
+using marsala::Deposition;
+using marsala::Neighbour;
+using marsala::TerrainTile;
+
 /// Agent -> world, repeated until admitted: who I am and what my body can do.
 struct AgentHello {
   std::uint32_t agent_id = 0;   ///< unique in the run, >= 1
@@ -46,23 +51,6 @@ struct Admission {
   double base_radius_m = 0.0;
 };
 
-/// A tile of the authoritative terrain: heights of cells [tile_row * tile_size, ...) x [tile_col * tile_size, ...).
-struct TerrainTile {
-  std::int32_t tile_row = 0;
-  std::int32_t tile_col = 0;
-  std::int32_t rows = 0;               ///< cells in this tile (tile_size, or fewer at the grid edge)
-  std::int32_t cols = 0;
-  std::vector<double> heights;         ///< rows * cols heights [m], row-major, row 0 northmost
-};
-
-/// Another robot within proximity range.
-struct Neighbour {
-  std::uint32_t agent_id = 0;
-  double x_m = 0.0;
-  double y_m = 0.0;
-  double z_m = 0.0;
-};
-
 /// Outcome of an agent's previous request, reported in its next frame.
 enum class ActionResult : std::uint8_t { kNone = 0, kAccepted = 1, kRejected = 2, kMissed = 3 };
 
@@ -79,13 +67,6 @@ struct SensorFrame {
   std::vector<TerrainTile> tiles;      ///< tiles in sensing range that changed since this agent last got them
   std::vector<Neighbour> neighbours;   ///< robots within proximity range
   bool run_over = false;               ///< the run has ended: the agent should exit
-};
-
-/// Raise one cell by `height_m` (> 0): additive construction only.
-struct Deposition {
-  std::int32_t row = 0;
-  std::int32_t col = 0;
-  double height_m = 0.0;
 };
 
 /// Agent -> world (its own partition only): what it wants to do in `step`.

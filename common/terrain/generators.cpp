@@ -1,5 +1,6 @@
 #include "marsala/terrain/generators.hpp"
 #include "marsala/core/format.hpp"
+#include "marsala/core/registry.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -76,34 +77,17 @@ struct GeneratorEntry {
   std::vector<ParamDef> params;
 };
 
-class GeneratorRegistry {
- public:
-  void add(const std::string& name, GeneratorEntry entry) { entries_[name] = std::move(entry); }
-  const GeneratorEntry& find(const std::string& name) const {
-    const auto it = entries_.find(name);
-    if (it == entries_.end())
-      throw InvalidArgument("unknown terrain generator '" + name + "'; valid generators: " + join(names()));
-    return it->second;
-  }
-  std::vector<std::string> names() const {
-    std::vector<std::string> out;
-    for (const auto& [name, entry] : entries_) out.push_back(name);
-    return out;  // std::map keeps them sorted
-  }
-
- private:
-  std::map<std::string, GeneratorEntry> entries_;
-};
+using GeneratorRegistry = NamedRegistry<GeneratorEntry>;
 
 // Default helpers: a fixed value, or a fraction of the map extent / width / depth.
 ParamDef param(std::string key, double fixed_default, double min, double max, bool integer, std::string meaning,
                std::string unit) {
-  return {std::move(key), fmt::format("{}", fixed_default), [fixed_default](const Frame&) { return fixed_default; },
+  return {std::move(key), fmt::format("{:g}", fixed_default), [fixed_default](const Frame&) { return fixed_default; },
           min, max, integer, std::move(meaning), std::move(unit)};
 }
 
 ParamDef scaled_param(std::string key, double fraction, double min, double max, std::string meaning) {
-  return {std::move(key), fmt::format("{}", 100.0 * fraction) + "% of the map extent",
+  return {std::move(key), fmt::format("{:g}", 100.0 * fraction) + "% of the map extent",
           [fraction](const Frame& f) { return fraction * f.extent_m; }, min, max, false, std::move(meaning), "m"};
 }
 
@@ -127,12 +111,12 @@ ParamValues resolve(const std::string& method, const GeneratorEntry& entry, cons
       continue;
     }
     const double v = it->second;
-    const std::string range = "[" + fmt::format("{}", d.min) + ", " + fmt::format("{}", d.max) + "]";
+    const std::string range = "[" + fmt::format("{:g}", d.min) + ", " + fmt::format("{:g}", d.max) + "]";
     if (!(v >= d.min && v <= d.max))
-      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key + "' = " + fmt::format("{}", v) +
+      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key + "' = " + fmt::format("{:g}", v) +
                             " is out of range " + range);
     if (d.integer && v != std::floor(v))
-      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key + "' = " + fmt::format("{}", v) +
+      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key + "' = " + fmt::format("{:g}", v) +
                             " must be a whole number in " + range);
     out[d.key] = v;
   }
@@ -148,8 +132,8 @@ void check_spec(const std::string& method, const GeneratorSpec& spec) {
     throw InvalidArgument(where + "grid of " + std::to_string(spec.rows) + " x " + std::to_string(spec.cols) +
                           " cells exceeds the limit of " + std::to_string(kMaxCells) + " cells");
   if (!(spec.cell_size_m > 0.0 && spec.cell_size_m <= kMaxLength))
-    throw InvalidArgument(where + "cell size must be in (0, " + fmt::format("{}", kMaxLength) + "] m, got " +
-                          fmt::format("{}", spec.cell_size_m));
+    throw InvalidArgument(where + "cell size must be in (0, " + fmt::format("{:g}", kMaxLength) + "] m, got " +
+                          fmt::format("{:g}", spec.cell_size_m));
 }
 
 // Cell-centre coordinates with the lower-left corner at (0, 0) [m].
@@ -244,8 +228,8 @@ HeightMatrix fractal(const Frame& f, const Params& p) {
   const double amplitude = p.get("amplitude");
   const double wavelength = p.get("wavelength");
   if (wavelength < f.cs)
-    throw InvalidArgument("terrain generator 'fractal': wavelength " + fmt::format("{}", wavelength) +
-                          " m is shorter than one cell (" + fmt::format("{}", f.cs) + " m)");
+    throw InvalidArgument("terrain generator 'fractal': wavelength " + fmt::format("{:g}", wavelength) +
+                          " m is shorter than one cell (" + fmt::format("{:g}", f.cs) + " m)");
   HeightMatrix h = detail::gradient_fbm(f.rows, f.cols, f.cs, random::derive_seed(f.seed, 0x6662), p.count("octaves"),
                                         p.get("persistence"), wavelength);
   const double lo = h.minCoeff();
@@ -263,8 +247,8 @@ HeightMatrix craters(const Frame& f, const Params& p) {
   const double r_min = p.get("radius_min");
   const double r_max = p.get("radius_max");
   if (r_min > r_max)
-    throw InvalidArgument("terrain generator 'craters': radius_min " + fmt::format("{}", r_min) +
-                          " m exceeds radius_max " + fmt::format("{}", r_max) + " m");
+    throw InvalidArgument("terrain generator 'craters': radius_min " + fmt::format("{:g}", r_min) +
+                          " m exceeds radius_max " + fmt::format("{:g}", r_max) + " m");
   const double depth = p.get("depth");
   const double rim_height = p.get("rim_height");
   random::Rng rng(random::derive_seed(f.seed, 0x63726174));
@@ -429,7 +413,7 @@ void register_builtins(GeneratorRegistry& reg) {
 
 const GeneratorRegistry& registry() {
   static const GeneratorRegistry reg = [] {
-    GeneratorRegistry r;
+    GeneratorRegistry r("terrain generator");
     register_builtins(r);
     return r;
   }();
@@ -451,7 +435,7 @@ std::vector<std::string> generator_names() { return registry().names(); }
 std::vector<std::string> generator_parameter_help(const std::string& method) {
   std::vector<std::string> lines;
   for (const auto& d : registry().find(method).params) {
-    const std::string range = "[" + fmt::format("{}", d.min) + ", " + fmt::format("{}", d.max) + "]";
+    const std::string range = "[" + fmt::format("{:g}", d.min) + ", " + fmt::format("{:g}", d.max) + "]";
     lines.push_back(d.key + " (default " + d.default_text + "): " + d.meaning + "; valid " +
                     (d.integer ? "whole numbers in " : "") + range + " [" + d.unit + "]");
   }

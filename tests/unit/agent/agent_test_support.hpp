@@ -14,8 +14,8 @@
 namespace marsala::agent::test {
 
 /// The tile (tr, tc) of `h` cut in tile_size tiles, as the world sends it.
-inline protocol::TerrainTile cut_tile(const Heightmap& h, int tile_size, int tr, int tc) {
-  protocol::TerrainTile t;
+inline TerrainTile cut_tile(const Heightmap& h, int tile_size, int tr, int tc) {
+  TerrainTile t;
   t.tile_row = tr;
   t.tile_col = tc;
   t.rows = std::min(tile_size, h.rows() - tr * tile_size);
@@ -34,7 +34,7 @@ inline executive::MappingSystem full_map(const Heightmap& h, int tile_size = 16)
 }
 
 /// A neighbour as a frame reports it: agent `id` standing at (x, y) [m] (height 0).
-inline protocol::Neighbour neighbour_at(std::uint32_t id, double x, double y) { return {id, x, y, 0.0}; }
+inline Neighbour neighbour_at(std::uint32_t id, double x, double y) { return {id, x, y, 0.0}; }
 
 /// A Husky-like body: delta 1 m, eps 5 cm, 20 cm steps, 0.02 m^3 per step, 1.5 m reach, 5 cm cubes.
 inline RobotBody husky(double kappa = 0.5) {

@@ -186,7 +186,7 @@ TEST(DepositionManager, NeverRingsInARobotWhoseOriginIsItsOwnCell) {
   EXPECT_LT(plan.depositions.size(), ring.size());
   // Independent check: after the plan's depositions the robot still reaches the window's border.
   Heightmap after = flat;
-  for (const protocol::Deposition& d : plan.depositions) after(CellIndex{d.row, d.col}) += d.height_m;
+  for (const Deposition& d : plan.depositions) after(CellIndex{d.row, d.col}) += d.height_m;
   const CellMask reach = NavigabilityProcessor::navigable_from(
       NavigabilityProcessor(p.navigability).occupiable(after), centre);
   EXPECT_TRUE(reach.row(0).any() || reach.row(kGrid.rows - 1).any() || reach.col(0).any() ||

@@ -13,8 +13,7 @@ namespace {
 
 TEST(GoalSynthesizer, FixedTargetIsTheAdmissionsTargetWhereverTheRobotIs) {
   AgentContext context;
-  context.admission.target_x_m = 12.5;
-  context.admission.target_y_m = -3.25;
+  context.assignment.target = {12.5, -3.25};
   const auto goal = make_goal_synthesizer("fixed_target", context);
   EXPECT_EQ(goal->name(), "fixed_target");
   for (const Position robot : {Position{0.0, 0.0}, Position{12.5, -3.25}, Position{-100.0, 7.0}}) {
@@ -53,10 +52,7 @@ TEST(GoalSynthesizer, RegistryListsValidNamesOnAnUnknownOne) {
 AgentContext site_context(std::uint32_t id) {
   AgentContext c;
   c.agent_id = id;
-  c.admission.agent_id = id;
-  c.admission.rows = 12;
-  c.admission.cols = 12;
-  c.admission.cell_size_m = 1.0;
+  c.assignment.world = {12, 12, 0.0, 0.0, 1.0};
   c.task.goal_synthesizer = "goal_vector_map";
   GoalVectorMapSpec spec;
   spec.x0_m = 2.0;
@@ -74,7 +70,7 @@ const auto neighbour = test::neighbour_at;
 
 // The target, which must exist, as a pair for EXPECT_EQ.
 std::pair<double, double> target_of(GoalVectorMapSynthesizer& goal, Position robot,
-                                    std::vector<protocol::Neighbour> neighbours = {}) {
+                                    std::vector<Neighbour> neighbours = {}) {
   const std::optional<Position> t = goal.target({robot, std::move(neighbours)});
   if (!t) ADD_FAILURE() << "no target from (" << robot.x << ", " << robot.y << ")";
   return t ? std::make_pair(t->x, t->y) : std::make_pair(std::nan(""), std::nan(""));
@@ -227,7 +223,7 @@ TEST(GoalVectorMapSynthesizer, RejectsAContextWithoutAUsableMap) {
   outside.task.goal_vector_map->x1_m = 12.5;  // the world ends at x = 12
   EXPECT_THROW(GoalVectorMapSynthesizer{outside}, InvalidArgument);
   AgentContext no_grid = site_context(1);
-  no_grid.admission.cell_size_m = 0.0;
+  no_grid.assignment.world.cell_size_m = 0.0;
   EXPECT_THROW(GoalVectorMapSynthesizer{no_grid}, InvalidArgument);
   GoalVectorMapSynthesizer goal(site_context(1));
   EXPECT_THROW(goal.target({{std::nan(""), 1.0}, {}}), InvalidArgument);

@@ -14,8 +14,8 @@ namespace {
 // A 5 x 7 world at 0.5 m cells cut in 3-cell tiles: tile rows 0..1 (3 and 2 cells), tile cols 0..2 (3, 3, 1).
 const GridGeometry kWorld{5, 7, 10.0, 20.0, 0.5};
 
-protocol::TerrainTile tile(int tr, int tc, int rows, int cols, double base) {
-  protocol::TerrainTile t;
+TerrainTile tile(int tr, int tc, int rows, int cols, double base) {
+  TerrainTile t;
   t.tile_row = tr;
   t.tile_col = tc;
   t.rows = rows;
@@ -30,8 +30,8 @@ bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; 
 TEST(MappingSystem, TilesLandBitForBitAndTheRestStaysUnknown) {
   MappingSystem map(kWorld, 3);
   EXPECT_EQ(map.known_cells(), 0);
-  const protocol::TerrainTile a = tile(1, 1, 2, 3, 7.0);  // rows 3..4, cols 3..5
-  const protocol::TerrainTile b = tile(0, 2, 3, 1, -2.0);  // rows 0..2, col 6 (cut by the east edge)
+  const TerrainTile a = tile(1, 1, 2, 3, 7.0);  // rows 3..4, cols 3..5
+  const TerrainTile b = tile(0, 2, 3, 1, -2.0);  // rows 0..2, col 6 (cut by the east edge)
   map.integrate_tile(a);
   map.integrate_tile(b);
   EXPECT_EQ(map.known_cells(), 6 + 3);
@@ -64,10 +64,10 @@ TEST(MappingSystem, RejectsTilesThatDoNotFit) {
   EXPECT_THROW(map.integrate_tile(tile(0, -1, 3, 3, 0.0)), InvalidArgument);  // negative
   EXPECT_THROW(map.integrate_tile(tile(1, 0, 3, 3, 0.0)), InvalidArgument);   // last tile row has 2 rows
   EXPECT_THROW(map.integrate_tile(tile(0, 2, 3, 3, 0.0)), InvalidArgument);   // last tile col has 1 col
-  protocol::TerrainTile short_tile = tile(0, 0, 3, 3, 0.0);
+  TerrainTile short_tile = tile(0, 0, 3, 3, 0.0);
   short_tile.heights.pop_back();
   EXPECT_THROW(map.integrate_tile(short_tile), InvalidArgument);
-  protocol::TerrainTile nan_tile = tile(0, 0, 3, 3, 0.0);
+  TerrainTile nan_tile = tile(0, 0, 3, 3, 0.0);
   nan_tile.heights[4] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(map.integrate_tile(nan_tile), InvalidArgument);
   EXPECT_EQ(map.known_cells(), 0);  // nothing of a rejected tile lands
@@ -88,11 +88,7 @@ TEST(MappingSystem, TrajectoryKeepsTheCellsStoodOnOnce) {
   EXPECT_THROW(map.record_pose({9.9, 22.0}), InvalidArgument);
   EXPECT_THROW(map.record_pose({std::nan(""), 22.0}), InvalidArgument);
 
-  protocol::SensorFrame f;
-  f.x_m = 13.25;  // (4, 6)
-  f.y_m = 20.25;
-  f.tiles.push_back(tile(0, 0, 3, 3, 1.0));
-  map.integrate(f);
+  map.integrate({tile(0, 0, 3, 3, 1.0)}, {13.25, 20.25});  // the pose is cell (4, 6)
   EXPECT_EQ(map.trajectory().back(), (CellIndex{4, 6}));
   EXPECT_EQ(map.known_cells(), 9);
 }

@@ -109,7 +109,7 @@ class MiniWorld {
         auto& seen = r.tiles_seen[{tr, tc}];
         if (seen == v) continue;
         seen = v;
-        protocol::TerrainTile t;
+        TerrainTile t;
         t.tile_row = tr;
         t.tile_col = tc;
         t.rows = std::min(tile_size_, g.rows - tr * tile_size_);

@@ -53,7 +53,7 @@ RunInfo info_for(const std::string& name, bool completed) {
   RunInfo info;
   info.scenario = name;
   info.completed = completed;
-  info.end_reason = completed ? "completed" : "max_steps";
+  info.end_reason = completed ? EndReason::kCompleted : EndReason::kMaxSteps;
   return info;
 }
 

@@ -1,0 +1,32 @@
+#include "marsala/world_server/end_reason.hpp"
+
+#include <gtest/gtest.h>
+
+#include "marsala/core/error.hpp"
+
+namespace marsala::world_server {
+namespace {
+
+TEST(EndReason, NamesAreTheDocumentedStringsAndReadBack) {
+  const std::pair<EndReason, const char*> names[] = {{EndReason::kSignal, "signal"},
+                                                     {EndReason::kCompleted, "completed"},
+                                                     {EndReason::kMaxSteps, "max_steps"},
+                                                     {EndReason::kNoLiveAgents, "no_live_agents"}};
+  for (const auto& [reason, name] : names) {
+    EXPECT_EQ(to_string(reason), name);
+    EXPECT_EQ(end_reason_from_string(name), reason);
+  }
+}
+
+TEST(EndReason, AnUnknownNameListsTheValidOnes) {
+  try {
+    end_reason_from_string("finished");
+    FAIL() << "no throw";
+  } catch (const InvalidArgument& e) {
+    EXPECT_STREQ(e.what(), "unknown end reason 'finished'; valid: signal, completed, max_steps, no_live_agents");
+  }
+  EXPECT_EQ(to_string(static_cast<EndReason>(42)), "unknown");
+}
+
+}  // namespace
+}  // namespace marsala::world_server

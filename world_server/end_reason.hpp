@@ -1,0 +1,21 @@
+#pragma once
+// Why a run ended (docs/runtime.md#end-reasons).
+
+#include <string>
+
+namespace marsala::world_server {
+
+/// Why the lockstep stopped; the first that holds at the top of a step wins, in this order.
+enum class EndReason {
+  kSignal,        ///< "signal": SIGINT or SIGTERM (an interrupted step is not applied)
+  kCompleted,     ///< "completed": the scenario's completion holds
+  kMaxSteps,      ///< "max_steps": the step limit was reached
+  kNoLiveAgents,  ///< "no_live_agents": every admitted agent was dropped
+};
+
+/// "signal", "completed", "max_steps", "no_live_agents".
+std::string to_string(EndReason reason);
+/// The reason named `name`; throws InvalidArgument listing the valid names.
+EndReason end_reason_from_string(const std::string& name);
+
+}  // namespace marsala::world_server
