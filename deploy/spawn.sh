@@ -47,6 +47,12 @@ for b in marsala-world marsala-agent; do
   [ -x "$bin/$b" ] || { echo "spawn.sh: $bin/$b not built (run deploy/build.sh)" >&2; exit 1; }
 done
 
+# The scenario is checked as the world would check it before any process starts.
+slots="$("$bin/marsala-world" --check --json "$scenario" | jq '.slots | length')" ||
+  { echo "spawn.sh: scenario '$scenario' is not valid (see above)" >&2; exit 2; }
+[ "$agents" -le "$slots" ] ||
+  { echo "spawn.sh: --agents $agents exceeds the $slots agent slots of '$scenario'" >&2; exit 2; }
+
 # Loopback only: DDS traffic never leaves this host's lo interface.
 export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
 export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-lo.xml"

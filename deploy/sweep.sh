@@ -97,34 +97,15 @@ timeout_s=$((10#$timeout_s)) jobs=$((10#$jobs))
 [ -f "$scenario" ] || die_usage "scenario file '$scenario' not found"
 scenario="$(cd "$(dirname "$scenario")" && pwd)/$(basename "$scenario")"
 
-# Agent slots: the `agent` entries of the scenario (protobuf text format: `agent {`, `agent: {`, `agent <`), counted
-# outside strings and comments; the file's n-th entry is agent id n.
-count_agent_slots() {
-  awk '
-    {
-      line = ""; q = ""
-      for (i = 1; i <= length($0); i++) {
-        ch = substr($0, i, 1)
-        if (q != "") { if (ch == "\\") i++; else if (ch == q) q = ""; continue }
-        if (ch == "\"" || ch == "\047") { q = ch; line = line " "; continue }
-        if (ch == "#") break
-        line = line ch
-      }
-      text = text " " line
-    }
-    END {
-      n = 0
-      while (match(text, /(^|[^A-Za-z0-9_.])agent[ \t]*:?[ \t]*[{<]/)) { n++; text = substr(text, RSTART + RLENGTH) }
-      print n
-    }' "$1"
-}
-slots="$(count_agent_slots "$scenario")"
-[ "$slots" -ge "$max_team" ] ||
-  die_usage "scenario '$scenario' has $slots agent slots, fewer than the largest team ($max_team); use smaller --teams"
-
 for b in marsala-world marsala-agent; do
   [ -x "$bin/$b" ] || die "$bin/$b not built (run deploy/build.sh)"
 done
+
+# Agent slots, as the world reads them (marsala-world --check validates the whole scenario first).
+check_json="$("$bin/marsala-world" --check --json "$scenario")" || die_usage "scenario '$scenario' is not valid (see above)"
+slots="$(jq '.slots | length' <<<"$check_json")"
+[ "$slots" -ge "$max_team" ] ||
+  die_usage "scenario '$scenario' has $slots agent slots, fewer than the largest team ($max_team); use smaller --teams"
 [ -x "$root/deploy/spawn.sh" ] || die "$root/deploy/spawn.sh missing or not executable"
 command -v jq >/dev/null || die "jq is not installed (deploy/install-deps.sh, or apt-get install jq)"
 

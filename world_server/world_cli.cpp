@@ -9,6 +9,7 @@
 #include "marsala/core/error.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
+#include "marsala/world_server/scenario_check.hpp"
 #include "marsala/world_server/world_runtime.hpp"
 
 namespace marsala::world_server {
@@ -25,7 +26,14 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   RuntimeOptions options;
   int domain = 0;
   bool quiet = false;
-  app.add_option("--scenario", scenario_path, "scenario file (protobuf text format)")->required();
+  std::string positional_scenario;
+  bool check = false, json = false;
+  app.add_option("--scenario", scenario_path, "scenario file (protobuf text format)");
+  app.add_option("scenario_file", positional_scenario, "the scenario file, with --check");
+  app.add_flag("--check", check,
+               "validate the scenario as the world would at start (no DDS), print its slots, robot types and "
+               "completion, and exit: 0 valid, 1 not (the error names file, line and field)");
+  app.add_flag("--json", json, "with --check: print one JSON object instead of text");
   app.add_option("--agents", options.agents, "agents to wait for, ids 1..N (default: every slot of the scenario)")
       ->check(CLI::Range(1u, 100000u));
   app.add_option("--dds", dds, "DDS vendor")->check(CLI::IsMember({"cyclone", "fastdds", "inprocess"}))
@@ -42,6 +50,23 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   app.add_flag("--quiet", quiet, "log warnings and errors only");
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-world", out, err)) return *code;
 
+  if (scenario_path.empty()) scenario_path = positional_scenario;
+  if (scenario_path.empty() || (!positional_scenario.empty() && scenario_path != positional_scenario) ||
+      (!check && !positional_scenario.empty()) || (json && !check)) {
+    err << "marsala-world: give the scenario as --scenario FILE, or as --check [--json] FILE (run with --help for "
+           "usage)\n";
+    return cli::kExitUsage;
+  }
+  if (check) {
+    try {
+      const CheckedScenario checked = check_scenario(scenario_path);
+      out << (json ? describe_json(checked) : describe_text(checked));
+      return 0;
+    } catch (const Error& e) {
+      err << "marsala-world: error: " << e.what() << "\n";
+      return 1;
+    }
+  }
   if (seed_option->count() > 0) options.seed = seed;
   spdlog::set_pattern("%H:%M:%S.%e %^%l%$ world: %v");
   spdlog::set_level(quiet ? spdlog::level::warn : spdlog::level::info);
