@@ -34,8 +34,6 @@ CellRect site_rect_or_throw(const Heightmap& terrain, const scenario::Site& site
   return rect;
 }
 
-NavigabilityParams payload_params(const scenario::PayloadPath& p) { return {p.kappa, p.delta_m, p.eps_m}; }
-NavigabilityParams site_params(const scenario::Site& s) { return {s.kappa, s.delta_m, s.eps_m}; }
 
 void check_on_mask(const CellMask& mask, CellIndex c, const char* what) {
   if (c.row < 0 || c.col < 0 || c.row >= mask.rows() || c.col >= mask.cols())
@@ -92,11 +90,11 @@ void start_completion_check(WorldState& state) {
       check.from = cell_of(state.terrain, p.from_x_m, p.from_y_m, "payload_path.from");
       check.to = cell_of(state.terrain, p.to_x_m, p.to_y_m, "payload_path.to");
       check.occupancy =
-          OccupancyCache(state.terrain, {{0, 0}, state.terrain.rows(), state.terrain.cols()}, payload_params(p));
+          OccupancyCache(state.terrain, {{0, 0}, state.terrain.rows(), state.terrain.cols()}, p.navigability);
       break;
     }
     case scenario::CompletionKind::kLevelSite:
-      check.occupancy = OccupancyCache(state.terrain, site_rect_or_throw(state.terrain, state.site), site_params(state.site));
+      check.occupancy = OccupancyCache(state.terrain, site_rect_or_throw(state.terrain, state.site), state.site.navigability);
       break;
   }
   evaluate_completion(state);
@@ -171,13 +169,13 @@ bool connected(const CellMask& passable, CellIndex from, CellIndex to) {
 bool payload_path_navigable(const Heightmap& terrain, const scenario::PayloadPath& path) {
   const CellIndex from = cell_of(terrain, path.from_x_m, path.from_y_m, "payload_path.from");
   const CellIndex to = cell_of(terrain, path.to_x_m, path.to_y_m, "payload_path.to");
-  return connected(NavigabilityProcessor(payload_params(path)).occupiable(terrain), from, to);
+  return connected(NavigabilityProcessor(path.navigability).occupiable(terrain), from, to);
 }
 
 double site_level_fraction(const Heightmap& terrain, const scenario::Site& site) {
   const CellRect rect = site_rect_or_throw(terrain, site);
   const CellMask mask =
-      NavigabilityProcessor(site_params(site)).occupiable(terrain.window(rect.first, rect.rows, rect.cols));
+      NavigabilityProcessor(site.navigability).occupiable(terrain.window(rect.first, rect.rows, rect.cols));
   return static_cast<double>(largest_component(mask)) / static_cast<double>(rect.size());
 }
 
@@ -200,7 +198,7 @@ std::optional<PayloadRoute> shortest_path(const CellMask& passable, CellIndex fr
 std::optional<PayloadRoute> payload_path(const Heightmap& terrain, const scenario::PayloadPath& path) {
   const CellIndex from = cell_of(terrain, path.from_x_m, path.from_y_m, "payload_path.from");
   const CellIndex to = cell_of(terrain, path.to_x_m, path.to_y_m, "payload_path.to");
-  return shortest_path(NavigabilityProcessor(payload_params(path)).occupiable(terrain), from, to,
+  return shortest_path(NavigabilityProcessor(path.navigability).occupiable(terrain), from, to,
                        terrain.cell_size_m());
 }
 

@@ -35,14 +35,14 @@ std::string completion_json(const scenario::Scenario& s) {
       const scenario::PayloadPath& p = s.payload_path;
       return fmt::format(
           R"({{"kind": {}, "kappa": {}, "delta_m": {}, "eps_m": {}, "from_m": [{}, {}], "to_m": [{}, {}]}})", kind,
-          p.kappa, p.delta_m, p.eps_m, p.from_x_m, p.from_y_m, p.to_x_m, p.to_y_m);
+          p.navigability.kappa, p.navigability.delta_m, p.navigability.eps_m, p.from_x_m, p.from_y_m, p.to_x_m, p.to_y_m);
     }
     case scenario::CompletionKind::kLevelSite: {
       const scenario::Site& t = s.site;
       return fmt::format(
           R"({{"kind": {}, "kappa": {}, "delta_m": {}, "eps_m": {}, "x0_m": {}, "y0_m": {}, "x1_m": {}, "y1_m": {}, )"
           R"("min_fraction": {}}})",
-          kind, t.kappa, t.delta_m, t.eps_m, t.x0_m, t.y0_m, t.x1_m, t.y1_m, t.min_fraction);
+          kind, t.navigability.kappa, t.navigability.delta_m, t.navigability.eps_m, t.x0_m, t.y0_m, t.x1_m, t.y1_m, t.min_fraction);
     }
   }
   return fmt::format(R"({{"kind": {}}})", kind);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <random>
 
+#include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 
 namespace marsala::agent::runtime {
@@ -17,14 +18,11 @@ constexpr std::chrono::milliseconds kStopPoll{100};
 }  // namespace
 
 std::string to_string(RunOutcome outcome) {
-  switch (outcome) {
-    case RunOutcome::kRunOver: return "run_over";
-    case RunOutcome::kStopped: return "stopped";
-    case RunOutcome::kRefused: return "refused";
-    case RunOutcome::kAdmitTimeout: return "admit_timeout";
-    case RunOutcome::kWorldTimeout: return "world_timeout";
-  }
-  return "unknown";
+  static constexpr EnumName<RunOutcome> kNames[] = {
+      {RunOutcome::kRunOver, "run_over"},         {RunOutcome::kStopped, "stopped"},
+      {RunOutcome::kRefused, "refused"},          {RunOutcome::kAdmitTimeout, "admit_timeout"},
+      {RunOutcome::kWorldTimeout, "world_timeout"}};
+  return enum_to_string(kNames, outcome);
 }
 
 std::uint64_t random_session() {

@@ -1,24 +1,19 @@
 #include "marsala/bus/bus.hpp"
 
 #include "marsala/bus/detail/backends.hpp"
+#include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 
 namespace marsala::bus {
 
-std::string to_string(Vendor v) {
-  switch (v) {
-    case Vendor::kCyclone: return "cyclone";
-    case Vendor::kFastDds: return "fastdds";
-    case Vendor::kInProcess: return "inprocess";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<Vendor> kVendorNames[] = {
+    {Vendor::kCyclone, "cyclone"}, {Vendor::kFastDds, "fastdds"}, {Vendor::kInProcess, "inprocess"}};
+}  // namespace
 
-Vendor vendor_from_string(const std::string& name) {
-  for (Vendor v : {Vendor::kCyclone, Vendor::kFastDds, Vendor::kInProcess})
-    if (to_string(v) == name) return v;
-  throw InvalidArgument("unknown DDS vendor '" + name + "'; valid: cyclone, fastdds, inprocess");
-}
+std::string to_string(Vendor v) { return enum_to_string(kVendorNames, v); }
+
+Vendor vendor_from_string(const std::string& name) { return enum_from_string(kVendorNames, name, "DDS vendor"); }
 
 void Signal::notify() {
   {

@@ -5,10 +5,14 @@
 #include <cmath>
 #include <cstdio>
 
+#include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 
 namespace marsala {
 namespace {
+
+constexpr EnumName<Heading> kHeadingNames[] = {
+    {Heading::kEast, "east"}, {Heading::kWest, "west"}, {Heading::kNorth, "north"}, {Heading::kSouth, "south"}};
 
 // Lengths computed from user metres (x1 - x0, k * L) carry rounding; comparisons against one cell or the grid's
 // extent forgive this much [m].
@@ -31,21 +35,9 @@ int pieces(double extent, double size) {
 
 }  // namespace
 
-std::string to_string(Heading heading) {
-  switch (heading) {
-    case Heading::kEast: return "east";
-    case Heading::kWest: return "west";
-    case Heading::kNorth: return "north";
-    case Heading::kSouth: return "south";
-  }
-  return "unknown";
-}
+std::string to_string(Heading heading) { return enum_to_string(kHeadingNames, heading); }
 
-Heading heading_from_string(const std::string& name) {
-  for (Heading h : {Heading::kEast, Heading::kWest, Heading::kNorth, Heading::kSouth})
-    if (to_string(h) == name) return h;
-  throw InvalidArgument("unknown heading '" + name + "'; valid: east, west, north, south");
-}
+Heading heading_from_string(const std::string& name) { return enum_from_string(kHeadingNames, name, "heading"); }
 
 GoalVectorMap::GoalVectorMap(const GoalVectorMapSpec& spec, const GridGeometry& grid) : spec_(spec) {
   check_finite("x0_m", spec.x0_m);

@@ -78,7 +78,7 @@ std::string to_string(CompletionKind kind);
 
 /// A payload robot's navigable path from (from_x, from_y) to (to_x, to_y) [m] for kappa, delta, eps.
 struct PayloadPath {
-  double kappa = 0.2, delta_m = 2.0, eps_m = 0.05;
+  NavigabilityParams navigability{0.2, 2.0, 0.05};   ///< the payload's kappa [m/m], delta_m [m], eps_m [m]
   double from_x_m = 0.0, from_y_m = 0.0, to_x_m = 0.0, to_y_m = 0.0;
   std::uint32_t check_every_steps = 10;
 };
@@ -87,7 +87,7 @@ struct PayloadPath {
 /// connected.
 struct Site {
   double x0_m = 0.0, y0_m = 0.0, x1_m = 0.0, y1_m = 0.0;
-  double kappa = 0.1, delta_m = 1.0, eps_m = 0.05;
+  NavigabilityParams navigability{0.1, 1.0, 0.05};   ///< what "level" means: kappa [m/m], delta_m [m], eps_m [m]
   double min_fraction = 1.0;
   std::uint32_t check_every_steps = 10;
 };

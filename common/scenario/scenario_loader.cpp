@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/enum_names.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/core/robot_body.hpp"
 #include "marsala/scenario/scenario.hpp"
@@ -229,10 +230,10 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     const proto::PayloadPath& pp = p.payload_path();
     PayloadPath& path = s.payload_path;
     const RobotBody body = to_body(pp.body());
-    path.kappa = check.positive("payload_path.body.navigability.kappa", body.navigability.kappa);
-    path.delta_m = check.positive("payload_path.body.navigability.delta_m", body.navigability.delta_m);
-    path.eps_m = check.finite("payload_path.body.navigability.eps_m", body.navigability.eps_m);
-    if (path.eps_m < 0.0) check.fail("payload_path.body.navigability.eps_m", "must be >= 0");
+    path.navigability.kappa = check.positive("payload_path.body.kappa", body.navigability.kappa);
+    path.navigability.delta_m = check.positive("payload_path.body.delta_m", body.navigability.delta_m);
+    path.navigability.eps_m = check.finite("payload_path.body.eps_m", body.navigability.eps_m);
+    if (path.navigability.eps_m < 0.0) check.fail("payload_path.body.eps_m", "must be >= 0");
     if (!pp.has_from()) check.fail("payload_path.from", "missing");
     if (!pp.has_to()) check.fail("payload_path.to", "missing");
     path.from_x_m = check.finite("payload_path.from.x_m", pp.from().x_m());
@@ -252,10 +253,10 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     site.y1_m = check.finite("site.y1_m", sp.y1_m());
     if (!(site.x0_m < site.x1_m) || !(site.y0_m < site.y1_m))
       check.fail("site", "the rectangle needs x0_m < x1_m and y0_m < y1_m");
-    if (sp.has_kappa()) site.kappa = check.positive("site.kappa", sp.kappa());
-    if (sp.has_delta_m()) site.delta_m = check.positive("site.delta_m", sp.delta_m());
-    if (sp.has_eps_m()) site.eps_m = check.finite("site.eps_m", sp.eps_m());
-    if (site.eps_m < 0.0) check.fail("site.eps_m", "must be >= 0");
+    if (sp.has_kappa()) site.navigability.kappa = check.positive("site.kappa", sp.kappa());
+    if (sp.has_delta_m()) site.navigability.delta_m = check.positive("site.delta_m", sp.delta_m());
+    if (sp.has_eps_m()) site.navigability.eps_m = check.finite("site.eps_m", sp.eps_m());
+    if (site.navigability.eps_m < 0.0) check.fail("site.eps_m", "must be >= 0");
     if (sp.has_min_fraction()) site.min_fraction = check.finite("site.min_fraction", sp.min_fraction());
     if (!(site.min_fraction > 0.0 && site.min_fraction <= 1.0))
       check.fail("site.min_fraction", fmt::format("{}", site.min_fraction) + " must be in (0, 1]");
@@ -311,12 +312,10 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
 }  // namespace
 
 std::string to_string(CompletionKind kind) {
-  switch (kind) {
-    case CompletionKind::kAgentsAtGoal: return "agents_at_goal";
-    case CompletionKind::kPayloadPath: return "payload_path";
-    case CompletionKind::kLevelSite: return "level_site";
-  }
-  return "unknown";
+  static constexpr EnumName<CompletionKind> kNames[] = {{CompletionKind::kAgentsAtGoal, "agents_at_goal"},
+                                                        {CompletionKind::kPayloadPath, "payload_path"},
+                                                        {CompletionKind::kLevelSite, "level_site"}};
+  return enum_to_string(kNames, kind);
 }
 
 Scenario parse_scenario(const std::string& text, const std::string& source_name) {

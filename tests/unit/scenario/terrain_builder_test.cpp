@@ -178,7 +178,7 @@ TEST(DeployScenarios, EachBuildsItsTerrainAndNeedsConstruction) {
     if (s.completion == CompletionKind::kPayloadPath) {
       ++payload;
       const PayloadPath& p = s.payload_path;
-      const NavigabilityProcessor nav({p.kappa, p.delta_m, p.eps_m});
+      const NavigabilityProcessor nav(p.navigability);
       const CellMask occupiable = nav.occupiable(h);
       const CellIndex from = cell(p.from_x_m, p.from_y_m), to = cell(p.to_x_m, p.to_y_m);
       EXPECT_EQ(occupiable(from.row, from.col), 1) << "the payload cannot stand at its start";
@@ -193,7 +193,7 @@ TEST(DeployScenarios, EachBuildsItsTerrainAndNeedsConstruction) {
       const CellIndex lo = cell(s.site.x0_m + 1e-6, s.site.y1_m - 1e-6), hi = cell(s.site.x1_m - 1e-6, s.site.y0_m + 1e-6);
       const Heightmap site = h.window(lo, hi.row - lo.row + 1, hi.col - lo.col + 1);
       const CellMask occupiable =
-          NavigabilityProcessor({s.site.kappa, s.site.delta_m, s.site.eps_m}).occupiable(site);
+          NavigabilityProcessor(s.site.navigability).occupiable(site);
       EXPECT_LT(occupiable.cast<long long>().sum(), static_cast<long long>(site.rows()) * site.cols())
           << "the site is level already";
     }

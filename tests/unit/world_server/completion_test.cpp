@@ -88,9 +88,7 @@ long long largest_component_brute_force(const CellMask& m) {
 
 scenario::PayloadPath payload(double kappa, double delta, double eps, Position from, Position to) {
   scenario::PayloadPath p;
-  p.kappa = kappa;
-  p.delta_m = delta;
-  p.eps_m = eps;
+  p.navigability = {kappa, delta, eps};
   p.from_x_m = from.x;
   p.from_y_m = from.y;
   p.to_x_m = to.x;
@@ -105,9 +103,7 @@ scenario::Site site(double x0, double y0, double x1, double y1, double kappa = 0
   s.y0_m = y0;
   s.x1_m = x1;
   s.y1_m = y1;
-  s.kappa = kappa;
-  s.delta_m = delta;
-  s.eps_m = eps;
+  s.navigability = {kappa, delta, eps};
   return s;
 }
 
@@ -120,7 +116,7 @@ TEST(PayloadPath, NavigabilityAndShortestPathsMatchBruteForce) {
     const Heightmap h = blocky(rng, rows, cols);
     const Position from{unit(rng) * cols * 0.1, unit(rng) * rows * 0.1}, to{unit(rng) * cols * 0.1, unit(rng) * rows * 0.1};
     const scenario::PayloadPath p = payload(0.3, delta(rng), 0.03, from, to);
-    const NavigabilityParams params{p.kappa, p.delta_m, p.eps_m};
+    const NavigabilityParams params = p.navigability;
     const CellIndex a = *h.cell_at(from), b = *h.cell_at(to);
     const bool navigable = testing::navigable_brute_force(h, params, a)(b.row, b.col) != 0;
     ASSERT_EQ(payload_path_navigable(h, p), navigable) << "trial " << trial;
@@ -270,7 +266,7 @@ TEST(LevelSite, FractionsMatchBruteForce) {
       continue;
     }
     const Heightmap crop = h.window({r0, c0}, r1 - r0 + 1, c1 - c0 + 1);
-    const CellMask occupiable = testing::occupiable_brute_force(crop, {s.kappa, s.delta_m, s.eps_m});
+    const CellMask occupiable = testing::occupiable_brute_force(crop, s.navigability);
     const double expected =
         static_cast<double>(largest_component_brute_force(occupiable)) / static_cast<double>(crop.size());
     EXPECT_DOUBLE_EQ(site_level_fraction(h, s), expected) << "trial " << trial;
