@@ -1,8 +1,8 @@
 #include "marsala/world_server/admission.hpp"
-#include "marsala/core/format.hpp"
 
 #include <cstdio>
 
+#include "marsala/core/format.hpp"
 #include "marsala/core/robot_body.hpp"
 #include "marsala/world_server/completion.hpp"
 

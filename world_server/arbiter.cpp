@@ -1,5 +1,4 @@
 #include "marsala/world_server/arbiter.hpp"
-#include "marsala/core/format.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,6 +6,7 @@
 #include <utility>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/core/iterators.hpp"
 #include "marsala/core/navigability_processor.hpp"
 

@@ -1,5 +1,4 @@
 #include "marsala/world_server/completion.hpp"
-#include "marsala/core/format.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,6 +10,7 @@
 #include <utility>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/core/navigability_processor.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
 #include "marsala/world_server/arbiter.hpp"
@@ -37,9 +37,7 @@ CellRect site_rect_or_throw(const Heightmap& terrain, const scenario::Site& site
 
 void check_on_mask(const CellMask& mask, CellIndex c, const char* what) {
   if (c.row < 0 || c.col < 0 || c.row >= mask.rows() || c.col >= mask.cols())
-    throw InvalidArgument(std::string(what) + " cell (" + std::to_string(c.row) + ", " + std::to_string(c.col) +
-                          ") is off the " + std::to_string(mask.rows()) + " x " + std::to_string(mask.cols()) +
-                          " mask");
+    throw InvalidArgument(fmt::format("{} cell {} is off the {} x {} mask", what, c, mask.rows(), mask.cols()));
 }
 
 }  // namespace

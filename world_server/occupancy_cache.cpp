@@ -6,6 +6,7 @@
 #include <string>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/core/iterators.hpp"
 #include "marsala/core/navigability_processor.hpp"
 
@@ -23,10 +24,8 @@ OccupancyCache::OccupancyCache(const Heightmap& terrain, CellRect area, Navigabi
   const NavigabilityProcessor processor(params);  // throws for invalid parameters
   if (area.empty() || !terrain.contains(area.first) ||
       !terrain.contains({area.first.row + area.rows - 1, area.first.col + area.cols - 1}))
-    throw InvalidArgument("OccupancyCache: area of " + std::to_string(area.rows) + " x " + std::to_string(area.cols) +
-                          " cells at (" + std::to_string(area.first.row) + ", " + std::to_string(area.first.col) +
-                          ") is empty or leaves the " + std::to_string(terrain.rows()) + " x " +
-                          std::to_string(terrain.cols()) + " grid");
+    throw InvalidArgument(fmt::format("OccupancyCache: area of {} x {} cells at {} is empty or leaves the {} x {} grid",
+                                      area.rows, area.cols, area.first, terrain.rows(), terrain.cols()));
   for (const CellIndex& o : disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m())))
     reach_ = std::max({reach_, std::abs(o.row), std::abs(o.col)});
   block_rows_ = (area.rows + kBlockCells - 1) / kBlockCells;

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/render/png_writer.hpp"
 #include "marsala/render/terrain_renderer.hpp"
 #include "marsala/terrain/asc_io.hpp"
@@ -201,10 +202,8 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
   const CellRect area = window ? *window : CellRect{{0, 0}, t.rows(), t.cols()};
   const CellIndex last{area.first.row + area.rows - 1, area.first.col + area.cols - 1};
   if (area.empty() || !t.contains(area.first) || !t.contains(last))
-    throw InvalidArgument("final_picture_options: window of " + std::to_string(area.rows) + " x " +
-                          std::to_string(area.cols) + " cells at (" + std::to_string(area.first.row) + ", " +
-                          std::to_string(area.first.col) + ") leaves the " + std::to_string(t.rows()) + " x " +
-                          std::to_string(t.cols()) + " grid");
+    throw InvalidArgument(fmt::format("final_picture_options: window of {} x {} cells at {} leaves the {} x {} grid",
+                                      area.rows, area.cols, area.first, t.rows(), t.cols()));
   if (state.depositor.rows() == t.rows() && state.depositor.cols() == t.cols()) {
     const render::CellLabels labels =
         state.depositor.block(area.first.row, area.first.col, area.rows, area.cols);

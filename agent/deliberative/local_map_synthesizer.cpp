@@ -6,12 +6,12 @@
 #include <string>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/core/iterators.hpp"
 
 namespace marsala::agent::deliberative {
 namespace {
 
-std::string describe(Position p) { return "(" + std::to_string(p.x) + ", " + std::to_string(p.y) + ") m"; }
 
 int clamp_int(double v, int lo, int hi) {
   if (!(v >= lo)) return lo;  // also catches NaN
@@ -25,7 +25,7 @@ Window sensing_window(const GridGeometry& world, Position robot, double range_m)
   if (!(range_m >= 0.0) || !std::isfinite(range_m))
     throw InvalidArgument("sensing range must be finite and >= 0 m, got " + std::to_string(range_m));
   if (!std::isfinite(robot.x) || !std::isfinite(robot.y) || !world.cell_at(robot))
-    throw InvalidArgument("local map: the robot at " + describe(robot) + " is off the grid");
+    throw InvalidArgument(fmt::format("local map: the robot at {} is off the grid", robot));
   const double cs = world.cell_size_m;
   const int col_lo = clamp_int(std::floor((robot.x - range_m - world.xll_m) / cs), 0, world.cols - 1);
   const int col_hi = clamp_int(std::floor((robot.x + range_m - world.xll_m) / cs), 0, world.cols - 1);
@@ -115,7 +115,7 @@ std::optional<CellIndex> LocalMapSynthesizer::local_origin(const LocalMap& local
 std::pair<CellIndex, bool> LocalMapSynthesizer::local_goal(const LocalMap& local, Position robot, Position target) {
   const GridGeometry& g = local.geometry();
   if (!std::isfinite(target.x) || !std::isfinite(target.y))
-    throw InvalidArgument("local map: the target " + describe(target) + " is not finite");
+    throw InvalidArgument(fmt::format("local map: the target {} is not finite", target));
   if (const auto cell = local.cell_at(target)) return {*cell, true};
 
   // Clip the segment robot -> target to the rectangle of the window's cell centres.

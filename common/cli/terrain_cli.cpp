@@ -13,6 +13,7 @@
 
 #include "marsala/cli/command_line.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/deposition.hpp"
 #include "marsala/core/mars_processor.hpp"
@@ -116,9 +117,7 @@ CellIndex to_cell(const std::pair<int, int>& rc) { return CellIndex{rc.first, rc
 
 void check_origin(const Heightmap& map, CellIndex origin) {
   if (!map.contains(origin))
-    throw InvalidArgument("origin cell (" + std::to_string(origin.row) + ", " + std::to_string(origin.col) +
-                          ") is off the " + std::to_string(map.rows()) + " x " + std::to_string(map.cols()) +
-                          " grid");
+    throw InvalidArgument(fmt::format("origin cell {} is off the {} x {} grid", origin, map.rows(), map.cols()));
 }
 
 }  // namespace

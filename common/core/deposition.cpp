@@ -1,10 +1,10 @@
 #include "marsala/core/deposition.hpp"
-#include "marsala/core/format.hpp"
 
 #include <cmath>
 #include <string>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/core/iterators.hpp"
 
 namespace marsala {

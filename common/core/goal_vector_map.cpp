@@ -1,5 +1,4 @@
 #include "marsala/core/goal_vector_map.hpp"
-#include "marsala/core/format.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,6 +6,7 @@
 
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 
 namespace marsala {
 namespace {

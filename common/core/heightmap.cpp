@@ -1,10 +1,10 @@
 #include "marsala/core/heightmap.hpp"
-#include "marsala/core/format.hpp"
 
 #include <cmath>
 #include <string>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 
 namespace marsala {
 namespace {

@@ -1,5 +1,4 @@
 #include "marsala/core/navigability_processor.hpp"
-#include "marsala/core/format.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -9,6 +8,7 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/detail/navigability_kernel.hpp"
+#include "marsala/core/format.hpp"
 
 namespace marsala {
 namespace {

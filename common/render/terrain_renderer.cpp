@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/render/detail/colormap.hpp"
 #include "marsala/render/detail/raster.hpp"
 
@@ -40,7 +41,6 @@ const std::vector<Rgb> kPalette{{228, 26, 28},  {40, 100, 220},  {60, 170, 60}, 
                                 {150, 70, 170}, {0, 200, 220},   {235, 50, 190}, {170, 230, 40},
                                 {150, 85, 35},  {250, 160, 200}, {0, 120, 120},  {180, 160, 255}};
 
-std::string cell_name(int r, int c) { return "(" + std::to_string(r) + ", " + std::to_string(c) + ")"; }
 std::string size_name(long long r, long long c) { return std::to_string(r) + " x " + std::to_string(c); }
 
 /// How grid cells map to pixels: `factor` x `factor` cells are averaged into one display cell, which is drawn
@@ -123,7 +123,7 @@ void validate(const Heightmap& map, const RenderOptions& o) {
   for (int r = 0; r < map.rows(); ++r)
     for (int c = 0; c < map.cols(); ++c)
       if (!std::isfinite(map(r, c)))
-        throw InvalidArgument("render_terrain: height at cell " + cell_name(r, c) + " is not finite");
+        throw InvalidArgument("render_terrain: height at cell " + fmt::format("{}", CellIndex{r, c}) + " is not finite");
   if (o.max_size_px < 1 || o.max_size_px > kMaxSizePx)
     throw InvalidArgument("render_terrain: max_size_px = " + std::to_string(o.max_size_px) + " is outside [1, " +
                           std::to_string(kMaxSizePx) + "]");
@@ -137,11 +137,11 @@ void validate(const Heightmap& map, const RenderOptions& o) {
     for (int r = 0; r < map.rows(); ++r)
       for (int c = 0; c < map.cols(); ++c)
         if (!std::isfinite((*o.gap)(r, c)))
-          throw InvalidArgument("render_terrain: gap at cell " + cell_name(r, c) + " is not finite");
+          throw InvalidArgument("render_terrain: gap at cell " + fmt::format("{}", CellIndex{r, c}) + " is not finite");
   }
   for (const CellIndex m : o.markers)
     if (!map.contains(m))
-      throw InvalidArgument("render_terrain: marker " + cell_name(m.row, m.col) + " is off the " +
+      throw InvalidArgument("render_terrain: marker " + fmt::format("{}", CellIndex{m.row, m.col}) + " is off the " +
                             size_name(map.rows(), map.cols()) + " grid");
   if (o.labels && (o.labels->rows() != map.rows() || o.labels->cols() != map.cols()))
     throw InvalidArgument("render_terrain: label grid is " + size_name(o.labels->rows(), o.labels->cols()) +

@@ -1,11 +1,11 @@
 #include "marsala/scenario/terrain_builder.hpp"
-#include "marsala/core/format.hpp"
 
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/terrain/asc_io.hpp"
 #include "marsala/terrain/generators.hpp"
 #include "marsala/terrain/geotiff_import.hpp"

@@ -1,6 +1,4 @@
 #include "marsala/terrain/generators.hpp"
-#include "marsala/core/format.hpp"
-#include "marsala/core/registry.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +7,8 @@
 #include <utility>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
+#include "marsala/core/registry.hpp"
 #include "marsala/terrain/detail/det_math.hpp"
 #include "marsala/terrain/detail/noise.hpp"
 #include "marsala/core/random.hpp"
