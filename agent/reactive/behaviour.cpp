@@ -4,6 +4,7 @@
 #include <string>
 
 #include "marsala/agent/reactive/idle_behaviour.hpp"
+#include "marsala/agent/reactive/path_builder.hpp"
 #include "marsala/agent/reactive/ramp_builder.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
@@ -15,11 +16,7 @@ BehaviourRegistry make_behaviour_registry() { return BehaviourRegistry("behaviou
 void register_builtins(BehaviourRegistry& registry) {
   registry.add("idle", [](const AgentContext& c) { return std::make_unique<IdleBehaviour>(c); });
   registry.add("ramp_builder", [](const AgentContext& c) { return std::make_unique<RampBuilder>(c); });
-  registry.add("path_builder", [](const AgentContext& c) {
-    RampBuilderOptions options;
-    options.pipeline = true;
-    return std::make_unique<RampBuilder>(c, options);
-  });
+  registry.add("path_builder", [](const AgentContext& c) { return std::make_unique<PathBuilder>(c); });
 }
 
 std::unique_ptr<Behaviour> make_behaviour(const std::string& name, const AgentContext& context) {

@@ -1,10 +1,14 @@
 #pragma once
-// Helpers for agent unit tests: an agent map that knows a whole terrain, tiles cut from a terrain, bodies.
+// Helpers for agent unit tests: an agent map that knows a whole terrain, tiles cut from a terrain, bodies, and the
+// context, admission and frames a behaviour is driven with.
 
 #include <algorithm>
 #include <cstdint>
 #include <optional>
+#include <utility>
+#include <vector>
 
+#include "marsala/agent/agent_context.hpp"
 #include "marsala/agent/deliberative/local_map_synthesizer.hpp"
 #include "marsala/agent/executive/mapping_system.hpp"
 #include "marsala/protocol/messages.hpp"
@@ -70,6 +74,64 @@ inline deliberative::LocalMap make_local_map(const Heightmap& heights, const Hei
   m.origin = origin;
   m.goal = robot;
   return m;
+}
+
+/// The context of agent `id` (session 77) with `body` and the keep-out of a team of such bodies.
+inline AgentContext agent_context(std::uint32_t id, const RobotBody& body) {
+  AgentContext c;
+  c.agent_id = id;
+  c.session = 77;
+  c.body = body;
+  c.neighbour_keep_out_m = neighbour_keep_out_m(body.navigability.delta_m, body.max_step_m);
+  return c;
+}
+
+/// The world's admission of `c` on `grid` in 16-cell tiles, heading for `target` [m], with its base station at
+/// `base` [m] (radius 0.5 m).
+inline protocol::Admission admission_on(const AgentContext& c, const GridGeometry& grid, Position target,
+                                   Position base) {
+  protocol::Admission a;
+  a.agent_id = c.agent_id;
+  a.session = c.session;
+  a.accepted = true;
+  a.run_id = "test";
+  a.rows = grid.rows;
+  a.cols = grid.cols;
+  a.xll_m = grid.xll_m;
+  a.yll_m = grid.yll_m;
+  a.cell_size_m = grid.cell_size_m;
+  a.tile_size = 16;
+  a.target_x_m = target.x;
+  a.target_y_m = target.y;
+  a.base_x_m = base.x;
+  a.base_y_m = base.y;
+  a.base_radius_m = 0.5;
+  return a;
+}
+
+/// The frame of step `step` for `c` at `pose` [m] with `material_m3` on board, carrying every 16-cell tile of `h`.
+inline protocol::SensorFrame full_frame(const AgentContext& c, std::uint64_t step, Position pose, double material_m3,
+                                   const Heightmap& h) {
+  protocol::SensorFrame f;
+  f.agent_id = c.agent_id;
+  f.step = step;
+  f.x_m = pose.x;
+  f.y_m = pose.y;
+  f.material_m3 = material_m3;
+  for (int tr = 0; tr * 16 < h.rows(); ++tr)
+    for (int tc = 0; tc * 16 < h.cols(); ++tc) f.tiles.push_back(cut_tile(h, 16, tr, tc));
+  return f;
+}
+
+/// `f` with only the tile holding the point `p` [m] of `grid` (16-cell tiles): what a robot that sees no farther
+/// than that tile would have.
+inline protocol::SensorFrame keep_tile_at(protocol::SensorFrame f, const GridGeometry& grid, Position p) {
+  const CellIndex cell = *grid.cell_at(p);
+  std::vector<protocol::TerrainTile> kept;
+  for (auto& t : f.tiles)
+    if (t.tile_row == cell.row / 16 && t.tile_col == cell.col / 16) kept.push_back(std::move(t));
+  f.tiles = std::move(kept);
+  return f;
 }
 
 }  // namespace marsala::agent::test

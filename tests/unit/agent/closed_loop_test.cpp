@@ -1,7 +1,8 @@
 // Closed loop without the world server: ramp builders drive a mini world (tests/unit/agent/mini_world.hpp) on the
 // paper's platform scenario (Fig. 2) at a small size: 12 x 8 m at 0.1 m, a 1.5 m platform on the east side.
 // Every request is checked against the rules of docs/runtime.md#validation before it is applied; the robots must end on the
-// platform top with a navigable way from their start, within a step budget.
+// platform top with a navigable way from their start, within a step budget. Path builders (paper Fig. 4) must lay
+// a way a payload can drive from the base to the platform.
 
 #include <gtest/gtest.h>
 
@@ -11,6 +12,7 @@
 #include <memory>
 #include <vector>
 
+#include "marsala/agent/reactive/path_builder.hpp"
 #include "marsala/agent/reactive/ramp_builder.hpp"
 #include "marsala/core/deposition.hpp"
 #include "marsala/core/mars_processor.hpp"
@@ -20,17 +22,17 @@
 namespace marsala::agent {
 namespace {
 
+using reactive::PathBuilder;
 using reactive::RampBuilder;
-using reactive::RampState;
 
 constexpr double kPlatformX = 8.0;   // west edge of the platform [m]
 constexpr double kPlatformH = 1.5;   // [m]
 
-Heightmap platform_terrain() {
+Heightmap platform_terrain(double height_m = kPlatformH) {
   Heightmap h({80, 120, 0.0, 0.0, 0.1}, 0.0);
   for (int r = 0; r < h.rows(); ++r)
     for (int c = 0; c < h.cols(); ++c)
-      if (h.cell_center({r, c}).x >= kPlatformX) h(r, c) = kPlatformH;
+      if (h.cell_center({r, c}).x >= kPlatformX) h(r, c) = height_m;
   return h;
 }
 
@@ -237,6 +239,59 @@ TEST(ClosedLoop, IsDeterministic) {
   EXPECT_EQ(a.trajectories, b.trajectories);
   EXPECT_TRUE(a.final_terrain.heights() == b.final_terrain.heights());  // bit for bit
   EXPECT_EQ(a.states, b.states);
+}
+
+/// Path builders (the construction pipeline) leave the base until a payload (kappa 0.25, 2 m wide) has a navigable
+/// way from the base to the target on the mini world's terrain, checked every 10 steps as the world server does.
+TEST(ClosedLoop, PathBuildersLayAPathForAPayload) {
+  constexpr double kHeightM = 0.75;
+  const Position base{1.0, 4.0}, target{10.0, 4.0};
+  test::MiniWorld world(platform_terrain(kHeightM), 16, base, 1.0);
+  const Heightmap initial = world.terrain();
+  const RobotBody body = husky(0.3, 0.5);
+  Task task;
+  task.construction_kappa = 0.25;
+  task.construction_width_m = 3.0;
+  task.separation_m = 2.0;
+  const NavigabilityProcessor payload({0.25, 2.0, 0.05});
+  const std::vector<Position> starts{{1.5, 4.0}, {1.0, 3.2}, {0.6, 4.6}};
+  std::vector<std::unique_ptr<PathBuilder>> builders;
+  for (std::uint32_t id = 1; id <= starts.size(); ++id) {
+    AgentContext c;
+    c.agent_id = id;
+    c.session = 2000 + id;
+    c.body = body;
+    c.neighbour_keep_out_m = neighbour_keep_out_m(body.navigability.delta_m, body.max_step_m);
+    c.task = task;
+    builders.push_back(std::make_unique<PathBuilder>(c));
+    builders.back()->on_admission(world.admit(id, c.session, body, starts[id - 1], target));
+  }
+  const CellIndex from = *initial.cell_at(base), to = *initial.cell_at(target);
+  int steps = 0, refills = 0;
+  bool done = false;
+  for (; steps < 2000 && !done; ++steps) {
+    std::vector<protocol::ActionRequest> requests;
+    for (std::uint32_t id = 1; id <= builders.size(); ++id) {
+      requests.push_back(builders[id - 1]->decide(world.frame_for(id)));
+      refills += requests.back().refill ? 1 : 0;
+    }
+    const auto reasons = world.apply_step(requests);
+    for (std::size_t i = 0; i < reasons.size(); ++i)
+      ASSERT_EQ(reasons[i], "") << "step " << steps << ": robot " << i + 1 << " in " << requests[i].state;
+    if (steps % 10 == 9)
+      done = NavigabilityProcessor::navigable_from(payload.occupiable(world.terrain()), from)(
+                 to.row, to.col) == 1;
+  }
+  double deposited_m3 = 0.0;
+  for (const auto& [id, r] : world.robots()) deposited_m3 += r.deposited_m3;
+  std::printf("[closed loop] path builders, 3 robots, %.2f m platform: payload path after %d steps | deposited "
+              "%.3f m^3 | refills %d\n",
+              kHeightM, steps, deposited_m3, refills);
+  EXPECT_TRUE(done) << "no navigable way for the payload after " << steps << " steps";
+  EXPECT_GE(refills, 1);
+  // The builders only fill the MARS gap at the construction kappa.
+  const Heightmap bound = MarsProcessor(0.25).project(initial);
+  EXPECT_LE((world.terrain().heights() - bound.heights()).maxCoeff(), 1e-9);
 }
 
 }  // namespace

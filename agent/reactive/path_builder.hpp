@@ -1,0 +1,105 @@
+#pragma once
+// "path_builder": the ramp builder's steps (ramp_steps.hpp) inside the construction pipeline (paper §V-A, Fig. 4;
+// pipeline.hpp). It builds for the task's construction parameters (e.g. a payload's kappa over a band wide enough
+// for it and two lanes); the front robot of the pipeline alone deposits, the others follow it at the task's
+// separation, and every robot goes back to the base to refill whenever it cannot make a deposition task or has
+// reached the target.
+//
+// States and transitions (checked in this order on every frame):
+//   any            --run_over frame---------------------------------------------------------------> kDone
+//   kWaitAdmission --on_admission()---------------------------------------------------------------> kSurvey
+//   kSurvey        --first frame: the map is built, then as kAdvance on the same frame
+//   any but kReturnToBase --material below one deposition threshold (not enough for a deposition task), or the
+//                    robot on the local goal's cell (the path is there: go back, refill, come again) -> kReturnToBase
+//   kReturnToBase  --retrace the trajectory through navigable cells; at the base: refill--------------> kAdvance
+//   otherwise, by the pipeline role of this frame:
+//     kActive  -> the ramp builder's building steps: from kRetreat its retreat step, else its build step
+//                 (-> kAdvance / kBuild / kRetreat); no deposition path through known cells: the state stays
+//     kFollow  -> advance along the deposition path through navigable cells without depositing ------> kFollow
+//                 no motion, or it would end closer than the separation to the front neighbour -----> kHold
+//     kHold    -> stand still ---------------------------------------------------------------------> kHold
+//     kBackOff -> step back the way it came, if that takes it away from the front neighbour --------> kBackOff
+// After a refill the robot is in kAdvance; its next frame's role decides whether it builds or follows.
+// Lanes: the band is wide enough for two, but robots do not yet keep to one side (lane_offset_m is not used yet);
+// the world does not model collisions between robots, so a returning robot passes a follower on the same line.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "marsala/agent/agent_context.hpp"
+#include "marsala/core/navigable_path_planner.hpp"
+#include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/agent/reactive/behaviour.hpp"
+#include "marsala/agent/reactive/pipeline.hpp"
+#include "marsala/agent/reactive/ramp_steps.hpp"
+
+namespace marsala::agent::reactive {
+
+/// States of the path builder.
+enum class PathState : std::uint8_t {
+  kWaitAdmission = 0,
+  kSurvey = 1,
+  kAdvance = 2,
+  kBuild = 3,
+  kRetreat = 4,
+  kReturnToBase = 5,
+  kFollow = 6,
+  kHold = 7,
+  kBackOff = 8,
+  kDone = 9,
+};
+/// "wait_admission", "survey", "advance", "build", "retreat", "return_to_base", "follow", "hold", "back_off",
+/// "done".
+std::string to_string(PathState state);
+/// The inverse of to_string; throws InvalidArgument listing the valid names.
+PathState path_state_from_string(const std::string& name);
+
+/// Options of the path builder. The goal synthesizer is the context's task.goal_synthesizer; what it builds (MARS
+/// kappa, band width) is construction_params(context); the pipeline's separation is task.separation_m.
+struct PathBuilderOptions {
+  std::optional<PlannerParams> planner;  ///< default: default_planner_params for the construction width
+};
+
+/// What the last decision saw and chose (for tests, logs and measurements).
+struct PathBuilderTrace : BuildTrace {
+  PathState before = PathState::kWaitAdmission;
+  PathState after = PathState::kWaitAdmission;
+  std::optional<PipelineRole> role;  ///< the pipeline role of this frame, when it was asked for
+};
+
+/// The pipeline's distances for a task: separation_m = task.separation_m, back_off_margin_m a quarter of it,
+/// return_detect_m three quarters of it [m].
+PipelineParams pipeline_params(const Task& task);
+
+/// Builds a navigable path in the construction pipeline; see the transition table above.
+class PathBuilder final : public Behaviour {
+ public:
+  /// Throws InvalidArgument for an unknown goal synthesizer, an invalid body, construction or separation.
+  explicit PathBuilder(const AgentContext& context, PathBuilderOptions options = {});
+
+  std::string name() const override { return "path_builder"; }
+  std::string state_name() const override { return to_string(state_); }
+  void on_admission(const protocol::Admission& admission) override;
+  protocol::ActionRequest decide(const protocol::SensorFrame& frame) override;
+
+  PathState state() const { return state_; }
+  const PathBuilderTrace& last_trace() const { return trace_; }
+  /// The pipeline tracker (neighbours seen in the last frame).
+  const PipelineTracker& pipeline() const { return pipeline_; }
+  /// The agent's own map; throws InvalidArgument before admission.
+  const executive::MappingSystem& map() const;
+
+ private:
+  void pipeline_step(const BuildView& view, const protocol::SensorFrame& frame, protocol::ActionRequest& request);
+  void follow_step(const BuildView& view, Position front, protocol::ActionRequest& request);
+  void back_off_step(const BuildView& view, Position front, protocol::ActionRequest& request);
+
+  RampSteps steps_;
+  PipelineTracker pipeline_;
+  double return_below_m3_ = 0.0;  // less material than this (one deposition task) on board: back to the base [m^3]
+  PathState state_ = PathState::kWaitAdmission;
+  PathBuilderTrace trace_;
+};
+
+}  // namespace marsala::agent::reactive

@@ -1,0 +1,251 @@
+#include "marsala/agent/reactive/ramp_steps.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "marsala/agent/reactive/behaviour.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/core/navigability_processor.hpp"
+
+namespace marsala::agent::reactive {
+namespace {
+
+/// Kept inside the world's base radius so a refill is never rejected on a tie [m].
+constexpr double kBaseMarginM = 1e-6;
+
+double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+executive::Neighbourhood neighbourhood(const protocol::SensorFrame& frame) {
+  return {frame.agent_id, {frame.x_m, frame.y_m}, frame.neighbours};
+}
+
+/// The navigable cell of the window whose centre has the smallest score, if that is below `bound` (row-major order:
+/// ties to the first).
+template <typename Score>
+std::optional<CellIndex> best_navigable_cell(const deliberative::LocalMap& local, double bound, Score score) {
+  std::optional<CellIndex> best;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      if (local.navigable(r, c) == 0) continue;
+      const double s = score(local.center({r, c}));
+      if (s < bound) bound = s, best = CellIndex{r, c};
+    }
+  return best;
+}
+
+}  // namespace
+
+std::string to_string(BuildPhase phase) {
+  switch (phase) {
+    case BuildPhase::kAdvance: return "advance";
+    case BuildPhase::kBuild: return "build";
+    case BuildPhase::kRetreat: return "retreat";
+  }
+  return "unknown";
+}
+
+struct RampSteps::Modules {
+  executive::MappingSystem map;
+  deliberative::LocalMapSynthesizer synthesizer;
+  NavigablePathPlanner planner;  // deposition paths (eq. 4-5)
+  NavigablePathPlanner router;   // shortest routes through navigable cells (alpha = 0)
+  executive::ActionManager actions;
+  executive::DepositionManager depositions;
+  int max_idle_retreat_moves;                  // retreat moves without work before trying to advance again
+};
+
+RampSteps::RampSteps(const AgentContext& context, std::optional<PlannerParams> planner)
+    : context_(context),
+      planner_(std::move(planner)) {
+  // Fail on an invalid body, construction or goal synthesizer name now rather than at admission.
+  (void)NavigabilityProcessor(context_.body.navigability);
+  (void)NavigabilityProcessor(construction_params(context_));
+  deliberative::require_goal_synthesizer(context_.task.goal_synthesizer);
+}
+
+RampSteps::~RampSteps() = default;
+
+const executive::MappingSystem& RampSteps::map() const {
+  if (!modules_) throw InvalidArgument("ramp steps: no map before admission");
+  return modules_->map;
+}
+
+void RampSteps::admit(const protocol::Admission& admission) {
+  context_.assignment = assignment_from(context_, admission);
+  const GridGeometry world = context_.assignment.world;
+  const RobotBody& body = context_.body;
+  const NavigabilityParams build = construction_params(context_);
+  PlannerParams planner = planner_ ? *planner_ : default_planner_params(build.delta_m, world.cell_size_m);
+  PlannerParams router = planner;
+  router.alpha = 0.0;
+  router.beta = 1.0;
+  modules_ = std::make_unique<Modules>(Modules{
+      executive::MappingSystem(world, context_.assignment.tile_size),
+      deliberative::LocalMapSynthesizer(body.navigability, body.sensing_range_m, build.kappa),
+      NavigablePathPlanner(planner), NavigablePathPlanner(router),
+      executive::ActionManager(body.max_step_m),
+      executive::DepositionManager(
+          executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m, build.delta_m)),
+      static_cast<int>(std::ceil((body.reach_m + body.navigability.delta_m) / body.max_step_m)) + 1});
+  goal_ = deliberative::make_goal_synthesizer(context_.task.goal_synthesizer, context_);
+}
+
+BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace) {
+  modules_->map.integrate(frame.tiles, {frame.x_m, frame.y_m});
+  const Position robot{frame.x_m, frame.y_m};
+  const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
+  const Position target = goal.value_or(robot);  // nothing left to build towards: stay
+  BuildView view{modules_->synthesizer.synthesize(modules_->map, robot, target), robot, target};
+  trace.window_offset = view.local.offset;
+  trace.local_goal = view.local.goal;
+  trace.local_origin = view.local.origin;
+  trace.navigable_cells = view.local.navigable.cast<long long>().sum();
+  return view;
+}
+
+bool RampSteps::plan_path(const deliberative::LocalMap& local, BuildTrace& trace) {
+  if (!trace.planned) {
+    trace.plan = modules_->planner.plan(local.gap, local.known, local.robot, local.goal);
+    trace.planned = true;
+  }
+  return trace.plan.found;
+}
+
+std::optional<executive::Motion> RampSteps::advance(const deliberative::LocalMap& local,
+                                                    const std::vector<CellIndex>& path, Position robot) const {
+  return modules_->actions.advance(local, path, robot);
+}
+
+void RampSteps::move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) const {
+  trace.motion = motion;
+  request.move = true;
+  request.target_x_m = motion.target.x;
+  request.target_y_m = motion.target.y;
+}
+
+void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position at,
+                        std::size_t from, BuildTrace& trace, protocol::ActionRequest& request) const {
+  // The path from where the robot will stand: the cells it leaves behind are its way back, not work.
+  const auto& path = trace.plan.path;
+  const std::vector<CellIndex> ahead(path.begin() + static_cast<std::ptrdiff_t>(std::min(from, path.size())),
+                                     path.end());
+  trace.deposition = modules_->depositions.plan(local, ahead, at, frame.material_m3, neighbourhood(frame));
+  request.depositions = trace.deposition.depositions;
+}
+
+std::optional<BuildPhase> RampSteps::build_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,
+                                                BuildTrace& trace, protocol::ActionRequest& request) {
+  const Position robot{frame.x_m, frame.y_m};
+  if (!plan_path(local, trace)) return std::nullopt;  // no path through known cells: wait for the map to grow
+  if (const auto motion = advance(local, trace.plan.path, robot)) {
+    move(*motion, trace, request);
+    deposit(local, frame, motion->target, motion->path_index, trace, request);
+    return BuildPhase::kAdvance;
+  }
+  deposit(local, frame, robot, 0, trace, request);
+  if (!request.depositions.empty()) return BuildPhase::kBuild;
+  deposited_since_blocked_ = false;
+  idle_retreat_moves_ = 0;
+  return retreat_step(local, frame, trace, request);
+}
+
+BuildPhase RampSteps::retreat_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,
+                                   BuildTrace& trace, protocol::ActionRequest& request) {
+  const Position robot{frame.x_m, frame.y_m};
+  if (!plan_path(local, trace)) {
+    ++idle_retreat_moves_;
+    return BuildPhase::kRetreat;
+  }
+  const auto& path = trace.plan.path;
+  deposit(local, frame, robot, 0, trace, request);
+  if (!request.depositions.empty()) {
+    deposited_since_blocked_ = true;
+    idle_retreat_moves_ = 0;
+    return BuildPhase::kRetreat;
+  }
+  // Advance again only once something changed (or after a long idle retreat): advancing onto the cell just left
+  // without building would only block again.
+  if (deposited_since_blocked_ || idle_retreat_moves_ >= modules_->max_idle_retreat_moves) {
+    if (const auto motion = advance(local, path, robot)) {
+      move(*motion, trace, request);
+      deposit(local, frame, motion->target, motion->path_index, trace, request);
+      return BuildPhase::kAdvance;
+    }
+    deposited_since_blocked_ = false;
+  }
+  // Step back the way the robot came and fill what comes into reach: the gap where it stood.
+  ++idle_retreat_moves_;
+  const auto motion = step_back(local, robot);
+  if (!motion) return BuildPhase::kRetreat;
+  move(*motion, trace, request);
+  deposit(local, frame, motion->target, 0, trace, request);
+  if (!request.depositions.empty()) {
+    deposited_since_blocked_ = true;
+    idle_retreat_moves_ = 0;
+  }
+  return BuildPhase::kRetreat;
+}
+
+std::optional<executive::Motion> RampSteps::step_back(const deliberative::LocalMap& local, Position robot) const {
+  std::optional<CellIndex> anchor;
+  if (local.origin && *local.origin != local.robot) anchor = local.origin;
+  if (!anchor) anchor = oldest_navigable_trajectory_cell(local);
+  if (!anchor) anchor = farthest_navigable_from_goal(local);
+  if (!anchor) return std::nullopt;
+  const auto route = modules_->router.plan(local.gap, local.navigable, local.robot, *anchor);
+  if (!route.found) return std::nullopt;
+  return advance(local, route.path, robot);
+}
+
+std::optional<CellIndex> RampSteps::farthest_navigable_from_goal(const deliberative::LocalMap& local) {
+  const Position goal = local.center(local.goal);
+  return best_navigable_cell(local, -distance(local.center(local.robot), goal),
+                             [&](Position p) { return -distance(p, goal); });
+}
+
+std::optional<CellIndex> RampSteps::oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const {
+  for (const CellIndex global : modules_->map.trajectory()) {
+    const CellIndex p = local.to_local(global);
+    if (local.contains(p) && p != local.robot && local.navigable(p.row, p.col) != 0) return p;
+  }
+  return std::nullopt;
+}
+
+bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, BuildTrace& trace,
+                            protocol::ActionRequest& request) {
+  const Position robot{frame.x_m, frame.y_m};
+  const Position base = context_.assignment.base;
+  const double radius = context_.assignment.base_radius_m - kBaseMarginM;
+  if (distance(robot, base) <= radius) {
+    request.refill = trace.refill = true;
+    return true;
+  }
+  // Where to go: the navigable cell within the base radius nearest the robot; else the navigable cell nearest the
+  // base when that is nearer than the robot by at least a cell; else the oldest navigable cell of the trajectory in
+  // the window (the way the robot came from the base).
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  std::optional<CellIndex> goal = best_navigable_cell(local, kNone, [&](Position p) {
+    return distance(p, base) <= radius ? distance(p, robot) : kNone;
+  });
+  if (!goal)
+    goal = best_navigable_cell(local, distance(robot, base) - local.geometry().cell_size_m,
+                               [&](Position p) { return distance(p, base); });
+  if (!goal) goal = oldest_navigable_trajectory_cell(local);
+  if (!goal) return false;
+  trace.plan = modules_->router.plan(local.gap, local.navigable, local.robot, *goal);
+  trace.planned = true;
+  if (!trace.plan.found) return false;
+  if (const auto motion = advance(local, trace.plan.path, robot)) {
+    move(*motion, trace, request);
+    if (distance(motion->target, base) <= radius) {
+      request.refill = trace.refill = true;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace marsala::agent::reactive

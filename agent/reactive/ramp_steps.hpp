@@ -1,0 +1,125 @@
+#pragma once
+// The ramp builder's steps (paper §IV, Fig. 2), shared by the "ramp_builder" and "path_builder" behaviours: each
+// behaviour keeps its own state machine and calls these steps with the deliberative and executive modules of paper
+// Fig. 1 that RampSteps owns.
+//
+// Each frame a behaviour first calls look(): the mapping system takes the frame's tiles, the goal synthesizer gives
+// the target and the local map synthesizer builds the augmented local map. Then, by its state, one of:
+//   build_step()   plan a deposition path to the local goal (once per frame); a motion along it is possible -> move
+//                  and deposit ahead (kAdvance); blocked, but depositions within reach -> deposit in place (kBuild);
+//                  blocked and nothing to deposit (the gap left is under the robot) -> retreat_step() (kRetreat)
+//   retreat_step() depositions within reach -> deposit in place (kRetreat); after depositing (or after many idle
+//                  retreat moves) and a motion along the path is possible -> move and deposit ahead (kAdvance); else
+//                  step back the way the robot came and fill what comes into reach (kRetreat)
+//   return_step()  retrace the way to the base through navigable cells; at the base: refill (true)
+// Building thus runs from the top of the ramp down to its toe (the robot backs off to fill where it stood), then the
+// robot climbs, filling ahead of itself. The steps fill the request and the trace; which state follows is the
+// behaviour's.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "marsala/agent/agent_context.hpp"
+#include "marsala/agent/deliberative/goal_synthesizer.hpp"
+#include "marsala/agent/deliberative/local_map_synthesizer.hpp"
+#include "marsala/core/navigable_path_planner.hpp"
+#include "marsala/agent/executive/action_manager.hpp"
+#include "marsala/agent/executive/deposition_manager.hpp"
+#include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/protocol/messages.hpp"
+
+namespace marsala::agent::reactive {
+
+/// What the building steps did: the robot moved along the path, deposited in place, or is backing off.
+enum class BuildPhase : std::uint8_t { kAdvance = 0, kBuild = 1, kRetreat = 2 };
+/// "advance", "build", "retreat".
+std::string to_string(BuildPhase phase);
+
+/// What the steps of one frame saw and chose (for tests, logs and measurements). Reset it at the start of every
+/// frame: it also holds the frame's deposition path, planned at most once per frame.
+struct BuildTrace {
+  CellIndex window_offset;                  ///< world index of the local map's top-left cell
+  CellIndex local_goal;                     ///< local index
+  std::optional<CellIndex> local_origin;    ///< local index
+  long long navigable_cells = 0;            ///< cells navigable from the robot in the local map [count]
+  bool planned = false;                     ///< a path was planned this frame (plan holds it)
+  PlannerResult plan;         ///< path in local indices
+  std::optional<executive::Motion> motion;  ///< local indices
+  executive::DepositionPlan deposition;
+  bool refill = false;
+};
+
+/// What the robot sees in one frame: the augmented local map around it and its target.
+struct BuildView {
+  deliberative::LocalMap local;
+  Position robot;   ///< the frame's position [m]
+  Position target;  ///< the goal synthesizer's target, or the robot's position when nothing is left to build [m]
+};
+
+/// The modules of one building robot and the steps that use them; see the header.
+class RampSteps {
+ public:
+  /// Throws InvalidArgument for an unknown goal synthesizer, an invalid body or construction. `planner` defaults to
+  /// default_planner_params for the construction width.
+  explicit RampSteps(const AgentContext& context, std::optional<PlannerParams> planner = std::nullopt);
+  ~RampSteps();
+
+  /// The agent's context (with its admission once admitted).
+  const AgentContext& context() const { return context_; }
+  /// Checks the admission against the context and makes the modules for its grid; throws InvalidArgument when the
+  /// admission is for another agent or session, or its grid is invalid.
+  void admit(const protocol::Admission& admission);
+  /// True once admitted.
+  bool admitted() const { return modules_ != nullptr; }
+  /// The agent's own map; throws InvalidArgument before admission.
+  const executive::MappingSystem& map() const;
+
+  /// Integrates the frame into the map, asks the goal synthesizer for the target and synthesizes the local map;
+  /// records the window in `trace`. Only after admission.
+  BuildView look(const protocol::SensorFrame& frame, BuildTrace& trace);
+
+  /// Plans the deposition path from the robot to the local goal into trace.plan, unless this frame planned one;
+  /// true when one was found.
+  bool plan_path(const deliberative::LocalMap& local, BuildTrace& trace);
+  /// The action manager's motion along `path` (local indices) from `robot` [m], or nullopt when no progress is
+  /// possible.
+  std::optional<executive::Motion> advance(const deliberative::LocalMap& local, const std::vector<CellIndex>& path,
+                                           Position robot) const;
+  /// Requests `motion` and records it.
+  void move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) const;
+  /// A step back the way the robot came: towards the local origin, or the oldest navigable cell of the trajectory in
+  /// the window when the robot stands on the origin, or (it has not moved yet) to the navigable cell farthest from
+  /// the local goal; nullopt when there is none or no route to it.
+  std::optional<executive::Motion> step_back(const deliberative::LocalMap& local, Position robot) const;
+
+  /// Advance, build or start retreating (see the header); nullopt, with nothing requested, when no deposition path
+  /// leads through known cells (the behaviour's state stays: wait for the map to grow).
+  std::optional<BuildPhase> build_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,
+                                       BuildTrace& trace, protocol::ActionRequest& request);
+  /// One step of a retreat (see the header): kRetreat, or kAdvance once the robot moves up the path again.
+  BuildPhase retreat_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, BuildTrace& trace,
+                          protocol::ActionRequest& request);
+  /// One step towards the base station through navigable cells; true when the request refills (the robot is within
+  /// the base radius now or after this motion).
+  bool return_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, BuildTrace& trace,
+                   protocol::ActionRequest& request);
+
+ private:
+  struct Modules;
+  void deposit(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position at, std::size_t from,
+               BuildTrace& trace, protocol::ActionRequest& request) const;
+  std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
+  static std::optional<CellIndex> farthest_navigable_from_goal(const deliberative::LocalMap& local);
+
+  AgentContext context_;
+  std::optional<PlannerParams> planner_;
+  std::unique_ptr<deliberative::GoalSynthesizer> goal_;
+  std::unique_ptr<Modules> modules_;  // made on admission, when the grid is known
+  bool deposited_since_blocked_ = false;
+  int idle_retreat_moves_ = 0;
+};
+
+}  // namespace marsala::agent::reactive

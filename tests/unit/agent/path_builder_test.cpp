@@ -1,0 +1,360 @@
+// The path builder (agent/reactive/path_builder.hpp): every state and transition of its state machine, on a flat
+// 6 x 10 m world with a platform, frame by frame (the pipeline role set by the neighbours in the frame) and closed
+// loop with the mini world.
+
+#include "marsala/agent/reactive/path_builder.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "agent_test_support.hpp"
+#include "marsala/core/error.hpp"
+#include "mini_world.hpp"
+
+namespace marsala::agent::reactive {
+namespace {
+
+// A flat 6 x 10 m world at 0.1 m cells with a 1.5 m platform from x = 7 m eastwards.
+Heightmap world_terrain() {
+  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
+  for (int r = 0; r < h.rows(); ++r)
+    for (int c = 70; c < h.cols(); ++c) h(r, c) = 1.5;
+  return h;
+}
+
+/// A path builder's context: the Husky body, building for its own kappa (0.5) and width, 2 m separation.
+AgentContext context(std::uint32_t id = 3, RobotBody body = test::husky()) {
+  AgentContext c = test::agent_context(id, body);
+  c.task.separation_m = 2.0;
+  return c;
+}
+
+protocol::Admission admission(const AgentContext& c, Position target, Position base = {0.55, 3.05}) {
+  return test::admission_on(c, world_terrain().geometry(), target, base);
+}
+
+/// A frame at `pose` carrying every tile of the world, with `neighbours`.
+protocol::SensorFrame frame(const AgentContext& c, std::uint64_t step, Position pose, double material_m3,
+                       std::vector<protocol::Neighbour> neighbours = {}) {
+  protocol::SensorFrame f = test::full_frame(c, step, pose, material_m3, world_terrain());
+  f.neighbours = std::move(neighbours);
+  return f;
+}
+
+double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+// The target lies on the platform, due east of the robots; a robot at x = 5.05 m has the gap at the platform's foot
+// (x > 4 m at kappa 0.5) within its 1.5 m reach.
+constexpr Position kTarget{8.55, 3.05};
+constexpr Position kAtFoot{5.05, 3.05};
+
+TEST(PathState, NamesRoundTrip) {
+  const std::vector<std::pair<PathState, std::string>> names{
+      {PathState::kWaitAdmission, "wait_admission"}, {PathState::kSurvey, "survey"},
+      {PathState::kAdvance, "advance"},              {PathState::kBuild, "build"},
+      {PathState::kRetreat, "retreat"},              {PathState::kReturnToBase, "return_to_base"},
+      {PathState::kFollow, "follow"},                {PathState::kHold, "hold"},
+      {PathState::kBackOff, "back_off"},             {PathState::kDone, "done"}};
+  for (const auto& [state, name] : names) {
+    EXPECT_EQ(to_string(state), name);
+    EXPECT_EQ(path_state_from_string(name), state);
+  }
+  try {
+    path_state_from_string("at_goal");  // the ramp builder's: at the target a path builder goes back to the base
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown path builder state 'at_goal'; valid: wait_admission, survey, "
+                                         "advance, build, retreat, return_to_base, follow, hold, back_off, done"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(PathBuilder, PipelineParamsFollowTheSeparation) {
+  Task task;
+  task.separation_m = 4.0;
+  const PipelineParams p = pipeline_params(task);
+  EXPECT_EQ(p.separation_m, 4.0);
+  EXPECT_EQ(p.back_off_margin_m, 1.0);
+  EXPECT_EQ(p.return_detect_m, 3.0);
+  EXPECT_EQ(PathBuilder(context()).pipeline().params().separation_m, 2.0);
+}
+
+TEST(PathBuilder, AdmissionIsCheckedAndFramesBeforeItAreRefused) {
+  const AgentContext c = context();
+  PathBuilder pb(c);
+  EXPECT_EQ(pb.state(), PathState::kWaitAdmission);
+  EXPECT_THROW(pb.decide(frame(c, 0, {1.05, 3.05}, 1.0)), InvalidArgument);
+  EXPECT_THROW(pb.map(), InvalidArgument);
+  protocol::Admission other = admission(c, kTarget);
+  other.agent_id = 4;
+  EXPECT_THROW(pb.on_admission(other), InvalidArgument);
+  other = admission(c, kTarget);
+  other.cell_size_m = 0.0;
+  EXPECT_THROW(pb.on_admission(other), InvalidArgument);
+  EXPECT_EQ(pb.state(), PathState::kWaitAdmission);
+  pb.on_admission(admission(c, kTarget));
+  EXPECT_EQ(pb.state(), PathState::kSurvey);
+  EXPECT_EQ(pb.state_name(), "survey");
+  protocol::SensorFrame stranger = frame(c, 0, {1.05, 3.05}, 1.0);
+  stranger.agent_id = 9;
+  EXPECT_THROW(pb.decide(stranger), InvalidArgument);
+}
+
+TEST(PathBuilder, AloneItIsTheActiveRobotSurveysThenAdvances) {
+  const AgentContext c = context();
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, kTarget));
+  const protocol::ActionRequest q = pb.decide(frame(c, 5, {1.05, 3.05}, 1.0));
+  EXPECT_EQ(pb.last_trace().before, PathState::kSurvey);
+  EXPECT_EQ(pb.last_trace().role, PipelineRole::kActive);
+  EXPECT_EQ(pb.state(), PathState::kAdvance);
+  EXPECT_EQ(q.state, "advance");
+  EXPECT_EQ(q.step, 5u);
+  ASSERT_TRUE(q.move);
+  EXPECT_NEAR(q.target_x_m, 1.25, 1e-12);
+  EXPECT_NEAR(q.target_y_m, 3.05, 1e-12);
+  EXPECT_TRUE(q.depositions.empty());  // the gap is out of reach
+  EXPECT_EQ(pb.map().known_cells(), 6000);
+}
+
+TEST(PathBuilder, ActiveAtTheFootOfThePlatformItDeposits) {
+  const AgentContext c = context();
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, kTarget));
+  const protocol::ActionRequest q = pb.decide(frame(c, 0, kAtFoot, 1.0));
+  EXPECT_EQ(pb.last_trace().role, PipelineRole::kActive);
+  EXPECT_EQ(pb.state(), PathState::kAdvance);
+  EXPECT_TRUE(q.move);
+  EXPECT_FALSE(q.depositions.empty());
+}
+
+TEST(PathBuilder, FollowsAFrontNeighbourBeyondTheSeparationWithoutDepositing) {
+  const AgentContext c = context();
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, kTarget));
+  const protocol::Neighbour front = test::neighbour_at(5, 7.65, 3.05);  // 2.6 m ahead, on the platform
+  const protocol::ActionRequest q = pb.decide(frame(c, 0, kAtFoot, 1.0, {front}));
+  EXPECT_EQ(pb.last_trace().role, PipelineRole::kFollow);
+  EXPECT_EQ(pb.state(), PathState::kFollow);
+  EXPECT_EQ(q.state, "follow");
+  ASSERT_TRUE(q.move);
+  EXPECT_GT(q.target_x_m, kAtFoot.x);  // along the path to the target
+  EXPECT_GE(distance({q.target_x_m, q.target_y_m}, {front.x_m, front.y_m}), 2.0);
+  EXPECT_TRUE(q.depositions.empty());  // the gap within reach is the front robot's work
+  EXPECT_FALSE(q.refill);
+}
+
+TEST(PathBuilder, HoldsWhenFollowingWouldComeWithinTheSeparation) {
+  const AgentContext c = context();
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, kTarget));
+  // 2.05 m ahead: a follower, but its step east along the path would leave less than 2 m.
+  const protocol::ActionRequest q = pb.decide(frame(c, 0, kAtFoot, 1.0, {test::neighbour_at(5, 7.1, 3.05)}));
+  EXPECT_EQ(pb.last_trace().role, PipelineRole::kFollow);
+  EXPECT_EQ(pb.last_trace().before, PathState::kSurvey);
+  EXPECT_EQ(pb.state(), PathState::kHold);
+  EXPECT_FALSE(q.move);
+  EXPECT_TRUE(q.depositions.empty());
+}
+
+TEST(PathBuilder, HoldsWithinTheSeparationAndFollowsAgainOnceTheFrontMovesOn) {
+  const AgentContext c = context();
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, kTarget));
+  protocol::ActionRequest q = pb.decide(frame(c, 0, kAtFoot, 1.0, {test::neighbour_at(5, 6.9, 3.05)}));  // 1.85 m
+  EXPECT_EQ(pb.last_trace().role, PipelineRole::kHold);
+  EXPECT_EQ(pb.state(), PathState::kHold);
+  EXPECT_FALSE(pb.last_trace().planned);  // standing still needs no path
+  EXPECT_FALSE(q.move);
+  EXPECT_TRUE(q.depositions.empty());
+  q = pb.decide(frame(c, 1, kAtFoot, 1.0, {test::neighbour_at(5, 7.65, 3.05)}));
+  EXPECT_EQ(pb.last_trace().before, PathState::kHold);
+  EXPECT_EQ(pb.state(), PathState::kFollow);
+  EXPECT_TRUE(q.move);
+}
+
+TEST(PathBuilder, BacksOffAwayFromAFrontNeighbourTooNear) {
+  const AgentContext c = context();
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, kTarget));
+  pb.decide(frame(c, 0, {4.85, 3.05}, 1.0, {test::neighbour_at(5, 7.65, 3.05)}));  // came from the west, following
+  ASSERT_EQ(pb.state(), PathState::kFollow);
+  // Another robot cuts in 0.95 m ahead: nearer than separation - margin (1.5 m). (Robot 5 out of range is forgotten;
+  // had it come back this far itself, it would count as returning.)
+  const Position front{6.0, 3.05};
+  const protocol::ActionRequest q = pb.decide(frame(c, 1, kAtFoot, 1.0, {test::neighbour_at(6, front.x, front.y)}));
+  EXPECT_EQ(pb.last_trace().role, PipelineRole::kBackOff);
+  EXPECT_EQ(pb.last_trace().before, PathState::kFollow);
+  EXPECT_EQ(pb.state(), PathState::kBackOff);
+  ASSERT_TRUE(q.move);
+  EXPECT_LT(q.target_x_m, kAtFoot.x);
+  EXPECT_GT(distance({q.target_x_m, q.target_y_m}, front), distance(kAtFoot, front));
+  EXPECT_TRUE(q.depositions.empty());
+}
+
+TEST(PathBuilder, ANeighbourTurnedBackIsNoLongerFollowed) {
+  const AgentContext c = context();
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, kTarget));
+  pb.decide(frame(c, 0, {4.85, 3.05}, 1.0, {test::neighbour_at(5, 7.65, 3.05)}));
+  ASSERT_EQ(pb.state(), PathState::kFollow);
+  // It moved 1.55 m away from the target (at least the 1.5 m return detection): it is heading for the base, so this
+  // robot is the front of the pipeline now, though the neighbour is still ahead and nearer than the separation.
+  const protocol::ActionRequest q = pb.decide(frame(c, 1, kAtFoot, 1.0, {test::neighbour_at(5, 6.1, 3.05)}));
+  EXPECT_TRUE(pb.pipeline().returning(5));
+  EXPECT_EQ(pb.last_trace().role, PipelineRole::kActive);
+  EXPECT_EQ(pb.last_trace().before, PathState::kFollow);
+  EXPECT_TRUE(pb.state() == PathState::kAdvance || pb.state() == PathState::kBuild) << to_string(pb.state());
+  EXPECT_FALSE(q.depositions.empty());
+}
+
+TEST(PathBuilder, ReturnsToBaseBelowOneDepositionThresholdAndRefillsThere) {
+  const AgentContext c = context();
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, kTarget, {0.55, 3.05}));
+  // Half a deposition threshold (0.02 m^3) on board: too little for a deposition task (a ramp builder would go on).
+  protocol::ActionRequest q = pb.decide(frame(c, 0, {1.55, 3.05}, 0.01));
+  EXPECT_EQ(pb.state(), PathState::kReturnToBase);
+  EXPECT_FALSE(pb.last_trace().role.has_value());  // going back, the pipeline does not decide
+  ASSERT_TRUE(q.move);
+  EXPECT_LT(q.target_x_m, 1.55);
+  EXPECT_FALSE(q.refill);
+  EXPECT_TRUE(q.depositions.empty());
+  // Within the base radius (0.5 m): refill, then the next frame's role decides.
+  q = pb.decide(frame(c, 1, {0.85, 3.05}, 0.01));
+  EXPECT_EQ(pb.last_trace().before, PathState::kReturnToBase);
+  EXPECT_TRUE(q.refill);
+  EXPECT_TRUE(pb.last_trace().refill);
+  EXPECT_EQ(pb.state(), PathState::kAdvance);
+  q = pb.decide(frame(c, 2, {0.85, 3.05}, 1.0, {test::neighbour_at(5, 3.0, 3.05)}));
+  EXPECT_EQ(pb.last_trace().before, PathState::kAdvance);
+  EXPECT_EQ(pb.state(), PathState::kFollow);
+}
+
+TEST(PathBuilder, AtTheTargetGoesBackToTheBaseToComeAgain) {
+  const AgentContext c = context();
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, {8.02, 3.03}));  // inside cell (29, 80), on the platform
+  protocol::ActionRequest q = pb.decide(frame(c, 0, {8.05, 3.05}, 1.0));
+  EXPECT_EQ(pb.last_trace().before, PathState::kSurvey);
+  EXPECT_EQ(pb.state(), PathState::kReturnToBase);
+  ASSERT_TRUE(q.move);
+  EXPECT_LT(q.target_x_m, 8.05);  // westwards, towards the base
+  EXPECT_TRUE(q.depositions.empty());
+  q = pb.decide(frame(c, 1, {q.target_x_m, q.target_y_m}, 1.0));
+  EXPECT_EQ(pb.last_trace().before, PathState::kReturnToBase);
+  EXPECT_EQ(pb.state(), PathState::kReturnToBase);
+}
+
+TEST(PathBuilder, NoDepositionPathThroughKnownCellsRequestsNothingAndKeepsTheState) {
+  // The robot has seen only its own tile: the local goal is unknown, so no deposition path leads there yet.
+  const AgentContext c = context();
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, kTarget));
+  const Position at{1.05, 2.05};
+  const auto own_tile = [&](protocol::SensorFrame f) { return test::keep_tile_at(f, world_terrain().geometry(), at); };
+  pb.decide(own_tile(frame(c, 0, at, 1.0, {test::neighbour_at(5, 2.9, 2.05)})));  // 1.85 m ahead
+  ASSERT_EQ(pb.state(), PathState::kHold);
+  const protocol::ActionRequest q = pb.decide(own_tile(frame(c, 1, at, 1.0)));  // alone: the active robot
+  EXPECT_EQ(pb.last_trace().role, PipelineRole::kActive);
+  EXPECT_TRUE(pb.last_trace().planned);
+  EXPECT_FALSE(pb.last_trace().plan.found);
+  EXPECT_EQ(pb.state(), PathState::kHold);
+  EXPECT_FALSE(q.move);
+  EXPECT_TRUE(q.depositions.empty());
+}
+
+TEST(PathBuilder, RunOverEndsInDone) {
+  const AgentContext c = context();
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, kTarget));
+  pb.decide(frame(c, 0, {1.05, 3.05}, 1.0));
+  protocol::SensorFrame over = frame(c, 1, {1.25, 3.05}, 1.0);
+  over.run_over = true;
+  const protocol::ActionRequest q = pb.decide(over);
+  EXPECT_EQ(pb.last_trace().before, PathState::kAdvance);
+  EXPECT_EQ(pb.state(), PathState::kDone);
+  EXPECT_EQ(q.state, "done");
+  EXPECT_FALSE(q.move);
+  EXPECT_EQ(q.step, 1u);
+  pb.decide(frame(c, 2, {1.25, 3.05}, 1.0));  // done stays done
+  EXPECT_EQ(pb.state(), PathState::kDone);
+}
+
+/// Every transition one path builder takes building up to the platform, going back and coming again, driven by the
+/// mini world.
+TEST(PathBuilder, AloneItBuildsToTheTargetGoesBackRefillsAndComesAgain) {
+  const AgentContext c = context(1, test::husky(0.3));
+  test::MiniWorld world(world_terrain(), 16, {0.55, 3.05}, 0.5);
+  PathBuilder pb(c);
+  pb.on_admission(world.admit(1, c.session, c.body, {1.05, 3.05}, {8.5, 3.05}));
+  std::set<std::pair<PathState, PathState>> seen;
+  int refills = 0;
+  for (int step = 0; step < 1500 && refills == 0; ++step) {
+    const protocol::ActionRequest q = pb.decide(world.frame_for(1));
+    seen.insert({pb.last_trace().before, pb.last_trace().after});
+    refills += q.refill ? 1 : 0;
+    ASSERT_EQ(world.validate(q), "") << "step " << step << " in " << q.state;
+    world.apply_step({q});
+  }
+  EXPECT_EQ(refills, 1);
+  for (const auto& t : std::vector<std::pair<PathState, PathState>>{
+           {PathState::kSurvey, PathState::kAdvance},      {PathState::kAdvance, PathState::kBuild},
+           {PathState::kBuild, PathState::kAdvance},       {PathState::kBuild, PathState::kRetreat},
+           {PathState::kRetreat, PathState::kRetreat},     {PathState::kRetreat, PathState::kAdvance},
+           {PathState::kAdvance, PathState::kReturnToBase}, {PathState::kReturnToBase, PathState::kReturnToBase},
+           {PathState::kReturnToBase, PathState::kAdvance}})
+    EXPECT_EQ(seen.count(t), 1u) << to_string(t.first) << " -> " << to_string(t.second);
+  for (const auto& [before, after] : seen)
+    for (PathState s : {before, after})
+      EXPECT_TRUE(s != PathState::kFollow && s != PathState::kHold && s != PathState::kBackOff)
+          << "alone, yet " << to_string(s);
+  pb.decide(world.frame_for(1, true));
+  EXPECT_EQ(pb.state(), PathState::kDone);
+}
+
+/// A pipeline of path builders from the base: the front robot alone deposits; the others follow, hold and back off,
+/// and take over the front when it goes back to refill.
+TEST(PathBuilder, InAPipelineOnlyTheActiveRobotDeposits) {
+  RobotBody body = test::husky(0.3);
+  body.material_capacity_m3 = 0.6;
+  test::MiniWorld world(world_terrain(), 16, {1.0, 3.05}, 1.2);
+  std::vector<std::unique_ptr<PathBuilder>> robots;
+  const std::vector<Position> starts{{1.5, 3.05}, {1.0, 2.4}, {0.5, 3.7}};
+  for (std::uint32_t id = 1; id <= starts.size(); ++id) {
+    AgentContext c = context(id, body);
+    c.session = 100 + id;
+    robots.push_back(std::make_unique<PathBuilder>(c));
+    robots.back()->on_admission(world.admit(id, c.session, body, starts[id - 1], {8.5, 3.05}));
+  }
+  std::set<PathState> states;
+  std::set<std::uint32_t> builders;
+  for (int step = 0; step < 300; ++step) {
+    std::vector<protocol::ActionRequest> requests;
+    for (std::uint32_t id = 1; id <= robots.size(); ++id) {
+      PathBuilder& pb = *robots[id - 1];
+      requests.push_back(pb.decide(world.frame_for(id)));
+      states.insert(pb.state());
+      if (!requests.back().depositions.empty()) {
+        builders.insert(id);
+        EXPECT_EQ(pb.last_trace().role, PipelineRole::kActive) << "step " << step << ": robot " << id;
+      }
+    }
+    const auto reasons = world.apply_step(requests);
+    for (std::size_t i = 0; i < reasons.size(); ++i)
+      ASSERT_EQ(reasons[i], "") << "step " << step << ": robot " << i + 1 << " in " << requests[i].state;
+  }
+  EXPECT_EQ(builders.size(), robots.size());
+  for (PathState s : {PathState::kAdvance, PathState::kBuild, PathState::kRetreat, PathState::kReturnToBase,
+                      PathState::kFollow, PathState::kHold, PathState::kBackOff})
+    EXPECT_EQ(states.count(s), 1u) << to_string(s);
+}
+
+}  // namespace
+}  // namespace marsala::agent::reactive

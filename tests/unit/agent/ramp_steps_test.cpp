@@ -1,0 +1,236 @@
+// The ramp builder's steps (agent/reactive/ramp_steps.hpp), called directly, as both behaviours call them: what
+// each step requests and which building phase it reports, on a flat 6 x 10 m world with a platform.
+
+#include "marsala/agent/reactive/ramp_steps.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include "marsala/agent/reactive/behaviour.hpp"
+#include "agent_test_support.hpp"
+#include "marsala/core/error.hpp"
+
+namespace marsala::agent::reactive {
+namespace {
+
+// A flat 6 x 10 m world at 0.1 m cells with a 1.5 m platform from x = 7 m eastwards.
+Heightmap world_terrain() {
+  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
+  for (int r = 0; r < h.rows(); ++r)
+    for (int c = 70; c < h.cols(); ++c) h(r, c) = 1.5;
+  return h;
+}
+
+constexpr Position kTarget{8.0, 3.05};
+constexpr Position kBase{0.55, 3.05};
+
+/// Steps of agent 3 with `body`, admitted with the target on the platform and the base at the west end.
+std::unique_ptr<RampSteps> admitted_steps(const RobotBody& body = test::husky()) {
+  const AgentContext c = test::agent_context(3, body);
+  auto steps = std::make_unique<RampSteps>(c);
+  steps->admit(test::admission_on(c, world_terrain().geometry(), kTarget, kBase));
+  return steps;
+}
+
+protocol::SensorFrame frame(const RampSteps& steps, std::uint64_t step, Position pose, double material_m3 = 1.0) {
+  return test::full_frame(steps.context(), step, pose, material_m3, world_terrain());
+}
+
+protocol::ActionRequest empty(const RampSteps& steps, const protocol::SensorFrame& f) {
+  return empty_request(steps.context(), f, "");
+}
+
+TEST(BuildPhase, Names) {
+  EXPECT_EQ(to_string(BuildPhase::kAdvance), "advance");
+  EXPECT_EQ(to_string(BuildPhase::kBuild), "build");
+  EXPECT_EQ(to_string(BuildPhase::kRetreat), "retreat");
+}
+
+TEST(RampSteps, RefusesAnInvalidBodyConstructionOrGoalSynthesizerAndHasNoMapBeforeAdmission) {
+  RobotBody bad = test::husky();
+  bad.navigability.kappa = -1.0;
+  EXPECT_THROW(RampSteps(test::agent_context(3, bad)), InvalidArgument);
+  AgentContext c = test::agent_context(3, test::husky());
+  c.task.construction_width_m = 0.0;
+  EXPECT_THROW(RampSteps{c}, InvalidArgument);
+  c = test::agent_context(3, test::husky());
+  c.task.goal_synthesizer = "anywhere";
+  EXPECT_THROW(RampSteps{c}, InvalidArgument);
+  c = test::agent_context(3, test::husky());
+  RampSteps steps(c);
+  EXPECT_FALSE(steps.admitted());
+  EXPECT_THROW(steps.map(), InvalidArgument);
+  protocol::Admission other = test::admission_on(c, world_terrain().geometry(), kTarget, kBase);
+  other.session = 1;
+  EXPECT_THROW(steps.admit(other), InvalidArgument);
+  EXPECT_FALSE(steps.admitted());
+  steps.admit(test::admission_on(c, world_terrain().geometry(), kTarget, kBase));
+  EXPECT_TRUE(steps.admitted());
+  EXPECT_EQ(steps.context().assignment.target.x, kTarget.x);
+  EXPECT_EQ(steps.map().known_cells(), 0);
+}
+
+TEST(RampSteps, LookBuildsTheLocalMapTowardsTheTarget) {
+  const auto owned = admitted_steps();
+  RampSteps& steps = *owned;
+  BuildTrace trace;
+  const BuildView view = steps.look(frame(steps, 0, {5.05, 3.05}), trace);
+  EXPECT_EQ(view.robot.x, 5.05);
+  EXPECT_EQ(view.target.x, kTarget.x);
+  EXPECT_EQ(view.target.y, kTarget.y);
+  EXPECT_EQ(steps.map().known_cells(), 6000);
+  EXPECT_EQ(trace.window_offset, view.local.offset);
+  EXPECT_EQ(trace.local_goal, view.local.goal);
+  EXPECT_GT(trace.navigable_cells, 0);
+  EXPECT_FALSE(trace.planned);
+}
+
+TEST(RampSteps, BuildStepAdvancesAlongThePathOnFlatGround) {
+  const auto owned = admitted_steps();
+  RampSteps& steps = *owned;
+  BuildTrace trace;
+  const protocol::SensorFrame f = frame(steps, 0, {1.05, 3.05});
+  const BuildView view = steps.look(f, trace);
+  protocol::ActionRequest q = empty(steps, f);
+  EXPECT_EQ(steps.build_step(view.local, f, trace, q), BuildPhase::kAdvance);
+  EXPECT_TRUE(trace.planned);
+  EXPECT_TRUE(trace.plan.found);
+  ASSERT_TRUE(q.move);
+  ASSERT_TRUE(trace.motion.has_value());
+  EXPECT_NEAR(q.target_x_m, 1.25, 1e-12);
+  EXPECT_EQ(trace.motion->target.x, q.target_x_m);
+  EXPECT_TRUE(q.depositions.empty());
+}
+
+TEST(RampSteps, BuildStepBlockedAtTheFootBuildsInPlace) {
+  const auto owned = admitted_steps();
+  RampSteps& steps = *owned;
+  BuildTrace trace;
+  const Position robot{6.45, 3.05};  // the next cell east touches the platform within half a body
+  const protocol::SensorFrame f = frame(steps, 0, robot);
+  const BuildView view = steps.look(f, trace);
+  protocol::ActionRequest q = empty(steps, f);
+  EXPECT_EQ(steps.build_step(view.local, f, trace, q), BuildPhase::kBuild);
+  EXPECT_FALSE(q.move);
+  ASSERT_FALSE(q.depositions.empty());
+  EXPECT_EQ(q.depositions.size(), trace.deposition.depositions.size());
+  const Heightmap h = world_terrain();
+  double volume_m3 = 0.0;
+  for (const protocol::Deposition& d : q.depositions) {
+    const Position centre = h.cell_center({d.row, d.col});
+    EXPECT_LE(std::hypot(centre.x - robot.x, centre.y - robot.y), test::husky().reach_m + 1e-9);
+    volume_m3 += d.height_m * 0.01;
+  }
+  EXPECT_LE(volume_m3, test::husky().max_deposit_m3 + 1e-12);
+}
+
+TEST(RampSteps, BlockedWithNothingInReachTheRobotRetreatsThenAdvancesAgainAfterIdleRetreatMoves) {
+  // reach = delta / 2: material only in a ring the robot never reaches, so retreating never deposits; after
+  // ceil((reach + delta) / max_step) + 1 = 9 idle retreat moves it tries the path again. (Its steps back follow the
+  // local origin, which here flips between the ends of its short trajectory: it paces between x = 6.05 and 6.25 m.)
+  RobotBody body = test::husky();
+  body.reach_m = 0.5;
+  const auto owned = admitted_steps(body);
+  RampSteps& steps = *owned;
+  Position robot{5.95, 3.05};
+  {
+    BuildTrace trace;
+    const protocol::SensorFrame f = frame(steps, 0, robot);
+    const BuildView view = steps.look(f, trace);
+    protocol::ActionRequest q = empty(steps, f);
+    ASSERT_EQ(steps.build_step(view.local, f, trace, q), BuildPhase::kAdvance);
+    robot = {6.45, 3.05};  // to the foot of the platform
+  }
+  BuildTrace trace;
+  protocol::SensorFrame f = frame(steps, 1, robot);
+  BuildView view = steps.look(f, trace);
+  protocol::ActionRequest q = empty(steps, f);
+  ASSERT_EQ(steps.build_step(view.local, f, trace, q), BuildPhase::kRetreat);
+  ASSERT_TRUE(q.move);
+  EXPECT_LT(q.target_x_m, robot.x);
+  EXPECT_TRUE(q.depositions.empty());
+  int retreat_moves = 1;
+  for (std::uint64_t step = 2; step < 20; ++step) {
+    const Position at{q.target_x_m, q.target_y_m};
+    trace = BuildTrace{};
+    f = frame(steps, step, at);
+    view = steps.look(f, trace);
+    q = empty(steps, f);
+    const BuildPhase phase = steps.retreat_step(view.local, f, trace, q);
+    ASSERT_TRUE(q.move) << "step " << step;
+    EXPECT_TRUE(q.depositions.empty());
+    if (phase == BuildPhase::kAdvance) {
+      EXPECT_GT(q.target_x_m, at.x);  // up the path again
+      break;
+    }
+    EXPECT_LT(q.target_x_m, robot.x);  // never up to the foot where it was blocked
+    ++retreat_moves;
+  }
+  EXPECT_EQ(retreat_moves, 9);
+}
+
+TEST(RampSteps, BuildStepWithoutAPathThroughKnownCellsRequestsNothing) {
+  const auto owned = admitted_steps();
+  RampSteps& steps = *owned;
+  BuildTrace trace;
+  const Position robot{1.05, 2.05};
+  const protocol::SensorFrame f = test::keep_tile_at(frame(steps, 0, robot), world_terrain().geometry(), robot);
+  const BuildView view = steps.look(f, trace);
+  protocol::ActionRequest q = empty(steps, f);
+  EXPECT_FALSE(steps.build_step(view.local, f, trace, q).has_value());
+  EXPECT_TRUE(trace.planned);
+  EXPECT_FALSE(trace.plan.found);
+  EXPECT_FALSE(q.move);
+  EXPECT_TRUE(q.depositions.empty());
+}
+
+TEST(RampSteps, ReturnStepHeadsForTheBaseAndRefillsWithinItsRadius) {
+  const auto owned = admitted_steps();
+  RampSteps& steps = *owned;
+  BuildTrace trace;
+  protocol::SensorFrame f = frame(steps, 0, {2.05, 3.05}, 0.0);
+  BuildView view = steps.look(f, trace);
+  protocol::ActionRequest q = empty(steps, f);
+  EXPECT_FALSE(steps.return_step(view.local, f, trace, q));
+  ASSERT_TRUE(q.move);
+  EXPECT_NEAR(q.target_x_m, 1.85, 1e-12);  // a whole step west
+  EXPECT_FALSE(q.refill);
+  EXPECT_TRUE(trace.planned);
+  // A step from the base radius (0.5 m): the motion ends inside it, so the same request refills.
+  trace = BuildTrace{};
+  f = frame(steps, 1, {1.15, 3.05}, 0.0);
+  view = steps.look(f, trace);
+  q = empty(steps, f);
+  EXPECT_TRUE(steps.return_step(view.local, f, trace, q));
+  EXPECT_TRUE(q.move);
+  EXPECT_TRUE(q.refill);
+  EXPECT_TRUE(trace.refill);
+  // Inside it already: refill in place.
+  trace = BuildTrace{};
+  f = frame(steps, 2, {0.85, 3.05}, 0.0);
+  view = steps.look(f, trace);
+  q = empty(steps, f);
+  EXPECT_TRUE(steps.return_step(view.local, f, trace, q));
+  EXPECT_FALSE(q.move);
+  EXPECT_TRUE(q.refill);
+}
+
+TEST(RampSteps, StepBackGoesAwayFromTheGoalBeforeTheRobotHasMoved) {
+  const auto owned = admitted_steps();
+  RampSteps& steps = *owned;
+  BuildTrace trace;
+  const Position robot{4.05, 3.05};
+  const BuildView view = steps.look(frame(steps, 0, robot), trace);
+  const auto motion = steps.step_back(view.local, robot);
+  ASSERT_TRUE(motion.has_value());
+  const Position goal = view.local.center(view.local.goal);
+  EXPECT_GT(std::hypot(motion->target.x - goal.x, motion->target.y - goal.y),
+            std::hypot(robot.x - goal.x, robot.y - goal.y));
+  EXPECT_LE(motion->distance_m, test::husky().max_step_m + 1e-12);
+}
+
+}  // namespace
+}  // namespace marsala::agent::reactive
