@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   spdlog::set_level(spdlog::level::from_str(log_level));
   try {
     const scenario::Scenario s = scenario::load_scenario(scenario_file);
-    const scenario::RobotType& type = s.robot_for(id);
+    const RobotType& type = s.robot_for(id);
     // Keep-out around neighbours: the largest body and step of the whole team (bodies may differ per slot).
     double max_delta = 0.0, max_step = 0.0;
     for (const scenario::AgentSlot& slot : s.slots) {
@@ -60,17 +60,10 @@ int main(int argc, char** argv) {
     agent::runtime::RuntimeConfig config;
     config.agent_id = id;
     config.name = type.name + "-" + std::to_string(id);
-    config.behaviour = type.behaviour;
-    config.body = type.body;
+    config.type = type;
     config.neighbour_keep_out_m = agent::neighbour_keep_out_m(max_delta, max_step);
     config.seed = seed.value_or(s.seed);
-    config.task.construction_kappa = type.construction.kappa;
-    config.task.construction_eps_m = type.construction.eps_m;
-    config.task.construction_width_m = type.construction.width_m;
-    config.task.separation_m = type.pipeline.separation_m;
-    config.task.lane_offset_m = type.pipeline.lane_offset_m;
-    config.task.goal_synthesizer = type.goal_synthesizer;
-    if (s.has_goal_vector_map) config.task.goal_vector_map = s.goal_vector_map;
+    if (s.has_goal_vector_map) config.goal_vector_map = s.goal_vector_map;
     config.admit_timeout = std::chrono::milliseconds(static_cast<long long>(admit_timeout_s * 1000.0));
     config.world_timeout = std::chrono::milliseconds(static_cast<long long>(world_timeout_s * 1000.0));
 

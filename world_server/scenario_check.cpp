@@ -63,7 +63,7 @@ std::string describe_text(const CheckedScenario& checked) {
   std::string out = fmt::format("scenario {} ({}): valid\n", s.name, s.source_path);
   out += fmt::format("terrain: {} x {} cells of {} m, lower-left corner ({}, {}) m\n", g.rows, g.cols, g.cell_size_m,
                      g.xll_m, g.yll_m);
-  for (const scenario::RobotType& t : s.robot_types)
+  for (const RobotType& t : s.robot_types)
     out += fmt::format("robot type {}: behaviour {}, {}, max_step {} m, cube {} m, goal synthesizer {}\n", t.name,
                        t.behaviour, t.body.navigability, t.body.max_step_m, t.body.cube_size_m, t.goal_synthesizer);
   for (const AgentRecord& a : checked.state.agents)
@@ -79,7 +79,7 @@ std::string describe_json(const CheckedScenario& checked) {
   const scenario::Scenario& s = checked.scenario;
   const GridGeometry g = checked.state.terrain.geometry();
   std::string types, slots;
-  for (const scenario::RobotType& t : s.robot_types) {
+  for (const RobotType& t : s.robot_types) {
     const NavigabilityParams& n = t.body.navigability;
     types += fmt::format(
         R"({}{{"name": {}, "behaviour": {}, "kappa": {}, "delta_m": {}, "eps_m": {}, "max_step_m": {}, )"

@@ -42,7 +42,7 @@ WorldState make_world_state(const scenario::Scenario& scenario, Heightmap terrai
   s.site = scenario.site;
   for (std::uint32_t id = 1; id <= agent_count; ++id) {
     const scenario::AgentSlot& slot = scenario.slots[id - 1];
-    const scenario::RobotType& type = scenario.robot_for(id);
+    const RobotType& type = scenario.robot_for(id);
     AgentRecord a;
     a.id = id;
     a.robot_type = type.name;

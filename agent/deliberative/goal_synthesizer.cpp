@@ -12,7 +12,7 @@ std::optional<Position> FixedTarget::target(const GoalQuery& /*query*/) { return
 GoalVectorMapSynthesizer::GoalVectorMapSynthesizer(const AgentContext& context)
     : self_id_(context.agent_id),
       cell_size_m_(context.assignment.world.cell_size_m),
-      map_(context.task.goal_vector_map ? *context.task.goal_vector_map
+      map_(context.goal_vector_map ? *context.goal_vector_map
                                         : throw InvalidArgument("goal synthesizer 'goal_vector_map' needs the "
                                                                 "scenario's goal_vector_map block"),
            context.assignment.world),

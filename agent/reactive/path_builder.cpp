@@ -52,9 +52,9 @@ PathState path_state_from_string(const std::string& name) {
   throw InvalidArgument("unknown path builder state '" + name + "'; valid: " + valid);
 }
 
-PipelineParams pipeline_params(const Task& task) {
+PipelineParams pipeline_params(const Pipeline& pipeline) {
   PipelineParams p;
-  p.separation_m = task.separation_m;
+  p.separation_m = pipeline.separation_m;
   p.back_off_margin_m = 0.25 * p.separation_m;
   p.return_detect_m = 0.75 * p.separation_m;
   return p;
@@ -62,7 +62,7 @@ PipelineParams pipeline_params(const Task& task) {
 
 PathBuilder::PathBuilder(const AgentContext& context, PathBuilderOptions options)
     : steps_(context, std::move(options.planner)),
-      pipeline_(pipeline_params(context.task)) {}
+      pipeline_(pipeline_params(context.type.pipeline)) {}
 
 const executive::MappingSystem& PathBuilder::map() const {
   if (!steps_.admitted()) throw InvalidArgument("path builder: no map before admission");
@@ -71,7 +71,7 @@ const executive::MappingSystem& PathBuilder::map() const {
 
 void PathBuilder::on_admission(const protocol::Admission& admission) {
   steps_.admit(admission);
-  const RobotBody& body = steps_.context().body;
+  const RobotBody& body = steps_.context().type.body;
   return_below_m3_ = std::min(body.max_deposit_m3, body.material_capacity_m3);
   state_ = PathState::kSurvey;
 }

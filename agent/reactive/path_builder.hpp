@@ -68,9 +68,9 @@ struct PathBuilderTrace : BuildTrace {
   std::optional<PipelineRole> role;  ///< the pipeline role of this frame, when it was asked for
 };
 
-/// The pipeline's distances for a task: separation_m = task.separation_m, back_off_margin_m a quarter of it,
+/// The pipeline's distances for a robot type's pipeline: separation_m = pipeline.separation_m, back_off_margin_m a quarter of it,
 /// return_detect_m three quarters of it [m].
-PipelineParams pipeline_params(const Task& task);
+PipelineParams pipeline_params(const Pipeline& pipeline);
 
 /// Builds a navigable path in the construction pipeline; see the transition table above.
 class PathBuilder final : public Behaviour {

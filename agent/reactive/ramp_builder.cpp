@@ -55,7 +55,7 @@ const executive::MappingSystem& RampBuilder::map() const {
 
 void RampBuilder::on_admission(const protocol::Admission& admission) {
   steps_.admit(admission);
-  const RobotBody& body = steps_.context().body;
+  const RobotBody& body = steps_.context().type.body;
   const double cell_size_m = steps_.context().assignment.world.cell_size_m;
   return_below_m3_ = cube_layer_m(body.cube_size_m, cell_size_m) * cell_size_m * cell_size_m;  // one cube
   state_ = RampState::kSurvey;

@@ -61,9 +61,9 @@ RampSteps::RampSteps(const AgentContext& context, std::optional<PlannerParams> p
     : context_(context),
       planner_(std::move(planner)) {
   // Fail on an invalid body, construction or goal synthesizer name now rather than at admission.
-  (void)NavigabilityProcessor(context_.body.navigability);
-  (void)NavigabilityProcessor(construction_params(context_));
-  deliberative::require_goal_synthesizer(context_.task.goal_synthesizer);
+  (void)NavigabilityProcessor(context_.type.body.navigability);
+  (void)NavigabilityProcessor(construction_params(context_.type));
+  deliberative::require_goal_synthesizer(context_.type.goal_synthesizer);
 }
 
 RampSteps::~RampSteps() = default;
@@ -76,8 +76,8 @@ const executive::MappingSystem& RampSteps::map() const {
 void RampSteps::admit(const protocol::Admission& admission) {
   context_.assignment = assignment_from(context_, admission);
   const GridGeometry world = context_.assignment.world;
-  const RobotBody& body = context_.body;
-  const NavigabilityParams build = construction_params(context_);
+  const RobotBody& body = context_.type.body;
+  const NavigabilityParams build = construction_params(context_.type);
   PlannerParams planner = planner_ ? *planner_ : default_planner_params(build.delta_m, world.cell_size_m);
   PlannerParams router = planner;
   router.alpha = 0.0;
@@ -90,7 +90,7 @@ void RampSteps::admit(const protocol::Admission& admission) {
       executive::DepositionManager(
           executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m, build.delta_m)),
       static_cast<int>(std::ceil((body.reach_m + body.navigability.delta_m) / body.max_step_m)) + 1});
-  goal_ = deliberative::make_goal_synthesizer(context_.task.goal_synthesizer, context_);
+  goal_ = deliberative::make_goal_synthesizer(context_.type.goal_synthesizer, context_);
 }
 
 BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace) {

@@ -43,13 +43,13 @@ AgentRuntime::AgentRuntime(bus::Participant& participant, RuntimeConfig config)
   AgentContext context;
   context.agent_id = config_.agent_id;
   context.session = config_.session;
-  context.body = config_.body;
+  context.type = config_.type;
   context.neighbour_keep_out_m = config_.neighbour_keep_out_m > 0.0
                                      ? config_.neighbour_keep_out_m
-                                     : neighbour_keep_out_m(config_.body.navigability.delta_m, config_.body.max_step_m);
+                                     : neighbour_keep_out_m(config_.type.body.navigability.delta_m, config_.type.body.max_step_m);
   context.seed = config_.seed;
-  context.task = config_.task;
-  behaviour_ = reactive::make_behaviour(config_.behaviour, context);
+  context.goal_vector_map = config_.goal_vector_map;
+  behaviour_ = reactive::make_behaviour(config_.type.behaviour, context);
 }
 
 AgentRuntime::~AgentRuntime() = default;
@@ -70,10 +70,10 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
   hello.agent_id = config_.agent_id;
   hello.session = config_.session;
   hello.name = config_.name;
-  hello.behaviour = config_.behaviour;
-  hello.body = config_.body;
+  hello.behaviour = config_.type.behaviour;
+  hello.body = config_.type.body;
   spdlog::info("agent {} ({}, {}): saying hello, session {:016x}", config_.agent_id, config_.name,
-               config_.behaviour, config_.session);
+               config_.type.behaviour, config_.session);
 
   const Clock::time_point deadline = Clock::now() + config_.admit_timeout;
   Clock::time_point next_hello = Clock::now();

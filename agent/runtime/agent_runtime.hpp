@@ -25,12 +25,11 @@ namespace marsala::agent::runtime {
 struct RuntimeConfig {
   std::uint32_t agent_id = 0;                       ///< >= 1: the scenario slot
   std::string name;                                 ///< human-readable, e.g. "husky-3"
-  std::string behaviour = "ramp_builder";           ///< reactive behaviour by name
-  RobotBody body;                             ///< declared in the hello; the world checks it
+  RobotType type;                                   ///< its slot's robot type; the hello declares its body
   std::uint64_t session = 0;                        ///< 0: a random one (random_session())
   double neighbour_keep_out_m = 0.0;                ///< 0: delta/2 + max_step of this body [m]
   std::uint64_t seed = 1;                           ///< scenario seed
-  Task task;                                        ///< what it builds and towards which goals
+  std::optional<GoalVectorMapSpec> goal_vector_map;  ///< the scenario's, for the "goal_vector_map" synthesizer
   std::chrono::milliseconds hello_period{200};      ///< between hellos until admitted
   std::chrono::milliseconds admit_timeout{60000};   ///< give up when not admitted by then
   std::chrono::milliseconds world_timeout{60000};   ///< give up when no frame comes for this long

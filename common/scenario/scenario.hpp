@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "marsala/core/robot_body.hpp"
+#include "marsala/core/robot_type.hpp"
 #include "marsala/core/goal_vector_map.hpp"
 
 namespace marsala::scenario {
@@ -28,29 +28,6 @@ struct TerrainSource {
   double crop_x0_m = 0.0, crop_y0_m = 0.0, crop_width_m = 0.0, crop_height_m = 0.0;
   double resample_cell_size_m = 0.0;         ///< 0 = keep the file's cell size
   bool zero_base = false;                    ///< shift so the lowest cell is at 0 m
-};
-
-/// What a robot builds: a structure navigable for kappa and eps, over a band width_m wide along its path.
-struct Construction {
-  double kappa = 0.3;                        ///< [m/m]
-  double eps_m = 0.05;                       ///< [m]
-  double width_m = 1.0;                      ///< [m]
-};
-
-/// The construction pipeline of the "path_builder" behaviour (paper §V-A, Fig. 4).
-struct Pipeline {
-  double separation_m = 2.0;                 ///< a follower keeps at least this far behind its front neighbour [m]
-  double lane_offset_m = 0.5;                ///< forward lane right of the path, backward lane left [m]
-};
-
-/// A kind of robot: body parameters, the reactive behaviour that drives it, and what it builds.
-struct RobotType {
-  std::string name;                          ///< e.g. "husky"
-  std::string behaviour = "ramp_builder";    ///< reactive behaviour by name (agent registry)
-  RobotBody body;
-  Construction construction;                 ///< defaults to the body's kappa, eps and delta
-  Pipeline pipeline;
-  std::string goal_synthesizer = "fixed_target";  ///< goal synthesizer by name (agent registry)
 };
 
 /// One agent of the team: agent id (slot index + 1), robot type, start and target [m].

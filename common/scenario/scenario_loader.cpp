@@ -163,18 +163,22 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     const std::string problem = body_problem(t.body);
     if (!problem.empty()) check.fail(field + ".body", problem);
     const proto::Construction& cp = rp.construction();
-    t.construction.kappa = cp.has_kappa() ? check.positive(field + ".construction.kappa", cp.kappa()) : t.body.navigability.kappa;
-    t.construction.eps_m = cp.has_eps_m() ? check.finite(field + ".construction.eps_m", cp.eps_m()) : t.body.navigability.eps_m;
-    if (t.construction.eps_m < 0.0) check.fail(field + ".construction.eps_m", "must be >= 0");
-    t.construction.width_m =
-        cp.has_width_m() ? check.positive(field + ".construction.width_m", cp.width_m()) : t.body.navigability.delta_m;
-    if (t.construction.kappa > t.body.navigability.kappa)
-      check.fail(field + ".construction.kappa", fmt::format("{}", t.construction.kappa) + " exceeds the body's kappa " +
-                                                    fmt::format("{}", t.body.navigability.kappa) + ": the builder could not climb what it builds");
-    if (t.construction.width_m > 2.0 * t.body.reach_m + t.body.navigability.delta_m)
-      check.fail(field + ".construction.width_m", fmt::format("{}", t.construction.width_m) + " is wider than the robot can reach " +
-                                                      "from its path (delta + 2 reach = " +
-                                                      fmt::format("{}", 2.0 * t.body.reach_m + t.body.navigability.delta_m) + " m)");
+    // Unset fields build for the robot's own body (kappa, eps, and its length as the band's width).
+    NavigabilityParams build = t.body.navigability;
+    if (cp.has_kappa()) build.kappa = check.positive(field + ".construction.kappa", cp.kappa());
+    if (cp.has_eps_m()) build.eps_m = check.finite(field + ".construction.eps_m", cp.eps_m());
+    if (build.eps_m < 0.0) check.fail(field + ".construction.eps_m", "must be >= 0");
+    if (cp.has_width_m()) build.delta_m = check.positive(field + ".construction.width_m", cp.width_m());
+    if (build.kappa > t.body.navigability.kappa)
+      check.fail(field + ".construction.kappa",
+                 fmt::format("{} exceeds the body's kappa {}: the builder could not climb what it builds", build.kappa,
+                             t.body.navigability.kappa));
+    const double reach_band_m = 2.0 * t.body.reach_m + t.body.navigability.delta_m;
+    if (build.delta_m > reach_band_m)
+      check.fail(field + ".construction.width_m",
+                 fmt::format("{} is wider than the robot can reach from its path (delta + 2 reach = {} m)",
+                             build.delta_m, reach_band_m));
+    t.construction = build;
     const proto::Pipeline& pp = rp.pipeline();
     if (pp.has_separation_m()) t.pipeline.separation_m = check.positive(field + ".pipeline.separation_m", pp.separation_m());
     if (pp.has_lane_offset_m()) t.pipeline.lane_offset_m = check.finite(field + ".pipeline.lane_offset_m", pp.lane_offset_m());

@@ -76,7 +76,7 @@ int run(int argc, char** argv) {
   const auto id = static_cast<std::uint32_t>(std::stoul(argv[2]));
   const bus::Vendor vendor = bus::vendor_from_string(argv[3]);
   const int domain = std::stoi(argv[4]);
-  const scenario::RobotType& robot = sc.robot_for(id);
+  const RobotType& robot = sc.robot_for(id);
 
   auto participant = bus::make_participant({vendor, domain});
   auto signal = std::make_shared<bus::Signal>();

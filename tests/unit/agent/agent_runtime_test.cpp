@@ -22,8 +22,8 @@ using Clock = std::chrono::steady_clock;
 RuntimeConfig config(std::uint32_t id, const std::string& behaviour = "idle") {
   RuntimeConfig c;
   c.agent_id = id;
-  c.behaviour = behaviour;
-  c.body = test::husky();
+  c.type.behaviour = behaviour;
+  c.type.body = test::husky();
   c.hello_period = 20ms;
   c.admit_timeout = 5s;
   c.world_timeout = 5s;

@@ -81,7 +81,7 @@ inline AgentContext agent_context(std::uint32_t id, const RobotBody& body) {
   AgentContext c;
   c.agent_id = id;
   c.session = 77;
-  c.body = body;
+  c.type.body = body;
   c.neighbour_keep_out_m = neighbour_keep_out_m(body.navigability.delta_m, body.max_step_m);
   return c;
 }

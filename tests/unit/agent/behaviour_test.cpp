@@ -65,7 +65,7 @@ TEST(BehaviourRegistry, MakesBuiltinsByNameAndListsThemOnAnUnknownOne) {
   EXPECT_THROW(make_behaviour("path_builder", context(3, bad)), InvalidArgument);
   // The pipeline's separation is the path builder's alone.
   AgentContext no_separation = context();
-  no_separation.task.separation_m = 0.0;
+  no_separation.type.pipeline.separation_m = 0.0;
   EXPECT_THROW(make_behaviour("path_builder", no_separation), InvalidArgument);
   EXPECT_EQ(make_behaviour("ramp_builder", no_separation)->name(), "ramp_builder");
 }

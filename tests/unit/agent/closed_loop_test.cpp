@@ -80,7 +80,7 @@ LoopResult run_loop(const RobotBody& body, const std::vector<Position>& starts,
     AgentContext ctx;
     ctx.agent_id = static_cast<std::uint32_t>(i + 1);
     ctx.session = 1000 + i;
-    ctx.body = body;
+    ctx.type.body = body;
     ctx.neighbour_keep_out_m = neighbour_keep_out_m(body.navigability.delta_m, body.max_step_m);
     agents.push_back(std::make_unique<RampBuilder>(ctx));
     agents.back()->on_admission(world.admit(ctx.agent_id, ctx.session, body, starts[i], targets[i]));
@@ -249,10 +249,11 @@ TEST(ClosedLoop, PathBuildersLayAPathForAPayload) {
   test::MiniWorld world(platform_terrain(kHeightM), 16, base, 1.0);
   const Heightmap initial = world.terrain();
   const RobotBody body = husky(0.3, 0.5);
-  Task task;
-  task.construction_kappa = 0.25;
-  task.construction_width_m = 3.0;
-  task.separation_m = 2.0;
+  RobotType type;
+  type.behaviour = "path_builder";
+  type.body = body;
+  type.construction = NavigabilityParams{0.25, 3.0, body.navigability.eps_m};
+  type.pipeline.separation_m = 2.0;
   const NavigabilityProcessor payload({0.25, 2.0, 0.05});
   const std::vector<Position> starts{{1.5, 4.0}, {1.0, 3.2}, {0.6, 4.6}};
   std::vector<std::unique_ptr<PathBuilder>> builders;
@@ -260,9 +261,8 @@ TEST(ClosedLoop, PathBuildersLayAPathForAPayload) {
     AgentContext c;
     c.agent_id = id;
     c.session = 2000 + id;
-    c.body = body;
+    c.type = type;
     c.neighbour_keep_out_m = neighbour_keep_out_m(body.navigability.delta_m, body.max_step_m);
-    c.task = task;
     builders.push_back(std::make_unique<PathBuilder>(c));
     builders.back()->on_admission(world.admit(id, c.session, body, starts[id - 1], target));
   }

@@ -53,7 +53,7 @@ AgentContext site_context(std::uint32_t id) {
   AgentContext c;
   c.agent_id = id;
   c.assignment.world = {12, 12, 0.0, 0.0, 1.0};
-  c.task.goal_synthesizer = "goal_vector_map";
+  c.type.goal_synthesizer = "goal_vector_map";
   GoalVectorMapSpec spec;
   spec.x0_m = 2.0;
   spec.y0_m = 2.0;
@@ -62,7 +62,7 @@ AgentContext site_context(std::uint32_t id) {
   spec.strip_width_m = 2.0;
   spec.arrow_length_m = 4.0;
   spec.heading = Heading::kEast;
-  c.task.goal_vector_map = spec;
+  c.goal_vector_map = spec;
   return c;
 }
 
@@ -211,7 +211,7 @@ TEST(GoalVectorMapSynthesizer, TwoRobotsFinishEveryArrowDeterministically) {
 
 TEST(GoalVectorMapSynthesizer, RejectsAContextWithoutAUsableMap) {
   AgentContext no_spec = site_context(1);
-  no_spec.task.goal_vector_map.reset();
+  no_spec.goal_vector_map.reset();
   try {
     make_goal_synthesizer("goal_vector_map", no_spec);
     FAIL() << "expected InvalidArgument";
@@ -220,7 +220,7 @@ TEST(GoalVectorMapSynthesizer, RejectsAContextWithoutAUsableMap) {
   }
   EXPECT_THROW(GoalVectorMapSynthesizer{no_spec}, InvalidArgument);
   AgentContext outside = site_context(1);
-  outside.task.goal_vector_map->x1_m = 12.5;  // the world ends at x = 12
+  outside.goal_vector_map->x1_m = 12.5;  // the world ends at x = 12
   EXPECT_THROW(GoalVectorMapSynthesizer{outside}, InvalidArgument);
   AgentContext no_grid = site_context(1);
   no_grid.assignment.world.cell_size_m = 0.0;

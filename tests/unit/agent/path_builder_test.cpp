@@ -30,7 +30,7 @@ Heightmap world_terrain() {
 /// A path builder's context: the Husky body, building for its own kappa (0.5) and width, 2 m separation.
 AgentContext context(std::uint32_t id = 3, RobotBody body = test::husky()) {
   AgentContext c = test::agent_context(id, body);
-  c.task.separation_m = 2.0;
+  c.type.pipeline.separation_m = 2.0;
   return c;
 }
 
@@ -76,9 +76,9 @@ TEST(PathState, NamesRoundTrip) {
 }
 
 TEST(PathBuilder, PipelineParamsFollowTheSeparation) {
-  Task task;
-  task.separation_m = 4.0;
-  const PipelineParams p = pipeline_params(task);
+  Pipeline pipeline;
+  pipeline.separation_m = 4.0;
+  const PipelineParams p = pipeline_params(pipeline);
   EXPECT_EQ(p.separation_m, 4.0);
   EXPECT_EQ(p.back_off_margin_m, 1.0);
   EXPECT_EQ(p.return_detect_m, 3.0);
@@ -293,7 +293,7 @@ TEST(PathBuilder, AloneItBuildsToTheTargetGoesBackRefillsAndComesAgain) {
   const AgentContext c = context(1, test::husky(0.3));
   test::MiniWorld world(world_terrain(), 16, {0.55, 3.05}, 0.5);
   PathBuilder pb(c);
-  pb.on_admission(world.admit(1, c.session, c.body, {1.05, 3.05}, {8.5, 3.05}));
+  pb.on_admission(world.admit(1, c.session, c.type.body, {1.05, 3.05}, {8.5, 3.05}));
   std::set<std::pair<PathState, PathState>> seen;
   int refills = 0;
   for (int step = 0; step < 1500 && refills == 0; ++step) {

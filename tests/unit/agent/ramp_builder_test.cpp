@@ -175,7 +175,7 @@ TEST(RampBuilder, ClimbingThePlatformExercisesTheBuildingTransitions) {
   const AgentContext c = context(1, test::husky(0.3));
   test::MiniWorld world(world_terrain(), 16, {0.55, 3.05}, 0.5);
   RampBuilder rb(c);
-  rb.on_admission(world.admit(1, c.session, c.body, {1.05, 3.05}, {8.5, 3.05}));
+  rb.on_admission(world.admit(1, c.session, c.type.body, {1.05, 3.05}, {8.5, 3.05}));
   std::set<std::pair<RampState, RampState>> seen;
   for (int step = 0; step < 800 && rb.state() != RampState::kAtGoal; ++step) {
     const protocol::ActionRequest q = rb.decide(world.frame_for(1));

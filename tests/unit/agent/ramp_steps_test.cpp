@@ -54,10 +54,10 @@ TEST(RampSteps, RefusesAnInvalidBodyConstructionOrGoalSynthesizerAndHasNoMapBefo
   bad.navigability.kappa = -1.0;
   EXPECT_THROW(RampSteps(test::agent_context(3, bad)), InvalidArgument);
   AgentContext c = test::agent_context(3, test::husky());
-  c.task.construction_width_m = 0.0;
+  c.type.construction = NavigabilityParams{c.type.body.navigability.kappa, 0.0, c.type.body.navigability.eps_m};
   EXPECT_THROW(RampSteps{c}, InvalidArgument);
   c = test::agent_context(3, test::husky());
-  c.task.goal_synthesizer = "anywhere";
+  c.type.goal_synthesizer = "anywhere";
   EXPECT_THROW(RampSteps{c}, InvalidArgument);
   c = test::agent_context(3, test::husky());
   RampSteps steps(c);

@@ -1,0 +1,37 @@
+#pragma once
+// A kind of robot (paper §IV, §V): its body, the reactive behaviour that drives it, what it builds and how it works
+// in the construction pipeline. Scenarios declare robot types; each agent process runs one; this is their one
+// definition, so the facts are not copied from struct to struct on the way.
+
+#include <optional>
+#include <string>
+
+#include "marsala/core/robot_body.hpp"
+#include "marsala/core/types.hpp"
+
+namespace marsala {
+
+/// The construction pipeline of the "path_builder" behaviour (paper §V-A, Fig. 4).
+struct Pipeline {
+  double separation_m = 2.0;   ///< a follower keeps at least this far behind its front neighbour [m]
+  double lane_offset_m = 0.5;  ///< forward lane right of the path, backward lane left [m]
+};
+
+/// A kind of robot.
+struct RobotType {
+  std::string name;                               ///< e.g. "husky"
+  std::string behaviour = "ramp_builder";         ///< reactive behaviour by name (agent registry)
+  RobotBody body;
+  /// What it builds: a structure navigable for kappa and eps_m over a band delta_m wide along its path; unset: for
+  /// its own body (construction_params()).
+  std::optional<NavigabilityParams> construction;
+  Pipeline pipeline;
+  std::string goal_synthesizer = "fixed_target";  ///< goal synthesizer by name (agent registry)
+};
+
+/// What `type` builds: its construction, or its own body's kappa, delta (as the band width) and eps.
+inline NavigabilityParams construction_params(const RobotType& type) {
+  return type.construction.value_or(type.body.navigability);
+}
+
+}  // namespace marsala
