@@ -50,9 +50,9 @@ if [ "$mode" = scenario ]; then
     ramp*) default_agents=3; what="robots build ramps to climb a 1.5 m platform (paper Fig. 2)" ;;
     path_*) default_agents=5; what="builders build a navigable path for a payload robot (paper §V-A)" ;;
     site_*) default_agents=11; what="robots level a site for kappa 0.1 (paper §V-B)" ;;
-    *) default_agents="$("${MARSALA_BUILD_DIR:-$root/build}/bin/marsala-world" --check --json "$file" |
-                         jq '.slots | length')" || exit 2
-       what="scenario $file" ;;
+    *)  # every agent slot, as the world counts them (marsala-world --check prints the scenario as JSON)
+      facts="$("${MARSALA_BUILD_DIR:-$root/build}/bin/marsala-world" --check --json "$file")" || exit $?
+      default_agents="$(jq '.slots | length' <<<"$facts")"; what="scenario $file" ;;
   esac
   agents="${agents:-$default_agents}"
   echo "== $name: $agents $what"

@@ -15,8 +15,8 @@ packages=(
   cyclonedds-dev cyclonedds-tools libfastrtps-dev libfastcdr-dev fastddsgen
   # multi-process tests run inside a private network namespace (unshare -n, ip link set lo up)
   iproute2 util-linux
-  # deploy/sweep.sh: summary.json parsing and the scalability plot
-  jq gnuplot-nox
+  # deploy/sweep.py (the sweep), jq for spawn.sh/demo.sh (marsala-world --check --json), the scalability plot
+  python3 jq gnuplot-nox
 )
 
 missing=()

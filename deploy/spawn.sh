@@ -9,12 +9,14 @@
 #   --monitor     also run `marsala-monitor tail` in the foreground output
 #   --timeout     give up (and stop everything) after S seconds of wall time (default 1800)
 #   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
+# Exit codes: 0 the run ended, 1 the world failed or wrote no summary or the binaries are missing, 2 usage error or
+#             a run that `marsala-world --check` rejects (bad scenario, too many agents: nothing started), 130 stopped.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
 scenario="" agents="" dds="cyclone" agent_dds="" out="" domain="" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0
-usage() { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -47,11 +49,21 @@ for b in marsala-world marsala-agent; do
   [ -x "$bin/$b" ] || { echo "spawn.sh: $bin/$b not built (run deploy/build.sh)" >&2; exit 1; }
 done
 
-# The scenario is checked as the world would check it before any process starts.
-slots="$("$bin/marsala-world" --check --json "$scenario" | jq '.slots | length')" ||
-  { echo "spawn.sh: scenario '$scenario' is not valid (see above)" >&2; exit 2; }
-[ "$agents" -le "$slots" ] ||
-  { echo "spawn.sh: --agents $agents exceeds the $slots agent slots of '$scenario'" >&2; exit 2; }
+world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$domain" --out "$out")
+[ -n "$max_steps" ] && world_args+=(--max-steps "$max_steps")
+[ "$quiet" -eq 1 ] && world_args+=(--quiet)
+seed_args=()
+[ -n "$seed" ] && seed_args=(--seed "$seed")
+world_args+=("${seed_args[@]}")
+
+# The world's own start-up checks with the run's arguments (scenario, terrain, completion, slots, --agents), before
+# any process starts: a bad scenario fails here with the check's message (marsala-world --check, no DDS).
+check_rc=0
+"$bin/marsala-world" --check "${world_args[@]}" >/dev/null || check_rc=$?
+if [ "$check_rc" -ne 0 ]; then
+  echo "spawn.sh: marsala-world --check rejects the run (exit $check_rc); nothing started" >&2
+  exit "$check_rc"
+fi
 
 # Loopback only: DDS traffic never leaves this host's lo interface.
 export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
@@ -69,12 +81,6 @@ cleanup() {
 trap cleanup EXIT
 trap 'echo "spawn.sh: interrupted, stopping children" >&2; exit 130' INT TERM
 
-world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$domain" --out "$out")
-[ -n "$max_steps" ] && world_args+=(--max-steps "$max_steps")
-[ "$quiet" -eq 1 ] && world_args+=(--quiet)
-seed_args=()
-[ -n "$seed" ] && seed_args=(--seed "$seed")
-world_args+=("${seed_args[@]}")
 "$bin/marsala-world" "${world_args[@]}" >"$out/logs/world.log" 2>&1 &
 world_pid=$!
 pids+=("$world_pid")

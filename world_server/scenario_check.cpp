@@ -1,103 +1,237 @@
 #include "marsala/world_server/scenario_check.hpp"
 
-#include <fmt/format.h>
+#include <google/protobuf/util/json_util.h>
 
-#include "marsala/core/format.hpp"
+#include <charconv>
+#include <new>
+#include <ostream>
+#include <sstream>
+
+#include "marsala/core/error.hpp"
+#include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
+#include "idl/scenario_check.pb.h"
+#include "marsala/world_server/completion.hpp"
 
 namespace marsala::world_server {
 namespace {
 
-/// A JSON string literal of `s` (RFC 8259 escapes; bytes >= 0x80 pass through as UTF-8).
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (c < 0x20) {
-      out += fmt::format("\\u{:04x}", c);
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
+/// `v` in its shortest form that reads back to the same double (std::to_chars, as terrain files are written).
+std::string number(double v) {
+  char buf[40];
+  const auto result = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, result.ptr);
 }
 
-std::string completion_json(const scenario::Scenario& s) {
-  const std::string kind = json_string(scenario::to_string(s.completion));
-  switch (s.completion) {
-    case scenario::CompletionKind::kAgentsAtGoal:
-      return fmt::format(R"({{"kind": {}, "x0_m": {}, "y0_m": {}, "x1_m": {}, "y1_m": {}, "min_height_m": {}}})", kind,
-                         s.goal.x0_m, s.goal.y0_m, s.goal.x1_m, s.goal.y1_m, s.goal.min_height_m);
+std::string point(double x_m, double y_m) { return "(" + number(x_m) + ", " + number(y_m) + ")"; }
+
+std::string box(double x0_m, double y0_m, double x1_m, double y1_m) {
+  return "x [" + number(x0_m) + ", " + number(x1_m) + "] y [" + number(y0_m) + ", " + number(y1_m) + "] m";
+}
+
+std::string terrain_source(const scenario::Scenario& s) {
+  return s.terrain.file.empty() ? "generator " + s.terrain.method : scenario::resolve_terrain_path(s);
+}
+
+void set_point(proto::CheckPoint* p, double x_m, double y_m) {
+  p->set_x_m(x_m);
+  p->set_y_m(y_m);
+}
+
+/// The slot's start as the world places it, when the world waits for that agent.
+const AgentRecord* record_of(const WorldState& state, std::uint32_t id) {
+  return state.has_agent(id) ? &state.agent(id) : nullptr;
+}
+
+long long site_cell_count(const WorldState& state) {
+  return site_cells(state.terrain.geometry(), state.site).size();
+}
+
+proto::ScenarioCheck to_message(const WorldStart& start) {
+  const scenario::Scenario& s = start.scenario;
+  const WorldState& state = start.state;
+  const GridGeometry& g = state.terrain.geometry();
+  proto::ScenarioCheck m;
+  m.set_scenario(s.name);
+  m.set_scenario_file(s.source_path);
+  proto::TerrainCheck* t = m.mutable_terrain();
+  t->set_source(terrain_source(s));
+  t->set_rows(g.rows);
+  t->set_cols(g.cols);
+  t->set_cell_size_m(g.cell_size_m);
+  t->set_x0_m(g.xll_m);
+  t->set_y0_m(g.yll_m);
+  t->set_width_m(g.cols * g.cell_size_m);
+  t->set_height_m(g.rows * g.cell_size_m);
+  t->set_min_height_m(state.terrain.min_height());
+  t->set_max_height_m(state.terrain.max_height());
+  for (const RobotType& type : s.robot_types) {
+    proto::RobotTypeCheck* r = m.add_robot_types();
+    r->set_name(type.name);
+    r->set_behaviour(type.behaviour);
+    r->set_kappa(type.body.navigability.kappa);
+    r->set_delta_m(type.body.navigability.delta_m);
+    r->set_eps_m(type.body.navigability.eps_m);
+    r->set_max_step_m(type.body.max_step_m);
+    r->set_cube_size_m(type.body.cube_size_m);
+    r->set_goal_synthesizer(type.goal_synthesizer);
+  }
+  for (const scenario::AgentSlot& slot : s.slots) {
+    proto::SlotCheck* p = m.add_slots();
+    p->set_id(slot.id);
+    p->set_robot_type(slot.robot_type);
+    set_point(p->mutable_start(), slot.start_x_m, slot.start_y_m);
+    set_point(p->mutable_target(), slot.target_x_m, slot.target_y_m);
+    if (const AgentRecord* a = record_of(state, slot.id))
+      set_point(p->mutable_world_start(), a->start_x_m, a->start_y_m);
+  }
+  m.set_agents(static_cast<std::uint32_t>(state.agents.size()));
+  m.set_completion(scenario::to_string(state.completion));
+  switch (state.completion) {
+    case scenario::CompletionKind::kAgentsAtGoal: {
+      proto::GoalCheck* goal = m.mutable_goal();
+      goal->set_x0_m(state.goal.x0_m);
+      goal->set_y0_m(state.goal.y0_m);
+      goal->set_x1_m(state.goal.x1_m);
+      goal->set_y1_m(state.goal.y1_m);
+      goal->set_min_height_m(state.goal.min_height_m);
+      break;
+    }
     case scenario::CompletionKind::kPayloadPath: {
-      const scenario::PayloadPath& p = s.payload_path;
-      return fmt::format(
-          R"({{"kind": {}, "kappa": {}, "delta_m": {}, "eps_m": {}, "from_m": [{}, {}], "to_m": [{}, {}]}})", kind,
-          p.navigability.kappa, p.navigability.delta_m, p.navigability.eps_m, p.from_x_m, p.from_y_m, p.to_x_m, p.to_y_m);
+      const scenario::PayloadPath& p = state.payload_path;
+      proto::PayloadPathCheck* path = m.mutable_payload_path();
+      path->set_kappa(p.navigability.kappa);
+      path->set_delta_m(p.navigability.delta_m);
+      path->set_eps_m(p.navigability.eps_m);
+      set_point(path->mutable_from(), p.from_x_m, p.from_y_m);
+      set_point(path->mutable_to(), p.to_x_m, p.to_y_m);
+      path->set_check_every_steps(p.check_every_steps);
+      path->set_met_at_start(state.check.met);
+      break;
     }
     case scenario::CompletionKind::kLevelSite: {
-      const scenario::Site& t = s.site;
-      return fmt::format(
-          R"({{"kind": {}, "kappa": {}, "delta_m": {}, "eps_m": {}, "x0_m": {}, "y0_m": {}, "x1_m": {}, "y1_m": {}, )"
-          R"("min_fraction": {}}})",
-          kind, t.navigability.kappa, t.navigability.delta_m, t.navigability.eps_m, t.x0_m, t.y0_m, t.x1_m, t.y1_m, t.min_fraction);
+      const scenario::Site& p = state.site;
+      proto::SiteCheck* site = m.mutable_site();
+      site->set_x0_m(p.x0_m);
+      site->set_y0_m(p.y0_m);
+      site->set_x1_m(p.x1_m);
+      site->set_y1_m(p.y1_m);
+      site->set_kappa(p.navigability.kappa);
+      site->set_delta_m(p.navigability.delta_m);
+      site->set_eps_m(p.navigability.eps_m);
+      site->set_min_fraction(p.min_fraction);
+      site->set_check_every_steps(p.check_every_steps);
+      site->set_cells(site_cell_count(state));
+      site->set_level_fraction_at_start(state.check.level_fraction);
+      site->set_met_at_start(state.check.met);
+      break;
     }
   }
-  return fmt::format(R"({{"kind": {}}})", kind);
+  set_point(m.mutable_base(), state.base.x_m, state.base.y_m);
+  m.set_base_radius_m(state.base.radius_m);
+  m.set_max_steps(start.options.max_steps);
+  m.set_seed(s.seed);
+  m.set_start_jitter_m(s.start_jitter_m);
+  m.set_step_deadline_s(start.options.step_deadline_s);
+  m.set_tile_size(state.tile_size);
+  m.set_run_id(start.options.run_id);
+  return m;
 }
 
 }  // namespace
 
-CheckedScenario check_scenario(const std::string& path) {
-  CheckedScenario checked{scenario::load_scenario(path), {}};
-  const scenario::Scenario& s = checked.scenario;
-  checked.state = make_world_state(s, scenario::build_terrain(s), static_cast<std::uint32_t>(s.slots.size()));
-  return checked;
-}
-
-std::string describe_text(const CheckedScenario& checked) {
-  const scenario::Scenario& s = checked.scenario;
-  const GridGeometry g = checked.state.terrain.geometry();
-  std::string out = fmt::format("scenario {} ({}): valid\n", s.name, s.source_path);
-  out += fmt::format("terrain: {} x {} cells of {} m, lower-left corner ({}, {}) m\n", g.rows, g.cols, g.cell_size_m,
-                     g.xll_m, g.yll_m);
-  for (const RobotType& t : s.robot_types)
-    out += fmt::format("robot type {}: behaviour {}, {}, max_step {} m, cube {} m, goal synthesizer {}\n", t.name,
-                       t.behaviour, t.body.navigability, t.body.max_step_m, t.body.cube_size_m, t.goal_synthesizer);
-  for (const AgentRecord& a : checked.state.agents)
-    out += fmt::format("slot {}: {} from ({}, {}) m to ({}, {}) m\n", a.id, a.robot_type, a.start_x_m, a.start_y_m,
-                       a.target_x_m, a.target_y_m);
-  out += fmt::format("completion: {}\n", scenario::to_string(s.completion));
-  out += fmt::format("max_steps {}, step deadline {} s, seed {}, start jitter {} m\n", s.max_steps,
-                     s.step_deadline_s, s.seed, s.start_jitter_m);
-  return out;
-}
-
-std::string describe_json(const CheckedScenario& checked) {
-  const scenario::Scenario& s = checked.scenario;
-  const GridGeometry g = checked.state.terrain.geometry();
-  std::string types, slots;
-  for (const RobotType& t : s.robot_types) {
-    const NavigabilityParams& n = t.body.navigability;
-    types += fmt::format(
-        R"({}{{"name": {}, "behaviour": {}, "kappa": {}, "delta_m": {}, "eps_m": {}, "max_step_m": {}, )"
-        R"("cube_size_m": {}, "goal_synthesizer": {}}})",
-        types.empty() ? "" : ", ", json_string(t.name), json_string(t.behaviour), n.kappa, n.delta_m, n.eps_m,
-        t.body.max_step_m, t.body.cube_size_m, json_string(t.goal_synthesizer));
+WorldStart check_scenario(const std::string& scenario_path, const RuntimeOptions& options, int domain_id) {
+  // What run_world_cli() does before it makes a participant, then what WorldRuntime's constructor does.
+  const scenario::Scenario scenario = scenario::load_scenario(scenario_path);
+  Heightmap terrain = scenario::build_terrain(scenario);
+  try {
+    return prepare_world_start(scenario, std::move(terrain), options, domain_id);
+  } catch (const InvalidArgument& e) {
+    // The loader's and the terrain builder's messages name the file; these (completion set-up, options) do not.
+    throw InvalidArgument("scenario " + scenario.source_path + ": " + e.what());
   }
-  for (const AgentRecord& a : checked.state.agents)
-    slots += fmt::format(R"({}{{"id": {}, "robot_type": {}, "start_m": [{}, {}], "target_m": [{}, {}]}})",
-                         slots.empty() ? "" : ", ", a.id, json_string(a.robot_type), a.start_x_m, a.start_y_m,
-                         a.target_x_m, a.target_y_m);
-  return fmt::format(
-      R"({{"scenario": {}, "source": {}, "terrain": {{"rows": {}, "cols": {}, "cell_size_m": {}, "xll_m": {}, )"
-      R"("yll_m": {}}}, "robot_types": [{}], "slots": [{}], "completion": {}, "max_steps": {}, )"
-      R"("step_deadline_s": {}, "seed": {}, "start_jitter_m": {}}})"
-      "\n",
-      json_string(s.name), json_string(s.source_path), g.rows, g.cols, g.cell_size_m, g.xll_m, g.yll_m, types, slots,
-      completion_json(s), s.max_steps, s.step_deadline_s, s.seed, s.start_jitter_m);
+}
+
+std::string scenario_check_text(const WorldStart& start) {
+  const scenario::Scenario& s = start.scenario;
+  const WorldState& state = start.state;
+  const GridGeometry& g = state.terrain.geometry();
+  std::ostringstream out;
+  out << "scenario " << s.name << " (" << s.source_path << "): valid\n";
+  out << "terrain: " << g.rows << " x " << g.cols << " cells of " << number(g.cell_size_m) << " m, "
+      << box(g.xll_m, g.yll_m, g.xll_m + g.cols * g.cell_size_m, g.yll_m + g.rows * g.cell_size_m) << ", heights ["
+      << number(state.terrain.min_height()) << ", " << number(state.terrain.max_height()) << "] m ("
+      << terrain_source(s) << ")\n";
+  out << "robot types (" << s.robot_types.size() << "):\n";
+  for (const RobotType& t : s.robot_types)
+    out << "  " << t.name << ": behaviour " << t.behaviour << ", kappa " << number(t.body.navigability.kappa) << ", delta_m "
+        << number(t.body.navigability.delta_m) << ", eps_m " << number(t.body.navigability.eps_m) << ", max_step_m " << number(t.body.max_step_m)
+        << ", cube_size_m " << number(t.body.cube_size_m) << ", goal_synthesizer " << t.goal_synthesizer << "\n";
+  out << "slots (" << s.slots.size() << "; the world waits for agents 1.." << state.agents.size() << "):\n";
+  for (const scenario::AgentSlot& slot : s.slots) {
+    out << "  " << slot.id << " " << slot.robot_type << ": start " << point(slot.start_x_m, slot.start_y_m)
+        << " target " << point(slot.target_x_m, slot.target_y_m);
+    const AgentRecord* a = record_of(state, slot.id);
+    if (a && (a->start_x_m != slot.start_x_m || a->start_y_m != slot.start_y_m))
+      out << ", jittered start " << point(a->start_x_m, a->start_y_m);
+    out << "\n";
+  }
+  out << "completion: " << scenario::to_string(state.completion);
+  switch (state.completion) {
+    case scenario::CompletionKind::kAgentsAtGoal:
+      out << ", goal " << box(state.goal.x0_m, state.goal.y0_m, state.goal.x1_m, state.goal.y1_m) << ", min_height_m "
+          << number(state.goal.min_height_m) << "\n";
+      break;
+    case scenario::CompletionKind::kPayloadPath: {
+      const scenario::PayloadPath& p = state.payload_path;
+      out << ", payload kappa " << number(p.navigability.kappa) << ", delta_m " << number(p.navigability.delta_m) << ", eps_m "
+          << number(p.navigability.eps_m) << ", from " << point(p.from_x_m, p.from_y_m) << " to " << point(p.to_x_m, p.to_y_m)
+          << ", checked every " << p.check_every_steps << " steps; at start: "
+          << (state.check.met ? "navigable (the run ends at once)" : "not navigable") << "\n";
+      break;
+    }
+    case scenario::CompletionKind::kLevelSite: {
+      const scenario::Site& p = state.site;
+      out << ", site " << box(p.x0_m, p.y0_m, p.x1_m, p.y1_m) << " (" << site_cell_count(state) << " cells), kappa "
+          << number(p.navigability.kappa) << ", delta_m " << number(p.navigability.delta_m) << ", eps_m " << number(p.navigability.eps_m)
+          << ", min_fraction " << number(p.min_fraction) << ", checked every " << p.check_every_steps
+          << " steps; at start: level fraction " << number(state.check.level_fraction)
+          << (state.check.met ? " (the run ends at once)" : "") << "\n";
+      break;
+    }
+  }
+  out << "base: " << point(state.base.x_m, state.base.y_m) << " m, radius " << number(state.base.radius_m) << " m\n";
+  out << "max_steps " << start.options.max_steps << ", seed " << s.seed << ", start_jitter_m "
+      << number(s.start_jitter_m) << ", step_deadline_s " << number(start.options.step_deadline_s) << ", tile_size "
+      << state.tile_size << ", run id " << start.options.run_id << "\n";
+  return out.str();
+}
+
+std::string scenario_check_json(const WorldStart& start) {
+  google::protobuf::util::JsonPrintOptions options;
+  options.add_whitespace = true;
+  options.always_print_primitive_fields = true;
+  options.preserve_proto_field_names = true;
+  std::string json;
+  const auto status = google::protobuf::util::MessageToJsonString(to_message(start), &json, options);
+  if (!status.ok()) throw Error("cannot print the scenario check as JSON: " + status.ToString());
+  if (json.empty() || json.back() != '\n') json += '\n';
+  return json;
+}
+
+int run_scenario_check(const std::string& scenario_path, const RuntimeOptions& options, int domain_id, bool json,
+                       std::ostream& out, std::ostream& err) {
+  try {
+    const WorldStart start = check_scenario(scenario_path, options, domain_id);
+    out << (json ? scenario_check_json(start) : scenario_check_text(start));
+  } catch (const Error& e) {
+    err << "marsala-world: error: " << e.what() << "\n";
+    return kExitInvalidScenario;
+  } catch (const std::bad_alloc&) {
+    err << "marsala-world: error: out of memory\n";
+    return 1;
+  }
+  return 0;
 }
 
 }  // namespace marsala::world_server

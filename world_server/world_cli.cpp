@@ -20,20 +20,25 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
                "lockstep (frames, requests, validation in agent-id order) and writes summary.json, terrain_initial.asc,\n"
                "terrain_final.asc, final.png, events.log, final_zoom.png (a close-up of what was built, unless it would\n"
                "cover more than half the terrain) and goal_vector_map.png (when the scenario has one) into --out.\n"
-               "The run id (partition prefix) defaults to <scenario name>-d<domain>.",
+               "The run id (partition prefix) defaults to <scenario name>-d<domain>.\n"
+               "marsala-world --check [--json] SCENARIO validates the scenario as the world would at start, without\n"
+               "DDS, prints what the run would start from and exits 0 when valid, 2 when not.",
                "marsala-world"};
-  std::string scenario_path, dds = "cyclone";
+  std::string scenario_path, check_path, dds = "cyclone";
   RuntimeOptions options;
   int domain = 0;
-  bool quiet = false;
-  std::string positional_scenario;
-  bool check = false, json = false;
-  app.add_option("--scenario", scenario_path, "scenario file (protobuf text format)");
-  app.add_option("scenario_file", positional_scenario, "the scenario file, with --check");
-  app.add_flag("--check", check,
-               "validate the scenario as the world would at start (no DDS), print its slots, robot types and "
-               "completion, and exit: 0 valid, 1 not (the error names file, line and field)");
-  app.add_flag("--json", json, "with --check: print one JSON object instead of text");
+  bool quiet = false, check = false, json = false;
+  CLI::Option* scenario_option =
+      app.add_option("--scenario", scenario_path, "scenario file (protobuf text format); required but with --check");
+  CLI::Option* check_option = app.add_flag(
+      "--check", check,
+      "validate the scenario as the world would at start (scenario, terrain, completion, slots, options) without\n"
+      "starting DDS, print what the run would start from and exit: 0 valid, 2 not (one line naming file and field)");
+  app.add_flag("--json", json, "with --check: print the report as one JSON object (idl/scenario_check.proto)")
+      ->needs(check_option);
+  app.add_option("SCENARIO", check_path, "with --check: the scenario file (or give --scenario)")
+      ->needs(check_option)
+      ->excludes(scenario_option);
   app.add_option("--agents", options.agents, "agents to wait for, ids 1..N (default: every slot of the scenario)")
       ->check(CLI::Range(1u, 100000u));
   app.add_option("--dds", dds, "DDS vendor")->check(CLI::IsMember({"cyclone", "fastdds", "inprocess"}))
@@ -48,26 +53,16 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   const CLI::Option* seed_option =
       app.add_option("--seed", seed, "override the scenario's seed (start jitter); summary.json reports the seed used");
   app.add_flag("--quiet", quiet, "log warnings and errors only");
+  app.callback([&] {
+    // --scenario is required of a run; a check takes its file either way.
+    if (scenario_option->count() == 0 && check_path.empty())
+      throw CLI::RequiredError(check ? "SCENARIO (or --scenario)" : "--scenario");
+  });
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-world", out, err)) return *code;
 
-  if (scenario_path.empty()) scenario_path = positional_scenario;
-  if (scenario_path.empty() || (!positional_scenario.empty() && scenario_path != positional_scenario) ||
-      (!check && !positional_scenario.empty()) || (json && !check)) {
-    err << "marsala-world: give the scenario as --scenario FILE, or as --check [--json] FILE (run with --help for "
-           "usage)\n";
-    return cli::kExitUsage;
-  }
-  if (check) {
-    try {
-      const CheckedScenario checked = check_scenario(scenario_path);
-      out << (json ? describe_json(checked) : describe_text(checked));
-      return 0;
-    } catch (const Error& e) {
-      err << "marsala-world: error: " << e.what() << "\n";
-      return 1;
-    }
-  }
   if (seed_option->count() > 0) options.seed = seed;
+  if (check)
+    return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, domain, json, out, err);
   spdlog::set_pattern("%H:%M:%S.%e %^%l%$ world: %v");
   spdlog::set_level(quiet ? spdlog::level::warn : spdlog::level::info);
   try {

@@ -81,27 +81,37 @@ struct AgentLink {
   bool writer_seen = false;  ///< its request writer has been alive at least once
 };
 
+WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, RuntimeOptions options,
+                               int domain_id) {
+  WorldStart start{s, std::move(options), {}};
+  RuntimeOptions& o = start.options;
+  if (o.seed) start.scenario.seed = *o.seed;
+  const std::uint32_t agents = o.agents == 0 ? static_cast<std::uint32_t>(s.slots.size()) : o.agents;
+  if (agents > s.slots.size())
+    throw InvalidArgument("--agents " + std::to_string(agents) + " exceeds the " + std::to_string(s.slots.size()) +
+                          " agent slots of scenario '" + s.name + "'");
+  o.agents = agents;
+  if (o.run_id.empty()) o.run_id = default_run_id(s.name, domain_id);
+  check_run_id(o.run_id);
+  if (!(o.admit_timeout_s >= 0.0) || !std::isfinite(o.admit_timeout_s))
+    throw InvalidArgument("admit timeout must be finite and >= 0 s");
+  if (o.max_steps == 0) o.max_steps = s.max_steps;
+  if (o.step_deadline_s == 0.0) o.step_deadline_s = s.step_deadline_s;
+  if (!(o.step_deadline_s > 0.0) || !std::isfinite(o.step_deadline_s))
+    throw InvalidArgument("step deadline must be finite and > 0 s");
+  start.state = make_world_state(start.scenario, std::move(terrain), agents);
+  return start;
+}
+
 struct WorldRuntime::Impl {
-  Impl(const scenario::Scenario& s, Heightmap terrain, RuntimeOptions o, bus::Participant& p)
-      : scenario(s), options(std::move(o)), participant(p) {
-    if (options.seed) scenario.seed = *options.seed;
-    const std::uint32_t agents = options.agents == 0 ? static_cast<std::uint32_t>(s.slots.size()) : options.agents;
-    if (agents > s.slots.size())
-      throw InvalidArgument("--agents " + std::to_string(agents) + " exceeds the " + std::to_string(s.slots.size()) +
-                            " agent slots of scenario '" + s.name + "'");
-    if (options.run_id.empty()) options.run_id = default_run_id(s.name, p.domain_id());
-    check_run_id(options.run_id);
-    if (!(options.admit_timeout_s >= 0.0) || !std::isfinite(options.admit_timeout_s))
-      throw InvalidArgument("admit timeout must be finite and >= 0 s");
-    if (options.max_steps == 0) options.max_steps = s.max_steps;
-    if (options.step_deadline_s == 0.0) options.step_deadline_s = s.step_deadline_s;
-    if (!(options.step_deadline_s > 0.0) || !std::isfinite(options.step_deadline_s))
-      throw InvalidArgument("step deadline must be finite and > 0 s");
-    if (scenario.has_goal_vector_map) initial_terrain = terrain;
-    state = make_world_state(scenario, std::move(terrain), agents);
+  Impl(WorldStart start, bus::Participant& p)
+      : scenario(std::move(start.scenario)), options(std::move(start.options)), participant(p),
+        state(std::move(start.state)) {
+    // make_world_state() keeps the terrain as given: the state's terrain is still the initial one.
+    if (scenario.has_goal_vector_map) initial_terrain = state.terrain;
     sensing.emplace(state);
-    links.resize(agents);
-    last_rejection.resize(agents);
+    links.resize(state.agents.size());
+    last_rejection.resize(state.agents.size());
   }
 
   void open_endpoints() {
@@ -416,7 +426,9 @@ struct WorldRuntime::Impl {
 
 WorldRuntime::WorldRuntime(const scenario::Scenario& scenario, Heightmap terrain, RuntimeOptions options,
                            bus::Participant& participant)
-    : impl_(std::make_unique<Impl>(scenario, std::move(terrain), std::move(options), participant)) {}
+    : impl_(std::make_unique<Impl>(
+          prepare_world_start(scenario, std::move(terrain), std::move(options), participant.domain_id()),
+          participant)) {}
 
 WorldRuntime::~WorldRuntime() = default;
 

@@ -51,11 +51,25 @@ std::string default_run_id(const std::string& scenario_name, int domain_id);
 /// Throws InvalidArgument unless `run_id` is non-empty letters, digits, '_', '-', '.' (no partition wildcards).
 void check_run_id(const std::string& run_id);
 
+/// What a run starts from, decided before the world touches the bus.
+struct WorldStart {
+  scenario::Scenario scenario;  ///< with the seed in use (RuntimeOptions::seed when given)
+  RuntimeOptions options;       ///< resolved: agents, run id, max_steps and step deadline filled in and checked
+  WorldState state;             ///< the initial state (make_world_state(): start jitter, completion check set up)
+};
+
+/// Everything the world checks and decides at start before it admits agents, on the run's terrain: applies the seed
+/// override, resolves the options (agents 0 = every slot, run id empty = default_run_id(scenario, domain_id), max_steps
+/// and step deadline 0 = the scenario's) and makes the initial state. Throws InvalidArgument when the agent count
+/// exceeds the scenario's slots, the run id or a timeout is invalid, or make_world_state() rejects the scenario
+/// (payload's `from` or `to` off the grid, a site with no cell on the grid).
+WorldStart prepare_world_start(const scenario::Scenario& scenario, Heightmap terrain, RuntimeOptions options,
+                               int domain_id);
+
 /// One run of the world server on one participant.
 class WorldRuntime {
  public:
-  /// Validates the options (agent count within the scenario's slots, run id, timeouts) and prepares the state;
-  /// throws InvalidArgument.
+  /// Validates the options and prepares the state with prepare_world_start(); throws InvalidArgument.
   WorldRuntime(const scenario::Scenario& scenario, Heightmap terrain, RuntimeOptions options,
                bus::Participant& participant);
   ~WorldRuntime();

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# deploy/sweep.sh end to end: bad arguments, the per-team aggregation on a hand-made CSV, a real two-run sweep of the
-# ramp scenario (teams 1 and 2, one seed), a re-run that appends nothing, a resume after a lost row, a sweep stopped
-# mid-run, and the plot. ctest runs it inside run_isolated.sh (a private network namespace with only lo, when
-# permitted); sweep.sh runs its processes through spawn.sh with the loopback DDS configs.
+# deploy/sweep.sh (the wrapper of deploy/sweep.py) end to end: bad arguments and a scenario marsala-world --check
+# rejects, the per-team aggregation on a hand-made CSV, a real two-run sweep of the ramp scenario (teams 1 and 2, one
+# seed), a re-run that appends nothing, a resume after a lost row, a sweep stopped mid-run, and the plot. ctest runs it
+# inside run_isolated.sh (a private network namespace with only lo, when permitted); the sweep runs its processes
+# through spawn.sh with the loopback DDS configs.
 #
 # Usage: sweep_test.sh
 set -euo pipefail
@@ -43,7 +44,12 @@ expect_usage_error "cyclone or fastdds, got 'opensplice'" --scenario "$scenario"
 expect_usage_error "--max-steps N needs an integer" --scenario "$scenario" --max-steps 1.5
 expect_usage_error "--jobs N needs an integer" --scenario "$scenario" --jobs 0
 expect_usage_error "not found" --scenario "$work/none.pbtxt"
-echo "ok: 13 bad argument lists exit 2 with their message"
+# A scenario the world would reject: exit 2 with marsala-world --check's message (file and field), nothing started.
+sed 's/robot_type: "husky" start { x_m: 5.05 y_m: 10.05 }/robot_type: "rover" start { x_m: 5.05 y_m: 10.05 }/' \
+  "$scenario" >"$work/rover.pbtxt"
+expect_usage_error "scenario $work/rover.pbtxt: agent\[1\] (agent 2).robot_type: unknown robot type 'rover'" \
+  --scenario "$work/rover.pbtxt" --teams 1
+echo "ok: 14 bad argument lists exit 2 with their message"
 
 # --- 2. aggregation on a hand-made CSV (no runs: every pair is there) ---------------------------------------------
 # team 1: steps 100 and 140, idle 50 and 28 -> mean 120 [100, 140], idle fractions 0.5 and 0.2 -> 0.35 [0.2, 0.5];
