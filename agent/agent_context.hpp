@@ -6,8 +6,8 @@
 #include <optional>
 #include <string>
 
-#include "marsala/core/heightmap.hpp"
 #include "marsala/core/goal_vector_map.hpp"
+#include "marsala/core/heightmap.hpp"
 #include "marsala/core/robot_type.hpp"
 #include "marsala/core/types.hpp"
 
@@ -16,25 +16,25 @@ namespace marsala::agent {
 /// Where the world placed this agent, read from its admission by the reactive layer (assignment_from): the layers
 /// below never see the wire message.
 struct Assignment {
-  GridGeometry world;           ///< the world grid (rows, cols, lower-left corner [m], cell size [m/cell])
-  int tile_size = 16;           ///< the terrain arrives in tiles of tile_size x tile_size cells
-  Position start;               ///< where the robot starts [m]
-  Position target;              ///< the scenario's goal for this agent [m]
-  Position base;                ///< base station centre: material is refilled only near it [m]
-  double base_radius_m = 0.0;   ///< [m]
+  GridGeometry world;          ///< the world grid (rows, cols, lower-left corner [m], cell size [m/cell])
+  int tile_size = 16;          ///< the terrain arrives in tiles of tile_size x tile_size cells
+  Position start;              ///< where the robot starts [m]
+  Position target;             ///< the scenario's goal for this agent [m]
+  Position base;               ///< base station centre: material is refilled only near it [m]
+  double base_radius_m = 0.0;  ///< [m]
 };
 
 /// The admitted agent: identity, body, the world's answer and team-wide margins.
 struct AgentContext {
-  std::uint32_t agent_id = 0;       ///< >= 1
-  std::uint64_t session = 0;        ///< echoed in every request
-  RobotType type;                   ///< body, behaviour, what it builds, pipeline, goal synthesizer
-  Assignment assignment;            ///< world grid, tile size, start, target and base station (once admitted)
+  std::uint32_t agent_id = 0;  ///< >= 1
+  std::uint64_t session = 0;   ///< echoed in every request
+  RobotType type;              ///< body, behaviour, what it builds, pipeline, goal synthesizer
+  Assignment assignment;       ///< world grid, tile size, start, target and base station (once admitted)
   /// Depositions stay farther than this from a neighbour's reported centre [m]: the world rejects cells under any
   /// robot, and a neighbour may move before its turn; default = delta/2 + max_step of this body (see
   /// neighbour_keep_out_m()).
   double neighbour_keep_out_m = 0.0;
-  std::uint64_t seed = 1;           ///< scenario seed; behaviours that randomise seed from seed + agent_id
+  std::uint64_t seed = 1;  ///< scenario seed; behaviours that randomise seed from seed + agent_id
   std::optional<GoalVectorMapSpec> goal_vector_map;  ///< the scenario's, for the "goal_vector_map" synthesizer
 };
 

@@ -118,13 +118,17 @@ void BM_BusPingPong(benchmark::State& state, Vendor ping, Vendor pong, int domai
 }
 
 BENCHMARK_CAPTURE(BM_BusPingPong, cyclone, Vendor::kCyclone, Vendor::kCyclone, 190)
-    ->Unit(benchmark::kMicrosecond)->UseRealTime();
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_BusPingPong, fastdds, Vendor::kFastDds, Vendor::kFastDds, 191)
-    ->Unit(benchmark::kMicrosecond)->UseRealTime();
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_BusPingPong, cyclone_to_fastdds, Vendor::kCyclone, Vendor::kFastDds, 192)
-    ->Unit(benchmark::kMicrosecond)->UseRealTime();
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_BusPingPong, fastdds_to_cyclone, Vendor::kFastDds, Vendor::kCyclone, 193)
-    ->Unit(benchmark::kMicrosecond)->UseRealTime();
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 }  // namespace
 

@@ -24,9 +24,9 @@
 
 namespace {
 
-using marsala::NavigabilityParams;
 using marsala::GridGeometry;
 using marsala::Heightmap;
+using marsala::NavigabilityParams;
 using marsala::NavigabilityProcessor;
 
 constexpr double kCellSizeM = 0.1;
@@ -41,8 +41,8 @@ std::uint64_t mix(std::uint64_t x) {  // splitmix64 finaliser
 
 /// Lattice value in [-1, 1] at integer point (x, y) of octave `octave`.
 double lattice(std::uint64_t seed, int octave, long long x, long long y) {
-  const std::uint64_t h = mix(seed ^ mix(static_cast<std::uint64_t>(octave) ^ mix(static_cast<std::uint64_t>(x) ^
-                                                                                   mix(static_cast<std::uint64_t>(y)))));
+  const std::uint64_t h = mix(seed ^ mix(static_cast<std::uint64_t>(octave) ^
+                                         mix(static_cast<std::uint64_t>(x) ^ mix(static_cast<std::uint64_t>(y)))));
   return static_cast<double>(h >> 11) * (2.0 / 9007199254740992.0) - 1.0;
 }
 
@@ -52,9 +52,10 @@ double value_noise(std::uint64_t seed, int octave, double x, double y) {
   const long long ix = static_cast<long long>(fx), iy = static_cast<long long>(fy);
   const double tx = x - fx, ty = y - fy;
   const double sx = tx * tx * (3.0 - 2.0 * tx), sy = ty * ty * (3.0 - 2.0 * ty);
-  const double top = lattice(seed, octave, ix, iy) + sx * (lattice(seed, octave, ix + 1, iy) - lattice(seed, octave, ix, iy));
-  const double bottom =
-      lattice(seed, octave, ix, iy + 1) + sx * (lattice(seed, octave, ix + 1, iy + 1) - lattice(seed, octave, ix, iy + 1));
+  const double top =
+      lattice(seed, octave, ix, iy) + sx * (lattice(seed, octave, ix + 1, iy) - lattice(seed, octave, ix, iy));
+  const double bottom = lattice(seed, octave, ix, iy + 1) +
+                        sx * (lattice(seed, octave, ix + 1, iy + 1) - lattice(seed, octave, ix, iy + 1));
   return top + sy * (bottom - top);
 }
 

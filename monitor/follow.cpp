@@ -168,8 +168,8 @@ int run_tail(bus::Participant& participant, const TailOptions& options, const St
     } else if (Clock::now() < *deadline) {
       signal->wait_until(*deadline);
     } else {
-      err << "marsala-monitor: no world status on " << where(participant) << " for "
-          << seconds_text(*options.timeout) << printer.last_seen() << std::endl;
+      err << "marsala-monitor: no world status on " << where(participant) << " for " << seconds_text(*options.timeout)
+          << printer.last_seen() << std::endl;
       return 1;
     }
   }
@@ -186,9 +186,10 @@ int run_tail(bus::Participant& participant, const TailOptions& options, const St
   return 0;
 }
 
-int run_status(bus::Participant& participant, const StatusOptions& options, const StopSource& stop,
-               std::ostream& out, std::ostream& err) {
-  auto statuses = participant.create_reader<protocol::WorldStatus>({"", stop.signal(), bus::Durability::kTransientLocal, 1});
+int run_status(bus::Participant& participant, const StatusOptions& options, const StopSource& stop, std::ostream& out,
+               std::ostream& err) {
+  auto statuses =
+      participant.create_reader<protocol::WorldStatus>({"", stop.signal(), bus::Durability::kTransientLocal, 1});
   const Clock::time_point deadline = Clock::now() + to_clock(options.timeout);
   for (;;) {
     const std::vector<protocol::WorldStatus> batch = statuses->take();

@@ -16,8 +16,8 @@ namespace marsala::monitor {
 
 /// Options of `tail`.
 struct TailOptions {
-  std::string run_id;                                  ///< follow this run only; empty = the first run seen
-  bool events = false;                                 ///< also print one line per WorldEvent
+  std::string run_id;                                    ///< follow this run only; empty = the first run seen
+  bool events = false;                                   ///< also print one line per WorldEvent
   std::optional<std::chrono::duration<double>> timeout;  ///< give up after this long without a status [s]; none = never
   /// How long to wait for late events (up to kRunOver) once the final status arrived [s].
   std::chrono::duration<double> drain = std::chrono::milliseconds(500);
@@ -36,7 +36,7 @@ int run_tail(bus::Participant& participant, const TailOptions& options, const St
 
 /// Waits for the latest WorldStatus and prints the status table (0); no status within options.timeout or
 /// `stop` requested first: a message on `err` and 1.
-int run_status(bus::Participant& participant, const StatusOptions& options, const StopSource& stop,
-               std::ostream& out, std::ostream& err);
+int run_status(bus::Participant& participant, const StatusOptions& options, const StopSource& stop, std::ostream& out,
+               std::ostream& err);
 
 }  // namespace marsala::monitor

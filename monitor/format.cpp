@@ -50,8 +50,8 @@ std::size_t count_alive(const protocol::WorldStatus& status) {
 }
 
 std::size_t count_at_goal(const protocol::WorldStatus& status) {
-  return static_cast<std::size_t>(std::count_if(status.agents.begin(), status.agents.end(),
-                                                [](const auto& a) { return a.alive && a.at_goal; }));
+  return static_cast<std::size_t>(
+      std::count_if(status.agents.begin(), status.agents.end(), [](const auto& a) { return a.alive && a.at_goal; }));
 }
 
 std::string state_of(const protocol::AgentStatus& agent) { return agent.state.empty() ? "?" : printable(agent.state); }
@@ -116,7 +116,8 @@ std::string format_step_header(const protocol::WorldStatus& status, const Format
   } else if (text_width == 0) {
     line += " live agents by state";
   } else {
-    for (const protocol::AgentStatus* a : by_id(status)) line += " " + pad_right(std::to_string(a->agent_id), text_width);
+    for (const protocol::AgentStatus* a : by_id(status))
+      line += " " + pad_right(std::to_string(a->agent_id), text_width);
   }
   return fit_width(trim_right(line), options.width);
 }
@@ -134,7 +135,8 @@ std::string format_step_line(const protocol::WorldStatus& status, const FormatOp
   } else if (text_width == 0) {
     line += " " + states_summary(status);
   } else {
-    for (const protocol::AgentStatus* a : by_id(status)) line += " " + pad_right(agent_column(*a, text_width), text_width);
+    for (const protocol::AgentStatus* a : by_id(status))
+      line += " " + pad_right(agent_column(*a, text_width), text_width);
   }
   return fit_width(trim_right(line), options.width);
 }
@@ -146,12 +148,12 @@ std::string format_run_summary(const protocol::WorldStatus& status) {
     rejected += a.rejected;
     missed += a.missed;
   }
-  return printf_string("run %s %s at step %llu (%.1f s) | live %zu/%zu, at goal %zu | dep %.3f m3 | acc %llu rej %llu "
-                       "miss %llu",
-                       printable(status.run_id).c_str(), run_outcome(status).c_str(),
-                       static_cast<unsigned long long>(status.step), status.wall_seconds, count_alive(status),
-                       status.agents.size(), count_at_goal(status), status.deposited_volume_m3, accepted, rejected,
-                       missed);
+  return printf_string(
+      "run %s %s at step %llu (%.1f s) | live %zu/%zu, at goal %zu | dep %.3f m3 | acc %llu rej %llu "
+      "miss %llu",
+      printable(status.run_id).c_str(), run_outcome(status).c_str(), static_cast<unsigned long long>(status.step),
+      status.wall_seconds, count_alive(status), status.agents.size(), count_at_goal(status), status.deposited_volume_m3,
+      accepted, rejected, missed);
 }
 
 std::string format_event(const protocol::WorldEvent& event, const FormatOptions& options) {
@@ -160,8 +162,8 @@ std::string format_event(const protocol::WorldEvent& event, const FormatOptions&
   const std::string kind = kind_value <= static_cast<unsigned>(protocol::EventKind::kRunOver)
                                ? protocol::to_string(event.kind)
                                : "kind " + std::to_string(kind_value);
-  std::string line = printf_string("%6llu > %-8s %-9s", static_cast<unsigned long long>(event.step), who.c_str(),
-                                   kind.c_str());
+  std::string line =
+      printf_string("%6llu > %-8s %-9s", static_cast<unsigned long long>(event.step), who.c_str(), kind.c_str());
   if (event.kind == protocol::EventKind::kDeposited) line += printf_string(" %.6g m3", event.volume_m3);
   if (!event.detail.empty()) line += " " + printable(event.detail);
   return fit_width(trim_right(line), options.width);
@@ -173,9 +175,9 @@ std::vector<std::string> format_status_table(const protocol::WorldStatus& status
                                 printable(status.run_id).c_str(), printable(status.scenario).c_str(),
                                 static_cast<unsigned long long>(status.step), status.wall_seconds,
                                 run_outcome(status).c_str(), 100.0 * status.progress, status.deposited_volume_m3));
-  lines.push_back(trim_right(printf_string("%3s %-12s %-11s %8s %8s %7s %7s %7s %5s %4s %4s %-5s %-4s", "id", "name",
-                                           "state", "x[m]", "y[m]", "z[m]", "mat[m3]", "dep[m3]", "acc", "rej", "miss",
-                                           "alive", "goal")));
+  lines.push_back(
+      trim_right(printf_string("%3s %-12s %-11s %8s %8s %7s %7s %7s %5s %4s %4s %-5s %-4s", "id", "name", "state",
+                               "x[m]", "y[m]", "z[m]", "mat[m3]", "dep[m3]", "acc", "rej", "miss", "alive", "goal")));
   double material_m3 = 0.0, deposited_m3 = 0.0;
   unsigned long long accepted = 0, rejected = 0, missed = 0;
   for (const protocol::AgentStatus* a : by_id(status)) {

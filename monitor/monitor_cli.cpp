@@ -25,11 +25,11 @@ constexpr const char* kTailLegend =
 
 }  // namespace
 
-int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err,
-                    const StopSource& stop) {
-  CLI::App app{"marsala-monitor: watch a running MARSala system (world status, agents, events). It only reads:\n"
-               "it joins and leaves a running system without disturbing it.",
-               "marsala-monitor"};
+int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err, const StopSource& stop) {
+  CLI::App app{
+      "marsala-monitor: watch a running MARSala system (world status, agents, events). It only reads:\n"
+      "it joins and leaves a running system without disturbing it.",
+      "marsala-monitor"};
   app.require_subcommand(1);
 
   std::string dds = "cyclone";

@@ -27,7 +27,8 @@ std::string body_difference(const RobotBody& got, const RobotBody& want) {
                 {"proximity_range_m", got.proximity_range_m, want.proximity_range_m},
                 {"cube_size_m", got.cube_size_m, want.cube_size_m}};
   for (const auto& f : fields)
-    if (!(f.got == f.want)) return std::string(f.name) + " " + fmt::format("{}", f.got) + " != " + fmt::format("{}", f.want);
+    if (!(f.got == f.want))
+      return std::string(f.name) + " " + fmt::format("{}", f.got) + " != " + fmt::format("{}", f.want);
   return {};
 }
 
@@ -70,7 +71,7 @@ bool admit(WorldState& state, const protocol::AgentHello& hello) {
 }
 
 protocol::Admission admission_message(const WorldState& state, const protocol::AgentHello& hello,
-                                 const AdmissionDecision& decision, const std::string& run_id) {
+                                      const AdmissionDecision& decision, const std::string& run_id) {
   protocol::Admission m;
   m.agent_id = hello.agent_id;
   m.session = hello.session;

@@ -28,6 +28,6 @@ bool admit(WorldState& state, const protocol::AgentHello& hello);
 
 /// The Admission message for `hello` and `decision`; geometry, start, target and base are filled for known ids.
 protocol::Admission admission_message(const WorldState& state, const protocol::AgentHello& hello,
-                                 const AdmissionDecision& decision, const std::string& run_id);
+                                      const AdmissionDecision& decision, const std::string& run_id);
 
 }  // namespace marsala::world_server

@@ -93,9 +93,11 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
                   std::to_string(state.step));
   const auto sane = [](double v) { return std::isfinite(v) && std::abs(v) < 1e6; };
   if (!sane(r.target_x_m) || !sane(r.target_y_m))
-    return reject("target (" + fmt::format("{}", r.target_x_m) + ", " + fmt::format("{}", r.target_y_m) + ") is not finite or too large");
+    return reject("target (" + fmt::format("{}", r.target_x_m) + ", " + fmt::format("{}", r.target_y_m) +
+                  ") is not finite or too large");
   for (const Deposition& d : r.depositions)
-    if (!sane(d.height_m)) return reject("deposition height " + fmt::format("{}", d.height_m) + " m is not finite or too large");
+    if (!sane(d.height_m))
+      return reject("deposition height " + fmt::format("{}", d.height_m) + " m is not finite or too large");
   const Heightmap& terrain = state.terrain;
   if (static_cast<long long>(r.depositions.size()) > terrain.size())
     return reject(std::to_string(r.depositions.size()) + " depositions exceed the grid's cells");
@@ -105,11 +107,14 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
   if (r.move) {
     const double d = distance(r.target_x_m, r.target_y_m, x, y);
     if (!(d <= me.body.max_step_m + tol::kLengthM))
-      return reject("motion of " + fmt::format("{}", d) + " m exceeds max_step_m " + fmt::format("{}", me.body.max_step_m));
+      return reject("motion of " + fmt::format("{}", d) + " m exceeds max_step_m " +
+                    fmt::format("{}", me.body.max_step_m));
     const auto cell = terrain.cell_at({r.target_x_m, r.target_y_m});
     if (!cell)
-      return reject("target (" + fmt::format("{}", r.target_x_m) + ", " + fmt::format("{}", r.target_y_m) + ") is off the grid");
-    if (!cell_occupiable(terrain, *cell, {me.body.navigability.kappa, me.body.navigability.delta_m, me.body.navigability.eps_m}))
+      return reject("target (" + fmt::format("{}", r.target_x_m) + ", " + fmt::format("{}", r.target_y_m) +
+                    ") is off the grid");
+    if (!cell_occupiable(terrain, *cell,
+                         {me.body.navigability.kappa, me.body.navigability.delta_m, me.body.navigability.eps_m}))
       return reject("target cell " + fmt::format("{}", *cell) + " is not occupiable for this body");
     x = r.target_x_m;
     y = r.target_y_m;
@@ -126,7 +131,8 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
     if (!terrain.contains(c)) return reject("deposition cell " + fmt::format("{}", c) + " is off the grid");
     cells.emplace_back(d.row, d.col);
     if (!(d.height_m > 0.0 && d.height_m <= tol::kMaxDepositionM + tol::kLengthM))
-      return reject("deposition height " + fmt::format("{}", d.height_m) + " m at " + fmt::format("{}", c) + " is not in (0, 1] m");
+      return reject("deposition height " + fmt::format("{}", d.height_m) + " m at " + fmt::format("{}", c) +
+                    " is not in (0, 1] m");
     const double layers = d.height_m / layer;
     const double whole = std::round(layers);
     if (!(whole >= 1.0 && std::abs(layers - whole) <= tol::kCubeMultiple))
@@ -135,8 +141,8 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
     const Position centre = terrain.cell_center(c);
     const double from_me = distance(centre.x, centre.y, x, y);
     if (!(from_me <= me.body.reach_m + tol::kLengthM))
-      return reject("deposition cell " + fmt::format("{}", c) + " is " + fmt::format("{}", from_me) + " m away, beyond reach_m " +
-                    fmt::format("{}", me.body.reach_m));
+      return reject("deposition cell " + fmt::format("{}", c) + " is " + fmt::format("{}", from_me) +
+                    " m away, beyond reach_m " + fmt::format("{}", me.body.reach_m));
     for (const AgentRecord& other : state.agents) {
       if (!other.alive) continue;
       const bool self = other.id == me.id;
@@ -176,7 +182,8 @@ void apply_request(WorldState& state, const protocol::ActionRequest& r, const Ve
   }
   if (!r.depositions.empty() &&
       (state.depositor.rows() != state.terrain.rows() || state.depositor.cols() != state.terrain.cols()))
-    state.depositor = AgentIdGrid::Zero(state.terrain.rows(), state.terrain.cols());  // a state not made by make_world_state
+    state.depositor =
+        AgentIdGrid::Zero(state.terrain.rows(), state.terrain.cols());  // a state not made by make_world_state
   for (const Deposition& d : r.depositions) {
     state.terrain(d.row, d.col) += d.height_m;
     state.depositor(d.row, d.col) = r.agent_id;

@@ -1,24 +1,24 @@
 #pragma once
-// The arbiter: validates one ActionRequest against the world state exactly as docs/runtime.md#validation says (rules 1-4,
-// all-or-nothing) and applies accepted ones. Pure functions of their arguments.
+// The arbiter: validates one ActionRequest against the world state exactly as docs/runtime.md#validation says (rules
+// 1-4, all-or-nothing) and applies accepted ones. Pure functions of their arguments.
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "marsala/protocol/messages.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/types.hpp"
+#include "marsala/protocol/messages.hpp"
 #include "marsala/world_server/world_state.hpp"
 
 namespace marsala::world_server {
 
 /// Tolerances of docs/runtime.md#tolerances.
 namespace arbiter_tolerance {
-inline constexpr double kLengthM = 1e-9;       ///< added to length limits [m]
-inline constexpr double kVolumeM3 = 1e-12;     ///< added to volume limits [m^3]
-inline constexpr double kCubeMultiple = 1e-6;  ///< |h/q - round(h/q)| limit for a whole number of cube layers
-inline constexpr double kMaxDepositionM = 1.0; ///< tallest single deposition [m]
+inline constexpr double kLengthM = 1e-9;        ///< added to length limits [m]
+inline constexpr double kVolumeM3 = 1e-12;      ///< added to volume limits [m^3]
+inline constexpr double kCubeMultiple = 1e-6;   ///< |h/q - round(h/q)| limit for a whole number of cube layers
+inline constexpr double kMaxDepositionM = 1.0;  ///< tallest single deposition [m]
 }  // namespace arbiter_tolerance
 
 /// How cell_occupiable decides; every method gives the same answer (ARCHITECTURE.md definition).
@@ -37,13 +37,13 @@ bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const Navigabilit
 /// The arbiter's answer to one request.
 struct Verdict {
   bool accepted = false;
-  std::string reason;        ///< why not, when rejected
-  double volume_m3 = 0.0;    ///< material the depositions place, when accepted [m^3]
+  std::string reason;      ///< why not, when rejected
+  double volume_m3 = 0.0;  ///< material the depositions place, when accepted [m^3]
 };
 
-/// Validates `request`, which arrived on the partition of agent `channel_id`, against `state` (docs/runtime.md#validation, rules
-/// 1-4: envelope, motion, depositions after the motion, refill). Duplicates and requests for other steps are
-/// apply_step's business; here a step other than state.step is a rejection.
+/// Validates `request`, which arrived on the partition of agent `channel_id`, against `state`
+/// (docs/runtime.md#validation, rules 1-4: envelope, motion, depositions after the motion, refill). Duplicates and
+/// requests for other steps are apply_step's business; here a step other than state.step is a rejection.
 Verdict validate_request(const WorldState& state, std::uint32_t channel_id, const protocol::ActionRequest& request);
 
 /// Applies a request validate_request accepted: position = target, depositions (each raised cell's depositor becomes

@@ -21,19 +21,20 @@ namespace {
 CellIndex cell_of(const Heightmap& terrain, double x_m, double y_m, const char* what) {
   const auto cell = terrain.cell_at({x_m, y_m});
   if (!cell)
-    throw InvalidArgument(std::string(what) + " (" + fmt::format("{}", x_m) + ", " + fmt::format("{}", y_m) + ") is off the " +
-                          std::to_string(terrain.rows()) + " x " + std::to_string(terrain.cols()) + " grid");
+    throw InvalidArgument(std::string(what) + " (" + fmt::format("{}", x_m) + ", " + fmt::format("{}", y_m) +
+                          ") is off the " + std::to_string(terrain.rows()) + " x " + std::to_string(terrain.cols()) +
+                          " grid");
   return *cell;
 }
 
 CellRect site_rect_or_throw(const Heightmap& terrain, const scenario::Site& site) {
   const CellRect rect = site_cells(terrain.geometry(), site);
   if (rect.empty())
-    throw InvalidArgument("site [" + fmt::format("{}", site.x0_m) + ", " + fmt::format("{}", site.x1_m) + "] x [" + fmt::format("{}", site.y0_m) +
-                          ", " + fmt::format("{}", site.y1_m) + "] holds no cell centre of the grid");
+    throw InvalidArgument("site [" + fmt::format("{}", site.x0_m) + ", " + fmt::format("{}", site.x1_m) + "] x [" +
+                          fmt::format("{}", site.y0_m) + ", " + fmt::format("{}", site.y1_m) +
+                          "] holds no cell centre of the grid");
   return rect;
 }
-
 
 void check_on_mask(const CellMask& mask, CellIndex c, const char* what) {
   if (c.row < 0 || c.col < 0 || c.row >= mask.rows() || c.col >= mask.cols())
@@ -45,8 +46,8 @@ void check_on_mask(const CellMask& mask, CellIndex c, const char* what) {
 bool at_goal(const WorldState& state, const AgentRecord& agent) {
   constexpr double tol = arbiter_tolerance::kLengthM;
   const scenario::Goal& g = state.goal;
-  const bool inside = agent.x_m >= g.x0_m - tol && agent.x_m <= g.x1_m + tol && agent.y_m >= g.y0_m - tol &&
-                      agent.y_m <= g.y1_m + tol;
+  const bool inside =
+      agent.x_m >= g.x0_m - tol && agent.x_m <= g.x1_m + tol && agent.y_m >= g.y0_m - tol && agent.y_m <= g.y1_m + tol;
   if (!inside) return false;
   const double h = height_under(state.terrain, agent.x_m, agent.y_m);
   return h >= g.min_height_m - tol;  // false for NaN (off the grid)
@@ -65,9 +66,12 @@ bool is_completed(const WorldState& state) {
 
 double progress(const WorldState& state) {
   switch (state.completion) {
-    case scenario::CompletionKind::kPayloadPath: return state.check.met ? 1.0 : 0.0;
-    case scenario::CompletionKind::kLevelSite: return state.check.level_fraction;
-    case scenario::CompletionKind::kAgentsAtGoal: break;
+    case scenario::CompletionKind::kPayloadPath:
+      return state.check.met ? 1.0 : 0.0;
+    case scenario::CompletionKind::kLevelSite:
+      return state.check.level_fraction;
+    case scenario::CompletionKind::kAgentsAtGoal:
+      break;
   }
   int live = 0, done = 0;
   for (const AgentRecord& a : state.agents) {
@@ -82,7 +86,8 @@ void start_completion_check(WorldState& state) {
   CompletionCheck& check = state.check;
   check = {};
   switch (state.completion) {
-    case scenario::CompletionKind::kAgentsAtGoal: return;
+    case scenario::CompletionKind::kAgentsAtGoal:
+      return;
     case scenario::CompletionKind::kPayloadPath: {
       const scenario::PayloadPath& p = state.payload_path;
       check.from = cell_of(state.terrain, p.from_x_m, p.from_y_m, "payload_path.from");
@@ -92,7 +97,8 @@ void start_completion_check(WorldState& state) {
       break;
     }
     case scenario::CompletionKind::kLevelSite:
-      check.occupancy = OccupancyCache(state.terrain, site_rect_or_throw(state.terrain, state.site), state.site.navigability);
+      check.occupancy =
+          OccupancyCache(state.terrain, site_rect_or_throw(state.terrain, state.site), state.site.navigability);
       break;
   }
   evaluate_completion(state);
@@ -177,8 +183,7 @@ double site_level_fraction(const Heightmap& terrain, const scenario::Site& site)
   return static_cast<double>(largest_component(mask)) / static_cast<double>(rect.size());
 }
 
-std::optional<PayloadRoute> shortest_path(const CellMask& passable, CellIndex from, CellIndex to,
-                                          double cell_size_m) {
+std::optional<PayloadRoute> shortest_path(const CellMask& passable, CellIndex from, CellIndex to, double cell_size_m) {
   check_on_mask(passable, from, "shortest_path: from");
   check_on_mask(passable, to, "shortest_path: to");
   if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m))
@@ -196,8 +201,7 @@ std::optional<PayloadRoute> shortest_path(const CellMask& passable, CellIndex fr
 std::optional<PayloadRoute> payload_path(const Heightmap& terrain, const scenario::PayloadPath& path) {
   const CellIndex from = cell_of(terrain, path.from_x_m, path.from_y_m, "payload_path.from");
   const CellIndex to = cell_of(terrain, path.to_x_m, path.to_y_m, "payload_path.to");
-  return shortest_path(NavigabilityProcessor(path.navigability).occupiable(terrain), from, to,
-                       terrain.cell_size_m());
+  return shortest_path(NavigabilityProcessor(path.navigability).occupiable(terrain), from, to, terrain.cell_size_m());
 }
 
 }  // namespace marsala::world_server

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "marsala/core/heightmap.hpp"
-#include "marsala/scenario/scenario.hpp"
 #include "marsala/core/types.hpp"
+#include "marsala/scenario/scenario.hpp"
 #include "marsala/world_server/world_state.hpp"
 
 namespace marsala::world_server {
@@ -66,9 +66,9 @@ struct PayloadRoute {
 
 /// A shortest 8-connected path through 1-cells of `passable` from `from` to `to`, found by the core's
 /// NavigablePathPlanner with alpha = 0 (Euclidean step costs: cs or cs * sqrt 2; among equally short paths a
-/// deterministic one), or nullopt when there is none (either end blocked or disconnected). Throws InvalidArgument when an end is off the mask or cell_size_m is not > 0.
-std::optional<PayloadRoute> shortest_path(const CellMask& passable, CellIndex from, CellIndex to,
-                                          double cell_size_m);
+/// deterministic one), or nullopt when there is none (either end blocked or disconnected). Throws InvalidArgument when
+/// an end is off the mask or cell_size_m is not > 0.
+std::optional<PayloadRoute> shortest_path(const CellMask& passable, CellIndex from, CellIndex to, double cell_size_m);
 
 /// The payload's constructed path on `terrain`: a shortest path through cells occupiable for the payload (whole
 /// grid) from the cell of `from` to the cell of `to`, or nullopt when there is none. Throws InvalidArgument when

@@ -47,8 +47,7 @@ void OccupancyCache::recompute(const Heightmap& terrain, const CellRect& t) {
   const int r0 = std::max(0, t.first.row - reach_), c0 = std::max(0, t.first.col - reach_);
   const int r1 = std::min(area_.rows, t.first.row + t.rows + reach_);
   const int c1 = std::min(area_.cols, t.first.col + t.cols + reach_);
-  const Heightmap window =
-      terrain.window({area_.first.row + r0, area_.first.col + c0}, r1 - r0, c1 - c0);
+  const Heightmap window = terrain.window({area_.first.row + r0, area_.first.col + c0}, r1 - r0, c1 - c0);
   const CellMask part = NavigabilityProcessor(params_).occupiable(window);
   mask_.block(t.first.row, t.first.col, t.rows, t.cols) =
       part.block(t.first.row - r0, t.first.col - c0, t.rows, t.cols);

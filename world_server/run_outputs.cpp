@@ -8,12 +8,12 @@
 #include <filesystem>
 #include <limits>
 
+#include "idl/run_summary.pb.h"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/render/png_writer.hpp"
 #include "marsala/render/terrain_renderer.hpp"
 #include "marsala/terrain/asc_io.hpp"
-#include "idl/run_summary.pb.h"
 #include "marsala/world_server/sha256.hpp"
 
 namespace marsala::world_server {
@@ -205,8 +205,7 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
     throw InvalidArgument(fmt::format("final_picture_options: window of {} x {} cells at {} leaves the {} x {} grid",
                                       area.rows, area.cols, area.first, t.rows(), t.cols()));
   if (state.depositor.rows() == t.rows() && state.depositor.cols() == t.cols()) {
-    const render::CellLabels labels =
-        state.depositor.block(area.first.row, area.first.col, area.rows, area.cols);
+    const render::CellLabels labels = state.depositor.block(area.first.row, area.first.col, area.rows, area.cols);
     if (labels.maxCoeff() > 0) o.labels = labels;
   }
   o.circles.push_back({{state.base.x_m, state.base.y_m}, state.base.radius_m, kWhite, 0.0});
@@ -259,9 +258,9 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
   }
   for (std::size_t k = 0; k < ids_of_colour.size(); ++k)
     if (!ids_of_colour[k].empty())
-      o.legend_entries.push_back({(ids_of_colour[k].find(',') == std::string::npos ? "agent " : "agents ") +
-                                      ids_of_colour[k],
-                                  render::default_palette()[k], render::LegendSwatch::kDisc});
+      o.legend_entries.push_back(
+          {(ids_of_colour[k].find(',') == std::string::npos ? "agent " : "agents ") + ids_of_colour[k],
+           render::default_palette()[k], render::LegendSwatch::kDisc});
   if (window) {
     const double cs = t.cell_size_m();
     const double x0 = t.geometry().xll_m + area.first.col * cs;
@@ -322,8 +321,8 @@ void write_final_outputs(const std::string& dir, const WorldState& state, const 
 }
 
 std::string format_event(const protocol::WorldEvent& e) {
-  std::string line = "step " + std::to_string(e.step) + " agent " + std::to_string(e.agent_id) + " " +
-                     protocol::to_string(e.kind);
+  std::string line =
+      "step " + std::to_string(e.step) + " agent " + std::to_string(e.agent_id) + " " + protocol::to_string(e.kind);
   if (e.kind == protocol::EventKind::kDeposited) {
     char buf[40];
     std::snprintf(buf, sizeof buf, " %.9g m3", e.volume_m3);

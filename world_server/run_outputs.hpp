@@ -19,12 +19,12 @@
 #include <optional>
 #include <string>
 
-#include "marsala/protocol/messages.hpp"
-#include "marsala/core/heightmap.hpp"
 #include "marsala/core/goal_vector_map.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/protocol/messages.hpp"
 #include "marsala/render/terrain_renderer.hpp"
-#include "marsala/world_server/end_reason.hpp"
 #include "marsala/world_server/completion.hpp"
+#include "marsala/world_server/end_reason.hpp"
 #include "marsala/world_server/occupancy_cache.hpp"
 #include "marsala/world_server/world_state.hpp"
 
@@ -32,20 +32,20 @@ namespace marsala::world_server {
 
 /// What the summary reports besides the world state.
 struct RunInfo {
-  std::string scenario;        ///< scenario name
+  std::string scenario;  ///< scenario name
   std::string scenario_file;
   std::string run_id;
-  std::string dds;             ///< cyclone, fastdds or inprocess
+  std::string dds;  ///< cyclone, fastdds or inprocess
   std::uint64_t seed = 0;
   bool completed = false;
   EndReason end_reason = EndReason::kSignal;  ///< why the run ended
-  double wall_seconds = 0.0;   ///< [s]
-  double step_wall_median_ms = 0.0;  ///< median wall time of one lockstep step [ms]
-  double step_wall_p90_ms = 0.0;     ///< its 90th percentile [ms]
-  double start_jitter_m = 0.0;       ///< the scenario's start jitter [m]
+  double wall_seconds = 0.0;                  ///< [s]
+  double step_wall_median_ms = 0.0;           ///< median wall time of one lockstep step [ms]
+  double step_wall_p90_ms = 0.0;              ///< its 90th percentile [ms]
+  double start_jitter_m = 0.0;                ///< the scenario's start jitter [m]
   /// The scenario's goal vector map, drawn into goal_vector_map.png when set.
   std::optional<GoalVectorMapSpec> goal_vector_map;
-  Heightmap initial_terrain;   ///< the terrain before the run (for goal_vector_map.png); empty = use the final
+  Heightmap initial_terrain;  ///< the terrain before the run (for goal_vector_map.png); empty = use the final
 };
 
 /// summary.json's text: every field present (zeros included); steps = state.step; terrain_sha256 of state.terrain;

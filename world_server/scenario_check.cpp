@@ -7,10 +7,10 @@
 #include <ostream>
 #include <sstream>
 
+#include "idl/scenario_check.pb.h"
 #include "marsala/core/error.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
-#include "idl/scenario_check.pb.h"
 #include "marsala/world_server/completion.hpp"
 
 namespace marsala::world_server {
@@ -43,9 +43,7 @@ const AgentRecord* record_of(const WorldState& state, std::uint32_t id) {
   return state.has_agent(id) ? &state.agent(id) : nullptr;
 }
 
-long long site_cell_count(const WorldState& state) {
-  return site_cells(state.terrain.geometry(), state.site).size();
-}
+long long site_cell_count(const WorldState& state) { return site_cells(state.terrain.geometry(), state.site).size(); }
 
 proto::ScenarioCheck to_message(const WorldStart& start) {
   const scenario::Scenario& s = start.scenario;
@@ -164,9 +162,10 @@ std::string scenario_check_text(const WorldStart& start) {
       << terrain_source(s) << ")\n";
   out << "robot types (" << s.robot_types.size() << "):\n";
   for (const RobotType& t : s.robot_types)
-    out << "  " << t.name << ": behaviour " << t.behaviour << ", kappa " << number(t.body.navigability.kappa) << ", delta_m "
-        << number(t.body.navigability.delta_m) << ", eps_m " << number(t.body.navigability.eps_m) << ", max_step_m " << number(t.body.max_step_m)
-        << ", cube_size_m " << number(t.body.cube_size_m) << ", goal_synthesizer " << t.goal_synthesizer << "\n";
+    out << "  " << t.name << ": behaviour " << t.behaviour << ", kappa " << number(t.body.navigability.kappa)
+        << ", delta_m " << number(t.body.navigability.delta_m) << ", eps_m " << number(t.body.navigability.eps_m)
+        << ", max_step_m " << number(t.body.max_step_m) << ", cube_size_m " << number(t.body.cube_size_m)
+        << ", goal_synthesizer " << t.goal_synthesizer << "\n";
   out << "slots (" << s.slots.size() << "; the world waits for agents 1.." << state.agents.size() << "):\n";
   for (const scenario::AgentSlot& slot : s.slots) {
     out << "  " << slot.id << " " << slot.robot_type << ": start " << point(slot.start_x_m, slot.start_y_m)
@@ -184,18 +183,18 @@ std::string scenario_check_text(const WorldStart& start) {
       break;
     case scenario::CompletionKind::kPayloadPath: {
       const scenario::PayloadPath& p = state.payload_path;
-      out << ", payload kappa " << number(p.navigability.kappa) << ", delta_m " << number(p.navigability.delta_m) << ", eps_m "
-          << number(p.navigability.eps_m) << ", from " << point(p.from_x_m, p.from_y_m) << " to " << point(p.to_x_m, p.to_y_m)
-          << ", checked every " << p.check_every_steps << " steps; at start: "
-          << (state.check.met ? "navigable (the run ends at once)" : "not navigable") << "\n";
+      out << ", payload kappa " << number(p.navigability.kappa) << ", delta_m " << number(p.navigability.delta_m)
+          << ", eps_m " << number(p.navigability.eps_m) << ", from " << point(p.from_x_m, p.from_y_m) << " to "
+          << point(p.to_x_m, p.to_y_m) << ", checked every " << p.check_every_steps
+          << " steps; at start: " << (state.check.met ? "navigable (the run ends at once)" : "not navigable") << "\n";
       break;
     }
     case scenario::CompletionKind::kLevelSite: {
       const scenario::Site& p = state.site;
       out << ", site " << box(p.x0_m, p.y0_m, p.x1_m, p.y1_m) << " (" << site_cell_count(state) << " cells), kappa "
-          << number(p.navigability.kappa) << ", delta_m " << number(p.navigability.delta_m) << ", eps_m " << number(p.navigability.eps_m)
-          << ", min_fraction " << number(p.min_fraction) << ", checked every " << p.check_every_steps
-          << " steps; at start: level fraction " << number(state.check.level_fraction)
+          << number(p.navigability.kappa) << ", delta_m " << number(p.navigability.delta_m) << ", eps_m "
+          << number(p.navigability.eps_m) << ", min_fraction " << number(p.min_fraction) << ", checked every "
+          << p.check_every_steps << " steps; at start: level fraction " << number(state.check.level_fraction)
           << (state.check.met ? " (the run ends at once)" : "") << "\n";
       break;
     }

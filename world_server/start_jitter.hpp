@@ -4,10 +4,10 @@
 
 #include <cstdint>
 
-#include "marsala/protocol/messages.hpp"
 #include "marsala/core/heightmap.hpp"
-#include "marsala/scenario/scenario.hpp"
 #include "marsala/core/types.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/scenario/scenario.hpp"
 
 namespace marsala::world_server {
 

@@ -11,7 +11,7 @@ namespace {
 constexpr std::size_t kMaxStateChars = 64;  // behaviour state names are for display only
 
 protocol::WorldEvent event(std::uint64_t step, std::uint32_t agent, protocol::EventKind kind, std::string detail,
-                      double volume_m3 = 0.0) {
+                           double volume_m3 = 0.0) {
   protocol::WorldEvent e;
   e.step = step;
   e.agent_id = agent;
@@ -42,9 +42,9 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const 
       continue;
     }
     if (r->step > step || answered) {
-      const std::string reason = r->step > step ? "request for future step " + std::to_string(r->step) + " rejected"
-                                                : "duplicate request for step " + std::to_string(step) +
-                                                      " rejected; the first stands";
+      const std::string reason =
+          r->step > step ? "request for future step " + std::to_string(r->step) + " rejected"
+                         : "duplicate request for step " + std::to_string(step) + " rejected; the first stands";
       ++agent.rejected;
       ++out.rejected;
       out.events.push_back(event(step, agent.id, protocol::EventKind::kRejected, reason));
@@ -81,8 +81,8 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const 
   agent.last_reason = "no request for step " + std::to_string(step) + " before the deadline";
   out.events.push_back(event(step, agent.id, protocol::EventKind::kMissed, agent.last_reason));
   if (agent.consecutive_missed >= kMaxConsecutiveMisses) {
-    out.events.push_back(drop_agent(state, agent.id,
-                                    std::to_string(agent.consecutive_missed) + " consecutive missed deadlines"));
+    out.events.push_back(
+        drop_agent(state, agent.id, std::to_string(agent.consecutive_missed) + " consecutive missed deadlines"));
     out.dropped.push_back(agent.id);
   }
 }

@@ -18,22 +18,22 @@ inline constexpr std::uint32_t kMaxConsecutiveMisses = 3;
 
 /// A request as it arrived: the agent whose partition carried it, and the request.
 struct Submission {
-  std::uint32_t channel_id = 0;   ///< owner of the partition (reader) it came from
+  std::uint32_t channel_id = 0;  ///< owner of the partition (reader) it came from
   protocol::ActionRequest request;
 };
 
 /// What happened in one step.
 struct StepOutcome {
-  std::uint64_t step = 0;                   ///< the step applied
-  std::vector<protocol::WorldEvent> events;      ///< in agent-id order, as they happened
-  std::vector<std::string> notes;           ///< things to log that are not events (late requests dropped)
-  std::vector<int> changed_tiles;           ///< TileLayout indices whose heights changed, ascending
-  std::vector<std::uint32_t> dropped;       ///< agents dropped in this step (3 consecutive misses)
-  std::uint32_t accepted = 0;               ///< requests accepted
-  std::uint32_t rejected = 0;               ///< requests rejected (including duplicates and future steps)
-  std::uint32_t missed = 0;                 ///< live agents without a request for this step
-  bool completion_checked = false;          ///< the payload/site check was evaluated in this step
-  bool completed = false;                   ///< is_completed() after the step
+  std::uint64_t step = 0;                    ///< the step applied
+  std::vector<protocol::WorldEvent> events;  ///< in agent-id order, as they happened
+  std::vector<std::string> notes;            ///< things to log that are not events (late requests dropped)
+  std::vector<int> changed_tiles;            ///< TileLayout indices whose heights changed, ascending
+  std::vector<std::uint32_t> dropped;        ///< agents dropped in this step (3 consecutive misses)
+  std::uint32_t accepted = 0;                ///< requests accepted
+  std::uint32_t rejected = 0;                ///< requests rejected (including duplicates and future steps)
+  std::uint32_t missed = 0;                  ///< live agents without a request for this step
+  bool completion_checked = false;           ///< the payload/site check was evaluated in this step
+  bool completed = false;                    ///< is_completed() after the step
 };
 
 /// Applies step `state.step`. `submissions` may come in any order across agents; within one agent's partition they

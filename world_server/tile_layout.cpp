@@ -45,7 +45,9 @@ std::vector<int> TileLayout::tiles_in_square(Position centre, double half_side_m
   };
   // A first guess from the arithmetic, widened by one tile, then settled by the exact predicates above.
   const double tile_m = tile_size_ * cs;
-  const auto clamp_index = [](double v, int n) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(n - 1))); };
+  const auto clamp_index = [](double v, int n) {
+    return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(n - 1)));
+  };
   const int c0 = clamp_index(std::floor((x_lo - grid_.xll_m) / tile_m) - 1.0, tile_cols_);
   const int c1 = clamp_index(std::floor((x_hi - grid_.xll_m) / tile_m) + 1.0, tile_cols_);
   const double top_y = grid_.yll_m + grid_.rows * cs;

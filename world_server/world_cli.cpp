@@ -16,14 +16,15 @@ namespace marsala::world_server {
 
 int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& stop, std::ostream& out,
                   std::ostream& err) {
-  CLI::App app{"marsala-world: the authoritative world server. Loads a scenario, admits agents over DDS, runs the\n"
-               "lockstep (frames, requests, validation in agent-id order) and writes summary.json, terrain_initial.asc,\n"
-               "terrain_final.asc, final.png, events.log, final_zoom.png (a close-up of what was built, unless it would\n"
-               "cover more than half the terrain) and goal_vector_map.png (when the scenario has one) into --out.\n"
-               "The run id (partition prefix) defaults to <scenario name>-d<domain>.\n"
-               "marsala-world --check [--json] SCENARIO validates the scenario as the world would at start, without\n"
-               "DDS, prints what the run would start from and exits 0 when valid, 2 when not.",
-               "marsala-world"};
+  CLI::App app{
+      "marsala-world: the authoritative world server. Loads a scenario, admits agents over DDS, runs the\n"
+      "lockstep (frames, requests, validation in agent-id order) and writes summary.json, terrain_initial.asc,\n"
+      "terrain_final.asc, final.png, events.log, final_zoom.png (a close-up of what was built, unless it would\n"
+      "cover more than half the terrain) and goal_vector_map.png (when the scenario has one) into --out.\n"
+      "The run id (partition prefix) defaults to <scenario name>-d<domain>.\n"
+      "marsala-world --check [--json] SCENARIO validates the scenario as the world would at start, without\n"
+      "DDS, prints what the run would start from and exits 0 when valid, 2 when not.",
+      "marsala-world"};
   std::string scenario_path, check_path, dds = "cyclone";
   RuntimeOptions options;
   int domain = 0;
@@ -41,14 +42,17 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       ->excludes(scenario_option);
   app.add_option("--agents", options.agents, "agents to wait for, ids 1..N (default: every slot of the scenario)")
       ->check(CLI::Range(1u, 100000u));
-  app.add_option("--dds", dds, "DDS vendor")->check(CLI::IsMember({"cyclone", "fastdds", "inprocess"}))
+  app.add_option("--dds", dds, "DDS vendor")
+      ->check(CLI::IsMember({"cyclone", "fastdds", "inprocess"}))
       ->capture_default_str();
   app.add_option("--domain", domain, "DDS domain id")->check(CLI::Range(0, 232))->capture_default_str();
   app.add_option("--out", options.out_dir, "output folder")->capture_default_str();
   app.add_option("--run-id", options.run_id, "run id, the prefix of every agent partition");
   app.add_option("--admit-timeout", options.admit_timeout_s, "seconds to wait for all agents")
-      ->check(CLI::Range(0.0, 86400.0))->capture_default_str();
-  app.add_option("--max-steps", options.max_steps, "override the scenario's max_steps")->check(CLI::Range(1ull, 1ull << 40));
+      ->check(CLI::Range(0.0, 86400.0))
+      ->capture_default_str();
+  app.add_option("--max-steps", options.max_steps, "override the scenario's max_steps")
+      ->check(CLI::Range(1ull, 1ull << 40));
   std::uint64_t seed = 0;
   const CLI::Option* seed_option =
       app.add_option("--seed", seed, "override the scenario's seed (start jitter); summary.json reports the seed used");

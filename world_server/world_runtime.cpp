@@ -41,7 +41,9 @@ double percentile(std::vector<double> values, double q) {
   return values[k];
 }
 
-Clock::duration seconds(double s) { return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)); }
+Clock::duration seconds(double s) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+}
 
 std::string format_seconds(double s) {
   char buf[32];
@@ -81,8 +83,7 @@ struct AgentLink {
   bool writer_seen = false;  ///< its request writer has been alive at least once
 };
 
-WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, RuntimeOptions options,
-                               int domain_id) {
+WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, RuntimeOptions options, int domain_id) {
   WorldStart start{s, std::move(options), {}};
   RuntimeOptions& o = start.options;
   if (o.seed) start.scenario.seed = *o.seed;
@@ -105,7 +106,9 @@ WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, R
 
 struct WorldRuntime::Impl {
   Impl(WorldStart start, bus::Participant& p)
-      : scenario(std::move(start.scenario)), options(std::move(start.options)), participant(p),
+      : scenario(std::move(start.scenario)),
+        options(std::move(start.options)),
+        participant(p),
         state(std::move(start.state)) {
     // make_world_state() keeps the terrain as given: the state's terrain is still the initial one.
     if (scenario.has_goal_vector_map) initial_terrain = state.terrain;
@@ -148,7 +151,8 @@ struct WorldRuntime::Impl {
       if (decision.accepted && admit(state, hello)) {
         const std::string partition = protocol::partition_for(options.run_id, hello.agent_id);
         AgentLink& link = links[hello.agent_id - 1];
-        link.frames = participant.create_writer<protocol::SensorFrame>({partition, nullptr, bus::Durability::kVolatile, 64});
+        link.frames =
+            participant.create_writer<protocol::SensorFrame>({partition, nullptr, bus::Durability::kVolatile, 64});
         link.requests =
             participant.create_reader<protocol::ActionRequest>({partition, signal, bus::Durability::kVolatile, 64});
         spdlog::info("admitted agent {} '{}' ({}) on partition {}", hello.agent_id, state.agent(hello.agent_id).name,
@@ -318,8 +322,8 @@ struct WorldRuntime::Impl {
       for (std::uint32_t id : outcome.dropped) send_frame(id, true);
       publish_status(true, outcome.completed, elapsed_s(start));
       if (state.step % kProgressEvery == 0)
-        spdlog::info("step {}: {} live agents, {:.6f} m3 deposited, progress {:.2f}", state.step, state.live_ids().size(),
-                     state.deposited_volume_m3, progress(state));
+        spdlog::info("step {}: {} live agents, {:.6f} m3 deposited, progress {:.2f}", state.step,
+                     state.live_ids().size(), state.deposited_volume_m3, progress(state));
     }
   }
 
@@ -361,8 +365,8 @@ struct WorldRuntime::Impl {
     event_log.emplace((std::filesystem::path(options.out_dir) / "events.log").string());
     open_endpoints();
     spdlog::info("run '{}': scenario '{}', {} x {} cells of {} m, waiting for {} agents (admit timeout {} s)",
-                 options.run_id, scenario.name, state.terrain.rows(), state.terrain.cols(),
-                 state.terrain.cell_size_m(), state.agents.size(), options.admit_timeout_s);
+                 options.run_id, scenario.name, state.terrain.rows(), state.terrain.cols(), state.terrain.cell_size_m(),
+                 state.agents.size(), options.admit_timeout_s);
     log_completion();
     admit_agents(stop);
     run_started = true;
@@ -413,7 +417,7 @@ struct WorldRuntime::Impl {
   std::vector<AgentLink> links;  ///< [id - 1]
   std::shared_ptr<bus::Signal> signal;
   std::vector<double> step_ms;  ///< wall time of each lockstep step [ms]
-  Heightmap initial_terrain;  ///< kept for goal_vector_map.png only
+  Heightmap initial_terrain;    ///< kept for goal_vector_map.png only
   std::unique_ptr<bus::Reader<protocol::AgentHello>> hellos;
   std::unique_ptr<bus::Writer<protocol::Admission>> admissions;
   std::unique_ptr<bus::Writer<protocol::WorldStatus>> status;

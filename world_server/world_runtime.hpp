@@ -5,7 +5,8 @@
 // completion).
 //
 //   hello/admission on the default partition     -> per admitted agent: SensorFrame writer and ActionRequest reader
-//   on protocol::partition_for(run_id, id)             -> step k: frames, wait for requests (deadline), apply_step, status
+//   on protocol::partition_for(run_id, id)             -> step k: frames, wait for requests (deadline), apply_step,
+//   status
 
 #include <atomic>
 #include <cstdint>
@@ -14,7 +15,6 @@
 #include <string>
 
 #include "marsala/bus/bus.hpp"
-#include "marsala/world_server/end_reason.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/world_server/end_reason.hpp"
@@ -24,13 +24,13 @@ namespace marsala::world_server {
 
 /// How to run.
 struct RuntimeOptions {
-  std::uint32_t agents = 0;         ///< expected agents, ids 1..agents; 0 = every slot of the scenario
-  std::string run_id;               ///< names the run's partitions; empty = default_run_id(scenario, domain)
-  double admit_timeout_s = 60.0;    ///< how long to wait for all agents before starting with those admitted [s]
-  std::uint64_t max_steps = 0;      ///< 0 = the scenario's max_steps
-  double step_deadline_s = 0.0;     ///< 0 = the scenario's step_deadline_s [s]
-  std::string out_dir = "out/run";  ///< summary.json, terrain_*.asc, final*.png, goal_vector_map.png, events.log
-  double linger_s = 2.0;            ///< after the run_over frames, wait up to this long for agents to leave [s]
+  std::uint32_t agents = 0;           ///< expected agents, ids 1..agents; 0 = every slot of the scenario
+  std::string run_id;                 ///< names the run's partitions; empty = default_run_id(scenario, domain)
+  double admit_timeout_s = 60.0;      ///< how long to wait for all agents before starting with those admitted [s]
+  std::uint64_t max_steps = 0;        ///< 0 = the scenario's max_steps
+  double step_deadline_s = 0.0;       ///< 0 = the scenario's step_deadline_s [s]
+  std::string out_dir = "out/run";    ///< summary.json, terrain_*.asc, final*.png, goal_vector_map.png, events.log
+  double linger_s = 2.0;              ///< after the run_over frames, wait up to this long for agents to leave [s]
   std::optional<std::uint64_t> seed;  ///< overrides the scenario's seed (start jitter; reported in summary.json)
 };
 
@@ -38,10 +38,10 @@ struct RuntimeOptions {
 struct RunResult {
   bool completed = false;
   EndReason end_reason = EndReason::kSignal;  ///< why the run ended
-  std::uint64_t steps = 0;          ///< steps applied
-  double wall_seconds = 0.0;        ///< from the first frame to the end [s]
+  std::uint64_t steps = 0;                    ///< steps applied
+  double wall_seconds = 0.0;                  ///< from the first frame to the end [s]
   std::uint32_t admitted = 0;
-  std::string terrain_sha256;       ///< of the final heights
+  std::string terrain_sha256;  ///< of the final heights
 };
 
 /// The default run id: "<scenario name>-d<domain id>", so runs of one scenario on different domains never share

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "marsala/protocol/messages.hpp"
 #include "marsala/core/heightmap.hpp"
+#include "marsala/protocol/messages.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/world_server/occupancy_cache.hpp"
 #include "marsala/world_server/tile_layout.hpp"
@@ -16,31 +16,31 @@ namespace marsala::world_server {
 
 /// One agent slot as the world sees it.
 struct AgentRecord {
-  std::uint32_t id = 0;                 ///< >= 1
-  std::string robot_type;               ///< from the scenario slot
-  std::string behaviour;                ///< from the scenario's robot type
-  RobotBody body;                 ///< from the scenario's robot type: what the hello must declare
+  std::uint32_t id = 0;                       ///< >= 1
+  std::string robot_type;                     ///< from the scenario slot
+  std::string behaviour;                      ///< from the scenario's robot type
+  RobotBody body;                             ///< from the scenario's robot type: what the hello must declare
   double start_x_m = 0.0, start_y_m = 0.0;    ///< [m]
   double target_x_m = 0.0, target_y_m = 0.0;  ///< [m]
 
   bool admitted = false;
-  bool alive = false;                   ///< admitted and not dropped: takes part in the lockstep
+  bool alive = false;  ///< admitted and not dropped: takes part in the lockstep
   bool dropped = false;
   std::string drop_reason;
-  std::uint64_t session = 0;            ///< from the admitted hello
-  std::string name;                     ///< from the admitted hello
+  std::uint64_t session = 0;  ///< from the admitted hello
+  std::string name;           ///< from the admitted hello
 
-  double x_m = 0.0, y_m = 0.0;          ///< position [m]
-  double z_m = 0.0;                     ///< terrain height of the cell under the centre [m]
-  double material_m3 = 0.0;             ///< material on board [m^3]
+  double x_m = 0.0, y_m = 0.0;  ///< position [m]
+  double z_m = 0.0;             ///< terrain height of the cell under the centre [m]
+  double material_m3 = 0.0;     ///< material on board [m^3]
 
-  std::uint32_t accepted = 0;           ///< requests accepted
-  std::uint32_t rejected = 0;           ///< requests rejected (duplicates and future steps included)
-  std::uint32_t missed = 0;             ///< steps without a request
+  std::uint32_t accepted = 0;  ///< requests accepted
+  std::uint32_t rejected = 0;  ///< requests rejected (duplicates and future steps included)
+  std::uint32_t missed = 0;    ///< steps without a request
   std::uint32_t consecutive_missed = 0;
-  double deposited_m3 = 0.0;            ///< material placed [m^3]
+  double deposited_m3 = 0.0;  ///< material placed [m^3]
   bool at_goal = false;
-  std::string state;                    ///< the behaviour's state from its latest request
+  std::string state;  ///< the behaviour's state from its latest request
 
   protocol::ActionResult last_result = protocol::ActionResult::kNone;  ///< for its next frame
   std::string last_reason;
@@ -57,30 +57,30 @@ using AgentIdGrid = Eigen::Matrix<std::uint32_t, Eigen::Dynamic, Eigen::Dynamic,
 
 /// The terrain check of payload-path and level-site runs (completion.hpp): its cache and its latest answer.
 struct CompletionCheck {
-  OccupancyCache occupancy;        ///< payload: the whole grid for the payload's body; site: the site's cells
-  CellIndex from;                  ///< payload: the cells of `from` and `to`
+  OccupancyCache occupancy;  ///< payload: the whole grid for the payload's body; site: the site's cells
+  CellIndex from;            ///< payload: the cells of `from` and `to`
   CellIndex to;
-  bool met = false;                ///< the latest evaluation found the payload's path / a level site
-  double level_fraction = 0.0;     ///< site: the latest level fraction [0, 1]
-  std::uint32_t evaluations = 0;   ///< evaluations run, the initial one included
+  bool met = false;               ///< the latest evaluation found the payload's path / a level site
+  double level_fraction = 0.0;    ///< site: the latest level fraction [0, 1]
+  std::uint32_t evaluations = 0;  ///< evaluations run, the initial one included
 };
 
 /// Everything the step function reads and changes.
 struct WorldState {
-  Heightmap terrain;              ///< authoritative heights [m]
-  std::vector<AgentRecord> agents;      ///< agents[i].id == i + 1, one per expected agent
-  std::uint64_t step = 0;               ///< the step whose requests are awaited
+  Heightmap terrain;                ///< authoritative heights [m]
+  std::vector<AgentRecord> agents;  ///< agents[i].id == i + 1, one per expected agent
+  std::uint64_t step = 0;           ///< the step whose requests are awaited
   scenario::Goal goal;
   scenario::BaseStation base;
-  int tile_size = 16;                   ///< [cells]
+  int tile_size = 16;                        ///< [cells]
   std::vector<std::uint64_t> tile_versions;  ///< per tile (TileLayout index): bumped in every step that changes it
-  double deposited_volume_m3 = 0.0;     ///< total placed [m^3]
+  double deposited_volume_m3 = 0.0;          ///< total placed [m^3]
   scenario::CompletionKind completion = scenario::CompletionKind::kAgentsAtGoal;
-  scenario::PayloadPath payload_path;   ///< kPayloadPath: the payload's body, from, to, schedule
-  scenario::Site site;                  ///< kLevelSite: the site, its parameters, schedule
-  CompletionCheck check;                ///< kPayloadPath and kLevelSite
-  AgentIdGrid depositor;                ///< per cell: the agent whose deposition last raised it (0 = never)
-  std::uint64_t idle_steps = 0;         ///< applied steps in which no deposition was accepted
+  scenario::PayloadPath payload_path;  ///< kPayloadPath: the payload's body, from, to, schedule
+  scenario::Site site;                 ///< kLevelSite: the site, its parameters, schedule
+  CompletionCheck check;               ///< kPayloadPath and kLevelSite
+  AgentIdGrid depositor;               ///< per cell: the agent whose deposition last raised it (0 = never)
+  std::uint64_t idle_steps = 0;        ///< applied steps in which no deposition was accepted
 
   /// True when `id` names an agent slot of this run.
   bool has_agent(std::uint32_t id) const { return id >= 1 && id <= agents.size(); }

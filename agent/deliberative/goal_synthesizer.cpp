@@ -13,8 +13,8 @@ GoalVectorMapSynthesizer::GoalVectorMapSynthesizer(const AgentContext& context)
     : self_id_(context.agent_id),
       cell_size_m_(context.assignment.world.cell_size_m),
       map_(context.goal_vector_map ? *context.goal_vector_map
-                                        : throw InvalidArgument("goal synthesizer 'goal_vector_map' needs the "
-                                                                "scenario's goal_vector_map block"),
+                                   : throw InvalidArgument("goal synthesizer 'goal_vector_map' needs the "
+                                                           "scenario's goal_vector_map block"),
            context.assignment.world),
       finished_(map_.arrows().size(), false) {}
 

@@ -14,15 +14,15 @@
 #include <vector>
 
 #include "marsala/agent/agent_context.hpp"
-#include "marsala/core/registry.hpp"
 #include "marsala/core/goal_vector_map.hpp"
+#include "marsala/core/registry.hpp"
 #include "marsala/core/types.hpp"
 
 namespace marsala::agent::deliberative {
 
 /// What a goal synthesizer sees in one frame.
 struct GoalQuery {
-  Position robot;                          ///< where the robot stands [m]
+  Position robot;                     ///< where the robot stands [m]
   std::vector<Neighbour> neighbours;  ///< robots within proximity range (from the frame)
 };
 

@@ -12,7 +12,6 @@
 namespace marsala::agent::deliberative {
 namespace {
 
-
 int clamp_int(double v, int lo, int hi) {
   if (!(v >= lo)) return lo;  // also catches NaN
   if (v > hi) return hi;

@@ -26,19 +26,19 @@ namespace marsala::agent::deliberative {
 /// The augmented local map: local heightmap, MARS gap, navigability, robot cell, local origin and local goal.
 /// All indices are local (row 0, col 0 = the window's top-left cell); `offset` maps them to the world grid.
 struct LocalMap {
-  GridGeometry world;          ///< the world grid: positions map to cells through it, as the world maps them
-  CellIndex offset;                  ///< world index of the window's top-left cell
-  Heightmap heights;           ///< the window [m], placed in the world frame; unknown cells hold the lowest known
-  CellMask known;              ///< 1 where the agent's map knows the cell
-  Heightmap gap;               ///< MARS gap P_kappa[h] - h of the window at the construction kappa [m]; 0 on
-                                     ///< unknown cells
-  CellMask blind;              ///< 1 where the cell's ball holds an unknown cell: it is never occupiable
-  CellMask occupiable;         ///< occupiable cells; never a blind one
-  CellMask navigable;          ///< occupiable cells 8-connected to the robot's cell
-  CellIndex robot;                   ///< the robot's cell
-  std::optional<CellIndex> origin;   ///< the local origin, when some trajectory cell in the window is occupiable
-  CellIndex goal;                    ///< the local goal
-  bool goal_is_target = false;       ///< true when the local goal is the target's own cell
+  GridGeometry world;               ///< the world grid: positions map to cells through it, as the world maps them
+  CellIndex offset;                 ///< world index of the window's top-left cell
+  Heightmap heights;                ///< the window [m], placed in the world frame; unknown cells hold the lowest known
+  CellMask known;                   ///< 1 where the agent's map knows the cell
+  Heightmap gap;                    ///< MARS gap P_kappa[h] - h of the window at the construction kappa [m]; 0 on
+                                    ///< unknown cells
+  CellMask blind;                   ///< 1 where the cell's ball holds an unknown cell: it is never occupiable
+  CellMask occupiable;              ///< occupiable cells; never a blind one
+  CellMask navigable;               ///< occupiable cells 8-connected to the robot's cell
+  CellIndex robot;                  ///< the robot's cell
+  std::optional<CellIndex> origin;  ///< the local origin, when some trajectory cell in the window is occupiable
+  CellIndex goal;                   ///< the local goal
+  bool goal_is_target = false;      ///< true when the local goal is the target's own cell
 
   /// The window's geometry (world placement, cell size [m]).
   const GridGeometry& geometry() const { return heights.geometry(); }

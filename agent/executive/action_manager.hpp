@@ -14,10 +14,10 @@ namespace marsala::agent::executive {
 
 /// One step's motion.
 struct Motion {
-  CellIndex cell;            ///< the target cell (local index)
-  Position target;           ///< its centre [m]
+  CellIndex cell;              ///< the target cell (local index)
+  Position target;             ///< its centre [m]
   std::size_t path_index = 0;  ///< index of the target cell on the path it follows (0 when not on a path)
-  double distance_m = 0.0;   ///< from the robot's position to the target [m]
+  double distance_m = 0.0;     ///< from the robot's position to the target [m]
 };
 
 /// Chooses motions within the distance threshold.

@@ -63,13 +63,12 @@ DepositionParams deposition_params(const RobotBody& body, double cell_size_m, do
   return p;
 }
 
-DepositionManager::DepositionManager(DepositionParams params)
-    : params_(params), navigability_(params.navigability) {
+DepositionManager::DepositionManager(DepositionParams params) : params_(params), navigability_(params.navigability) {
   if (!positive_finite(params.reach_m) || !positive_finite(params.max_deposit_m3) ||
       !positive_finite(params.cube_layer_m) || !positive_finite(params.max_height_m) ||
-      !positive_finite(params.footprint_m) ||
-      !(params.neighbour_keep_out_m >= 0.0) || !std::isfinite(params.neighbour_keep_out_m) ||
-      !(params.neighbour_step_m >= 0.0) || !std::isfinite(params.neighbour_step_m))
+      !positive_finite(params.footprint_m) || !(params.neighbour_keep_out_m >= 0.0) ||
+      !std::isfinite(params.neighbour_keep_out_m) || !(params.neighbour_step_m >= 0.0) ||
+      !std::isfinite(params.neighbour_step_m))
     throw InvalidArgument("deposition manager: reach (" + std::to_string(params.reach_m) + " m), max deposit (" +
                           std::to_string(params.max_deposit_m3) + " m^3), cube layer (" +
                           std::to_string(params.cube_layer_m) + " m) and max height (" +
@@ -147,8 +146,7 @@ bool DepositionManager::keeps_way_back(const deliberative::LocalMap& map, Positi
         if (map.contains(p)) robots.push_back(p);
       }
   const bool has_origin = map.origin && map.occupiable(map.origin->row, map.origin->col) != 0;
-  const CellMask before =
-      has_origin ? NavigabilityProcessor::navigable_from(map.occupiable, *map.origin) : CellMask();
+  const CellMask before = has_origin ? NavigabilityProcessor::navigable_from(map.occupiable, *map.origin) : CellMask();
 
   Heightmap after = map.heights;
   for (const auto& d : depositions) after(d.cell) += d.height_m;
@@ -176,8 +174,7 @@ bool DepositionManager::keeps_way_back(const deliberative::LocalMap& map, Positi
 }
 
 DepositionPlan DepositionManager::plan(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
-                                       Position robot, double material_m3,
-                                       const Neighbourhood& neighbours) const {
+                                       Position robot, double material_m3, const Neighbourhood& neighbours) const {
   DepositionPlan plan;
   std::vector<DepositionCandidate> chosen = candidates(map, path, robot, material_m3, neighbours);
   plan.candidates = static_cast<int>(chosen.size());
@@ -186,8 +183,7 @@ DepositionPlan DepositionManager::plan(const deliberative::LocalMap& map, const 
     std::size_t good = 0, bad = chosen.size();
     while (bad - good > 1) {
       const std::size_t mid = good + (bad - good) / 2;
-      if (keeps_way_back(map, robot, {chosen.begin(), chosen.begin() + static_cast<std::ptrdiff_t>(mid)},
-                         neighbours))
+      if (keeps_way_back(map, robot, {chosen.begin(), chosen.begin() + static_cast<std::ptrdiff_t>(mid)}, neighbours))
         good = mid;
       else
         bad = mid;

@@ -14,22 +14,22 @@
 #include <vector>
 
 #include "marsala/agent/deliberative/local_map_synthesizer.hpp"
-#include "marsala/core/robot_body.hpp"
 #include "marsala/core/navigability_processor.hpp"
+#include "marsala/core/robot_body.hpp"
 #include "marsala/core/types.hpp"
 
 namespace marsala::agent::executive {
 
 /// The body's limits that bound a step's depositions.
 struct DepositionParams {
-  NavigabilityParams navigability;      ///< the robot's kappa [m/m], delta [m], eps [m]
-  double footprint_m = 1.0;             ///< diameter of the band filled around each path cell [m] (construction width)
-  double reach_m = 1.2;                 ///< manipulator reach from the robot's centre [m]
-  double max_deposit_m3 = 0.01;         ///< deposition threshold per step [m^3]
-  double cube_layer_m = 0.0125;         ///< q = cube^3 / cs^2: the height of one cube spread over a cell [m]
-  double max_height_m = 1.0;            ///< largest single deposition [m]
-  double neighbour_keep_out_m = 0.7;    ///< no deposition this close to a neighbour's centre [m]
-  double neighbour_step_m = 0.2;        ///< how far a neighbour may move this step [m]
+  NavigabilityParams navigability;    ///< the robot's kappa [m/m], delta [m], eps [m]
+  double footprint_m = 1.0;           ///< diameter of the band filled around each path cell [m] (construction width)
+  double reach_m = 1.2;               ///< manipulator reach from the robot's centre [m]
+  double max_deposit_m3 = 0.01;       ///< deposition threshold per step [m^3]
+  double cube_layer_m = 0.0125;       ///< q = cube^3 / cs^2: the height of one cube spread over a cell [m]
+  double max_height_m = 1.0;          ///< largest single deposition [m]
+  double neighbour_keep_out_m = 0.7;  ///< no deposition this close to a neighbour's centre [m]
+  double neighbour_step_m = 0.2;      ///< how far a neighbour may move this step [m]
 };
 
 /// The deposition parameters of a body on a grid of cell_size_m [m], with the team's keep-out [m]; the footprint is
@@ -39,9 +39,9 @@ DepositionParams deposition_params(const RobotBody& body, double cell_size_m, do
 
 /// The robots around this one at the start of the step, as its frame reports them.
 struct Neighbourhood {
-  std::uint32_t self_id = 0;             ///< this robot's agent id
-  Position self;                         ///< this robot's position at the start of the step [m]
-  std::vector<Neighbour> others;    ///< the other robots within proximity range
+  std::uint32_t self_id = 0;      ///< this robot's agent id
+  Position self;                  ///< this robot's position at the start of the step [m]
+  std::vector<Neighbour> others;  ///< the other robots within proximity range
 };
 
 /// One candidate deposition (local index).
@@ -54,9 +54,9 @@ struct DepositionCandidate {
 /// This step's depositions.
 struct DepositionPlan {
   std::vector<Deposition> depositions;  ///< world indices, in path order
-  double volume_m3 = 0.0;                    ///< sum of height * cs^2 [m^3]
-  int candidates = 0;                        ///< candidates before the way-back check [count]
-  int dropped_for_way_back = 0;              ///< candidates dropped to keep the way back [count]
+  double volume_m3 = 0.0;               ///< sum of height * cs^2 [m^3]
+  int candidates = 0;                   ///< candidates before the way-back check [count]
+  int dropped_for_way_back = 0;         ///< candidates dropped to keep the way back [count]
 };
 
 /// Chooses a step's depositions along a path.
@@ -78,16 +78,16 @@ class DepositionManager {
   DepositionPlan plan(const deliberative::LocalMap& map, const std::vector<CellIndex>& path, Position robot,
                       double material_m3, const Neighbourhood& neighbours) const;
   /// True when the depositions, simulated on the local map, keep the robot's cell at `robot` [m] occupiable (if
-  /// it was), keep a navigable way from it to the window's border (if it had one), and keep every robot that was connected to the local origin connected to it: this one, and each
-  /// neighbour in the window wherever its own motion may take it this step (cells within neighbour_step_m). The
-  /// neighbours' own depositions of the same step are unknown here: robots closer than about a body length can
-  /// still wall each other in between them.
+  /// it was), keep a navigable way from it to the window's border (if it had one), and keep every robot that was
+  /// connected to the local origin connected to it: this one, and each neighbour in the window wherever its own motion
+  /// may take it this step (cells within neighbour_step_m). The neighbours' own depositions of the same step are
+  /// unknown here: robots closer than about a body length can still wall each other in between them.
   bool keeps_way_back(const deliberative::LocalMap& map, Position robot,
                       const std::vector<DepositionCandidate>& depositions, const Neighbourhood& neighbours) const;
 
  private:
-  bool in_territory(const deliberative::LocalMap& map, CellIndex cell, Position centre,
-                    const Neighbourhood& neighbours, std::optional<CellIndex> self_cell) const;
+  bool in_territory(const deliberative::LocalMap& map, CellIndex cell, Position centre, const Neighbourhood& neighbours,
+                    std::optional<CellIndex> self_cell) const;
   DepositionParams params_;
   NavigabilityProcessor navigability_;
 };

@@ -10,14 +10,13 @@ namespace marsala::agent::executive {
 namespace {
 
 std::string describe(const TerrainTile& t) {
-  return "tile (" + std::to_string(t.tile_row) + ", " + std::to_string(t.tile_col) + ") of " +
-         std::to_string(t.rows) + " x " + std::to_string(t.cols) + " cells";
+  return "tile (" + std::to_string(t.tile_row) + ", " + std::to_string(t.tile_col) + ") of " + std::to_string(t.rows) +
+         " x " + std::to_string(t.cols) + " cells";
 }
 
 }  // namespace
 
-MappingSystem::MappingSystem(const GridGeometry& world, int tile_size)
-    : heights_(world, 0.0), tile_size_(tile_size) {
+MappingSystem::MappingSystem(const GridGeometry& world, int tile_size) : heights_(world, 0.0), tile_size_(tile_size) {
   if (tile_size < 1) throw InvalidArgument("mapping system: tile size must be >= 1, got " + std::to_string(tile_size));
   known_ = CellMask::Zero(world.rows, world.cols);
 }

@@ -26,7 +26,7 @@ std::unique_ptr<Behaviour> make_behaviour(const std::string& name, const AgentCo
 }
 
 protocol::ActionRequest empty_request(const AgentContext& context, const protocol::SensorFrame& frame,
-                                 const std::string& state) {
+                                      const std::string& state) {
   protocol::ActionRequest request;
   request.agent_id = context.agent_id;
   request.session = context.session;

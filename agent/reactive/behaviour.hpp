@@ -45,7 +45,8 @@ void register_builtins(BehaviourRegistry& registry);
 std::unique_ptr<Behaviour> make_behaviour(const std::string& name, const AgentContext& context);
 
 /// An empty request answering `frame`: the envelope filled, no motion, no deposition, no refill.
-protocol::ActionRequest empty_request(const AgentContext& context, const protocol::SensorFrame& frame, const std::string& state);
+protocol::ActionRequest empty_request(const AgentContext& context, const protocol::SensorFrame& frame,
+                                      const std::string& state);
 /// The assignment an admission gives `context`'s agent; throws InvalidArgument when the admission is not for it (id,
 /// session, refused) or its grid or tile size is not valid.
 Assignment assignment_from(const AgentContext& context, const protocol::Admission& admission);

@@ -10,8 +10,8 @@ void IdleBehaviour::on_admission(const protocol::Admission& admission) {
 }
 
 protocol::ActionRequest IdleBehaviour::decide(const protocol::SensorFrame& frame) {
-  if (!admitted_) throw InvalidArgument("idle behaviour: frame for step " + std::to_string(frame.step) +
-                                        " before admission");
+  if (!admitted_)
+    throw InvalidArgument("idle behaviour: frame for step " + std::to_string(frame.step) + " before admission");
   check_frame(context_, frame);
   if (frame.run_over) done_ = true;
   return empty_request(context_, frame, state_name());

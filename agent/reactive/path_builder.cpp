@@ -9,18 +9,20 @@
 namespace marsala::agent::reactive {
 namespace {
 
-constexpr PathState kStates[] = {PathState::kWaitAdmission, PathState::kSurvey,       PathState::kAdvance,
-                                 PathState::kBuild,         PathState::kRetreat,      PathState::kReturnToBase,
-                                 PathState::kFollow,        PathState::kHold,         PathState::kBackOff,
-                                 PathState::kDone};
+constexpr PathState kStates[] = {
+    PathState::kWaitAdmission, PathState::kSurvey, PathState::kAdvance, PathState::kBuild,   PathState::kRetreat,
+    PathState::kReturnToBase,  PathState::kFollow, PathState::kHold,    PathState::kBackOff, PathState::kDone};
 
 double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
 PathState state_of(BuildPhase phase) {
   switch (phase) {
-    case BuildPhase::kAdvance: return PathState::kAdvance;
-    case BuildPhase::kBuild: return PathState::kBuild;
-    case BuildPhase::kRetreat: return PathState::kRetreat;
+    case BuildPhase::kAdvance:
+      return PathState::kAdvance;
+    case BuildPhase::kBuild:
+      return PathState::kBuild;
+    case BuildPhase::kRetreat:
+      return PathState::kRetreat;
   }
   return PathState::kAdvance;
 }
@@ -29,16 +31,26 @@ PathState state_of(BuildPhase phase) {
 
 std::string to_string(PathState state) {
   switch (state) {
-    case PathState::kWaitAdmission: return "wait_admission";
-    case PathState::kSurvey: return "survey";
-    case PathState::kAdvance: return "advance";
-    case PathState::kBuild: return "build";
-    case PathState::kRetreat: return "retreat";
-    case PathState::kReturnToBase: return "return_to_base";
-    case PathState::kFollow: return "follow";
-    case PathState::kHold: return "hold";
-    case PathState::kBackOff: return "back_off";
-    case PathState::kDone: return "done";
+    case PathState::kWaitAdmission:
+      return "wait_admission";
+    case PathState::kSurvey:
+      return "survey";
+    case PathState::kAdvance:
+      return "advance";
+    case PathState::kBuild:
+      return "build";
+    case PathState::kRetreat:
+      return "retreat";
+    case PathState::kReturnToBase:
+      return "return_to_base";
+    case PathState::kFollow:
+      return "follow";
+    case PathState::kHold:
+      return "hold";
+    case PathState::kBackOff:
+      return "back_off";
+    case PathState::kDone:
+      return "done";
   }
   return "unknown";
 }
@@ -61,8 +73,7 @@ PipelineParams pipeline_params(const Pipeline& pipeline) {
 }
 
 PathBuilder::PathBuilder(const AgentContext& context, PathBuilderOptions options)
-    : steps_(context, std::move(options.planner)),
-      pipeline_(pipeline_params(context.type.pipeline)) {}
+    : steps_(context, std::move(options.planner)), pipeline_(pipeline_params(context.type.pipeline)) {}
 
 const executive::MappingSystem& PathBuilder::map() const {
   if (!steps_.admitted()) throw InvalidArgument("path builder: no map before admission");
@@ -105,7 +116,8 @@ protocol::ActionRequest PathBuilder::decide(const protocol::SensorFrame& frame) 
   return request;
 }
 
-void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFrame& frame, protocol::ActionRequest& request) {
+void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFrame& frame,
+                                protocol::ActionRequest& request) {
   const PipelinePlace place = pipeline_.place(view.robot, view.target);
   trace_.role = place.role;
   switch (place.role) {
@@ -116,9 +128,15 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
         state_ = state_of(*phase);
       }
       return;
-    case PipelineRole::kFollow: follow_step(view, {place.front->x_m, place.front->y_m}, request); return;
-    case PipelineRole::kHold: state_ = PathState::kHold; return;
-    case PipelineRole::kBackOff: back_off_step(view, {place.front->x_m, place.front->y_m}, request); return;
+    case PipelineRole::kFollow:
+      follow_step(view, {place.front->x_m, place.front->y_m}, request);
+      return;
+    case PipelineRole::kHold:
+      state_ = PathState::kHold;
+      return;
+    case PipelineRole::kBackOff:
+      back_off_step(view, {place.front->x_m, place.front->y_m}, request);
+      return;
   }
 }
 

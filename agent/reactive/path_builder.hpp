@@ -28,11 +28,11 @@
 #include <string>
 
 #include "marsala/agent/agent_context.hpp"
-#include "marsala/core/navigable_path_planner.hpp"
 #include "marsala/agent/executive/mapping_system.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/agent/reactive/pipeline.hpp"
 #include "marsala/agent/reactive/ramp_steps.hpp"
+#include "marsala/core/navigable_path_planner.hpp"
 
 namespace marsala::agent::reactive {
 
@@ -68,8 +68,8 @@ struct PathBuilderTrace : BuildTrace {
   std::optional<PipelineRole> role;  ///< the pipeline role of this frame, when it was asked for
 };
 
-/// The pipeline's distances for a robot type's pipeline: separation_m = pipeline.separation_m, back_off_margin_m a quarter of it,
-/// return_detect_m three quarters of it [m].
+/// The pipeline's distances for a robot type's pipeline: separation_m = pipeline.separation_m, back_off_margin_m a
+/// quarter of it, return_detect_m three quarters of it [m].
 PipelineParams pipeline_params(const Pipeline& pipeline);
 
 /// Builds a navigable path in the construction pipeline; see the transition table above.

@@ -15,10 +15,14 @@ Position where(const Neighbour& n) { return {n.x_m, n.y_m}; }
 
 std::string to_string(PipelineRole role) {
   switch (role) {
-    case PipelineRole::kActive: return "active";
-    case PipelineRole::kFollow: return "follow";
-    case PipelineRole::kHold: return "hold";
-    case PipelineRole::kBackOff: return "back_off";
+    case PipelineRole::kActive:
+      return "active";
+    case PipelineRole::kFollow:
+      return "follow";
+    case PipelineRole::kHold:
+      return "hold";
+    case PipelineRole::kBackOff:
+      return "back_off";
   }
   return "unknown";
 }
@@ -83,9 +87,9 @@ PipelinePlace PipelineTracker::place(Position self, Position target) const {
   p.front = front(self, target);
   if (!p.front) return p;
   const double d = distance(where(*p.front), self);
-  p.role = d > params_.separation_m                                    ? PipelineRole::kFollow
+  p.role = d > params_.separation_m                                ? PipelineRole::kFollow
            : d >= params_.separation_m - params_.back_off_margin_m ? PipelineRole::kHold
-                                                                    : PipelineRole::kBackOff;
+                                                                   : PipelineRole::kBackOff;
   return p;
 }
 

@@ -5,8 +5,8 @@
 // target (straight-line distance) by more than kAheadMarginM, and *returning* once it has moved away from the target
 // by at least return_detect_m since it was nearest to it (it is heading back to the base along the other lane; a
 // short retreat of the active robot while it builds does not count); it counts as approaching again once it has come
-// return_detect_m nearer than it was when farthest (it refilled and rejoined the pipeline). The *front neighbour* is the nearest (to this
-// robot) neighbour that is ahead and not returning. The robot's role follows:
+// return_detect_m nearer than it was when farthest (it refilled and rejoined the pipeline). The *front neighbour* is
+// the nearest (to this robot) neighbour that is ahead and not returning. The robot's role follows:
 //
 //   no front neighbour                                  -> kActive  (the front of the pipeline: it alone deposits)
 //   front neighbour farther than separation_m           -> kFollow  (advance towards the target, never deposit)
@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "marsala/protocol/messages.hpp"
 #include "marsala/core/types.hpp"
+#include "marsala/protocol/messages.hpp"
 
 namespace marsala::agent::reactive {
 
@@ -41,9 +41,9 @@ struct PipelinePlace {
 
 /// Distances of the pipeline rule.
 struct PipelineParams {
-  double separation_m = 2.0;        ///< a follower keeps at least this far from its front neighbour [m]
-  double back_off_margin_m = 0.5;   ///< it steps back only when nearer than separation - this [m]
-  double return_detect_m = 1.5;     ///< a neighbour that moved this far away from the target is returning [m]
+  double separation_m = 2.0;       ///< a follower keeps at least this far from its front neighbour [m]
+  double back_off_margin_m = 0.5;  ///< it steps back only when nearer than separation - this [m]
+  double return_detect_m = 1.5;    ///< a neighbour that moved this far away from the target is returning [m]
 };
 
 /// A neighbour ahead by less than this is level with the robot, not ahead [m].

@@ -13,9 +13,12 @@ constexpr RampState kStates[] = {RampState::kWaitAdmission, RampState::kSurvey, 
 
 RampState state_of(BuildPhase phase) {
   switch (phase) {
-    case BuildPhase::kAdvance: return RampState::kAdvance;
-    case BuildPhase::kBuild: return RampState::kBuild;
-    case BuildPhase::kRetreat: return RampState::kRetreat;
+    case BuildPhase::kAdvance:
+      return RampState::kAdvance;
+    case BuildPhase::kBuild:
+      return RampState::kBuild;
+    case BuildPhase::kRetreat:
+      return RampState::kRetreat;
   }
   return RampState::kAdvance;
 }
@@ -24,14 +27,22 @@ RampState state_of(BuildPhase phase) {
 
 std::string to_string(RampState state) {
   switch (state) {
-    case RampState::kWaitAdmission: return "wait_admission";
-    case RampState::kSurvey: return "survey";
-    case RampState::kAdvance: return "advance";
-    case RampState::kBuild: return "build";
-    case RampState::kRetreat: return "retreat";
-    case RampState::kReturnToBase: return "return_to_base";
-    case RampState::kAtGoal: return "at_goal";
-    case RampState::kDone: return "done";
+    case RampState::kWaitAdmission:
+      return "wait_admission";
+    case RampState::kSurvey:
+      return "survey";
+    case RampState::kAdvance:
+      return "advance";
+    case RampState::kBuild:
+      return "build";
+    case RampState::kRetreat:
+      return "retreat";
+    case RampState::kReturnToBase:
+      return "return_to_base";
+    case RampState::kAtGoal:
+      return "at_goal";
+    case RampState::kDone:
+      return "done";
   }
   return "unknown";
 }

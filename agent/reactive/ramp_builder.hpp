@@ -32,10 +32,10 @@
 #include <string>
 
 #include "marsala/agent/agent_context.hpp"
-#include "marsala/core/navigable_path_planner.hpp"
 #include "marsala/agent/executive/mapping_system.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/agent/reactive/ramp_steps.hpp"
+#include "marsala/core/navigable_path_planner.hpp"
 
 namespace marsala::agent::reactive {
 

@@ -40,9 +40,12 @@ std::optional<CellIndex> best_navigable_cell(const deliberative::LocalMap& local
 
 std::string to_string(BuildPhase phase) {
   switch (phase) {
-    case BuildPhase::kAdvance: return "advance";
-    case BuildPhase::kBuild: return "build";
-    case BuildPhase::kRetreat: return "retreat";
+    case BuildPhase::kAdvance:
+      return "advance";
+    case BuildPhase::kBuild:
+      return "build";
+    case BuildPhase::kRetreat:
+      return "retreat";
   }
   return "unknown";
 }
@@ -54,12 +57,11 @@ struct RampSteps::Modules {
   NavigablePathPlanner router;   // shortest routes through navigable cells (alpha = 0)
   executive::ActionManager actions;
   executive::DepositionManager depositions;
-  int max_idle_retreat_moves;                  // retreat moves without work before trying to advance again
+  int max_idle_retreat_moves;  // retreat moves without work before trying to advance again
 };
 
 RampSteps::RampSteps(const AgentContext& context, std::optional<PlannerParams> planner)
-    : context_(context),
-      planner_(std::move(planner)) {
+    : context_(context), planner_(std::move(planner)) {
   // Fail on an invalid body, construction or goal synthesizer name now rather than at admission.
   (void)NavigabilityProcessor(context_.type.body.navigability);
   (void)NavigabilityProcessor(construction_params(context_.type));
@@ -82,14 +84,13 @@ void RampSteps::admit(const protocol::Admission& admission) {
   PlannerParams router = planner;
   router.alpha = 0.0;
   router.beta = 1.0;
-  modules_ = std::make_unique<Modules>(Modules{
-      executive::MappingSystem(world, context_.assignment.tile_size),
-      deliberative::LocalMapSynthesizer(body.navigability, body.sensing_range_m, build.kappa),
-      NavigablePathPlanner(planner), NavigablePathPlanner(router),
-      executive::ActionManager(body.max_step_m),
-      executive::DepositionManager(
-          executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m, build.delta_m)),
-      static_cast<int>(std::ceil((body.reach_m + body.navigability.delta_m) / body.max_step_m)) + 1});
+  modules_ = std::make_unique<Modules>(
+      Modules{executive::MappingSystem(world, context_.assignment.tile_size),
+              deliberative::LocalMapSynthesizer(body.navigability, body.sensing_range_m, build.kappa),
+              NavigablePathPlanner(planner), NavigablePathPlanner(router), executive::ActionManager(body.max_step_m),
+              executive::DepositionManager(
+                  executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m, build.delta_m)),
+              static_cast<int>(std::ceil((body.reach_m + body.navigability.delta_m) / body.max_step_m)) + 1});
   goal_ = deliberative::make_goal_synthesizer(context_.type.goal_synthesizer, context_);
 }
 
@@ -227,9 +228,8 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
   // base when that is nearer than the robot by at least a cell; else the oldest navigable cell of the trajectory in
   // the window (the way the robot came from the base).
   constexpr double kNone = std::numeric_limits<double>::infinity();
-  std::optional<CellIndex> goal = best_navigable_cell(local, kNone, [&](Position p) {
-    return distance(p, base) <= radius ? distance(p, robot) : kNone;
-  });
+  std::optional<CellIndex> goal = best_navigable_cell(
+      local, kNone, [&](Position p) { return distance(p, base) <= radius ? distance(p, robot) : kNone; });
   if (!goal)
     goal = best_navigable_cell(local, distance(robot, base) - local.geometry().cell_size_m,
                                [&](Position p) { return distance(p, base); });

@@ -25,10 +25,10 @@
 #include "marsala/agent/agent_context.hpp"
 #include "marsala/agent/deliberative/goal_synthesizer.hpp"
 #include "marsala/agent/deliberative/local_map_synthesizer.hpp"
-#include "marsala/core/navigable_path_planner.hpp"
 #include "marsala/agent/executive/action_manager.hpp"
 #include "marsala/agent/executive/deposition_manager.hpp"
 #include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/core/navigable_path_planner.hpp"
 #include "marsala/protocol/messages.hpp"
 
 namespace marsala::agent::reactive {
@@ -46,7 +46,7 @@ struct BuildTrace {
   std::optional<CellIndex> local_origin;    ///< local index
   long long navigable_cells = 0;            ///< cells navigable from the robot in the local map [count]
   bool planned = false;                     ///< a path was planned this frame (plan holds it)
-  PlannerResult plan;         ///< path in local indices
+  PlannerResult plan;                       ///< path in local indices
   std::optional<executive::Motion> motion;  ///< local indices
   executive::DepositionPlan deposition;
   bool refill = false;

@@ -18,10 +18,11 @@ constexpr std::chrono::milliseconds kStopPoll{100};
 }  // namespace
 
 std::string to_string(RunOutcome outcome) {
-  static constexpr EnumName<RunOutcome> kNames[] = {
-      {RunOutcome::kRunOver, "run_over"},         {RunOutcome::kStopped, "stopped"},
-      {RunOutcome::kRefused, "refused"},          {RunOutcome::kAdmitTimeout, "admit_timeout"},
-      {RunOutcome::kWorldTimeout, "world_timeout"}};
+  static constexpr EnumName<RunOutcome> kNames[] = {{RunOutcome::kRunOver, "run_over"},
+                                                    {RunOutcome::kStopped, "stopped"},
+                                                    {RunOutcome::kRefused, "refused"},
+                                                    {RunOutcome::kAdmitTimeout, "admit_timeout"},
+                                                    {RunOutcome::kWorldTimeout, "world_timeout"}};
   return enum_to_string(kNames, outcome);
 }
 
@@ -36,17 +37,17 @@ AgentRuntime::AgentRuntime(bus::Participant& participant, RuntimeConfig config)
     : participant_(participant), config_(std::move(config)) {
   if (config_.agent_id == 0) throw InvalidArgument("agent id must be >= 1");
   if (config_.hello_period.count() <= 0 || config_.admit_timeout.count() <= 0 || config_.world_timeout.count() <= 0)
-    throw InvalidArgument("agent " + std::to_string(config_.agent_id) +
-                          ": hello period and timeouts must be positive");
+    throw InvalidArgument("agent " + std::to_string(config_.agent_id) + ": hello period and timeouts must be positive");
   if (config_.session == 0) config_.session = random_session();
   if (config_.name.empty()) config_.name = "agent-" + std::to_string(config_.agent_id);
   AgentContext context;
   context.agent_id = config_.agent_id;
   context.session = config_.session;
   context.type = config_.type;
-  context.neighbour_keep_out_m = config_.neighbour_keep_out_m > 0.0
-                                     ? config_.neighbour_keep_out_m
-                                     : neighbour_keep_out_m(config_.type.body.navigability.delta_m, config_.type.body.max_step_m);
+  context.neighbour_keep_out_m =
+      config_.neighbour_keep_out_m > 0.0
+          ? config_.neighbour_keep_out_m
+          : neighbour_keep_out_m(config_.type.body.navigability.delta_m, config_.type.body.max_step_m);
   context.seed = config_.seed;
   context.goal_vector_map = config_.goal_vector_map;
   behaviour_ = reactive::make_behaviour(config_.type.behaviour, context);
@@ -100,8 +101,8 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
       admission = a;
       result.run_id = a.run_id;
       behaviour_->on_admission(a);
-      spdlog::info("agent {}: admitted to run '{}' ({} x {} cells of {} m)", config_.agent_id, a.run_id, a.rows,
-                   a.cols, a.cell_size_m);
+      spdlog::info("agent {}: admitted to run '{}' ({} x {} cells of {} m)", config_.agent_id, a.run_id, a.rows, a.cols,
+                   a.cell_size_m);
       return true;
     }
   }
@@ -114,7 +115,8 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
   const std::string partition = protocol::partition_for(admission.run_id, config_.agent_id);
   auto signal = std::make_shared<bus::Signal>();
   auto frames = participant_.create_reader<protocol::SensorFrame>({partition, signal, bus::Durability::kVolatile, 64});
-  auto requests = participant_.create_writer<protocol::ActionRequest>({partition, nullptr, bus::Durability::kVolatile, 64});
+  auto requests =
+      participant_.create_writer<protocol::ActionRequest>({partition, nullptr, bus::Durability::kVolatile, 64});
   bool answered_any = false;
   std::uint64_t last_answered = 0;
   Clock::time_point deadline = Clock::now() + config_.world_timeout;
@@ -137,8 +139,7 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
       deadline = Clock::now() + config_.world_timeout;
       if (frame.last_result == protocol::ActionResult::kRejected) {
         ++result.rejected;
-        spdlog::warn("agent {}: request before step {} rejected: {}", config_.agent_id, frame.step,
-                     frame.last_reason);
+        spdlog::warn("agent {}: request before step {} rejected: {}", config_.agent_id, frame.step, frame.last_reason);
       }
       if (frame.run_over) {
         behaviour_->decide(frame);

@@ -23,16 +23,16 @@ namespace marsala::agent::runtime {
 
 /// Who the agent is and how patient it is.
 struct RuntimeConfig {
-  std::uint32_t agent_id = 0;                       ///< >= 1: the scenario slot
-  std::string name;                                 ///< human-readable, e.g. "husky-3"
-  RobotType type;                                   ///< its slot's robot type; the hello declares its body
-  std::uint64_t session = 0;                        ///< 0: a random one (random_session())
-  double neighbour_keep_out_m = 0.0;                ///< 0: delta/2 + max_step of this body [m]
-  std::uint64_t seed = 1;                           ///< scenario seed
+  std::uint32_t agent_id = 0;                        ///< >= 1: the scenario slot
+  std::string name;                                  ///< human-readable, e.g. "husky-3"
+  RobotType type;                                    ///< its slot's robot type; the hello declares its body
+  std::uint64_t session = 0;                         ///< 0: a random one (random_session())
+  double neighbour_keep_out_m = 0.0;                 ///< 0: delta/2 + max_step of this body [m]
+  std::uint64_t seed = 1;                            ///< scenario seed
   std::optional<GoalVectorMapSpec> goal_vector_map;  ///< the scenario's, for the "goal_vector_map" synthesizer
-  std::chrono::milliseconds hello_period{200};      ///< between hellos until admitted
-  std::chrono::milliseconds admit_timeout{60000};   ///< give up when not admitted by then
-  std::chrono::milliseconds world_timeout{60000};   ///< give up when no frame comes for this long
+  std::chrono::milliseconds hello_period{200};       ///< between hellos until admitted
+  std::chrono::milliseconds admit_timeout{60000};    ///< give up when not admitted by then
+  std::chrono::milliseconds world_timeout{60000};    ///< give up when no frame comes for this long
 };
 
 /// Why run() returned.
@@ -43,13 +43,13 @@ std::string to_string(RunOutcome outcome);
 /// What happened in a run.
 struct RunResult {
   RunOutcome outcome = RunOutcome::kStopped;
-  std::string message;            ///< one line for the operator
-  std::string run_id;             ///< from the admission
-  std::uint64_t frames = 0;       ///< frames received [count]
-  std::uint64_t requests = 0;     ///< requests sent [count]
-  std::uint64_t rejected = 0;     ///< frames reporting the previous request rejected [count]
-  std::uint64_t last_step = 0;    ///< step of the last frame
-  std::string final_state;        ///< the behaviour's state at the end
+  std::string message;          ///< one line for the operator
+  std::string run_id;           ///< from the admission
+  std::uint64_t frames = 0;     ///< frames received [count]
+  std::uint64_t requests = 0;   ///< requests sent [count]
+  std::uint64_t rejected = 0;   ///< frames reporting the previous request rejected [count]
+  std::uint64_t last_step = 0;  ///< step of the last frame
+  std::string final_state;      ///< the behaviour's state at the end
 };
 
 /// A non-zero random session id (std::random_device): tells a restarted agent process apart.

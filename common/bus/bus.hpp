@@ -60,10 +60,10 @@ enum class Durability { kVolatile, kTransientLocal };
 
 /// Options of one reader or writer.
 struct EndpointOptions {
-  std::string partition;                 ///< empty = the default partition
-  std::shared_ptr<Signal> signal;        ///< readers: notified on data and on writer liveliness changes
+  std::string partition;           ///< empty = the default partition
+  std::shared_ptr<Signal> signal;  ///< readers: notified on data and on writer liveliness changes
   Durability durability = Durability::kVolatile;
-  std::int32_t depth = 64;               ///< KEEP_LAST history depth per instance
+  std::int32_t depth = 64;  ///< KEEP_LAST history depth per instance
 };
 
 /// Writes samples of one message type.
@@ -110,7 +110,7 @@ class Participant {
   }
 
  protected:
-#define MARSALA_BUS_ENDPOINTS(T)                                                              \
+#define MARSALA_BUS_ENDPOINTS(T)                                                      \
   virtual std::unique_ptr<Writer<T>> make_writer(Tag<T>, const EndpointOptions&) = 0; \
   virtual std::unique_ptr<Reader<T>> make_reader(Tag<T>, const EndpointOptions&) = 0;
   MARSALA_BUS_MESSAGES(MARSALA_BUS_ENDPOINTS)
@@ -120,7 +120,7 @@ class Participant {
 /// How to make a participant.
 struct BusConfig {
   Vendor vendor = Vendor::kCyclone;
-  int domain_id = 0;   ///< 0..232
+  int domain_id = 0;  ///< 0..232
 };
 
 /// Creates a participant of the chosen vendor; throws BusError naming vendor and domain on failure.

@@ -1,6 +1,5 @@
 #include "marsala/cli/terrain_cli.hpp"
 
-
 #include <algorithm>
 #include <cstdint>
 #include <iomanip>
@@ -12,10 +11,10 @@
 #include <vector>
 
 #include "marsala/cli/command_line.hpp"
+#include "marsala/core/deposition.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/core/heightmap.hpp"
-#include "marsala/core/deposition.hpp"
 #include "marsala/core/mars_processor.hpp"
 #include "marsala/core/navigability_processor.hpp"
 #include "marsala/render/png_writer.hpp"
@@ -68,8 +67,7 @@ std::map<std::string, double> parse_params(const std::vector<std::string>& pairs
   std::map<std::string, double> params;
   for (const std::string& pair : pairs) {
     const auto eq = pair.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw UsageError("--param expects KEY=VALUE, got '" + pair + "'");
+    if (eq == std::string::npos || eq == 0) throw UsageError("--param expects KEY=VALUE, got '" + pair + "'");
     const std::string key = pair.substr(0, eq);
     const std::string text = pair.substr(eq + 1);
     std::size_t used = 0;
@@ -99,8 +97,8 @@ std::string methods_help() {
 void add_navigability_options(CLI::App& cmd, NavigabilityParams& params, bool required) {
   auto* kappa = cmd.add_option("--kappa", params.kappa, "maximum climbable slope, rise over run [m/m]")
                     ->check(CLI::PositiveNumber);
-  auto* eps = cmd.add_option("--eps", params.eps_m, "largest discontinuity per body length [m]")
-                  ->check(CLI::NonNegativeNumber);
+  auto* eps =
+      cmd.add_option("--eps", params.eps_m, "largest discontinuity per body length [m]")->check(CLI::NonNegativeNumber);
   auto* delta = cmd.add_option("--delta", params.delta_m, "robot body length [m]")->check(CLI::PositiveNumber);
   if (required) {
     kappa->required();
@@ -123,9 +121,10 @@ void check_origin(const Heightmap& map, CellIndex origin) {
 }  // namespace
 
 int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
-  CLI::App app{"marsala-terrain: generate, import, inspect and render terrains; compute MARS and navigability.\n"
-               "Heights are metres; files are ESRI ASCII grids (.asc); GeoTIFF (.tif) is accepted as input.",
-               "marsala-terrain"};
+  CLI::App app{
+      "marsala-terrain: generate, import, inspect and render terrains; compute MARS and navigability.\n"
+      "Heights are metres; files are ESRI ASCII grids (.asc); GeoTIFF (.tif) is accepted as input.",
+      "marsala-terrain"};
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "help for every subcommand");
 
@@ -198,7 +197,8 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
   auto* render = app.add_subcommand("render", "write a hillshaded, colour-mapped PNG with optional overlays");
   render->add_option("input", in_path, "input .asc or .tif")->required()->check(CLI::ExistingFile);
   render->add_option("-o,--output", out_path, "output .png")->required();
-  render->add_option("--navigable-from", render_origins, "overlay the region navigable from ROW COL (repeatable; give the input file first)");
+  render->add_option("--navigable-from", render_origins,
+                     "overlay the region navigable from ROW COL (repeatable; give the input file first)");
   render->add_flag("--gap", render_gap, "overlay the MARS gap at --kappa");
   add_navigability_options(*render, render_params, false);
   render->add_option("--title", title, "title drawn above the picture");
@@ -251,8 +251,8 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       const Heightmap bound = processor.project(map);
       Heightmap gap(map.geometry(), (bound.heights() - map.heights()).eval());
       terrain::write_asc(write_gap ? gap : bound, out_path);
-      out << "MARS at kappa " << kappa << ": gap volume " << deposition_target_volume(gap)
-          << " m^3, largest gap " << gap.max_height() << " m -> " << out_path << "\n";
+      out << "MARS at kappa " << kappa << ": gap volume " << deposition_target_volume(gap) << " m^3, largest gap "
+          << gap.max_height() << " m -> " << out_path << "\n";
     } else if (*navigable) {
       const Heightmap map = load_terrain(in_path, fill_nodata);
       const NavigabilityProcessor processor(nav_params);
@@ -267,8 +267,8 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
         const CellMask reach = NavigabilityProcessor::navigable_from(occupiable, to_cell(origin));
         terrain::write_asc(mask_as_heights(reach, map.geometry()), out_path);
         out << "navigable from (" << origin.first << ", " << origin.second << "): " << count(reach) << " of "
-            << map.size() << " cells (" << percent(count(reach), map.size()) << "); occupiable "
-            << count(occupiable) << " -> " << out_path << "\n";
+            << map.size() << " cells (" << percent(count(reach), map.size()) << "); occupiable " << count(occupiable)
+            << " -> " << out_path << "\n";
         if (count(reach) == 0) out << "note: the origin cell is not occupiable, so nothing is navigable\n";
       }
     } else if (*render) {

@@ -29,9 +29,7 @@ bool forward(Heading h) { return h == Heading::kEast || h == Heading::kNorth; }
 
 // Pieces of n units of `size` covering `extent`, the last one possibly shorter: ceil(extent / size), at least 1;
 // a quotient a rounding error above an integer does not open an extra, empty piece.
-int pieces(double extent, double size) {
-  return std::max(1, static_cast<int>(std::ceil(extent / size - kTolM)));
-}
+int pieces(double extent, double size) { return std::max(1, static_cast<int>(std::ceil(extent / size - kTolM))); }
 
 }  // namespace
 
@@ -51,22 +49,25 @@ GoalVectorMap::GoalVectorMap(const GoalVectorMapSpec& spec, const GridGeometry& 
       !std::isfinite(grid.yll_m))
     fail("the grid " + std::to_string(grid.rows) + " x " + std::to_string(grid.cols) + " with cell size " +
          fmt::format("{}", cs) + " m is not a valid grid");
-  const std::string rect = "[" + fmt::format("{}", spec.x0_m) + ", " + fmt::format("{}", spec.x1_m) + "] x [" + fmt::format("{}", spec.y0_m) + ", " +
-                           fmt::format("{}", spec.y1_m) + "] m";
+  const std::string rect = "[" + fmt::format("{}", spec.x0_m) + ", " + fmt::format("{}", spec.x1_m) + "] x [" +
+                           fmt::format("{}", spec.y0_m) + ", " + fmt::format("{}", spec.y1_m) + "] m";
   if (!(spec.x0_m < spec.x1_m) || !(spec.y0_m < spec.y1_m))
     fail("the rectangle " + rect + " is empty (needs x0_m < x1_m and y0_m < y1_m)");
   const double gx1 = grid.xll_m + grid.cols * cs;
   const double gy1 = grid.yll_m + grid.rows * cs;
   if (spec.x0_m < grid.xll_m - kTolM || spec.x1_m > gx1 + kTolM || spec.y0_m < grid.yll_m - kTolM ||
       spec.y1_m > gy1 + kTolM)
-    fail("the rectangle " + rect + " is not inside the grid [" + fmt::format("{}", grid.xll_m) + ", " + fmt::format("{}", gx1) + "] x [" +
-         fmt::format("{}", grid.yll_m) + ", " + fmt::format("{}", gy1) + "] m");
+    fail("the rectangle " + rect + " is not inside the grid [" + fmt::format("{}", grid.xll_m) + ", " +
+         fmt::format("{}", gx1) + "] x [" + fmt::format("{}", grid.yll_m) + ", " + fmt::format("{}", gy1) + "] m");
   if (!(spec.strip_width_m > 0.0)) fail("strip_width_m is " + fmt::format("{}", spec.strip_width_m) + ", must be > 0");
-  if (!(spec.arrow_length_m > 0.0)) fail("arrow_length_m is " + fmt::format("{}", spec.arrow_length_m) + ", must be > 0");
+  if (!(spec.arrow_length_m > 0.0))
+    fail("arrow_length_m is " + fmt::format("{}", spec.arrow_length_m) + ", must be > 0");
   if (spec.strip_width_m < cs - kTolM)
-    fail("strip_width_m " + fmt::format("{}", spec.strip_width_m) + " m is narrower than one cell (" + fmt::format("{}", cs) + " m)");
+    fail("strip_width_m " + fmt::format("{}", spec.strip_width_m) + " m is narrower than one cell (" +
+         fmt::format("{}", cs) + " m)");
   if (spec.arrow_length_m < cs - kTolM)
-    fail("arrow_length_m " + fmt::format("{}", spec.arrow_length_m) + " m is shorter than one cell (" + fmt::format("{}", cs) + " m)");
+    fail("arrow_length_m " + fmt::format("{}", spec.arrow_length_m) + " m is shorter than one cell (" +
+         fmt::format("{}", cs) + " m)");
 
   const Heading heading = spec.heading;
   const bool ax = along_x(heading);
@@ -156,7 +157,8 @@ GoalVectorMap::GoalVectorMap(const GoalVectorMapSpec& spec, const GridGeometry& 
 
 std::optional<std::size_t> GoalVectorMap::nearest_free_tail(Position p, const std::vector<bool>& excluded) const {
   if (!std::isfinite(p.x) || !std::isfinite(p.y))
-    fail("nearest_free_tail from (" + fmt::format("{}", p.x) + ", " + fmt::format("{}", p.y) + ") m: not a finite position");
+    fail("nearest_free_tail from (" + fmt::format("{}", p.x) + ", " + fmt::format("{}", p.y) +
+         ") m: not a finite position");
   std::optional<std::size_t> best;
   double best_d2 = 0.0;
   for (std::size_t i = 0; i < arrows_.size(); ++i) {
@@ -174,8 +176,7 @@ std::optional<std::size_t> GoalVectorMap::nearest_free_tail(Position p, const st
 
 std::optional<std::size_t> GoalVectorMap::next(std::size_t i) const {
   if (i >= arrows_.size())
-    fail("arrow " + std::to_string(i) + " is out of range (the map has " + std::to_string(arrows_.size()) +
-         " arrows)");
+    fail("arrow " + std::to_string(i) + " is out of range (the map has " + std::to_string(arrows_.size()) + " arrows)");
   if (i + 1 < arrows_.size() && arrows_[i + 1].strip == arrows_[i].strip) return i + 1;
   return std::nullopt;
 }

@@ -11,13 +11,10 @@ namespace {
 
 void check_geometry(const GridGeometry& g) {
   if (g.rows <= 0 || g.cols <= 0)
-    throw InvalidArgument("grid size must be positive, got " + std::to_string(g.rows) + " x " +
-                          std::to_string(g.cols));
+    throw InvalidArgument("grid size must be positive, got " + std::to_string(g.rows) + " x " + std::to_string(g.cols));
   if (!(g.cell_size_m > 0.0) || !std::isfinite(g.cell_size_m))
-    throw InvalidArgument("cell size must be a positive finite number of metres, got " +
-                          std::to_string(g.cell_size_m));
-  if (!std::isfinite(g.xll_m) || !std::isfinite(g.yll_m))
-    throw InvalidArgument("grid corner must be finite");
+    throw InvalidArgument("cell size must be a positive finite number of metres, got " + std::to_string(g.cell_size_m));
+  if (!std::isfinite(g.xll_m) || !std::isfinite(g.yll_m)) throw InvalidArgument("grid corner must be finite");
 }
 
 }  // namespace
@@ -34,8 +31,7 @@ Heightmap::Heightmap(GridGeometry geometry, double fill) : geometry_(geometry) {
   heights_.setConstant(geometry_.rows, geometry_.cols, fill);
 }
 
-Heightmap::Heightmap(GridGeometry geometry, HeightMatrix heights)
-    : geometry_(geometry), heights_(std::move(heights)) {
+Heightmap::Heightmap(GridGeometry geometry, HeightMatrix heights) : geometry_(geometry), heights_(std::move(heights)) {
   geometry_.rows = static_cast<int>(heights_.rows());
   geometry_.cols = static_cast<int>(heights_.cols());
   check_geometry(geometry_);

@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "marsala/core/error.hpp"
 #include "marsala/core/detail/mars_common.hpp"
 #include "marsala/core/detail/mars_search.hpp"
 #include "marsala/core/detail/mars_seed.hpp"
 #include "marsala/core/detail/mars_source_tree.hpp"
+#include "marsala/core/error.hpp"
 
 namespace marsala {
 namespace {
@@ -37,8 +37,8 @@ Heightmap MarsProcessor::project(const Heightmap& h) const {
     for (int c = 0; c < cols; ++c) {
       const double v = h(r, c);
       if (!std::isfinite(v))
-        throw InvalidArgument("MarsProcessor: height at cell (row " + std::to_string(r) + ", col " +
-                              std::to_string(c) + ") is not finite");
+        throw InvalidArgument("MarsProcessor: height at cell (row " + std::to_string(r) + ", col " + std::to_string(c) +
+                              ") is not finite");
       max_abs = std::max(max_abs, std::abs(v));
     }
   detail::Problem pb;

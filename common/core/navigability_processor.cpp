@@ -6,8 +6,8 @@
 #include <sstream>
 #include <string>
 
-#include "marsala/core/error.hpp"
 #include "marsala/core/detail/navigability_kernel.hpp"
+#include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 
 namespace marsala {
@@ -40,8 +40,7 @@ void check_origin(int rows, int cols, CellIndex origin) {
 
 NavigabilityProcessor::NavigabilityProcessor(NavigabilityParams params) : params_(params) {
   require(std::isfinite(params_.kappa) && params_.kappa > 0.0, "kappa", params_.kappa, "finite and > 0 [m/m]");
-  require(std::isfinite(params_.delta_m) && params_.delta_m > 0.0, "delta_m", params_.delta_m,
-          "finite and > 0 [m]");
+  require(std::isfinite(params_.delta_m) && params_.delta_m > 0.0, "delta_m", params_.delta_m, "finite and > 0 [m]");
   require(std::isfinite(params_.eps_m) && params_.eps_m >= 0.0, "eps_m", params_.eps_m, "finite and >= 0 [m]");
 }
 

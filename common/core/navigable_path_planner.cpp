@@ -9,10 +9,10 @@
 #include <string>
 #include <tuple>
 
+#include "marsala/core/deposition.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/core/iterators.hpp"
-#include "marsala/core/deposition.hpp"
 
 namespace marsala {
 namespace {
@@ -32,8 +32,8 @@ struct Entry {
 
 PlannerParams default_planner_params(double delta_m, double cell_size_m) {
   if (!(delta_m > 0.0) || !std::isfinite(delta_m) || !(cell_size_m > 0.0) || !std::isfinite(cell_size_m))
-    throw InvalidArgument(fmt::format("planner: body length {} m and cell size {} m must be finite and > 0", delta_m,
-                                      cell_size_m));
+    throw InvalidArgument(
+        fmt::format("planner: body length {} m and cell size {} m must be finite and > 0", delta_m, cell_size_m));
   PlannerParams p;
   p.delta_m = delta_m;
   p.beta = 1.0;
@@ -75,8 +75,7 @@ PlannerResult NavigablePathPlanner::plan(const Heightmap& gap, const CellMask& a
         const CellIndex q{r + o.row, c + o.col};
         if (!gap.contains(q)) continue;
         const double v = gap(q);
-        if (!(v >= 0.0) || !std::isfinite(v))
-          throw InvalidArgument(fmt::format("planner: MARS gap at {} is {}", q, v));
+        if (!(v >= 0.0) || !std::isfinite(v)) throw InvalidArgument(fmt::format("planner: MARS gap at {} is {}", q, v));
         s += v;
         ++inside;
       }
@@ -134,8 +133,7 @@ PlannerResult NavigablePathPlanner::plan(const Heightmap& gap, const CellMask& a
   result.found = true;
   result.length_m = g_of[goal_index];
   result.gap_cost_m = c_of[goal_index];
-  result.target_volume_m3 = deposition_target_volume(
-      gap, path_footprint(gap.geometry(), result.path, params_.delta_m));
+  result.target_volume_m3 = deposition_target_volume(gap, path_footprint(gap.geometry(), result.path, params_.delta_m));
   return result;
 }
 

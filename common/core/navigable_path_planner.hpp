@@ -33,12 +33,12 @@ PlannerParams default_planner_params(double delta_m, double cell_size_m);
 
 /// What the planner found.
 struct PlannerResult {
-  bool found = false;                ///< false: no path through allowed cells (an expected outcome)
-  std::vector<CellIndex> path;       ///< start ... goal, 8-connected (local indices)
-  double length_m = 0.0;             ///< g at the goal [m]
-  double gap_cost_m = 0.0;           ///< c at the goal [m]
-  double target_volume_m3 = 0.0;     ///< deposition target volume: the MARS gap over the path's footprint [m^3]
-  int expanded = 0;                  ///< nodes expanded [count]
+  bool found = false;             ///< false: no path through allowed cells (an expected outcome)
+  std::vector<CellIndex> path;    ///< start ... goal, 8-connected (local indices)
+  double length_m = 0.0;          ///< g at the goal [m]
+  double gap_cost_m = 0.0;        ///< c at the goal [m]
+  double target_volume_m3 = 0.0;  ///< deposition target volume: the MARS gap over the path's footprint [m^3]
+  int expanded = 0;               ///< nodes expanded [count]
 };
 
 /// A* with the cost of eq. 4-5. The agent plans deposition paths with it on its augmented local map; the world, with

@@ -21,8 +21,8 @@ inline std::uint64_t derive_seed(std::uint64_t seed, std::uint64_t tag) {
 
 /// Hash of a 2D lattice point under a seed.
 inline std::uint64_t hash2(std::uint64_t seed, std::int64_t i, std::int64_t j) {
-  const std::uint64_t key = (static_cast<std::uint64_t>(i) * 0x9e3779b97f4a7c15ULL) ^
-                            (static_cast<std::uint64_t>(j) * 0xc2b2ae3d27d4eb4fULL);
+  const std::uint64_t key =
+      (static_cast<std::uint64_t>(i) * 0x9e3779b97f4a7c15ULL) ^ (static_cast<std::uint64_t>(j) * 0xc2b2ae3d27d4eb4fULL);
   return mix64(key ^ seed);
 }
 

@@ -27,8 +27,9 @@ bool operator==(const RobotBody& a, const RobotBody& b) {
 std::string body_problem(const RobotBody& b) {
   const NavigabilityParams& n = b.navigability;
   for (const std::string& problem :
-       {check("kappa", n.kappa, true, "m/m"), check("delta_m", n.delta_m, true, "m"), check("eps_m", n.eps_m, false, "m"),
-        check("max_step_m", b.max_step_m, true, "m"), check("max_deposit_m3", b.max_deposit_m3, true, "m^3"),
+       {check("kappa", n.kappa, true, "m/m"), check("delta_m", n.delta_m, true, "m"),
+        check("eps_m", n.eps_m, false, "m"), check("max_step_m", b.max_step_m, true, "m"),
+        check("max_deposit_m3", b.max_deposit_m3, true, "m^3"),
         check("material_capacity_m3", b.material_capacity_m3, false, "m^3"), check("reach_m", b.reach_m, false, "m"),
         check("sensing_range_m", b.sensing_range_m, false, "m"),
         check("proximity_range_m", b.proximity_range_m, false, "m"), check("cube_size_m", b.cube_size_m, true, "m")})

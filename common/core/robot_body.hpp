@@ -11,14 +11,14 @@ namespace marsala {
 
 /// A robot's body, kinematics and capabilities.
 struct RobotBody {
-  NavigabilityParams navigability;     ///< kappa [m/m], delta_m [m], eps_m [m] of eq. 1
-  double max_step_m = 0.2;             ///< distance threshold: longest motion in one step [m]
-  double max_deposit_m3 = 0.01;        ///< deposition threshold: most material placed in one step [m^3]
-  double material_capacity_m3 = 2.0;   ///< material carried when full [m^3]
-  double reach_m = 1.2;                ///< manipulator reach from the robot's centre [m]
-  double sensing_range_m = 3.0;        ///< half-side of the square terrain window it senses [m]
-  double proximity_range_m = 3.0;      ///< neighbours within this distance are reported [m]
-  double cube_size_m = 0.05;           ///< smallest deposition: a cube of this side [m]
+  NavigabilityParams navigability;    ///< kappa [m/m], delta_m [m], eps_m [m] of eq. 1
+  double max_step_m = 0.2;            ///< distance threshold: longest motion in one step [m]
+  double max_deposit_m3 = 0.01;       ///< deposition threshold: most material placed in one step [m^3]
+  double material_capacity_m3 = 2.0;  ///< material carried when full [m^3]
+  double reach_m = 1.2;               ///< manipulator reach from the robot's centre [m]
+  double sensing_range_m = 3.0;       ///< half-side of the square terrain window it senses [m]
+  double proximity_range_m = 3.0;     ///< neighbours within this distance are reported [m]
+  double cube_size_m = 0.05;          ///< smallest deposition: a cube of this side [m]
 
   /// Equal field by field, bit for bit (both sides read the same scenario file).
   friend bool operator==(const RobotBody& a, const RobotBody& b);

@@ -19,8 +19,8 @@ struct Pipeline {
 
 /// A kind of robot.
 struct RobotType {
-  std::string name;                               ///< e.g. "husky"
-  std::string behaviour = "ramp_builder";         ///< reactive behaviour by name (agent registry)
+  std::string name;                        ///< e.g. "husky"
+  std::string behaviour = "ramp_builder";  ///< reactive behaviour by name (agent registry)
   RobotBody body;
   /// What it builds: a structure navigable for kappa and eps_m over a band delta_m wide along its path; unset: for
   /// its own body (construction_params()).

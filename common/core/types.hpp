@@ -31,13 +31,14 @@ struct NavigabilityParams {
   friend bool operator!=(const NavigabilityParams& a, const NavigabilityParams& b) { return !(a == b); }
 };
 
-/// A tile of the authoritative terrain, as a robot's terrain sensing delivers it: heights of cells [tile_row * tile_size, ...) x [tile_col * tile_size, ...).
+/// A tile of the authoritative terrain, as a robot's terrain sensing delivers it: heights of cells [tile_row *
+/// tile_size, ...) x [tile_col * tile_size, ...).
 struct TerrainTile {
   std::int32_t tile_row = 0;
   std::int32_t tile_col = 0;
-  std::int32_t rows = 0;               ///< cells in this tile (tile_size, or fewer at the grid edge)
+  std::int32_t rows = 0;  ///< cells in this tile (tile_size, or fewer at the grid edge)
   std::int32_t cols = 0;
-  std::vector<double> heights;         ///< rows * cols heights [m], row-major, row 0 northmost
+  std::vector<double> heights;  ///< rows * cols heights [m], row-major, row 0 northmost
 };
 
 /// Another robot within proximity range, as proximity sensing reports it.

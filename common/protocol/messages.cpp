@@ -11,9 +11,9 @@ constexpr EnumName<ActionResult> kActionResultNames[] = {{ActionResult::kNone, "
                                                          {ActionResult::kMissed, "missed"}};
 
 constexpr EnumName<EventKind> kEventKindNames[] = {
-    {EventKind::kAdmitted, "admitted"}, {EventKind::kRefused, "refused"}, {EventKind::kRejected, "rejected"},
-    {EventKind::kDeposited, "deposited"}, {EventKind::kMissed, "missed"}, {EventKind::kDropped, "dropped"},
-    {EventKind::kAtGoal, "at_goal"}, {EventKind::kRunOver, "run_over"}};
+    {EventKind::kAdmitted, "admitted"},   {EventKind::kRefused, "refused"}, {EventKind::kRejected, "rejected"},
+    {EventKind::kDeposited, "deposited"}, {EventKind::kMissed, "missed"},   {EventKind::kDropped, "dropped"},
+    {EventKind::kAtGoal, "at_goal"},      {EventKind::kRunOver, "run_over"}};
 
 }  // namespace
 

@@ -22,31 +22,31 @@ using marsala::TerrainTile;
 
 /// Agent -> world, repeated until admitted: who I am and what my body can do.
 struct AgentHello {
-  std::uint32_t agent_id = 0;   ///< unique in the run, >= 1
-  std::uint64_t session = 0;    ///< random per process start, so a restarted agent is told apart
-  std::string name;             ///< human-readable, e.g. "builder-3"
-  std::string behaviour;        ///< reactive behaviour name, e.g. "ramp_builder"
-  RobotBody body;                ///< declared body; admitted only if equal to its slot's robot type
+  std::uint32_t agent_id = 0;  ///< unique in the run, >= 1
+  std::uint64_t session = 0;   ///< random per process start, so a restarted agent is told apart
+  std::string name;            ///< human-readable, e.g. "builder-3"
+  std::string behaviour;       ///< reactive behaviour name, e.g. "ramp_builder"
+  RobotBody body;              ///< declared body; admitted only if equal to its slot's robot type
 };
 
 /// World -> agent: the answer to a hello, with what the agent needs to build its own map.
 struct Admission {
   std::uint32_t agent_id = 0;
-  std::uint64_t session = 0;     ///< echoes the hello's session
+  std::uint64_t session = 0;  ///< echoes the hello's session
   bool accepted = false;
-  std::string reason;            ///< why not, when rejected
-  std::string run_id;            ///< names the run; endpoints of this agent use partition partition_for(run, id)
-  std::int32_t rows = 0;         ///< world grid size [cells]
+  std::string reason;     ///< why not, when rejected
+  std::string run_id;     ///< names the run; endpoints of this agent use partition partition_for(run, id)
+  std::int32_t rows = 0;  ///< world grid size [cells]
   std::int32_t cols = 0;
-  double xll_m = 0.0;            ///< world grid lower-left corner [m]
+  double xll_m = 0.0;  ///< world grid lower-left corner [m]
   double yll_m = 0.0;
-  double cell_size_m = 0.0;      ///< [m/cell]
-  std::int32_t tile_size = 16;   ///< terrain tiles are tile_size x tile_size cells (smaller at the grid edge)
-  double start_x_m = 0.0;        ///< where the agent starts [m]
+  double cell_size_m = 0.0;     ///< [m/cell]
+  std::int32_t tile_size = 16;  ///< terrain tiles are tile_size x tile_size cells (smaller at the grid edge)
+  double start_x_m = 0.0;       ///< where the agent starts [m]
   double start_y_m = 0.0;
-  double target_x_m = 0.0;       ///< the goal of the scenario for this agent [m]
+  double target_x_m = 0.0;  ///< the goal of the scenario for this agent [m]
   double target_y_m = 0.0;
-  double base_x_m = 0.0;         ///< base station centre: material is refilled only there [m]
+  double base_x_m = 0.0;  ///< base station centre: material is refilled only there [m]
   double base_y_m = 0.0;
   double base_radius_m = 0.0;
 };
@@ -58,15 +58,15 @@ enum class ActionResult : std::uint8_t { kNone = 0, kAccepted = 1, kRejected = 2
 struct SensorFrame {
   std::uint32_t agent_id = 0;
   std::uint64_t step = 0;
-  double x_m = 0.0;                    ///< pose: the world's record of where the robot stands [m]
+  double x_m = 0.0;  ///< pose: the world's record of where the robot stands [m]
   double y_m = 0.0;
-  double z_m = 0.0;                    ///< terrain height under the robot's centre [m]
-  double material_m3 = 0.0;            ///< material on board [m^3]
+  double z_m = 0.0;          ///< terrain height under the robot's centre [m]
+  double material_m3 = 0.0;  ///< material on board [m^3]
   ActionResult last_result = ActionResult::kNone;
-  std::string last_reason;             ///< why the previous request was rejected, if it was
-  std::vector<TerrainTile> tiles;      ///< tiles in sensing range that changed since this agent last got them
-  std::vector<Neighbour> neighbours;   ///< robots within proximity range
-  bool run_over = false;               ///< the run has ended: the agent should exit
+  std::string last_reason;            ///< why the previous request was rejected, if it was
+  std::vector<TerrainTile> tiles;     ///< tiles in sensing range that changed since this agent last got them
+  std::vector<Neighbour> neighbours;  ///< robots within proximity range
+  bool run_over = false;              ///< the run has ended: the agent should exit
 };
 
 /// Agent -> world (its own partition only): what it wants to do in `step`.
@@ -74,12 +74,12 @@ struct ActionRequest {
   std::uint32_t agent_id = 0;
   std::uint64_t session = 0;
   std::uint64_t step = 0;
-  bool move = false;                   ///< move to (target_x_m, target_y_m) this step
+  bool move = false;  ///< move to (target_x_m, target_y_m) this step
   double target_x_m = 0.0;
   double target_y_m = 0.0;
-  std::vector<Deposition> depositions; ///< applied after the motion, within reach of the new position
-  bool refill = false;                 ///< top up material (only at the base station)
-  std::string state;                   ///< the behaviour's state name, for the monitor
+  std::vector<Deposition> depositions;  ///< applied after the motion, within reach of the new position
+  bool refill = false;                  ///< top up material (only at the base station)
+  std::string state;                    ///< the behaviour's state name, for the monitor
 };
 
 /// One agent as the world sees it, for status and the monitor.
@@ -92,9 +92,9 @@ struct AgentStatus {
   double z_m = 0.0;
   double material_m3 = 0.0;
   double deposited_m3 = 0.0;
-  std::uint32_t accepted = 0;          ///< requests accepted
-  std::uint32_t rejected = 0;          ///< requests rejected
-  std::uint32_t missed = 0;            ///< steps whose deadline passed without its request
+  std::uint32_t accepted = 0;  ///< requests accepted
+  std::uint32_t rejected = 0;  ///< requests rejected
+  std::uint32_t missed = 0;    ///< steps whose deadline passed without its request
   bool alive = true;
   bool at_goal = false;
 };
@@ -106,7 +106,7 @@ struct WorldStatus {
   std::uint64_t step = 0;
   double wall_seconds = 0.0;
   double deposited_volume_m3 = 0.0;
-  double progress = 0.0;               ///< [0, 1]: agents at goal (fraction), payload path (0/1), site (level fraction)
+  double progress = 0.0;  ///< [0, 1]: agents at goal (fraction), payload path (0/1), site (level fraction)
   bool running = true;
   bool completed = false;
   std::vector<AgentStatus> agents;
@@ -127,9 +127,9 @@ enum class EventKind : std::uint8_t {
 /// World -> everyone: something happened.
 struct WorldEvent {
   std::uint64_t step = 0;
-  std::uint32_t agent_id = 0;          ///< 0 when not about one agent
+  std::uint32_t agent_id = 0;  ///< 0 when not about one agent
   EventKind kind = EventKind::kAdmitted;
-  double volume_m3 = 0.0;              ///< for kDeposited
+  double volume_m3 = 0.0;  ///< for kDeposited
   std::string detail;
 };
 

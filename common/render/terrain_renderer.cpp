@@ -94,7 +94,8 @@ std::vector<double> hillshade(const std::vector<double>& h, int rows, int cols, 
                (4.0 * (rs - rn) * cell_m);
       dzdx *= kShadeExaggeration;
       dzdy *= kShadeExaggeration;
-      const double lit = (kSinAltitude - kSunEast * dzdx - kSunNorth * dzdy) / std::sqrt(1.0 + dzdx * dzdx + dzdy * dzdy);
+      const double lit =
+          (kSinAltitude - kSunEast * dzdx - kSunNorth * dzdy) / std::sqrt(1.0 + dzdx * dzdx + dzdy * dzdy);
       out[static_cast<std::size_t>(r) * cols + c] = std::max(0.0, lit) / kSinAltitude;
     }
   }
@@ -123,7 +124,8 @@ void validate(const Heightmap& map, const RenderOptions& o) {
   for (int r = 0; r < map.rows(); ++r)
     for (int c = 0; c < map.cols(); ++c)
       if (!std::isfinite(map(r, c)))
-        throw InvalidArgument("render_terrain: height at cell " + fmt::format("{}", CellIndex{r, c}) + " is not finite");
+        throw InvalidArgument("render_terrain: height at cell " + fmt::format("{}", CellIndex{r, c}) +
+                              " is not finite");
   if (o.max_size_px < 1 || o.max_size_px > kMaxSizePx)
     throw InvalidArgument("render_terrain: max_size_px = " + std::to_string(o.max_size_px) + " is outside [1, " +
                           std::to_string(kMaxSizePx) + "]");
@@ -149,7 +151,9 @@ void validate(const Heightmap& map, const RenderOptions& o) {
   if (!(o.label_alpha >= 0.0 && o.label_alpha <= 1.0))
     throw InvalidArgument("render_terrain: label_alpha = " + std::to_string(o.label_alpha) + " is outside [0, 1]");
   const auto check = [](bool ok, const std::string& what, std::size_t i) {
-    if (!ok) throw InvalidArgument("render_terrain: " + what + " " + std::to_string(i) + " has a non-finite or negative value");
+    if (!ok)
+      throw InvalidArgument("render_terrain: " + what + " " + std::to_string(i) +
+                            " has a non-finite or negative value");
   };
   const auto finite = [](Position p) { return std::isfinite(p.x) && std::isfinite(p.y); };
   const auto width_ok = [](double w) { return std::isfinite(w) && w >= 0.0; };
@@ -532,7 +536,8 @@ Image compose(const TerrainLayer& layer, const Heightmap& map, const RenderOptio
 
   const int title_h = o.title.empty() ? 0 : detail::text_height(title_font) + pad;
   const int left_w = std::max({tw, scale_row_w, detail::text_width(caption, font)});
-  const int width = std::max(pad + left_w + 3 * pad + panel_w + pad, pad + detail::text_width(o.title, title_font) + pad);
+  const int width =
+      std::max(pad + left_w + 3 * pad + panel_w + pad, pad + detail::text_width(o.title, title_font) + pad);
   const int top = pad + title_h;
   const int height = top + std::max(th + bottom_h, panel_h) + pad;
 

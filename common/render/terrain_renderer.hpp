@@ -20,8 +20,8 @@
 #include <vector>
 
 #include "marsala/core/heightmap.hpp"
-#include "marsala/render/image.hpp"
 #include "marsala/core/types.hpp"
+#include "marsala/render/image.hpp"
 
 namespace marsala::render {
 
@@ -36,9 +36,9 @@ Rgb label_colour(std::uint32_t label, const std::vector<Rgb>& palette = {});
 
 /// A line through world points [m], drawn with a dark halo one pixel wide on each side.
 struct Polyline {
-  std::vector<Position> points;              ///< at least 2 to draw anything [m]
+  std::vector<Position> points;  ///< at least 2 to draw anything [m]
   Rgb colour{255, 214, 0};
-  double width_px = 0.0;                     ///< 0 = automatic (about 1/200 of the terrain area's longest side)
+  double width_px = 0.0;  ///< 0 = automatic (about 1/200 of the terrain area's longest side)
 };
 
 /// An arrow from `tail` to `head` [m]: a shaft and a filled triangular head at `head`, with a dark halo.
@@ -46,7 +46,7 @@ struct Arrow {
   Position tail;
   Position head;
   Rgb colour{220, 30, 30};
-  double width_px = 0.0;                     ///< shaft width; 0 = automatic
+  double width_px = 0.0;  ///< shaft width; 0 = automatic
 };
 
 /// The outline of the axis-aligned rectangle with opposite corners `a` and `b` [m].
@@ -54,7 +54,7 @@ struct RectangleOutline {
   Position a;
   Position b;
   Rgb colour{255, 255, 255};
-  double width_px = 0.0;                     ///< 0 = automatic
+  double width_px = 0.0;  ///< 0 = automatic
 };
 
 /// A circle of radius_m around `centre` [m], outlined.
@@ -62,7 +62,7 @@ struct CircleOutline {
   Position centre;
   double radius_m = 1.0;
   Rgb colour{255, 255, 255};
-  double width_px = 0.0;                     ///< 0 = automatic
+  double width_px = 0.0;  ///< 0 = automatic
 };
 
 /// Shape of a point mark.
@@ -73,7 +73,7 @@ struct PointMark {
   Position at;
   Rgb colour{255, 255, 255};
   PointShape shape = PointShape::kDisc;
-  double radius_px = 0.0;                    ///< half-size of the mark; 0 = automatic
+  double radius_px = 0.0;  ///< half-size of the mark; 0 = automatic
 };
 
 /// How a legend entry's swatch is drawn: a filled square, a point mark's shape, a line, a circle or rectangle
@@ -89,21 +89,21 @@ struct LegendEntry {
 
 /// What to draw over the hillshaded, colour-mapped terrain.
 struct RenderOptions {
-  std::optional<CellMask> navigable;   ///< tint navigable cells (translucent green), outline its border
-  std::optional<Heightmap> gap;        ///< MARS gap [m]: a heat overlay where gap > 1e-9 m
-  std::vector<CellIndex> markers;            ///< e.g. navigability origins: drawn as crosses
-  std::optional<CellLabels> labels;          ///< tint labelled cells with their palette colour (below the overlays)
-  std::vector<Rgb> palette;                  ///< colours of labels 1, 2, ...; empty = default_palette()
-  double label_alpha = 0.6;                  ///< opacity of the label tint, in [0, 1]
+  std::optional<CellMask> navigable;  ///< tint navigable cells (translucent green), outline its border
+  std::optional<Heightmap> gap;       ///< MARS gap [m]: a heat overlay where gap > 1e-9 m
+  std::vector<CellIndex> markers;     ///< e.g. navigability origins: drawn as crosses
+  std::optional<CellLabels> labels;   ///< tint labelled cells with their palette colour (below the overlays)
+  std::vector<Rgb> palette;           ///< colours of labels 1, 2, ...; empty = default_palette()
+  double label_alpha = 0.6;           ///< opacity of the label tint, in [0, 1]
   std::vector<RectangleOutline> rectangles;
   std::vector<CircleOutline> circles;
   std::vector<Polyline> polylines;
   std::vector<Arrow> arrows;
   std::vector<PointMark> points;
-  std::vector<LegendEntry> legend_entries;   ///< extra key lines (legend only), after the built-in ones
-  int max_size_px = 1024;                    ///< longest side of the terrain area [px]; small grids upscale by an integer
-  bool legend = true;                        ///< a colour bar with min/max height, a scale bar in metres, title
-  std::string title;                         ///< drawn above the terrain when not empty (legend only)
+  std::vector<LegendEntry> legend_entries;  ///< extra key lines (legend only), after the built-in ones
+  int max_size_px = 1024;  ///< longest side of the terrain area [px]; small grids upscale by an integer
+  bool legend = true;      ///< a colour bar with min/max height, a scale bar in metres, title
+  std::string title;       ///< drawn above the terrain when not empty (legend only)
 };
 
 /// Renders the heightmap (north up, row 0 at the top) with hillshading (sun from the NW, 45 deg) and a colour map.

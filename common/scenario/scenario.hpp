@@ -8,32 +8,32 @@
 #include <string>
 #include <vector>
 
-#include "marsala/core/robot_type.hpp"
 #include "marsala/core/goal_vector_map.hpp"
+#include "marsala/core/robot_type.hpp"
 
 namespace marsala::scenario {
 
 /// Where the world's terrain comes from: a generator (common/terrain/generators.hpp) or a file.
 struct TerrainSource {
   // Generated terrain (used when `file` is empty).
-  std::string method = "flat";               ///< generator name
+  std::string method = "flat";  ///< generator name
   int rows = 100;
   int cols = 100;
   double cell_size_m = 0.1;
   std::uint64_t seed = 1;
-  std::map<std::string, double> params;      ///< generator parameters
+  std::map<std::string, double> params;  ///< generator parameters
   // Or a terrain file (.asc or .tif), relative paths resolved against the scenario file's folder.
   std::string file;
   bool has_crop = false;
   double crop_x0_m = 0.0, crop_y0_m = 0.0, crop_width_m = 0.0, crop_height_m = 0.0;
-  double resample_cell_size_m = 0.0;         ///< 0 = keep the file's cell size
-  bool zero_base = false;                    ///< shift so the lowest cell is at 0 m
+  double resample_cell_size_m = 0.0;  ///< 0 = keep the file's cell size
+  bool zero_base = false;             ///< shift so the lowest cell is at 0 m
 };
 
 /// One agent of the team: agent id (slot index + 1), robot type, start and target [m].
 struct AgentSlot {
   std::uint32_t id = 0;
-  std::string robot_type;                    ///< a RobotType name
+  std::string robot_type;  ///< a RobotType name
   double start_x_m = 0.0, start_y_m = 0.0;
   double target_x_m = 0.0, target_y_m = 0.0;
 };
@@ -46,16 +46,16 @@ struct Goal {
 
 /// How the world decides that a run is complete.
 enum class CompletionKind : std::uint8_t {
-  kAgentsAtGoal = 0,   ///< every live agent inside the goal rectangle (Scenario::goal)
-  kPayloadPath = 1,    ///< a payload has a navigable path (Scenario::payload_path)
-  kLevelSite = 2,      ///< the site is level (Scenario::site)
+  kAgentsAtGoal = 0,  ///< every live agent inside the goal rectangle (Scenario::goal)
+  kPayloadPath = 1,   ///< a payload has a navigable path (Scenario::payload_path)
+  kLevelSite = 2,     ///< the site is level (Scenario::site)
 };
 /// "agents_at_goal", "payload_path", "level_site".
 std::string to_string(CompletionKind kind);
 
 /// A payload robot's navigable path from (from_x, from_y) to (to_x, to_y) [m] for kappa, delta, eps.
 struct PayloadPath {
-  NavigabilityParams navigability{0.2, 2.0, 0.05};   ///< the payload's kappa [m/m], delta_m [m], eps_m [m]
+  NavigabilityParams navigability{0.2, 2.0, 0.05};  ///< the payload's kappa [m/m], delta_m [m], eps_m [m]
   double from_x_m = 0.0, from_y_m = 0.0, to_x_m = 0.0, to_y_m = 0.0;
   std::uint32_t check_every_steps = 10;
 };
@@ -64,11 +64,10 @@ struct PayloadPath {
 /// connected.
 struct Site {
   double x0_m = 0.0, y0_m = 0.0, x1_m = 0.0, y1_m = 0.0;
-  NavigabilityParams navigability{0.1, 1.0, 0.05};   ///< what "level" means: kappa [m/m], delta_m [m], eps_m [m]
+  NavigabilityParams navigability{0.1, 1.0, 0.05};  ///< what "level" means: kappa [m/m], delta_m [m], eps_m [m]
   double min_fraction = 1.0;
   std::uint32_t check_every_steps = 10;
 };
-
 
 /// The base station: material is refilled only within radius of its centre.
 struct BaseStation {
@@ -78,17 +77,17 @@ struct BaseStation {
 /// A whole scenario.
 struct Scenario {
   std::string name;
-  std::string source_path;                   ///< the file it was loaded from (for messages and relative paths)
+  std::string source_path;  ///< the file it was loaded from (for messages and relative paths)
   TerrainSource terrain;
   std::vector<RobotType> robot_types;
-  std::vector<AgentSlot> slots;              ///< slots[i].id == i + 1
+  std::vector<AgentSlot> slots;  ///< slots[i].id == i + 1
   CompletionKind completion = CompletionKind::kAgentsAtGoal;
-  Goal goal;                                 ///< kAgentsAtGoal
-  PayloadPath payload_path;                  ///< kPayloadPath
-  Site site;                                 ///< kLevelSite
+  Goal goal;                 ///< kAgentsAtGoal
+  PayloadPath payload_path;  ///< kPayloadPath
+  Site site;                 ///< kLevelSite
   bool has_goal_vector_map = false;
   GoalVectorMapSpec goal_vector_map;
-  double start_jitter_m = 0.0;               ///< the world moves each start by up to this much (seeded) [m]
+  double start_jitter_m = 0.0;  ///< the world moves each start by up to this much (seeded) [m]
   BaseStation base;
   std::uint64_t max_steps = 5000;
   double step_deadline_s = 10.0;

@@ -9,14 +9,14 @@
 #include <fstream>
 #include <sstream>
 
-#include "marsala/core/error.hpp"
+#include "idl/scenario.pb.h"
 #include "marsala/core/enum_names.hpp"
+#include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/core/robot_body.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
 #include "marsala/terrain/generators.hpp"
-#include "idl/scenario.pb.h"
 
 namespace marsala::scenario {
 namespace {
@@ -64,7 +64,8 @@ class Validator {
     throw InvalidArgument("scenario " + source_ + ": " + field + ": " + problem);
   }
   double finite(const std::string& field, double v) const {
-    if (!std::isfinite(v) || std::abs(v) >= kMaxMagnitude) fail(field, fmt::format("{}", v) + " must be finite and < 1e6 in magnitude");
+    if (!std::isfinite(v) || std::abs(v) >= kMaxMagnitude)
+      fail(field, fmt::format("{}", v) + " must be finite and < 1e6 in magnitude");
     return v;
   }
   double positive(const std::string& field, double v) const {
@@ -180,8 +181,10 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
                              build.delta_m, reach_band_m));
     t.construction = build;
     const proto::Pipeline& pp = rp.pipeline();
-    if (pp.has_separation_m()) t.pipeline.separation_m = check.positive(field + ".pipeline.separation_m", pp.separation_m());
-    if (pp.has_lane_offset_m()) t.pipeline.lane_offset_m = check.finite(field + ".pipeline.lane_offset_m", pp.lane_offset_m());
+    if (pp.has_separation_m())
+      t.pipeline.separation_m = check.positive(field + ".pipeline.separation_m", pp.separation_m());
+    if (pp.has_lane_offset_m())
+      t.pipeline.lane_offset_m = check.finite(field + ".pipeline.lane_offset_m", pp.lane_offset_m());
     if (t.pipeline.lane_offset_m < 0.0) check.fail(field + ".pipeline.lane_offset_m", "must be >= 0");
     if (rp.has_goal_synthesizer()) t.goal_synthesizer = rp.goal_synthesizer();
     if (t.goal_synthesizer.empty()) check.fail(field + ".goal_synthesizer", "must not be empty");
@@ -196,8 +199,8 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     const std::uint32_t id = static_cast<std::uint32_t>(i) + 1;
     const std::string field = "agent[" + std::to_string(i) + "] (agent " + std::to_string(id) + ")";
     if (ap.has_id() && ap.id() != id)
-      check.fail(field + ".id", std::to_string(ap.id()) + " differs from its position in the file (" +
-                                    std::to_string(id) + ")");
+      check.fail(field + ".id",
+                 std::to_string(ap.id()) + " differs from its position in the file (" + std::to_string(id) + ")");
     AgentSlot slot;
     slot.id = id;
     slot.robot_type = ap.robot_type();
@@ -218,7 +221,8 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
   }
 
   const int completions = (p.has_goal() ? 1 : 0) + (p.has_payload_path() ? 1 : 0) + (p.has_site() ? 1 : 0);
-  if (completions != 1) check.fail("goal", "give exactly one of 'goal', 'payload_path' and 'site' (how the run completes)");
+  if (completions != 1)
+    check.fail("goal", "give exactly one of 'goal', 'payload_path' and 'site' (how the run completes)");
   if (p.has_goal()) {
     s.completion = CompletionKind::kAgentsAtGoal;
     s.goal.x0_m = check.finite("goal.x0_m", p.goal().x0_m());
@@ -299,7 +303,8 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
   if (s.max_steps == 0) check.fail("max_steps", "must be >= 1");
   if (p.has_step_deadline_s()) s.step_deadline_s = check.positive("step_deadline_s", p.step_deadline_s());
   if (p.has_tile_size()) s.tile_size = p.tile_size();
-  if (s.tile_size < 1 || s.tile_size > 4096) check.fail("tile_size", std::to_string(s.tile_size) + " must be in 1..4096");
+  if (s.tile_size < 1 || s.tile_size > 4096)
+    check.fail("tile_size", std::to_string(s.tile_size) + " must be in 1..4096");
   if (p.has_seed()) s.seed = p.seed();
 
   // Generated terrains have a known extent: check placements now. File terrains are checked by build_terrain().

@@ -68,13 +68,14 @@ Heightmap build_terrain(const Scenario& s) {
 void check_placement(const Scenario& s, const GridGeometry& g) {
   const double x1 = g.xll_m + g.cols * g.cell_size_m;
   const double y1 = g.yll_m + g.rows * g.cell_size_m;
-  const std::string extent = "[" + fmt::format("{}", g.xll_m) + ", " + fmt::format("{}", x1) + "] x [" + fmt::format("{}", g.yll_m) + ", " +
-                             fmt::format("{}", y1) + "] m";
+  const std::string extent = "[" + fmt::format("{}", g.xll_m) + ", " + fmt::format("{}", x1) + "] x [" +
+                             fmt::format("{}", g.yll_m) + ", " + fmt::format("{}", y1) + "] m";
   const auto fail = [&](const std::string& field, const std::string& problem) {
     throw InvalidArgument("scenario " + s.source_path + ": " + field + ": " + problem + " (terrain " + extent + ")");
   };
   const auto on_grid = [&](const std::string& field, double x, double y) {
-    if (!g.cell_at({x, y})) fail(field, "(" + fmt::format("{}", x) + ", " + fmt::format("{}", y) + ") is off the terrain");
+    if (!g.cell_at({x, y}))
+      fail(field, "(" + fmt::format("{}", x) + ", " + fmt::format("{}", y) + ") is off the terrain");
   };
   for (std::size_t i = 0; i < s.slots.size(); ++i) {
     const AgentSlot& slot = s.slots[i];
@@ -85,16 +86,20 @@ void check_placement(const Scenario& s, const GridGeometry& g) {
   on_grid("base", s.base.x_m, s.base.y_m);
   const auto inside = [&](const std::string& field, double x0, double y0, double xa, double ya) {
     if (x0 < g.xll_m || xa > x1 || y0 < g.yll_m || ya > y1)
-      fail(field, "[" + fmt::format("{}", x0) + ", " + fmt::format("{}", xa) + "] x [" + fmt::format("{}", y0) + ", " + fmt::format("{}", ya) +
-                      "] m is not inside the terrain");
+      fail(field, "[" + fmt::format("{}", x0) + ", " + fmt::format("{}", xa) + "] x [" + fmt::format("{}", y0) + ", " +
+                      fmt::format("{}", ya) + "] m is not inside the terrain");
   };
   switch (s.completion) {
-    case CompletionKind::kAgentsAtGoal: inside("goal", s.goal.x0_m, s.goal.y0_m, s.goal.x1_m, s.goal.y1_m); break;
+    case CompletionKind::kAgentsAtGoal:
+      inside("goal", s.goal.x0_m, s.goal.y0_m, s.goal.x1_m, s.goal.y1_m);
+      break;
     case CompletionKind::kPayloadPath:
       on_grid("payload_path.from", s.payload_path.from_x_m, s.payload_path.from_y_m);
       on_grid("payload_path.to", s.payload_path.to_x_m, s.payload_path.to_y_m);
       break;
-    case CompletionKind::kLevelSite: inside("site", s.site.x0_m, s.site.y0_m, s.site.x1_m, s.site.y1_m); break;
+    case CompletionKind::kLevelSite:
+      inside("site", s.site.x0_m, s.site.y0_m, s.site.x1_m, s.site.y1_m);
+      break;
   }
   if (s.has_goal_vector_map) {
     const GoalVectorMapSpec& m = s.goal_vector_map;

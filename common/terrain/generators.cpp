@@ -8,10 +8,10 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
+#include "marsala/core/random.hpp"
 #include "marsala/core/registry.hpp"
 #include "marsala/terrain/detail/det_math.hpp"
 #include "marsala/terrain/detail/noise.hpp"
-#include "marsala/core/random.hpp"
 
 namespace marsala::terrain {
 namespace {
@@ -19,9 +19,9 @@ namespace {
 using ParamValues = std::map<std::string, double>;
 
 constexpr long long kMaxCells = 1LL << 28;
-constexpr double kMaxLength = 1e7;   // [m]
-constexpr double kMaxHeight = 1e4;   // [m]
-constexpr double kEdgeTol = 1e-9;    // [m], platform edges: west/south inclusive, east/north exclusive
+constexpr double kMaxLength = 1e7;  // [m]
+constexpr double kMaxHeight = 1e4;  // [m]
+constexpr double kEdgeTol = 1e-9;   // [m], platform edges: west/south inclusive, east/north exclusive
 
 std::string join(const std::vector<std::string>& items) {
   std::string out;
@@ -82,20 +82,32 @@ using GeneratorRegistry = NamedRegistry<GeneratorEntry>;
 // Default helpers: a fixed value, or a fraction of the map extent / width / depth.
 ParamDef param(std::string key, double fixed_default, double min, double max, bool integer, std::string meaning,
                std::string unit) {
-  return {std::move(key), fmt::format("{:g}", fixed_default), [fixed_default](const Frame&) { return fixed_default; },
-          min, max, integer, std::move(meaning), std::move(unit)};
+  return {std::move(key),
+          fmt::format("{:g}", fixed_default),
+          [fixed_default](const Frame&) { return fixed_default; },
+          min,
+          max,
+          integer,
+          std::move(meaning),
+          std::move(unit)};
 }
 
 ParamDef scaled_param(std::string key, double fraction, double min, double max, std::string meaning) {
-  return {std::move(key), fmt::format("{:g}", 100.0 * fraction) + "% of the map extent",
-          [fraction](const Frame& f) { return fraction * f.extent_m; }, min, max, false, std::move(meaning), "m"};
+  return {std::move(key),
+          fmt::format("{:g}", 100.0 * fraction) + "% of the map extent",
+          [fraction](const Frame& f) { return fraction * f.extent_m; },
+          min,
+          max,
+          false,
+          std::move(meaning),
+          "m"};
 }
 
 ParamValues resolve(const std::string& method, const GeneratorEntry& entry, const Frame& frame,
                     const ParamValues& given) {
   for (const auto& [key, value] : given) {
-    const bool known = std::any_of(entry.params.begin(), entry.params.end(),
-                                   [&k = key](const ParamDef& d) { return d.key == k; });
+    const bool known =
+        std::any_of(entry.params.begin(), entry.params.end(), [&k = key](const ParamDef& d) { return d.key == k; });
     if (!known) {
       std::vector<std::string> keys;
       for (const auto& d : entry.params) keys.push_back(d.key);
@@ -113,11 +125,11 @@ ParamValues resolve(const std::string& method, const GeneratorEntry& entry, cons
     const double v = it->second;
     const std::string range = "[" + fmt::format("{:g}", d.min) + ", " + fmt::format("{:g}", d.max) + "]";
     if (!(v >= d.min && v <= d.max))
-      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key + "' = " + fmt::format("{:g}", v) +
-                            " is out of range " + range);
+      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key +
+                            "' = " + fmt::format("{:g}", v) + " is out of range " + range);
     if (d.integer && v != std::floor(v))
-      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key + "' = " + fmt::format("{:g}", v) +
-                            " must be a whole number in " + range);
+      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key +
+                            "' = " + fmt::format("{:g}", v) + " must be a whole number in " + range);
     out[d.key] = v;
   }
   return out;
@@ -157,9 +169,7 @@ std::pair<int, int> row_range(const Frame& f, double y_low, double y_high) {
 
 // ---- methods ----
 
-HeightMatrix flat(const Frame& f, const Params& p) {
-  return HeightMatrix::Constant(f.rows, f.cols, p.get("height"));
-}
+HeightMatrix flat(const Frame& f, const Params& p) { return HeightMatrix::Constant(f.rows, f.cols, p.get("height")); }
 
 HeightMatrix platform(const Frame& f, const Params& p) {
   const double height = p.get("height");
@@ -184,8 +194,8 @@ HeightMatrix ramp(const Frame& f, const Params& p) {
   // Offsets from the south-west cell centre as integer multiples of the cell size keep ramps along the axes
   // exact: along azimuth 90, h(r, c) = slope * (c * cs).
   const auto along = [&](int r, int c) { return (c * f.cs) * ux + ((f.rows - 1 - r) * f.cs) * uy; };
-  const double lowest = std::min({along(f.rows - 1, 0), along(f.rows - 1, f.cols - 1), along(0, 0),
-                                  along(0, f.cols - 1)});
+  const double lowest =
+      std::min({along(f.rows - 1, 0), along(f.rows - 1, f.cols - 1), along(0, 0), along(0, f.cols - 1)});
   HeightMatrix h(f.rows, f.cols);
   for (int r = 0; r < f.rows; ++r)
     for (int c = 0; c < f.cols; ++c) h(r, c) = slope * (along(r, c) - lowest);
@@ -258,7 +268,7 @@ HeightMatrix craters(const Frame& f, const Params& p) {
     const double cy = rng.uniform(0.0, f.depth_m);
     const double u = rng.uniform();
     const double radius = r_min + (r_max - r_min) * u * u;  // small craters are more common
-    const double scale = radius / r_max;                     // depth and rim grow with the radius
+    const double scale = radius / r_max;                    // depth and rim grow with the radius
     const double d = depth * scale;
     const double rim = rim_height * scale;
     const double reach = 2.0 * radius;
@@ -335,8 +345,7 @@ HeightMatrix mix(const Frame& f, const Params& p) {
             {"rim_height", p.get("crater_depth") / 3.0}});
   sub.seed = random::derive_seed(f.seed, 4);
   const double azimuth = std::floor(360.0 * random::Rng(random::derive_seed(f.seed, 5)).uniform());
-  h += run("steps", sub,
-           {{"count", p.get("step_count")}, {"step_height", p.get("step_height")}, {"azimuth", azimuth}});
+  h += run("steps", sub, {{"count", p.get("step_count")}, {"step_height", p.get("step_height")}, {"azimuth", azimuth}});
   return h;
 }
 
@@ -346,34 +355,33 @@ void register_builtins(GeneratorRegistry& reg) {
   };
   reg.add("flat", {flat, {height(0.0, "height of every cell")}});
 
-  reg.add("platform",
-          {platform,
-           {height(1.5, "height of the box above the ground at 0 m"),
-            {"width", "30% of the map width", [](const Frame& f) { return 0.3 * f.width_m; }, 0.0, kMaxLength,
-             false, "west-east size of the box; cells whose centre lies in it are raised", "m"},
-            {"depth", "30% of the map depth", [](const Frame& f) { return 0.3 * f.depth_m; }, 0.0, kMaxLength,
-             false, "south-north size of the box", "m"},
-            {"centre_x", "map centre", [](const Frame& f) { return 0.5 * f.width_m; }, -kMaxLength, kMaxLength,
-             false, "x of the box centre, east of the lower-left corner", "m"},
-            {"centre_y", "map centre", [](const Frame& f) { return 0.5 * f.depth_m; }, -kMaxLength, kMaxLength,
-             false, "y of the box centre, north of the lower-left corner", "m"}}});
+  reg.add("platform", {platform,
+                       {height(1.5, "height of the box above the ground at 0 m"),
+                        {"width", "30% of the map width", [](const Frame& f) { return 0.3 * f.width_m; }, 0.0,
+                         kMaxLength, false, "west-east size of the box; cells whose centre lies in it are raised", "m"},
+                        {"depth", "30% of the map depth", [](const Frame& f) { return 0.3 * f.depth_m; }, 0.0,
+                         kMaxLength, false, "south-north size of the box", "m"},
+                        {"centre_x", "map centre", [](const Frame& f) { return 0.5 * f.width_m; }, -kMaxLength,
+                         kMaxLength, false, "x of the box centre, east of the lower-left corner", "m"},
+                        {"centre_y", "map centre", [](const Frame& f) { return 0.5 * f.depth_m; }, -kMaxLength,
+                         kMaxLength, false, "y of the box centre, north of the lower-left corner", "m"}}});
 
   reg.add("ramp", {ramp,
                    {param("slope", 0.2, 0.0, 100.0, false, "rise over run of the plane", "m/m"),
                     param("azimuth", 90.0, -360.0, 360.0, false,
                           "direction of ascent, clockwise from north (90 = rising to the east)", "deg")}});
 
-  reg.add("gaussian_hills",
-          {gaussian_hills,
-           {param("count", 12, 0, 10000, true, "number of hills", "count"),
-            scaled_param("amplitude", 0.03, 0.0, kMaxHeight, "height of the tallest hills (each gets 50-100%)"),
-            scaled_param("sigma", 0.06, 1e-6, kMaxLength, "typical standard deviation of a hill (each gets 60-140%)")}});
+  reg.add(
+      "gaussian_hills",
+      {gaussian_hills,
+       {param("count", 12, 0, 10000, true, "number of hills", "count"),
+        scaled_param("amplitude", 0.03, 0.0, kMaxHeight, "height of the tallest hills (each gets 50-100%)"),
+        scaled_param("sigma", 0.06, 1e-6, kMaxLength, "typical standard deviation of a hill (each gets 60-140%)")}});
 
   reg.add("fractal",
           {fractal,
            {scaled_param("amplitude", 0.025, 0.0, kMaxHeight, "half the relief: heights span [-amplitude, amplitude]"),
-            param("octaves", 6, 1, 16, true, "number of noise octaves (those finer than 2 cells are skipped)",
-                  "count"),
+            param("octaves", 6, 1, 16, true, "number of noise octaves (those finer than 2 cells are skipped)", "count"),
             param("persistence", 0.5, 0.0, 1.0, false, "weight ratio of each octave to the previous one", "ratio"),
             {"wavelength", "25% of the map extent, at least 2 cells",
              [](const Frame& f) { return std::max(0.25 * f.extent_m, 2.0 * f.cs); }, 1e-6, kMaxLength, false,
@@ -389,26 +397,25 @@ void register_builtins(GeneratorRegistry& reg) {
             scaled_param("rim_height", 0.01, 0.0, kMaxHeight,
                          "rim height above the ground of the largest crater (scales with the radius)")}});
 
-  reg.add("steps",
-          {steps,
-           {param("count", 3, 0, 1000, true, "number of cliffs across the map", "count"),
-            scaled_param("step_height", 0.005, -kMaxHeight, kMaxHeight, "height of each cliff"),
-            param("azimuth", 90.0, -360.0, 360.0, false,
-                  "direction of ascent, clockwise from north (90 = terraces rising to the east)", "deg"),
-            param("jitter", 0.25, 0.0, 1.0, false, "random shift of each cliff as a fraction of their spacing",
-                  "fraction"),
-            scaled_param("waviness", 0.02, 0.0, kMaxLength, "largest sideways excursion of a cliff line")}});
+  reg.add(
+      "steps",
+      {steps,
+       {param("count", 3, 0, 1000, true, "number of cliffs across the map", "count"),
+        scaled_param("step_height", 0.005, -kMaxHeight, kMaxHeight, "height of each cliff"),
+        param("azimuth", 90.0, -360.0, 360.0, false,
+              "direction of ascent, clockwise from north (90 = terraces rising to the east)", "deg"),
+        param("jitter", 0.25, 0.0, 1.0, false, "random shift of each cliff as a fraction of their spacing", "fraction"),
+        scaled_param("waviness", 0.02, 0.0, kMaxLength, "largest sideways excursion of a cliff line")}});
 
-  reg.add("mix",
-          {mix,
-           {scaled_param("fractal_amplitude", 0.015, 0.0, kMaxHeight, "half the relief of the fractal base"),
-            param("hill_count", 6, 0, 10000, true, "number of Gaussian hills", "count"),
-            scaled_param("hill_amplitude", 0.02, 0.0, kMaxHeight, "height of the tallest hills"),
-            param("crater_count", 5, 0, 10000, true, "number of craters", "count"),
-            scaled_param("crater_depth", 0.02, 0.0, kMaxHeight,
-                         "floor depth of the largest crater (rims are a third of it)"),
-            param("step_count", 2, 0, 1000, true, "number of cliffs", "count"),
-            scaled_param("step_height", 0.004, -kMaxHeight, kMaxHeight, "height of each cliff")}});
+  reg.add("mix", {mix,
+                  {scaled_param("fractal_amplitude", 0.015, 0.0, kMaxHeight, "half the relief of the fractal base"),
+                   param("hill_count", 6, 0, 10000, true, "number of Gaussian hills", "count"),
+                   scaled_param("hill_amplitude", 0.02, 0.0, kMaxHeight, "height of the tallest hills"),
+                   param("crater_count", 5, 0, 10000, true, "number of craters", "count"),
+                   scaled_param("crater_depth", 0.02, 0.0, kMaxHeight,
+                                "floor depth of the largest crater (rims are a third of it)"),
+                   param("step_count", 2, 0, 1000, true, "number of cliffs", "count"),
+                   scaled_param("step_height", 0.004, -kMaxHeight, kMaxHeight, "height of each cliff")}});
 }
 
 const GeneratorRegistry& registry() {

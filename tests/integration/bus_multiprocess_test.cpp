@@ -72,8 +72,10 @@ class Child {
       if (poll(&p, 1, static_cast<int>(left)) <= 0) continue;
       char chunk[4096];
       const ssize_t n = read(fd_, chunk, sizeof chunk);
-      if (n <= 0) eof_ = true;
-      else buffer_.append(chunk, static_cast<std::size_t>(n));
+      if (n <= 0)
+        eof_ = true;
+      else
+        buffer_.append(chunk, static_cast<std::size_t>(n));
     }
   }
   /// Reads output until a line equal to `expected` arrives; false on timeout or end of output.
@@ -122,8 +124,8 @@ std::string pair_name(const ::testing::TestParamInfo<Pair>& info) {
 }
 
 std::vector<std::string> probe(const std::string& mode, Vendor vendor, int domain, std::vector<std::string> more) {
-  std::vector<std::string> args{MARSALA_BUS_PROBE, mode,  "--dds", to_string(vendor),
-                                "--domain",        std::to_string(domain)};
+  std::vector<std::string> args{MARSALA_BUS_PROBE, mode,       "--dds",
+                                to_string(vendor), "--domain", std::to_string(domain)};
   args.insert(args.end(), more.begin(), more.end());
   return args;
 }

@@ -21,8 +21,8 @@ using namespace std::chrono_literals;
 
 /// The bad request for the n-th step of the attack, built on a valid empty one; `spoof` is set when the request
 /// must go out on the victim's partition instead of the rogue's own.
-protocol::ActionRequest attack(int n, const protocol::ActionRequest& valid, const protocol::SensorFrame& frame, double cell_m,
-                          bool& spoof, std::string& what) {
+protocol::ActionRequest attack(int n, const protocol::ActionRequest& valid, const protocol::SensorFrame& frame,
+                               double cell_m, bool& spoof, std::string& what) {
   protocol::ActionRequest r = valid;
   spoof = false;
   switch (n) {
@@ -102,7 +102,8 @@ int run(int argc, char** argv) {
   const std::string mine = protocol::partition_for(admission.run_id, id);
   auto frames = participant->create_reader<protocol::SensorFrame>({mine, signal});
   auto requests = participant->create_writer<protocol::ActionRequest>({mine, nullptr});
-  auto victim = participant->create_writer<protocol::ActionRequest>({protocol::partition_for(admission.run_id, 1), nullptr});
+  auto victim =
+      participant->create_writer<protocol::ActionRequest>({protocol::partition_for(admission.run_id, 1), nullptr});
 
   int attacks_sent = 0;
   constexpr int kAttacks = 8;
@@ -128,7 +129,7 @@ int run(int argc, char** argv) {
       const protocol::ActionRequest bad = attack(attacks_sent, valid, frame, admission.cell_size_m, spoof, what);
       std::cout << "rogue: step " << frame.step << " sending " << what << std::endl;
       (spoof ? victim : requests)->write(bad);
-      if (attacks_sent == kAttacks - 1) requests->write(bad);  // the duplicate goes out twice
+      if (attacks_sent == kAttacks - 1) requests->write(bad);       // the duplicate goes out twice
       if (spoof || bad.step != frame.step) requests->write(valid);  // keep our own barrier slot filled
       ++attacks_sent;
     }

@@ -133,8 +133,8 @@ class CycloneWriter final : public Writer<T> {
     // Late joiners get the last `depth` samples of a transient-local writer, and only the latest of a volatile one
     // (which its volatile readers drop).
     const std::int32_t kept = options.durability == Durability::kTransientLocal ? options.depth : 1;
-    dds_qset_durability_service(qos.get(), 0, DDS_HISTORY_KEEP_LAST, kept, DDS_LENGTH_UNLIMITED,
-                                DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
+    dds_qset_durability_service(qos.get(), 0, DDS_HISTORY_KEEP_LAST, kept, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED,
+                                DDS_LENGTH_UNLIMITED);
     dds_qset_liveliness(qos.get(), DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(kWriterLease.count()));
     writer_ = dds_create_writer(publisher_, topic, qos.get(), nullptr);
     if (writer_ < 0) {
@@ -278,7 +278,6 @@ class CycloneParticipant final : public ParticipantBase<CycloneParticipant> {
   std::unique_ptr<Reader<T>> reader(const EndpointOptions& options) {
     return std::make_unique<CycloneReader<T>>(context_, options);
   }
-
 
  private:
   std::shared_ptr<Context> context_;

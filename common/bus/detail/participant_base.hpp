@@ -13,12 +13,12 @@ namespace marsala::bus::detail {
 template <typename Backend>
 class ParticipantBase : public Participant {
  protected:
-#define MARSALA_BUS_ENDPOINTS(T)                                                                      \
-  std::unique_ptr<Writer<T>> make_writer(Tag<T>, const EndpointOptions& o) override {          \
-    return self().template writer<T>(o);                                                       \
-  }                                                                                            \
-  std::unique_ptr<Reader<T>> make_reader(Tag<T>, const EndpointOptions& o) override {          \
-    return self().template reader<T>(o);                                                       \
+#define MARSALA_BUS_ENDPOINTS(T)                                                      \
+  std::unique_ptr<Writer<T>> make_writer(Tag<T>, const EndpointOptions& o) override { \
+    return self().template writer<T>(o);                                              \
+  }                                                                                   \
+  std::unique_ptr<Reader<T>> make_reader(Tag<T>, const EndpointOptions& o) override { \
+    return self().template reader<T>(o);                                              \
   }
   MARSALA_BUS_MESSAGES(MARSALA_BUS_ENDPOINTS)
 #undef MARSALA_BUS_ENDPOINTS

@@ -21,9 +21,9 @@ class VolatileFilter {
  public:
   explicit VolatileFilter(Durability durability)
       : volatile_(durability == Durability::kVolatile),
-        created_ns_(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                        std::chrono::system_clock::now().time_since_epoch())
-                        .count()) {}
+        created_ns_(
+            std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+                .count()) {}
   /// Whether a sample with this source timestamp [ns since the epoch] is delivered.
   bool passes(std::int64_t source_timestamp_ns) const { return !volatile_ || source_timestamp_ns >= created_ns_; }
 

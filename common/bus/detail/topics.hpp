@@ -14,9 +14,9 @@ namespace marsala::bus::detail {
 /// The DDS topic that carries one message type (one topic per type).
 template <typename T>
 struct TopicName;
-#define MARSALA_BUS_TOPIC(T)                      \
-  template <>                                     \
-  struct TopicName<T> {                           \
+#define MARSALA_BUS_TOPIC(T)                            \
+  template <>                                           \
+  struct TopicName<T> {                                 \
     static constexpr const char* value = "marsala_" #T; \
   };
 MARSALA_BUS_MESSAGES(MARSALA_BUS_TOPIC)

@@ -4,6 +4,9 @@
 // DDS's listener thread, convert them and queue them (detail::ReaderQueue). Participants of one process talk over
 // loopback like participants of different processes (intraprocess delivery off, see configure_library()).
 
+#include <fastrtps/attributes/LibrarySettingsAttributes.h>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
+#include <spdlog/spdlog.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -14,9 +17,6 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
-#include <fastrtps/attributes/LibrarySettingsAttributes.h>
-#include <fastrtps/xmlparser/XMLProfileManager.h>
-#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <map>
@@ -315,7 +315,6 @@ class FastDdsParticipant final : public ParticipantBase<FastDdsParticipant> {
   std::unique_ptr<Reader<T>> reader(const EndpointOptions& options) {
     return std::make_unique<FastDdsReader<T>>(context_, options);
   }
-
 
  private:
   std::shared_ptr<Context> context_;

@@ -100,13 +100,13 @@ class Hub {
   }
   int writers_in(const std::string& partition) const {
     std::lock_guard<std::mutex> lock(mutex_);
-    return static_cast<int>(std::count_if(writers_.begin(), writers_.end(),
-                                          [&](auto* w) { return w->options().partition == partition; }));
+    return static_cast<int>(
+        std::count_if(writers_.begin(), writers_.end(), [&](auto* w) { return w->options().partition == partition; }));
   }
   int readers_in(const std::string& partition) const {
     std::lock_guard<std::mutex> lock(mutex_);
-    return static_cast<int>(std::count_if(readers_.begin(), readers_.end(),
-                                          [&](auto* r) { return r->options().partition == partition; }));
+    return static_cast<int>(
+        std::count_if(readers_.begin(), readers_.end(), [&](auto* r) { return r->options().partition == partition; }));
   }
 
  private:
@@ -124,11 +124,10 @@ class Hub {
 /// One hub per message type for one domain.
 struct Domain {
   std::tuple<std::shared_ptr<Hub<AgentHello>>, std::shared_ptr<Hub<Admission>>, std::shared_ptr<Hub<SensorFrame>>,
-             std::shared_ptr<Hub<ActionRequest>>, std::shared_ptr<Hub<WorldStatus>>,
-             std::shared_ptr<Hub<WorldEvent>>>
-      hubs{std::make_shared<Hub<AgentHello>>(),    std::make_shared<Hub<Admission>>(),
-           std::make_shared<Hub<SensorFrame>>(),   std::make_shared<Hub<ActionRequest>>(),
-           std::make_shared<Hub<WorldStatus>>(),   std::make_shared<Hub<WorldEvent>>()};
+             std::shared_ptr<Hub<ActionRequest>>, std::shared_ptr<Hub<WorldStatus>>, std::shared_ptr<Hub<WorldEvent>>>
+      hubs{std::make_shared<Hub<AgentHello>>(),  std::make_shared<Hub<Admission>>(),
+           std::make_shared<Hub<SensorFrame>>(), std::make_shared<Hub<ActionRequest>>(),
+           std::make_shared<Hub<WorldStatus>>(), std::make_shared<Hub<WorldEvent>>()};
 };
 
 std::shared_ptr<Domain> domain(int domain_id) {
@@ -166,7 +165,6 @@ class InProcessParticipant final : public ParticipantBase<InProcessParticipant> 
     hub->add_reader(r.get());
     return r;
   }
-
 
  private:
   int domain_id_;

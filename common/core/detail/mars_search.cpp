@@ -56,7 +56,8 @@ class BlockSearch {
     if (x * x <= kcs2_ * d2) return true;  // height: max h - kcs d <= limit
     for (const Shape& s : nd.shapes) {
       switch (s.kind) {
-        case Shape::Kind::kNone: return false;
+        case Shape::Kind::kNone:
+          return false;
         case Shape::Kind::kPlane: {
           const double y = s.m + s.ar * (r - s.r) + s.ac * (c - s.c) - limit;
           if (y <= 0 || y * y <= s.deficit2 * d2) return true;
@@ -146,8 +147,6 @@ class BlockSearch {
 
 }  // namespace
 
-void search_sources(const Problem& pb, const SourceTree& tree, double* lower) {
-  BlockSearch(pb, tree, lower).run();
-}
+void search_sources(const Problem& pb, const SourceTree& tree, double* lower) { BlockSearch(pb, tree, lower).run(); }
 
 }  // namespace marsala::detail

@@ -98,7 +98,8 @@ void resolve_chains(const Problem& pb, std::int32_t* src) {
       const std::int32_t root = src[src[q]];  // src[q] is resolved: a survivor or points at one
       const int qr = row_of(q, inv_cols), rr = row_of(root, inv_cols);
       const long long dr = qr - rr;
-      const long long dc = (q - static_cast<std::int64_t>(qr) * pb.cols) - (root - static_cast<std::int64_t>(rr) * pb.cols);
+      const long long dc =
+          (q - static_cast<std::int64_t>(qr) * pb.cols) - (root - static_cast<std::int64_t>(rr) * pb.cols);
       src[q] = cone_value(pb.h[root], pb.kcs, dr * dr + dc * dc) >= pb.h[q] - pb.tol ? root : q;
     }
   }
@@ -122,7 +123,7 @@ std::vector<std::uint64_t> seed_lower_bound(const Problem& pb, double* lower) {
       const std::int64_t i = static_cast<std::int64_t>(r) * pb.cols + c;
       if (src[i] == i)
         masks[static_cast<std::size_t>(r / kBlock) * leaf_cols + c / kBlock] |= std::uint64_t{1}
-                                                                               << ((r % kBlock) * kBlock + c % kBlock);
+                                                                                << ((r % kBlock) * kBlock + c % kBlock);
     }
   return masks;
 }

@@ -106,10 +106,14 @@ struct Moments {
 inline double residual(const Shape& s, double kcs, double r, double c, double h) {
   const double dr = r - s.r, dc = c - s.c;
   switch (s.kind) {
-    case Shape::Kind::kPlane: return h - s.ar * dr - s.ac * dc;
-    case Shape::Kind::kCone: return h + kcs * std::sqrt(dr * dr + dc * dc);
-    case Shape::Kind::kBowl: return h - kcs * std::sqrt(dr * dr + dc * dc);
-    case Shape::Kind::kNone: break;
+    case Shape::Kind::kPlane:
+      return h - s.ar * dr - s.ac * dc;
+    case Shape::Kind::kCone:
+      return h + kcs * std::sqrt(dr * dr + dc * dc);
+    case Shape::Kind::kBowl:
+      return h - kcs * std::sqrt(dr * dr + dc * dc);
+    case Shape::Kind::kNone:
+      break;
   }
   return kInf;
 }
@@ -337,7 +341,8 @@ struct SourceTree::Builder {
       for (int qi = 0; qi < 4; ++qi) {
         if (quadrant_n[qi] < 5) continue;
         double raw_slope = 0;
-        add(Moments::of(pts, quadrant[qi], quadrant_n[qi]).plane(pb.kcs, &raw_slope), quadrant[qi], quadrant_n[qi], true);
+        add(Moments::of(pts, quadrant[qi], quadrant_n[qi]).plane(pb.kcs, &raw_slope), quadrant[qi], quadrant_n[qi],
+            true);
         if (raw_slope >= 0.5 * pb.kcs && raw_slope <= 1.5 * pb.kcs)
           add(fit_apex(pts, quadrant[qi], quadrant_n[qi], pb.kcs), quadrant[qi], quadrant_n[qi], true);
       }

@@ -34,22 +34,22 @@ struct Partner {
 
 /// Ball, partner offsets and lens tables for one grid shape and cell size.
 struct Stencil {
-  int reach = 0;                       // ball half-width table covers |dr| <= reach
-  std::vector<int> half_width;         // [dr + reach]: ball row dr holds |dc| <= half_width
-  int ball_reach = 0;                  // min(reach, rows - 1): ball rows that can lie on the grid
-  std::vector<int> ball_width;         // [dr + ball_reach]: min(half_width, cols - 1)
-  std::vector<int> ball_first_bit;     // [dr + ball_reach]: bit of (dr, -ball_width)
-  std::vector<std::ptrdiff_t> ball_offset;  // [bit]: dr * cols + dc
-  int max_ring = 0;                    // largest Chebyshev ring holding a partner
-  int partner_rows = 0, partner_cols = 0;  // largest |dr| and |dc| of a partner
-  std::vector<Partner> partners;       // ordered by ring, then length (nearest first)
+  int reach = 0;                               // ball half-width table covers |dr| <= reach
+  std::vector<int> half_width;                 // [dr + reach]: ball row dr holds |dc| <= half_width
+  int ball_reach = 0;                          // min(reach, rows - 1): ball rows that can lie on the grid
+  std::vector<int> ball_width;                 // [dr + ball_reach]: min(half_width, cols - 1)
+  std::vector<int> ball_first_bit;             // [dr + ball_reach]: bit of (dr, -ball_width)
+  std::vector<std::ptrdiff_t> ball_offset;     // [bit]: dr * cols + dc
+  int max_ring = 0;                            // largest Chebyshev ring holding a partner
+  int partner_rows = 0, partner_cols = 0;      // largest |dr| and |dc| of a partner
+  std::vector<Partner> partners;               // ordered by ring, then length (nearest first)
   std::vector<std::ptrdiff_t> partner_offset;  // partners[i].offset, packed for the interior scan
   std::vector<double> partner_threshold_m;     // partners[i].threshold_m, packed for the interior scan
-  std::vector<int> ring_begin;         // ring k holds partners [ring_begin[k], ring_begin[k + 1])
-  std::vector<double> ring_threshold_m;  // [k]: eps + kappa * cs * k, a lower bound of ring k's thresholds
-  std::vector<Flags> ring_bit;         // [k]: flag bit of ring k's group
-  int lens_words = 0;                  // 64-bit words per lens bitset (0 when marking spans)
-  std::vector<std::uint64_t> lens_bits;  // partners.size() * lens_words
+  std::vector<int> ring_begin;                 // ring k holds partners [ring_begin[k], ring_begin[k + 1])
+  std::vector<double> ring_threshold_m;        // [k]: eps + kappa * cs * k, a lower bound of ring k's thresholds
+  std::vector<Flags> ring_bit;                 // [k]: flag bit of ring k's group
+  int lens_words = 0;                          // 64-bit words per lens bitset (0 when marking spans)
+  std::vector<std::uint64_t> lens_bits;        // partners.size() * lens_words
 };
 
 int ring_group(int k, int max_ring) {
@@ -109,8 +109,8 @@ Stencil build_stencil(const NavigabilityParams& params, int rows, int cols, doub
     width = std::min(width, cols - 1);
     for (int b = -width; b <= width; ++b) {
       if (a == 0 && b == 0) continue;
-      found.push_back({a, b, std::max(std::abs(a), std::abs(b)), static_cast<long long>(a) * a +
-                                                                     static_cast<long long>(b) * b});
+      found.push_back(
+          {a, b, std::max(std::abs(a), std::abs(b)), static_cast<long long>(a) * a + static_cast<long long>(b) * b});
     }
   }
   std::sort(found.begin(), found.end(), [](const Candidate& x, const Candidate& y) {
@@ -147,9 +147,9 @@ Stencil build_stencil(const NavigabilityParams& params, int rows, int cols, doub
   }
 
   const int words = (bits + 63) / 64;
-  const bool bitsets = marking == LensMarking::kBitsets ||
-                       (marking == LensMarking::kAutomatic &&
-                        s.partners.size() * static_cast<std::size_t>(words) <= kMaxLensTableWords);
+  const bool bitsets =
+      marking == LensMarking::kBitsets ||
+      (marking == LensMarking::kAutomatic && s.partners.size() * static_cast<std::size_t>(words) <= kMaxLensTableWords);
   if (bitsets) {
     s.lens_words = words;
     s.lens_bits.assign(s.partners.size() * static_cast<std::size_t>(words), 0);
@@ -334,8 +334,8 @@ class LensClearer {
   /// ring_hi] whose group bit is in `groups`.
   void run(std::ptrdiff_t index, int row, int col, Flags groups, int ring_lo, int ring_hi) {
     if (use_tiles_ && !tiles_.any(std::max(row - s_.ball_reach, 0), std::min(row + s_.ball_reach, rows_ - 1),
-                               std::max(col - s_.ball_width[s_.ball_reach], 0),
-                               std::min(col + s_.ball_width[s_.ball_reach], cols_ - 1)))
+                                  std::max(col - s_.ball_width[s_.ball_reach], 0),
+                                  std::min(col + s_.ball_width[s_.ball_reach], cols_ - 1)))
       return;
     const bool interior = row >= s_.partner_rows && row + s_.partner_rows < rows_ && col >= s_.partner_cols &&
                           col + s_.partner_cols < cols_;
@@ -464,7 +464,8 @@ class LensClearer {
       if (w < 0 || other < 0) continue;
       const int c0 = std::max({0, col - w, col + v.dc - other});
       const int c1 = std::min({cols_ - 1, col + w, col + v.dc + other});
-      if (c0 <= c1) std::memset(occ_ + static_cast<std::ptrdiff_t>(y) * cols_ + c0, 0, static_cast<std::size_t>(c1 - c0 + 1));
+      if (c0 <= c1)
+        std::memset(occ_ + static_cast<std::ptrdiff_t>(y) * cols_ + c0, 0, static_cast<std::size_t>(c1 - c0 + 1));
     }
   }
 

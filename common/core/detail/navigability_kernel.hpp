@@ -29,6 +29,6 @@ enum class LensMarking {
 
 /// Occupiable mask of `h` (1 = occupiable) for valid `params` and finite heights; `marking` only changes speed.
 CellMask occupiable_mask(const Heightmap& h, const NavigabilityParams& params,
-                               LensMarking marking = LensMarking::kAutomatic);
+                         LensMarking marking = LensMarking::kAutomatic);
 
 }  // namespace marsala::detail

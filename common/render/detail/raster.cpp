@@ -129,7 +129,8 @@ void draw_text(Image& image, int x, int y, const std::string& text, int scale, R
     const auto rows = glyph_rows(ch);
     for (int r = 0; r < kGlyphHeight; ++r)
       for (int c = 0; c < kGlyphWidth; ++c)
-        if (rows[r] & (1u << (kGlyphWidth - 1 - c))) fill_rect(image, pen + c * scale, y + r * scale, scale, scale, colour);
+        if (rows[r] & (1u << (kGlyphWidth - 1 - c)))
+          fill_rect(image, pen + c * scale, y + r * scale, scale, scale, colour);
     pen += kGlyphAdvance * scale;
   }
 }

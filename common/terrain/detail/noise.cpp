@@ -4,8 +4,8 @@
 #include <cmath>
 #include <vector>
 
-#include "marsala/terrain/detail/det_math.hpp"
 #include "marsala/core/random.hpp"
+#include "marsala/terrain/detail/det_math.hpp"
 
 namespace marsala::terrain::detail {
 namespace {
@@ -28,8 +28,7 @@ inline std::int64_t floor_to_int(double x) {
   return static_cast<double>(i) > x ? i - 1 : i;
 }
 
-void add_octave(HeightMatrix& out, double cell_size_m, std::uint64_t seed, double wavelength_m,
-                double amplitude) {
+void add_octave(HeightMatrix& out, double cell_size_m, std::uint64_t seed, double wavelength_m, double amplitude) {
   const int rows = static_cast<int>(out.rows());
   const int cols = static_cast<int>(out.cols());
   Rng rng(seed);
@@ -92,8 +91,8 @@ void add_octave(HeightMatrix& out, double cell_size_m, std::uint64_t seed, doubl
 
 }  // namespace
 
-HeightMatrix gradient_fbm(int rows, int cols, double cell_size_m, std::uint64_t seed, int octaves,
-                                double persistence, double base_wavelength_m) {
+HeightMatrix gradient_fbm(int rows, int cols, double cell_size_m, std::uint64_t seed, int octaves, double persistence,
+                          double base_wavelength_m) {
   HeightMatrix out = HeightMatrix::Zero(rows, cols);
   double wavelength = base_wavelength_m;
   double amplitude = 1.0;

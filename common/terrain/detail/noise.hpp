@@ -11,8 +11,8 @@ namespace marsala::terrain::detail {
 /// corner is (0, 0): octave o has wavelength base_wavelength_m / 2^o and weight persistence^o. Octaves after
 /// the first whose wavelength is below two cells are skipped. Values are unnormalised (roughly [-1, 1] times
 /// the sum of the weights). Requires base_wavelength_m >= cell_size_m.
-HeightMatrix gradient_fbm(int rows, int cols, double cell_size_m, std::uint64_t seed, int octaves,
-                                double persistence, double base_wavelength_m);
+HeightMatrix gradient_fbm(int rows, int cols, double cell_size_m, std::uint64_t seed, int octaves, double persistence,
+                          double base_wavelength_m);
 
 /// Smooth 1D value noise in [-1, 1] with the given wavelength [m], for wavy lines (cliff edges).
 class ValueNoise1d {

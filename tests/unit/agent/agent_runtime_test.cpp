@@ -65,8 +65,9 @@ struct ScriptedWorld {
     throw Error("no hello from agent " + std::to_string(id));
   }
 
-  std::vector<protocol::ActionRequest> run(const std::function<protocol::Admission(const protocol::AgentHello&)>& answer,
-                                      int steps, bool send_frames = true) {
+  std::vector<protocol::ActionRequest> run(
+      const std::function<protocol::Admission(const protocol::AgentHello&)>& answer, int steps,
+      bool send_frames = true) {
     auto hello_signal = std::make_shared<bus::Signal>();
     auto hellos = p.create_reader<protocol::AgentHello>({"", hello_signal});
     auto admissions = p.create_writer<protocol::Admission>();

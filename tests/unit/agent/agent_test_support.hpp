@@ -11,9 +11,9 @@
 #include "marsala/agent/agent_context.hpp"
 #include "marsala/agent/deliberative/local_map_synthesizer.hpp"
 #include "marsala/agent/executive/mapping_system.hpp"
-#include "marsala/protocol/messages.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/navigability_processor.hpp"
+#include "marsala/protocol/messages.hpp"
 
 namespace marsala::agent::test {
 
@@ -58,9 +58,8 @@ inline RobotBody husky(double kappa = 0.5) {
 
 /// A local map with hand-made heights and gap (all known, placed at the world's origin), masks from the
 /// navigability processor.
-inline deliberative::LocalMap make_local_map(const Heightmap& heights, const Heightmap& gap,
-                                             NavigabilityParams nav, CellIndex robot,
-                                             std::optional<CellIndex> origin) {
+inline deliberative::LocalMap make_local_map(const Heightmap& heights, const Heightmap& gap, NavigabilityParams nav,
+                                             CellIndex robot, std::optional<CellIndex> origin) {
   deliberative::LocalMap m;
   m.world = heights.geometry();
   m.offset = {0, 0};
@@ -89,7 +88,7 @@ inline AgentContext agent_context(std::uint32_t id, const RobotBody& body) {
 /// The world's admission of `c` on `grid` in 16-cell tiles, heading for `target` [m], with its base station at
 /// `base` [m] (radius 0.5 m).
 inline protocol::Admission admission_on(const AgentContext& c, const GridGeometry& grid, Position target,
-                                   Position base) {
+                                        Position base) {
   protocol::Admission a;
   a.agent_id = c.agent_id;
   a.session = c.session;
@@ -111,7 +110,7 @@ inline protocol::Admission admission_on(const AgentContext& c, const GridGeometr
 
 /// The frame of step `step` for `c` at `pose` [m] with `material_m3` on board, carrying every 16-cell tile of `h`.
 inline protocol::SensorFrame full_frame(const AgentContext& c, std::uint64_t step, Position pose, double material_m3,
-                                   const Heightmap& h) {
+                                        const Heightmap& h) {
   protocol::SensorFrame f;
   f.agent_id = c.agent_id;
   f.step = step;

@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "agent_test_support.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/agent/reactive/idle_behaviour.hpp"
 #include "marsala/agent/reactive/path_builder.hpp"
 #include "marsala/agent/reactive/ramp_builder.hpp"
-#include "agent_test_support.hpp"
 #include "marsala/core/error.hpp"
 
 namespace marsala::agent::reactive {
@@ -24,9 +24,7 @@ Heightmap world_terrain() {
   return h;
 }
 
-AgentContext context(std::uint32_t id = 3, RobotBody body = test::husky()) {
-  return test::agent_context(id, body);
-}
+AgentContext context(std::uint32_t id = 3, RobotBody body = test::husky()) { return test::agent_context(id, body); }
 
 protocol::Admission admission(const AgentContext& c, Position target, Position base = {0.55, 3.05}) {
   return test::admission_on(c, world_terrain().geometry(), target, base);

@@ -1,7 +1,7 @@
 // Closed loop without the world server: ramp builders drive a mini world (tests/unit/agent/mini_world.hpp) on the
 // paper's platform scenario (Fig. 2) at a small size: 12 x 8 m at 0.1 m, a 1.5 m platform on the east side.
-// Every request is checked against the rules of docs/runtime.md#validation before it is applied; the robots must end on the
-// platform top with a navigable way from their start, within a step budget. Path builders (paper Fig. 4) must lay
+// Every request is checked against the rules of docs/runtime.md#validation before it is applied; the robots must end on
+// the platform top with a navigable way from their start, within a step budget. Path builders (paper Fig. 4) must lay
 // a way a payload can drive from the base to the platform.
 
 #include <gtest/gtest.h>
@@ -25,8 +25,8 @@ namespace {
 using reactive::PathBuilder;
 using reactive::RampBuilder;
 
-constexpr double kPlatformX = 8.0;   // west edge of the platform [m]
-constexpr double kPlatformH = 1.5;   // [m]
+constexpr double kPlatformX = 8.0;  // west edge of the platform [m]
+constexpr double kPlatformH = 1.5;  // [m]
 
 Heightmap platform_terrain(double height_m = kPlatformH) {
   Heightmap h({80, 120, 0.0, 0.0, 0.1}, 0.0);
@@ -54,24 +54,22 @@ RobotBody husky(double kappa, double capacity_m3) {
 struct LoopResult {
   bool all_on_top = false;
   int steps = 0;
-  std::vector<int> steps_to_top;          // per robot, -1 if never
+  std::vector<int> steps_to_top;  // per robot, -1 if never
   Heightmap initial, final_terrain;
   std::vector<std::vector<CellIndex>> trajectories;
   std::vector<Position> final_positions;
   double deposited_m3 = 0.0;
   double decide_ms_mean = 0.0, decide_ms_max = 0.0;
   int refills = 0;
-  std::vector<std::string> states;        // last state per robot
+  std::vector<std::string> states;  // last state per robot
 };
 
-bool on_top(const Heightmap& h, Position p) {
-  return p.x >= kPlatformX && h(*h.cell_at(p)) >= kPlatformH - 0.1;
-}
+bool on_top(const Heightmap& h, Position p) { return p.x >= kPlatformX && h(*h.cell_at(p)) >= kPlatformH - 0.1; }
 
 /// Runs `starts.size()` ramp builders until all stand on the platform top or `max_steps` pass. Every request must
 /// be accepted by the mini world (ASSERTed inside).
-LoopResult run_loop(const RobotBody& body, const std::vector<Position>& starts,
-                    const std::vector<Position>& targets, int max_steps) {
+LoopResult run_loop(const RobotBody& body, const std::vector<Position>& starts, const std::vector<Position>& targets,
+                    int max_steps) {
   LoopResult out;
   test::MiniWorld world(platform_terrain(), 16, {1.0, 4.0}, 1.0);
   out.initial = world.terrain();
@@ -117,15 +115,15 @@ LoopResult run_loop(const RobotBody& body, const std::vector<Position>& starts,
       for (std::size_t i = 0; i < agents.size(); ++i) {
         const auto& rb = world.robot(static_cast<std::uint32_t>(i + 1));
         const auto& tr = agents[i]->last_trace();
-        std::printf("step %d robot %zu at (%.2f, %.2f) z %.3f material %.3f state %s plan %d/%zu goal (%d,%d) "
-                    "move %d deps %zu (cand %d, dropped %d) origin (%d,%d) nav %lld\n",
-                    step, i + 1, rb.pos.x, rb.pos.y, world.terrain()(*world.terrain().cell_at(rb.pos)),
-                    rb.material_m3, requests[i].state.c_str(), tr.plan.found, tr.plan.path.size(),
-                    tr.local_goal.row + tr.window_offset.row, tr.local_goal.col + tr.window_offset.col,
-                    requests[i].move, requests[i].depositions.size(), tr.deposition.candidates,
-                    tr.deposition.dropped_for_way_back,
-                    tr.local_origin ? tr.local_origin->row + tr.window_offset.row : -1,
-                    tr.local_origin ? tr.local_origin->col + tr.window_offset.col : -1, tr.navigable_cells);
+        std::printf(
+            "step %d robot %zu at (%.2f, %.2f) z %.3f material %.3f state %s plan %d/%zu goal (%d,%d) "
+            "move %d deps %zu (cand %d, dropped %d) origin (%d,%d) nav %lld\n",
+            step, i + 1, rb.pos.x, rb.pos.y, world.terrain()(*world.terrain().cell_at(rb.pos)), rb.material_m3,
+            requests[i].state.c_str(), tr.plan.found, tr.plan.path.size(), tr.local_goal.row + tr.window_offset.row,
+            tr.local_goal.col + tr.window_offset.col, requests[i].move, requests[i].depositions.size(),
+            tr.deposition.candidates, tr.deposition.dropped_for_way_back,
+            tr.local_origin ? tr.local_origin->row + tr.window_offset.row : -1,
+            tr.local_origin ? tr.local_origin->col + tr.window_offset.col : -1, tr.navigable_cells);
       }
     bool all = true;
     for (std::size_t i = 0; i < agents.size(); ++i) {
@@ -176,14 +174,15 @@ void check_and_report(const char* name, const RobotBody& body, const std::vector
   const Heightmap gap = MarsProcessor(body.navigability.kappa).gap(r.initial);
   std::vector<CellIndex> driven;
   for (const auto& t : r.trajectories) driven.insert(driven.end(), t.begin(), t.end());
-  const double target = deposition_target_volume(
-      gap, path_footprint(gap.geometry(), driven, body.navigability.delta_m));
+  const double target =
+      deposition_target_volume(gap, path_footprint(gap.geometry(), driven, body.navigability.delta_m));
   std::string tops;
   for (int s : r.steps_to_top) tops += std::to_string(s) + " ";
-  std::printf("[closed loop] %s: steps to the top per robot: %s| run %d steps | deposited %.3f m^3 | MARS target "
-              "of the driven paths %.3f m^3 (ratio %.2f) | refills %d | decide %.2f ms mean, %.2f ms max\n",
-              name, tops.c_str(), r.steps, r.deposited_m3, target, r.deposited_m3 / target, r.refills,
-              r.decide_ms_mean, r.decide_ms_max);
+  std::printf(
+      "[closed loop] %s: steps to the top per robot: %s| run %d steps | deposited %.3f m^3 | MARS target "
+      "of the driven paths %.3f m^3 (ratio %.2f) | refills %d | decide %.2f ms mean, %.2f ms max\n",
+      name, tops.c_str(), r.steps, r.deposited_m3, target, r.deposited_m3 / target, r.refills, r.decide_ms_mean,
+      r.decide_ms_max);
   // Filling the gap under the driven footprint is necessary for a navigable path; more than 3x is waste.
   EXPECT_GT(r.deposited_m3, 0.5 * target);
   EXPECT_LT(r.deposited_m3, 3.0 * target);
@@ -279,14 +278,14 @@ TEST(ClosedLoop, PathBuildersLayAPathForAPayload) {
     for (std::size_t i = 0; i < reasons.size(); ++i)
       ASSERT_EQ(reasons[i], "") << "step " << steps << ": robot " << i + 1 << " in " << requests[i].state;
     if (steps % 10 == 9)
-      done = NavigabilityProcessor::navigable_from(payload.occupiable(world.terrain()), from)(
-                 to.row, to.col) == 1;
+      done = NavigabilityProcessor::navigable_from(payload.occupiable(world.terrain()), from)(to.row, to.col) == 1;
   }
   double deposited_m3 = 0.0;
   for (const auto& [id, r] : world.robots()) deposited_m3 += r.deposited_m3;
-  std::printf("[closed loop] path builders, 3 robots, %.2f m platform: payload path after %d steps | deposited "
-              "%.3f m^3 | refills %d\n",
-              kHeightM, steps, deposited_m3, refills);
+  std::printf(
+      "[closed loop] path builders, 3 robots, %.2f m platform: payload path after %d steps | deposited "
+      "%.3f m^3 | refills %d\n",
+      kHeightM, steps, deposited_m3, refills);
   EXPECT_TRUE(done) << "no navigable way for the payload after " << steps << " steps";
   EXPECT_GE(refills, 1);
   // The builders only fill the MARS gap at the construction kappa.

@@ -49,10 +49,10 @@ const GridGeometry kGrid{21, 31, 0.0, 0.0, kCs};
 
 TEST(DepositionManager, RoundsDownToWholeCubeLayersAndCapsOneMetre) {
   Heightmap gap(kGrid, 0.0);
-  gap(10, 20) = 2.8 * kQ;          // -> 2 layers: never above P (nearest would overshoot)
-  gap(10, 21) = 3.0 * kQ;          // an exact multiple -> 3 layers
-  gap(10, 22) = 0.999999 * kQ;     // below one layer -> nothing
-  gap(10, 23) = 2.5;               // -> capped at 1 m (80 layers)
+  gap(10, 20) = 2.8 * kQ;       // -> 2 layers: never above P (nearest would overshoot)
+  gap(10, 21) = 3.0 * kQ;       // an exact multiple -> 3 layers
+  gap(10, 22) = 0.999999 * kQ;  // below one layer -> nothing
+  gap(10, 23) = 2.5;            // -> capped at 1 m (80 layers)
   const LocalMap map = make_map(Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, {{10, 0}});
   const DepositionManager dm(params(0.4, 1.0));  // budget large enough for all of them
   const Position robot = kGrid.cell_center({10, 10});
@@ -78,8 +78,8 @@ TEST(DepositionManager, RespectsReachBudgetAndNeverDepositsUnderTheRobot) {
   double volume = 0.0;
   for (const auto& d : plan.depositions) {
     const double r = dist(kGrid.cell_center({d.row, d.col}), robot);
-    EXPECT_GT(r, 0.2);   // delta / 2
-    EXPECT_LE(r, 1.5);   // reach
+    EXPECT_GT(r, 0.2);  // delta / 2
+    EXPECT_LE(r, 1.5);  // reach
     const double n = d.height_m / kQ;
     EXPECT_NEAR(n, std::round(n), 1e-9);
     volume += d.height_m * kCs * kCs;
@@ -187,8 +187,8 @@ TEST(DepositionManager, NeverRingsInARobotWhoseOriginIsItsOwnCell) {
   // Independent check: after the plan's depositions the robot still reaches the window's border.
   Heightmap after = flat;
   for (const Deposition& d : plan.depositions) after(CellIndex{d.row, d.col}) += d.height_m;
-  const CellMask reach = NavigabilityProcessor::navigable_from(
-      NavigabilityProcessor(p.navigability).occupiable(after), centre);
+  const CellMask reach =
+      NavigabilityProcessor::navigable_from(NavigabilityProcessor(p.navigability).occupiable(after), centre);
   EXPECT_TRUE(reach.row(0).any() || reach.row(kGrid.rows - 1).any() || reach.col(0).any() ||
               reach.col(kGrid.cols - 1).any());
 }
@@ -205,7 +205,7 @@ TEST(DepositionManager, KeepsANeighboursWayBack) {
   const auto alone = dm.plan(map, path, robot, 10.0, {1, robot, {}});
   EXPECT_FALSE(alone.depositions.empty());  // nobody to wall in
   const auto with = dm.plan(map, path, robot, 10.0, {1, robot, {{2, other.x, other.y, 0.0}}});
-  EXPECT_TRUE(with.depositions.empty());    // every one of them would cut the neighbour off the origin
+  EXPECT_TRUE(with.depositions.empty());  // every one of them would cut the neighbour off the origin
   EXPECT_GT(with.dropped_for_way_back, 0);
 }
 

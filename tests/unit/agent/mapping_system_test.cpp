@@ -30,7 +30,7 @@ bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; 
 TEST(MappingSystem, TilesLandBitForBitAndTheRestStaysUnknown) {
   MappingSystem map(kWorld, 3);
   EXPECT_EQ(map.known_cells(), 0);
-  const TerrainTile a = tile(1, 1, 2, 3, 7.0);  // rows 3..4, cols 3..5
+  const TerrainTile a = tile(1, 1, 2, 3, 7.0);   // rows 3..4, cols 3..5
   const TerrainTile b = tile(0, 2, 3, 1, -2.0);  // rows 0..2, col 6 (cut by the east edge)
   map.integrate_tile(a);
   map.integrate_tile(b);

@@ -14,9 +14,9 @@
 #include <utility>
 #include <vector>
 
-#include "marsala/protocol/messages.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/navigability_processor.hpp"
+#include "marsala/protocol/messages.hpp"
 
 namespace marsala::agent::test {
 
@@ -52,7 +52,7 @@ class MiniWorld {
 
   /// Admits robot `id` at `start` heading for `target` with a full load.
   protocol::Admission admit(std::uint32_t id, std::uint64_t session, const RobotBody& body, Position start,
-                       Position target) {
+                            Position target) {
     MiniRobot r;
     r.id = id;
     r.session = session;
@@ -142,8 +142,8 @@ class MiniWorld {
       if (d > b.max_step_m + 1e-9) return "motion of " + num(d) + " m exceeds max_step";
       const auto cell = terrain_.cell_at(t);
       if (!cell) return "motion target off the grid";
-      const CellMask occ =
-          NavigabilityProcessor({b.navigability.kappa, b.navigability.delta_m, b.navigability.eps_m}).occupiable(terrain_);
+      const CellMask occ = NavigabilityProcessor({b.navigability.kappa, b.navigability.delta_m, b.navigability.eps_m})
+                               .occupiable(terrain_);
       if (occ(cell->row, cell->col) == 0) return "motion target cell not occupiable";
       pos = t;
     }

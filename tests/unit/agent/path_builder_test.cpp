@@ -40,7 +40,7 @@ protocol::Admission admission(const AgentContext& c, Position target, Position b
 
 /// A frame at `pose` carrying every tile of the world, with `neighbours`.
 protocol::SensorFrame frame(const AgentContext& c, std::uint64_t step, Position pose, double material_m3,
-                       std::vector<protocol::Neighbour> neighbours = {}) {
+                            std::vector<protocol::Neighbour> neighbours = {}) {
   protocol::SensorFrame f = test::full_frame(c, step, pose, material_m3, world_terrain());
   f.neighbours = std::move(neighbours);
   return f;
@@ -54,12 +54,16 @@ constexpr Position kTarget{8.55, 3.05};
 constexpr Position kAtFoot{5.05, 3.05};
 
 TEST(PathState, NamesRoundTrip) {
-  const std::vector<std::pair<PathState, std::string>> names{
-      {PathState::kWaitAdmission, "wait_admission"}, {PathState::kSurvey, "survey"},
-      {PathState::kAdvance, "advance"},              {PathState::kBuild, "build"},
-      {PathState::kRetreat, "retreat"},              {PathState::kReturnToBase, "return_to_base"},
-      {PathState::kFollow, "follow"},                {PathState::kHold, "hold"},
-      {PathState::kBackOff, "back_off"},             {PathState::kDone, "done"}};
+  const std::vector<std::pair<PathState, std::string>> names{{PathState::kWaitAdmission, "wait_admission"},
+                                                             {PathState::kSurvey, "survey"},
+                                                             {PathState::kAdvance, "advance"},
+                                                             {PathState::kBuild, "build"},
+                                                             {PathState::kRetreat, "retreat"},
+                                                             {PathState::kReturnToBase, "return_to_base"},
+                                                             {PathState::kFollow, "follow"},
+                                                             {PathState::kHold, "hold"},
+                                                             {PathState::kBackOff, "back_off"},
+                                                             {PathState::kDone, "done"}};
   for (const auto& [state, name] : names) {
     EXPECT_EQ(to_string(state), name);
     EXPECT_EQ(path_state_from_string(name), state);
@@ -304,12 +308,16 @@ TEST(PathBuilder, AloneItBuildsToTheTargetGoesBackRefillsAndComesAgain) {
     world.apply_step({q});
   }
   EXPECT_EQ(refills, 1);
-  for (const auto& t : std::vector<std::pair<PathState, PathState>>{
-           {PathState::kSurvey, PathState::kAdvance},      {PathState::kAdvance, PathState::kBuild},
-           {PathState::kBuild, PathState::kAdvance},       {PathState::kBuild, PathState::kRetreat},
-           {PathState::kRetreat, PathState::kRetreat},     {PathState::kRetreat, PathState::kAdvance},
-           {PathState::kAdvance, PathState::kReturnToBase}, {PathState::kReturnToBase, PathState::kReturnToBase},
-           {PathState::kReturnToBase, PathState::kAdvance}})
+  for (const auto& t :
+       std::vector<std::pair<PathState, PathState>>{{PathState::kSurvey, PathState::kAdvance},
+                                                    {PathState::kAdvance, PathState::kBuild},
+                                                    {PathState::kBuild, PathState::kAdvance},
+                                                    {PathState::kBuild, PathState::kRetreat},
+                                                    {PathState::kRetreat, PathState::kRetreat},
+                                                    {PathState::kRetreat, PathState::kAdvance},
+                                                    {PathState::kAdvance, PathState::kReturnToBase},
+                                                    {PathState::kReturnToBase, PathState::kReturnToBase},
+                                                    {PathState::kReturnToBase, PathState::kAdvance}})
     EXPECT_EQ(seen.count(t), 1u) << to_string(t.first) << " -> " << to_string(t.second);
   for (const auto& [before, after] : seen)
     for (PathState s : {before, after})

@@ -74,7 +74,7 @@ TEST(Pipeline, ANeighbourMovingAwayFromTheTargetIsReturningAfterTheDetectionDist
   t.observe({at(3, 0.0, 53.5)}, kTarget);  // 1.5 m back: returning
   EXPECT_TRUE(t.returning(3));
   EXPECT_EQ(t.place(self, kTarget).role, PipelineRole::kActive);  // this robot is now the front of the pipeline
-  t.observe({at(3, 0.0, 50.5)}, kTarget);  // passing by on the backward lane: no back-off
+  t.observe({at(3, 0.0, 50.5)}, kTarget);                         // passing by on the backward lane: no back-off
   EXPECT_EQ(t.place(self, kTarget).role, PipelineRole::kActive);
   // Refilled, it comes again: approaching by the detection distance from its farthest point rejoins it.
   t.observe({at(3, 0.0, 40.0)}, kTarget);

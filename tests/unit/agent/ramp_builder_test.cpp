@@ -24,9 +24,7 @@ Heightmap world_terrain() {
   return h;
 }
 
-AgentContext context(std::uint32_t id = 3, RobotBody body = test::husky()) {
-  return test::agent_context(id, body);
-}
+AgentContext context(std::uint32_t id = 3, RobotBody body = test::husky()) { return test::agent_context(id, body); }
 
 protocol::Admission admission(const AgentContext& c, Position target, Position base = {0.55, 3.05}) {
   return test::admission_on(c, world_terrain().geometry(), target, base);
@@ -34,16 +32,19 @@ protocol::Admission admission(const AgentContext& c, Position target, Position b
 
 /// A frame at `pose` carrying every tile of `h`.
 protocol::SensorFrame frame(const AgentContext& c, std::uint64_t step, Position pose, double material_m3,
-                       const Heightmap& h = world_terrain()) {
+                            const Heightmap& h = world_terrain()) {
   return test::full_frame(c, step, pose, material_m3, h);
 }
 
 TEST(RampState, NamesRoundTrip) {
-  const std::vector<std::pair<RampState, std::string>> names{
-      {RampState::kWaitAdmission, "wait_admission"}, {RampState::kSurvey, "survey"},
-      {RampState::kAdvance, "advance"},              {RampState::kBuild, "build"},
-      {RampState::kRetreat, "retreat"},              {RampState::kReturnToBase, "return_to_base"},
-      {RampState::kAtGoal, "at_goal"},               {RampState::kDone, "done"}};
+  const std::vector<std::pair<RampState, std::string>> names{{RampState::kWaitAdmission, "wait_admission"},
+                                                             {RampState::kSurvey, "survey"},
+                                                             {RampState::kAdvance, "advance"},
+                                                             {RampState::kBuild, "build"},
+                                                             {RampState::kRetreat, "retreat"},
+                                                             {RampState::kReturnToBase, "return_to_base"},
+                                                             {RampState::kAtGoal, "at_goal"},
+                                                             {RampState::kDone, "done"}};
   for (const auto& [state, name] : names) {
     EXPECT_EQ(to_string(state), name);
     EXPECT_EQ(ramp_state_from_string(name), state);
@@ -161,7 +162,7 @@ TEST(RampBuilder, BlockedWithNothingInReachRetreats) {
   const AgentContext c = context(3, body);
   RampBuilder rb(c);
   rb.on_admission(admission(c, {8.0, 3.05}));
-  rb.decide(frame(c, 0, {5.95, 3.05}, 1.0));  // came from the west...
+  rb.decide(frame(c, 0, {5.95, 3.05}, 1.0));                                    // came from the west...
   const protocol::ActionRequest q = rb.decide(frame(c, 1, {6.45, 3.05}, 1.0));  // ... to the foot of the platform
   EXPECT_EQ(rb.last_trace().before, RampState::kAdvance);
   EXPECT_EQ(rb.state(), RampState::kRetreat);
@@ -185,11 +186,13 @@ TEST(RampBuilder, ClimbingThePlatformExercisesTheBuildingTransitions) {
   }
   EXPECT_EQ(rb.state(), RampState::kAtGoal);
   // kappa 0.3: the ramp is longer than the robot sees when it first meets the platform, so it has to back off.
-  for (const auto& t : std::vector<std::pair<RampState, RampState>>{
-           {RampState::kSurvey, RampState::kAdvance}, {RampState::kAdvance, RampState::kBuild},
-           {RampState::kBuild, RampState::kAdvance},  {RampState::kBuild, RampState::kRetreat},
-           {RampState::kRetreat, RampState::kRetreat}, {RampState::kRetreat, RampState::kAdvance},
-           {RampState::kAdvance, RampState::kAtGoal}})
+  for (const auto& t : std::vector<std::pair<RampState, RampState>>{{RampState::kSurvey, RampState::kAdvance},
+                                                                    {RampState::kAdvance, RampState::kBuild},
+                                                                    {RampState::kBuild, RampState::kAdvance},
+                                                                    {RampState::kBuild, RampState::kRetreat},
+                                                                    {RampState::kRetreat, RampState::kRetreat},
+                                                                    {RampState::kRetreat, RampState::kAdvance},
+                                                                    {RampState::kAdvance, RampState::kAtGoal}})
     EXPECT_EQ(seen.count(t), 1u) << to_string(t.first) << " -> " << to_string(t.second);
   rb.decide(world.frame_for(1, true));
   EXPECT_EQ(rb.state(), RampState::kDone);

@@ -9,8 +9,8 @@
 #include <memory>
 #include <optional>
 
-#include "marsala/agent/reactive/behaviour.hpp"
 #include "agent_test_support.hpp"
+#include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/core/error.hpp"
 
 namespace marsala::agent::reactive {

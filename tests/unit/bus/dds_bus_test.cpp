@@ -198,9 +198,7 @@ class Filler {
   std::uint64_t u64() { return rng_() | 0x8000000000000001ull; }
   std::int32_t i32() { return -static_cast<std::int32_t>(rng_() % 100000) - 1; }
 
-  RobotBody body() {
-    return {{real(), real(), real()}, real(), real(), real(), real(), real(), real(), real()};
-  }
+  RobotBody body() { return {{real(), real(), real()}, real(), real(), real(), real(), real(), real(), real()}; }
   TerrainTile tile(int rows, int cols) {
     TerrainTile t{i32(), i32(), rows, cols, {}};
     for (int i = 0; i < rows * cols; ++i) t.heights.push_back(any_bits());
@@ -213,7 +211,9 @@ class Filler {
 
 // Non-ASCII UTF-8 text: the strings carry bytes, whatever the script.
 const std::string kUtf8 =
-    "r\xC3\xA9" "f\xC3\xBA" "s\xC3\xA9 \xE2\x89\xA4 1 m \xE2\x80\x94 \xE6\x9C\xBA\xE5\x99\xA8\xE4\xBA\xBA";
+    "r\xC3\xA9"
+    "f\xC3\xBA"
+    "s\xC3\xA9 \xE2\x89\xA4 1 m \xE2\x80\x94 \xE6\x9C\xBA\xE5\x99\xA8\xE4\xBA\xBA";
 
 AgentHello filled_hello(Filler& f) { return {f.u32(), f.u64(), "builder-" + kUtf8, "ramp_builder", f.body()}; }
 
@@ -531,7 +531,8 @@ TEST_P(DdsBus, AliveWritersFollowsWritersAndWakesTheReader) {
   auto second = other_side->create_writer<ActionRequest>({"run-l/agent-3", nullptr});
   ASSERT_TRUE(wait_for(*signal, [&] { return reader->alive_writers() == 2; }));
   // Idle writers stay alive past several leases (automatic liveliness is asserted for them).
-  EXPECT_FALSE(wait_for(*signal, [&] { return reader->alive_writers() < 2; }, 2500ms));
+  EXPECT_FALSE(wait_for(
+      *signal, [&] { return reader->alive_writers() < 2; }, 2500ms));
   // Known gaps of a Fast DDS reader facing Cyclone writers, both specific to writers that go away while their
   // process lives on (a dead process is seen within the lease: tests/integration): it ignores Cyclone's
   // unregistration of a deleted writer, and Cyclone participants of one process share one protocol stack whose
@@ -569,10 +570,14 @@ TEST_P(DdsBus, SamplesWrittenAsSoonAsTheWriterMatchesArrive) {
     frame.step = static_cast<std::uint64_t>(round);
     writer->write(frame);
     std::vector<SensorFrame> got;
-    ASSERT_TRUE(wait_for(*signal, [&] {
-      for (auto& f : reader->take()) got.push_back(f);
-      return !got.empty();
-    }, 3s)) << "round " << round << ": the first frame was lost";
+    ASSERT_TRUE(wait_for(
+        *signal,
+        [&] {
+          for (auto& f : reader->take()) got.push_back(f);
+          return !got.empty();
+        },
+        3s))
+        << "round " << round << ": the first frame was lost";
     EXPECT_EQ(got[0].step, static_cast<std::uint64_t>(round));
   }
 }

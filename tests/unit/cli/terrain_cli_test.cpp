@@ -30,8 +30,8 @@ std::string slurp(const std::string& path) {
 class TerrainCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = ::testing::TempDir() + "terrain_cli_" +
-           ::testing::UnitTest::GetInstance()->current_test_info()->name() + "/";
+    dir_ =
+        ::testing::TempDir() + "terrain_cli_" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + "/";
     ASSERT_EQ(std::system(("mkdir -p '" + dir_ + "'").c_str()), 0);
   }
 
@@ -72,8 +72,7 @@ TEST_F(TerrainCli, UsageErrorsExitTwoWithOneLine) {
         std::string("generate --method flat --rows 0 --cols 3 --cell-size 1 -o x.asc"),
         std::string("generate --method nosuch --rows 3 --cols 3 --cell-size 1 -o " + path("x.asc")),
         std::string("generate --method flat --rows 3 --cols 3 --cell-size 1 --param bogus=1 -o " + path("x.asc")),
-        std::string("generate --method flat --rows 3 --cols 3 --cell-size 1 --param height=abc -o " +
-                    path("x.asc"))}) {
+        std::string("generate --method flat --rows 3 --cols 3 --cell-size 1 --param height=abc -o " + path("x.asc"))}) {
     const CliRun r = run(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
     EXPECT_EQ(r.err.rfind("marsala-terrain: ", 0), 0u) << args << ": " << r.err;
@@ -98,9 +97,8 @@ TEST_F(TerrainCli, DataErrorsExitOneNamingFileAndLine) {
 }
 
 TEST_F(TerrainCli, GenerateThenInfo) {
-  ASSERT_EQ(run("generate --method platform --seed 3 --rows 40 --cols 50 --cell-size 0.1 -o " + path("p.asc"))
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      run("generate --method platform --seed 3 --rows 40 --cols 50 --cell-size 0.1 -o " + path("p.asc")).exit_code, 0);
   const Heightmap map = terrain::read_asc(path("p.asc"));
   EXPECT_EQ(map.rows(), 40);
   EXPECT_EQ(map.cols(), 50);
@@ -111,10 +109,8 @@ TEST_F(TerrainCli, GenerateThenInfo) {
   EXPECT_NE(info.out.find("40 rows x 50 cols"), std::string::npos) << info.out;
   EXPECT_NE(info.out.find("mean slope"), std::string::npos) << info.out;
   // Same seed, same file: determinism through the CLI.
-  ASSERT_EQ(run("generate --method mix --seed 9 --rows 30 --cols 30 --cell-size 0.2 -o " + path("a.asc")).exit_code,
-            0);
-  ASSERT_EQ(run("generate --method mix --seed 9 --rows 30 --cols 30 --cell-size 0.2 -o " + path("b.asc")).exit_code,
-            0);
+  ASSERT_EQ(run("generate --method mix --seed 9 --rows 30 --cols 30 --cell-size 0.2 -o " + path("a.asc")).exit_code, 0);
+  ASSERT_EQ(run("generate --method mix --seed 9 --rows 30 --cols 30 --cell-size 0.2 -o " + path("b.asc")).exit_code, 0);
   EXPECT_EQ(slurp(path("a.asc")), slurp(path("b.asc")));
 }
 
@@ -163,7 +159,7 @@ TEST_F(TerrainCli, NavigableAcrossAStep) {
 TEST_F(TerrainCli, RenderWritesAPng) {
   ASSERT_EQ(run("generate --method platform --rows 60 --cols 80 --cell-size 0.1 -o " + path("p.asc")).exit_code, 0);
   const CliRun r = run("render " + path("p.asc") + " -o " + path("p.png") +
-                    " --navigable-from 2 2 --gap --kappa 0.5 --title platform");
+                       " --navigable-from 2 2 --gap --kappa 0.5 --title platform");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string png = slurp(path("p.png"));
   ASSERT_GT(png.size(), 8u);
@@ -184,8 +180,7 @@ TEST_F(TerrainCli, ImportCropsAndResamples) {
 
 TEST_F(TerrainCli, ImportsTheGaleGeoTiff) {
   const char* root = std::getenv("MARSALA_SOURCE_DIR");
-  const std::string tif =
-      std::string(root ? root : ".") + "/../shared/data/terrains/gale_crater_1m_original.tif";
+  const std::string tif = std::string(root ? root : ".") + "/../shared/data/terrains/gale_crater_1m_original.tif";
   if (!std::ifstream(tif)) GTEST_SKIP() << "Gale crater DEM not found at " << tif << "; skipping";
   const CliRun r = run("import " + tif + " --crop 10 20 160 160 --cell-size 0.5 --zero-base -o " + path("g.asc"));
   ASSERT_EQ(r.exit_code, 0) << r.err;

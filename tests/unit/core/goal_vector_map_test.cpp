@@ -53,11 +53,14 @@ void expect_arrows(const GoalVectorMap& map, const std::vector<Golden>& golden) 
 TEST(GoalVectorMap, GoldenEast) {
   const GoalVectorMap map(spec(100, -20, 110, -15, 2, 4, Heading::kEast), grid_1m());
   EXPECT_EQ(map.strips(), 3);
-  expect_arrows(map, {{100.5, -18.5, 104.5, -18.5, 0, 0}, {104.5, -18.5, 108.5, -18.5, 0, 1},
+  expect_arrows(map, {{100.5, -18.5, 104.5, -18.5, 0, 0},
+                      {104.5, -18.5, 108.5, -18.5, 0, 1},
                       {108.5, -18.5, 109.5, -18.5, 0, 2},  // the last arrow is shorter
-                      {100.5, -16.5, 104.5, -16.5, 1, 0}, {104.5, -16.5, 108.5, -16.5, 1, 1},
+                      {100.5, -16.5, 104.5, -16.5, 1, 0},
+                      {104.5, -16.5, 108.5, -16.5, 1, 1},
                       {108.5, -16.5, 109.5, -16.5, 1, 2},
-                      {100.5, -15.5, 104.5, -15.5, 2, 0}, {104.5, -15.5, 108.5, -15.5, 2, 1},
+                      {100.5, -15.5, 104.5, -15.5, 2, 0},
+                      {104.5, -15.5, 108.5, -15.5, 2, 1},
                       {108.5, -15.5, 109.5, -15.5, 2, 2}});
 }
 
@@ -65,11 +68,14 @@ TEST(GoalVectorMap, GoldenEast) {
 TEST(GoalVectorMap, GoldenWest) {
   const GoalVectorMap map(spec(100, -20, 110, -15, 2, 4, Heading::kWest), grid_1m());
   EXPECT_EQ(map.strips(), 3);
-  expect_arrows(map, {{109.5, -18.5, 106.5, -18.5, 0, 0}, {106.5, -18.5, 102.5, -18.5, 0, 1},
+  expect_arrows(map, {{109.5, -18.5, 106.5, -18.5, 0, 0},
+                      {106.5, -18.5, 102.5, -18.5, 0, 1},
                       {102.5, -18.5, 100.5, -18.5, 0, 2},
-                      {109.5, -16.5, 106.5, -16.5, 1, 0}, {106.5, -16.5, 102.5, -16.5, 1, 1},
+                      {109.5, -16.5, 106.5, -16.5, 1, 0},
+                      {106.5, -16.5, 102.5, -16.5, 1, 1},
                       {102.5, -16.5, 100.5, -16.5, 1, 2},
-                      {109.5, -15.5, 106.5, -15.5, 2, 0}, {106.5, -15.5, 102.5, -15.5, 2, 1},
+                      {109.5, -15.5, 106.5, -15.5, 2, 0},
+                      {106.5, -15.5, 102.5, -15.5, 2, 1},
                       {102.5, -15.5, 100.5, -15.5, 2, 2}});
 }
 
@@ -79,11 +85,14 @@ TEST(GoalVectorMap, GoldenWest) {
 TEST(GoalVectorMap, GoldenNorth) {
   const GoalVectorMap map(spec(100, -20, 105, -10, 2, 4, Heading::kNorth), grid_1m());
   EXPECT_EQ(map.strips(), 3);
-  expect_arrows(map, {{101.5, -19.5, 101.5, -15.5, 0, 0}, {101.5, -15.5, 101.5, -11.5, 0, 1},
+  expect_arrows(map, {{101.5, -19.5, 101.5, -15.5, 0, 0},
+                      {101.5, -15.5, 101.5, -11.5, 0, 1},
                       {101.5, -11.5, 101.5, -10.5, 0, 2},
-                      {103.5, -19.5, 103.5, -15.5, 1, 0}, {103.5, -15.5, 103.5, -11.5, 1, 1},
+                      {103.5, -19.5, 103.5, -15.5, 1, 0},
+                      {103.5, -15.5, 103.5, -11.5, 1, 1},
                       {103.5, -11.5, 103.5, -10.5, 1, 2},
-                      {104.5, -19.5, 104.5, -15.5, 2, 0}, {104.5, -15.5, 104.5, -11.5, 2, 1},
+                      {104.5, -19.5, 104.5, -15.5, 2, 0},
+                      {104.5, -15.5, 104.5, -11.5, 2, 1},
                       {104.5, -11.5, 104.5, -10.5, 2, 2}});
 }
 
@@ -91,11 +100,14 @@ TEST(GoalVectorMap, GoldenNorth) {
 TEST(GoalVectorMap, GoldenSouth) {
   const GoalVectorMap map(spec(100, -20, 105, -10, 2, 4, Heading::kSouth), grid_1m());
   EXPECT_EQ(map.strips(), 3);
-  expect_arrows(map, {{101.5, -10.5, 101.5, -13.5, 0, 0}, {101.5, -13.5, 101.5, -17.5, 0, 1},
+  expect_arrows(map, {{101.5, -10.5, 101.5, -13.5, 0, 0},
+                      {101.5, -13.5, 101.5, -17.5, 0, 1},
                       {101.5, -17.5, 101.5, -19.5, 0, 2},
-                      {103.5, -10.5, 103.5, -13.5, 1, 0}, {103.5, -13.5, 103.5, -17.5, 1, 1},
+                      {103.5, -10.5, 103.5, -13.5, 1, 0},
+                      {103.5, -13.5, 103.5, -17.5, 1, 1},
                       {103.5, -17.5, 103.5, -19.5, 1, 2},
-                      {104.5, -10.5, 104.5, -13.5, 2, 0}, {104.5, -13.5, 104.5, -17.5, 2, 1},
+                      {104.5, -10.5, 104.5, -13.5, 2, 0},
+                      {104.5, -13.5, 104.5, -17.5, 2, 1},
                       {104.5, -17.5, 104.5, -19.5, 2, 2}});
 }
 
@@ -119,9 +131,9 @@ TEST(GoalVectorMap, RemainderThatSnapsToNothingMergesIntoThePreviousArrow) {
   expect_arrows(map, {{100.5, -19.5, 104.5, -19.5, 0, 0}, {104.5, -19.5, 108.5, -19.5, 0, 1}});
   // Two cells of remainder survive as a one-cell arrow.
   const GoalVectorMap longer(spec(100, -20, 110, -19, 1, 4, Heading::kEast), grid_1m());
-  expect_arrows(longer, {{100.5, -19.5, 104.5, -19.5, 0, 0},
-                         {104.5, -19.5, 108.5, -19.5, 0, 1},
-                         {108.5, -19.5, 109.5, -19.5, 0, 2}});
+  expect_arrows(
+      longer,
+      {{100.5, -19.5, 104.5, -19.5, 0, 0}, {104.5, -19.5, 108.5, -19.5, 0, 1}, {108.5, -19.5, 109.5, -19.5, 0, 2}});
 }
 
 // Half-metre cells: site [0, 3] x [0, 1.5], strips 1 m, arrows 1.25 m east. Across: bands [0, 1], [1, 1.5] ->
@@ -130,8 +142,10 @@ TEST(GoalVectorMap, RemainderThatSnapsToNothingMergesIntoThePreviousArrow) {
 TEST(GoalVectorMap, GoldenHalfMetreCells) {
   const GoalVectorMap map(spec(0, 0, 3, 1.5, 1, 1.25, Heading::kEast), {4, 8, 0.0, 0.0, 0.5});
   EXPECT_EQ(map.strips(), 2);
-  expect_arrows(map, {{0.25, 0.75, 1.25, 0.75, 0, 0}, {1.25, 0.75, 2.75, 0.75, 0, 1},
-                      {0.25, 1.25, 1.25, 1.25, 1, 0}, {1.25, 1.25, 2.75, 1.25, 1, 1}});
+  expect_arrows(map, {{0.25, 0.75, 1.25, 0.75, 0, 0},
+                      {1.25, 0.75, 2.75, 0.75, 0, 1},
+                      {0.25, 1.25, 1.25, 1.25, 1, 0},
+                      {1.25, 1.25, 2.75, 1.25, 1, 1}});
 }
 
 // Random specs in every heading. `aligned`: the rectangle on cell edges, strip width and arrow length whole numbers
@@ -181,10 +195,14 @@ std::optional<GoalVectorMap> try_make(const GoalVectorMapSpec& s, const GridGeom
 
 double along(const GoalVectorMapSpec& s, Position p) {
   switch (s.heading) {
-    case Heading::kEast: return p.x;
-    case Heading::kWest: return -p.x;
-    case Heading::kNorth: return p.y;
-    case Heading::kSouth: return -p.y;
+    case Heading::kEast:
+      return p.x;
+    case Heading::kWest:
+      return -p.x;
+    case Heading::kNorth:
+      return p.y;
+    case Heading::kSouth:
+      return -p.y;
   }
   return 0.0;
 }
@@ -369,7 +387,11 @@ TEST(GoalVectorMap, RejectsBadSpecsWithClearMessages) {
   EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.x1_m = 112.1; }), "not inside the grid"));
   EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.y0_m = -20.01; }), "not inside the grid"));
   EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.y1_m = -7.5; }), "not inside the grid"));
-  EXPECT_EQ(with([](GoalVectorMapSpec& s) { s.x1_m = 112; s.y1_m = -8; }), "");  // touching the edges is inside
+  EXPECT_EQ(with([](GoalVectorMapSpec& s) {
+              s.x1_m = 112;
+              s.y1_m = -8;
+            }),
+            "");  // touching the edges is inside
   // Non-positive strip width or arrow length.
   EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.strip_width_m = 0; }), "strip_width_m is 0, must be > 0"));
   EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.strip_width_m = -1; }), "must be > 0"));
@@ -377,9 +399,16 @@ TEST(GoalVectorMap, RejectsBadSpecsWithClearMessages) {
   EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.arrow_length_m = -4; }), "must be > 0"));
   // Strips narrower than a cell: all of them, or the last one (5.5 m across in strips of 2.5 m leaves 0.5 m).
   EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.strip_width_m = 0.75; }), "narrower than one cell (1 m)"));
-  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.y1_m = -14.5; s.strip_width_m = 2.5; }),
+  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) {
+                         s.y1_m = -14.5;
+                         s.strip_width_m = 2.5;
+                       }),
                        "strip 2 of 3 is only 0.5 m wide, narrower than one cell"));
-  EXPECT_EQ(with([](GoalVectorMapSpec& s) { s.y1_m = -14; s.strip_width_m = 2.5; }), "");  // last strip 1 m
+  EXPECT_EQ(with([](GoalVectorMapSpec& s) {
+              s.y1_m = -14;
+              s.strip_width_m = 2.5;
+            }),
+            "");  // last strip 1 m
   // Arrows shorter than a cell, and a site whose upwind and downwind cells coincide.
   EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.arrow_length_m = 0.5; }), "shorter than one cell"));
   EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.x1_m = 101; }), "only 1 m long along heading east"));

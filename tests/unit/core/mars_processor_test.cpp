@@ -16,7 +16,6 @@
 namespace marsala {
 namespace {
 
-
 // Documented accuracy of MarsProcessor: never above the exact P (beyond rounding), at most
 // 2 * 1e-10 m below it for these magnitudes.
 constexpr double kShortfallM = 2e-10;
@@ -40,8 +39,8 @@ void expect_matches_brute_force(const Heightmap& h, double kappa, const std::str
       const double diff = fast(r, c) - slow(r, c);
       if (diff > kRoundingM || diff < -(kShortfallM + kRoundingM)) {
         if (++bad <= 5)
-          ADD_FAILURE() << label << ": cell (" << r << ", " << c << ") fast " << fast(r, c) << " brute "
-                        << slow(r, c) << " diff " << diff;
+          ADD_FAILURE() << label << ": cell (" << r << ", " << c << ") fast " << fast(r, c) << " brute " << slow(r, c)
+                        << " diff " << diff;
       }
     }
   EXPECT_EQ(bad, 0) << label;
@@ -211,8 +210,7 @@ std::vector<Case> random_cases(std::mt19937& rng, int count) {
   const double sizes[] = {0.05, 0.1, 0.25, 1.0, 2.5};
   const double kappas[] = {0.05, 0.3, 0.5, 1.0, 3.0};
   std::vector<Case> cases;
-  for (int k = 0; k < count; ++k)
-    cases.push_back({size(rng), size(rng), sizes[rng() % 5], kappas[rng() % 5]});
+  for (int k = 0; k < count; ++k) cases.push_back({size(rng), size(rng), sizes[rng() % 5], kappas[rng() % 5]});
   return cases;
 }
 
@@ -231,7 +229,8 @@ void run_family(const std::string& family, int count,
 }
 
 TEST(MarsProcessorBruteForce, UniformNoise) {
-  run_family("uniform", 8, [](std::mt19937& rng, const Case& k) { return uniform_noise(rng, k.rows, k.cols, k.cs, 3.0); });
+  run_family("uniform", 8,
+             [](std::mt19937& rng, const Case& k) { return uniform_noise(rng, k.rows, k.cols, k.cs, 3.0); });
 }
 
 TEST(MarsProcessorBruteForce, SmoothNoise) {
@@ -264,7 +263,8 @@ TEST(MarsProcessorBruteForce, ShortSatelliteConesOnFlatGround) {
   // Cones reaching only 5 to 15 cells: the search then runs where the lower bound is flat.
   run_family("short-satellites", 16, [](std::mt19937& rng, const Case& k) {
     Heightmap h(geometry(k.rows, k.cols, k.cs), 0.0);
-    for (int round = 0; round < 3; ++round) add_satellites(rng, k.kappa, round == 2 ? 1e-5 : 1e-3, h, 5.0 * k.kappa * k.cs);
+    for (int round = 0; round < 3; ++round)
+      add_satellites(rng, k.kappa, round == 2 ? 1e-5 : 1e-3, h, 5.0 * k.kappa * k.cs);
     return h;
   });
 }
@@ -294,18 +294,28 @@ TEST(MarsProcessorBruteForce, BowlsAtSlopeKappa) {
 }
 
 TEST(MarsProcessorBruteForce, RidgesAndRoofsAtSlopeKappa) {
-  run_family("ridge", 6, [](std::mt19937& rng, const Case& k) { return exact_ridge(rng, k.kappa, k.rows, k.cols, k.cs, false); });
-  run_family("roof", 6, [](std::mt19937& rng, const Case& k) { return exact_ridge(rng, k.kappa, k.rows, k.cols, k.cs, true); });
+  run_family("ridge", 6,
+             [](std::mt19937& rng, const Case& k) { return exact_ridge(rng, k.kappa, k.rows, k.cols, k.cs, false); });
+  run_family("roof", 6,
+             [](std::mt19937& rng, const Case& k) { return exact_ridge(rng, k.kappa, k.rows, k.cols, k.cs, true); });
 }
 
 TEST(MarsProcessorBruteForce, SatellitesOnSlopeKappaSurfaces) {
   run_family("satellites-on-exact", 24, [](std::mt19937& rng, const Case& k) {
     Heightmap h;
     switch (rng() % 4) {
-      case 0: h = exact_plane(k.kappa, std::uniform_real_distribution<double>(0, 2 * M_PI)(rng), k.rows, k.cols, k.cs); break;
-      case 1: h = exact_cones(rng, k.kappa, k.rows, k.cols, k.cs, 2, false); break;
-      case 2: h = exact_bowls(rng, k.kappa, k.rows, k.cols, k.cs, 2); break;
-      default: h = exact_ridge(rng, k.kappa, k.rows, k.cols, k.cs, false); break;
+      case 0:
+        h = exact_plane(k.kappa, std::uniform_real_distribution<double>(0, 2 * M_PI)(rng), k.rows, k.cols, k.cs);
+        break;
+      case 1:
+        h = exact_cones(rng, k.kappa, k.rows, k.cols, k.cs, 2, false);
+        break;
+      case 2:
+        h = exact_bowls(rng, k.kappa, k.rows, k.cols, k.cs, 2);
+        break;
+      default:
+        h = exact_ridge(rng, k.kappa, k.rows, k.cols, k.cs, false);
+        break;
     }
     const double margins[] = {1e-3, 1e-5, 3e-9};
     if (rng() % 2)
@@ -350,7 +360,8 @@ TEST(MarsProcessorBruteForce, ExtremeKappaAndCellSizes) {
 
 TEST(MarsProcessorBruteForce, MarsOutputFedBack) {
   run_family("fed-back", 8, [](std::mt19937& rng, const Case& k) {
-    const Heightmap h = rng() % 2 ? spikes(rng, k.rows, k.cols, k.cs, 6) : smooth_noise(rng, k.rows, k.cols, k.cs, 3.0, 5);
+    const Heightmap h =
+        rng() % 2 ? spikes(rng, k.rows, k.cols, k.cs, 6) : smooth_noise(rng, k.rows, k.cols, k.cs, 3.0, 5);
     // Both the reference's and the fast projection, so ties from either formula are exercised.
     return rng() % 2 ? testing::mars_brute_force(h, k.kappa) : MarsProcessor(k.kappa).project(h);
   });
@@ -367,7 +378,8 @@ TEST(MarsProcessorBruteForce, MixedTerrainAndCones) {
 
 TEST(MarsProcessorBruteForce, DegenerateShapes) {
   std::mt19937 rng(42);
-  for (const auto& shape : std::vector<std::pair<int, int>>{{1, 1}, {1, 2}, {1, 37}, {53, 1}, {2, 2}, {3, 65}, {9, 9}}) {
+  for (const auto& shape :
+       std::vector<std::pair<int, int>>{{1, 1}, {1, 2}, {1, 37}, {53, 1}, {2, 2}, {3, 65}, {9, 9}}) {
     for (double kappa : {0.1, 0.7, 2.0}) {
       const std::string label = std::to_string(shape.first) + "x" + std::to_string(shape.second);
       expect_matches_brute_force(uniform_noise(rng, shape.first, shape.second, 0.3, 2.0), kappa, "uniform " + label);

@@ -10,13 +10,12 @@
 #include <utility>
 #include <vector>
 
-#include "marsala/core/error.hpp"
 #include "marsala/core/detail/navigability_kernel.hpp"
+#include "marsala/core/error.hpp"
 #include "support/navigability_brute_force.hpp"
 
 namespace marsala {
 namespace {
-
 
 Heightmap flat(int rows, int cols, double cs, double height = 0.0) {
   return Heightmap(GridGeometry{rows, cols, 3.0, -2.0, cs}, height);
@@ -45,14 +44,22 @@ enum class Terrain { kSmooth, kRough, kCliffs, kSpikes, kRampAlongRows, kRampAlo
 
 const char* name(Terrain t) {
   switch (t) {
-    case Terrain::kSmooth: return "smooth";
-    case Terrain::kRough: return "rough";
-    case Terrain::kCliffs: return "cliffs";
-    case Terrain::kSpikes: return "spikes";
-    case Terrain::kRampAlongRows: return "ramp along rows";
-    case Terrain::kRampAlongCols: return "ramp along cols";
-    case Terrain::kRampDiagonal: return "diagonal ramp";
-    case Terrain::kQuantized: return "quantized";
+    case Terrain::kSmooth:
+      return "smooth";
+    case Terrain::kRough:
+      return "rough";
+    case Terrain::kCliffs:
+      return "cliffs";
+    case Terrain::kSpikes:
+      return "spikes";
+    case Terrain::kRampAlongRows:
+      return "ramp along rows";
+    case Terrain::kRampAlongCols:
+      return "ramp along cols";
+    case Terrain::kRampDiagonal:
+      return "diagonal ramp";
+    case Terrain::kQuantized:
+      return "quantized";
   }
   return "?";
 }
@@ -118,7 +125,7 @@ Heightmap make_terrain(Terrain t, int rows, int cols, const NavigabilityParams& 
       for (int r = 0; r < rows; ++r)
         for (int c = 0; c < cols; ++c) {
           const Position x = h.cell_center({r, c});
-          h(r, c) = t == Terrain::kRampAlongRows  ? slope * x.x
+          h(r, c) = t == Terrain::kRampAlongRows   ? slope * x.x
                     : t == Terrain::kRampAlongCols ? slope * x.y
                                                    : slope * (x.x + x.y) / std::sqrt(2.0);
         }
@@ -146,25 +153,25 @@ struct Case {
 /// than the grid, balls past 16 rings (ring groups), exact height ties (cs = 1, kappa = 0.5, eps = 0).
 const std::vector<Case>& cases() {
   static const std::vector<Case> all = {
-      {0.1, 0.6, 0.3, 0.05, 20},         // radius 2.9999999999999996 cells: (3, 0) is in by the tolerance
-      {0.1, 1.0, 0.3, 0.05, 22},         // the robot of the benchmarks: radius 5 cells
-      {0.2, 0.6, 0.3, 0.0, 16},          // radius 1.4999999999999998, eps 0
-      {0.5, 2.0, 0.5, 0.0, 16},          // radius exactly 2
+      {0.1, 0.6, 0.3, 0.05, 20},                  // radius 2.9999999999999996 cells: (3, 0) is in by the tolerance
+      {0.1, 1.0, 0.3, 0.05, 22},                  // the robot of the benchmarks: radius 5 cells
+      {0.2, 0.6, 0.3, 0.0, 16},                   // radius 1.4999999999999998, eps 0
+      {0.5, 2.0, 0.5, 0.0, 16},                   // radius exactly 2
       {1.0, 2.0 * std::sqrt(2.0), 0.5, 0.1, 16},  // radius^2 = 2 up to rounding: diagonal tie
-      {1.0, 1.0, 0.5, 0.0, 14},          // radius 0.5: the ball is one cell
-      {0.1, 0.05, 0.3, 0.05, 8},         // delta < cs: one cell
-      {1.0, 2.0, 0.3, 0.05, 14},         // radius 1: a plus
-      {0.25, 1.5, 1.0, 0.2, 16},         // radius 3, steep robot
-      {1.0, 7.0, 0.5, 0.0, 12},          // radius 3.5, exact height ties
-      {0.05, 1.0, 0.3, 0.05, 13},        // radius 10: 20 rings share 16 flag bits
-      {0.01, 0.7, 0.3, 0.05, 12},        // radius 35, clipped by the grid's extent
-      {1.0, 1e6, 0.5, 0.0, 9},           // a ball far larger than the grid: every ball holds the whole grid
+      {1.0, 1.0, 0.5, 0.0, 14},                   // radius 0.5: the ball is one cell
+      {0.1, 0.05, 0.3, 0.05, 8},                  // delta < cs: one cell
+      {1.0, 2.0, 0.3, 0.05, 14},                  // radius 1: a plus
+      {0.25, 1.5, 1.0, 0.2, 16},                  // radius 3, steep robot
+      {1.0, 7.0, 0.5, 0.0, 12},                   // radius 3.5, exact height ties
+      {0.05, 1.0, 0.3, 0.05, 13},                 // radius 10: 20 rings share 16 flag bits
+      {0.01, 0.7, 0.3, 0.05, 12},                 // radius 35, clipped by the grid's extent
+      {1.0, 1e6, 0.5, 0.0, 9},                    // a ball far larger than the grid: every ball holds the whole grid
   };
   return all;
 }
 
-constexpr Terrain kTerrains[] = {Terrain::kSmooth,        Terrain::kRough,         Terrain::kCliffs,
-                                 Terrain::kSpikes,        Terrain::kRampAlongRows, Terrain::kRampAlongCols,
+constexpr Terrain kTerrains[] = {Terrain::kSmooth,       Terrain::kRough,         Terrain::kCliffs,
+                                 Terrain::kSpikes,       Terrain::kRampAlongRows, Terrain::kRampAlongCols,
                                  Terrain::kRampDiagonal, Terrain::kQuantized};
 
 // ---- fast == brute force ---------------------------------------------------------------------------------
@@ -182,8 +189,8 @@ TEST(NavigabilityProcessor, OccupiableEqualsBruteForceOnRandomGrids) {
         const Heightmap h = make_terrain(t, rows, cols, p, k.cs, rng);
         const CellMask reference = testing::occupiable_brute_force(h, p);
         const CellMask fast = processor.occupiable(h);
-        SCOPED_TRACE(std::string(name(t)) + " " + std::to_string(rows) + "x" + std::to_string(cols) +
-                     " cs " + std::to_string(k.cs) + " delta " + std::to_string(k.delta));
+        SCOPED_TRACE(std::string(name(t)) + " " + std::to_string(rows) + "x" + std::to_string(cols) + " cs " +
+                     std::to_string(k.cs) + " delta " + std::to_string(k.delta));
         EXPECT_EQ(first_difference(fast, reference), "");
         // Both ways of clearing lenses give the same cells.
         EXPECT_EQ(first_difference(detail::occupiable_mask(h, p, detail::LensMarking::kSpans), reference), "");

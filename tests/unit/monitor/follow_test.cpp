@@ -3,12 +3,12 @@
 
 #include <chrono>
 #include <future>
-#include <utility>
 #include <memory>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <typeinfo>
+#include <utility>
 #include <vector>
 
 #include "marsala/core/error.hpp"
@@ -49,7 +49,8 @@ protocol::WorldStatus final_status(const std::string& run_id, std::uint64_t step
   return s;
 }
 
-protocol::WorldEvent event(std::uint64_t step, std::uint32_t agent_id, protocol::EventKind kind, const std::string& detail = "") {
+protocol::WorldEvent event(std::uint64_t step, std::uint32_t agent_id, protocol::EventKind kind,
+                           const std::string& detail = "") {
   protocol::WorldEvent e;
   e.step = step;
   e.agent_id = agent_id;
@@ -356,7 +357,8 @@ TEST(Monitor, OnlyReadsWithTheContractsQos) {
   EXPECT_EQ(run_status(spy, StatusOptions{}, stop, out, err), 0) << err.str();
   EXPECT_EQ(spy.writers_requested, 0);
   ASSERT_EQ(spy.readers.size(), 3u);
-  const std::string status_type = typeid(protocol::WorldStatus).name(), event_type = typeid(protocol::WorldEvent).name();
+  const std::string status_type = typeid(protocol::WorldStatus).name(),
+                    event_type = typeid(protocol::WorldEvent).name();
   // tail: statuses transient-local (a late monitor sees the latest at once), events volatile.
   EXPECT_EQ(spy.readers[0].first, status_type);
   EXPECT_EQ(spy.readers[0].second.durability, bus::Durability::kTransientLocal);

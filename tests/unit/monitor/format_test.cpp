@@ -10,7 +10,7 @@ namespace marsala::monitor {
 namespace {
 
 protocol::AgentStatus agent(std::uint32_t id, const std::string& state, double material_m3 = 1.0, bool alive = true,
-                       bool at_goal = false) {
+                            bool at_goal = false) {
   protocol::AgentStatus a;
   a.agent_id = id;
   a.name = "builder-" + std::to_string(id);

@@ -147,7 +147,7 @@ TEST(RenderOverlays, RectangleAndCircleOutlines) {
   const Image base = render_terrain(map, o);
   // Cell edges: x 10 + 0.5 * 4 = 12 m is pixel x 40; y 20 + 0.5 * 14 = 27 m is pixel y (20 - 14) * 10 = 60.
   o.rectangles.push_back({{12.0, 27.0}, {17.0, 22.0}, {255, 255, 255}, 2.0});  // pixels x 40 .. 140, y 60 .. 160
-  o.circles.push_back({{15.0, 24.5}, 1.0, {0, 200, 0}, 2.0});                 // centre (100, 110), radius 20 px
+  o.circles.push_back({{15.0, 24.5}, 1.0, {0, 200, 0}, 2.0});                  // centre (100, 110), radius 20 px
   const Image img = render_terrain(map, o);
   const Pixel white{255, 255, 255}, green{0, 200, 0};
   EXPECT_EQ(at(img, 90, 59), white);
@@ -157,7 +157,7 @@ TEST(RenderOverlays, RectangleAndCircleOutlines) {
   EXPECT_EQ(at(img, 90, 58), kHalo);
   EXPECT_EQ(at(img, 70, 70), at(base, 70, 70));  // inside
   EXPECT_EQ(at(img, 90, 40), at(base, 90, 40));  // outside
-  EXPECT_EQ(at(img, 120, 110), green);            // on the circle (pixel centre 120.5: 20.5 px from the centre)
+  EXPECT_EQ(at(img, 120, 110), green);           // on the circle (pixel centre 120.5: 20.5 px from the centre)
   EXPECT_EQ(at(img, 100, 89), green);
   EXPECT_EQ(at(img, 100, 110), at(base, 100, 110));  // its centre
 }
@@ -166,19 +166,19 @@ TEST(RenderOverlays, PointMarksHaveTheirShapeColourAndOutline) {
   const auto map = flat(20, 20);
   RenderOptions o = plain(200);
   const Image base = render_terrain(map, o);
-  o.points.push_back({map.cell_center({5, 5}), {0, 0, 255}, PointShape::kSquare, 5.0});     // centre (55, 55)
-  o.points.push_back({map.cell_center({5, 14}), {0, 255, 0}, PointShape::kDiamond, 5.0});   // centre (145, 55)
-  o.points.push_back({map.cell_center({14, 10}), {255, 0, 0}, PointShape::kDisc, 5.0});     // centre (105, 145)
+  o.points.push_back({map.cell_center({5, 5}), {0, 0, 255}, PointShape::kSquare, 5.0});    // centre (55, 55)
+  o.points.push_back({map.cell_center({5, 14}), {0, 255, 0}, PointShape::kDiamond, 5.0});  // centre (145, 55)
+  o.points.push_back({map.cell_center({14, 10}), {255, 0, 0}, PointShape::kDisc, 5.0});    // centre (105, 145)
   const Image img = render_terrain(map, o);
   EXPECT_EQ(at(img, 55, 55), (Pixel{0, 0, 255}));
   EXPECT_EQ(at(img, 51, 51), (Pixel{0, 0, 255}));  // a square's corner
   EXPECT_EQ(at(img, 145, 55), (Pixel{0, 255, 0}));
   EXPECT_EQ(at(img, 142, 52), (Pixel{0, 255, 0}));  // on the diamond's edge: |dx| + |dy| = 5
-  EXPECT_EQ(at(img, 142, 51), kHalo);              // |dx| + |dy| = 6: inside its outline (6.5)
+  EXPECT_EQ(at(img, 142, 51), kHalo);               // |dx| + |dy| = 6: inside its outline (6.5)
   EXPECT_EQ(at(img, 148, 55), (Pixel{0, 255, 0}));
   EXPECT_EQ(at(img, 105, 145), (Pixel{255, 0, 0}));
   EXPECT_EQ(at(img, 108, 148), (Pixel{255, 0, 0}));  // pixel centre 4.95 px away
-  EXPECT_EQ(at(img, 109, 149), kHalo);              // 6.36 px away: the outline (6.5)
+  EXPECT_EQ(at(img, 109, 149), kHalo);               // 6.36 px away: the outline (6.5)
   EXPECT_EQ(at(img, 105, 160), at(base, 105, 160));
 }
 
@@ -215,12 +215,12 @@ TEST(RenderOverlays, LegendEntriesShowTheirColourSwatch) {
   // The swatches are 14 x 14 px here (legend font 1).
   EXPECT_GT(count[0], 100);  // a filled square less its frame: 12 x 12
   EXPECT_GT(count[1], 100);
-  EXPECT_GT(count[2], 40);   // a disc of radius 4.5 px: about 64
+  EXPECT_GT(count[2], 40);  // a disc of radius 4.5 px: about 64
   EXPECT_LT(count[2], 100);
-  EXPECT_GT(count[3], 20);   // a line 2.8 px wide, 12 px long
+  EXPECT_GT(count[3], 20);  // a line 2.8 px wide, 12 px long
   EXPECT_LT(count[3], 60);
-  EXPECT_GT(count[4], 20);   // shaft and head
-  EXPECT_GT(count[5], 20);   // a ring of radius 4, 2 px wide: about 50
+  EXPECT_GT(count[4], 20);  // shaft and head
+  EXPECT_GT(count[5], 20);  // a ring of radius 4, 2 px wide: about 50
 }
 
 TEST(RenderOverlays, BadOverlaysAreRejected) {

@@ -15,9 +15,7 @@ using test::at;
 using test::Pixel;
 using test::plain;
 
-Heightmap make_map(int rows, int cols, double cs = 0.5) {
-  return Heightmap(GridGeometry{rows, cols, 0.0, 0.0, cs});
-}
+Heightmap make_map(int rows, int cols, double cs = 0.5) { return Heightmap(GridGeometry{rows, cols, 0.0, 0.0, cs}); }
 
 // An uneven but smooth test terrain.
 Heightmap bumpy(int rows, int cols, double cs = 0.5) {
@@ -32,14 +30,14 @@ TEST(TerrainRenderer, TerrainAreaSizeRules) {
     int rows, cols, max_px, width, height;
   };
   const Case cases[] = {
-      {10, 20, 100, 100, 50},      // upscale by 5
-      {1, 1, 64, 64, 64},          // one cell fills the area
-      {1, 37, 100, 74, 2},         // 1 x N strip, upscale by 2
-      {37, 1, 100, 2, 74},         // N x 1 strip
+      {10, 20, 100, 100, 50},         // upscale by 5
+      {1, 1, 64, 64, 64},             // one cell fills the area
+      {1, 37, 100, 74, 2},            // 1 x N strip, upscale by 2
+      {37, 1, 100, 2, 74},            // N x 1 strip
       {2048, 1024, 1024, 512, 1024},  // block-average 2 x 2
-      {3000, 5, 1024, 2, 1000},    // factor 3: 3000 / 3 rows, ceil(5 / 3) cols
-      {1025, 1025, 1024, 513, 513},  // factor 2 with a partial last block
-      {7, 7, 7, 7, 7},             // exactly fits
+      {3000, 5, 1024, 2, 1000},       // factor 3: 3000 / 3 rows, ceil(5 / 3) cols
+      {1025, 1025, 1024, 513, 513},   // factor 2 with a partial last block
+      {7, 7, 7, 7, 7},                // exactly fits
   };
   for (const Case& c : cases) {
     const Image img = render_terrain(make_map(c.rows, c.cols), plain(c.max_px));

@@ -121,14 +121,16 @@ name: "d"
 terrain { generator: "flat" }
 robot_type { name: "bot" }
 agent { robot_type: "bot" start { x_m: 1 y_m: 1 } target { x_m: 9.95 y_m: 9.95 } }
-goal { x0_m: 9 y0_m: 9 x1_m: 10 y1_m: 10 })", "d.pbtxt");
+goal { x0_m: 9 y0_m: 9 x1_m: 10 y1_m: 10 })",
+                                    "d.pbtxt");
   EXPECT_EQ(d.terrain.rows, 100);
   EXPECT_EQ(d.terrain.cols, 100);
   EXPECT_EQ(d.terrain.cell_size_m, 0.1);
   // Heterogeneous teams: slots name different robot types.
   const Scenario h = parse_scenario(std::string(kMinimal) + R"(
 robot_type { name: "digger" behaviour: "digger" body { kappa: 0.5 reach_m: 2 } }
-agent { id: 2 robot_type: "digger" start { x_m: 2 y_m: 2 } target { x_m: 3 y_m: 3 } })", "h.pbtxt");
+agent { id: 2 robot_type: "digger" start { x_m: 2 y_m: 2 } target { x_m: 3 y_m: 3 } })",
+                                    "h.pbtxt");
   EXPECT_EQ(h.robot_for(1).name, "bot");
   EXPECT_EQ(h.robot_for(2).behaviour, "digger");
   EXPECT_EQ(h.robot_for(2).body.navigability.kappa, 0.5);
@@ -151,32 +153,41 @@ TEST(ScenarioLoader, SyntaxErrorsNameFileLineAndColumn) {
     EXPECT_EQ(std::string(e.what()).rfind("unknown.pbtxt:8:", 0), 0u) << e.what();
     EXPECT_NE(std::string(e.what()).find("speed"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(parse_scenario(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { wheels: 4 } }"), "t"),
-               ParseError);
+  EXPECT_THROW(
+      parse_scenario(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { wheels: 4 } }"), "t"),
+      ParseError);
   EXPECT_THROW(parse_scenario(edit("name: \"mini\"", "name: \"mini\" name: \"again\""), "t"), ParseError);
   EXPECT_THROW(load_scenario("/nonexistent/scenario.pbtxt"), IoError);
 }
 
 TEST(ScenarioLoader, BadValuesNameTheField) {
-  EXPECT_NE(invalid(edit("robot_type: \"bot\"", "robot_type: \"tank\"")).find("agent[0] (agent 1).robot_type: unknown robot type 'tank'; valid: bot"),
+  EXPECT_NE(invalid(edit("robot_type: \"bot\"", "robot_type: \"tank\""))
+                .find("agent[0] (agent 1).robot_type: unknown robot type 'tank'; valid: bot"),
             std::string::npos);
-  EXPECT_NE(invalid(edit("\"flat\"", "\"volcano\"")).find("terrain.generator: unknown generator 'volcano'; valid generators:"),
+  EXPECT_NE(invalid(edit("\"flat\"", "\"volcano\""))
+                .find("terrain.generator: unknown generator 'volcano'; valid generators:"),
             std::string::npos);
-  EXPECT_NE(invalid(edit("target { x_m: 10 y_m: 5 }", "target { x_m: 16 y_m: 5 }")).find("agent[0] (agent 1).target: (16, 5) is off the terrain"),
+  EXPECT_NE(invalid(edit("target { x_m: 10 y_m: 5 }", "target { x_m: 16 y_m: 5 }"))
+                .find("agent[0] (agent 1).target: (16, 5) is off the terrain"),
             std::string::npos);
   EXPECT_NE(invalid(edit("start { x_m: 1 y_m: 1 }", "start { x_m: 1 y_m: -0.1 }")).find(".start"), std::string::npos);
   EXPECT_NE(invalid(edit("start { x_m: 1 y_m: 1 }", "start { x_m: nan y_m: 1 }")).find("start.x_m: nan must be finite"),
             std::string::npos);
-  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { kappa: nan } }")).find("robot_type[0].body: kappa"),
+  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { kappa: nan } }"))
+                .find("robot_type[0].body: kappa"),
             std::string::npos);
-  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { reach_m: inf } }")).find("reach_m"),
+  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { reach_m: inf } }"))
+                .find("reach_m"),
             std::string::npos);
-  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { delta_m: -1 } }")).find("delta_m = -1"),
+  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { delta_m: -1 } }"))
+                .find("delta_m = -1"),
             std::string::npos);
-  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { max_step_m: 2e6 } }")).find("max_step_m"),
+  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { max_step_m: 2e6 } }"))
+                .find("max_step_m"),
             std::string::npos);
   // Zero agents, no robot types.
-  const std::string no_agents = edit("agent { robot_type: \"bot\" start { x_m: 1 y_m: 1 } target { x_m: 10 y_m: 5 } }", "");
+  const std::string no_agents =
+      edit("agent { robot_type: \"bot\" start { x_m: 1 y_m: 1 } target { x_m: 10 y_m: 5 } }", "");
   EXPECT_NE(invalid(no_agents).find("agent: at least one agent slot"), std::string::npos);
   EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "")).find("robot_type: at least one"), std::string::npos);
   // Negative and zero sizes.
@@ -187,19 +198,23 @@ TEST(ScenarioLoader, BadValuesNameTheField) {
   EXPECT_NE(invalid(std::string(kMinimal) + "tile_size: 0").find("tile_size"), std::string::npos);
   EXPECT_NE(invalid(std::string(kMinimal) + "max_steps: 0").find("max_steps"), std::string::npos);
   EXPECT_NE(invalid(std::string(kMinimal) + "step_deadline_s: -1").find("step_deadline_s"), std::string::npos);
-  EXPECT_NE(invalid(std::string(kMinimal) + "base { x_m: 1 y_m: 1 radius_m: 0 }").find("base.radius_m"), std::string::npos);
+  EXPECT_NE(invalid(std::string(kMinimal) + "base { x_m: 1 y_m: 1 radius_m: 0 }").find("base.radius_m"),
+            std::string::npos);
   EXPECT_NE(invalid(std::string(kMinimal) + "base { x_m: 100 y_m: 1 }").find("base: (100, 1) is off the terrain"),
             std::string::npos);
   // Structure.
-  EXPECT_NE(invalid(edit("goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }", "goal { x0_m: 11 y0_m: 4 x1_m: 9 y1_m: 6 }")).find("goal"),
+  EXPECT_NE(invalid(edit("goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }", "goal { x0_m: 11 y0_m: 4 x1_m: 9 y1_m: 6 }"))
+                .find("goal"),
             std::string::npos);
-  EXPECT_NE(invalid(edit("goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }", "goal { x0_m: 9 y0_m: 4 x1_m: 16 y1_m: 6 }")).find("not inside the terrain"),
+  EXPECT_NE(invalid(edit("goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }", "goal { x0_m: 9 y0_m: 4 x1_m: 16 y1_m: 6 }"))
+                .find("not inside the terrain"),
             std::string::npos);
   EXPECT_NE(invalid(edit("goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }", "")).find("goal: give exactly one of"),
             std::string::npos);
   EXPECT_NE(invalid(edit("name: \"mini\"", "name: \"a b\"")).find("name"), std::string::npos);
   EXPECT_NE(invalid(edit("name: \"mini\"", "")).find("name"), std::string::npos);
-  EXPECT_NE(invalid(edit("generator: \"flat\"", "generator: \"flat\" file: \"x.asc\"")).find("exactly one"), std::string::npos);
+  EXPECT_NE(invalid(edit("generator: \"flat\"", "generator: \"flat\" file: \"x.asc\"")).find("exactly one"),
+            std::string::npos);
   EXPECT_NE(invalid(edit("robot_type: \"bot\"", "id: 2 robot_type: \"bot\"")).find("differs from its position"),
             std::string::npos);
   EXPECT_NE(invalid(std::string(kMinimal) + "robot_type { name: \"bot\" }").find("defined twice"), std::string::npos);

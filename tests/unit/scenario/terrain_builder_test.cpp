@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <iostream>
 #include <fstream>
+#include <iostream>
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/goal_vector_map.hpp"
@@ -99,7 +99,8 @@ TEST_F(TerrainBuilderTest, FileTerrainRelativeToTheScenarioWithCropResampleAndZe
   const Heightmap same = build_terrain(plain);
   EXPECT_TRUE(same.heights() == source.heights());
 
-  const Scenario edited = scenario(R"(terrain { file: "maps/site.asc" crop { x0_m: 0.5 y0_m: 0.5 width_m: 6 height_m: 4 }
+  const Scenario edited =
+      scenario(R"(terrain { file: "maps/site.asc" crop { x0_m: 0.5 y0_m: 0.5 width_m: 6 height_m: 4 }
                                                 resample_cell_size_m: 0.25 zero_base: true })");
   Heightmap want = terrain::resample_bilinear(terrain::crop(source, 0.5, 0.5, 6, 4), 0.25);
   want.heights().array() -= want.min_height();
@@ -190,10 +191,10 @@ TEST(DeployScenarios, EachBuildsItsTerrainAndNeedsConstruction) {
       ASSERT_TRUE(s.has_goal_vector_map);
       const GoalVectorMap map(s.goal_vector_map, h.geometry());
       EXPECT_GE(static_cast<std::size_t>(map.strips()), 1u);
-      const CellIndex lo = cell(s.site.x0_m + 1e-6, s.site.y1_m - 1e-6), hi = cell(s.site.x1_m - 1e-6, s.site.y0_m + 1e-6);
+      const CellIndex lo = cell(s.site.x0_m + 1e-6, s.site.y1_m - 1e-6),
+                      hi = cell(s.site.x1_m - 1e-6, s.site.y0_m + 1e-6);
       const Heightmap site = h.window(lo, hi.row - lo.row + 1, hi.col - lo.col + 1);
-      const CellMask occupiable =
-          NavigabilityProcessor(s.site.navigability).occupiable(site);
+      const CellMask occupiable = NavigabilityProcessor(s.site.navigability).occupiable(site);
       EXPECT_LT(occupiable.cast<long long>().sum(), static_cast<long long>(site.rows()) * site.cols())
           << "the site is level already";
     }

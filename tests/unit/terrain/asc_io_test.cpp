@@ -20,7 +20,6 @@
 namespace marsala::terrain {
 namespace {
 
-
 const char* const kHeader3x2 = "ncols 3\nnrows 2\nxllcorner 10\nyllcorner 20\ncellsize 0.5\n";
 
 Heightmap parse(const std::string& text, AscReadOptions options = {}) {
@@ -268,9 +267,18 @@ TEST(AscWrite, RoundTripIsBitExact) {
   std::mt19937_64 rng(20240611);
   GridGeometry g{17, 23, 1234.5678901234567, -0.1, 0.1};
   Heightmap map(g);
-  const double specials[] = {0.0,    -0.0,    1e-300,  -1e-300, 1e300,  -1e300,
-                             std::numeric_limits<double>::min(),   std::numeric_limits<double>::max(),
-                             -std::numeric_limits<double>::max(),  0.1,    1.0 / 3.0, -9999.000000000002};
+  const double specials[] = {0.0,
+                             -0.0,
+                             1e-300,
+                             -1e-300,
+                             1e300,
+                             -1e300,
+                             std::numeric_limits<double>::min(),
+                             std::numeric_limits<double>::max(),
+                             -std::numeric_limits<double>::max(),
+                             0.1,
+                             1.0 / 3.0,
+                             -9999.000000000002};
   std::uniform_real_distribution<double> ordinary(-5000.0, 5000.0);
   long long i = 0;
   for (int r = 0; r < map.rows(); ++r)

@@ -16,8 +16,8 @@
 namespace marsala::terrain {
 namespace {
 
-const std::vector<std::string> kMethods = {"craters", "flat", "fractal", "gaussian_hills", "mix", "platform", "ramp",
-                                           "steps"};
+const std::vector<std::string> kMethods = {"craters", "flat",     "fractal", "gaussian_hills",
+                                           "mix",     "platform", "ramp",    "steps"};
 
 GeneratorSpec spec(int rows, int cols, double cs, std::uint64_t seed, std::map<std::string, double> params = {}) {
   GeneratorSpec s;
@@ -183,8 +183,8 @@ TEST(Generators, PlatformGolden) {
   // 3.5 .. 6.5 (cols 3..6); y in [4, 6) holds y = 4.5 (row 5) and 5.5 (row 4).
   expect_box(generate_terrain("platform", spec(10, 10, 1.0, 1, {{"width", 4.0}, {"depth", 2.0}})), 4, 5, 3, 6, 1.5);
   // Odd grid, edges through cell centres: west/south edges inclusive, east/north exclusive -> 3 x 3 cells.
-  expect_box(generate_terrain("platform", spec(9, 9, 1.0, 1, {{"width", 3.0}, {"depth", 3.0}, {"height", 2.0}})), 3,
-             5, 3, 5, 2.0);
+  expect_box(generate_terrain("platform", spec(9, 9, 1.0, 1, {{"width", 3.0}, {"depth", 3.0}, {"height", 2.0}})), 3, 5,
+             3, 5, 2.0);
   // Non-dyadic cells, explicit centre: x in [0.75, 1.25) -> cols 7..11; y in [0.35, 0.65) -> rows 14..16.
   expect_box(generate_terrain("platform", spec(20, 30, 0.1, 1,
                                                {{"width", 0.5}, {"centre_x", 1.0}, {"depth", 0.3}, {"centre_y", 0.5}})),
@@ -207,7 +207,8 @@ TEST(Generators, RampGoldenAlongTheAxes) {
   for (const auto& [azimuth, height] : expected) {
     const auto h = generate_terrain("ramp", spec(4, 6, 0.5, 1, {{"slope", 0.25}, {"azimuth", azimuth}}));
     for (int r = 0; r < 4; ++r)
-      for (int c = 0; c < 6; ++c) EXPECT_EQ(h(r, c), height(r, c)) << "azimuth " << azimuth << " (" << r << ", " << c << ")";
+      for (int c = 0; c < 6; ++c)
+        EXPECT_EQ(h(r, c), height(r, c)) << "azimuth " << azimuth << " (" << r << ", " << c << ")";
   }
 }
 
@@ -237,9 +238,9 @@ TEST(Generators, StepsGoldenWithStraightCliffs) {
   for (int r = 0; r < 6; ++r)
     for (int c = 0; c < 40; ++c) EXPECT_EQ(h(r, c), 0.5 * (c / 10)) << "(" << r << ", " << c << ")";
   // Rising to the north: row 0 (northmost) is on the top terrace.
-  const auto n = generate_terrain("steps", spec(40, 3, 1.0, 3,
-                                                {{"count", 3}, {"step_height", 0.5}, {"azimuth", 0.0}, {"jitter", 0.0},
-                                                 {"waviness", 0.0}}));
+  const auto n = generate_terrain(
+      "steps",
+      spec(40, 3, 1.0, 3, {{"count", 3}, {"step_height", 0.5}, {"azimuth", 0.0}, {"jitter", 0.0}, {"waviness", 0.0}}));
   for (int r = 0; r < 40; ++r) EXPECT_EQ(n(r, 1), 0.5 * ((39 - r) / 10)) << r;
 }
 
@@ -347,7 +348,7 @@ TEST(Generators, HelpListsExactlyTheAcceptedParameters) {
       ASSERT_EQ(std::sscanf(line.c_str() + line.find('[', valid), "[%lf, %lf]", &lo, &hi), 2) << line;
       ASSERT_LE(lo, hi) << line;
       if (m == "craters" && (key == "radius_min" || key == "radius_max")) continue;  // must stay ordered
-      if (m == "fractal" && key == "wavelength") continue;                              // must exceed a cell
+      if (m == "fractal" && key == "wavelength") continue;                           // must exceed a cell
       for (const double v : {lo, hi})
         EXPECT_NO_THROW(generate_terrain(m, spec(3, 4, 0.5, 1, {{key, v}}))) << m << " " << key << " = " << v;
     }

@@ -22,7 +22,6 @@
 namespace marsala::terrain {
 namespace {
 
-
 constexpr uint32_t kModelPixelScaleTag = 33550;
 constexpr uint32_t kModelTransformationTag = 34264;
 constexpr uint32_t kGdalNodataTag = 42113;
@@ -59,8 +58,7 @@ std::string write_tiff(const std::string& name, const TiffLayout& layout, const 
   }
   static const TIFFFieldInfo kGeoFields[] = {
       {kModelPixelScaleTag, -1, -1, TIFF_DOUBLE, FIELD_CUSTOM, 1, 1, const_cast<char*>("ModelPixelScaleTag")},
-      {kModelTransformationTag, -1, -1, TIFF_DOUBLE, FIELD_CUSTOM, 1, 1,
-       const_cast<char*>("ModelTransformationTag")},
+      {kModelTransformationTag, -1, -1, TIFF_DOUBLE, FIELD_CUSTOM, 1, 1, const_cast<char*>("ModelTransformationTag")},
       {kGdalNodataTag, -1, -1, TIFF_ASCII, FIELD_CUSTOM, 1, 0, const_cast<char*>("GDALNoDataValue")},
   };
   TIFFMergeFieldInfo(tif, kGeoFields, 3);
@@ -73,8 +71,8 @@ std::string write_tiff(const std::string& name, const TiffLayout& layout, const 
   TIFFSetField(tif, TIFFTAG_PHOTOMETRIC, layout.photometric);
   TIFFSetField(tif, TIFFTAG_COMPRESSION, layout.compression);
   if (layout.compression == COMPRESSION_ADOBE_DEFLATE)
-    TIFFSetField(tif, TIFFTAG_PREDICTOR, layout.format == SAMPLEFORMAT_IEEEFP ? PREDICTOR_FLOATINGPOINT
-                                                                               : PREDICTOR_HORIZONTAL);
+    TIFFSetField(tif, TIFFTAG_PREDICTOR,
+                 layout.format == SAMPLEFORMAT_IEEEFP ? PREDICTOR_FLOATINGPOINT : PREDICTOR_HORIZONTAL);
   if (layout.pixel_scale) TIFFSetField(tif, kModelPixelScaleTag, 3, layout.pixel_scale->data());
   if (layout.transformation) TIFFSetField(tif, kModelTransformationTag, 16, layout.transformation->data());
   if (layout.nodata) TIFFSetField(tif, kGdalNodataTag, layout.nodata->c_str());
@@ -97,9 +95,8 @@ std::string write_tiff(const std::string& name, const TiffLayout& layout, const 
   } else {
     TIFFSetField(tif, TIFFTAG_ROWSPERSTRIP, layout.rows_per_strip);
     for (uint32_t r = 0; r < layout.height; ++r)
-      EXPECT_EQ(TIFFWriteScanline(tif, const_cast<T*>(&samples[static_cast<std::size_t>(r) * layout.width *
-                                                                layout.samples]),
-                                  r, 0),
+      EXPECT_EQ(TIFFWriteScanline(
+                    tif, const_cast<T*>(&samples[static_cast<std::size_t>(r) * layout.width * layout.samples]), r, 0),
                 1);
   }
   TIFFClose(tif);
@@ -381,10 +378,11 @@ std::string write_truncated_tiff(const std::string& name, std::size_t data_bytes
     uint16_t tag, type;
     uint32_t value;
   };
-  const Entry directory[] = {{256, kLong, 4},   {257, kLong, 4},           {258, kShort, 32},
-                             {259, kShort, 1},  {262, kShort, 1},          {273, kLong, data_offset},
-                             {277, kShort, 1},  {278, kLong, 4},           {279, kLong, 64},
-                             {339, kShort, SAMPLEFORMAT_IEEEFP}};
+  const Entry directory[] = {{256, kLong, 4},   {257, kLong, 4},
+                             {258, kShort, 32}, {259, kShort, 1},
+                             {262, kShort, 1},  {273, kLong, data_offset},
+                             {277, kShort, 1},  {278, kLong, 4},
+                             {279, kLong, 64},  {339, kShort, SAMPLEFORMAT_IEEEFP}};
   put16(static_cast<uint16_t>(entries));
   for (const Entry& e : directory) {
     put16(e.tag);

@@ -51,8 +51,8 @@ TEST_P(ProcessorsOnGenerators, MarsMatchesBruteForce) {
 
 TEST_P(ProcessorsOnGenerators, NavigabilityMatchesBruteForce) {
   const Heightmap h = terrain(33, 41, 0.1);
-  for (const NavigabilityParams params : {NavigabilityParams{0.3, 0.6, 0.05}, NavigabilityParams{0.5, 1.0, 0.02},
-                                          NavigabilityParams{0.2, 0.3, 0.0}}) {
+  for (const NavigabilityParams params :
+       {NavigabilityParams{0.3, 0.6, 0.05}, NavigabilityParams{0.5, 1.0, 0.02}, NavigabilityParams{0.2, 0.3, 0.0}}) {
     const NavigabilityProcessor processor(params);
     const CellMask fast = processor.occupiable(h);
     const CellMask brute = testing::occupiable_brute_force(h, params);

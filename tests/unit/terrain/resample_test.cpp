@@ -14,7 +14,6 @@
 namespace marsala::terrain {
 namespace {
 
-
 double plane(Position p) { return 2.0 + 0.3 * p.x - 0.7 * p.y; }
 
 Heightmap plane_map(GridGeometry g) {
@@ -56,8 +55,8 @@ TEST(Resample, ReproducesAPlaneBetweenTheOutermostCentres) {
       for (int c = 0; c < out.cols(); ++c) {
         const Position p = out.cell_center({r, c});
         // Clamping makes the border flat; inside the hull of source centres the plane is exact.
-        const bool inside = p.x >= g.xll_m + 0.25 && p.x <= g.xll_m + 4.25 && p.y >= g.yll_m + 0.25 &&
-                            p.y <= g.yll_m + 3.25;
+        const bool inside =
+            p.x >= g.xll_m + 0.25 && p.x <= g.xll_m + 4.25 && p.y >= g.yll_m + 0.25 && p.y <= g.yll_m + 3.25;
         if (!inside) continue;
         EXPECT_NEAR(out(r, c), plane(p), 1e-9) << "cs " << cs << " cell (" << r << ", " << c << ")";
         ++checked;
@@ -72,7 +71,7 @@ TEST(Resample, ClampsAtTheBorder) {
   const GridGeometry g{4, 4, 0.0, 0.0, 1.0};
   const Heightmap map = plane_map(g);
   const Heightmap out = resample_bilinear(map, 0.25);  // 16 x 16, first centre at 0.125 m
-  const Position corner = out.cell_center({15, 0});       // (0.125, 0.125): clamped to (0.5, 0.5)
+  const Position corner = out.cell_center({15, 0});    // (0.125, 0.125): clamped to (0.5, 0.5)
   EXPECT_NEAR(corner.x, 0.125, 1e-12);
   EXPECT_NEAR(out(15, 0), plane({0.5, 0.5}), 1e-12);
   EXPECT_NEAR(out(0, 15), plane({3.5, 3.5}), 1e-12);
@@ -104,10 +103,8 @@ TEST(Resample, GoldenSaddleTwoByTwoToFourByFour) {
   const Heightmap out = resample_bilinear(map, 0.5);
   ASSERT_EQ(out.rows(), 4);
   ASSERT_EQ(out.cols(), 4);
-  const double expected[4][4] = {{0.0, 0.0, 0.0, 0.0},
-                                 {0.0, 0.0625, 0.1875, 0.25},
-                                 {0.0, 0.1875, 0.5625, 0.75},
-                                 {0.0, 0.25, 0.75, 1.0}};
+  const double expected[4][4] = {
+      {0.0, 0.0, 0.0, 0.0}, {0.0, 0.0625, 0.1875, 0.25}, {0.0, 0.1875, 0.5625, 0.75}, {0.0, 0.25, 0.75, 1.0}};
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) EXPECT_DOUBLE_EQ(out(r, c), expected[r][c]) << r << ", " << c;
 
@@ -142,7 +139,7 @@ TEST(Crop, MatchesABruteForceSelectionOfCentres) {
     double x0, y0, w, h;
   };
   // Edges on centres (10.25 + k / 2), between centres, past the grid, one cell.
-  const Rect rects[] = {{10.25, 20.25, 1.0, 1.0}, {10.3, 20.0, 2.2, 1.6}, {9.0, 19.0, 100.0, 100.0},
+  const Rect rects[] = {{10.25, 20.25, 1.0, 1.0}, {10.3, 20.0, 2.2, 1.6},   {9.0, 19.0, 100.0, 100.0},
                         {11.75, 21.25, 0.5, 0.5}, {11.0, 21.0, 0.26, 0.26}, {13.0, 21.5, 5.0, 0.75}};
   for (const Rect& rect : rects) {
     const Heightmap out = crop(map, rect.x0, rect.y0, rect.w, rect.h);
@@ -186,17 +183,16 @@ TEST(Crop, RejectsEmptyOrBadRectangles) {
   const Heightmap map(GridGeometry{4, 4, 0.0, 0.0, 1.0});
   EXPECT_THROW(crop(map, 0.0, 0.0, 0.0, 1.0), InvalidArgument);
   EXPECT_THROW(crop(map, 0.0, 0.0, 1.0, -1.0), InvalidArgument);
-  EXPECT_THROW(crop(map, 10.0, 0.0, 2.0, 2.0), InvalidArgument);   // east of the grid
-  EXPECT_THROW(crop(map, 0.0, -5.0, 2.0, 2.0), InvalidArgument);   // south of the grid
-  EXPECT_THROW(crop(map, 0.6, 0.6, 0.3, 0.3), InvalidArgument);    // between centres 0.5 and 1.5
+  EXPECT_THROW(crop(map, 10.0, 0.0, 2.0, 2.0), InvalidArgument);  // east of the grid
+  EXPECT_THROW(crop(map, 0.0, -5.0, 2.0, 2.0), InvalidArgument);  // south of the grid
+  EXPECT_THROW(crop(map, 0.6, 0.6, 0.3, 0.3), InvalidArgument);   // between centres 0.5 and 1.5
   EXPECT_THROW(crop(map, std::numeric_limits<double>::quiet_NaN(), 0.0, 1.0, 1.0), InvalidArgument);
   EXPECT_THROW(crop(map, 0.0, 0.0, std::numeric_limits<double>::infinity(), 1.0), InvalidArgument);
 }
 
 TEST(CropResampleGale, WindowAtHalfMetre) {
   const char* root = std::getenv("MARSALA_SOURCE_DIR");
-  const std::string path =
-      root ? std::string(root) + "/../shared/data/terrains/gale_crater_1m.asc" : std::string();
+  const std::string path = root ? std::string(root) + "/../shared/data/terrains/gale_crater_1m.asc" : std::string();
   if (path.empty() || !std::filesystem::exists(path))
     GTEST_SKIP() << "gale_crater_1m.asc not found under $MARSALA_SOURCE_DIR/../shared/data/terrains";
   const Heightmap gale = read_asc(path);

@@ -4,8 +4,8 @@
 
 #include <limits>
 
-#include "unit/world_server/world_fixtures.hpp"
 #include "marsala/world_server/step.hpp"
+#include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
 namespace {

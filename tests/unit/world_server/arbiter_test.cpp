@@ -23,7 +23,9 @@ using testing::small_scenario;
 protocol::Deposition dep(int row, int col, double h) { return {row, col, h}; }
 
 /// Row and column of the cell whose centre is (x, y) on the 40 x 40 test grid.
-CellIndex cell_of(double x, double y) { return {40 - 1 - static_cast<int>(std::floor(y / 0.1)), static_cast<int>(std::floor(x / 0.1))}; }
+CellIndex cell_of(double x, double y) {
+  return {40 - 1 - static_cast<int>(std::floor(y / 0.1)), static_cast<int>(std::floor(x / 0.1))};
+}
 
 class ArbiterTest : public ::testing::Test {
  protected:
@@ -41,7 +43,7 @@ class ArbiterTest : public ::testing::Test {
 };
 
 TEST_F(ArbiterTest, AcceptsAMoveWithDepositionsAndBooksThemExactly) {
-  protocol::ActionRequest r = move_to(state_, 1, 1.25, 1.05);  // 0.2 m east
+  protocol::ActionRequest r = move_to(state_, 1, 1.25, 1.05);        // 0.2 m east
   const CellIndex a = cell_of(1.25, 1.95), b = cell_of(0.45, 1.05);  // 0.9 m north, 0.8 m west of the new position
   r.depositions = {dep(a.row, a.col, kLayer), dep(b.row, b.col, 2 * kLayer)};
   const Verdict v = check(r);
@@ -320,11 +322,12 @@ TEST(CellOccupiable, BigBallsUseTheWindowAndAgree) {
   Heightmap h(g, 0.0);
   for (int r = 0; r < g.rows; ++r)
     for (int c = 0; c < g.cols; ++c) h(r, c) = (r + c) % 7 == 0 ? 0.04 : 0.0;
-  h(5, 5) = 3.0;  // a pillar near a corner
+  h(5, 5) = 3.0;                                    // a pillar near a corner
   const NavigabilityParams params{0.3, 6.0, 0.05};  // ball radius 30 cells: about 2800 cells
   const CellMask want = NavigabilityProcessor(params).occupiable(h);
   int occupiable = 0;
-  for (const CellIndex c : {CellIndex{35, 35}, CellIndex{5, 40}, CellIndex{60, 60}, CellIndex{20, 20}, CellIndex{5, 30}}) {
+  for (const CellIndex c :
+       {CellIndex{35, 35}, CellIndex{5, 40}, CellIndex{60, 60}, CellIndex{20, 20}, CellIndex{5, 30}}) {
     occupiable += want(c.row, c.col);
     EXPECT_EQ(cell_occupiable(h, c, params), want(c.row, c.col) != 0);
     EXPECT_EQ(cell_occupiable(h, c, params, OccupancyMethod::kPairs), want(c.row, c.col) != 0);

@@ -114,7 +114,8 @@ TEST(PayloadPath, NavigabilityAndShortestPathsMatchBruteForce) {
   for (int trial = 0; trial < 150; ++trial) {
     const int rows = 8 + trial % 7, cols = 9 + trial % 5;
     const Heightmap h = blocky(rng, rows, cols);
-    const Position from{unit(rng) * cols * 0.1, unit(rng) * rows * 0.1}, to{unit(rng) * cols * 0.1, unit(rng) * rows * 0.1};
+    const Position from{unit(rng) * cols * 0.1, unit(rng) * rows * 0.1},
+        to{unit(rng) * cols * 0.1, unit(rng) * rows * 0.1};
     const scenario::PayloadPath p = payload(0.3, delta(rng), 0.03, from, to);
     const NavigabilityParams params = p.navigability;
     const CellIndex a = *h.cell_at(from), b = *h.cell_at(to);

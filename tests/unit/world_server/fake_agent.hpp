@@ -17,9 +17,9 @@ namespace marsala::world_server::testing {
 
 /// What a fake agent does with its frames.
 enum class FakeMode {
-  kWalker,     ///< walks straight to its target, at most max_step_m per step
-  kSilent,     ///< is admitted, then never answers
-  kQuitter,    ///< walks, then vanishes (endpoints destroyed) when the frame of `quit_at_step` arrives
+  kWalker,   ///< walks straight to its target, at most max_step_m per step
+  kSilent,   ///< is admitted, then never answers
+  kQuitter,  ///< walks, then vanishes (endpoints destroyed) when the frame of `quit_at_step` arrives
 };
 
 struct FakeAgentConfig {
@@ -29,8 +29,8 @@ struct FakeAgentConfig {
   RobotBody body;
   FakeMode mode = FakeMode::kWalker;
   std::uint64_t quit_at_step = 0;
-  bool deposit_first = false;   ///< at step 0, also deposit two cube layers on the cell centred at (0.55, 1.95)
-  double timeout_s = 30.0;      ///< gives up after this long
+  bool deposit_first = false;  ///< at step 0, also deposit two cube layers on the cell centred at (0.55, 1.95)
+  double timeout_s = 30.0;     ///< gives up after this long
 };
 
 class FakeAgent {

@@ -14,8 +14,8 @@
 #include "marsala/core/error.hpp"
 #include "marsala/core/navigability_processor.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
-#include "unit/world_server/world_fixtures.hpp"
 #include "marsala/world_server/completion.hpp"
+#include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -139,11 +139,10 @@ TEST(CompletionCheckCost, PayloadAndSiteChecksOn640x640) {
        "payload_path { body { kappa: 0.2 delta_m: 2.0 eps_m: 0.05 } from { x_m: 1 y_m: 1 } to { x_m: 63 y_m: 63 } }"},
   };
   for (const Case& c : cases) {
-    const std::string text = "name: \"bench\"\nterrain { generator: \"" + std::string(c.generator) +
-                             "\" rows: 640 cols: 640 cell_size_m: " + std::to_string(c.cs) + " seed: 7 }\n" +
-                             testing::kTestRobotType +
-                             "agent { robot_type: \"tester\" start { x_m: 1 y_m: 1 } target { x_m: 2 y_m: 2 } }\n" +
-                             c.completion + "\n";
+    const std::string text =
+        "name: \"bench\"\nterrain { generator: \"" + std::string(c.generator) +
+        "\" rows: 640 cols: 640 cell_size_m: " + std::to_string(c.cs) + " seed: 7 }\n" + testing::kTestRobotType +
+        "agent { robot_type: \"tester\" start { x_m: 1 y_m: 1 } target { x_m: 2 y_m: 2 } }\n" + c.completion + "\n";
     const scenario::Scenario sc = scenario::parse_scenario(text, "bench.pbtxt");
     auto t0 = std::chrono::steady_clock::now();
     WorldState s = make_world_state(sc, scenario::build_terrain(sc), 1);
@@ -165,10 +164,11 @@ TEST(CompletionCheckCost, PayloadAndSiteChecksOn640x640) {
     }
     std::sort(check_ms.begin(), check_ms.end());
     std::sort(whole_ms.begin(), whole_ms.end());
-    std::printf("%-12s %-8s cs %.2f m: one check %.1f ms (median of 5; max %.1f), whole computation %.1f ms, "
-                "initial %.1f ms; met %d, level fraction %.4f\n",
-                scenario::to_string(sc.completion).c_str(), c.generator, c.cs, check_ms[2], check_ms[4], whole_ms[2],
-                initial_ms, s.check.met ? 1 : 0, s.check.level_fraction);
+    std::printf(
+        "%-12s %-8s cs %.2f m: one check %.1f ms (median of 5; max %.1f), whole computation %.1f ms, "
+        "initial %.1f ms; met %d, level fraction %.4f\n",
+        scenario::to_string(sc.completion).c_str(), c.generator, c.cs, check_ms[2], check_ms[4], whole_ms[2],
+        initial_ms, s.check.met ? 1 : 0, s.check.level_fraction);
   }
 }
 

@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "marsala/core/error.hpp"
-#include "unit/world_server/world_fixtures.hpp"
 #include "marsala/world_server/completion.hpp"
 #include "marsala/world_server/step.hpp"
+#include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -172,10 +172,8 @@ TEST(FinalPicture, SitesAndGoalsAreOutlinedAndColoursRepeatAfterTwelveAgents) {
   for (int i = 0; i < 13; ++i)
     agents += "agent { robot_type: \"tester\" start { x_m: " + std::to_string(0.25 + 0.3 * i) +
               " y_m: 3.5 } target { x_m: 3 y_m: 3 } }\n";
-  const scenario::Scenario many =
-      scenario::parse_scenario(small_scenario_text_completing("goal { x0_m: 2.9 y0_m: 1.9 x1_m: 3.2 y1_m: 2.2 }",
-                                                              agents),
-                               "many.pbtxt");
+  const scenario::Scenario many = scenario::parse_scenario(
+      small_scenario_text_completing("goal { x0_m: 2.9 y0_m: 1.9 x1_m: 3.2 y1_m: 2.2 }", agents), "many.pbtxt");
   const WorldState s = admitted_state(many, flat_terrain(), 16);
   const render::RenderOptions o = final_picture_options(s, info_for("many", false), std::nullopt);
   EXPECT_TRUE(has_legend(o, "agents 1, 13", render::label_colour(1)));
@@ -355,9 +353,9 @@ TEST(ZoomPicture, OptionsCropLabelsAndMarkersKeepWorldOverlaysAndSayCloseUp) {
   ASSERT_TRUE(zoom.labels);
   EXPECT_EQ(zoom.labels->rows(), 16);
   EXPECT_EQ(zoom.labels->cols(), 16);
-  EXPECT_EQ(zoom.labels->sum(), 16u);      // the 4 x 4 raised cells, all inside
-  EXPECT_EQ((*zoom.labels)(2, 10), 1u);    // cell (2, 94)
-  EXPECT_EQ((*zoom.labels)(5, 13), 1u);    // cell (5, 97)
+  EXPECT_EQ(zoom.labels->sum(), 16u);    // the 4 x 4 raised cells, all inside
+  EXPECT_EQ((*zoom.labels)(2, 10), 1u);  // cell (2, 94)
+  EXPECT_EQ((*zoom.labels)(5, 13), 1u);  // cell (5, 97)
   EXPECT_EQ((*zoom.labels)(6, 13), 0u);
   ASSERT_EQ(whole.markers.size(), 1u);
   EXPECT_EQ(whole.markers[0], (CellIndex{4, 95}));
@@ -475,16 +473,15 @@ TEST_F(OutputFiles, TheCloseUpShowsTheTintedDepositLargerAtItsWorldPlace) {
   // block are plain: the tint sits where the world puts it.
   EXPECT_EQ(count_in(zoom, za, zoom_deposit), 16 * 32 * 32);
   EXPECT_EQ(count_in(whole, wa, zoom_deposit), 16 * 5 * 5);
-  EXPECT_EQ(pixel(zoom, za.x + 16 * 32 - 1, za.y + 17 * 32 + 16), zoom_plain);  // window col 15 = cell 149
+  EXPECT_EQ(pixel(zoom, za.x + 16 * 32 - 1, za.y + 17 * 32 + 16), zoom_plain);   // window col 15 = cell 149
   EXPECT_EQ(pixel(zoom, za.x + 20 * 32 + 16, za.y + 20 * 32 + 16), zoom_plain);  // cell (54, 154)
   EXPECT_EQ(pixel(zoom, za.x + 20 * 32 - 1, za.y + 20 * 32 - 1), zoom_deposit);  // cell (53, 153)
 }
 
 TEST_F(OutputFiles, NoCloseUpWhenTheWindowWouldHoldMostOfTheTerrain) {
   // The 4 x 4 m test world: any window is at least 10 m, i.e. the whole grid.
-  const WorldState s =
-      testing::admitted_state(scenario::parse_scenario(testing::small_scenario_text(), "small.pbtxt"),
-                              testing::flat_terrain(), 1);
+  const WorldState s = testing::admitted_state(scenario::parse_scenario(testing::small_scenario_text(), "small.pbtxt"),
+                                               testing::flat_terrain(), 1);
   write_final_outputs(dir_.string(), s, info_for("small", false));
   EXPECT_TRUE(fs::exists(dir_ / "final.png"));
   EXPECT_FALSE(fs::exists(dir_ / "final_zoom.png"));

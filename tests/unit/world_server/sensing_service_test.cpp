@@ -8,8 +8,8 @@
 #include <utility>
 
 #include "marsala/core/error.hpp"
-#include "unit/world_server/world_fixtures.hpp"
 #include "marsala/world_server/step.hpp"
+#include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -34,7 +34,7 @@ WorldState sensing_state() {
   w.agent(1).y_m = 0.35;
   w.agent(2).x_m = 6.65;  // 1.5 m north of agent 1: exactly its proximity range
   w.agent(2).y_m = 1.85;
-  w.agent(3).x_m = 5.0;   // 1.65 m west of agent 1
+  w.agent(3).x_m = 5.0;  // 1.65 m west of agent 1
   w.agent(3).y_m = 0.35;
   return w;
 }

@@ -8,9 +8,9 @@
 #include <cmath>
 
 #include "marsala/core/error.hpp"
+#include "marsala/world_server/admission.hpp"
 #include "support/navigability_brute_force.hpp"
 #include "unit/world_server/world_fixtures.hpp"
-#include "marsala/world_server/admission.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -89,7 +89,8 @@ TEST(StartJitter, OnlyOccupiableCellsOnTheGridAreChosen) {
   }
   EXPECT_EQ(moved, 300);
   // Near the grid's corner, draws off the grid are skipped.
-  for (std::uint32_t id = 1; id <= 100; ++id) EXPECT_TRUE(h.cell_at(jittered_start(h, slot(id, 0.02, 0.02), body(), 1.0, 5)));
+  for (std::uint32_t id = 1; id <= 100; ++id)
+    EXPECT_TRUE(h.cell_at(jittered_start(h, slot(id, 0.02, 0.02), body(), 1.0, 5)));
 }
 
 TEST(StartJitter, WithNoOccupiableCellInReachTheSlotsStartStays) {

@@ -6,9 +6,9 @@
 #include <cmath>
 
 #include "marsala/core/error.hpp"
-#include "unit/world_server/world_fixtures.hpp"
 #include "marsala/world_server/completion.hpp"
 #include "marsala/world_server/step.hpp"
+#include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -64,7 +64,8 @@ TEST(PayloadCompletion, TheCheckRunsOnItsScheduleOnlyAfterChanges) {
   s.agent(1).y_m = 3.05;
 
   // Step 0 fills the hole; no check at steps 0 and 1, the check at step 2 finds the path.
-  StepOutcome o = apply_step(s, std::vector<protocol::ActionRequest>{deposit(s, 1, hole, 8 * kLayer), request_for(s, 2)});
+  StepOutcome o =
+      apply_step(s, std::vector<protocol::ActionRequest>{deposit(s, 1, hole, 8 * kLayer), request_for(s, 2)});
   ASSERT_EQ(s.agent(1).last_result, protocol::ActionResult::kAccepted) << s.agent(1).last_reason;
   EXPECT_EQ(s.terrain(hole), 0.0);
   EXPECT_FALSE(o.completion_checked);
@@ -87,8 +88,9 @@ TEST(PayloadCompletion, TheCheckRunsOnItsScheduleOnlyAfterChanges) {
 }
 
 TEST(PayloadCompletion, EndsOffTheGridAreRefusedWhenTheStateIsMade) {
-  const std::string off = "payload_path { body { kappa: 0.2 delta_m: 0.3 eps_m: 0.05 } from { x_m: 0.55 y_m: 0.55 } "
-                          "to { x_m: 4.05 y_m: 3.05 } }";
+  const std::string off =
+      "payload_path { body { kappa: 0.2 delta_m: 0.3 eps_m: 0.05 } from { x_m: 0.55 y_m: 0.55 } "
+      "to { x_m: 4.05 y_m: 3.05 } }";
   EXPECT_THROW(make_world_state(scenario_with(off), flat_terrain(), 1), InvalidArgument);
   EXPECT_THROW(make_world_state(scenario_with("site { x0_m: 5 y0_m: 0 x1_m: 6 y1_m: 1 }"), flat_terrain(), 1),
                InvalidArgument);

@@ -7,9 +7,9 @@
 #include <random>
 
 #include "marsala/core/error.hpp"
-#include "unit/world_server/world_fixtures.hpp"
 #include "marsala/world_server/completion.hpp"
 #include "marsala/world_server/sha256.hpp"
+#include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -32,7 +32,8 @@ protocol::ActionRequest with_deposition(protocol::ActionRequest r, double x, dou
 }
 
 int count(const StepOutcome& o, protocol::EventKind kind) {
-  return static_cast<int>(std::count_if(o.events.begin(), o.events.end(), [&](const auto& e) { return e.kind == kind; }));
+  return static_cast<int>(
+      std::count_if(o.events.begin(), o.events.end(), [&](const auto& e) { return e.kind == kind; }));
 }
 
 TEST(ApplyStep, IdOrderDecidesConflictsWhateverTheArrivalOrder) {
@@ -40,7 +41,8 @@ TEST(ApplyStep, IdOrderDecidesConflictsWhateverTheArrivalOrder) {
   const scenario::Scenario s = small_scenario();
   WorldState base = admitted_state(s, flat_terrain(), 2);  // agent 1 at (1.05, 1.05), agent 2 at (2.55, 1.05)
   const protocol::ActionRequest one = move_to(base, 1, 1.25, 1.05);
-  const protocol::ActionRequest two = with_deposition(request_for(base, 2), 1.65, 1.05, kLayer);  // 0.4 m from (1.25, 1.05)
+  const protocol::ActionRequest two =
+      with_deposition(request_for(base, 2), 1.65, 1.05, kLayer);  // 0.4 m from (1.25, 1.05)
 
   WorldState a = base, b = base;
   const StepOutcome oa = apply_step(a, std::vector<protocol::ActionRequest>{one, two});
@@ -71,7 +73,8 @@ TEST(ApplyStep, ADepositionOfALowerIdCanBlockAMotionOfAHigherId) {
   // A 1 m column at (2.05, 1.55): 1.118 m from agent 1, 0.566 m from agent 2, 0.424 m from agent 2's target.
   const protocol::ActionRequest column = with_deposition(request_for(base, 1), 2.05, 1.55, 80 * kLayer);
   const protocol::ActionRequest step_in = move_to(base, 2, 2.35, 1.25);
-  for (const auto& order : {std::vector<protocol::ActionRequest>{column, step_in}, std::vector<protocol::ActionRequest>{step_in, column}}) {
+  for (const auto& order :
+       {std::vector<protocol::ActionRequest>{column, step_in}, std::vector<protocol::ActionRequest>{step_in, column}}) {
     WorldState w = base;
     apply_step(w, order);
     EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kAccepted);
@@ -131,7 +134,8 @@ TEST(ApplyStep, DuplicatesPastAndFutureRequests) {
   future.step = 2;
   protocol::ActionRequest future_of_2 = request_for(w, 2);
   future_of_2.step = 2;
-  const StepOutcome o = apply_step(w, std::vector<Submission>{{1, past}, {1, first}, {2, future_of_2}, {1, second}, {1, future}});
+  const StepOutcome o =
+      apply_step(w, std::vector<Submission>{{1, past}, {1, first}, {2, future_of_2}, {1, second}, {1, future}});
 
   EXPECT_EQ(w.agent(1).x_m, 1.25);  // the first stands
   EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kAccepted);
@@ -159,8 +163,8 @@ TEST(ApplyStep, AForgedRequestOnAnAgentsPartitionDoesNotTakeItsSlot) {
   forged.session += 1;
   protocol::ActionRequest claims_2 = request_for(w, 2);
   const protocol::ActionRequest real = move_to(w, 1, 1.25, 1.05);
-  const StepOutcome o = apply_step(
-      w, std::vector<Submission>{{1, forged}, {1, claims_2}, {1, real}, {2, request_for(w, 2)}});
+  const StepOutcome o =
+      apply_step(w, std::vector<Submission>{{1, forged}, {1, claims_2}, {1, real}, {2, request_for(w, 2)}});
   EXPECT_EQ(w.agent(1).x_m, 1.25);
   EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kAccepted);
   EXPECT_EQ(w.agent(1).missed, 0u);
@@ -223,7 +227,8 @@ TEST(ApplyStep, OnlyChangedTilesGetANewVersion) {
   WorldState w = admitted_state(s, flat_terrain(), 1);
   ASSERT_EQ(w.tile_versions.size(), 9u);
   // (1.05, 2.05) is cell (19, 10): tile (1, 0).
-  const StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{with_deposition(request_for(w, 1), 1.05, 2.05, kLayer)});
+  const StepOutcome o =
+      apply_step(w, std::vector<protocol::ActionRequest>{with_deposition(request_for(w, 1), 1.05, 2.05, kLayer)});
   EXPECT_EQ(o.changed_tiles, std::vector<int>{3});
   EXPECT_EQ(w.tile_versions, (std::vector<std::uint64_t>{0, 0, 0, 1, 0, 0, 0, 0, 0}));
   ASSERT_EQ(count(o, protocol::EventKind::kDeposited), 1);

@@ -70,8 +70,8 @@ TEST_F(WorldCliTest, BadScenariosExitWith1OnOneLineNamingFileAndLine) {
   const std::string ok = write("ok.pbtxt", testing::small_scenario_text());
   EXPECT_EQ(run({"--scenario", ok, "--agents", "5", "--dds", "inprocess"}), 1);
   EXPECT_NE(err_.str().find("exceeds the 3 agent slots"), std::string::npos) << err_.str();
-  EXPECT_EQ(run({"--scenario", ok, "--dds", "inprocess", "--domain", "49", "--admit-timeout", "0.1", "--quiet",
-                 "--out", (dir_ / "none").string()}),
+  EXPECT_EQ(run({"--scenario", ok, "--dds", "inprocess", "--domain", "49", "--admit-timeout", "0.1", "--quiet", "--out",
+                 (dir_ / "none").string()}),
             1);
   EXPECT_NE(err_.str().find("no agent admitted"), std::string::npos) << err_.str();
 }

@@ -4,8 +4,8 @@
 
 #include <string>
 
-#include "marsala/protocol/messages.hpp"
 #include "marsala/core/heightmap.hpp"
+#include "marsala/protocol/messages.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/world_server/admission.hpp"
 #include "marsala/world_server/world_state.hpp"
@@ -27,11 +27,13 @@ inline std::string small_scenario_text_completing(const std::string& completion,
   return std::string(R"(
 name: "small"
 terrain { generator: "flat" rows: 40 cols: 40 cell_size_m: 0.1 }
-)") + kTestRobotType + R"(
+)") + kTestRobotType +
+         R"(
 agent { robot_type: "tester" start { x_m: 1.05 y_m: 1.05 } target { x_m: 3.05 y_m: 2.05 } }
 agent { robot_type: "tester" start { x_m: 2.55 y_m: 1.05 } target { x_m: 3.05 y_m: 2.05 } }
 agent { robot_type: "tester" start { x_m: 1.05 y_m: 3.05 } target { x_m: 3.05 y_m: 2.05 } }
-)" + completion + R"(
+)" + completion +
+         R"(
 base { x_m: 0.55 y_m: 0.55 radius_m: 0.5 }
 tile_size: 16
 )" + extra;

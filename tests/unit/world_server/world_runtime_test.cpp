@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -9,13 +10,12 @@
 #include <fstream>
 #include <sstream>
 #include <thread>
-#include <unistd.h>
 
 #include "marsala/core/error.hpp"
 #include "marsala/terrain/asc_io.hpp"
+#include "marsala/world_server/sha256.hpp"
 #include "unit/world_server/fake_agent.hpp"
 #include "unit/world_server/world_fixtures.hpp"
-#include "marsala/world_server/sha256.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -49,9 +49,8 @@ std::string read_text(const fs::path& p) {
 class RuntimeTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    out_ = fs::temp_directory_path() /
-           ("marsala_runtime_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    out_ = fs::temp_directory_path() / ("marsala_runtime_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(out_);
   }
   void TearDown() override { fs::remove_all(out_); }
@@ -190,10 +189,10 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   for (const std::string& field :
        {std::string("\"completed\": true"), std::string("\"steps\": 11"), std::string("\"agents\": 2"),
         std::string("\"admitted\": 2"), std::string("\"missed_deadlines\": 0"), std::string("\"dds\": \"inprocess\""),
-        std::string("\"scenario\": \"small\""), std::string("\"seed\": \"1\""), std::string("\"end_reason\": \"completed\""),
-        "\"terrain_sha256\": \"" + terrain_sha256(s.terrain) + "\"", std::string("\"per_agent\""),
-        std::string("\"accepted\": 11"), std::string("\"at_goal\": true"), std::string("\"dropped\": false"),
-        std::string("\"wall_seconds\"")})
+        std::string("\"scenario\": \"small\""), std::string("\"seed\": \"1\""),
+        std::string("\"end_reason\": \"completed\""), "\"terrain_sha256\": \"" + terrain_sha256(s.terrain) + "\"",
+        std::string("\"per_agent\""), std::string("\"accepted\": 11"), std::string("\"at_goal\": true"),
+        std::string("\"dropped\": false"), std::string("\"wall_seconds\"")})
     EXPECT_NE(summary.find(field), std::string::npos) << field << " not in\n" << summary;
   EXPECT_EQ(json_number(summary, "deposited_volume_m3"), s.deposited_volume_m3);  // printed to round-trip
   EXPECT_EQ(json_number(summary, "deposited_m3"), s.agent(1).deposited_m3);
