@@ -43,9 +43,9 @@ AdmissionDecision decide_admission(const WorldState& state, const protocol::Agen
   const AgentRecord& slot = state.agent(hello.agent_id);
   const std::string problem = body_problem(hello.body);
   if (!problem.empty()) return refuse(who + ": invalid body: " + problem);
-  const std::string difference = body_difference(hello.body, slot.body);
+  const std::string difference = body_difference(hello.body, slot.type.body);
   if (!difference.empty())
-    return refuse(who + ": body differs from robot type '" + slot.robot_type + "' of its slot: " + difference);
+    return refuse(who + ": body differs from robot type '" + slot.type.name + "' of its slot: " + difference);
   if (slot.dropped) return refuse(who + " was dropped from the run: " + slot.drop_reason);
   if (slot.admitted) {
     if (slot.session == hello.session) return {true, {}};
@@ -65,7 +65,7 @@ bool admit(WorldState& state, const protocol::AgentHello& hello) {
   a.x_m = a.start_x_m;
   a.y_m = a.start_y_m;
   a.z_m = height_under(state.terrain, a.x_m, a.y_m);
-  a.material_m3 = a.body.material_capacity_m3;
+  a.material_m3 = a.type.body.material_capacity_m3;
   a.at_goal = at_goal(state, a);
   return true;
 }

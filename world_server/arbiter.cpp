@@ -106,15 +106,16 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
   double x = me.x_m, y = me.y_m;
   if (r.move) {
     const double d = distance(r.target_x_m, r.target_y_m, x, y);
-    if (!(d <= me.body.max_step_m + tol::kLengthM))
+    if (!(d <= me.type.body.max_step_m + tol::kLengthM))
       return reject("motion of " + fmt::format("{}", d) + " m exceeds max_step_m " +
-                    fmt::format("{}", me.body.max_step_m));
+                    fmt::format("{}", me.type.body.max_step_m));
     const auto cell = terrain.cell_at({r.target_x_m, r.target_y_m});
     if (!cell)
       return reject("target (" + fmt::format("{}", r.target_x_m) + ", " + fmt::format("{}", r.target_y_m) +
                     ") is off the grid");
-    if (!cell_occupiable(terrain, *cell,
-                         {me.body.navigability.kappa, me.body.navigability.delta_m, me.body.navigability.eps_m}))
+    if (!cell_occupiable(
+            terrain, *cell,
+            {me.type.body.navigability.kappa, me.type.body.navigability.delta_m, me.type.body.navigability.eps_m}))
       return reject("target cell " + fmt::format("{}", *cell) + " is not occupiable for this body");
     x = r.target_x_m;
     y = r.target_y_m;
@@ -122,7 +123,7 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
 
   // 3. Depositions, from the position after the motion.
   const double cs = terrain.cell_size_m();
-  const double layer = cube_layer_m(me.body.cube_size_m, cs);
+  const double layer = cube_layer_m(me.type.body.cube_size_m, cs);
   std::vector<std::pair<int, int>> cells;
   cells.reserve(r.depositions.size());
   double volume = 0.0;
@@ -140,14 +141,14 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
                     " is not a whole multiple of the cube layer " + fmt::format("{}", layer) + " m");
     const Position centre = terrain.cell_center(c);
     const double from_me = distance(centre.x, centre.y, x, y);
-    if (!(from_me <= me.body.reach_m + tol::kLengthM))
+    if (!(from_me <= me.type.body.reach_m + tol::kLengthM))
       return reject("deposition cell " + fmt::format("{}", c) + " is " + fmt::format("{}", from_me) +
-                    " m away, beyond reach_m " + fmt::format("{}", me.body.reach_m));
+                    " m away, beyond reach_m " + fmt::format("{}", me.type.body.reach_m));
     for (const AgentRecord& other : state.agents) {
       if (!other.alive) continue;
       const bool self = other.id == me.id;
       const double gap = distance(centre.x, centre.y, self ? x : other.x_m, self ? y : other.y_m);
-      if (gap <= 0.5 * other.body.navigability.delta_m + tol::kLengthM)
+      if (gap <= 0.5 * other.type.body.navigability.delta_m + tol::kLengthM)
         return reject("deposition cell " + fmt::format("{}", c) + " is under agent " + std::to_string(other.id));
     }
     volume += d.height_m * cs * cs;
@@ -156,9 +157,9 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
   const auto twice = std::adjacent_find(cells.begin(), cells.end());
   if (twice != cells.end())
     return reject("deposition cell " + fmt::format("{}", CellIndex{twice->first, twice->second}) + " is listed twice");
-  if (!(volume <= me.body.max_deposit_m3 + tol::kVolumeM3))
+  if (!(volume <= me.type.body.max_deposit_m3 + tol::kVolumeM3))
     return reject("deposited volume " + fmt::format("{}", volume) + " m^3 exceeds max_deposit_m3 " +
-                  fmt::format("{}", me.body.max_deposit_m3));
+                  fmt::format("{}", me.type.body.max_deposit_m3));
   if (!(volume <= me.material_m3 + tol::kVolumeM3))
     return reject("deposited volume " + fmt::format("{}", volume) + " m^3 exceeds the material on board " +
                   fmt::format("{}", me.material_m3) + " m^3");
@@ -191,7 +192,7 @@ void apply_request(WorldState& state, const protocol::ActionRequest& r, const Ve
   }
   me.z_m = height_under(state.terrain, me.x_m, me.y_m);
   me.material_m3 = std::max(0.0, me.material_m3 - verdict.volume_m3);
-  if (r.refill) me.material_m3 = me.body.material_capacity_m3;
+  if (r.refill) me.material_m3 = me.type.body.material_capacity_m3;
   me.deposited_m3 += verdict.volume_m3;
   state.deposited_volume_m3 += verdict.volume_m3;
   ++me.accepted;

@@ -109,7 +109,7 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
     proto::AgentSummary* p = s.add_per_agent();
     p->set_agent_id(a.id);
     p->set_name(a.name);
-    p->set_robot_type(a.robot_type);
+    p->set_robot_type(a.type.name);
     p->set_admitted(a.admitted);
     p->set_accepted(a.accepted);
     p->set_rejected(a.rejected);

@@ -30,7 +30,7 @@ protocol::SensorFrame SensingService::frame_for(const WorldState& state, std::ui
 
   std::vector<std::uint64_t>& seen = seen_[id - 1];
   const Heightmap& terrain = state.terrain;
-  for (int index : layout_.tiles_in_square({me.x_m, me.y_m}, me.body.sensing_range_m)) {
+  for (int index : layout_.tiles_in_square({me.x_m, me.y_m}, me.type.body.sensing_range_m)) {
     const std::uint64_t version = state.tile_versions[static_cast<std::size_t>(index)];
     if (seen[static_cast<std::size_t>(index)] == version) continue;
     seen[static_cast<std::size_t>(index)] = version;
@@ -49,7 +49,7 @@ protocol::SensorFrame SensingService::frame_for(const WorldState& state, std::ui
   for (const AgentRecord& other : state.agents) {
     if (!other.alive || other.id == id) continue;
     const double dx = other.x_m - me.x_m, dy = other.y_m - me.y_m;
-    if (std::sqrt(dx * dx + dy * dy) <= me.body.proximity_range_m + arbiter_tolerance::kLengthM)
+    if (std::sqrt(dx * dx + dy * dy) <= me.type.body.proximity_range_m + arbiter_tolerance::kLengthM)
       f.neighbours.push_back({other.id, other.x_m, other.y_m, other.z_m});
   }
   return f;

@@ -156,7 +156,7 @@ struct WorldRuntime::Impl {
         link.requests =
             participant.create_reader<protocol::ActionRequest>({partition, signal, bus::Durability::kVolatile, 64});
         spdlog::info("admitted agent {} '{}' ({}) on partition {}", hello.agent_id, state.agent(hello.agent_id).name,
-                     state.agent(hello.agent_id).robot_type, partition);
+                     state.agent(hello.agent_id).type.name, partition);
         emit(make_event(hello.agent_id, protocol::EventKind::kAdmitted, state.agent(hello.agent_id).name));
       } else if (!decision.accepted && refused.insert({hello.agent_id, hello.session}).second) {
         // Agents repeat their hello: each (id, session) is logged and published once, answered every time.

@@ -45,9 +45,7 @@ WorldState make_world_state(const scenario::Scenario& scenario, Heightmap terrai
     const RobotType& type = scenario.robot_for(id);
     AgentRecord a;
     a.id = id;
-    a.robot_type = type.name;
-    a.behaviour = type.behaviour;
-    a.body = type.body;
+    a.type = type;
     const Position start = jittered_start(s.terrain, slot, type.body, scenario.start_jitter_m, scenario.seed);
     a.start_x_m = start.x;
     a.start_y_m = start.y;

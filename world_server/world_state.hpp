@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "marsala/core/heightmap.hpp"
+#include "marsala/core/robot_type.hpp"
 #include "marsala/protocol/messages.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/world_server/occupancy_cache.hpp"
@@ -16,10 +17,8 @@ namespace marsala::world_server {
 
 /// One agent slot as the world sees it.
 struct AgentRecord {
-  std::uint32_t id = 0;                       ///< >= 1
-  std::string robot_type;                     ///< from the scenario slot
-  std::string behaviour;                      ///< from the scenario's robot type
-  RobotBody body;                             ///< from the scenario's robot type: what the hello must declare
+  std::uint32_t id = 0;  ///< >= 1
+  RobotType type;        ///< its slot's robot type: body (what the hello must declare), behaviour, name
   double start_x_m = 0.0, start_y_m = 0.0;    ///< [m]
   double target_x_m = 0.0, target_y_m = 0.0;  ///< [m]
 

@@ -112,7 +112,7 @@ TEST(StartJitter, TheWorldStateAndTheAdmissionUseTheJitteredStart) {
   for (std::uint32_t id = 1; id <= 3; ++id) {
     const scenario::AgentSlot& sl = plain.slots[id - 1];
     const AgentRecord& a = s.agent(id);
-    const Position expected = jittered_start(s.terrain, sl, a.body, 0.4, 17);
+    const Position expected = jittered_start(s.terrain, sl, a.type.body, 0.4, 17);
     EXPECT_EQ(a.start_x_m, expected.x);
     EXPECT_EQ(a.start_y_m, expected.y);
     EXPECT_EQ(a.x_m, expected.x);

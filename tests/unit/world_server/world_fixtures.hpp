@@ -70,8 +70,8 @@ inline protocol::AgentHello hello_for(const WorldState& state, std::uint32_t id,
   h.agent_id = id;
   h.session = session;
   h.name = "tester-" + std::to_string(id);
-  h.behaviour = state.agent(id).behaviour;
-  h.body = state.agent(id).body;
+  h.behaviour = state.agent(id).type.behaviour;
+  h.body = state.agent(id).type.body;
   return h;
 }
 
