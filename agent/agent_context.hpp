@@ -6,23 +6,13 @@
 #include <optional>
 #include <string>
 
+#include "marsala/core/assignment.hpp"
 #include "marsala/core/goal_vector_map.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/robot_type.hpp"
 #include "marsala/core/types.hpp"
 
 namespace marsala::agent {
-
-/// Where the world placed this agent, read from its admission by the reactive layer (assignment_from): the layers
-/// below never see the wire message.
-struct Assignment {
-  GridGeometry world;          ///< the world grid (rows, cols, lower-left corner [m], cell size [m/cell])
-  int tile_size = 16;          ///< the terrain arrives in tiles of tile_size x tile_size cells
-  Position start;              ///< where the robot starts [m]
-  Position target;             ///< the scenario's goal for this agent [m]
-  Position base;               ///< base station centre: material is refilled only near it [m]
-  double base_radius_m = 0.0;  ///< [m]
-};
 
 /// The admitted agent: identity, body, the world's answer and team-wide margins.
 struct AgentContext {

@@ -79,21 +79,14 @@ protocol::Admission admission_message(const WorldState& state, const protocol::A
   m.reason = decision.reason;
   m.run_id = run_id;
   const GridGeometry& g = state.terrain.geometry();
-  m.rows = g.rows;
-  m.cols = g.cols;
-  m.xll_m = g.xll_m;
-  m.yll_m = g.yll_m;
-  m.cell_size_m = g.cell_size_m;
-  m.tile_size = state.tile_size;
-  m.base_x_m = state.base.x_m;
-  m.base_y_m = state.base.y_m;
-  m.base_radius_m = state.base.radius_m;
+  m.assignment.world = g;
+  m.assignment.tile_size = state.tile_size;
+  m.assignment.base = {state.base.x_m, state.base.y_m};
+  m.assignment.base_radius_m = state.base.radius_m;
   if (state.has_agent(hello.agent_id)) {
     const AgentRecord& a = state.agent(hello.agent_id);
-    m.start_x_m = a.start_x_m;
-    m.start_y_m = a.start_y_m;
-    m.target_x_m = a.target_x_m;
-    m.target_y_m = a.target_y_m;
+    m.assignment.start = {a.start_x_m, a.start_y_m};
+    m.assignment.target = {a.target_x_m, a.target_y_m};
   }
   return m;
 }

@@ -41,18 +41,9 @@ Assignment assignment_from(const AgentContext& context, const protocol::Admissio
                           std::to_string(admission.session) + (admission.accepted ? "" : ", refused") +
                           ") does not admit agent " + std::to_string(context.agent_id) + " (session " +
                           std::to_string(context.session) + ")");
-  if (admission.rows <= 0 || admission.cols <= 0 || !(admission.cell_size_m > 0.0) ||
-      !std::isfinite(admission.cell_size_m) || !std::isfinite(admission.xll_m) || !std::isfinite(admission.yll_m))
-    throw InvalidArgument(fmt::format("admission: world grid {} x {} with cell size {} m is not a valid grid",
-                                      admission.rows, admission.cols, admission.cell_size_m));
-  if (admission.tile_size < 1)
-    throw InvalidArgument("admission: tile size must be >= 1, got " + std::to_string(admission.tile_size));
-  return {{admission.rows, admission.cols, admission.xll_m, admission.yll_m, admission.cell_size_m},
-          admission.tile_size,
-          {admission.start_x_m, admission.start_y_m},
-          {admission.target_x_m, admission.target_y_m},
-          {admission.base_x_m, admission.base_y_m},
-          admission.base_radius_m};
+  if (const std::string problem = assignment_problem(admission.assignment); !problem.empty())
+    throw InvalidArgument("admission: " + problem);
+  return admission.assignment;
 }
 
 void check_frame(const AgentContext& context, const protocol::SensorFrame& frame) {

@@ -101,8 +101,8 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
       admission = a;
       result.run_id = a.run_id;
       behaviour_->on_admission(a);
-      spdlog::info("agent {}: admitted to run '{}' ({} x {} cells of {} m)", config_.agent_id, a.run_id, a.rows, a.cols,
-                   a.cell_size_m);
+      spdlog::info("agent {}: admitted to run '{}' ({} x {} cells of {} m)", config_.agent_id, a.run_id,
+                   a.assignment.world.rows, a.assignment.world.cols, a.assignment.world.cell_size_m);
       return true;
     }
   }

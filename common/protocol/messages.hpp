@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "marsala/core/assignment.hpp"
 #include "marsala/core/robot_body.hpp"
 
 namespace marsala::protocol {
@@ -36,19 +37,7 @@ struct Admission {
   bool accepted = false;
   std::string reason;     ///< why not, when rejected
   std::string run_id;     ///< names the run; endpoints of this agent use partition partition_for(run, id)
-  std::int32_t rows = 0;  ///< world grid size [cells]
-  std::int32_t cols = 0;
-  double xll_m = 0.0;  ///< world grid lower-left corner [m]
-  double yll_m = 0.0;
-  double cell_size_m = 0.0;     ///< [m/cell]
-  std::int32_t tile_size = 16;  ///< terrain tiles are tile_size x tile_size cells (smaller at the grid edge)
-  double start_x_m = 0.0;       ///< where the agent starts [m]
-  double start_y_m = 0.0;
-  double target_x_m = 0.0;  ///< the goal of the scenario for this agent [m]
-  double target_y_m = 0.0;
-  double base_x_m = 0.0;  ///< base station centre: material is refilled only there [m]
-  double base_y_m = 0.0;
-  double base_radius_m = 0.0;
+  Assignment assignment;  ///< when accepted: grid, tile size, start, target and base station
 };
 
 /// Outcome of an agent's previous request, reported in its next frame.

@@ -126,7 +126,8 @@ int run(int argc, char** argv) {
       valid.state = "rogue";
       bool spoof = false;
       std::string what;
-      const protocol::ActionRequest bad = attack(attacks_sent, valid, frame, admission.cell_size_m, spoof, what);
+      const protocol::ActionRequest bad =
+          attack(attacks_sent, valid, frame, admission.assignment.world.cell_size_m, spoof, what);
       std::cout << "rogue: step " << frame.step << " sending " << what << std::endl;
       (spoof ? victim : requests)->write(bad);
       if (attacks_sent == kAttacks - 1) requests->write(bad);       // the duplicate goes out twice

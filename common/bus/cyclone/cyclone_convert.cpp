@@ -91,19 +91,19 @@ marsala_wire_Admission to_msg(const Admission& in, Storage&) {
   out.accepted = in.accepted;
   out.reason = borrow(in.reason);
   out.run_id = borrow(in.run_id);
-  out.rows = in.rows;
-  out.cols = in.cols;
-  out.xll_m = in.xll_m;
-  out.yll_m = in.yll_m;
-  out.cell_size_m = in.cell_size_m;
-  out.tile_size = in.tile_size;
-  out.start_x_m = in.start_x_m;
-  out.start_y_m = in.start_y_m;
-  out.target_x_m = in.target_x_m;
-  out.target_y_m = in.target_y_m;
-  out.base_x_m = in.base_x_m;
-  out.base_y_m = in.base_y_m;
-  out.base_radius_m = in.base_radius_m;
+  out.rows = in.assignment.world.rows;
+  out.cols = in.assignment.world.cols;
+  out.xll_m = in.assignment.world.xll_m;
+  out.yll_m = in.assignment.world.yll_m;
+  out.cell_size_m = in.assignment.world.cell_size_m;
+  out.tile_size = in.assignment.tile_size;
+  out.start_x_m = in.assignment.start.x;
+  out.start_y_m = in.assignment.start.y;
+  out.target_x_m = in.assignment.target.x;
+  out.target_y_m = in.assignment.target.y;
+  out.base_x_m = in.assignment.base.x;
+  out.base_y_m = in.assignment.base.y;
+  out.base_radius_m = in.assignment.base_radius_m;
   return out;
 }
 
@@ -114,19 +114,19 @@ Admission from_msg(const marsala_wire_Admission& in) {
   out.accepted = in.accepted;
   out.reason = copy(in.reason);
   out.run_id = copy(in.run_id);
-  out.rows = in.rows;
-  out.cols = in.cols;
-  out.xll_m = in.xll_m;
-  out.yll_m = in.yll_m;
-  out.cell_size_m = in.cell_size_m;
-  out.tile_size = in.tile_size;
-  out.start_x_m = in.start_x_m;
-  out.start_y_m = in.start_y_m;
-  out.target_x_m = in.target_x_m;
-  out.target_y_m = in.target_y_m;
-  out.base_x_m = in.base_x_m;
-  out.base_y_m = in.base_y_m;
-  out.base_radius_m = in.base_radius_m;
+  out.assignment.world.rows = in.rows;
+  out.assignment.world.cols = in.cols;
+  out.assignment.world.xll_m = in.xll_m;
+  out.assignment.world.yll_m = in.yll_m;
+  out.assignment.world.cell_size_m = in.cell_size_m;
+  out.assignment.tile_size = in.tile_size;
+  out.assignment.start.x = in.start_x_m;
+  out.assignment.start.y = in.start_y_m;
+  out.assignment.target.x = in.target_x_m;
+  out.assignment.target.y = in.target_y_m;
+  out.assignment.base.x = in.base_x_m;
+  out.assignment.base.y = in.base_y_m;
+  out.assignment.base_radius_m = in.base_radius_m;
   return out;
 }
 

@@ -36,13 +36,13 @@ protocol::Admission admission_for(const protocol::AgentHello& hello, const Heigh
   a.session = hello.session;
   a.accepted = true;
   a.run_id = "rt";
-  a.rows = h.rows();
-  a.cols = h.cols();
-  a.cell_size_m = h.cell_size_m();
-  a.tile_size = 16;
-  a.target_x_m = 2.55;
-  a.target_y_m = 1.05;
-  a.base_radius_m = 0.5;
+  a.assignment.world.rows = h.rows();
+  a.assignment.world.cols = h.cols();
+  a.assignment.world.cell_size_m = h.cell_size_m();
+  a.assignment.tile_size = 16;
+  a.assignment.target.x = 2.55;
+  a.assignment.target.y = 1.05;
+  a.assignment.base_radius_m = 0.5;
   return a;
 }
 

@@ -94,17 +94,17 @@ inline protocol::Admission admission_on(const AgentContext& c, const GridGeometr
   a.session = c.session;
   a.accepted = true;
   a.run_id = "test";
-  a.rows = grid.rows;
-  a.cols = grid.cols;
-  a.xll_m = grid.xll_m;
-  a.yll_m = grid.yll_m;
-  a.cell_size_m = grid.cell_size_m;
-  a.tile_size = 16;
-  a.target_x_m = target.x;
-  a.target_y_m = target.y;
-  a.base_x_m = base.x;
-  a.base_y_m = base.y;
-  a.base_radius_m = 0.5;
+  a.assignment.world.rows = grid.rows;
+  a.assignment.world.cols = grid.cols;
+  a.assignment.world.xll_m = grid.xll_m;
+  a.assignment.world.yll_m = grid.yll_m;
+  a.assignment.world.cell_size_m = grid.cell_size_m;
+  a.assignment.tile_size = 16;
+  a.assignment.target.x = target.x;
+  a.assignment.target.y = target.y;
+  a.assignment.base.x = base.x;
+  a.assignment.base.y = base.y;
+  a.assignment.base_radius_m = 0.5;
   return a;
 }
 

@@ -66,19 +66,19 @@ class MiniWorld {
     a.session = session;
     a.accepted = true;
     a.run_id = "mini";
-    a.rows = terrain_.rows();
-    a.cols = terrain_.cols();
-    a.xll_m = terrain_.geometry().xll_m;
-    a.yll_m = terrain_.geometry().yll_m;
-    a.cell_size_m = terrain_.cell_size_m();
-    a.tile_size = tile_size_;
-    a.start_x_m = start.x;
-    a.start_y_m = start.y;
-    a.target_x_m = target.x;
-    a.target_y_m = target.y;
-    a.base_x_m = base_.x;
-    a.base_y_m = base_.y;
-    a.base_radius_m = base_radius_m_;
+    a.assignment.world.rows = terrain_.rows();
+    a.assignment.world.cols = terrain_.cols();
+    a.assignment.world.xll_m = terrain_.geometry().xll_m;
+    a.assignment.world.yll_m = terrain_.geometry().yll_m;
+    a.assignment.world.cell_size_m = terrain_.cell_size_m();
+    a.assignment.tile_size = tile_size_;
+    a.assignment.start.x = start.x;
+    a.assignment.start.y = start.y;
+    a.assignment.target.x = target.x;
+    a.assignment.target.y = target.y;
+    a.assignment.base.x = base_.x;
+    a.assignment.base.y = base_.y;
+    a.assignment.base_radius_m = base_radius_m_;
     return a;
   }
 

@@ -99,7 +99,7 @@ TEST(PathBuilder, AdmissionIsCheckedAndFramesBeforeItAreRefused) {
   other.agent_id = 4;
   EXPECT_THROW(pb.on_admission(other), InvalidArgument);
   other = admission(c, kTarget);
-  other.cell_size_m = 0.0;
+  other.assignment.world.cell_size_m = 0.0;
   EXPECT_THROW(pb.on_admission(other), InvalidArgument);
   EXPECT_EQ(pb.state(), PathState::kWaitAdmission);
   pb.on_admission(admission(c, kTarget));

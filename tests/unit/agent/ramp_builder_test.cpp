@@ -77,7 +77,7 @@ TEST(RampBuilder, AdmissionIsCheckedAndFramesBeforeItAreRefused) {
   other.accepted = false;
   EXPECT_THROW(rb.on_admission(other), InvalidArgument);
   other = admission(c, {8.0, 3.0});
-  other.cell_size_m = 0.0;
+  other.assignment.world.cell_size_m = 0.0;
   EXPECT_THROW(rb.on_admission(other), InvalidArgument);
   EXPECT_EQ(rb.state(), RampState::kWaitAdmission);
   rb.on_admission(admission(c, {8.0, 3.0}));

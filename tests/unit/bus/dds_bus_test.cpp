@@ -83,19 +83,19 @@ void expect_same(const Admission& a, const Admission& b) {
   EXPECT_EQ(a.accepted, b.accepted);
   EXPECT_EQ(a.reason, b.reason);
   EXPECT_EQ(a.run_id, b.run_id);
-  EXPECT_EQ(a.rows, b.rows);
-  EXPECT_EQ(a.cols, b.cols);
-  EXPECT_SAME_DOUBLE(a.xll_m, b.xll_m);
-  EXPECT_SAME_DOUBLE(a.yll_m, b.yll_m);
-  EXPECT_SAME_DOUBLE(a.cell_size_m, b.cell_size_m);
-  EXPECT_EQ(a.tile_size, b.tile_size);
-  EXPECT_SAME_DOUBLE(a.start_x_m, b.start_x_m);
-  EXPECT_SAME_DOUBLE(a.start_y_m, b.start_y_m);
-  EXPECT_SAME_DOUBLE(a.target_x_m, b.target_x_m);
-  EXPECT_SAME_DOUBLE(a.target_y_m, b.target_y_m);
-  EXPECT_SAME_DOUBLE(a.base_x_m, b.base_x_m);
-  EXPECT_SAME_DOUBLE(a.base_y_m, b.base_y_m);
-  EXPECT_SAME_DOUBLE(a.base_radius_m, b.base_radius_m);
+  EXPECT_EQ(a.assignment.world.rows, b.assignment.world.rows);
+  EXPECT_EQ(a.assignment.world.cols, b.assignment.world.cols);
+  EXPECT_SAME_DOUBLE(a.assignment.world.xll_m, b.assignment.world.xll_m);
+  EXPECT_SAME_DOUBLE(a.assignment.world.yll_m, b.assignment.world.yll_m);
+  EXPECT_SAME_DOUBLE(a.assignment.world.cell_size_m, b.assignment.world.cell_size_m);
+  EXPECT_EQ(a.assignment.tile_size, b.assignment.tile_size);
+  EXPECT_SAME_DOUBLE(a.assignment.start.x, b.assignment.start.x);
+  EXPECT_SAME_DOUBLE(a.assignment.start.y, b.assignment.start.y);
+  EXPECT_SAME_DOUBLE(a.assignment.target.x, b.assignment.target.x);
+  EXPECT_SAME_DOUBLE(a.assignment.target.y, b.assignment.target.y);
+  EXPECT_SAME_DOUBLE(a.assignment.base.x, b.assignment.base.x);
+  EXPECT_SAME_DOUBLE(a.assignment.base.y, b.assignment.base.y);
+  EXPECT_SAME_DOUBLE(a.assignment.base_radius_m, b.assignment.base_radius_m);
 }
 
 void expect_same(const SensorFrame& a, const SensorFrame& b) {
@@ -224,19 +224,19 @@ Admission filled_admission(Filler& f) {
   a.accepted = true;
   a.reason = kUtf8;
   a.run_id = "run-\xC3\xA4";
-  a.rows = f.i32();
-  a.cols = f.i32();
-  a.xll_m = f.real();
-  a.yll_m = f.real();
-  a.cell_size_m = f.real();
-  a.tile_size = f.i32();
-  a.start_x_m = f.real();
-  a.start_y_m = f.real();
-  a.target_x_m = f.real();
-  a.target_y_m = f.real();
-  a.base_x_m = f.real();
-  a.base_y_m = f.real();
-  a.base_radius_m = f.real();
+  a.assignment.world.rows = f.i32();
+  a.assignment.world.cols = f.i32();
+  a.assignment.world.xll_m = f.real();
+  a.assignment.world.yll_m = f.real();
+  a.assignment.world.cell_size_m = f.real();
+  a.assignment.tile_size = f.i32();
+  a.assignment.start.x = f.real();
+  a.assignment.start.y = f.real();
+  a.assignment.target.x = f.real();
+  a.assignment.target.y = f.real();
+  a.assignment.base.x = f.real();
+  a.assignment.base.y = f.real();
+  a.assignment.base_radius_m = f.real();
   return a;
 }
 

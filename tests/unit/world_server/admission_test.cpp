@@ -47,15 +47,15 @@ TEST_F(AdmissionTest, AdmitsAMatchingHelloAndPlacesTheAgentAtItsStart) {
   EXPECT_EQ(m.session, 77u);
   EXPECT_TRUE(m.accepted);
   EXPECT_EQ(m.run_id, "small-d4");
-  EXPECT_EQ(m.rows, 40);
-  EXPECT_EQ(m.cols, 40);
-  EXPECT_EQ(m.cell_size_m, 0.1);
-  EXPECT_EQ(m.tile_size, 16);
-  EXPECT_EQ(m.start_x_m, 2.55);
-  EXPECT_EQ(m.target_x_m, 3.05);
-  EXPECT_EQ(m.target_y_m, 2.05);
-  EXPECT_EQ(m.base_x_m, 0.55);
-  EXPECT_EQ(m.base_radius_m, 0.5);
+  EXPECT_EQ(m.assignment.world.rows, 40);
+  EXPECT_EQ(m.assignment.world.cols, 40);
+  EXPECT_EQ(m.assignment.world.cell_size_m, 0.1);
+  EXPECT_EQ(m.assignment.tile_size, 16);
+  EXPECT_EQ(m.assignment.start.x, 2.55);
+  EXPECT_EQ(m.assignment.target.x, 3.05);
+  EXPECT_EQ(m.assignment.target.y, 2.05);
+  EXPECT_EQ(m.assignment.base.x, 0.55);
+  EXPECT_EQ(m.assignment.base_radius_m, 0.5);
 }
 
 TEST_F(AdmissionTest, Refusals) {

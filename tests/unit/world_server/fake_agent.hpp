@@ -106,18 +106,20 @@ class FakeAgent {
     r.session = config_.session;
     r.step = f.step;
     r.state = "walking";
-    const double dx = a.target_x_m - f.x_m, dy = a.target_y_m - f.y_m;
+    const double dx = a.assignment.target.x - f.x_m, dy = a.assignment.target.y - f.y_m;
     const double d = std::sqrt(dx * dx + dy * dy);
     if (d > 0.0) {
       r.move = true;
       const double s = std::min(1.0, config_.body.max_step_m / d);
-      r.target_x_m = d <= config_.body.max_step_m ? a.target_x_m : f.x_m + s * dx;
-      r.target_y_m = d <= config_.body.max_step_m ? a.target_y_m : f.y_m + s * dy;
+      r.target_x_m = d <= config_.body.max_step_m ? a.assignment.target.x : f.x_m + s * dx;
+      r.target_y_m = d <= config_.body.max_step_m ? a.assignment.target.y : f.y_m + s * dy;
     }
     if (config_.deposit_first && f.step == 0) {
-      const double layer = std::pow(config_.body.cube_size_m, 3) / (a.cell_size_m * a.cell_size_m);
-      const int row = a.rows - 1 - static_cast<int>(std::floor((1.95 - a.yll_m) / a.cell_size_m));
-      const int col = static_cast<int>(std::floor((0.55 - a.xll_m) / a.cell_size_m));
+      const double layer =
+          std::pow(config_.body.cube_size_m, 3) / (a.assignment.world.cell_size_m * a.assignment.world.cell_size_m);
+      const int row = a.assignment.world.rows - 1 -
+                      static_cast<int>(std::floor((1.95 - a.assignment.world.yll_m) / a.assignment.world.cell_size_m));
+      const int col = static_cast<int>(std::floor((0.55 - a.assignment.world.xll_m) / a.assignment.world.cell_size_m));
       r.depositions.push_back({row, col, 2 * layer});
     }
     return r;

@@ -126,8 +126,8 @@ TEST(StartJitter, TheWorldStateAndTheAdmissionUseTheJitteredStart) {
   const protocol::AgentHello hello = testing::hello_for(t, 2, 77);
   admit(t, hello);
   const protocol::Admission m = admission_message(t, hello, decide_admission(t, hello, false), "run");
-  EXPECT_EQ(m.start_x_m, t.agent(2).start_x_m);
-  EXPECT_EQ(m.start_y_m, t.agent(2).start_y_m);
+  EXPECT_EQ(m.assignment.start.x, t.agent(2).start_x_m);
+  EXPECT_EQ(m.assignment.start.y, t.agent(2).start_y_m);
   EXPECT_EQ(t.agent(2).x_m, t.agent(2).start_x_m);
 }
 
