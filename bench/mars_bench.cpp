@@ -154,30 +154,14 @@ const Heightmap& input(Input kind, int n) {
   if (it != cache.end()) return it->second;
   Heightmap h;
   switch (kind) {
-    case Input::kTerrain:
-      h = make_rough_terrain(n, 2024);
-      break;
-    case Input::kFedBack:
-      h = MarsProcessor(kKappa).project(make_rough_terrain(n, 2024));
-      break;
-    case Input::kCones:
-      h = make_exact_cones(n, 7);
-      break;
-    case Input::kPlane:
-      h = make_plane(n, 1.0);
-      break;
-    case Input::kRoof:
-      h = make_roof(n);
-      break;
-    case Input::kSteepPlane:
-      h = make_plane(n, 1.001);
-      break;
-    case Input::kMix:
-      h = make_generated("mix", n);
-      break;
-    case Input::kFractal:
-      h = make_generated("fractal", n);
-      break;
+    case Input::kTerrain: h = make_rough_terrain(n, 2024); break;
+    case Input::kFedBack: h = MarsProcessor(kKappa).project(make_rough_terrain(n, 2024)); break;
+    case Input::kCones: h = make_exact_cones(n, 7); break;
+    case Input::kPlane: h = make_plane(n, 1.0); break;
+    case Input::kRoof: h = make_roof(n); break;
+    case Input::kSteepPlane: h = make_plane(n, 1.001); break;
+    case Input::kMix: h = make_generated("mix", n); break;
+    case Input::kFractal: h = make_generated("fractal", n); break;
   }
   return cache.emplace(key, std::move(h)).first->second;
 }

@@ -66,12 +66,9 @@ bool is_completed(const WorldState& state) {
 
 double progress(const WorldState& state) {
   switch (state.completion) {
-    case scenario::CompletionKind::kPayloadPath:
-      return state.check.met ? 1.0 : 0.0;
-    case scenario::CompletionKind::kLevelSite:
-      return state.check.level_fraction;
-    case scenario::CompletionKind::kAgentsAtGoal:
-      break;
+    case scenario::CompletionKind::kPayloadPath: return state.check.met ? 1.0 : 0.0;
+    case scenario::CompletionKind::kLevelSite: return state.check.level_fraction;
+    case scenario::CompletionKind::kAgentsAtGoal: break;
   }
   int live = 0, done = 0;
   for (const AgentRecord& a : state.agents) {
@@ -86,8 +83,7 @@ void start_completion_check(WorldState& state) {
   CompletionCheck& check = state.check;
   check = {};
   switch (state.completion) {
-    case scenario::CompletionKind::kAgentsAtGoal:
-      return;
+    case scenario::CompletionKind::kAgentsAtGoal: return;
     case scenario::CompletionKind::kPayloadPath: {
       const scenario::PayloadPath& p = state.payload_path;
       check.from = cell_of(state.terrain, p.from_x_m, p.from_y_m, "payload_path.from");

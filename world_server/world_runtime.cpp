@@ -330,9 +330,7 @@ struct WorldRuntime::Impl {
   /// One line on how the run completes and where its terrain check stands at the start.
   void log_completion() const {
     switch (state.completion) {
-      case scenario::CompletionKind::kAgentsAtGoal:
-        spdlog::info("completion: agents_at_goal");
-        break;
+      case scenario::CompletionKind::kAgentsAtGoal: spdlog::info("completion: agents_at_goal"); break;
       case scenario::CompletionKind::kPayloadPath:
         spdlog::info("completion: payload_path from ({}, {}) to ({}, {}), checked every {} steps: {}",
                      state.payload_path.from_x_m, state.payload_path.from_y_m, state.payload_path.to_x_m,

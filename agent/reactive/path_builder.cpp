@@ -4,64 +4,40 @@
 #include <cmath>
 #include <utility>
 
+#include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 
 namespace marsala::agent::reactive {
 namespace {
 
-constexpr PathState kStates[] = {
-    PathState::kWaitAdmission, PathState::kSurvey, PathState::kAdvance, PathState::kBuild,   PathState::kRetreat,
-    PathState::kReturnToBase,  PathState::kFollow, PathState::kHold,    PathState::kBackOff, PathState::kDone};
+constexpr EnumName<PathState> kPathStateNames[] = {{PathState::kWaitAdmission, "wait_admission"},
+                                                   {PathState::kSurvey, "survey"},
+                                                   {PathState::kAdvance, "advance"},
+                                                   {PathState::kBuild, "build"},
+                                                   {PathState::kRetreat, "retreat"},
+                                                   {PathState::kReturnToBase, "return_to_base"},
+                                                   {PathState::kFollow, "follow"},
+                                                   {PathState::kHold, "hold"},
+                                                   {PathState::kBackOff, "back_off"},
+                                                   {PathState::kDone, "done"}};
 
 double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
 PathState state_of(BuildPhase phase) {
   switch (phase) {
-    case BuildPhase::kAdvance:
-      return PathState::kAdvance;
-    case BuildPhase::kBuild:
-      return PathState::kBuild;
-    case BuildPhase::kRetreat:
-      return PathState::kRetreat;
+    case BuildPhase::kAdvance: return PathState::kAdvance;
+    case BuildPhase::kBuild: return PathState::kBuild;
+    case BuildPhase::kRetreat: return PathState::kRetreat;
   }
   return PathState::kAdvance;
 }
 
 }  // namespace
 
-std::string to_string(PathState state) {
-  switch (state) {
-    case PathState::kWaitAdmission:
-      return "wait_admission";
-    case PathState::kSurvey:
-      return "survey";
-    case PathState::kAdvance:
-      return "advance";
-    case PathState::kBuild:
-      return "build";
-    case PathState::kRetreat:
-      return "retreat";
-    case PathState::kReturnToBase:
-      return "return_to_base";
-    case PathState::kFollow:
-      return "follow";
-    case PathState::kHold:
-      return "hold";
-    case PathState::kBackOff:
-      return "back_off";
-    case PathState::kDone:
-      return "done";
-  }
-  return "unknown";
-}
+std::string to_string(PathState state) { return enum_to_string(kPathStateNames, state); }
 
 PathState path_state_from_string(const std::string& name) {
-  std::string valid;
-  for (PathState s : kStates) {
-    if (to_string(s) == name) return s;
-    valid += (valid.empty() ? "" : ", ") + to_string(s);
-  }
-  throw InvalidArgument("unknown path builder state '" + name + "'; valid: " + valid);
+  return enum_from_string(kPathStateNames, name, "path builder state");
 }
 
 PipelineParams pipeline_params(const Pipeline& pipeline) {
@@ -128,15 +104,9 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
         state_ = state_of(*phase);
       }
       return;
-    case PipelineRole::kFollow:
-      follow_step(view, {place.front->x_m, place.front->y_m}, request);
-      return;
-    case PipelineRole::kHold:
-      state_ = PathState::kHold;
-      return;
-    case PipelineRole::kBackOff:
-      back_off_step(view, {place.front->x_m, place.front->y_m}, request);
-      return;
+    case PipelineRole::kFollow: follow_step(view, {place.front->x_m, place.front->y_m}, request); return;
+    case PipelineRole::kHold: state_ = PathState::kHold; return;
+    case PipelineRole::kBackOff: back_off_step(view, {place.front->x_m, place.front->y_m}, request); return;
   }
 }
 

@@ -3,29 +3,23 @@
 #include <cmath>
 #include <limits>
 
+#include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 
 namespace marsala::agent::reactive {
 namespace {
+
+constexpr EnumName<PipelineRole> kPipelineRoleNames[] = {{PipelineRole::kActive, "active"},
+                                                         {PipelineRole::kFollow, "follow"},
+                                                         {PipelineRole::kHold, "hold"},
+                                                         {PipelineRole::kBackOff, "back_off"}};
 
 double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
 Position where(const Neighbour& n) { return {n.x_m, n.y_m}; }
 
 }  // namespace
 
-std::string to_string(PipelineRole role) {
-  switch (role) {
-    case PipelineRole::kActive:
-      return "active";
-    case PipelineRole::kFollow:
-      return "follow";
-    case PipelineRole::kHold:
-      return "hold";
-    case PipelineRole::kBackOff:
-      return "back_off";
-  }
-  return "unknown";
-}
+std::string to_string(PipelineRole role) { return enum_to_string(kPipelineRoleNames, role); }
 
 PipelineTracker::PipelineTracker(PipelineParams params) : params_(params) {
   const auto finite = [](double v) { return std::isfinite(v); };

@@ -2,58 +2,36 @@
 
 #include <utility>
 
+#include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 
 namespace marsala::agent::reactive {
 namespace {
 
-constexpr RampState kStates[] = {RampState::kWaitAdmission, RampState::kSurvey,  RampState::kAdvance,
-                                 RampState::kBuild,         RampState::kRetreat, RampState::kReturnToBase,
-                                 RampState::kAtGoal,        RampState::kDone};
+constexpr EnumName<RampState> kRampStateNames[] = {{RampState::kWaitAdmission, "wait_admission"},
+                                                   {RampState::kSurvey, "survey"},
+                                                   {RampState::kAdvance, "advance"},
+                                                   {RampState::kBuild, "build"},
+                                                   {RampState::kRetreat, "retreat"},
+                                                   {RampState::kReturnToBase, "return_to_base"},
+                                                   {RampState::kAtGoal, "at_goal"},
+                                                   {RampState::kDone, "done"}};
 
 RampState state_of(BuildPhase phase) {
   switch (phase) {
-    case BuildPhase::kAdvance:
-      return RampState::kAdvance;
-    case BuildPhase::kBuild:
-      return RampState::kBuild;
-    case BuildPhase::kRetreat:
-      return RampState::kRetreat;
+    case BuildPhase::kAdvance: return RampState::kAdvance;
+    case BuildPhase::kBuild: return RampState::kBuild;
+    case BuildPhase::kRetreat: return RampState::kRetreat;
   }
   return RampState::kAdvance;
 }
 
 }  // namespace
 
-std::string to_string(RampState state) {
-  switch (state) {
-    case RampState::kWaitAdmission:
-      return "wait_admission";
-    case RampState::kSurvey:
-      return "survey";
-    case RampState::kAdvance:
-      return "advance";
-    case RampState::kBuild:
-      return "build";
-    case RampState::kRetreat:
-      return "retreat";
-    case RampState::kReturnToBase:
-      return "return_to_base";
-    case RampState::kAtGoal:
-      return "at_goal";
-    case RampState::kDone:
-      return "done";
-  }
-  return "unknown";
-}
+std::string to_string(RampState state) { return enum_to_string(kRampStateNames, state); }
 
 RampState ramp_state_from_string(const std::string& name) {
-  std::string valid;
-  for (RampState s : kStates) {
-    if (to_string(s) == name) return s;
-    valid += (valid.empty() ? "" : ", ") + to_string(s);
-  }
-  throw InvalidArgument("unknown ramp builder state '" + name + "'; valid: " + valid);
+  return enum_from_string(kRampStateNames, name, "ramp builder state");
 }
 
 RampBuilder::RampBuilder(const AgentContext& context, RampBuilderOptions options)

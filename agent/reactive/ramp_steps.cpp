@@ -7,11 +7,15 @@
 #include <vector>
 
 #include "marsala/agent/reactive/behaviour.hpp"
+#include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::agent::reactive {
 namespace {
+
+constexpr EnumName<BuildPhase> kBuildPhaseNames[] = {
+    {BuildPhase::kAdvance, "advance"}, {BuildPhase::kBuild, "build"}, {BuildPhase::kRetreat, "retreat"}};
 
 /// Kept inside the world's base radius so a refill is never rejected on a tie [m].
 constexpr double kBaseMarginM = 1e-6;
@@ -38,17 +42,7 @@ std::optional<CellIndex> best_navigable_cell(const deliberative::LocalMap& local
 
 }  // namespace
 
-std::string to_string(BuildPhase phase) {
-  switch (phase) {
-    case BuildPhase::kAdvance:
-      return "advance";
-    case BuildPhase::kBuild:
-      return "build";
-    case BuildPhase::kRetreat:
-      return "retreat";
-  }
-  return "unknown";
-}
+std::string to_string(BuildPhase phase) { return enum_to_string(kBuildPhaseNames, phase); }
 
 struct RampSteps::Modules {
   executive::MappingSystem map;

@@ -38,12 +38,9 @@ std::unique_ptr<Participant> make_participant(const BusConfig& config) {
   if (config.domain_id < 0 || config.domain_id > 232)
     throw InvalidArgument("DDS domain id must be in 0..232, got " + std::to_string(config.domain_id));
   switch (config.vendor) {
-    case Vendor::kInProcess:
-      return detail::make_inprocess_participant(config.domain_id);
-    case Vendor::kCyclone:
-      return detail::make_cyclone_participant(config.domain_id);
-    case Vendor::kFastDds:
-      return detail::make_fastdds_participant(config.domain_id);
+    case Vendor::kInProcess: return detail::make_inprocess_participant(config.domain_id);
+    case Vendor::kCyclone: return detail::make_cyclone_participant(config.domain_id);
+    case Vendor::kFastDds: return detail::make_fastdds_participant(config.domain_id);
   }
   throw InvalidArgument("unknown DDS vendor");
 }

@@ -246,9 +246,7 @@ void draw_arrow(Image& img, const PixelMapper& px, const Arrow& a, double auto_w
 
 void draw_point(Image& img, double x, double y, PointShape shape, double r, Rgb colour) {
   switch (shape) {
-    case PointShape::kDisc:
-      detail::fill_disc(img, x, y, r, colour);
-      break;
+    case PointShape::kDisc: detail::fill_disc(img, x, y, r, colour); break;
     case PointShape::kSquare: {
       const int x0 = static_cast<int>(std::floor(x - r)), y0 = static_cast<int>(std::floor(y - r));
       const int side = static_cast<int>(std::floor(x + r)) - x0 + 1;

@@ -90,16 +90,12 @@ void check_placement(const Scenario& s, const GridGeometry& g) {
                       fmt::format("{}", ya) + "] m is not inside the terrain");
   };
   switch (s.completion) {
-    case CompletionKind::kAgentsAtGoal:
-      inside("goal", s.goal.x0_m, s.goal.y0_m, s.goal.x1_m, s.goal.y1_m);
-      break;
+    case CompletionKind::kAgentsAtGoal: inside("goal", s.goal.x0_m, s.goal.y0_m, s.goal.x1_m, s.goal.y1_m); break;
     case CompletionKind::kPayloadPath:
       on_grid("payload_path.from", s.payload_path.from_x_m, s.payload_path.from_y_m);
       on_grid("payload_path.to", s.payload_path.to_x_m, s.payload_path.to_y_m);
       break;
-    case CompletionKind::kLevelSite:
-      inside("site", s.site.x0_m, s.site.y0_m, s.site.x1_m, s.site.y1_m);
-      break;
+    case CompletionKind::kLevelSite: inside("site", s.site.x0_m, s.site.y0_m, s.site.x1_m, s.site.y1_m); break;
   }
   if (s.has_goal_vector_map) {
     const GoalVectorMapSpec& m = s.goal_vector_map;

@@ -34,16 +34,11 @@ enum class SampleKind { kFloat32, kFloat64, kInt16, kUInt16, kInt32 };
 
 int sample_bytes(SampleKind kind) {
   switch (kind) {
-    case SampleKind::kFloat32:
-      return 4;
-    case SampleKind::kFloat64:
-      return 8;
-    case SampleKind::kInt16:
-      return 2;
-    case SampleKind::kUInt16:
-      return 2;
-    case SampleKind::kInt32:
-      return 4;
+    case SampleKind::kFloat32: return 4;
+    case SampleKind::kFloat64: return 8;
+    case SampleKind::kInt16: return 2;
+    case SampleKind::kUInt16: return 2;
+    case SampleKind::kInt32: return 4;
   }
   return 0;
 }
@@ -60,21 +55,11 @@ void convert_as(const unsigned char* src, std::size_t count, double* dst) {
 // Converts `count` decoded samples (native byte order: libtiff swaps them) to doubles.
 void convert(SampleKind kind, const unsigned char* src, std::size_t count, double* dst) {
   switch (kind) {
-    case SampleKind::kFloat32:
-      convert_as<float>(src, count, dst);
-      break;
-    case SampleKind::kFloat64:
-      convert_as<double>(src, count, dst);
-      break;
-    case SampleKind::kInt16:
-      convert_as<int16_t>(src, count, dst);
-      break;
-    case SampleKind::kUInt16:
-      convert_as<uint16_t>(src, count, dst);
-      break;
-    case SampleKind::kInt32:
-      convert_as<int32_t>(src, count, dst);
-      break;
+    case SampleKind::kFloat32: convert_as<float>(src, count, dst); break;
+    case SampleKind::kFloat64: convert_as<double>(src, count, dst); break;
+    case SampleKind::kInt16: convert_as<int16_t>(src, count, dst); break;
+    case SampleKind::kUInt16: convert_as<uint16_t>(src, count, dst); break;
+    case SampleKind::kInt32: convert_as<int32_t>(src, count, dst); break;
   }
 }
 
@@ -187,18 +172,12 @@ class GeoTiffReader {
 
   static std::string format_name(uint16_t format) {
     switch (format) {
-      case SAMPLEFORMAT_UINT:
-        return "unsigned integer";
-      case SAMPLEFORMAT_INT:
-        return "signed integer";
-      case SAMPLEFORMAT_IEEEFP:
-        return "floating point";
-      case SAMPLEFORMAT_COMPLEXINT:
-        return "complex integer";
-      case SAMPLEFORMAT_COMPLEXIEEEFP:
-        return "complex floating point";
-      default:
-        return "sample format " + std::to_string(format);
+      case SAMPLEFORMAT_UINT: return "unsigned integer";
+      case SAMPLEFORMAT_INT: return "signed integer";
+      case SAMPLEFORMAT_IEEEFP: return "floating point";
+      case SAMPLEFORMAT_COMPLEXINT: return "complex integer";
+      case SAMPLEFORMAT_COMPLEXIEEEFP: return "complex floating point";
+      default: return "sample format " + std::to_string(format);
     }
   }
 

@@ -60,9 +60,7 @@ protocol::ActionRequest attack(int n, const protocol::ActionRequest& valid, cons
       what = "negative deposition";
       r.depositions.push_back({0, 0, -cell_m});
       break;
-    default:
-      what = "duplicate request for the same step";
-      break;
+    default: what = "duplicate request for the same step"; break;
   }
   return r;
 }

@@ -56,8 +56,7 @@ class BlockSearch {
     if (x * x <= kcs2_ * d2) return true;  // height: max h - kcs d <= limit
     for (const Shape& s : nd.shapes) {
       switch (s.kind) {
-        case Shape::Kind::kNone:
-          return false;
+        case Shape::Kind::kNone: return false;
         case Shape::Kind::kPlane: {
           const double y = s.m + s.ar * (r - s.r) + s.ac * (c - s.c) - limit;
           if (y <= 0 || y * y <= s.deficit2 * d2) return true;

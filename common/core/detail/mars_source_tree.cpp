@@ -106,14 +106,10 @@ struct Moments {
 inline double residual(const Shape& s, double kcs, double r, double c, double h) {
   const double dr = r - s.r, dc = c - s.c;
   switch (s.kind) {
-    case Shape::Kind::kPlane:
-      return h - s.ar * dr - s.ac * dc;
-    case Shape::Kind::kCone:
-      return h + kcs * std::sqrt(dr * dr + dc * dc);
-    case Shape::Kind::kBowl:
-      return h - kcs * std::sqrt(dr * dr + dc * dc);
-    case Shape::Kind::kNone:
-      break;
+    case Shape::Kind::kPlane: return h - s.ar * dr - s.ac * dc;
+    case Shape::Kind::kCone: return h + kcs * std::sqrt(dr * dr + dc * dc);
+    case Shape::Kind::kBowl: return h - kcs * std::sqrt(dr * dr + dc * dc);
+    case Shape::Kind::kNone: break;
   }
   return kInf;
 }

@@ -79,14 +79,10 @@ double det_sin_deg(double degrees) {
   reduce_deg(degrees, q, rest);
   const double r = rest * (kPi / 180.0);
   switch (q) {
-    case 0:
-      return sin_poly(r);
-    case 1:
-      return cos_poly(r);
-    case 2:
-      return -sin_poly(r);
-    default:
-      return -cos_poly(r);
+    case 0: return sin_poly(r);
+    case 1: return cos_poly(r);
+    case 2: return -sin_poly(r);
+    default: return -cos_poly(r);
   }
 }
 
@@ -96,14 +92,10 @@ double det_cos_deg(double degrees) {
   reduce_deg(degrees, q, rest);
   const double r = rest * (kPi / 180.0);
   switch (q) {
-    case 0:
-      return cos_poly(r);
-    case 1:
-      return -sin_poly(r);
-    case 2:
-      return -cos_poly(r);
-    default:
-      return sin_poly(r);
+    case 0: return cos_poly(r);
+    case 1: return -sin_poly(r);
+    case 2: return -cos_poly(r);
+    default: return sin_poly(r);
   }
 }
 

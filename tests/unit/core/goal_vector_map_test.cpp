@@ -195,14 +195,10 @@ std::optional<GoalVectorMap> try_make(const GoalVectorMapSpec& s, const GridGeom
 
 double along(const GoalVectorMapSpec& s, Position p) {
   switch (s.heading) {
-    case Heading::kEast:
-      return p.x;
-    case Heading::kWest:
-      return -p.x;
-    case Heading::kNorth:
-      return p.y;
-    case Heading::kSouth:
-      return -p.y;
+    case Heading::kEast: return p.x;
+    case Heading::kWest: return -p.x;
+    case Heading::kNorth: return p.y;
+    case Heading::kSouth: return -p.y;
   }
   return 0.0;
 }

@@ -307,15 +307,9 @@ TEST(MarsProcessorBruteForce, SatellitesOnSlopeKappaSurfaces) {
       case 0:
         h = exact_plane(k.kappa, std::uniform_real_distribution<double>(0, 2 * M_PI)(rng), k.rows, k.cols, k.cs);
         break;
-      case 1:
-        h = exact_cones(rng, k.kappa, k.rows, k.cols, k.cs, 2, false);
-        break;
-      case 2:
-        h = exact_bowls(rng, k.kappa, k.rows, k.cols, k.cs, 2);
-        break;
-      default:
-        h = exact_ridge(rng, k.kappa, k.rows, k.cols, k.cs, false);
-        break;
+      case 1: h = exact_cones(rng, k.kappa, k.rows, k.cols, k.cs, 2, false); break;
+      case 2: h = exact_bowls(rng, k.kappa, k.rows, k.cols, k.cs, 2); break;
+      default: h = exact_ridge(rng, k.kappa, k.rows, k.cols, k.cs, false); break;
     }
     const double margins[] = {1e-3, 1e-5, 3e-9};
     if (rng() % 2)

@@ -44,22 +44,14 @@ enum class Terrain { kSmooth, kRough, kCliffs, kSpikes, kRampAlongRows, kRampAlo
 
 const char* name(Terrain t) {
   switch (t) {
-    case Terrain::kSmooth:
-      return "smooth";
-    case Terrain::kRough:
-      return "rough";
-    case Terrain::kCliffs:
-      return "cliffs";
-    case Terrain::kSpikes:
-      return "spikes";
-    case Terrain::kRampAlongRows:
-      return "ramp along rows";
-    case Terrain::kRampAlongCols:
-      return "ramp along cols";
-    case Terrain::kRampDiagonal:
-      return "diagonal ramp";
-    case Terrain::kQuantized:
-      return "quantized";
+    case Terrain::kSmooth: return "smooth";
+    case Terrain::kRough: return "rough";
+    case Terrain::kCliffs: return "cliffs";
+    case Terrain::kSpikes: return "spikes";
+    case Terrain::kRampAlongRows: return "ramp along rows";
+    case Terrain::kRampAlongCols: return "ramp along cols";
+    case Terrain::kRampDiagonal: return "diagonal ramp";
+    case Terrain::kQuantized: return "quantized";
   }
   return "?";
 }

@@ -11,7 +11,7 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/render/terrain_renderer.hpp"
-#include "render_test_support.hpp"
+#include "unit/render/render_test_support.hpp"
 
 namespace marsala::render {
 namespace {

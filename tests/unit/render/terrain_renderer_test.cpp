@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "marsala/core/error.hpp"
-#include "render_test_support.hpp"
+#include "unit/render/render_test_support.hpp"
 
 namespace marsala::render {
 namespace {

@@ -10,7 +10,7 @@
 #include <future>
 #include <thread>
 
-#include "agent_test_support.hpp"
+#include "unit/agent/agent_test_support.hpp"
 #include "marsala/core/error.hpp"
 
 namespace marsala::agent::runtime {

@@ -9,7 +9,7 @@
 #include <memory>
 #include <optional>
 
-#include "agent_test_support.hpp"
+#include "unit/agent/agent_test_support.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/core/error.hpp"
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "agent_test_support.hpp"
+#include "unit/agent/agent_test_support.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/agent/reactive/idle_behaviour.hpp"
 #include "marsala/agent/reactive/path_builder.hpp"

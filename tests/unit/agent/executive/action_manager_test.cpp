@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "agent_test_support.hpp"
+#include "unit/agent/agent_test_support.hpp"
 #include "marsala/core/error.hpp"
 
 namespace marsala::agent::executive {

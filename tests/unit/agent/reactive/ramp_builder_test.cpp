@@ -9,9 +9,9 @@
 #include <utility>
 #include <vector>
 
-#include "agent_test_support.hpp"
+#include "unit/agent/agent_test_support.hpp"
 #include "marsala/core/error.hpp"
-#include "mini_world.hpp"
+#include "unit/agent/mini_world.hpp"
 
 namespace marsala::agent::reactive {
 namespace {

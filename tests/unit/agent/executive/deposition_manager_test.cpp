@@ -6,7 +6,7 @@
 #include <set>
 #include <utility>
 
-#include "agent_test_support.hpp"
+#include "unit/agent/agent_test_support.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/navigability_processor.hpp"
 

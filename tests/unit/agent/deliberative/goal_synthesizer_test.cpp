@@ -5,7 +5,7 @@
 #include <cmath>
 #include <utility>
 
-#include "agent_test_support.hpp"
+#include "unit/agent/agent_test_support.hpp"
 #include "marsala/core/error.hpp"
 
 namespace marsala::agent::deliberative {

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "agent_test_support.hpp"
+#include "unit/agent/agent_test_support.hpp"
 #include "marsala/core/error.hpp"
 #include "support/mars_brute_force.hpp"
 #include "support/navigability_brute_force.hpp"

@@ -17,7 +17,7 @@
 #include "marsala/core/deposition.hpp"
 #include "marsala/core/mars_processor.hpp"
 #include "marsala/core/navigability_processor.hpp"
-#include "mini_world.hpp"
+#include "unit/agent/mini_world.hpp"
 
 namespace marsala::agent {
 namespace {
