@@ -17,6 +17,14 @@
 
 namespace marsala::agent::test {
 
+/// The behaviours' test world: a flat 6 x 10 m terrain at 0.1 m cells with a 1.5 m platform from x = 7 m eastwards.
+inline Heightmap platform_world() {
+  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
+  for (int r = 0; r < h.rows(); ++r)
+    for (int c = 70; c < h.cols(); ++c) h(r, c) = 1.5;
+  return h;
+}
+
 /// The tile (tr, tc) of `h` cut in tile_size tiles, as the world sends it.
 inline TerrainTile cut_tile(const Heightmap& h, int tile_size, int tr, int tc) {
   TerrainTile t;

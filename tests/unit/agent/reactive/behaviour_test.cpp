@@ -6,33 +6,25 @@
 #include <string>
 #include <vector>
 
-#include "unit/agent/agent_test_support.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/agent/reactive/idle_behaviour.hpp"
 #include "marsala/agent/reactive/path_builder.hpp"
 #include "marsala/agent/reactive/ramp_builder.hpp"
 #include "marsala/core/error.hpp"
+#include "unit/agent/agent_test_support.hpp"
 
 namespace marsala::agent::reactive {
 namespace {
 
-// A flat 6 x 10 m world at 0.1 m cells with a 1.5 m platform from x = 7 m eastwards.
-Heightmap world_terrain() {
-  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
-  for (int r = 0; r < h.rows(); ++r)
-    for (int c = 70; c < h.cols(); ++c) h(r, c) = 1.5;
-  return h;
-}
-
 AgentContext context(std::uint32_t id = 3, RobotBody body = test::husky()) { return test::agent_context(id, body); }
 
 protocol::Admission admission(const AgentContext& c, Position target, Position base = {0.55, 3.05}) {
-  return test::admission_on(c, world_terrain().geometry(), target, base);
+  return test::admission_on(c, test::platform_world().geometry(), target, base);
 }
 
 /// A frame at `pose` carrying every tile of the world.
 protocol::SensorFrame frame(const AgentContext& c, std::uint64_t step, Position pose, double material_m3) {
-  return test::full_frame(c, step, pose, material_m3, world_terrain());
+  return test::full_frame(c, step, pose, material_m3, test::platform_world());
 }
 
 TEST(BehaviourRegistry, MakesBuiltinsByNameAndListsThemOnAnUnknownOne) {

@@ -12,20 +12,12 @@
 #include <utility>
 #include <vector>
 
-#include "unit/agent/agent_test_support.hpp"
 #include "marsala/core/error.hpp"
+#include "unit/agent/agent_test_support.hpp"
 #include "unit/agent/mini_world.hpp"
 
 namespace marsala::agent::reactive {
 namespace {
-
-// A flat 6 x 10 m world at 0.1 m cells with a 1.5 m platform from x = 7 m eastwards.
-Heightmap world_terrain() {
-  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
-  for (int r = 0; r < h.rows(); ++r)
-    for (int c = 70; c < h.cols(); ++c) h(r, c) = 1.5;
-  return h;
-}
 
 /// A path builder's context: the Husky body, building for its own kappa (0.5) and width, 2 m separation.
 AgentContext context(std::uint32_t id = 3, RobotBody body = test::husky()) {
@@ -35,13 +27,13 @@ AgentContext context(std::uint32_t id = 3, RobotBody body = test::husky()) {
 }
 
 protocol::Admission admission(const AgentContext& c, Position target, Position base = {0.55, 3.05}) {
-  return test::admission_on(c, world_terrain().geometry(), target, base);
+  return test::admission_on(c, test::platform_world().geometry(), target, base);
 }
 
 /// A frame at `pose` carrying every tile of the world, with `neighbours`.
 protocol::SensorFrame frame(const AgentContext& c, std::uint64_t step, Position pose, double material_m3,
                             std::vector<protocol::Neighbour> neighbours = {}) {
-  protocol::SensorFrame f = test::full_frame(c, step, pose, material_m3, world_terrain());
+  protocol::SensorFrame f = test::full_frame(c, step, pose, material_m3, test::platform_world());
   f.neighbours = std::move(neighbours);
   return f;
 }
@@ -262,7 +254,9 @@ TEST(PathBuilder, NoDepositionPathThroughKnownCellsRequestsNothingAndKeepsTheSta
   PathBuilder pb(c);
   pb.on_admission(admission(c, kTarget));
   const Position at{1.05, 2.05};
-  const auto own_tile = [&](protocol::SensorFrame f) { return test::keep_tile_at(f, world_terrain().geometry(), at); };
+  const auto own_tile = [&](protocol::SensorFrame f) {
+    return test::keep_tile_at(f, test::platform_world().geometry(), at);
+  };
   pb.decide(own_tile(frame(c, 0, at, 1.0, {test::neighbour_at(5, 2.9, 2.05)})));  // 1.85 m ahead
   ASSERT_EQ(pb.state(), PathState::kHold);
   const protocol::ActionRequest q = pb.decide(own_tile(frame(c, 1, at, 1.0)));  // alone: the active robot
@@ -295,7 +289,7 @@ TEST(PathBuilder, RunOverEndsInDone) {
 /// mini world.
 TEST(PathBuilder, AloneItBuildsToTheTargetGoesBackRefillsAndComesAgain) {
   const AgentContext c = context(1, test::husky(0.3));
-  test::MiniWorld world(world_terrain(), 16, {0.55, 3.05}, 0.5);
+  test::MiniWorld world(test::platform_world(), 16, {0.55, 3.05}, 0.5);
   PathBuilder pb(c);
   pb.on_admission(world.admit(1, c.session, c.type.body, {1.05, 3.05}, {8.5, 3.05}));
   std::set<std::pair<PathState, PathState>> seen;
@@ -332,7 +326,7 @@ TEST(PathBuilder, AloneItBuildsToTheTargetGoesBackRefillsAndComesAgain) {
 TEST(PathBuilder, InAPipelineOnlyTheActiveRobotDeposits) {
   RobotBody body = test::husky(0.3);
   body.material_capacity_m3 = 0.6;
-  test::MiniWorld world(world_terrain(), 16, {1.0, 3.05}, 1.2);
+  test::MiniWorld world(test::platform_world(), 16, {1.0, 3.05}, 1.2);
   std::vector<std::unique_ptr<PathBuilder>> robots;
   const std::vector<Position> starts{{1.5, 3.05}, {1.0, 2.4}, {0.5, 3.7}};
   for (std::uint32_t id = 1; id <= starts.size(); ++id) {

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "unit/agent/agent_test_support.hpp"
 #include "marsala/core/error.hpp"
+#include "unit/agent/agent_test_support.hpp"
 
 namespace marsala::agent::reactive {
 namespace {

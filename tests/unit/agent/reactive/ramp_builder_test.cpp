@@ -9,30 +9,22 @@
 #include <utility>
 #include <vector>
 
-#include "unit/agent/agent_test_support.hpp"
 #include "marsala/core/error.hpp"
+#include "unit/agent/agent_test_support.hpp"
 #include "unit/agent/mini_world.hpp"
 
 namespace marsala::agent::reactive {
 namespace {
 
-// A flat 6 x 10 m world at 0.1 m cells with a 1.5 m platform from x = 7 m eastwards.
-Heightmap world_terrain() {
-  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
-  for (int r = 0; r < h.rows(); ++r)
-    for (int c = 70; c < h.cols(); ++c) h(r, c) = 1.5;
-  return h;
-}
-
 AgentContext context(std::uint32_t id = 3, RobotBody body = test::husky()) { return test::agent_context(id, body); }
 
 protocol::Admission admission(const AgentContext& c, Position target, Position base = {0.55, 3.05}) {
-  return test::admission_on(c, world_terrain().geometry(), target, base);
+  return test::admission_on(c, test::platform_world().geometry(), target, base);
 }
 
 /// A frame at `pose` carrying every tile of `h`.
 protocol::SensorFrame frame(const AgentContext& c, std::uint64_t step, Position pose, double material_m3,
-                            const Heightmap& h = world_terrain()) {
+                            const Heightmap& h = test::platform_world()) {
   return test::full_frame(c, step, pose, material_m3, h);
 }
 
@@ -174,7 +166,7 @@ TEST(RampBuilder, BlockedWithNothingInReachRetreats) {
 /// Every transition the ramp builder takes on the way up the platform, driven by the mini world.
 TEST(RampBuilder, ClimbingThePlatformExercisesTheBuildingTransitions) {
   const AgentContext c = context(1, test::husky(0.3));
-  test::MiniWorld world(world_terrain(), 16, {0.55, 3.05}, 0.5);
+  test::MiniWorld world(test::platform_world(), 16, {0.55, 3.05}, 0.5);
   RampBuilder rb(c);
   rb.on_admission(world.admit(1, c.session, c.type.body, {1.05, 3.05}, {8.5, 3.05}));
   std::set<std::pair<RampState, RampState>> seen;
@@ -204,7 +196,7 @@ TEST(RampBuilder, NoDepositionPathThroughKnownCellsRequestsNothingAndKeepsTheSta
   RampBuilder rb(c);
   rb.on_admission(admission(c, {8.0, 3.05}));
   const Position at{1.05, 2.05};
-  const protocol::SensorFrame f = test::keep_tile_at(frame(c, 0, at, 1.0), world_terrain().geometry(), at);
+  const protocol::SensorFrame f = test::keep_tile_at(frame(c, 0, at, 1.0), test::platform_world().geometry(), at);
   ASSERT_EQ(f.tiles.size(), 1u);
   const protocol::ActionRequest q = rb.decide(f);
   EXPECT_TRUE(rb.last_trace().planned);

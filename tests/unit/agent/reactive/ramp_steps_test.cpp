@@ -9,20 +9,12 @@
 #include <memory>
 #include <optional>
 
-#include "unit/agent/agent_test_support.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/core/error.hpp"
+#include "unit/agent/agent_test_support.hpp"
 
 namespace marsala::agent::reactive {
 namespace {
-
-// A flat 6 x 10 m world at 0.1 m cells with a 1.5 m platform from x = 7 m eastwards.
-Heightmap world_terrain() {
-  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
-  for (int r = 0; r < h.rows(); ++r)
-    for (int c = 70; c < h.cols(); ++c) h(r, c) = 1.5;
-  return h;
-}
 
 constexpr Position kTarget{8.0, 3.05};
 constexpr Position kBase{0.55, 3.05};
@@ -31,12 +23,12 @@ constexpr Position kBase{0.55, 3.05};
 std::unique_ptr<RampSteps> admitted_steps(const RobotBody& body = test::husky()) {
   const AgentContext c = test::agent_context(3, body);
   auto steps = std::make_unique<RampSteps>(c);
-  steps->admit(test::admission_on(c, world_terrain().geometry(), kTarget, kBase));
+  steps->admit(test::admission_on(c, test::platform_world().geometry(), kTarget, kBase));
   return steps;
 }
 
 protocol::SensorFrame frame(const RampSteps& steps, std::uint64_t step, Position pose, double material_m3 = 1.0) {
-  return test::full_frame(steps.context(), step, pose, material_m3, world_terrain());
+  return test::full_frame(steps.context(), step, pose, material_m3, test::platform_world());
 }
 
 protocol::ActionRequest empty(const RampSteps& steps, const protocol::SensorFrame& f) {
@@ -63,11 +55,11 @@ TEST(RampSteps, RefusesAnInvalidBodyConstructionOrGoalSynthesizerAndHasNoMapBefo
   RampSteps steps(c);
   EXPECT_FALSE(steps.admitted());
   EXPECT_THROW(steps.map(), InvalidArgument);
-  protocol::Admission other = test::admission_on(c, world_terrain().geometry(), kTarget, kBase);
+  protocol::Admission other = test::admission_on(c, test::platform_world().geometry(), kTarget, kBase);
   other.session = 1;
   EXPECT_THROW(steps.admit(other), InvalidArgument);
   EXPECT_FALSE(steps.admitted());
-  steps.admit(test::admission_on(c, world_terrain().geometry(), kTarget, kBase));
+  steps.admit(test::admission_on(c, test::platform_world().geometry(), kTarget, kBase));
   EXPECT_TRUE(steps.admitted());
   EXPECT_EQ(steps.context().assignment.target.x, kTarget.x);
   EXPECT_EQ(steps.map().known_cells(), 0);
@@ -117,7 +109,7 @@ TEST(RampSteps, BuildStepBlockedAtTheFootBuildsInPlace) {
   EXPECT_FALSE(q.move);
   ASSERT_FALSE(q.depositions.empty());
   EXPECT_EQ(q.depositions.size(), trace.deposition.depositions.size());
-  const Heightmap h = world_terrain();
+  const Heightmap h = test::platform_world();
   double volume_m3 = 0.0;
   for (const protocol::Deposition& d : q.depositions) {
     const Position centre = h.cell_center({d.row, d.col});
@@ -177,7 +169,7 @@ TEST(RampSteps, BuildStepWithoutAPathThroughKnownCellsRequestsNothing) {
   RampSteps& steps = *owned;
   BuildTrace trace;
   const Position robot{1.05, 2.05};
-  const protocol::SensorFrame f = test::keep_tile_at(frame(steps, 0, robot), world_terrain().geometry(), robot);
+  const protocol::SensorFrame f = test::keep_tile_at(frame(steps, 0, robot), test::platform_world().geometry(), robot);
   const BuildView view = steps.look(f, trace);
   protocol::ActionRequest q = empty(steps, f);
   EXPECT_FALSE(steps.build_step(view.local, f, trace, q).has_value());
