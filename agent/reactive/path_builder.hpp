@@ -1,7 +1,7 @@
 #pragma once
 // "path_builder": the ramp builder's steps (ramp_steps.hpp) inside the construction pipeline (paper §V-A, Fig. 4;
-// pipeline.hpp). It builds for the task's construction parameters (e.g. a payload's kappa over a band wide enough
-// for it and two lanes); the front robot of the pipeline alone deposits, the others follow it at the task's
+// pipeline.hpp). It builds for its robot type's construction parameters (e.g. a payload's kappa over a band wide enough
+// for it and two lanes); the front robot of the pipeline alone deposits, the others follow it at the pipeline's
 // separation, and every robot goes back to the base to refill whenever it cannot make a deposition task or has
 // reached the target.
 //
@@ -55,8 +55,8 @@ std::string to_string(PathState state);
 /// The inverse of to_string; throws InvalidArgument listing the valid names.
 PathState path_state_from_string(const std::string& name);
 
-/// Options of the path builder. The goal synthesizer is the context's task.goal_synthesizer; what it builds (MARS
-/// kappa, band width) is construction_params(context); the pipeline's separation is task.separation_m.
+/// Options of the path builder. The goal synthesizer is the robot type's goal_synthesizer; what it builds (MARS
+/// kappa, band width) is construction_params(type); the pipeline's separation is type.pipeline.separation_m.
 struct PathBuilderOptions {
   std::optional<PlannerParams> planner;  ///< default: default_planner_params for the construction width
 };

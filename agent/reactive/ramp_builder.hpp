@@ -55,8 +55,8 @@ std::string to_string(RampState state);
 /// The inverse of to_string; throws InvalidArgument listing the valid names.
 RampState ramp_state_from_string(const std::string& name);
 
-/// Options of the ramp builder. The goal synthesizer is the context's task.goal_synthesizer; what it builds (MARS
-/// kappa, band width) is construction_params(context).
+/// Options of the ramp builder. The goal synthesizer is the robot type's goal_synthesizer; what it builds (MARS
+/// kappa, band width) is construction_params(type).
 struct RampBuilderOptions {
   std::optional<PlannerParams> planner;  ///< default: default_planner_params for the construction width
 };
