@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
+#include "marsala/core/mars_processor.hpp"
 #include "marsala/world_server/admission.hpp"
 #include "marsala/world_server/completion.hpp"
 #include "marsala/world_server/run_outputs.hpp"
@@ -100,6 +102,18 @@ WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, R
   if (o.step_deadline_s == 0.0) o.step_deadline_s = s.step_deadline_s;
   if (!(o.step_deadline_s > 0.0) || !std::isfinite(o.step_deadline_s))
     throw InvalidArgument("step deadline must be finite and > 0 s");
+  // Every builder computes MARS at its construction kappa on windows of this terrain, whose heights grow as it is
+  // built, up to the world's height limit (kMaxMagnitude): refuse combinations that doubles cannot compute there
+  // (docs/runtime.md#scenario-validation) instead of letting an agent's processor fail mid-run.
+  const double highest_m = kMaxMagnitude;
+  for (std::uint32_t id = 1; id <= agents; ++id) {
+    const RobotType& type = s.robot_for(id);
+    const std::string problem =
+        mars_problem(construction_params(type).kappa, terrain.cell_size_m(), highest_m, terrain.rows(), terrain.cols());
+    if (!problem.empty())
+      throw InvalidArgument(
+          fmt::format("scenario {}: robot type '{}': construction kappa: {}", s.source_path, type.name, problem));
+  }
   start.state = make_world_state(start.scenario, std::move(terrain), agents);
   return start;
 }

@@ -12,6 +12,7 @@
 #include "marsala/core/detail/mars_seed.hpp"
 #include "marsala/core/detail/mars_source_tree.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 
 namespace marsala {
 namespace {
@@ -20,6 +21,22 @@ constexpr double kAbsoluteTolM = 1e-10;  // tie tolerance [m] ...
 constexpr double kRelativeTol = 1e-15;   // ... grown with the magnitudes of heights and drops
 
 }  // namespace
+
+std::string mars_problem(double kappa, double cell_size_m, double max_abs_height_m, int rows, int cols) {
+  const double rise_m = kappa * cell_size_m;
+  const double magnitude_m =
+      std::abs(max_abs_height_m) + rise_m * std::hypot(static_cast<double>(rows), static_cast<double>(cols));
+  if (!std::isfinite(rise_m) || !std::isfinite(magnitude_m))
+    return fmt::format("kappa {} x cell size {} m over a {} x {} grid with heights up to {} m overflows doubles", kappa,
+                       cell_size_m, rows, cols, max_abs_height_m);
+  const double spacing_m = std::nextafter(magnitude_m, std::numeric_limits<double>::infinity()) - magnitude_m;
+  if (!(rise_m > 16.0 * spacing_m))
+    return fmt::format(
+        "kappa {} x cell size {} m = {} m per cell is lost in rounding at heights of {} m (doubles there are {} m "
+        "apart): MARS cannot be computed; use a steeper kappa, larger cells or heights nearer 0",
+        kappa, cell_size_m, rise_m, max_abs_height_m, spacing_m);
+  return {};
+}
 
 MarsProcessor::MarsProcessor(double kappa) : kappa_(kappa) {
   if (!std::isfinite(kappa) || !(kappa > 0.0))
@@ -41,6 +58,8 @@ Heightmap MarsProcessor::project(const Heightmap& h) const {
                               ") is not finite");
       max_abs = std::max(max_abs, std::abs(v));
     }
+  if (const std::string problem = mars_problem(kappa_, h.cell_size_m(), max_abs, rows, cols); !problem.empty())
+    throw InvalidArgument("MarsProcessor: " + problem);
   detail::Problem pb;
   pb.h = h.data();
   pb.rows = rows;

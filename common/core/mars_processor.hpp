@@ -29,9 +29,17 @@
 // Known slow case: surfaces steeper than kappa by less than ~0.1%, e.g. a plane of slope
 // 1.001 kappa (0.75 s at 1024 x 1024) or a cone of slope 1.0001 kappa with its apex between cell
 // centres (~4 s): near-ties that no node bound separates. Results stay exact.
+#include <string>
+
 #include "marsala/core/heightmap.hpp"
 
 namespace marsala {
+
+/// Empty when MARS can be computed in doubles for slope `kappa` [m/m] on a grid of rows x cols cells of
+/// `cell_size_m` [m] whose heights reach `max_abs_height_m` [m] in magnitude; otherwise why not. The rise over one
+/// cell (kappa x cell size) must exceed 16 spacings of doubles at the magnitude the heights and the longest drop
+/// reach: below that a rise is lost in rounding and the cone search cannot climb (it would never end).
+std::string mars_problem(double kappa, double cell_size_m, double max_abs_height_m, int rows, int cols);
 
 /// Computes P_kappa[h] (paper eq. 2) and the MARS gap (eq. 3) exactly on a whole grid.
 class MarsProcessor {
@@ -40,7 +48,8 @@ class MarsProcessor {
   explicit MarsProcessor(double kappa);
   /// Maximum climbable slope, rise over run [m/m].
   double kappa() const { return kappa_; }
-  /// P_kappa[h] with the geometry of h [m]; throws InvalidArgument naming the first non-finite cell.
+  /// P_kappa[h] with the geometry of h [m]; throws InvalidArgument naming the first non-finite cell, or saying why
+  /// kappa, the cell size and the heights cannot be computed together (mars_problem()).
   Heightmap project(const Heightmap& h) const;
   /// P_kappa[h] - h [m], >= 0 everywhere; throws like project().
   Heightmap gap(const Heightmap& h) const;

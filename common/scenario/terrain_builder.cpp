@@ -6,6 +6,7 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
+#include "marsala/core/robot_body.hpp"
 #include "marsala/terrain/asc_io.hpp"
 #include "marsala/terrain/generators.hpp"
 #include "marsala/terrain/geotiff_import.hpp"
@@ -36,6 +37,19 @@ Heightmap read_terrain_file(const Scenario& s) {
   return map;
 }
 
+/// A world's cells and heights stay within what every processor computes in doubles
+/// (docs/runtime.md#scenario-validation).
+void check_magnitudes(const Scenario& s, const Heightmap& map) {
+  const double cs = map.cell_size_m();
+  if (!(cs >= kMinCellSizeM && cs <= kMaxMagnitude))
+    throw InvalidArgument(fmt::format("scenario {}: terrain: cell size {} m is outside [{}, {}] m", s.source_path, cs,
+                                      kMinCellSizeM, kMaxMagnitude));
+  const double highest = std::max(std::abs(map.min_height()), std::abs(map.max_height()));
+  if (!(highest <= kMaxMagnitude))
+    throw InvalidArgument(
+        fmt::format("scenario {}: terrain: a height of {} m is beyond +-{} m", s.source_path, highest, kMaxMagnitude));
+}
+
 }  // namespace
 
 std::string resolve_terrain_path(const Scenario& s) {
@@ -61,6 +75,7 @@ Heightmap build_terrain(const Scenario& s) {
   } catch (const InvalidArgument& e) {
     throw InvalidArgument("scenario " + s.source_path + ": terrain: " + e.what());
   }
+  check_magnitudes(s, map);
   check_placement(s, map.geometry());
   return map;
 }

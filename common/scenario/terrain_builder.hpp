@@ -8,10 +8,14 @@
 
 namespace marsala::scenario {
 
+/// Smallest cell size a world may have [m]; the largest, and the largest height magnitude, are kMaxMagnitude (1e6 m).
+inline constexpr double kMinCellSizeM = 1e-4;
+
 /// The scenario's terrain [m]: generated (lower-left corner at (0, 0)), or read from its .asc/.tif file (path
 /// resolved against the scenario file's folder), then cropped, resampled and shifted to a zero base as the scenario
-/// says. Then check_placement(). Throws IoError for a missing file, ParseError for a bad file, InvalidArgument for
-/// bad generator parameters or placements; every message names the scenario.
+/// says. Then the magnitudes (cell size in [kMinCellSizeM, kMaxMagnitude] m, |height| <= kMaxMagnitude m) and
+/// check_placement(). Throws IoError for a missing file, ParseError for a bad file, InvalidArgument for bad generator
+/// parameters, magnitudes or placements; every message names the scenario.
 Heightmap build_terrain(const Scenario& scenario);
 
 /// The scenario's terrain file resolved against the scenario file's folder (unchanged when absolute).

@@ -198,6 +198,38 @@ Heightmap exact_ridge(std::mt19937& rng, double kappa, int rows, int cols, doubl
   return h;
 }
 
+// ---- numeric limits: combinations doubles cannot compute are refused, never looped on ----------------------
+
+TEST(MarsProcessorLimits, ARiseLostInRoundingIsRefusedNotLoopedOn) {
+  // Heights of 1e16 m: doubles there are 2 m apart, so a 0.3 m rise per cell vanishes (this looped before).
+  Heightmap high({5, 6, 0.0, 0.0, 1.0}, 1e16);
+  high(2, 3) = 1e16 + 4.0;
+  EXPECT_THROW(MarsProcessor(0.3).project(high), InvalidArgument);
+  try {
+    MarsProcessor(0.3).gap(high);
+    FAIL() << "no throw";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("kappa 0.3 x cell size 1 m = 0.3 m per cell is lost in rounding"),
+              std::string::npos)
+        << e.what();
+  }
+  // A scenario-legal but absurd kappa on ordinary heights.
+  EXPECT_THROW(MarsProcessor(1e-300).project(Heightmap({4, 4, 0.0, 0.0, 0.1}, 1.0)), InvalidArgument);
+  EXPECT_NE(mars_problem(1e-300, 0.1, 1.0, 4, 4).find("lost in rounding"), std::string::npos);
+  // Overflow of the magnitude itself.
+  EXPECT_NE(mars_problem(1e300, 1e300, 1.0, 4, 4).find("overflows"), std::string::npos);
+}
+
+TEST(MarsProcessorLimits, LargeButComputableHeightsStillMatchBruteForce) {
+  // Heights of 1e12 m (doubles 1.2e-4 m apart) with 0.3 m per cell: 16 spacings are 2e-3 m, well below the rise.
+  EXPECT_EQ(mars_problem(0.3, 1.0, 1e12, 9, 9), "");
+  EXPECT_EQ(mars_problem(0.3, 0.1, 9000.0, 4000, 4000), "");  // a large real world
+  Heightmap h({9, 9, 0.0, 0.0, 1.0}, 1e12);
+  h(4, 4) = 1e12 + 5.0;
+  h(0, 8) = 1e12 + 2.0;
+  expect_matches_brute_force(h, 0.3, "1e12 m heights");
+}
+
 // ---- fast == brute force on many seeded random grids ---------------------------------------
 
 struct Case {

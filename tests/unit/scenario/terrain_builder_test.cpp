@@ -133,6 +133,29 @@ TEST_F(TerrainBuilderTest, BadFileTerrainsAreClearErrors) {
     EXPECT_NE(std::string(e.what()).find("agent[0] (agent 1).target: (2, 2) is off the terrain"), std::string::npos)
         << e.what();
   }
+  // Absurd magnitudes are refused up front: a height of 1e308 m, a cell of 1e-5 m.
+  Heightmap huge(g, 0.0);
+  huge(0, 0) = 1e308;
+  terrain::write_asc(huge, (dir_ / "maps" / "huge.asc").string());
+  try {
+    build_terrain(scenario(R"(terrain { file: "maps/huge.asc" })"));
+    FAIL() << "expected an InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("s.pbtxt: terrain: a height of 1e+308 m is beyond +-1000000 m"),
+              std::string::npos)
+        << e.what();
+  }
+  GridGeometry fine = g;
+  fine.cell_size_m = 1e-5;
+  terrain::write_asc(Heightmap(fine, 0.0), (dir_ / "maps" / "fine.asc").string());
+  try {
+    build_terrain(scenario(R"(terrain { file: "maps/fine.asc" })"));
+    FAIL() << "expected an InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("terrain: cell size 1e-05 m is outside [0.0001, 1000000] m"),
+              std::string::npos)
+        << e.what();
+  }
   // Generator parameters are checked by the generator, and the message names the scenario.
   try {
     build_terrain(scenario(R"(terrain { generator: "flat" rows: 40 cols: 40 params { key: "slope" value: 1 } })"));

@@ -225,6 +225,11 @@ TEST_F(ScenarioCheckTest, BadScenariosExitWith2NamingFileAndField) {
                        "terrain { file: \"nowhere.asc\" }"),
                   "terrain.file 'nowhere.asc' not found");
 
+  // A kappa no double can climb by (the loader accepts any kappa > 0): refused at start, not by an agent mid-run.
+  expect_rejected(edit(ok, "body { kappa: 0.3 delta_m: 1.0", "body { kappa: 1e-300 delta_m: 1.0"),
+                  "robot type 'tester': construction kappa: kappa 1e-300 x cell size 0.1 m = 1e-301 m per cell is "
+                  "lost in rounding");
+
   // Syntax errors name file, line and column, as a run reports them.
   const std::string broken =
       write("broken.pbtxt", "name: \"x\"\nterrain { generator: \"flat\" }\nagent { robot_type: }\n");
