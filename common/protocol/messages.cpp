@@ -27,4 +27,22 @@ EventKind event_kind_from_string(const std::string& name) {
   return enum_from_string(kEventKindNames, name, "event kind");
 }
 
+namespace {
+
+template <typename Enum, std::size_t N>
+Enum from_wire(const EnumName<Enum> (&names)[N], std::uint8_t value, const char* type) {
+  for (const EnumName<Enum>& n : names)
+    if (static_cast<std::uint8_t>(n.value) == value) return n.value;
+  throw InvalidArgument("malformed sample: " + std::to_string(value) + " is not an " + type + " (valid 0.." +
+                        std::to_string(N - 1) + ")");
+}
+
+}  // namespace
+
+ActionResult action_result_from_wire(std::uint8_t value) {
+  return from_wire(kActionResultNames, value, "ActionResult");
+}
+
+EventKind event_kind_from_wire(std::uint8_t value) { return from_wire(kEventKindNames, value, "EventKind"); }
+
 }  // namespace marsala::protocol

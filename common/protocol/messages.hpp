@@ -130,4 +130,9 @@ std::string to_string(ActionResult r);
 std::string to_string(EventKind k);
 EventKind event_kind_from_string(const std::string& name);
 
+/// The enum a wire octet encodes; throws InvalidArgument ("malformed ...") for a value the protocol does not define,
+/// so a converter drops the sample instead of passing a value no switch expects.
+ActionResult action_result_from_wire(std::uint8_t value);
+EventKind event_kind_from_wire(std::uint8_t value);
+
 }  // namespace marsala::protocol

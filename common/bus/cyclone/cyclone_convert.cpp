@@ -173,7 +173,7 @@ SensorFrame from_msg(const marsala_wire_SensorFrame& in) {
   out.y_m = in.y_m;
   out.z_m = in.z_m;
   out.material_m3 = in.material_m3;
-  out.last_result = static_cast<ActionResult>(in.last_result);
+  out.last_result = protocol::action_result_from_wire(in.last_result);
   out.last_reason = copy(in.last_reason);
   out.tiles.reserve(in.tiles._length);
   for (std::uint32_t i = 0; i < in.tiles._length; ++i) {
@@ -322,7 +322,7 @@ WorldEvent from_msg(const marsala_wire_WorldEvent& in) {
   WorldEvent out;
   out.step = in.step;
   out.agent_id = in.agent_id;
-  out.kind = static_cast<EventKind>(in.kind);
+  out.kind = protocol::event_kind_from_wire(in.kind);
   out.volume_m3 = in.volume_m3;
   out.detail = copy(in.detail);
   return out;

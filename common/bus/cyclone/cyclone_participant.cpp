@@ -13,6 +13,7 @@
 #include "marsala/bus/detail/backends.hpp"
 #include "marsala/bus/detail/participant_base.hpp"
 #include "marsala/bus/detail/reader_queue.hpp"
+#include "marsala/bus/detail/sample_conversion.hpp"
 #include "marsala/bus/detail/topics.hpp"
 #include "marsala/core/error.hpp"
 
@@ -227,7 +228,13 @@ class CycloneReader final : public Reader<T> {
       Loan loan{reader, samples, n};
       for (dds_return_t i = 0; i < n; ++i)
         if (infos[i].valid_data && filter_.passes(infos[i].source_timestamp))
-          received.push_back(cyclone::from_msg(*static_cast<const typename CycloneType<T>::Msg*>(samples[i])));
+          convert_sample(
+              [&] { return cyclone::from_msg(*static_cast<const typename CycloneType<T>::Msg*>(samples[i])); },
+              received, malformed_,
+              [](const std::string& what, std::uint64_t total) {
+                spdlog::warn("bus (cyclone): dropped a malformed sample of {} ({} so far): {}", TopicName<T>::value,
+                             total, what);
+              });
     }
     queue_.push(std::move(received));
   }
@@ -254,6 +261,7 @@ class CycloneReader final : public Reader<T> {
 
   std::shared_ptr<Context> context_;
   VolatileFilter filter_;
+  MalformedSamples malformed_;  // touched on Cyclone's listener thread only (drain)
   ReaderQueue<T> queue_;
   dds_entity_t subscriber_ = 0;
   dds_entity_t reader_ = 0;

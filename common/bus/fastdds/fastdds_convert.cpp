@@ -149,7 +149,7 @@ SensorFrame from_msg(const wire::SensorFrame& in) {
   out.y_m = in.y_m();
   out.z_m = in.z_m();
   out.material_m3 = in.material_m3();
-  out.last_result = static_cast<ActionResult>(in.last_result());
+  out.last_result = protocol::action_result_from_wire(in.last_result());
   out.last_reason = in.last_reason();
   out.tiles.reserve(in.tiles().size());
   for (const wire::TerrainTile& t : in.tiles()) {
@@ -292,7 +292,7 @@ WorldEvent from_msg(const wire::WorldEvent& in) {
   WorldEvent out;
   out.step = in.step();
   out.agent_id = in.agent_id();
-  out.kind = static_cast<EventKind>(in.kind());
+  out.kind = protocol::event_kind_from_wire(in.kind());
   out.volume_m3 = in.volume_m3();
   out.detail = in.detail();
   return out;

@@ -26,6 +26,7 @@
 #include "marsala/bus/detail/backends.hpp"
 #include "marsala/bus/detail/participant_base.hpp"
 #include "marsala/bus/detail/reader_queue.hpp"
+#include "marsala/bus/detail/sample_conversion.hpp"
 #include "marsala/bus/detail/topics.hpp"
 #include "marsala/bus/fastdds/fastdds_convert.hpp"
 #include "marsala/core/error.hpp"
@@ -268,7 +269,11 @@ class FastDdsReader final : public Reader<T> {
         dds::SampleInfo info;
         while (reader->take_next_sample(&msg, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
           if (info.valid_data && filter.passes(info.source_timestamp.to_ns()))
-            received.push_back(fastdds::from_msg(msg));
+            convert_sample([&] { return fastdds::from_msg(msg); }, received, malformed,
+                           [](const std::string& what, std::uint64_t total) {
+                             spdlog::warn("bus (fastdds): dropped a malformed sample of {} ({} so far): {}",
+                                          TopicName<T>::value, total, what);
+                           });
         queue.push(std::move(received));
       } catch (const std::exception& e) {
         spdlog::error("bus (fastdds): dropping samples of {}: {}", TopicName<T>::value, e.what());
@@ -286,7 +291,8 @@ class FastDdsReader final : public Reader<T> {
       }
     }
 
-    VolatileFilter filter;  // Fast DDS readers stay volatile; a Cyclone writer may still replay its latest sample
+    VolatileFilter filter;       // Fast DDS readers stay volatile; a Cyclone writer may still replay its latest sample
+    MalformedSamples malformed;  // touched on Fast DDS's listener thread only
     ReaderQueue<T> queue;
   };
 
