@@ -1,7 +1,9 @@
 #include "marsala/world_server/step.hpp"
 
 #include <algorithm>
+#include <bitset>
 
+#include "marsala/core/format.hpp"
 #include "marsala/world_server/arbiter.hpp"
 #include "marsala/world_server/completion.hpp"
 
@@ -70,6 +72,7 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const 
       out.events.push_back(event(step, agent.id, protocol::EventKind::kRejected, verdict.reason));
     }
   }
+  agent.recent_misses = static_cast<std::uint16_t>((agent.recent_misses << 1) | (answered ? 0u : 1u));
   if (answered) {
     agent.consecutive_missed = 0;
     return;
@@ -80,9 +83,14 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const 
   agent.last_result = protocol::ActionResult::kMissed;
   agent.last_reason = "no request for step " + std::to_string(step) + " before the deadline";
   out.events.push_back(event(step, agent.id, protocol::EventKind::kMissed, agent.last_reason));
-  if (agent.consecutive_missed >= kMaxConsecutiveMisses) {
-    out.events.push_back(
-        drop_agent(state, agent.id, std::to_string(agent.consecutive_missed) + " consecutive missed deadlines"));
+  const int recent = std::bitset<kMissWindowSteps>(agent.recent_misses).count();
+  std::string why;
+  if (agent.consecutive_missed >= kMaxConsecutiveMisses)
+    why = std::to_string(agent.consecutive_missed) + " consecutive missed deadlines";
+  else if (recent >= kMaxMissesInWindow)
+    why = fmt::format("{} missed deadlines in its last {} steps", recent, kMissWindowSteps);
+  if (!why.empty()) {
+    out.events.push_back(drop_agent(state, agent.id, why));
     out.dropped.push_back(agent.id);
   }
 }

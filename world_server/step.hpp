@@ -13,8 +13,12 @@
 
 namespace marsala::world_server {
 
-/// Consecutive missed steps after which an agent is dropped from the run.
+/// Consecutive missed steps after which an agent is dropped from the run (docs/runtime.md#dropping-agents).
 inline constexpr std::uint32_t kMaxConsecutiveMisses = 3;
+/// A chronically late agent is dropped too: one that missed more than half of the last kMissWindowSteps steps it
+/// was live for, i.e. kMaxMissesInWindow of them (e.g. two deadlines in every three, never three in a row).
+inline constexpr int kMissWindowSteps = 16;
+inline constexpr int kMaxMissesInWindow = 9;
 
 /// A request as it arrived: the agent whose partition carried it, and the request.
 struct Submission {

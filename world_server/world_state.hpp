@@ -37,7 +37,8 @@ struct AgentRecord {
   std::uint32_t rejected = 0;  ///< requests rejected (duplicates and future steps included)
   std::uint32_t missed = 0;    ///< steps without a request
   std::uint32_t consecutive_missed = 0;
-  double deposited_m3 = 0.0;  ///< material placed [m^3]
+  std::uint16_t recent_misses = 0;  ///< bit i set: missed the deadline of the step i steps ago (kMissWindowSteps)
+  double deposited_m3 = 0.0;        ///< material placed [m^3]
   bool at_goal = false;
   std::string state;  ///< the behaviour's state from its latest request
 

@@ -222,6 +222,36 @@ TEST(ApplyStep, ThreeConsecutiveMissesDropAnAgent) {
   EXPECT_EQ(w.agent(2).missed, 5u);
 }
 
+TEST(ApplyStep, AChronicallyLateAgentIsDropped) {
+  const scenario::Scenario s = small_scenario();
+  WorldState w = admitted_state(s, flat_terrain(), 2);
+  // Agent 2 misses two deadlines in every three, never three in a row: its misses fall on steps 0, 1, 3, 4, 6, 7,
+  // 9, 10, 12, ...; the 9th, at step 12, is more than half of its last 16 steps.
+  for (int step = 0; step <= 12; ++step) {
+    std::vector<protocol::ActionRequest> requests{request_for(w, 1)};
+    if (step % 3 == 2) requests.push_back(request_for(w, 2));
+    const StepOutcome o = apply_step(w, requests);
+    if (step < 12) {
+      EXPECT_TRUE(o.dropped.empty()) << "step " << step;
+    } else {
+      EXPECT_EQ(o.dropped, std::vector<std::uint32_t>{2});
+    }
+  }
+  EXPECT_FALSE(w.agent(2).alive);
+  EXPECT_EQ(w.agent(2).missed, 9u);
+  EXPECT_NE(w.agent(2).drop_reason.find("9 missed deadlines in its last 16 steps"), std::string::npos)
+      << w.agent(2).drop_reason;
+  // One miss in every two is tolerated for good: 8 of every 16.
+  WorldState half = admitted_state(s, flat_terrain(), 2);
+  for (int step = 0; step < 64; ++step) {
+    std::vector<protocol::ActionRequest> requests{request_for(half, 1)};
+    if (step % 2 == 1) requests.push_back(request_for(half, 2));
+    EXPECT_TRUE(apply_step(half, requests).dropped.empty()) << "step " << step;
+  }
+  EXPECT_TRUE(half.agent(2).alive);
+  EXPECT_EQ(half.agent(2).missed, 32u);
+}
+
 TEST(ApplyStep, OnlyChangedTilesGetANewVersion) {
   const scenario::Scenario s = small_scenario();  // 40 x 40 cells, tiles of 16: 3 x 3 tiles
   WorldState w = admitted_state(s, flat_terrain(), 1);
