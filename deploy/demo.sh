@@ -56,7 +56,7 @@ if [ "$mode" = scenario ]; then
   esac
   agents="${agents:-$default_agents}"
   echo "== $name: $agents $what"
-  exec "$root/deploy/spawn.sh" --scenario "$file" --agents "$agents" --dds "$dds" --out "$out"
+  exec "$root/deploy/spawn.sh" --scenario "$file" --agents "$agents" --dds "$dds" --out "$out" --replace
 fi
 
 terrain="${MARSALA_BUILD_DIR:-$root/build}/bin/marsala-terrain"

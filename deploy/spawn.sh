@@ -3,7 +3,10 @@
 # loopback configuration, waits for the end, prints the summary, and stops every child it started on exit or Ctrl-C.
 #
 # Usage: deploy/spawn.sh --scenario FILE --agents N [--dds cyclone|fastdds] [--agent-dds cyclone|fastdds]
-#                        [--out DIR] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N] [--quiet]
+#                        [--out DIR [--replace]] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N]
+#                        [--quiet]
+#   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
+#                 folder that holds another run's files, unless --replace removes them (and logs/) first
 #   --dds         vendor of every process (default cyclone); --agent-dds overrides it for the agents (mixed runs)
 #   --domain      DDS domain id (default: a free-looking one derived from the process id)
 #   --monitor     also run `marsala-monitor tail` in the foreground output
@@ -16,7 +19,8 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
 scenario="" agents="" dds="cyclone" agent_dds="" out="" domain="" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0
-usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; }
+replace=0
+usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -30,6 +34,7 @@ while [ $# -gt 0 ]; do
     --timeout) timeout_s="$2"; shift 2 ;;
     --seed) seed="$2"; shift 2 ;;
     --quiet) quiet=1; shift ;;
+    --replace) replace=1; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "spawn.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
@@ -44,10 +49,16 @@ done
   { echo "spawn.sh: --seed N needs a non-negative integer, got '$seed'" >&2; exit 2; }
 agent_dds="${agent_dds:-$dds}"
 domain="${domain:-$(( ($$ % 200) + 20 ))}"
-out="${out:-$root/out/$(basename "${scenario%.*}")-$agents}"
+[ -n "$out" ] || { out="$root/out/$(basename "${scenario%.*}")-$agents"; replace=1; }
 for b in marsala-world marsala-agent; do
   [ -x "$bin/$b" ] || { echo "spawn.sh: $bin/$b not built (run deploy/build.sh)" >&2; exit 1; }
 done
+
+# A run never mixes its outputs with another's: the world refuses a folder holding a run; --replace clears one.
+if [ "$replace" -eq 1 ] && [ -d "$out" ]; then
+  (cd "$out" && rm -rf -- summary.json events.log terrain_initial.asc terrain_final.asc final.png final_zoom.png \
+    goal_vector_map.png logs)
+fi
 
 world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$domain" --out "$out")
 [ -n "$max_steps" ] && world_args+=(--max-steps "$max_steps")

@@ -29,6 +29,27 @@ void make_dir(const std::string& dir) {
 
 std::string path_in(const std::string& dir, const char* name) { return (fs::path(dir) / name).string(); }
 
+/// Writes `path` through write(tmp) into "<path>.tmp", then renames it over `path`: a reader (or a crash, or a full
+/// disk) never sees a half-written file under the final name. Throws IoError; the temporary is removed.
+template <typename Write>
+void write_atomically(const std::string& path, Write&& write) {
+  const std::string tmp = path + ".tmp";
+  try {
+    write(tmp);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw;
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw IoError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
+  }
+}
+
 constexpr render::Rgb kWhite{255, 255, 255};
 constexpr render::Rgb kPathYellow{255, 214, 0};
 constexpr render::Rgb kFromRed{228, 26, 28};
@@ -291,32 +312,39 @@ render::RenderOptions goal_vector_map_picture_options(const WorldState& state, c
 
 void write_initial_outputs(const std::string& dir, const Heightmap& terrain) {
   make_dir(dir);
-  terrain::write_asc(terrain, path_in(dir, "terrain_initial.asc"));
+  write_atomically(path_in(dir, "terrain_initial.asc"), [&](const std::string& p) { terrain::write_asc(terrain, p); });
 }
 
 void write_final_outputs(const std::string& dir, const WorldState& state, const RunInfo& info) {
   make_dir(dir);
-  terrain::write_asc(state.terrain, path_in(dir, "terrain_final.asc"));
+  write_atomically(path_in(dir, "terrain_final.asc"),
+                   [&](const std::string& p) { terrain::write_asc(state.terrain, p); });
 
   const FinalTerrainReport report = final_terrain_report(state);
-  render::write_png(render::render_terrain(state.terrain, final_picture_options(state, info, report.route)),
-                    path_in(dir, "final.png"));
+  write_atomically(path_in(dir, "final.png"), [&](const std::string& p) {
+    render::write_png(render::render_terrain(state.terrain, final_picture_options(state, info, report.route)), p);
+  });
   if (const auto window = zoom_window(state, report.route))
-    render::write_png(render::render_terrain(state.terrain.window(window->first, window->rows, window->cols),
-                                             final_picture_options(state, info, report.route, window)),
-                      path_in(dir, "final_zoom.png"));
+    write_atomically(path_in(dir, "final_zoom.png"), [&](const std::string& p) {
+      render::write_png(render::render_terrain(state.terrain.window(window->first, window->rows, window->cols),
+                                               final_picture_options(state, info, report.route, window)),
+                        p);
+    });
 
-  const std::string path = path_in(dir, "summary.json");
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << summary_text(state, info, report);
-  out.close();
-  if (!out) throw IoError("cannot write '" + path + "'");
+  const std::string summary = summary_text(state, info, report);
+  write_atomically(path_in(dir, "summary.json"), [&](const std::string& p) {
+    std::ofstream out(p, std::ios::binary | std::ios::trunc);
+    out << summary;
+    out.close();
+    if (!out) throw IoError("cannot write '" + p + "'");
+  });
 
   if (info.goal_vector_map) {
     const Heightmap& initial = info.initial_terrain.size() > 0 ? info.initial_terrain : state.terrain;
     const GoalVectorMap map(*info.goal_vector_map, initial.geometry());
-    render::write_png(render::render_terrain(initial, goal_vector_map_picture_options(state, info, map)),
-                      path_in(dir, "goal_vector_map.png"));
+    write_atomically(path_in(dir, "goal_vector_map.png"), [&](const std::string& p) {
+      render::write_png(render::render_terrain(initial, goal_vector_map_picture_options(state, info, map)), p);
+    });
   }
 }
 
@@ -338,10 +366,33 @@ EventLog::EventLog(const std::string& path) : path_(path) {
   if (!out_) throw IoError("cannot write '" + path + "'");
 }
 
-void EventLog::append(const protocol::WorldEvent& event) { out_ << format_event(event) << std::endl; }
+void EventLog::append(const protocol::WorldEvent& event) { write_line(format_event(event)); }
 
 void EventLog::note(std::uint64_t step, const std::string& text) {
-  out_ << "step " << step << " note: " << text << std::endl;
+  write_line("step " + std::to_string(step) + " note: " + text);
+}
+
+void EventLog::write_line(const std::string& line) {
+  out_ << line << std::endl;
+  if (!out_) throw IoError("cannot write '" + path_ + "' (disk full or the file gone?): the run's record is lost");
+}
+
+std::vector<std::string> run_files_in(const std::string& dir) {
+  std::vector<std::string> found;
+  for (const char* name : kRunFiles) {
+    std::error_code ec;
+    if (fs::exists(fs::path(dir) / name, ec)) found.push_back(name);
+  }
+  return found;
+}
+
+void check_fresh_output_dir(const std::string& dir) {
+  const std::vector<std::string> found = run_files_in(dir);
+  if (found.empty()) return;
+  std::string list;
+  for (const std::string& f : found) list += (list.empty() ? "" : ", ") + f;
+  throw IoError("output folder '" + dir + "' holds another run (" + list +
+                "): give a fresh --out, or remove those files (deploy/spawn.sh --replace does)");
 }
 
 }  // namespace marsala::world_server

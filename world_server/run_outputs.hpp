@@ -18,6 +18,7 @@
 #include <fstream>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "marsala/core/goal_vector_map.hpp"
 #include "marsala/core/heightmap.hpp"
@@ -88,7 +89,19 @@ void write_final_outputs(const std::string& dir, const WorldState& state, const 
 /// One event as a log line: "step 12 agent 2 deposited 0.000125 m3: 1 cells".
 std::string format_event(const protocol::WorldEvent& event);
 
-/// events.log: appends one line per event or note, flushed at once so that a crash keeps what happened.
+/// events.log: appends one line per event or note, flushed at once so that a crash keeps what happened; a line that
+/// cannot be written throws IoError (the run then ends with an error).
+/// The files a run writes into its output folder (docs/runtime.md#outputs).
+inline constexpr const char* kRunFiles[] = {"summary.json",       "events.log", "terrain_initial.asc",
+                                            "terrain_final.asc",  "final.png",  "final_zoom.png",
+                                            "goal_vector_map.png"};
+
+/// The kRunFiles present in `dir` (none when it does not exist).
+std::vector<std::string> run_files_in(const std::string& dir);
+
+/// Throws IoError naming them when `dir` holds any of a run's files: a run never mixes its outputs with another's.
+void check_fresh_output_dir(const std::string& dir);
+
 class EventLog {
  public:
   /// Creates (truncates) the file; throws IoError.
@@ -98,6 +111,8 @@ class EventLog {
   void note(std::uint64_t step, const std::string& text);
 
  private:
+  /// Writes and flushes one line; throws IoError when it cannot (a lost event log is an error, never silent).
+  void write_line(const std::string& line);
   std::string path_;
   std::ofstream out_;
 };

@@ -114,6 +114,7 @@ WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, R
       throw InvalidArgument(
           fmt::format("scenario {}: robot type '{}': construction kappa: {}", s.source_path, type.name, problem));
   }
+  if (!o.out_dir.empty()) check_fresh_output_dir(o.out_dir);
   start.state = make_world_state(start.scenario, std::move(terrain), agents);
   return start;
 }

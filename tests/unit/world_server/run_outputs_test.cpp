@@ -195,6 +195,38 @@ class OutputFiles : public ::testing::Test {
   fs::path dir_;
 };
 
+TEST_F(OutputFiles, ARunNeverWritesIntoAnotherRunsFolderAndLeavesNoTemporaries) {
+  EXPECT_NO_THROW(check_fresh_output_dir(dir_.string()));  // missing: fresh
+  fs::create_directories(dir_ / "logs");
+  std::ofstream(dir_ / "spawn.log") << "not a run file\n";
+  EXPECT_NO_THROW(check_fresh_output_dir(dir_.string()));  // other files do not count
+  const WorldState s = admitted_state(scenario_with(site_block()), flat_terrain(), 1);
+  write_initial_outputs(dir_.string(), s.terrain);
+  write_final_outputs(dir_.string(), s, info_for("small", false));
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();  // every file was renamed into place
+  EXPECT_EQ(run_files_in(dir_.string()),
+            (std::vector<std::string>{"summary.json", "terrain_initial.asc", "terrain_final.asc", "final.png"}));
+  try {
+    check_fresh_output_dir(dir_.string());
+    FAIL() << "no throw";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("holds another run (summary.json, terrain_initial.asc, terrain_final.asc, "
+                                         "final.png)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST_F(OutputFiles, AnEventLogThatCannotBeWrittenIsAnErrorNotASilentLoss) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full here to play a full disk";
+  EventLog log("/dev/full");  // opens, but every write fails with ENOSPC
+  protocol::WorldEvent e;
+  e.kind = protocol::EventKind::kDeposited;
+  EXPECT_THROW(log.append(e), IoError);
+  EXPECT_THROW(log.note(3, "a note"), IoError);
+}
+
 TEST_F(OutputFiles, GoalVectorMapPictureOnlyWhenTheScenarioHasOne) {
   const WorldState s = admitted_state(scenario_with(site_block()), flat_terrain(), 1);
   RunInfo info = info_for("small", false);
