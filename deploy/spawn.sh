@@ -12,8 +12,9 @@
 #   --monitor     also run `marsala-monitor tail` in the foreground output
 #   --timeout     give up (and stop everything) after S seconds of wall time (default 1800)
 #   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
-# Exit codes: 0 the run ended, 1 the world failed or wrote no summary or the binaries are missing, 2 usage error or
-#             a run that `marsala-world --check` rejects (bad scenario, too many agents: nothing started), 130 stopped.
+# Exit codes: marsala-world's for a run that ended: 0 completed, 3 max_steps, 4 no_live_agents, 5 stopped by a
+#             signal (the summary is written in every case); 1 the world failed or wrote no summary or the binaries
+#             are missing; 2 usage error or a run that `marsala-world --check` rejects (nothing started); 130 stopped.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
@@ -119,11 +120,14 @@ while kill -0 "$world_pid" 2>/dev/null; do
 done
 world_rc=0
 wait "$world_pid" || world_rc=$?
-if [ "$world_rc" -ne 0 ]; then
-  echo "spawn.sh: marsala-world exited with $world_rc; last lines of its log:" >&2
-  tail -n 20 "$out/logs/world.log" >&2
-  exit "$world_rc"
-fi
+# 0 completed, 3 max_steps, 4 no_live_agents, 5 signal: the run ended and wrote its outputs (docs/runtime.md).
+case "$world_rc" in
+  0|3|4|5) ;;
+  *)
+    echo "spawn.sh: marsala-world exited with $world_rc; last lines of its log:" >&2
+    tail -n 20 "$out/logs/world.log" >&2
+    exit "$world_rc" ;;
+esac
 if [ -f "$out/summary.json" ]; then
   [ "$quiet" -eq 1 ] || { echo "Summary ($out/summary.json):"; cat "$out/summary.json"; echo; }
 else
@@ -131,3 +135,5 @@ else
   exit 1
 fi
 [ "$quiet" -eq 1 ] || { echo "Pictures:"; ls -1 "$out"/*.png 2>/dev/null | sed 's/^/  /'; }
+[ "$world_rc" -eq 0 ] || echo "spawn.sh: the run ended without completing ($(jq -r .end_reason "$out/summary.json" 2>/dev/null || echo "exit $world_rc")); exit $world_rc" >&2
+exit "$world_rc"

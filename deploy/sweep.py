@@ -522,7 +522,9 @@ class Sweep:
         run_dir = os.path.join(self.out, f"n{team}-s{seed}")
         summary = os.path.join(run_dir, "summary.json")
         spawn_log = os.path.join(run_dir, "spawn.log")
-        if rc != 0 or not os.path.isfile(summary):
+        # spawn.sh passes marsala-world's exit code on: 0 completed, 3 max_steps, 4 no_live_agents, 5 signal (spawn.sh's
+        # --timeout) each ended a run with its summary; the row says which.
+        if rc not in (0, 3, 4, 5) or not os.path.isfile(summary):
             out(f"  team {team}, seed {seed}: FAILED (spawn.sh exit {rc}, no row written; see {spawn_log} and "
                 f"{run_dir}/logs)")
             try:

@@ -12,6 +12,16 @@ constexpr EnumName<EndReason> kEndReasonNames[] = {{EndReason::kSignal, "signal"
 
 }  // namespace
 
+int exit_code(EndReason reason) {
+  switch (reason) {
+    case EndReason::kCompleted: return 0;
+    case EndReason::kMaxSteps: return 3;
+    case EndReason::kNoLiveAgents: return 4;
+    case EndReason::kSignal: return 5;
+  }
+  return 1;
+}
+
 std::string to_string(EndReason reason) { return enum_to_string(kEndReasonNames, reason); }
 
 EndReason end_reason_from_string(const std::string& name) {

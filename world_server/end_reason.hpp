@@ -13,6 +13,11 @@ enum class EndReason {
   kNoLiveAgents,  ///< "no_live_agents": every admitted agent was dropped
 };
 
+/// marsala-world's exit code for a run that ended for `reason` and wrote its outputs (docs/runtime.md#exit-codes):
+/// 0 completed, 3 max_steps, 4 no_live_agents, 5 signal. 1 (an error) and 2 (usage, or a run refused at start) are
+/// not end reasons.
+int exit_code(EndReason reason);
+
 /// "signal", "completed", "max_steps", "no_live_agents".
 std::string to_string(EndReason reason);
 /// The reason named `name`; throws InvalidArgument listing the valid names.

@@ -77,6 +77,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
     const RunResult result = runtime.run(stop);
     out << "run " << runtime.run_id() << ": " << to_string(result.end_reason) << " after " << result.steps << " steps, "
         << result.admitted << " agents, terrain sha256 " << result.terrain_sha256 << "\n";
+    return exit_code(result.end_reason);
   } catch (const Error& e) {
     err << "marsala-world: error: " << e.what() << "\n";
     return 1;

@@ -18,6 +18,13 @@ TEST(EndReason, NamesAreTheDocumentedStringsAndReadBack) {
   }
 }
 
+TEST(EndReason, ExitCodesSayHowTheRunEnded) {
+  EXPECT_EQ(exit_code(EndReason::kCompleted), 0);
+  EXPECT_EQ(exit_code(EndReason::kMaxSteps), 3);
+  EXPECT_EQ(exit_code(EndReason::kNoLiveAgents), 4);
+  EXPECT_EQ(exit_code(EndReason::kSignal), 5);
+}
+
 TEST(EndReason, AnUnknownNameListsTheValidOnes) {
   try {
     end_reason_from_string("finished");

@@ -76,7 +76,7 @@ TEST_F(WorldCliTest, BadScenariosExitWith1OnOneLineNamingFileAndLine) {
   EXPECT_NE(err_.str().find("no agent admitted"), std::string::npos) << err_.str();
 }
 
-TEST_F(WorldCliTest, ARunOverTheInProcessBusExitsWith0) {
+TEST_F(WorldCliTest, ARunThatReachesMaxStepsExitsWith3) {
   const std::string scenario = write("small.pbtxt", testing::small_scenario_text());
   const fs::path out = dir_ / "out";
   int rc = -1;
@@ -92,7 +92,7 @@ TEST_F(WorldCliTest, ARunOverTheInProcessBusExitsWith0) {
   testing::FakeAgent agent(c);
   world.join();
   agent.join();
-  EXPECT_EQ(rc, 0) << err_.str();
+  EXPECT_EQ(rc, 3) << err_.str();  // the exit code says how the run ended: max_steps
   EXPECT_NE(out_.str().find("run small-d48: max_steps after 3 steps, 1 agents"), std::string::npos) << out_.str();
   for (const char* name : {"summary.json", "terrain_initial.asc", "terrain_final.asc", "final.png", "events.log"})
     EXPECT_TRUE(fs::exists(out / name)) << name;
@@ -116,7 +116,7 @@ TEST_F(WorldCliTest, SeedOverridesTheScenariosAndIsReported) {
   testing::FakeAgent agent(c);
   world.join();
   agent.join();
-  EXPECT_EQ(rc, 0) << err_.str();
+  EXPECT_EQ(rc, 3) << err_.str();  // max_steps
   std::ifstream in(out / "summary.json");
   std::stringstream text;
   text << in.rdbuf();
