@@ -32,6 +32,10 @@ using namespace std::chrono_literals;
 constexpr auto kPollInterval = 100ms;
 // Between readiness checks once every agent is admitted (matching is not signalled to the world's writers).
 constexpr auto kReadyPollInterval = 5ms;
+// How long a live agent's request writer may stay not alive before the agent is dropped: a process paused (SIGSTOP,
+// a swapped or overloaded machine) for up to 5 s, world or agent, comes back and loses nothing; a dead agent costs
+// its team this long once (docs/runtime.md#dropping-agents).
+constexpr auto kLivelinessGrace = 6s;
 // Progress lines at info level every this many steps.
 constexpr std::uint64_t kProgressEvery = 500;
 
@@ -82,7 +86,8 @@ void check_run_id(const std::string& run_id) {
 struct AgentLink {
   std::unique_ptr<bus::Writer<protocol::SensorFrame>> frames;
   std::unique_ptr<bus::Reader<protocol::ActionRequest>> requests;
-  bool writer_seen = false;  ///< its request writer has been alive at least once
+  bool writer_seen = false;                          ///< its request writer has been alive at least once
+  std::optional<Clock::time_point> not_alive_since;  ///< when its seen writer was last found not alive
 };
 
 WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, RuntimeOptions options, int domain_id) {
@@ -182,15 +187,24 @@ struct WorldRuntime::Impl {
     }
   }
 
-  /// Drops every live agent whose request writer was alive and is no longer.
+  /// Drops every live agent whose request writer was alive and has not been alive again for kLivelinessGrace.
   void check_liveliness() {
+    const Clock::time_point now = Clock::now();
     for (std::uint32_t id : state.live_ids()) {
       AgentLink& link = links[id - 1];
       if (link.requests->alive_writers() >= 1) {
+        if (link.not_alive_since) spdlog::info("agent {}: its request writer is alive again", id);
         link.writer_seen = true;
+        link.not_alive_since.reset();
       } else if (link.writer_seen) {
-        spdlog::warn("agent {} dropped: its request writer lost liveliness", id);
-        emit(drop_agent(state, id, "request writer lost liveliness"));
+        if (!link.not_alive_since) {
+          link.not_alive_since = now;
+          spdlog::info("agent {}: its request writer lost liveliness; dropped unless it is back within {} s", id,
+                       std::chrono::duration_cast<std::chrono::seconds>(kLivelinessGrace).count());
+        } else if (now - *link.not_alive_since >= kLivelinessGrace) {
+          spdlog::warn("agent {} dropped: its request writer lost liveliness", id);
+          emit(drop_agent(state, id, "request writer lost liveliness"));
+        }
       }
     }
   }

@@ -9,6 +9,8 @@
 #   determinism                                                      2 Cyclone runs + 1 Fast DDS run: same sha256
 #   rogue                                                            a misbehaving agent is rejected, run completes
 #   kill                                                             SIGKILL one of 3 agents mid-run, others finish
+#   pause                                                            SIGSTOP the world, then an agent, 3 s each: the
+#                                                                    run loses nothing (same sha256 as unpaused)
 #   monitor                                                          marsala-monitor tail follows a run to its end
 set -euo pipefail
 case_name="$1"
@@ -109,6 +111,39 @@ case "$case_name" in
     echo "$entry2" | grep -q '"dropped":true' || fail "agent 2 is not marked dropped: $entry2"
     [ "${accepted2:-0}" -gt 0 ] || fail "agent 2 was killed before it took part (accepted $accepted2)"
     echo "ok: agent 2 killed, dropped, the other two completed in $(field steps "$s") steps"
+    ;;
+  pause)
+    reference=$(run_spawn reference 3 cyclone)
+    expect_completed "$reference" 3
+    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+    out="$work/pause"
+    mkdir -p "$out/logs"
+    "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
+      >"$out/logs/world.log" 2>&1 &
+    world=$!
+    pids=()
+    for id in 1 2 3; do
+      "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" \
+        >"$out/logs/agent-$id.log" 2>&1 &
+      pids+=($!)
+    done
+    wait_for_event() {  # wait_for_event PATTERN: until events.log (written live) holds it
+      for _ in $(seq 1 3000); do grep -q "$1" "$out/events.log" 2>/dev/null && return 0; sleep 0.02; done
+      fail "no '$1' in events.log (see $out/logs)"
+    }
+    # Mid-run for sure: pause the world for 3 s (longer than the 1 s DDS liveliness lease), then agent 3.
+    wait_for_event "agent 2 deposited"
+    kill -STOP "$world"; sleep 3; kill -CONT "$world"
+    wait_for_event "agent 1 deposited"
+    kill -STOP "${pids[2]}"; sleep 3; kill -CONT "${pids[2]}"
+    wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
+    for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero after the pauses (see $out/logs)"; done
+    s="$out/summary.json"
+    expect_completed "$s" 3
+    ! grep -q " dropped" "$out/events.log" || { grep " dropped" "$out/events.log"; fail "a pause dropped an agent"; }
+    [ "$(field terrain_sha256 "$s")" = "$(field terrain_sha256 "$reference")" ] ||
+      fail "paused run ended on $(field terrain_sha256 "$s"), unpaused on $(field terrain_sha256 "$reference")"
+    echo "ok: world and agent paused 3 s each; completed in $(field steps "$s") steps on the unpaused terrain"
     ;;
   monitor)
     export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
