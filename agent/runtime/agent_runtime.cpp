@@ -14,6 +14,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 /// The longest a wait lasts before the stop flag is looked at again.
 constexpr std::chrono::milliseconds kStopPoll{100};
+// How long the world's frame writer may stay not alive before the agent concludes that the world is gone: longer
+// than the pauses a world must survive (5 s, docs/runtime.md#dropping-agents), so an agent learns of a dead world
+// within about 7 s (the 1 s DDS lease, then this) instead of world_timeout.
+constexpr std::chrono::seconds kWorldGrace{6};
 
 }  // namespace
 
@@ -22,7 +26,8 @@ std::string to_string(RunOutcome outcome) {
                                                     {RunOutcome::kStopped, "stopped"},
                                                     {RunOutcome::kRefused, "refused"},
                                                     {RunOutcome::kAdmitTimeout, "admit_timeout"},
-                                                    {RunOutcome::kWorldTimeout, "world_timeout"}};
+                                                    {RunOutcome::kWorldTimeout, "world_timeout"},
+                                                    {RunOutcome::kWorldGone, "world_gone"}};
   return enum_to_string(kNames, outcome);
 }
 
@@ -120,8 +125,23 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
   bool answered_any = false;
   std::uint64_t last_answered = 0;
   Clock::time_point deadline = Clock::now() + config_.world_timeout;
+  bool world_seen = false, world_lost = false;
+  Clock::time_point world_lost_at{};  // when the world's frame writer was first found not alive (world_lost)
   while (!stop.load()) {
     const Clock::time_point now = Clock::now();
+    if (frames->alive_writers() >= 1) {
+      world_seen = true;
+      world_lost = false;
+    } else if (world_seen) {
+      if (!world_lost) world_lost_at = now;
+      world_lost = true;
+      if (now - world_lost_at >= kWorldGrace) {
+        result.outcome = RunOutcome::kWorldGone;
+        result.message = fmt::format("the world is gone: its frame writer lost liveliness {} s ago (last step {})",
+                                     std::chrono::duration<double>(now - world_lost_at).count(), result.last_step);
+        return;
+      }
+    }
     if (now >= deadline) {
       result.outcome = RunOutcome::kWorldTimeout;
       result.message = fmt::format("no sensor frame for {} s (last step {})", config_.world_timeout.count() / 1000.0,

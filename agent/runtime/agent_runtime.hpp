@@ -3,7 +3,8 @@
 //
 //   hello every hello_period on the default partition  ──▶  world
 //   admission (this id and session)                    ◀──  world      (refused: kRefused; none: kAdmitTimeout)
-//   frames on partition_for(run, id)                   ◀──  world      (none for world_timeout -> kWorldTimeout)
+//   frames on partition_for(run, id)                   ◀──  world      (none for world_timeout -> kWorldTimeout;
+//                                                                       its writer gone for 6 s -> kWorldGone)
 //   one request per frame, same step                   ──▶  world      (run_over frame -> kRunOver)
 //
 // Single-threaded: the bus backends queue samples on their own threads and wake this one through a Signal; the
@@ -36,8 +37,8 @@ struct RuntimeConfig {
 };
 
 /// Why run() returned.
-enum class RunOutcome { kRunOver, kStopped, kRefused, kAdmitTimeout, kWorldTimeout };
-/// "run_over", "stopped", "refused", "admit_timeout", "world_timeout".
+enum class RunOutcome { kRunOver, kStopped, kRefused, kAdmitTimeout, kWorldTimeout, kWorldGone };
+/// "run_over", "stopped", "refused", "admit_timeout", "world_timeout", "world_gone".
 std::string to_string(RunOutcome outcome);
 
 /// What happened in a run.

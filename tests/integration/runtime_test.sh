@@ -11,6 +11,8 @@
 #   kill                                                             SIGKILL one of 3 agents mid-run, others finish
 #   pause                                                            SIGSTOP the world, then an agent, 3 s each: the
 #                                                                    run loses nothing (same sha256 as unpaused)
+#   world-kill                                                       SIGKILL the world mid-run: every agent learns that
+#                                                                    it is gone within 15 s and exits 1 saying so
 #   monitor                                                          marsala-monitor tail follows a run to its end
 set -euo pipefail
 case_name="$1"
@@ -144,6 +146,33 @@ case "$case_name" in
     [ "$(field terrain_sha256 "$s")" = "$(field terrain_sha256 "$reference")" ] ||
       fail "paused run ended on $(field terrain_sha256 "$s"), unpaused on $(field terrain_sha256 "$reference")"
     echo "ok: world and agent paused 3 s each; completed in $(field steps "$s") steps on the unpaused terrain"
+    ;;
+  world-kill)
+    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+    out="$work/world-kill"
+    mkdir -p "$out/logs"
+    "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
+      >"$out/logs/world.log" 2>&1 &
+    world=$!
+    pids=()
+    for id in 1 2 3; do
+      "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" \
+        >"$out/logs/agent-$id.log" 2>&1 &
+      pids+=($!)
+    done
+    for _ in $(seq 1 3000); do grep -q "agent 1 deposited" "$out/events.log" 2>/dev/null && break; sleep 0.02; done
+    grep -q "agent 1 deposited" "$out/events.log" || fail "agent 1 never deposited (see $out/logs)"
+    kill -KILL "$world"
+    killed=$SECONDS
+    for id in 1 2 3; do
+      rc=0
+      wait "${pids[$((id - 1))]}" || rc=$?
+      [ "$rc" -eq 1 ] || fail "agent $id exited $rc after the world died (expected 1)"
+      grep -q "the world is gone" "$out/logs/agent-$id.log" || { cat "$out/logs/agent-$id.log"; fail "agent $id did not say the world is gone"; }
+    done
+    took=$((SECONDS - killed))
+    [ "$took" -le 15 ] || fail "the agents took $took s to notice the dead world (at most 15 s)"
+    echo "ok: world killed; all three agents exited within $took s saying it is gone"
     ;;
   monitor)
     export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
