@@ -33,6 +33,20 @@ run_spawn() {  # run_spawn OUT_NAME AGENTS DDS [AGENT_DDS]
   [ -f "$out/summary.json" ] || fail "no summary.json in $out"
   echo "$out/summary.json"
 }
+start_run() {  # start_run OUT: marsala-world and agents 1..3 on Cyclone in the background; sets out, world, pids
+  export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+  out="$1"
+  mkdir -p "$out/logs"
+  "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
+    >"$out/logs/world.log" 2>&1 &
+  world=$!
+  pids=()
+  for id in 1 2 3; do
+    "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" \
+      >"$out/logs/agent-$id.log" 2>&1 &
+    pids+=($!)
+  done
+}
 expect_completed() {  # expect_completed SUMMARY AGENTS
   [ "$(field completed "$1")" = "true" ] || { cat "$1"; fail "run did not complete"; }
   [ "$(field agents "$1")" = "$2" ] || { cat "$1"; fail "expected $2 agents in the summary"; }
@@ -87,18 +101,7 @@ case "$case_name" in
     echo "ok: $sent attacks, $rejected rejections logged, honest agent completed in $(field steps "$s") steps"
     ;;
   kill)
-    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
-    out="$work/kill"
-    mkdir -p "$out/logs"
-    "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
-      >"$out/logs/world.log" 2>&1 &
-    world=$!
-    pids=()
-    for id in 1 2 3; do
-      "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" \
-        >"$out/logs/agent-$id.log" 2>&1 &
-      pids+=($!)
-    done
+    start_run "$work/kill"
     # Kill agent 2 without warning as soon as it has deposited (events.log is written live): mid-run for sure.
     for _ in $(seq 1 3000); do grep -q "agent 2 deposited" "$out/events.log" 2>/dev/null && break; sleep 0.02; done
     grep -q "agent 2 deposited" "$out/events.log" || fail "agent 2 never deposited (see $out/logs)"
@@ -117,18 +120,7 @@ case "$case_name" in
   pause)
     reference=$(run_spawn reference 3 cyclone)
     expect_completed "$reference" 3
-    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
-    out="$work/pause"
-    mkdir -p "$out/logs"
-    "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
-      >"$out/logs/world.log" 2>&1 &
-    world=$!
-    pids=()
-    for id in 1 2 3; do
-      "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" \
-        >"$out/logs/agent-$id.log" 2>&1 &
-      pids+=($!)
-    done
+    start_run "$work/pause"
     wait_for_event() {  # wait_for_event PATTERN: until events.log (written live) holds it
       for _ in $(seq 1 3000); do grep -q "$1" "$out/events.log" 2>/dev/null && return 0; sleep 0.02; done
       fail "no '$1' in events.log (see $out/logs)"
@@ -148,18 +140,7 @@ case "$case_name" in
     echo "ok: world and agent paused 3 s each; completed in $(field steps "$s") steps on the unpaused terrain"
     ;;
   world-kill)
-    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
-    out="$work/world-kill"
-    mkdir -p "$out/logs"
-    "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
-      >"$out/logs/world.log" 2>&1 &
-    world=$!
-    pids=()
-    for id in 1 2 3; do
-      "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" \
-        >"$out/logs/agent-$id.log" 2>&1 &
-      pids+=($!)
-    done
+    start_run "$work/world-kill"
     for _ in $(seq 1 3000); do grep -q "agent 1 deposited" "$out/events.log" 2>/dev/null && break; sleep 0.02; done
     grep -q "agent 1 deposited" "$out/events.log" || fail "agent 1 never deposited (see $out/logs)"
     kill -KILL "$world"
