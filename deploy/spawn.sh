@@ -8,7 +8,7 @@
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
 #                 folder that holds another run's files, unless --replace removes them (and logs/) first
 #   --dds         vendor of every process (default cyclone); --agent-dds overrides it for the agents (mixed runs)
-#   --domain      DDS domain id (default: a free-looking one derived from the process id)
+#   --domain      DDS domain id (default: a random one on which no world answers within 1 s)
 #   --monitor     also run `marsala-monitor tail` in the foreground output
 #   --timeout     give up (and stop everything) after S seconds of wall time (default 1800)
 #   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
@@ -49,11 +49,26 @@ done
 [ -z "$seed" ] || [[ "$seed" =~ ^[0-9]+$ ]] ||
   { echo "spawn.sh: --seed N needs a non-negative integer, got '$seed'" >&2; exit 2; }
 agent_dds="${agent_dds:-$dds}"
-domain="${domain:-$(( ($$ % 200) + 20 ))}"
 [ -n "$out" ] || { out="$root/out/$(basename "${scenario%.*}")-$agents"; replace=1; }
 for b in marsala-world marsala-agent; do
   [ -x "$bin/$b" ] || { echo "spawn.sh: $bin/$b not built (run deploy/build.sh)" >&2; exit 1; }
 done
+
+# Loopback only: DDS traffic never leaves this host's lo interface.
+export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-lo.xml"
+
+# Without --domain: a random one (not derived from the PID, whose values repeat) on which no world answers
+# `marsala-monitor status` within 1 s. A world still admitting its agents publishes no status yet, so two runs
+# started at the same moment may still meet: give each its own --domain for certainty.
+if [ -z "$domain" ]; then
+  for _ in 1 2 3 4 5; do
+    domain=$(( (RANDOM % 200) + 20 ))
+    [ -x "$bin/marsala-monitor" ] || break
+    "$bin/marsala-monitor" status --dds "$dds" --domain "$domain" --timeout 1 >/dev/null 2>&1 || break
+    [ "$quiet" -eq 1 ] || echo "spawn.sh: domain $domain is busy (a world answers there), trying another"
+  done
+fi
 
 # A run never mixes its outputs with another's: the world refuses a folder holding a run; --replace clears one.
 if [ "$replace" -eq 1 ] && [ -d "$out" ]; then
@@ -76,10 +91,6 @@ if [ "$check_rc" -ne 0 ]; then
   echo "spawn.sh: marsala-world --check rejects the run (exit $check_rc); nothing started" >&2
   exit "$check_rc"
 fi
-
-# Loopback only: DDS traffic never leaves this host's lo interface.
-export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
-export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-lo.xml"
 
 mkdir -p "$out/logs"
 pids=()
