@@ -17,6 +17,7 @@
 #include "marsala/core/error.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
 #include "marsala/world_server/world_cli.hpp"
+#include "unit/world_server/world_cli_fixture.hpp"
 #include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
@@ -56,30 +57,8 @@ const Value& at(const Struct& object, const std::string& key) {
   return it == object.fields().end() ? kMissing : it->second;
 }
 
-class ScenarioCheckTest : public ::testing::Test {
+class ScenarioCheckTest : public testing::WorldCliFixture {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("marsala_scenario_check_test_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-  /// marsala-world with `args`, in process, as main() runs it.
-  int run(std::vector<std::string> args) {
-    args.insert(args.begin(), "marsala-world");
-    std::vector<const char*> argv;
-    for (const auto& a : args) argv.push_back(a.c_str());
-    out_.str("");
-    err_.str("");
-    return run_world_cli(static_cast<int>(argv.size()), argv.data(), stop_, out_, err_);
-  }
   /// Expects `marsala-world --check FILE` to reject `text` with exit 2, nothing on stdout and one error line that
   /// names the file and contains `problem`.
   void expect_rejected(const std::string& text, const std::string& problem) {
@@ -91,10 +70,6 @@ class ScenarioCheckTest : public ::testing::Test {
     EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
     EXPECT_EQ(out_.str(), "");
   }
-
-  fs::path dir_;
-  std::atomic<bool> stop_{false};
-  std::ostringstream out_, err_;
 };
 
 TEST_F(ScenarioCheckTest, TheRampScenarioIsValidAndReportedInFull) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "unit/world_server/fake_agent.hpp"
+#include "unit/world_server/world_cli_fixture.hpp"
 #include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
@@ -18,34 +19,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class WorldCliTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("marsala_world_cli_test_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-  int run(std::vector<std::string> args) {
-    args.insert(args.begin(), "marsala-world");
-    std::vector<const char*> argv;
-    for (const auto& a : args) argv.push_back(a.c_str());
-    out_.str("");
-    err_.str("");
-    return run_world_cli(static_cast<int>(argv.size()), argv.data(), stop_, out_, err_);
-  }
-
-  fs::path dir_;
-  std::atomic<bool> stop_{false};
-  std::ostringstream out_, err_;
-};
+using WorldCliTest = testing::WorldCliFixture;
 
 TEST_F(WorldCliTest, UsageErrorsExitWith2) {
   EXPECT_EQ(run({}), 2);
