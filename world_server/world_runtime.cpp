@@ -110,11 +110,11 @@ WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, R
   // Every builder computes MARS at its construction kappa on windows of this terrain, whose heights grow as it is
   // built, up to the world's height limit (kMaxMagnitude): refuse combinations that doubles cannot compute there
   // (docs/runtime.md#scenario-validation) instead of letting an agent's processor fail mid-run.
-  const double highest_m = kMaxMagnitude;
+  const double height_limit_m = kMaxMagnitude;
   for (std::uint32_t id = 1; id <= agents; ++id) {
     const RobotType& type = s.robot_for(id);
-    const std::string problem =
-        mars_problem(construction_params(type).kappa, terrain.cell_size_m(), highest_m, terrain.rows(), terrain.cols());
+    const std::string problem = mars_problem(construction_params(type).kappa, terrain.cell_size_m(), height_limit_m,
+                                             terrain.rows(), terrain.cols());
     if (!problem.empty())
       throw InvalidArgument(
           fmt::format("scenario {}: robot type '{}': construction kappa: {}", s.source_path, type.name, problem));

@@ -126,10 +126,12 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
   std::uint64_t last_answered = 0;
   Clock::time_point deadline = Clock::now() + config_.world_timeout;
   bool world_seen = false, world_lost = false;
+  bool frame_since_check = false;     // a frame proves the world alive: no DDS status query on the per-step path
   Clock::time_point world_lost_at{};  // when the world's frame writer was first found not alive (world_lost)
   while (!stop.load()) {
     const Clock::time_point now = Clock::now();
-    if (frames->alive_writers() >= 1) {
+    if (frame_since_check || frames->alive_writers() >= 1) {
+      frame_since_check = false;
       world_seen = true;
       world_lost = false;
     } else if (world_seen) {
@@ -155,6 +157,7 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
         continue;
       }
       ++result.frames;
+      frame_since_check = true;
       result.last_step = frame.step;
       deadline = Clock::now() + config_.world_timeout;
       if (frame.last_result == protocol::ActionResult::kRejected) {
