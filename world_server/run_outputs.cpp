@@ -14,7 +14,7 @@
 #include "marsala/render/png_writer.hpp"
 #include "marsala/render/terrain_renderer.hpp"
 #include "marsala/terrain/asc_io.hpp"
-#include "marsala/world_server/sha256.hpp"
+#include "marsala/runlog/sha256.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -147,7 +147,7 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_admitted(admitted);
   s.set_missed_deadlines(missed);
   s.set_rejected_requests(rejected);
-  s.set_terrain_sha256(terrain_sha256(state.terrain));
+  s.set_terrain_sha256(runlog::terrain_sha256(state.terrain));
   s.set_rows(state.terrain.rows());
   s.set_cols(state.terrain.cols());
   s.set_cell_size_m(state.terrain.cell_size_m());

@@ -19,7 +19,7 @@
 #include "marsala/world_server/completion.hpp"
 #include "marsala/world_server/run_outputs.hpp"
 #include "marsala/world_server/sensing_service.hpp"
-#include "marsala/world_server/sha256.hpp"
+#include "marsala/runlog/sha256.hpp"
 #include "marsala/world_server/step.hpp"
 
 namespace marsala::world_server {
@@ -429,7 +429,7 @@ struct WorldRuntime::Impl {
     info.step_wall_p90_ms = percentile(step_ms, 0.9);
     write_final_outputs(options.out_dir, state, info);
     for (const AgentRecord& a : state.agents) result.admitted += a.admitted ? 1 : 0;
-    result.terrain_sha256 = terrain_sha256(state.terrain);
+    result.terrain_sha256 = runlog::terrain_sha256(state.terrain);
     spdlog::info("run over ({}): {} steps in {:.3f} s, {:.6f} m3 deposited, terrain sha256 {}", to_string(end_reason),
                  result.steps, result.wall_seconds, state.deposited_volume_m3, result.terrain_sha256);
     linger(live);

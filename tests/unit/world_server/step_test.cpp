@@ -8,7 +8,7 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/world_server/completion.hpp"
-#include "marsala/world_server/sha256.hpp"
+#include "marsala/runlog/sha256.hpp"
 #include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
@@ -111,7 +111,7 @@ TEST(ApplyStep, ArrivalOrderAcrossAgentsNeverChangesTheResult) {
     ASSERT_EQ(a.accepted, b.accepted);
     ASSERT_EQ(a.changed_tiles, b.changed_tiles);
   }
-  EXPECT_EQ(terrain_sha256(in_order.terrain), terrain_sha256(shuffled.terrain));
+  EXPECT_EQ(runlog::terrain_sha256(in_order.terrain), runlog::terrain_sha256(shuffled.terrain));
   EXPECT_GT(in_order.deposited_volume_m3, 0.0);
   EXPECT_EQ(in_order.deposited_volume_m3, shuffled.deposited_volume_m3);
   for (std::uint32_t id = 1; id <= 3; ++id) {
@@ -178,11 +178,11 @@ TEST(ApplyStep, AForgedRequestOnAnAgentsPartitionDoesNotTakeItsSlot) {
 TEST(ApplyStep, ARejectedRequestChangesNothingAndIsReportedInTheNextFrame) {
   const scenario::Scenario s = small_scenario();
   WorldState w = admitted_state(s, flat_terrain(), 1);
-  const std::string before = terrain_sha256(w.terrain);
+  const std::string before = runlog::terrain_sha256(w.terrain);
   protocol::ActionRequest r = with_deposition(move_to(w, 1, 1.25, 1.05), 1.25, 2.05, kLayer);
   r = with_deposition(r, 1.25, 2.55, kLayer);  // 1.5 m away: out of reach, so nothing of it happens
   const StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{r});
-  EXPECT_EQ(terrain_sha256(w.terrain), before);
+  EXPECT_EQ(runlog::terrain_sha256(w.terrain), before);
   EXPECT_EQ(w.agent(1).x_m, 1.05);
   EXPECT_EQ(w.agent(1).material_m3, 0.05);
   EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kRejected);

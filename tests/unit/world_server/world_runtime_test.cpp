@@ -13,7 +13,7 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/terrain/asc_io.hpp"
-#include "marsala/world_server/sha256.hpp"
+#include "marsala/runlog/sha256.hpp"
 #include "unit/world_server/fake_agent.hpp"
 #include "unit/world_server/world_fixtures.hpp"
 
@@ -190,7 +190,7 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
        {std::string("\"completed\": true"), std::string("\"steps\": 11"), std::string("\"agents\": 2"),
         std::string("\"admitted\": 2"), std::string("\"missed_deadlines\": 0"), std::string("\"dds\": \"inprocess\""),
         std::string("\"scenario\": \"small\""), std::string("\"seed\": \"1\""),
-        std::string("\"end_reason\": \"completed\""), "\"terrain_sha256\": \"" + terrain_sha256(s.terrain) + "\"",
+        std::string("\"end_reason\": \"completed\""), "\"terrain_sha256\": \"" + runlog::terrain_sha256(s.terrain) + "\"",
         std::string("\"per_agent\""), std::string("\"accepted\": 11"), std::string("\"at_goal\": true"),
         std::string("\"dropped\": false"), std::string("\"wall_seconds\"")})
     EXPECT_NE(summary.find(field), std::string::npos) << field << " not in\n" << summary;
@@ -198,7 +198,7 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   EXPECT_EQ(json_number(summary, "deposited_m3"), s.agent(1).deposited_m3);
   EXPECT_GT(json_number(summary, "wall_seconds"), 0.0);
   const Heightmap final_terrain = terrain::read_asc((out_ / "terrain_final.asc").string());
-  EXPECT_EQ(terrain_sha256(final_terrain), terrain_sha256(s.terrain));
+  EXPECT_EQ(runlog::terrain_sha256(final_terrain), runlog::terrain_sha256(s.terrain));
   EXPECT_EQ(terrain::read_asc((out_ / "terrain_initial.asc").string()).max_height(), 0.0);
   EXPECT_GT(fs::file_size(out_ / "final.png"), 1000u);
   const std::string log = read_text(out_ / "events.log");

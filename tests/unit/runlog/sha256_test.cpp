@@ -1,4 +1,4 @@
-#include "marsala/world_server/sha256.hpp"
+#include "marsala/runlog/sha256.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace marsala::world_server {
+namespace marsala::runlog {
 namespace {
 
 std::string hex_of(const std::string& s) { return sha256_hex(s.data(), s.size()); }
@@ -66,4 +66,4 @@ TEST(Sha256, TerrainDigestIsOfLittleEndianDoublesRowMajor) {
 }
 
 }  // namespace
-}  // namespace marsala::world_server
+}  // namespace marsala::runlog

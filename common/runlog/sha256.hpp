@@ -10,7 +10,7 @@
 
 #include "marsala/core/heightmap.hpp"
 
-namespace marsala::world_server {
+namespace marsala::runlog {
 
 /// Incremental SHA-256 (FIPS 180-4).
 class Sha256 {
@@ -39,4 +39,4 @@ std::string sha256_hex(const void* data, std::size_t size);
 /// Hex SHA-256 of the heights as little-endian IEEE doubles, row-major (row 0 first).
 std::string terrain_sha256(const Heightmap& terrain);
 
-}  // namespace marsala::world_server
+}  // namespace marsala::runlog

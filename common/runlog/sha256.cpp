@@ -1,4 +1,4 @@
-#include "marsala/world_server/sha256.hpp"
+#include "marsala/runlog/sha256.hpp"
 
 #include <openssl/evp.h>
 
@@ -6,7 +6,7 @@
 
 #include "marsala/core/error.hpp"
 
-namespace marsala::world_server {
+namespace marsala::runlog {
 
 struct Sha256::Context {
   std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> md{EVP_MD_CTX_new(), &EVP_MD_CTX_free};
@@ -66,4 +66,4 @@ std::string terrain_sha256(const Heightmap& terrain) {
   return to_hex(hash.finish());
 }
 
-}  // namespace marsala::world_server
+}  // namespace marsala::runlog
