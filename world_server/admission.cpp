@@ -34,8 +34,12 @@ std::string body_difference(const RobotBody& got, const RobotBody& want) {
 
 }  // namespace
 
-AdmissionDecision decide_admission(const WorldState& state, const protocol::AgentHello& hello, bool run_started) {
-  const auto refuse = [](std::string reason) { return AdmissionDecision{false, std::move(reason)}; };
+AdmissionDecision decide_admission(const WorldState& state, const protocol::AgentHello& hello, bool run_started,
+                                   bool holder_connected) {
+  const auto refuse = [](std::string reason) {
+    return AdmissionDecision{false, std::move(reason), AdmissionKind::kRefused};
+  };
+  const auto accept = [](AdmissionKind kind) { return AdmissionDecision{true, {}, kind}; };
   const std::string who = "agent " + std::to_string(hello.agent_id);
   if (!state.has_agent(hello.agent_id))
     return refuse("unknown agent id " + std::to_string(hello.agent_id) + ": this run has agents 1.." +
@@ -46,18 +50,38 @@ AdmissionDecision decide_admission(const WorldState& state, const protocol::Agen
   const std::string difference = body_difference(hello.body, slot.type.body);
   if (!difference.empty())
     return refuse(who + ": body differs from robot type '" + slot.type.name + "' of its slot: " + difference);
-  if (slot.dropped) return refuse(who + " was dropped from the run: " + slot.drop_reason);
+  if (slot.dropped) {
+    if (slot.readmissions >= kMaxReadmissions)
+      return refuse(
+          fmt::format("{} was dropped from the run: {}; it has taken its slot back {} times, the most a run "
+                      "allows",
+                      who, slot.drop_reason, slot.readmissions));
+    return accept(AdmissionKind::kReadmission);
+  }
   if (slot.admitted) {
-    if (slot.session == hello.session) return {true, {}};
-    return refuse(who + " is already admitted with another session");
+    if (slot.session == hello.session) return accept(AdmissionKind::kRepeat);
+    if (!holder_connected) return accept(AdmissionKind::kTakeover);
+    return refuse(who + " is already admitted with another session that is still connected");
   }
   if (run_started) return refuse(who + ": the run has already started");
-  return {true, {}};
+  return accept(AdmissionKind::kFirst);
 }
 
-bool admit(WorldState& state, const protocol::AgentHello& hello) {
+bool admit(WorldState& state, const protocol::AgentHello& hello, AdmissionKind kind) {
   AgentRecord& a = state.agent(hello.agent_id);
-  if (a.admitted) return false;
+  if (kind == AdmissionKind::kReadmission || kind == AdmissionKind::kTakeover) {
+    if (kind == AdmissionKind::kReadmission) ++a.readmissions;
+    a.alive = true;
+    a.dropped = false;
+    a.drop_reason.clear();
+    a.session = hello.session;
+    a.name = hello.name.substr(0, kMaxNameChars);
+    a.consecutive_missed = 0;
+    a.recent_misses = 0;
+    a.at_goal = at_goal(state, a);
+    return true;
+  }
+  if (kind != AdmissionKind::kFirst || a.admitted) return false;
   a.admitted = true;
   a.alive = true;
   a.session = hello.session;

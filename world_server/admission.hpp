@@ -2,6 +2,7 @@
 // Admission of agents (docs/runtime.md#admission): pure decisions on hellos, and the Admission
 // message that answers each one.
 
+#include <cstdint>
 #include <string>
 
 #include "marsala/protocol/messages.hpp"
@@ -9,22 +10,38 @@
 
 namespace marsala::world_server {
 
+/// How often a dropped agent may take its slot back in one run (docs/runtime.md#re-admission).
+inline constexpr std::uint32_t kMaxReadmissions = 3;
+
+/// What an accepted hello does.
+enum class AdmissionKind {
+  kRefused,      ///< nothing: the hello is refused
+  kFirst,        ///< admits the slot for the first time (before the run starts)
+  kRepeat,       ///< the admitted session says hello again: nothing changes
+  kReadmission,  ///< a dropped agent takes its slot back (any session), with the state the world kept
+  kTakeover,     ///< a new session takes a live slot whose session is no longer connected (a restarted process)
+};
+
 /// The world's answer to one hello.
 struct AdmissionDecision {
   bool accepted = false;
   std::string reason;  ///< why not, when refused
+  AdmissionKind kind = AdmissionKind::kRefused;
 };
 
-/// Decides on `hello`: refused for an unknown id (no slot in this run), a body with non-finite or absurd values, a
-/// body that differs from the slot's robot type, an agent already dropped, an id admitted with another session, or
-/// (when `run_started`) an agent not admitted before the start. A repeated hello of an admitted session is accepted
-/// again.
-AdmissionDecision decide_admission(const WorldState& state, const protocol::AgentHello& hello, bool run_started);
+/// Decides on `hello` (docs/runtime.md#refusal-reasons): refused for an unknown id (no slot in this run), a body with
+/// non-finite or absurd values, a body that differs from the slot's robot type, an agent dropped kMaxReadmissions
+/// times already, an id admitted with another session that is still connected (`holder_connected`: the slot's
+/// request writer is alive), or (when `run_started`) an agent not admitted before the start. A dropped agent is
+/// re-admitted; a live slot whose session is no longer connected is taken over by the new session.
+AdmissionDecision decide_admission(const WorldState& state, const protocol::AgentHello& hello, bool run_started,
+                                   bool holder_connected = true);
 
-/// Admits the hello's agent (decide_admission accepted it): session, name, alive, pose at its start with the height
-/// under it, material at capacity. A repeated hello of the admitted session changes nothing. Returns true when the
-/// agent was newly admitted.
-bool admit(WorldState& state, const protocol::AgentHello& hello);
+/// Carries out an accepted decision. kFirst: session, name, alive, pose at its start with the height under it,
+/// material at capacity. kReadmission and kTakeover: alive again under the hello's session and name, pose and
+/// material as the world kept them, miss counts cleared, readmissions + 1 (kReadmission). kRepeat: nothing.
+/// Returns true when the slot's session changed or it became live (its endpoints must be opened).
+bool admit(WorldState& state, const protocol::AgentHello& hello, AdmissionKind kind = AdmissionKind::kFirst);
 
 /// The Admission message for `hello` and `decision`; geometry, start, target and base are filled for known ids.
 protocol::Admission admission_message(const WorldState& state, const protocol::AgentHello& hello,

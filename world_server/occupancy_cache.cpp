@@ -42,6 +42,16 @@ void OccupancyCache::mark_changed(CellIndex cell) {
   has_changes_ = true;
 }
 
+std::vector<CellIndex> OccupancyCache::pending_changes() const {
+  std::vector<CellIndex> cells;
+  for (const Box& b : changed_) {
+    if (b.row0 > b.row1) continue;
+    cells.push_back({area_.first.row + b.row0, area_.first.col + b.col0});
+    cells.push_back({area_.first.row + b.row1, area_.first.col + b.col1});
+  }
+  return cells;
+}
+
 void OccupancyCache::recompute(const Heightmap& terrain, const CellRect& t) {
   // The window holds every cell of T's balls that the area holds (see the header).
   const int r0 = std::max(0, t.first.row - reach_), c0 = std::max(0, t.first.col - reach_);

@@ -57,6 +57,10 @@ class OccupancyCache {
   void mark_changed(CellIndex cell);
   /// True when a cell of the area changed since the last update (or construction).
   bool has_changes() const { return has_changes_; }
+  /// Cells (grid coordinates) whose marking reproduces the changes recorded since the last update: the corners of
+  /// each block's box. A cache rebuilt on the current terrain and given these behaves as this one does from here on
+  /// (a snapshot of the world keeps them).
+  std::vector<CellIndex> pending_changes() const;
   /// Brings the mask up to date with `terrain` (the grid it was built on), recomputing only the cells the recorded
   /// changes can affect; returns how many cells were recomputed (0 without changes).
   long long update(const Heightmap& terrain);

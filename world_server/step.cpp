@@ -24,12 +24,14 @@ protocol::WorldEvent event(std::uint64_t step, std::uint32_t agent, protocol::Ev
 }
 
 /// Applies the requests that arrived on one live agent's partition.
-void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const protocol::ActionRequest*>& requests,
-                 std::vector<CellIndex>& changed_cells, StepOutcome& out, bool& deposited) {
+void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submission>& submissions,
+                 const std::vector<std::size_t>& mine, std::vector<CellIndex>& changed_cells, StepOutcome& out,
+                 bool& deposited) {
   const std::uint64_t step = state.step;
   const std::string who = "agent " + std::to_string(agent.id);
   bool answered = false;
-  for (const protocol::ActionRequest* r : requests) {
+  for (std::size_t index : mine) {
+    const protocol::ActionRequest* r = &submissions[index].request;
     if (!carries_identity_of(agent, *r)) {
       ++agent.rejected;
       ++out.rejected;
@@ -57,6 +59,7 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<const 
     const Verdict verdict = validate_request(state, agent.id, *r);
     if (verdict.accepted) {
       apply_request(state, *r, verdict, changed_cells);
+      out.accepted_submissions[index] = true;
       deposited = deposited || !r->depositions.empty();
       agent.last_result = protocol::ActionResult::kAccepted;
       agent.last_reason.clear();
@@ -101,19 +104,21 @@ StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submiss
   StepOutcome out;
   out.step = state.step;
   // Per partition, in arrival order; partitions in id order. The order across partitions never matters.
-  std::vector<std::vector<const protocol::ActionRequest*>> by_agent(state.agents.size());
-  for (const Submission& s : submissions) {
+  std::vector<std::vector<std::size_t>> by_agent(state.agents.size());
+  out.accepted_submissions.assign(submissions.size(), false);
+  for (std::size_t i = 0; i < submissions.size(); ++i) {
+    const Submission& s = submissions[i];
     if (!state.has_agent(s.channel_id) || !state.agent(s.channel_id).alive) {
       out.notes.push_back("request on the partition of agent " + std::to_string(s.channel_id) +
                           ", which is not in the run, ignored");
       continue;
     }
-    by_agent[s.channel_id - 1].push_back(&s.request);
+    by_agent[s.channel_id - 1].push_back(i);
   }
   std::vector<CellIndex> changed_cells;
   bool deposited = false;
   for (AgentRecord& agent : state.agents)
-    if (agent.alive) apply_agent(state, agent, by_agent[agent.id - 1], changed_cells, out, deposited);
+    if (agent.alive) apply_agent(state, agent, submissions, by_agent[agent.id - 1], changed_cells, out, deposited);
   if (!deposited) ++state.idle_steps;
 
   const TileLayout tiles = state.tiles();

@@ -26,7 +26,8 @@ struct AgentRecord {
   bool alive = false;  ///< admitted and not dropped: takes part in the lockstep
   bool dropped = false;
   std::string drop_reason;
-  std::uint64_t session = 0;  ///< from the admitted hello
+  std::uint32_t readmissions = 0;  ///< times it took its slot back after a drop (admission.hpp)
+  std::uint64_t session = 0;       ///< from the admitted hello
   std::string name;           ///< from the admitted hello
 
   double x_m = 0.0, y_m = 0.0;  ///< position [m]

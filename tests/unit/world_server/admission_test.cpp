@@ -79,17 +79,57 @@ TEST_F(AdmissionTest, Refusals) {
   h.body.max_step_m = 1e9;
   expect_refused(h, "invalid body: max_step_m");
 
-  // Admitted with one session: another session of the same id is refused.
+  // Admitted with one session: another session of the same id is refused while the first is connected, and takes
+  // the slot over when it is not (a restarted process).
   ASSERT_TRUE(admit(state_, hello_for(state_, 1, 5)));
-  expect_refused(hello_for(state_, 1, 6), "already admitted with another session");
+  expect_refused(hello_for(state_, 1, 6), "already admitted with another session that is still connected");
+  EXPECT_EQ(decide_admission(state_, hello_for(state_, 1, 6), true, false).kind, AdmissionKind::kTakeover);
   // Not admitted before the start: refused once the run has started.
   expect_refused(hello_for(state_, 2, 9), "already started", true);
-  // Dropped agents stay out.
+  // A dropped agent takes its slot back kMaxReadmissions times, then stays out.
+  for (std::uint32_t i = 0; i < kMaxReadmissions; ++i) {
+    drop_agent(state_, 1, "lost");
+    const protocol::AgentHello back = hello_for(state_, 1, 70 + i);
+    const AdmissionDecision again = decide_admission(state_, back, true);
+    ASSERT_TRUE(again.accepted) << i;
+    ASSERT_EQ(again.kind, AdmissionKind::kReadmission);
+    EXPECT_TRUE(admit(state_, back, again.kind));
+    EXPECT_EQ(state_.agent(1).readmissions, i + 1);
+  }
   drop_agent(state_, 1, "lost");
-  expect_refused(hello_for(state_, 1, 5), "was dropped");
+  expect_refused(hello_for(state_, 1, 99), "lost; it has taken its slot back 3 times, the most a run allows", true);
   const protocol::Admission m = admission_message(state_, hello_for(state_, 1, 5), {false, "no"}, "r");
   EXPECT_FALSE(m.accepted);
   EXPECT_EQ(m.reason, "no");
+}
+
+// Re-admission keeps what the world knows of the robot (pose, material, counts) and clears its misses.
+TEST_F(AdmissionTest, ReadmissionKeepsTheWorldsRecordOfTheRobot) {
+  ASSERT_TRUE(admit(state_, hello_for(state_, 1, 5)));
+  AgentRecord& a = state_.agent(1);
+  a.x_m += 1.0;
+  a.material_m3 = 0.25;
+  a.accepted = 12;
+  a.consecutive_missed = 2;
+  a.recent_misses = 0x5;
+  const double x = a.x_m;
+  drop_agent(state_, 1, "request writer lost liveliness");
+  const protocol::AgentHello back = hello_for(state_, 1, 6);
+  const AdmissionDecision d = decide_admission(state_, back, true);
+  ASSERT_EQ(d.kind, AdmissionKind::kReadmission);
+  EXPECT_TRUE(admit(state_, back, d.kind));
+  EXPECT_TRUE(a.alive);
+  EXPECT_FALSE(a.dropped);
+  EXPECT_EQ(a.drop_reason, "");
+  EXPECT_EQ(a.session, 6u);
+  EXPECT_EQ(a.x_m, x);
+  EXPECT_EQ(a.material_m3, 0.25);
+  EXPECT_EQ(a.accepted, 12u);
+  EXPECT_EQ(a.consecutive_missed, 0u);
+  EXPECT_EQ(a.recent_misses, 0u);
+  // The re-admitted session repeats its hello: nothing changes.
+  EXPECT_EQ(decide_admission(state_, back, true).kind, AdmissionKind::kRepeat);
+  EXPECT_FALSE(admit(state_, back, AdmissionKind::kRepeat));
 }
 
 }  // namespace
