@@ -180,6 +180,9 @@ proto::Snapshot make_snapshot(const WorldState& state, const std::string& run_id
     p->set_last_result(static_cast<std::uint32_t>(a.last_result));
     p->set_last_reason(a.last_reason);
   }
+  s.set_unattributed_rejections(state.unattributed_rejections);
+  s.set_surplus_requests(state.surplus_requests);
+  s.set_resumes(state.resumes);
   s.set_terrain_sha256(runlog::terrain_sha256(state.terrain));
   s.set_snapshot_crc32c(snapshot_crc(s));
   return s;
@@ -230,6 +233,9 @@ void restore_snapshot(WorldState& state, const proto::Snapshot& s, const std::st
     state.tile_versions[static_cast<std::size_t>(i)] = s.tile_versions(i);
   state.deposited_volume_m3 = s.deposited_volume_m3();
   state.idle_steps = s.idle_steps();
+  state.unattributed_rejections = s.unattributed_rejections();
+  state.surplus_requests = s.surplus_requests();
+  state.resumes = s.resumes();
   for (std::size_t i = 0; i < state.agents.size(); ++i) {
     const proto::AgentSnapshot& p = s.agents(static_cast<int>(i));
     AgentRecord& a = state.agents[i];
@@ -308,6 +314,7 @@ void apply_record(WorldState& state, const proto::LogRecord& record, const std::
       submissions.reserve(static_cast<std::size_t>(r.requests_size()));
       for (const proto::LoggedRequest& q : r.requests()) submissions.push_back(submission(q));
       const StepOutcome outcome = apply_step(state, submissions);
+      state.surplus_requests += r.surplus_requests();
       for (int i = 0; i < r.requests_size(); ++i)
         if (outcome.accepted_submissions[static_cast<std::size_t>(i)] != r.requests(i).accepted())
           throw bad("step " + std::to_string(r.step()) + ": request " + std::to_string(i) + " of agent " +
@@ -321,9 +328,9 @@ void apply_record(WorldState& state, const proto::LogRecord& record, const std::
                   fmt::format("{}", r.deposited_volume_m3()) + " m3 in the run");
       return;
     }
+    case proto::LogRecord::kResumed: ++state.resumes; return;
     case proto::LogRecord::kHeader:
     case proto::LogRecord::kEnd:
-    case proto::LogRecord::kResumed:
     case proto::LogRecord::RECORD_NOT_SET: return;
   }
 }

@@ -13,8 +13,8 @@
 #include "marsala/core/format.hpp"
 #include "marsala/render/png_writer.hpp"
 #include "marsala/render/terrain_renderer.hpp"
-#include "marsala/terrain/asc_io.hpp"
 #include "marsala/runlog/sha256.hpp"
+#include "marsala/terrain/asc_io.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -153,6 +153,12 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_cell_size_m(state.terrain.cell_size_m());
   s.set_completion(scenario::to_string(state.completion));
   s.set_idle_steps(static_cast<std::uint32_t>(state.idle_steps));
+  s.set_unattributed_rejections(state.unattributed_rejections);
+  s.set_surplus_requests(state.surplus_requests);
+  s.set_resumes(state.resumes);
+  std::uint32_t readmissions = 0;
+  for (const AgentRecord& a : state.agents) readmissions += a.readmissions;
+  s.set_readmissions(readmissions);
   s.set_path_found(report.route.has_value());
   s.set_path_length_m(report.route ? report.route->length_m : 0.0);
   s.set_site_level_fraction(report.site_fraction);
@@ -360,9 +366,9 @@ std::string format_event(const protocol::WorldEvent& e) {
   return line;
 }
 
-EventLog::EventLog(const std::string& path) : path_(path) {
+EventLog::EventLog(const std::string& path, bool append) : path_(path) {
   make_dir(fs::path(path).parent_path().empty() ? "." : fs::path(path).parent_path().string());
-  out_.open(path, std::ios::trunc);
+  out_.open(path, append ? std::ios::app : std::ios::trunc);
   if (!out_) throw IoError("cannot write '" + path + "'");
 }
 

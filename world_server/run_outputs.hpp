@@ -92,9 +92,9 @@ std::string format_event(const protocol::WorldEvent& event);
 /// events.log: appends one line per event or note, flushed at once so that a crash keeps what happened; a line that
 /// cannot be written throws IoError (the run then ends with an error).
 /// The files a run writes into its output folder (docs/runtime.md#outputs).
-inline constexpr const char* kRunFiles[] = {"summary.json",       "events.log", "terrain_initial.asc",
-                                            "terrain_final.asc",  "final.png",  "final_zoom.png",
-                                            "goal_vector_map.png"};
+inline constexpr const char* kRunFiles[] = {"summary.json",        "events.log", "terrain_initial.asc",
+                                            "terrain_final.asc",   "final.png",  "final_zoom.png",
+                                            "goal_vector_map.png", "run.log",    "snapshot.pb"};
 
 /// The kRunFiles present in `dir` (none when it does not exist).
 std::vector<std::string> run_files_in(const std::string& dir);
@@ -104,8 +104,8 @@ void check_fresh_output_dir(const std::string& dir);
 
 class EventLog {
  public:
-  /// Creates (truncates) the file; throws IoError.
-  explicit EventLog(const std::string& path);
+  /// Creates (truncates) the file, or with `append` continues it (a resumed run); throws IoError.
+  explicit EventLog(const std::string& path, bool append = false);
   void append(const protocol::WorldEvent& event);
   /// A line that is not an event, e.g. "step 7 note: agent 2: request for past step 5 dropped".
   void note(std::uint64_t step, const std::string& text);

@@ -30,12 +30,20 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
   const std::uint64_t step = state.step;
   const std::string who = "agent " + std::to_string(agent.id);
   bool answered = false;
+  const protocol::ActionRequest* first = nullptr;  // the request that answered the step
   for (std::size_t index : mine) {
     const protocol::ActionRequest* r = &submissions[index].request;
     if (!carries_identity_of(agent, *r)) {
-      ++agent.rejected;
+      // Forged or misdirected: charged to the admitted agent whose identity it carries (it wrote on another's
+      // partition), else to no agent; never to the partition's owner, the victim.
+      const bool known = state.has_agent(r->agent_id) && state.agent(r->agent_id).admitted &&
+                         state.agent(r->agent_id).session == r->session;
+      if (known)
+        ++state.agent(r->agent_id).rejected;
+      else
+        ++state.unattributed_rejections;
       ++out.rejected;
-      out.events.push_back(event(step, agent.id, protocol::EventKind::kRejected,
+      out.events.push_back(event(step, known ? r->agent_id : 0, protocol::EventKind::kRejected,
                                  "request claiming agent " + std::to_string(r->agent_id) + " session " +
                                      std::to_string(r->session) + " on agent " + std::to_string(agent.id) +
                                      "'s partition rejected: not its admitted identity"));
@@ -43,6 +51,10 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
     }
     if (r->step < step) {
       out.notes.push_back(who + ": request for past step " + std::to_string(r->step) + " dropped");
+      continue;
+    }
+    if (answered && r->step == step && protocol::same_request(*r, *first)) {
+      out.notes.push_back(who + ": request for step " + std::to_string(step) + " repeated; the first stands");
       continue;
     }
     if (r->step > step || answered) {
@@ -55,6 +67,7 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
       continue;
     }
     answered = true;
+    first = r;
     agent.state = r->state.substr(0, kMaxStateChars);
     const Verdict verdict = validate_request(state, agent.id, *r);
     if (verdict.accepted) {

@@ -23,9 +23,12 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       "cover more than half the terrain) and goal_vector_map.png (when the scenario has one) into --out.\n"
       "The run id (partition prefix) defaults to <scenario name>-d<domain>.\n"
       "marsala-world --check [--json] SCENARIO validates the scenario as the world would at start, without\n"
-      "DDS, prints what the run would start from and exits 0 when valid, 2 when not.",
+      "DDS, prints what the run would start from and exits 0 when valid, 2 when not.\n"
+      "Every run also writes run.log (every accepted change, checksummed) and snapshot.pb; after a crash,\n"
+      "marsala-world --resume DIR continues the run in DIR with its agents (docs/runtime.md#resume).\n"
+      "Exit codes: 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 1 error, 2 usage.",
       "marsala-world"};
-  std::string scenario_path, check_path, dds = "cyclone";
+  std::string scenario_path, check_path, resume_dir, dds = "cyclone";
   RuntimeOptions options;
   int domain = 0;
   bool quiet = false, check = false, json = false;
@@ -56,11 +59,21 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   std::uint64_t seed = 0;
   const CLI::Option* seed_option =
       app.add_option("--seed", seed, "override the scenario's seed (start jitter); summary.json reports the seed used");
+  CLI::Option* resume_option =
+      app.add_option(
+             "--resume", resume_dir,
+             "continue the run whose output folder is DIR after a crash of the world: its scenario, options and\n"
+             "state come from DIR/run.log (and snapshot.pb); the agents that were running reconnect")
+          ->excludes(scenario_option)
+          ->excludes(check_option);
+  app.add_option("--snapshot-every", options.snapshot_every, "write snapshot.pb after every N steps (0: never)")
+      ->check(CLI::Range(0ull, 1ull << 40))
+      ->capture_default_str();
   app.add_flag("--quiet", quiet, "log warnings and errors only");
   app.callback([&] {
-    // --scenario is required of a run; a check takes its file either way.
-    if (scenario_option->count() == 0 && check_path.empty())
-      throw CLI::RequiredError(check ? "SCENARIO (or --scenario)" : "--scenario");
+    // --scenario is required of a run; a check takes its file either way; a resume reads it from the log.
+    if (scenario_option->count() == 0 && check_path.empty() && resume_option->count() == 0)
+      throw CLI::RequiredError(check ? "SCENARIO (or --scenario)" : "--scenario (or --resume DIR)");
   });
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-world", out, err)) return *code;
 
@@ -70,12 +83,19 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   spdlog::set_pattern("%H:%M:%S.%e %^%l%$ world: %v");
   spdlog::set_level(quiet ? spdlog::level::warn : spdlog::level::info);
   try {
-    const scenario::Scenario scenario = scenario::load_scenario(scenario_path);
-    Heightmap terrain = scenario::build_terrain(scenario);
+    WorldStart start;
+    if (!resume_dir.empty()) {
+      start = prepare_resume(resume_dir, options, domain);
+    } else {
+      options.scenario_text = scenario::read_scenario_text(scenario_path);
+      const scenario::Scenario scenario = scenario::parse_scenario(options.scenario_text, scenario_path);
+      start = prepare_world_start(scenario, scenario::build_terrain(scenario), options, domain);
+    }
     const auto participant = bus::make_participant({bus::vendor_from_string(dds), domain});
-    WorldRuntime runtime(scenario, std::move(terrain), options, *participant);
+    WorldRuntime runtime(std::move(start), *participant);
     const RunResult result = runtime.run(stop);
-    out << "run " << runtime.run_id() << ": " << to_string(result.end_reason) << " after " << result.steps << " steps, "
+    out << "run " << runtime.run_id() << ": " << to_string(result.end_reason) << " after " << result.steps << " steps"
+        << (result.resumed_at_step ? " (resumed at step " + std::to_string(*result.resumed_at_step) + ")" : "") << ", "
         << result.admitted << " agents, terrain sha256 " << result.terrain_sha256 << "\n";
     return exit_code(result.end_reason);
   } catch (const Error& e) {

@@ -1,5 +1,6 @@
 #include "marsala/world_server/world_runtime.hpp"
 
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -7,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <set>
 #include <utility>
@@ -15,11 +17,13 @@
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/core/mars_processor.hpp"
+#include "marsala/runlog/sha256.hpp"
+#include "marsala/terrain/asc_io.hpp"
 #include "marsala/world_server/admission.hpp"
 #include "marsala/world_server/completion.hpp"
+#include "marsala/world_server/persistence.hpp"
 #include "marsala/world_server/run_outputs.hpp"
 #include "marsala/world_server/sensing_service.hpp"
-#include "marsala/runlog/sha256.hpp"
 #include "marsala/world_server/step.hpp"
 
 namespace marsala::world_server {
@@ -38,6 +42,19 @@ constexpr auto kReadyPollInterval = 5ms;
 constexpr auto kLivelinessGrace = 6s;
 // Progress lines at info level every this many steps.
 constexpr std::uint64_t kProgressEvery = 500;
+// Hellos do not wake the world (a flood of them must not stall the lockstep): they are taken at most this often and
+// whenever the world wakes anyway (docs/runtime.md#load-limits).
+constexpr auto kHelloInterval = 20ms;
+// Each (id, session) is answered at most this often; the legitimate agent says hello every 200 ms.
+constexpr auto kAnswerInterval = 150ms;
+// Bounds of the per-sender bookkeeping: beyond them, hellos are counted, not remembered.
+constexpr std::size_t kMaxAnswerKeys = 4096;
+constexpr std::size_t kMaxRefusalKeys = 1024;
+// Requests taken from one partition in one step beyond this many are counted (surplus) and never applied.
+constexpr std::size_t kMaxRequestsPerPartition = 8;
+// A live agent that has not answered its frame after this long gets the same frame again (its reader may have
+// matched late, e.g. after a resume); an agent that receives a frame twice repeats its request, which is ignored.
+constexpr auto kResendInterval = 500ms;
 
 /// The q-quantile (nearest rank) of `values`; 0 when empty.
 double percentile(std::vector<double> values, double q) {
@@ -82,16 +99,24 @@ void check_run_id(const std::string& run_id) {
   if (!ok) throw InvalidArgument("run id '" + run_id + "' must be non-empty letters, digits, '_', '-', '.'");
 }
 
-/// The endpoints of one admitted agent.
+/// The endpoints of one admitted agent (process): its session's partition.
 struct AgentLink {
+  std::uint64_t session = 0;  ///< the session whose partition the endpoints use
   std::unique_ptr<bus::Writer<protocol::SensorFrame>> frames;
   std::unique_ptr<bus::Reader<protocol::ActionRequest>> requests;
   bool writer_seen = false;                          ///< its request writer has been alive at least once
   std::optional<Clock::time_point> not_alive_since;  ///< when its seen writer was last found not alive
+  std::optional<protocol::SensorFrame> frame;        ///< the current step's frame, for resends
 };
 
+/// True when `n` is 1, 10, 100, ...: bounded logging of repeated things.
+bool power_of_ten(std::uint64_t n) {
+  while (n >= 10 && n % 10 == 0) n /= 10;
+  return n == 1;
+}
+
 WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, RuntimeOptions options, int domain_id) {
-  WorldStart start{s, std::move(options), {}};
+  WorldStart start{s, std::move(options), {}, std::nullopt};
   RuntimeOptions& o = start.options;
   if (o.seed) start.scenario.seed = *o.seed;
   const std::uint32_t agents = o.agents == 0 ? static_cast<std::uint32_t>(s.slots.size()) : o.agents;
@@ -124,14 +149,65 @@ WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, R
   return start;
 }
 
+WorldStart prepare_resume(const std::string& dir, RuntimeOptions options, int domain_id) {
+  namespace fs = std::filesystem;
+  const Clock::time_point began = Clock::now();
+  const std::string log_path = (fs::path(dir) / kRunLogFile).string();
+  if (!fs::exists(log_path))
+    throw Error("--resume " + dir + ": no " + kRunLogFile + " there (only runs of this version can be resumed)");
+  runlog::RunLogReader reader(log_path);
+  const proto::LogHeader& h = reader.header();
+  if (h.scenario_text().empty())
+    throw Error(log_path + ": the header holds no scenario text (the run was started without a scenario file)");
+  const scenario::Scenario scenario = scenario::parse_scenario(h.scenario_text(), h.scenario_file());
+  const std::string terrain_path = (fs::path(dir) / "terrain_initial.asc").string();
+  Heightmap terrain = terrain::read_asc(terrain_path);
+  if (terrain.rows() != h.rows() || terrain.cols() != h.cols() || terrain.cell_size_m() != h.cell_size_m() ||
+      runlog::terrain_sha256(terrain) != h.initial_terrain_sha256())
+    throw ParseError(terrain_path, 0,
+                     "it is not the initial terrain run.log was written from (grid or SHA-256 differs)");
+  options.agents = h.agents();
+  options.run_id = h.run_id();
+  options.seed = h.seed();
+  if (options.max_steps == 0) options.max_steps = h.max_steps();
+  options.step_deadline_s = h.step_deadline_s();
+  options.scenario_text = h.scenario_text();
+  const std::string out_dir = dir;
+  options.out_dir.clear();  // the folder holds this run's files: no freshness check
+  WorldStart start = prepare_world_start(scenario, std::move(terrain), std::move(options), domain_id);
+  start.options.out_dir = out_dir;
+  RebuiltState rebuilt = rebuild_state(dir, std::move(start.state), reader);
+  if (rebuilt.ended)
+    throw Error("--resume " + dir + ": the run ended (" + rebuilt.end_reason + ") after " +
+                std::to_string(rebuilt.state.step) + " steps; there is nothing to resume");
+  for (const char* name : {"summary.json", "terrain_final.asc"})
+    if (fs::exists(fs::path(dir) / name))
+      throw Error("--resume " + dir + ": " + name + " exists, so the run ended; there is nothing to resume");
+  start.state = std::move(rebuilt.state);
+  ResumeInfo info;
+  info.good_bytes = rebuilt.good_bytes;
+  info.snapshot_step = rebuilt.snapshot_step;
+  info.records = rebuilt.records;
+  info.tail_problem = rebuilt.tail_problem;
+  info.snapshot_problem = rebuilt.snapshot_problem;
+  info.rebuild_seconds = elapsed_s(began);
+  start.resume = info;
+  return start;
+}
+
 struct WorldRuntime::Impl {
   Impl(WorldStart start, bus::Participant& p)
       : scenario(std::move(start.scenario)),
         options(std::move(start.options)),
         participant(p),
-        state(std::move(start.state)) {
-    // make_world_state() keeps the terrain as given: the state's terrain is still the initial one.
-    if (scenario.has_goal_vector_map) initial_terrain = state.terrain;
+        state(std::move(start.state)),
+        resume(std::move(start.resume)),
+        resume_step(state.step) {
+    // make_world_state() keeps the terrain as given: the state's terrain is still the initial one, unless resumed.
+    if (scenario.has_goal_vector_map)
+      initial_terrain =
+          resume ? terrain::read_asc((std::filesystem::path(options.out_dir) / "terrain_initial.asc").string())
+                 : state.terrain;
     sensing.emplace(state);
     links.resize(state.agents.size());
     last_rejection.resize(state.agents.size());
@@ -139,7 +215,7 @@ struct WorldRuntime::Impl {
 
   void open_endpoints() {
     signal = std::make_shared<bus::Signal>();
-    hellos = participant.create_reader<protocol::AgentHello>({"", signal, bus::Durability::kVolatile, 64});
+    hellos = participant.create_reader<protocol::AgentHello>({"", nullptr, bus::Durability::kVolatile, 64});
     admissions = participant.create_writer<protocol::Admission>({"", nullptr, bus::Durability::kVolatile, 64});
     status = participant.create_writer<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
     events = participant.create_writer<protocol::WorldEvent>({"", nullptr, bus::Durability::kVolatile, 256});
@@ -164,26 +240,79 @@ struct WorldRuntime::Impl {
     return e;
   }
 
-  /// Answers every pending hello; admits the accepted newcomers and opens their partition endpoints.
-  void service_hellos() {
+  /// Appends a record to run.log (IoError ends the run: nothing the world does goes unrecorded).
+  void record(const proto::LogRecord& r) { run_log->append(r); }
+
+  /// Opens the partition endpoints of agent `id`'s admitted session (replacing another session's).
+  void open_link(std::uint32_t id) {
+    const AgentRecord& a = state.agent(id);
+    AgentLink& link = links[id - 1];
+    if (link.requests && link.session == a.session) return;
+    const std::string partition = protocol::partition_for(options.run_id, id, a.session);
+    link = AgentLink{};
+    link.session = a.session;
+    link.frames =
+        participant.create_writer<protocol::SensorFrame>({partition, nullptr, bus::Durability::kVolatile, 64});
+    link.requests =
+        participant.create_reader<protocol::ActionRequest>({partition, signal, bus::Durability::kVolatile, 64});
+    spdlog::info("agent {} '{}' ({}) on partition {}", id, a.name, a.type.name, partition);
+  }
+
+  /// True when the request writer of the slot's admitted session is alive.
+  bool holder_connected(std::uint32_t id) const {
+    if (!state.has_agent(id)) return false;
+    const AgentLink& link = links[id - 1];
+    return link.requests && link.requests->alive_writers() >= 1;
+  }
+
+  /// True when (id, session) may be answered now: each at most every kAnswerInterval (bounded bookkeeping).
+  bool may_answer(const protocol::AgentHello& hello, Clock::time_point now) {
+    const auto key = std::make_pair(hello.agent_id, hello.session);
+    const auto it = answered_at.find(key);
+    if (it != answered_at.end() && now - it->second < kAnswerInterval) return false;
+    if (answered_at.size() >= kMaxAnswerKeys) answered_at.clear();
+    answered_at[key] = now;
+    return true;
+  }
+
+  /// Takes the pending hellos (at most every kHelloInterval unless `now_please`) and answers them; carries out accepted
+  /// admissions (first, re-admission, takeover), records them in run.log and opens the session's endpoints.
+  void service_hellos(bool now_please = false) {
+    const Clock::time_point now = Clock::now();
+    if (!now_please && now < next_hello_service) return;
+    next_hello_service = now + kHelloInterval;
     for (const protocol::AgentHello& hello : hellos->take()) {
-      const AdmissionDecision decision = decide_admission(state, hello, run_started);
-      if (decision.accepted && admit(state, hello)) {
-        const std::string partition = protocol::partition_for(options.run_id, hello.agent_id);
-        AgentLink& link = links[hello.agent_id - 1];
-        link.frames =
-            participant.create_writer<protocol::SensorFrame>({partition, nullptr, bus::Durability::kVolatile, 64});
-        link.requests =
-            participant.create_reader<protocol::ActionRequest>({partition, signal, bus::Durability::kVolatile, 64});
-        spdlog::info("admitted agent {} '{}' ({}) on partition {}", hello.agent_id, state.agent(hello.agent_id).name,
-                     state.agent(hello.agent_id).type.name, partition);
-        emit(make_event(hello.agent_id, protocol::EventKind::kAdmitted, state.agent(hello.agent_id).name));
-      } else if (!decision.accepted && refused.insert({hello.agent_id, hello.session}).second) {
-        // Agents repeat their hello: each (id, session) is logged and published once, answered every time.
-        spdlog::warn("refused agent {}: {}", hello.agent_id, decision.reason);
-        emit(make_event(hello.agent_id, protocol::EventKind::kRefused, decision.reason));
+      ++hellos_taken;
+      const AdmissionDecision decision = decide_admission(state, hello, run_started, holder_connected(hello.agent_id));
+      if (decision.accepted && decision.kind != AdmissionKind::kRepeat) {
+        const std::uint64_t previous = state.agent(hello.agent_id).session;
+        if (admit(state, hello, decision.kind)) {
+          record(admitted_record(state, hello.agent_id, decision.kind));
+          AgentRecord& a = state.agent(hello.agent_id);
+          if (decision.kind != AdmissionKind::kFirst && a.session != previous) sensing->forget(hello.agent_id);
+          open_link(hello.agent_id);
+          links[hello.agent_id - 1].not_alive_since.reset();
+          std::string detail = a.name;
+          if (decision.kind == AdmissionKind::kReadmission)
+            detail += fmt::format(" (re-admitted, {} of {})", a.readmissions, kMaxReadmissions);
+          if (decision.kind == AdmissionKind::kTakeover)
+            detail += fmt::format(" (session {:016x} takes over from {:016x})", a.session, previous);
+          spdlog::info("admitted agent {}: {}", hello.agent_id, detail);
+          emit(make_event(hello.agent_id, protocol::EventKind::kAdmitted, detail));
+        }
+      } else if (!decision.accepted) {
+        ++refusals;
+        // Agents repeat their hello: each (id, session) is logged and published once (while the bounded memory of
+        // them lasts; then every 1st, 10th, 100th ... refusal), answered every time it may be.
+        const bool fresh = refused.size() < kMaxRefusalKeys ? refused.insert({hello.agent_id, hello.session}).second
+                                                            : power_of_ten(refusals);
+        if (fresh) {
+          spdlog::warn("refused agent {}: {} ({} refusals so far)", hello.agent_id, decision.reason, refusals);
+          emit(make_event(hello.agent_id, protocol::EventKind::kRefused, decision.reason));
+        }
       }
-      write_logged(*admissions, admission_message(state, hello, decision, options.run_id), "an admission");
+      if (may_answer(hello, now))
+        write_logged(*admissions, admission_message(state, hello, decision, options.run_id), "an admission");
     }
   }
 
@@ -203,6 +332,7 @@ struct WorldRuntime::Impl {
                        std::chrono::duration_cast<std::chrono::seconds>(kLivelinessGrace).count());
         } else if (now - *link.not_alive_since >= kLivelinessGrace) {
           spdlog::warn("agent {} dropped: its request writer lost liveliness", id);
+          record(dropped_record(state, id, "request writer lost liveliness"));
           emit(drop_agent(state, id, "request writer lost liveliness"));
         }
       }
@@ -218,7 +348,7 @@ struct WorldRuntime::Impl {
     const Clock::time_point deadline = Clock::now() + seconds(options.admit_timeout_s);
     const std::size_t expected = state.agents.size();
     for (;;) {
-      service_hellos();
+      service_hellos(true);
       check_liveliness();
       std::size_t admitted = 0;
       bool all_ready = true;
@@ -229,7 +359,9 @@ struct WorldRuntime::Impl {
       if (admitted == expected && all_ready) return;
       const Clock::time_point now = Clock::now();
       if (stop || now >= deadline) break;
-      signal->wait_until(std::min(deadline, now + (admitted == expected ? kReadyPollInterval : kPollInterval)));
+      signal->wait_until(std::min(
+          deadline, now + (admitted == expected ? kReadyPollInterval
+                                                : std::chrono::duration_cast<Clock::duration>(kHelloInterval))));
     }
     std::size_t admitted = 0, ready_count = 0;
     for (const AgentRecord& a : state.agents) {
@@ -245,14 +377,21 @@ struct WorldRuntime::Impl {
   }
 
   void send_frame(std::uint32_t id, bool run_over) {
-    write_logged(*links[id - 1].frames, sensing->frame_for(state, id, run_over), "a sensor frame");
+    AgentLink& link = links[id - 1];
+    link.frame = sensing->frame_for(state, id, run_over);
+    write_logged(*link.frames, *link.frame, "a sensor frame");
   }
 
-  /// Requests of the current step's live agents until all answered, the deadline passes, or stop.
-  std::vector<Submission> collect(const std::atomic<bool>& stop) {
+  /// Requests of the current step's live agents until all answered, the deadline passes, or stop. At most
+  /// kMaxRequestsPerPartition are taken from one partition in a step; the rest are counted in `surplus`. An agent
+  /// that has not answered after kResendInterval gets its frame again.
+  std::vector<Submission> collect(const std::atomic<bool>& stop, std::uint32_t& surplus) {
     const Clock::time_point deadline = Clock::now() + seconds(options.step_deadline_s);
+    Clock::time_point next_resend = Clock::now() + kResendInterval;
     std::vector<Submission> submissions;
     std::vector<bool> answered(state.agents.size(), false);
+    std::vector<std::size_t> taken(state.agents.size(), 0);
+    surplus = 0;
     for (;;) {
       service_hellos();
       for (const AgentRecord& a : state.agents) {
@@ -260,6 +399,11 @@ struct WorldRuntime::Impl {
         std::vector<protocol::ActionRequest> received = links[a.id - 1].requests->take();
         if (!a.alive) continue;  // a dropped agent's requests are read only to be discarded
         for (protocol::ActionRequest& r : received) {
+          if (taken[a.id - 1] >= kMaxRequestsPerPartition) {
+            ++surplus;
+            continue;
+          }
+          ++taken[a.id - 1];
           if (r.step == state.step && carries_identity_of(a, r)) answered[a.id - 1] = true;
           submissions.push_back({a.id, std::move(r)});
         }
@@ -269,7 +413,13 @@ struct WorldRuntime::Impl {
       if (std::all_of(live.begin(), live.end(), [&](std::uint32_t id) { return answered[id - 1]; })) break;
       const Clock::time_point now = Clock::now();
       if (stop || now >= deadline) break;
-      signal->wait_until(std::min(deadline, now + kPollInterval));
+      if (now >= next_resend) {
+        for (std::uint32_t id : live)
+          if (!answered[id - 1] && links[id - 1].frame)
+            write_logged(*links[id - 1].frames, *links[id - 1].frame, "a sensor frame");
+        next_resend = now + kResendInterval;
+      }
+      signal->wait_until(std::min({deadline, next_resend, now + kPollInterval}));
     }
     return submissions;
   }
@@ -308,6 +458,12 @@ struct WorldRuntime::Impl {
   /// Logs a rejection at info level, or at debug level when it repeats the agent's previous one (a stuck agent would
   /// otherwise fill the log; events.log keeps every one).
   void log_rejection(const protocol::WorldEvent& e) {
+    if (e.agent_id == 0) {  // forged: bounded, whoever sends them
+      if (power_of_ten(state.unattributed_rejections))
+        spdlog::warn("step {}: {} requests without an admitted identity rejected so far, e.g.: {}", e.step,
+                     state.unattributed_rejections, e.detail);
+      return;
+    }
     std::string& last = last_rejection[e.agent_id - 1];
     if (e.detail == last) {
       spdlog::debug("step {}: agent {} rejected again: {}", e.step, e.agent_id, e.detail);
@@ -327,9 +483,16 @@ struct WorldRuntime::Impl {
       if (live.empty()) return EndReason::kNoLiveAgents;
       const Clock::time_point step_start = Clock::now();
       for (std::uint32_t id : live) send_frame(id, false);
-      std::vector<Submission> submissions = collect(stop);
+      std::uint32_t surplus = 0;
+      std::vector<Submission> submissions = collect(stop, surplus);
       if (stop) return EndReason::kSignal;  // the interrupted step is not applied
       const StepOutcome outcome = apply_step(state, submissions);
+      state.surplus_requests += surplus;
+      // Recorded before anything of the step is published: a crash never loses a step an agent has seen applied.
+      record(step_record(submissions, outcome, state, surplus));
+      if (surplus > 0)
+        note(fmt::format("{} requests beyond {} per partition ignored", surplus, kMaxRequestsPerPartition));
+      if (options.snapshot_every > 0 && state.step % options.snapshot_every == 0) take_snapshot();
       step_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - step_start).count());
       if (outcome.completion_checked)
         spdlog::debug("step {}: {} check: {} (level fraction {:.4f})", outcome.step,
@@ -387,15 +550,88 @@ struct WorldRuntime::Impl {
     }
   }
 
+  /// snapshot.pb of the state after the step just recorded; run.log is synced first, so that the snapshot never
+  /// points past what a crash of the machine keeps.
+  void take_snapshot() {
+    run_log->sync();
+    write_snapshot((std::filesystem::path(options.out_dir) / kSnapshotFile).string(),
+                   make_snapshot(state, options.run_id, run_log->bytes()));
+  }
+
+  /// Opens run.log: a new one with its header, or (resumed) the existing one cut after its last good record.
+  void open_run_log() {
+    const std::string path = (std::filesystem::path(options.out_dir) / kRunLogFile).string();
+    if (!resume) {
+      LogStart start;
+      start.scenario_text = options.scenario_text;
+      start.run_id = options.run_id;
+      start.agents = static_cast<std::uint32_t>(state.agents.size());
+      start.max_steps = options.max_steps;
+      start.step_deadline_s = options.step_deadline_s;
+      run_log = runlog::RunLogWriter::create(path, log_header(scenario, start, state.terrain));
+      return;
+    }
+    run_log = runlog::RunLogWriter::continue_at(path, resume->good_bytes);
+    proto::LogRecord r;
+    r.mutable_resumed()->set_step(state.step);
+    r.mutable_resumed()->set_snapshot_step(resume->snapshot_step);
+    record(r);
+    ++state.resumes;
+  }
+
+  /// A resumed run: reopens the endpoints of the agents that were live and waits (answering hellos) until each is
+  /// ready again, or the admit timeout; agents that do not come back miss their steps and are dropped by the rules.
+  void reconnect_agents(const std::atomic<bool>& stop) {
+    for (const AgentRecord& a : state.agents)
+      if (a.alive) open_link(a.id);
+    const Clock::time_point deadline = Clock::now() + seconds(options.admit_timeout_s);
+    for (;;) {
+      service_hellos(true);
+      const std::vector<std::uint32_t> live = state.live_ids();
+      if (std::all_of(live.begin(), live.end(), [&](std::uint32_t id) { return ready(id); })) return;
+      const Clock::time_point now = Clock::now();
+      if (stop || now >= deadline) break;
+      signal->wait_until(std::min(deadline, now + std::chrono::duration_cast<Clock::duration>(kHelloInterval)));
+    }
+    std::vector<std::uint32_t> missing;
+    for (std::uint32_t id : state.live_ids())
+      if (!ready(id)) missing.push_back(id);
+    spdlog::warn("resuming without {} of {} live agents reconnected: {}", missing.size(), state.live_ids().size(),
+                 fmt::join(missing, ", "));
+  }
+
   RunResult run(const std::atomic<bool>& stop) {
-    write_initial_outputs(options.out_dir, state.terrain);
-    event_log.emplace((std::filesystem::path(options.out_dir) / "events.log").string());
+    if (resume) {
+      event_log.emplace((std::filesystem::path(options.out_dir) / "events.log").string(), true);
+    } else {
+      write_initial_outputs(options.out_dir, state.terrain);
+      event_log.emplace((std::filesystem::path(options.out_dir) / "events.log").string());
+    }
+    open_run_log();
     open_endpoints();
-    spdlog::info("run '{}': scenario '{}', {} x {} cells of {} m, waiting for {} agents (admit timeout {} s)",
-                 options.run_id, scenario.name, state.terrain.rows(), state.terrain.cols(), state.terrain.cell_size_m(),
-                 state.agents.size(), options.admit_timeout_s);
-    log_completion();
-    admit_agents(stop);
+    if (resume) {
+      run_started = true;
+      spdlog::info("run '{}' resumed at step {}: {} records replayed{} in {:.3f} s", options.run_id, state.step,
+                   resume->records,
+                   resume->snapshot_step > 0 ? fmt::format(" after the snapshot of step {}", resume->snapshot_step)
+                                             : std::string(),
+                   resume->rebuild_seconds);
+      if (!resume->tail_problem.empty()) spdlog::warn("cut run.log's damaged tail: {}", resume->tail_problem);
+      if (!resume->snapshot_problem.empty())
+        spdlog::warn("snapshot not used ({}); replayed run.log from its start", resume->snapshot_problem);
+      note(fmt::format("resumed: {} records replayed{}{}", resume->records,
+                       resume->snapshot_step > 0 ? fmt::format(" after the snapshot of step {}", resume->snapshot_step)
+                                                 : std::string(),
+                       resume->tail_problem.empty() ? std::string() : "; cut " + resume->tail_problem));
+      log_completion();
+      reconnect_agents(stop);
+    } else {
+      spdlog::info("run '{}': scenario '{}', {} x {} cells of {} m, waiting for {} agents (admit timeout {} s)",
+                   options.run_id, scenario.name, state.terrain.rows(), state.terrain.cols(),
+                   state.terrain.cell_size_m(), state.agents.size(), options.admit_timeout_s);
+      log_completion();
+      admit_agents(stop);
+    }
     run_started = true;
     const Clock::time_point start = Clock::now();
     publish_status(true, false, 0.0);
@@ -407,6 +643,12 @@ struct WorldRuntime::Impl {
     result.steps = state.step;
     result.wall_seconds = elapsed_s(start);
     const std::vector<std::uint32_t> live = state.live_ids();
+    proto::LogRecord end;
+    end.mutable_end()->set_steps(state.step);
+    end.mutable_end()->set_end_reason(to_string(end_reason));
+    end.mutable_end()->set_terrain_sha256(runlog::terrain_sha256(state.terrain));
+    record(end);
+    run_log->sync();
     for (std::uint32_t id : live) send_frame(id, true);
     emit(make_event(0, protocol::EventKind::kRunOver, to_string(end_reason)));
     publish_status(false, result.completed, result.wall_seconds);
@@ -430,6 +672,7 @@ struct WorldRuntime::Impl {
     write_final_outputs(options.out_dir, state, info);
     for (const AgentRecord& a : state.agents) result.admitted += a.admitted ? 1 : 0;
     result.terrain_sha256 = runlog::terrain_sha256(state.terrain);
+    if (resume) result.resumed_at_step = resume_step;
     spdlog::info("run over ({}): {} steps in {:.3f} s, {:.6f} m3 deposited, terrain sha256 {}", to_string(end_reason),
                  result.steps, result.wall_seconds, state.deposited_volume_m3, result.terrain_sha256);
     linger(live);
@@ -452,7 +695,14 @@ struct WorldRuntime::Impl {
   std::optional<EventLog> event_log;
   std::vector<std::string> last_rejection;  ///< [id - 1]: the rejection reason last logged at info level
   std::set<std::pair<std::uint32_t, std::uint64_t>> refused;  ///< (id, session) already reported as refused
+  std::map<std::pair<std::uint32_t, std::uint64_t>, Clock::time_point> answered_at;  ///< last answer per sender
+  std::uint64_t hellos_taken = 0;
+  std::uint64_t refusals = 0;
+  Clock::time_point next_hello_service{};
   bool run_started = false;
+  std::optional<ResumeInfo> resume;
+  std::uint64_t resume_step = 0;  ///< the step a resumed run continued at
+  std::optional<runlog::RunLogWriter> run_log;
 };
 
 WorldRuntime::WorldRuntime(const scenario::Scenario& scenario, Heightmap terrain, RuntimeOptions options,
@@ -460,6 +710,9 @@ WorldRuntime::WorldRuntime(const scenario::Scenario& scenario, Heightmap terrain
     : impl_(std::make_unique<Impl>(
           prepare_world_start(scenario, std::move(terrain), std::move(options), participant.domain_id()),
           participant)) {}
+
+WorldRuntime::WorldRuntime(WorldStart start, bus::Participant& participant)
+    : impl_(std::make_unique<Impl>(std::move(start), participant)) {}
 
 WorldRuntime::~WorldRuntime() = default;
 

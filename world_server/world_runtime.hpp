@@ -24,14 +24,26 @@ namespace marsala::world_server {
 
 /// How to run.
 struct RuntimeOptions {
-  std::uint32_t agents = 0;           ///< expected agents, ids 1..agents; 0 = every slot of the scenario
-  std::string run_id;                 ///< names the run's partitions; empty = default_run_id(scenario, domain)
-  double admit_timeout_s = 60.0;      ///< how long to wait for all agents before starting with those admitted [s]
-  std::uint64_t max_steps = 0;        ///< 0 = the scenario's max_steps
-  double step_deadline_s = 0.0;       ///< 0 = the scenario's step_deadline_s [s]
-  std::string out_dir = "out/run";    ///< summary.json, terrain_*.asc, final*.png, goal_vector_map.png, events.log
-  double linger_s = 2.0;              ///< after the run_over frames, wait up to this long for agents to leave [s]
-  std::optional<std::uint64_t> seed;  ///< overrides the scenario's seed (start jitter; reported in summary.json)
+  std::uint32_t agents = 0;             ///< expected agents, ids 1..agents; 0 = every slot of the scenario
+  std::string run_id;                   ///< names the run's partitions; empty = default_run_id(scenario, domain)
+  double admit_timeout_s = 60.0;        ///< how long to wait for all agents before starting with those admitted [s]
+  std::uint64_t max_steps = 0;          ///< 0 = the scenario's max_steps
+  double step_deadline_s = 0.0;         ///< 0 = the scenario's step_deadline_s [s]
+  std::string out_dir = "out/run";      ///< summary.json, terrain_*.asc, final*.png, goal_vector_map.png, events.log
+  double linger_s = 2.0;                ///< after the run_over frames, wait up to this long for agents to leave [s]
+  std::optional<std::uint64_t> seed;    ///< overrides the scenario's seed (start jitter; reported in summary.json)
+  std::uint64_t snapshot_every = 1000;  ///< write snapshot.pb after every this many steps; 0 = never
+  std::string scenario_text;  ///< the scenario file's text, recorded in run.log so that --resume needs no file
+};
+
+/// Where a resumed run picks up (prepare_resume()).
+struct ResumeInfo {
+  std::uint64_t good_bytes = 0;     ///< run.log's length up to its last good record; anything after it is cut
+  std::uint64_t snapshot_step = 0;  ///< the snapshot restored (0: replayed from the header)
+  std::uint64_t records = 0;        ///< records replayed
+  std::string tail_problem;         ///< run.log's damaged tail, cut and never applied (empty: clean)
+  std::string snapshot_problem;     ///< why snapshot.pb was not used, when present and unusable
+  double rebuild_seconds = 0.0;     ///< wall time to rebuild the state [s]
 };
 
 /// How a run ended.
@@ -41,7 +53,8 @@ struct RunResult {
   std::uint64_t steps = 0;                    ///< steps applied
   double wall_seconds = 0.0;                  ///< from the first frame to the end [s]
   std::uint32_t admitted = 0;
-  std::string terrain_sha256;  ///< of the final heights
+  std::string terrain_sha256;                    ///< of the final heights
+  std::optional<std::uint64_t> resumed_at_step;  ///< set when this process continued a run from its log
 };
 
 /// The default run id: "<scenario name>-d<domain id>", so runs of one scenario on different domains never share
@@ -53,9 +66,10 @@ void check_run_id(const std::string& run_id);
 
 /// What a run starts from, decided before the world touches the bus.
 struct WorldStart {
-  scenario::Scenario scenario;  ///< with the seed in use (RuntimeOptions::seed when given)
-  RuntimeOptions options;       ///< resolved: agents, run id, max_steps and step deadline filled in and checked
-  WorldState state;             ///< the initial state (make_world_state(): start jitter, completion check set up)
+  scenario::Scenario scenario;       ///< with the seed in use (RuntimeOptions::seed when given)
+  RuntimeOptions options;            ///< resolved: agents, run id, max_steps and step deadline filled in and checked
+  WorldState state;                  ///< the initial state (make_world_state(): start jitter, completion check set up)
+  std::optional<ResumeInfo> resume;  ///< set by prepare_resume(): `state` is the rebuilt one
 };
 
 /// Everything the world checks and decides at start before it admits agents, on the run's terrain: applies the seed
@@ -66,19 +80,29 @@ struct WorldStart {
 WorldStart prepare_world_start(const scenario::Scenario& scenario, Heightmap terrain, RuntimeOptions options,
                                int domain_id);
 
+/// The start of `marsala-world --resume DIR` (docs/runtime.md#resume): the scenario from run.log's header (its text,
+/// not the file), the terrain from DIR/terrain_initial.asc (checked against the header's digest), the options the run
+/// had (agents, run id, seed, max_steps and step deadline; options.max_steps > 0 raises the limit) and the state
+/// rebuilt by rebuild_state() from snapshot.pb and run.log. Throws Error when there is nothing to resume (no log, the
+/// run ended, no scenario text) and ParseError/IoError on files that cannot be read or disagree.
+WorldStart prepare_resume(const std::string& dir, RuntimeOptions options, int domain_id);
+
 /// One run of the world server on one participant.
 class WorldRuntime {
  public:
   /// Validates the options and prepares the state with prepare_world_start(); throws InvalidArgument.
   WorldRuntime(const scenario::Scenario& scenario, Heightmap terrain, RuntimeOptions options,
                bus::Participant& participant);
+  /// Runs a prepared start: prepare_world_start() or prepare_resume().
+  WorldRuntime(WorldStart start, bus::Participant& participant);
   ~WorldRuntime();
   WorldRuntime(const WorldRuntime&) = delete;
   WorldRuntime& operator=(const WorldRuntime&) = delete;
 
-  /// Admits agents, runs the lockstep until completion, max_steps, no live agent or `stop`, sends run_over frames
-  /// and writes the outputs. Throws Error when no agent is admitted within the admit timeout (or before `stop`),
-  /// IoError when the outputs cannot be written.
+  /// Admits agents (a resumed run: reconnects its agents), runs the lockstep until completion, max_steps, no live
+  /// agent or `stop`, sends run_over frames and writes the outputs; run.log records every change of the state before
+  /// its results are published. Throws Error when no agent is admitted within the admit timeout (or before `stop`),
+  /// IoError when the outputs or the log cannot be written.
   RunResult run(const std::atomic<bool>& stop);
 
   /// The world state (after run(): the final one).

@@ -28,7 +28,7 @@ struct AgentRecord {
   std::string drop_reason;
   std::uint32_t readmissions = 0;  ///< times it took its slot back after a drop (admission.hpp)
   std::uint64_t session = 0;       ///< from the admitted hello
-  std::string name;           ///< from the admitted hello
+  std::string name;                ///< from the admitted hello
 
   double x_m = 0.0, y_m = 0.0;  ///< position [m]
   double z_m = 0.0;             ///< terrain height of the cell under the centre [m]
@@ -77,11 +77,14 @@ struct WorldState {
   std::vector<std::uint64_t> tile_versions;  ///< per tile (TileLayout index): bumped in every step that changes it
   double deposited_volume_m3 = 0.0;          ///< total placed [m^3]
   scenario::CompletionKind completion = scenario::CompletionKind::kAgentsAtGoal;
-  scenario::PayloadPath payload_path;  ///< kPayloadPath: the payload's body, from, to, schedule
-  scenario::Site site;                 ///< kLevelSite: the site, its parameters, schedule
-  CompletionCheck check;               ///< kPayloadPath and kLevelSite
-  AgentIdGrid depositor;               ///< per cell: the agent whose deposition last raised it (0 = never)
-  std::uint64_t idle_steps = 0;        ///< applied steps in which no deposition was accepted
+  scenario::PayloadPath payload_path;         ///< kPayloadPath: the payload's body, from, to, schedule
+  scenario::Site site;                        ///< kLevelSite: the site, its parameters, schedule
+  CompletionCheck check;                      ///< kPayloadPath and kLevelSite
+  AgentIdGrid depositor;                      ///< per cell: the agent whose deposition last raised it (0 = never)
+  std::uint64_t idle_steps = 0;               ///< applied steps in which no deposition was accepted
+  std::uint32_t unattributed_rejections = 0;  ///< rejected requests carrying no admitted identity (forged)
+  std::uint32_t surplus_requests = 0;         ///< requests beyond a partition's per-step limit, never applied (runtime)
+  std::uint32_t resumes = 0;                  ///< times the world was resumed from its run log
 
   /// True when `id` names an agent slot of this run.
   bool has_agent(std::uint32_t id) const { return id >= 1 && id <= agents.size(); }

@@ -18,6 +18,10 @@ constexpr std::chrono::milliseconds kStopPoll{100};
 // than the pauses a world must survive (5 s, docs/runtime.md#dropping-agents), so an agent learns of a dead world
 // within about 7 s (the 1 s DDS lease, then this) instead of world_timeout.
 constexpr std::chrono::seconds kWorldGrace{6};
+// How long without a frame before the agent says hello again: the world answers whether it still counts the agent
+// in (a pause longer than the world's grace dropped it; docs/runtime.md#re-admission), so a dropped agent learns it
+// within about this long after it runs again, and is re-admitted where the rules allow.
+constexpr std::chrono::seconds kRehelloAfter{2};
 
 }  // namespace
 
@@ -69,10 +73,14 @@ RunResult AgentRuntime::run(const std::atomic<bool>& stop) {
 }
 
 bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, protocol::Admission& admission) {
-  auto signal = std::make_shared<bus::Signal>();
-  auto hellos = participant_.create_writer<protocol::AgentHello>({"", nullptr, bus::Durability::kVolatile, 64});
-  auto admissions = participant_.create_reader<protocol::Admission>({"", signal, bus::Durability::kVolatile, 64});
-  protocol::AgentHello hello;
+  admission_signal_ = std::make_shared<bus::Signal>();
+  hellos_ = participant_.create_writer<protocol::AgentHello>({"", nullptr, bus::Durability::kVolatile, 64});
+  admissions_ =
+      participant_.create_reader<protocol::Admission>({"", admission_signal_, bus::Durability::kVolatile, 64});
+  const auto& signal = admission_signal_;
+  const auto& hellos = hellos_;
+  const auto& admissions = admissions_;
+  protocol::AgentHello& hello = hello_;
   hello.agent_id = config_.agent_id;
   hello.session = config_.session;
   hello.name = config_.name;
@@ -117,13 +125,17 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
 }
 
 void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admission& admission, RunResult& result) {
-  const std::string partition = protocol::partition_for(admission.run_id, config_.agent_id);
+  const std::string partition = protocol::partition_for(admission.run_id, config_.agent_id, config_.session);
   auto signal = std::make_shared<bus::Signal>();
   auto frames = participant_.create_reader<protocol::SensorFrame>({partition, signal, bus::Durability::kVolatile, 64});
   auto requests =
       participant_.create_writer<protocol::ActionRequest>({partition, nullptr, bus::Durability::kVolatile, 64});
   bool answered_any = false;
   std::uint64_t last_answered = 0;
+  protocol::ActionRequest last_request;  // repeated when the world sends the frame of its step again
+  Clock::time_point last_frame_at = Clock::now();
+  Clock::time_point next_hello = last_frame_at + kRehelloAfter;
+  bool asked = false;  // a hello went out since the last frame
   Clock::time_point deadline = Clock::now() + config_.world_timeout;
   bool world_seen = false, world_lost = false;
   bool frame_since_check = false;     // a frame proves the world alive: no DDS status query on the per-step path
@@ -150,7 +162,23 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
                                    result.last_step);
       return;
     }
-    signal->wait_until(std::min(deadline, now + kStopPoll));
+    if (now - last_frame_at >= kRehelloAfter && now >= next_hello) {
+      if (!asked)
+        spdlog::info("agent {}: no frame for {} s; asking the world whether it still counts this agent in",
+                     config_.agent_id, std::chrono::duration<double>(now - last_frame_at).count());
+      hellos_->write(hello_);
+      asked = true;
+      next_hello = now + config_.hello_period;
+    }
+    for (const protocol::Admission& a : admissions_->take()) {
+      if (a.agent_id != config_.agent_id || a.session != config_.session || !asked) continue;
+      if (!a.accepted) {
+        result.outcome = RunOutcome::kRefused;
+        result.message = "the world no longer counts this agent in: " + a.reason;
+        return;
+      }
+    }
+    signal->wait_until(std::min({deadline, now + kStopPoll, asked ? next_hello : now + kStopPoll}));
     for (const protocol::SensorFrame& frame : frames->take()) {
       if (frame.agent_id != config_.agent_id) {
         spdlog::warn("agent {}: ignoring a frame addressed to agent {}", config_.agent_id, frame.agent_id);
@@ -158,6 +186,9 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
       }
       ++result.frames;
       frame_since_check = true;
+      last_frame_at = Clock::now();
+      if (asked) spdlog::info("agent {}: frames again at step {}", config_.agent_id, frame.step);
+      asked = false;
       result.last_step = frame.step;
       deadline = Clock::now() + config_.world_timeout;
       if (frame.last_result == protocol::ActionResult::kRejected) {
@@ -172,12 +203,19 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
                      result.rejected);
         return;
       }
-      if (answered_any && frame.step <= last_answered) {
-        spdlog::warn("agent {}: ignoring a repeated frame for step {}", config_.agent_id, frame.step);
+      if (answered_any && frame.step == last_answered) {
+        // The world did not get (or not yet) the answer: the same request again, never a second decision.
+        spdlog::debug("agent {}: the frame of step {} again; repeating its request", config_.agent_id, frame.step);
+        requests->write(last_request);
+        continue;
+      }
+      if (answered_any && frame.step < last_answered) {
+        spdlog::warn("agent {}: ignoring a stale frame for step {}", config_.agent_id, frame.step);
         continue;
       }
       const std::string before = behaviour_->state_name();
-      requests->write(behaviour_->decide(frame));
+      last_request = behaviour_->decide(frame);
+      requests->write(last_request);
       ++result.requests;
       answered_any = true;
       last_answered = frame.step;

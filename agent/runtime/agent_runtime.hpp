@@ -3,9 +3,12 @@
 //
 //   hello every hello_period on the default partition  ──▶  world
 //   admission (this id and session)                    ◀──  world      (refused: kRefused; none: kAdmitTimeout)
-//   frames on partition_for(run, id)                   ◀──  world      (none for world_timeout -> kWorldTimeout;
+//   frames on partition_for(run, id, session)          ◀──  world      (none for world_timeout -> kWorldTimeout;
 //                                                                       its writer gone for 6 s -> kWorldGone)
-//   one request per frame, same step                   ──▶  world      (run_over frame -> kRunOver)
+//   one request per frame, same step                   ──▶  world      (run_over frame -> kRunOver; the frame of
+//                                                                       the step already answered: the same request)
+//   no frame for 2 s: hello again                      ──▶  world      (refused, e.g. dropped for good: kRefused;
+//                                                                       accepted: still in, or re-admitted)
 //
 // Single-threaded: the bus backends queue samples on their own threads and wake this one through a Signal; the
 // behaviour's decide() runs here, never in a backend callback.
@@ -77,6 +80,10 @@ class AgentRuntime {
 
   bus::Participant& participant_;
   RuntimeConfig config_;
+  protocol::AgentHello hello_;
+  std::shared_ptr<bus::Signal> admission_signal_;
+  std::unique_ptr<bus::Writer<protocol::AgentHello>> hellos_;
+  std::unique_ptr<bus::Reader<protocol::Admission>> admissions_;
   std::unique_ptr<reactive::Behaviour> behaviour_;
 };
 

@@ -1,6 +1,9 @@
 #include "marsala/protocol/messages.hpp"
 
+#include <cstring>
+
 #include "marsala/core/enum_names.hpp"
+#include "marsala/core/format.hpp"
 
 namespace marsala::protocol {
 namespace {
@@ -17,8 +20,22 @@ constexpr EnumName<EventKind> kEventKindNames[] = {
 
 }  // namespace
 
-std::string partition_for(const std::string& run_id, std::uint32_t agent_id) {
-  return run_id + "/agent-" + std::to_string(agent_id);
+std::string partition_for(const std::string& run_id, std::uint32_t agent_id, std::uint64_t session) {
+  return fmt::format("{}/agent-{}-{:016x}", run_id, agent_id, session);
+}
+
+bool same_request(const ActionRequest& a, const ActionRequest& b) {
+  // Bitwise on the doubles, so that a repeated request is recognised even when it carries a NaN.
+  const auto same = [](double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+  if (a.agent_id != b.agent_id || a.session != b.session || a.step != b.step || a.move != b.move ||
+      !same(a.target_x_m, b.target_x_m) || !same(a.target_y_m, b.target_y_m) || a.refill != b.refill ||
+      a.state != b.state || a.depositions.size() != b.depositions.size())
+    return false;
+  for (std::size_t i = 0; i < a.depositions.size(); ++i) {
+    const Deposition &p = a.depositions[i], &q = b.depositions[i];
+    if (p.row != q.row || p.col != q.col || !same(p.height_m, q.height_m)) return false;
+  }
+  return true;
 }
 
 std::string to_string(ActionResult r) { return enum_to_string(kActionResultNames, r); }

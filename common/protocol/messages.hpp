@@ -36,7 +36,7 @@ struct Admission {
   std::uint64_t session = 0;  ///< echoes the hello's session
   bool accepted = false;
   std::string reason;     ///< why not, when rejected
-  std::string run_id;     ///< names the run; endpoints of this agent use partition partition_for(run, id)
+  std::string run_id;     ///< names the run; the agent's endpoints use partition_for(run, id, session)
   Assignment assignment;  ///< when accepted: grid, tile size, start, target and base station
 };
 
@@ -122,8 +122,13 @@ struct WorldEvent {
   std::string detail;
 };
 
-/// The partition that carries one agent's frames and requests in one run: "<run_id>/agent-<id>".
-std::string partition_for(const std::string& run_id, std::uint32_t agent_id);
+/// The partition that carries the frames and requests of one agent process (its session) in one run:
+/// "<run_id>/agent-<id>-<session, 16 hex digits>". Every process has a partition of its own, so the world counts only
+/// that process's endpoints as ready, and a process that left (or merely listens) never takes a successor's frames.
+std::string partition_for(const std::string& run_id, std::uint32_t agent_id, std::uint64_t session);
+
+/// True when the two requests are the same in every field (an agent that repeats a request it already sent).
+bool same_request(const ActionRequest& a, const ActionRequest& b);
 
 /// Names of the enums, for logs and the monitor; from_string throws InvalidArgument listing valid names.
 std::string to_string(ActionResult r);

@@ -102,6 +102,8 @@ struct Scenario {
 /// errors and unknown fields, InvalidArgument naming the field for bad values (non-positive sizes, unknown
 /// robot type or generator, slots outside the terrain, NaN).
 Scenario load_scenario(const std::string& path);
+/// The text of a scenario file; throws IoError when it cannot be read.
+std::string read_scenario_text(const std::string& path);
 /// Same from text; `source_name` names it in messages and anchors relative terrain paths.
 Scenario parse_scenario(const std::string& text, const std::string& source_name);
 

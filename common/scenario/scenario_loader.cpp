@@ -340,13 +340,15 @@ Scenario parse_scenario(const std::string& text, const std::string& source_name)
   return to_scenario(message, source_name);
 }
 
-Scenario load_scenario(const std::string& path) {
+std::string read_scenario_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError("cannot open scenario file '" + path + "'");
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw IoError("cannot read scenario file '" + path + "'");
-  return parse_scenario(text.str(), path);
+  return text.str();
 }
+
+Scenario load_scenario(const std::string& path) { return parse_scenario(read_scenario_text(path), path); }
 
 }  // namespace marsala::scenario

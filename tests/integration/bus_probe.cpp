@@ -153,8 +153,8 @@ int run_idle(Participant& participant, const Args&, Clock::time_point start) {
   auto signal = std::make_shared<Signal>();
   auto hello = participant.create_writer<AgentHello>();
   auto admission = participant.create_reader<Admission>({"", signal});
-  auto frames = participant.create_reader<SensorFrame>({partition_for("rss", 1), signal});
-  auto requests = participant.create_writer<ActionRequest>({partition_for("rss", 1), nullptr});
+  auto frames = participant.create_reader<SensorFrame>({partition_for("rss", 1, 1), signal});
+  auto requests = participant.create_writer<ActionRequest>({partition_for("rss", 1, 1), nullptr});
   const auto created = std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - start).count();
   say("created " + std::to_string(created));
   const auto settle = Clock::now() + 2s;

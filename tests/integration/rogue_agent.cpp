@@ -97,11 +97,12 @@ int run(int argc, char** argv) {
     for (const auto& a : admissions->take())
       if (a.agent_id == id && a.session == hello.session) admission = a;
   }
-  const std::string mine = protocol::partition_for(admission.run_id, id);
+  const std::string mine = protocol::partition_for(admission.run_id, id, hello.session);
   auto frames = participant->create_reader<protocol::SensorFrame>({mine, signal});
   auto requests = participant->create_writer<protocol::ActionRequest>({mine, nullptr});
   auto victim =
-      participant->create_writer<protocol::ActionRequest>({protocol::partition_for(admission.run_id, 1), nullptr});
+      // Agent 1's partition is named by its session, which the rogue does not know: a partition wildcard reaches it.
+      participant->create_writer<protocol::ActionRequest>({admission.run_id + "/agent-1-*", nullptr});
 
   int attacks_sent = 0;
   constexpr int kAttacks = 8;

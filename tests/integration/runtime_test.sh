@@ -96,9 +96,15 @@ case "$case_name" in
     [ "$(field completed "$s")" = "true" ] || { cat "$s"; tail -30 "$out/logs/world.log"; fail "honest agent did not complete"; }
     sent=$(grep -c "sending" "$out/logs/rogue.log" || true)
     [ "$sent" -ge 8 ] || { cat "$out/logs/rogue.log"; fail "rogue sent only $sent attacks"; }
-    rejected=$(grep -ci "reject" "$out/logs/world.log" || true)
-    [ "$rejected" -ge 7 ] || { tail -40 "$out/logs/world.log"; fail "world logged only $rejected rejections"; }
-    echo "ok: $sent attacks, $rejected rejections logged, honest agent completed in $(field steps "$s") steps"
+    # Every attack is rejected (or, the identical duplicate, ignored) and charged to the sender: the rogue's own
+    # identity, or no agent when it forged one; never the victim, agent 1.
+    entry() { tr -d '\n ' <"$s" | grep -o "{\"agent_id\":$1,[^}]*}" | grep -o "\"$2\":[0-9]*" | cut -d: -f2; }
+    [ "$(entry 1 rejected)" = "0" ] || fail "the victim was charged $(entry 1 rejected) rejections"
+    [ "$(entry 2 rejected)" -ge 5 ] || fail "the rogue was charged only $(entry 2 rejected) rejections"
+    [ "$(field unattributed_rejections "$s")" -ge 1 ] || fail "the forged request was not counted as unattributed"
+    grep -q "repeated; the first stands" "$out/events.log" || fail "the identical duplicate was not noted"
+    echo "ok: $sent attacks; rogue charged $(entry 2 rejected), forged $(field unattributed_rejections "$s"), victim 0;" \
+      "honest agent completed in $(field steps "$s") steps"
     ;;
   kill)
     start_run "$work/kill"
@@ -134,7 +140,8 @@ case "$case_name" in
     for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero after the pauses (see $out/logs)"; done
     s="$out/summary.json"
     expect_completed "$s" 3
-    ! grep -q " dropped" "$out/events.log" || { grep " dropped" "$out/events.log"; fail "a pause dropped an agent"; }
+    ! grep -Eq "agent [0-9]+ dropped" "$out/events.log" ||
+      { grep -E "agent [0-9]+ dropped" "$out/events.log"; fail "a pause dropped an agent"; }
     [ "$(field terrain_sha256 "$s")" = "$(field terrain_sha256 "$reference")" ] ||
       fail "paused run ended on $(field terrain_sha256 "$s"), unpaused on $(field terrain_sha256 "$reference")"
     echo "ok: world and agent paused 3 s each; completed in $(field steps "$s") steps on the unpaused terrain"

@@ -80,7 +80,7 @@ TEST(Bus, NamesAndErrors) {
   EXPECT_EQ(vendor_from_string("fastdds"), Vendor::kFastDds);
   EXPECT_THROW(vendor_from_string("opensplice"), InvalidArgument);
   EXPECT_THROW(make_participant({Vendor::kInProcess, 233}), InvalidArgument);
-  EXPECT_EQ(partition_for("r7", 12), "r7/agent-12");
+  EXPECT_EQ(partition_for("r7", 12, 0xab), "r7/agent-12-00000000000000ab");
   for (EventKind k : {EventKind::kAdmitted, EventKind::kDropped, EventKind::kRunOver})
     EXPECT_EQ(event_kind_from_string(to_string(k)), k);
   EXPECT_THROW(event_kind_from_string("exploded"), InvalidArgument);

@@ -10,7 +10,7 @@
 namespace marsala::protocol {
 namespace {
 
-TEST(Messages, PartitionsNameTheRunAndTheAgent) { EXPECT_EQ(partition_for("ramp-d7", 12), "ramp-d7/agent-12"); }
+TEST(Messages, PartitionsNameTheRunAndTheAgent) { EXPECT_EQ(partition_for("ramp-d7", 12, 0x1234abcd5678ef90), "ramp-d7/agent-12-1234abcd5678ef90"); }
 
 TEST(Messages, EnumNamesReadBack) {
   for (const EventKind k : {EventKind::kAdmitted, EventKind::kRefused, EventKind::kRejected, EventKind::kDeposited,

@@ -82,7 +82,7 @@ class FakeAgent {
       }
     }
     if (!admitted_) return;
-    const std::string partition = protocol::partition_for(admission.run_id, config_.id);
+    const std::string partition = protocol::partition_for(admission.run_id, config_.id, admission.session);
     auto frames = participant->create_reader<protocol::SensorFrame>({partition, signal});
     auto requests = participant->create_writer<protocol::ActionRequest>({partition, nullptr});
     while (!stop_ && std::chrono::steady_clock::now() < give_up) {

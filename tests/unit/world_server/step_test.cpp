@@ -7,8 +7,8 @@
 #include <random>
 
 #include "marsala/core/error.hpp"
-#include "marsala/world_server/completion.hpp"
 #include "marsala/runlog/sha256.hpp"
+#include "marsala/world_server/completion.hpp"
 #include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
@@ -168,11 +168,34 @@ TEST(ApplyStep, AForgedRequestOnAnAgentsPartitionDoesNotTakeItsSlot) {
   EXPECT_EQ(w.agent(1).x_m, 1.25);
   EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kAccepted);
   EXPECT_EQ(w.agent(1).missed, 0u);
-  EXPECT_EQ(w.agent(1).rejected, 2u);
+  // Rejections are charged to the sender, never to the victim: the request with agent 2's admitted identity to
+  // agent 2, the one with no admitted identity to no agent.
+  EXPECT_EQ(w.agent(1).rejected, 0u);
   EXPECT_EQ(w.agent(2).accepted, 1u);
-  EXPECT_EQ(w.agent(2).rejected, 0u);
+  EXPECT_EQ(w.agent(2).rejected, 1u);
+  EXPECT_EQ(w.unattributed_rejections, 1u);
   EXPECT_EQ(o.accepted, 2u);
   EXPECT_EQ(o.rejected, 2u);
+  std::vector<std::uint32_t> charged;
+  for (const protocol::WorldEvent& e : o.events)
+    if (e.kind == protocol::EventKind::kRejected) charged.push_back(e.agent_id);
+  EXPECT_EQ(charged, (std::vector<std::uint32_t>{0, 2}));
+}
+
+// An agent that got its frame twice sends the same request twice: the repeat is ignored, not a rejection.
+TEST(ApplyStep, ARepeatedIdenticalRequestIsIgnored) {
+  const scenario::Scenario s = small_scenario();
+  WorldState w = admitted_state(s, flat_terrain(), 1);
+  const protocol::ActionRequest r = move_to(w, 1, 1.25, 1.05);
+  protocol::ActionRequest other = r;
+  other.target_x_m = 1.15;
+  const StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{r, r, other});
+  EXPECT_EQ(w.agent(1).accepted, 1u);
+  EXPECT_EQ(w.agent(1).rejected, 1u);  // only the different one
+  EXPECT_EQ(w.agent(1).x_m, 1.25);
+  EXPECT_EQ(o.rejected, 1u);
+  ASSERT_EQ(o.notes.size(), 1u);
+  EXPECT_NE(o.notes[0].find("repeated; the first stands"), std::string::npos) << o.notes[0];
 }
 
 TEST(ApplyStep, ARejectedRequestChangesNothingAndIsReportedInTheNextFrame) {

@@ -12,8 +12,8 @@
 #include <thread>
 
 #include "marsala/core/error.hpp"
-#include "marsala/terrain/asc_io.hpp"
 #include "marsala/runlog/sha256.hpp"
+#include "marsala/terrain/asc_io.hpp"
 #include "unit/world_server/fake_agent.hpp"
 #include "unit/world_server/world_fixtures.hpp"
 
@@ -190,9 +190,10 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
        {std::string("\"completed\": true"), std::string("\"steps\": 11"), std::string("\"agents\": 2"),
         std::string("\"admitted\": 2"), std::string("\"missed_deadlines\": 0"), std::string("\"dds\": \"inprocess\""),
         std::string("\"scenario\": \"small\""), std::string("\"seed\": \"1\""),
-        std::string("\"end_reason\": \"completed\""), "\"terrain_sha256\": \"" + runlog::terrain_sha256(s.terrain) + "\"",
-        std::string("\"per_agent\""), std::string("\"accepted\": 11"), std::string("\"at_goal\": true"),
-        std::string("\"dropped\": false"), std::string("\"wall_seconds\"")})
+        std::string("\"end_reason\": \"completed\""),
+        "\"terrain_sha256\": \"" + runlog::terrain_sha256(s.terrain) + "\"", std::string("\"per_agent\""),
+        std::string("\"accepted\": 11"), std::string("\"at_goal\": true"), std::string("\"dropped\": false"),
+        std::string("\"wall_seconds\"")})
     EXPECT_NE(summary.find(field), std::string::npos) << field << " not in\n" << summary;
   EXPECT_EQ(json_number(summary, "deposited_volume_m3"), s.deposited_volume_m3);  // printed to round-trip
   EXPECT_EQ(json_number(summary, "deposited_m3"), s.agent(1).deposited_m3);

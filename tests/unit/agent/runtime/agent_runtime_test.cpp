@@ -73,7 +73,7 @@ struct ScriptedWorld {
     auto admissions = p.create_writer<protocol::Admission>();
     const protocol::AgentHello hello = wait_hello(*hellos, *hello_signal);
     const protocol::Admission a = answer(hello);
-    const std::string partition = protocol::partition_for(a.run_id, id);
+    const std::string partition = protocol::partition_for(a.run_id, id, a.session);
     auto signal = std::make_shared<bus::Signal>();
     auto frames = p.create_writer<protocol::SensorFrame>({partition, nullptr});
     auto requests = p.create_reader<protocol::ActionRequest>({partition, signal});
