@@ -1,4 +1,5 @@
-// marsala-monitor: tail a running system (tail, status). Reads only; Ctrl-C ends it cleanly.
+// marsala-monitor: tail a running system (tail, status), replay a run's log (replay). Reads only; Ctrl-C ends it
+// cleanly.
 #include <exception>
 #include <iostream>
 

@@ -3,6 +3,8 @@
 // CLI11 2.1's option conversions trip a false -Wmaybe-uninitialized at -O2; keep our own warnings on.
 #include "marsala/cli/command_line.hpp"
 
+#include <cstdint>
+#include <cstdlib>
 #include <exception>
 #include <new>
 #include <ostream>
@@ -11,6 +13,7 @@
 #include "marsala/bus/bus.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/monitor/follow.hpp"
+#include "marsala/monitor/replay.hpp"
 
 namespace marsala::monitor {
 namespace {
@@ -23,12 +26,29 @@ constexpr const char* kTailLegend =
     "(* at its goal, -- dropped, ? no state yet). Beyond what fits the width, live agents are counted per\n"
     "state. Event lines: step > agent kind [volume] detail.";
 
+constexpr const char* kReplayFooter =
+    "Rebuilds the terrain from DIR/run.log on DIR/terrain_initial.asc (its SHA-256 must match the log's header),\n"
+    "applying the accepted depositions step by step and checking each step's number and deposited volume and the\n"
+    "run end's terrain SHA-256 against the replay. A damaged tail (a crash of the world) is reported on stderr and\n"
+    "not applied. Prints a summary; the last line is \"terrain_sha256 <hex>\". Exit 0 ok, 1 the log and the replay\n"
+    "disagree or a file is missing or bad, 2 usage. With ffmpeg on PATH the frames also become timelapse.mp4.";
+
+/// A whole number >= 1 (CLI11's PositiveNumber explains a 0 with a range of 300 digits).
+const CLI::Validator kAtLeastOne(
+    [](std::string& text) {
+      const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+      return digits && text.find_first_not_of('0') != std::string::npos
+                 ? std::string()
+                 : "must be a whole number of at least 1, not " + text;
+    },
+    ">= 1");
+
 }  // namespace
 
 int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err, const StopSource& stop) {
   CLI::App app{
-      "marsala-monitor: watch a running MARSala system (world status, agents, events). It only reads:\n"
-      "it joins and leaves a running system without disturbing it.",
+      "marsala-monitor: watch a running MARSala system (world status, agents, events), or replay a run from its\n"
+      "output folder. It only reads: it joins and leaves a running system without disturbing it.",
       "marsala-monitor"};
   app.require_subcommand(1);
 
@@ -63,9 +83,40 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       ->check(CLI::Range(1e-3, 1e6))
       ->capture_default_str();
 
+  std::string replay_dir;
+  std::uint64_t to_step = 0;
+  ReplayOptions replay_options;
+  auto* replay = app.add_subcommand("replay", "rebuild a run's terrain from its run.log, without any agent");
+  replay->add_option("DIR", replay_dir, "the run's output folder (run.log, terrain_initial.asc)")->required();
+  auto* replay_to_step =
+      replay
+          ->add_option("--to-step", to_step,
+                       "stop after N steps (0..N-1): the terrain the world had when it awaited step N")
+          ->check(CLI::NonNegativeNumber)
+          ->type_name("N");
+  auto* replay_frames =
+      replay->add_option("--frames-every", replay_options.frames_every, "write a PNG frame every K steps and the last")
+          ->check(kAtLeastOne)
+          ->type_name("K");
+  replay
+      ->add_option("--out", replay_options.frames_dir,
+                   "the frames' folder (default DIR/replay); one that holds frames is refused")
+      ->type_name("FRAMES_DIR")
+      ->needs(replay_frames);
+  replay->footer(kReplayFooter);
+
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-monitor", out, err)) return *code;
 
   try {
+    if (*replay) {
+      if (replay_to_step->count() > 0) replay_options.to_step = to_step;
+      if (const char* path = std::getenv("PATH")) replay_options.search_path = path;
+      const ReplayReport report = replay_run(replay_dir, replay_options);
+      if (!report.tail_problem.empty())
+        err << "marsala-monitor: replayed the " << report.steps << " good steps; " << report.tail_problem << "\n";
+      out << format_replay_report(report);
+      return 0;
+    }
     auto participant = bus::make_participant({bus::vendor_from_string(dds), domain});
     if (*tail) {
       if (tail_timeout->count() > 0) tail_options.timeout = std::chrono::duration<double>(tail_timeout_s);

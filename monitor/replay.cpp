@@ -1,0 +1,422 @@
+#include "marsala/monitor/replay.hpp"
+
+#include <fmt/format.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <utility>
+#include <vector>
+
+#include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
+#include "marsala/render/png_writer.hpp"
+#include "marsala/runlog/run_log.hpp"
+#include "marsala/runlog/sha256.hpp"
+#include "marsala/terrain/asc_io.hpp"
+
+extern char** environ;
+
+namespace marsala::monitor {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+/// Agreement of the log's deposited volume with the replay's: the world sums the same terms in the same order, so
+/// they agree bit for bit unless the log lies; the tolerance only forgives a writer that rounds differently.
+constexpr double kVolumeRelativeTolerance = 1e-9;
+constexpr double kVolumeAbsoluteToleranceM3 = 1e-12;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+/// Writes `path` through write(tmp) into "<path>.tmp", then renames it over `path`, as the world writes its outputs
+/// (world_server/run_outputs.cpp): nobody ever sees a half-written file under the final name.
+template <typename Write>
+void write_atomically(const std::string& path, Write&& write) {
+  const std::string tmp = path + ".tmp";
+  try {
+    write(tmp);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw;
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw IoError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
+  }
+}
+
+/// A record's kind as messages name it.
+const char* record_kind(const proto::LogRecord& record) {
+  switch (record.record_case()) {
+    case proto::LogRecord::kHeader: return "header";
+    case proto::LogRecord::kAdmitted: return "admission";
+    case proto::LogRecord::kDropped: return "drop";
+    case proto::LogRecord::kStep: return "step";
+    case proto::LogRecord::kEnd: return "run end";
+    case proto::LogRecord::kResumed: return "resumption";
+    case proto::LogRecord::RECORD_NOT_SET: break;
+  }
+  return "empty";
+}
+
+std::string frame_name(std::uint64_t step) { return fmt::format("frame_{:06}.png", step); }
+
+/// Throws IoError when `dir` already holds a replay's frames or timelapse: two replays never mix.
+void check_fresh_frames_dir(const std::string& dir) {
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) return;
+  if (!fs::is_directory(dir, ec)) throw IoError("frames folder '" + dir + "' is not a folder");
+  std::vector<std::string> found;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    const bool frame = name.size() > 10 && name.rfind("frame_", 0) == 0 && name.substr(name.size() - 4) == ".png";
+    if (frame || name == "timelapse.mp4") found.push_back(name);
+  }
+  if (ec) throw IoError("cannot list frames folder '" + dir + "': " + ec.message());
+  if (found.empty()) return;
+  std::sort(found.begin(), found.end());
+  throw IoError(
+      fmt::format("frames folder '{}' already holds a replay ({} file{}, e.g. {}); give another --out or "
+                  "empty it",
+                  dir, found.size(), found.size() == 1 ? "" : "s", found.front()));
+}
+
+/// The first executable "ffmpeg" in the colon-separated `search_path`, or empty.
+std::string find_ffmpeg(const std::string& search_path) {
+  std::size_t begin = 0;
+  while (begin <= search_path.size() && !search_path.empty()) {
+    const std::size_t end = std::min(search_path.find(':', begin), search_path.size());
+    const std::string dir = search_path.substr(begin, end - begin);
+    if (!dir.empty()) {
+      const std::string candidate = (fs::path(dir) / "ffmpeg").string();
+      if (::access(candidate.c_str(), X_OK) == 0) return candidate;
+    }
+    begin = end + 1;
+  }
+  return {};
+}
+
+/// Runs argv[0] with argv, its output on ours; returns its exit status (128 + signal when killed).
+int run_program(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (::posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0)
+    throw IoError("cannot start '" + args[0] + "'");
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) throw IoError("cannot wait for '" + args[0] + "'");
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+/// Assembles frames_dir/timelapse.mp4 from `frames` (names in step order) with ffmpeg at 10 frames/s. The frames'
+/// step numbers are not consecutive, so ffmpeg reads numbered links to them from a scratch folder; frames of
+/// different sizes (a legend that grew) are padded to the largest, even-sized.
+void write_timelapse(const std::string& ffmpeg, const std::string& frames_dir, const std::vector<std::string>& frames,
+                     int width_px, int height_px) {
+  const fs::path scratch = fs::path(frames_dir) / ".timelapse_frames";
+  std::error_code ec;
+  fs::remove_all(scratch, ec);
+  fs::create_directories(scratch, ec);
+  if (ec) throw IoError("cannot create '" + scratch.string() + "': " + ec.message());
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    fs::create_symlink(fs::path("..") / frames[k], scratch / fmt::format("{:06}.png", k), ec);
+    if (ec) throw IoError("cannot link '" + frames[k] + "' in '" + scratch.string() + "': " + ec.message());
+  }
+  const std::string out = (fs::path(frames_dir) / "timelapse.mp4").string();
+  int status = 0;
+  try {
+    write_atomically(out, [&](const std::string& tmp) {
+      status = run_program({ffmpeg, "-y", "-loglevel", "error", "-framerate", "10", "-i",
+                            (scratch / "%06d.png").string(), "-pix_fmt", "yuv420p", "-vf",
+                            fmt::format("pad={}:{}:0:0:white", width_px + width_px % 2, height_px + height_px % 2),
+                            "-f", "mp4", tmp});
+      if (status != 0) throw IoError(fmt::format("ffmpeg failed (exit {}) making '{}'", status, out));
+    });
+  } catch (...) {
+    fs::remove_all(scratch, ec);
+    throw;
+  }
+  fs::remove_all(scratch, ec);
+}
+
+/// Frames of a replay: one every `every` steps and the last, each written once.
+class FrameWriter {
+ public:
+  FrameWriter(std::string dir, std::uint64_t every) : dir_(std::move(dir)), every_(every) {}
+
+  /// Draws the replay's current state when its step is due (or `last`) and not drawn yet.
+  void maybe_write(const TerrainReplayer& replayer, bool last) {
+    const std::uint64_t step = replayer.steps();
+    if (written_ && *written_ == step) return;
+    if (!last && step % every_ != 0) return;
+    const auto start = Clock::now();
+    const render::Image image = render::render_terrain(replayer.terrain(), replay_picture_options(replayer));
+    const std::string name = frame_name(step);
+    write_atomically((fs::path(dir_) / name).string(), [&](const std::string& tmp) { render::write_png(image, tmp); });
+    names_.push_back(name);
+    width_px_ = std::max(width_px_, image.width);
+    height_px_ = std::max(height_px_, image.height);
+    written_ = step;
+    seconds_ += seconds_since(start);
+  }
+
+  const std::vector<std::string>& names() const { return names_; }
+  int width_px() const { return width_px_; }
+  int height_px() const { return height_px_; }
+  double seconds() const { return seconds_; }
+
+ private:
+  std::string dir_;
+  std::uint64_t every_;
+  std::optional<std::uint64_t> written_;
+  std::vector<std::string> names_;
+  int width_px_ = 0;
+  int height_px_ = 0;
+  double seconds_ = 0.0;
+};
+
+}  // namespace
+
+void check_initial_terrain(const proto::LogHeader& header, const Heightmap& terrain, const std::string& terrain_name) {
+  if (terrain.rows() != header.rows() || terrain.cols() != header.cols() ||
+      terrain.cell_size_m() != header.cell_size_m())
+    throw ParseError(terrain_name, 0,
+                     fmt::format("{} x {} cells of {} m, but the run log's header says {} x {} cells of {} m: not "
+                                 "this run's initial terrain",
+                                 terrain.rows(), terrain.cols(), terrain.cell_size_m(), header.rows(), header.cols(),
+                                 header.cell_size_m()));
+  const std::string sha = runlog::terrain_sha256(terrain);
+  if (sha != header.initial_terrain_sha256())
+    throw ParseError(terrain_name, 0,
+                     "SHA-256 " + sha + ", but the run log's header says " + header.initial_terrain_sha256() +
+                         ": not this run's initial terrain");
+}
+
+TerrainReplayer::TerrainReplayer(const proto::LogHeader& header, Heightmap initial_terrain, std::string log_name)
+    : header_(header),
+      terrain_(std::move(initial_terrain)),
+      depositor_(render::CellLabels::Zero(terrain_.rows(), terrain_.cols())),
+      log_name_(std::move(log_name)) {}
+
+ReplayedAgent& TerrainReplayer::agent(std::uint32_t id) {
+  ReplayedAgent& a = agents_[id];
+  a.id = id;
+  return a;
+}
+
+void TerrainReplayer::apply(const proto::LogRecord& record, std::uint64_t offset) {
+  const std::string where = fmt::format("{} record at byte {}", record_kind(record), offset);
+  if (run_end_)
+    throw ParseError(log_name_, 0,
+                     fmt::format("{}: a record after the run's end (RunEnd after {} steps)", where, run_end_->steps()));
+  switch (record.record_case()) {
+    case proto::LogRecord::kHeader: throw ParseError(log_name_, 0, where + ": a second header");
+    case proto::LogRecord::kAdmitted: {
+      ReplayedAgent& a = agent(record.admitted().agent_id());
+      a.name = record.admitted().name();
+      a.admitted = true;
+      a.dropped = false;
+      return;
+    }
+    case proto::LogRecord::kDropped: agent(record.dropped().agent_id()).dropped = true; return;
+    case proto::LogRecord::kResumed: ++resumptions_; return;
+    case proto::LogRecord::kStep: apply_step(record.step(), where); return;
+    case proto::LogRecord::kEnd: {
+      const proto::RunEnd& end = record.end();
+      if (end.steps() != steps_)
+        throw ParseError(log_name_, 0,
+                         fmt::format("{}: the log says {} steps, the replay applied {}", where, end.steps(), steps_));
+      const std::string sha = runlog::terrain_sha256(terrain_);
+      if (end.terrain_sha256() != sha)
+        throw ParseError(log_name_, 0,
+                         fmt::format("{}: the log's final terrain sha256 {} differs from the replayed terrain's {}",
+                                     where, end.terrain_sha256(), sha));
+      run_end_ = end;
+      return;
+    }
+    case proto::LogRecord::RECORD_NOT_SET: break;
+  }
+  throw ParseError(log_name_, 0, where + ": an empty record");
+}
+
+void TerrainReplayer::apply_step(const proto::StepRecord& step, const std::string& where) {
+  if (step.step() != steps_)
+    throw ParseError(log_name_, 0,
+                     fmt::format("{}: step {} where step {} was due ({})", where, step.step(), steps_,
+                                 step.step() > steps_ ? "a gap" : "a repeat"));
+  const double cs = terrain_.cell_size_m();
+  for (const proto::LoggedRequest& r : step.requests()) {
+    ++requests_;
+    if (!r.accepted()) {
+      if (r.channel_id() != 0) ++agent(r.channel_id()).rejected;
+      continue;
+    }
+    ++accepted_requests_;
+    // What apply_request() does for an accepted request (docs/runtime.md#applying-requests), minus what no picture
+    // needs (material, heights under the agents).
+    ReplayedAgent& me = agent(r.agent_id());
+    ++me.accepted;
+    if (r.move()) me.position = Position{r.target_x_m(), r.target_y_m()};
+    double volume_m3 = 0.0;
+    for (const proto::LoggedDeposition& d : r.depositions()) {
+      if (!terrain_.contains({d.row(), d.col()}) || !std::isfinite(d.height_m()))
+        throw ParseError(log_name_, 0,
+                         fmt::format("{}: step {}: agent {} deposited {} m on cell {}, off the {} x {} grid or not a "
+                                     "height, yet the world accepted it",
+                                     where, step.step(), r.agent_id(), d.height_m(), CellIndex{d.row(), d.col()},
+                                     terrain_.rows(), terrain_.cols()));
+      terrain_(d.row(), d.col()) += d.height_m();
+      depositor_(d.row(), d.col()) = r.agent_id();
+      volume_m3 += d.height_m() * cs * cs;
+    }
+    me.deposited_m3 += volume_m3;
+    deposited_volume_m3_ += volume_m3;
+  }
+  const double logged = step.deposited_volume_m3();
+  const double tolerance =
+      std::max(kVolumeAbsoluteToleranceM3,
+               kVolumeRelativeTolerance * std::max(std::abs(logged), std::abs(deposited_volume_m3_)));
+  if (!(std::abs(logged - deposited_volume_m3_) <= tolerance))
+    throw ParseError(log_name_, 0,
+                     fmt::format("{}: step {}: the log says {} m3 deposited in the run, the replay {} m3: the log and "
+                                 "the replay disagree",
+                                 where, step.step(), logged, deposited_volume_m3_));
+  ++steps_;
+}
+
+render::RenderOptions replay_picture_options(const TerrainReplayer& replayer) {
+  render::RenderOptions o;
+  if (replayer.depositor().size() > 0 && replayer.depositor().maxCoeff() > 0) o.labels = replayer.depositor();
+  const std::vector<render::Rgb>& palette = render::default_palette();
+  // Every slot gets its legend line from the first frame on, so that the legend (and the picture's size) stays put.
+  std::vector<std::string> ids_of_colour(palette.size());
+  auto list_id = [&](std::uint32_t id) {
+    std::string& ids = ids_of_colour[(id - 1) % ids_of_colour.size()];
+    ids += (ids.empty() ? "" : ", ") + std::to_string(id);
+  };
+  for (std::uint32_t id = 1; id <= replayer.header().agents(); ++id) list_id(id);
+  for (const auto& [id, a] : replayer.agents()) {
+    if (id == 0) continue;
+    if (id > replayer.header().agents()) list_id(id);
+    if (a.admitted && a.position)
+      o.points.push_back({*a.position, render::label_colour(id), render::PointShape::kDisc, 0.0});
+  }
+  for (std::size_t k = 0; k < ids_of_colour.size(); ++k)
+    if (!ids_of_colour[k].empty())
+      o.legend_entries.push_back(
+          {(ids_of_colour[k].find(',') == std::string::npos ? "agent " : "agents ") + ids_of_colour[k], palette[k],
+           render::LegendSwatch::kDisc});
+  o.title = replayer.header().scenario() + ": step " + std::to_string(replayer.steps());
+  return o;
+}
+
+ReplayReport replay_run(const std::string& dir, const ReplayOptions& options) {
+  const auto start = Clock::now();
+  const std::string log_path = (fs::path(dir) / "run.log").string();
+  const std::string terrain_path = (fs::path(dir) / "terrain_initial.asc").string();
+  ReplayReport report;
+  report.log_path = log_path;
+
+  std::optional<FrameWriter> frames;
+  if (options.frames_every > 0) {
+    report.frames_dir = options.frames_dir.empty() ? (fs::path(dir) / "replay").string() : options.frames_dir;
+    check_fresh_frames_dir(report.frames_dir);
+  }
+
+  runlog::RunLogReader reader(log_path);
+  const proto::LogHeader& header = reader.header();
+  Heightmap initial = terrain::read_asc(terrain_path);
+  check_initial_terrain(header, initial, terrain_path);
+  TerrainReplayer replayer(header, std::move(initial), log_path);
+
+  if (options.frames_every > 0) {
+    std::error_code ec;
+    fs::create_directories(report.frames_dir, ec);
+    if (ec) throw IoError("cannot create frames folder '" + report.frames_dir + "': " + ec.message());
+    frames.emplace(report.frames_dir, options.frames_every);
+  }
+
+  proto::LogRecord record;
+  for (std::uint64_t at = reader.offset(); reader.next(record); at = reader.offset()) {
+    if (record.has_step()) {
+      // The state the world had when it awaited this step: drawn before the step, and the place --to-step stops.
+      if (options.to_step && replayer.steps() == *options.to_step) break;
+      if (frames) frames->maybe_write(replayer, false);
+    }
+    replayer.apply(record, at);
+  }
+  report.tail_problem = reader.tail_problem();
+  if (options.to_step && replayer.steps() < *options.to_step)
+    throw InvalidArgument(fmt::format("{} holds {} steps{}; --to-step {} is beyond it", log_path, replayer.steps(),
+                                      report.tail_problem.empty() ? "" : " before its damaged tail", *options.to_step));
+  if (frames) frames->maybe_write(replayer, true);
+
+  report.scenario = header.scenario();
+  report.run_id = header.run_id();
+  report.steps = replayer.steps();
+  report.slots = header.agents();
+  for (const auto& [id, a] : replayer.agents()) {
+    report.admitted += a.admitted ? 1 : 0;
+    report.dropped += a.dropped ? 1 : 0;
+  }
+  report.requests = replayer.requests();
+  report.accepted = replayer.accepted_requests();
+  report.resumptions = replayer.resumptions();
+  report.deposited_volume_m3 = replayer.deposited_volume_m3();
+  if (replayer.run_end()) report.end_reason = replayer.run_end()->end_reason();
+  report.terrain = replayer.terrain();
+  report.terrain_sha256 = runlog::terrain_sha256(report.terrain);
+
+  if (frames) {
+    report.frames = frames->names().size();
+    report.frame_seconds = frames->seconds();
+    const std::string ffmpeg = find_ffmpeg(options.search_path);
+    if (ffmpeg.empty()) {
+      report.timelapse_note = "skipped timelapse.mp4: ffmpeg is not installed (not on PATH)";
+    } else {
+      const auto video_start = Clock::now();
+      write_timelapse(ffmpeg, report.frames_dir, frames->names(), frames->width_px(), frames->height_px());
+      report.timelapse_seconds = seconds_since(video_start);
+      report.timelapse = (fs::path(report.frames_dir) / "timelapse.mp4").string();
+    }
+  }
+  report.replay_seconds = seconds_since(start) - report.frame_seconds - report.timelapse_seconds;
+  return report;
+}
+
+std::string format_replay_report(const ReplayReport& r) {
+  std::string text = fmt::format("replay {}: scenario {}, run {}\n", r.log_path, r.scenario, r.run_id);
+  text += fmt::format("steps {}, agents {} admitted of {} slots ({} dropped), requests {} ({} accepted){}\n", r.steps,
+                      r.admitted, r.slots, r.dropped, r.requests, r.accepted,
+                      r.resumptions > 0 ? fmt::format(", resumed {} times", r.resumptions) : std::string());
+  text += fmt::format("deposited {:.6f} m3\n", r.deposited_volume_m3);
+  text += fmt::format("run end: {}\n", r.end_reason ? *r.end_reason + ", final terrain sha256 matches the log"
+                                                    : std::string("not reached"));
+  const double speed = r.replay_seconds > 0.0 ? static_cast<double>(r.steps) / r.replay_seconds : 0.0;
+  text += fmt::format("wall {:.3f} s, replay speed {:.0f} steps/s (frames excluded)\n",
+                      r.replay_seconds + r.frame_seconds + r.timelapse_seconds, speed);
+  if (!r.frames_dir.empty()) {
+    text += fmt::format("frames: {} in {} ({:.3f} s, {:.1f} ms per frame)\n", r.frames, r.frames_dir, r.frame_seconds,
+                        r.frames > 0 ? 1e3 * r.frame_seconds / static_cast<double>(r.frames) : 0.0);
+    text += r.timelapse.empty()
+                ? r.timelapse_note + "\n"
+                : fmt::format("timelapse: {} ({:.3f} s with ffmpeg)\n", r.timelapse, r.timelapse_seconds);
+  }
+  text += "terrain_sha256 " + r.terrain_sha256 + "\n";
+  return text;
+}
+
+}  // namespace marsala::monitor
