@@ -8,6 +8,7 @@
 #   mixed-cyclone-fastdds | mixed-fastdds-cyclone                    world on one vendor, agents on the other
 #   determinism                                                      2 Cyclone runs + 1 Fast DDS run: same sha256
 #   rogue                                                            a misbehaving agent is rejected, run completes
+#   resume                                                           world killed 3 times and resumed: same terrain
 #   kill                                                             SIGKILL one of 3 agents mid-run, others finish
 #   pause                                                            SIGSTOP the world, then an agent, 3 s each: the
 #                                                                    run loses nothing (same sha256 as unpaused)
@@ -145,6 +146,38 @@ case "$case_name" in
     [ "$(field terrain_sha256 "$s")" = "$(field terrain_sha256 "$reference")" ] ||
       fail "paused run ended on $(field terrain_sha256 "$s"), unpaused on $(field terrain_sha256 "$reference")"
     echo "ok: world and agent paused 3 s each; completed in $(field steps "$s") steps on the unpaused terrain"
+    ;;
+  resume)
+    # SIGKILL of the world at three different steps, each time continued with --resume while the agents wait: the
+    # run ends on the uninterrupted run's terrain, and a replay of its run.log gives the same digest.
+    reference=$(run_spawn reference 3 cyclone)
+    expect_completed "$reference" 3
+    start_run "$work/resume"
+    step_reached() {  # step_reached N: events.log (written live) holds a line of step N or later
+      awk -v n="$1" '$1 == "step" && $2 + 0 >= n { found = 1 } END { exit !found }' "$out/events.log" 2>/dev/null
+    }
+    resumes=0
+    for at in 40 120 200; do
+      for _ in $(seq 1 3000); do step_reached "$at" && break; sleep 0.01; done
+      step_reached "$at" || fail "the run never reached step $at (see $out/logs)"
+      kill -KILL "$world"
+      wait "$world" 2>/dev/null || true
+      resumes=$((resumes + 1))
+      "$bin/marsala-world" --resume "$out" --dds cyclone --domain "$domain" >"$out/logs/world-resume-$resumes.log" 2>&1 &
+      world=$!
+    done
+    wait "$world" || { tail -30 "$out/logs/world-resume-$resumes.log"; fail "the resumed world exited non-zero"; }
+    for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero across the resumes (see $out/logs)"; done
+    s="$out/summary.json"
+    expect_completed "$s" 3
+    [ "$(field resumes "$s")" = "3" ] || fail "summary says $(field resumes "$s") resumes, not 3"
+    [ "$(field terrain_sha256 "$s")" = "$(field terrain_sha256 "$reference")" ] ||
+      fail "resumed run ended on $(field terrain_sha256 "$s"), uninterrupted on $(field terrain_sha256 "$reference")"
+    replayed=$("$bin/marsala-monitor" replay "$out" | tail -1)
+    [ "$replayed" = "terrain_sha256 $(field terrain_sha256 "$s")" ] || fail "replay printed '$replayed'"
+    grep -h "resumed at step" "$out"/logs/world-resume-*.log | sed 's/^[^:]*: //'
+    echo "ok: world killed 3 times, resumed; completed in $(field steps "$s") steps on the uninterrupted terrain;" \
+      "replay agrees"
     ;;
   world-kill)
     start_run "$work/world-kill"
