@@ -70,13 +70,12 @@ if [ -z "$domain" ]; then
   done
 fi
 
-# A run never mixes its outputs with another's: the world refuses a folder holding a run; --replace clears one.
-if [ "$replace" -eq 1 ] && [ -d "$out" ]; then
-  (cd "$out" && rm -rf -- summary.json events.log terrain_initial.asc terrain_final.asc final.png final_zoom.png \
-    goal_vector_map.png logs)
-fi
+# A run never mixes its outputs with another's: the world refuses a folder holding a run; with --replace it removes
+# that run's files itself (marsala-world --replace knows the list), and the agents' old logs go here.
+[ "$replace" -eq 1 ] && [ -d "$out" ] && rm -rf -- "$out/logs"
 
 world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$domain" --out "$out")
+[ "$replace" -eq 1 ] && world_args+=(--replace)
 [ -n "$max_steps" ] && world_args+=(--max-steps "$max_steps")
 [ "$quiet" -eq 1 ] && world_args+=(--quiet)
 seed_args=()

@@ -392,13 +392,22 @@ std::vector<std::string> run_files_in(const std::string& dir) {
   return found;
 }
 
+void clear_run_files(const std::string& dir) {
+  for (const char* name : kRunFiles)
+    for (const std::string& file : {std::string(name), std::string(name) + ".tmp"}) {
+      std::error_code ec;
+      fs::remove(fs::path(dir) / file, ec);
+      if (ec) throw IoError("cannot remove '" + (fs::path(dir) / file).string() + "' (--replace): " + ec.message());
+    }
+}
+
 void check_fresh_output_dir(const std::string& dir) {
   const std::vector<std::string> found = run_files_in(dir);
   if (found.empty()) return;
   std::string list;
   for (const std::string& f : found) list += (list.empty() ? "" : ", ") + f;
   throw IoError("output folder '" + dir + "' holds another run (" + list +
-                "): give a fresh --out, or remove those files (deploy/spawn.sh --replace does)");
+                "): give a fresh --out, or --replace to remove them first");
 }
 
 }  // namespace marsala::world_server

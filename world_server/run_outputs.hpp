@@ -102,6 +102,9 @@ std::vector<std::string> run_files_in(const std::string& dir);
 /// Throws IoError naming them when `dir` holds any of a run's files: a run never mixes its outputs with another's.
 void check_fresh_output_dir(const std::string& dir);
 
+/// Removes the kRunFiles (and their temporary .tmp names) from `dir` (marsala-world --replace); throws IoError.
+void clear_run_files(const std::string& dir);
+
 class EventLog {
  public:
   /// Creates (truncates) the file, or with `append` continues it (a resumed run); throws IoError.

@@ -9,6 +9,7 @@
 #include "marsala/core/error.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
+#include "marsala/world_server/run_outputs.hpp"
 #include "marsala/world_server/scenario_check.hpp"
 #include "marsala/world_server/world_runtime.hpp"
 
@@ -69,6 +70,9 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   app.add_option("--snapshot-every", options.snapshot_every, "write snapshot.pb after every N steps (0: never)")
       ->check(CLI::Range(0ull, 1ull << 40))
       ->capture_default_str();
+  app.add_flag("--replace", options.replace,
+               "remove a previous run's files from --out before starting (without it such a folder is refused)")
+      ->excludes(resume_option);
   app.add_flag("--quiet", quiet, "log warnings and errors only");
   app.callback([&] {
     // --scenario is required of a run; a check takes its file either way; a resume reads it from the log.
@@ -88,6 +92,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       start = prepare_resume(resume_dir, options, domain);
     } else {
       options.scenario_text = scenario::read_scenario_text(scenario_path);
+      if (options.replace) clear_run_files(options.out_dir);
       const scenario::Scenario scenario = scenario::parse_scenario(options.scenario_text, scenario_path);
       start = prepare_world_start(scenario, scenario::build_terrain(scenario), options, domain);
     }

@@ -50,6 +50,10 @@ constexpr auto kAnswerInterval = 150ms;
 // Bounds of the per-sender bookkeeping: beyond them, hellos are counted, not remembered.
 constexpr std::size_t kMaxAnswerKeys = 4096;
 constexpr std::size_t kMaxRefusalKeys = 1024;
+// A new session of an admitted agent (a restarted process) gets no answer while the old session's request writer is
+// still alive, for up to this long: its liveliness lapses within the 1 s DDS lease when the old process died, and
+// the new session then takes the slot over. Still alive after this: refused (two processes with one id).
+constexpr auto kTakeoverWait = 3s;
 // Requests taken from one partition in one step beyond this many are counted (surplus) and never applied.
 constexpr std::size_t kMaxRequestsPerPartition = 8;
 // A live agent that has not answered its frame after this long gets the same frame again (its reader may have
@@ -144,7 +148,7 @@ WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, R
       throw InvalidArgument(
           fmt::format("scenario {}: robot type '{}': construction kappa: {}", s.source_path, type.name, problem));
   }
-  if (!o.out_dir.empty()) check_fresh_output_dir(o.out_dir);
+  if (!o.out_dir.empty() && !o.replace) check_fresh_output_dir(o.out_dir);
   start.state = make_world_state(start.scenario, std::move(terrain), agents);
   return start;
 }
@@ -265,6 +269,23 @@ struct WorldRuntime::Impl {
     return link.requests && link.requests->alive_writers() >= 1;
   }
 
+  /// True when `hello` is a new session of a live agent whose session is still connected, seen for less than
+  /// kTakeoverWait: it is not answered yet (see kTakeoverWait).
+  bool waits_for_takeover(const protocol::AgentHello& hello, Clock::time_point now) {
+    if (!state.has_agent(hello.agent_id)) return false;
+    const AgentRecord& a = state.agent(hello.agent_id);
+    if (!a.alive || a.session == hello.session || !holder_connected(hello.agent_id)) return false;
+    if (takeover_since.size() >= kMaxRefusalKeys) takeover_since.clear();
+    const auto [it, first] = takeover_since.try_emplace({hello.agent_id, hello.session}, now);
+    if (first)
+      spdlog::info(
+          "agent {}: session {:016x} says hello while session {:016x} is still connected; waiting up to {} s "
+          "for it to go",
+          hello.agent_id, hello.session, a.session,
+          std::chrono::duration_cast<std::chrono::seconds>(kTakeoverWait).count());
+    return now - it->second < kTakeoverWait;
+  }
+
   /// True when (id, session) may be answered now: each at most every kAnswerInterval (bounded bookkeeping).
   bool may_answer(const protocol::AgentHello& hello, Clock::time_point now) {
     const auto key = std::make_pair(hello.agent_id, hello.session);
@@ -283,6 +304,7 @@ struct WorldRuntime::Impl {
     next_hello_service = now + kHelloInterval;
     for (const protocol::AgentHello& hello : hellos->take()) {
       ++hellos_taken;
+      if (waits_for_takeover(hello, now)) continue;
       const AdmissionDecision decision = decide_admission(state, hello, run_started, holder_connected(hello.agent_id));
       if (decision.accepted && decision.kind != AdmissionKind::kRepeat) {
         const std::uint64_t previous = state.agent(hello.agent_id).session;
@@ -414,9 +436,14 @@ struct WorldRuntime::Impl {
       const Clock::time_point now = Clock::now();
       if (stop || now >= deadline) break;
       if (now >= next_resend) {
-        for (std::uint32_t id : live)
-          if (!answered[id - 1] && links[id - 1].frame)
-            write_logged(*links[id - 1].frames, *links[id - 1].frame, "a sensor frame");
+        for (std::uint32_t id : live) {
+          if (answered[id - 1]) continue;
+          AgentLink& link = links[id - 1];
+          if (link.frame && link.frame->step == state.step)
+            write_logged(*link.frames, *link.frame, "a sensor frame");
+          else
+            send_frame(id, false);  // admitted during this step (re-admission, takeover): its first frame of it
+        }
         next_resend = now + kResendInterval;
       }
       signal->wait_until(std::min({deadline, next_resend, now + kPollInterval}));
@@ -696,6 +723,8 @@ struct WorldRuntime::Impl {
   std::vector<std::string> last_rejection;  ///< [id - 1]: the rejection reason last logged at info level
   std::set<std::pair<std::uint32_t, std::uint64_t>> refused;  ///< (id, session) already reported as refused
   std::map<std::pair<std::uint32_t, std::uint64_t>, Clock::time_point> answered_at;  ///< last answer per sender
+  std::map<std::pair<std::uint32_t, std::uint64_t>, Clock::time_point>
+      takeover_since;  ///< first hello of a new session
   std::uint64_t hellos_taken = 0;
   std::uint64_t refusals = 0;
   Clock::time_point next_hello_service{};

@@ -34,6 +34,7 @@ struct RuntimeOptions {
   std::optional<std::uint64_t> seed;    ///< overrides the scenario's seed (start jitter; reported in summary.json)
   std::uint64_t snapshot_every = 1000;  ///< write snapshot.pb after every this many steps; 0 = never
   std::string scenario_text;  ///< the scenario file's text, recorded in run.log so that --resume needs no file
+  bool replace = false;       ///< out_dir may hold another run's files: the caller clears them (clear_run_files())
 };
 
 /// Where a resumed run picks up (prepare_resume()).

@@ -137,24 +137,24 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
   Clock::time_point next_hello = last_frame_at + kRehelloAfter;
   bool asked = false;  // a hello went out since the last frame
   Clock::time_point deadline = Clock::now() + config_.world_timeout;
-  bool world_seen = false, world_lost = false;
-  bool frame_since_check = false;     // a frame proves the world alive: no DDS status query on the per-step path
-  Clock::time_point world_lost_at{};  // when the world's frame writer was first found not alive (world_lost)
+  // Signs that the world lives: a frame, an answer to a hello (the world answers while it waits for a slow agent,
+  // whose step can last the whole deadline) or its frame writer's DDS liveliness. A frame or an answer spares the
+  // DDS status query on the per-step path.
+  bool world_seen = false;
+  bool sign_since_check = false;
+  Clock::time_point last_sign = Clock::now();
   while (!stop.load()) {
     const Clock::time_point now = Clock::now();
-    if (frame_since_check || frames->alive_writers() >= 1) {
-      frame_since_check = false;
+    if (sign_since_check || frames->alive_writers() >= 1) {
+      sign_since_check = false;
       world_seen = true;
-      world_lost = false;
-    } else if (world_seen) {
-      if (!world_lost) world_lost_at = now;
-      world_lost = true;
-      if (now - world_lost_at >= kWorldGrace) {
-        result.outcome = RunOutcome::kWorldGone;
-        result.message = fmt::format("the world is gone: its frame writer lost liveliness {} s ago (last step {})",
-                                     std::chrono::duration<double>(now - world_lost_at).count(), result.last_step);
-        return;
-      }
+      last_sign = now;
+    } else if (world_seen && now - last_sign >= kWorldGrace) {
+      result.outcome = RunOutcome::kWorldGone;
+      result.message =
+          fmt::format("the world is gone: no frame, no answer and its frame writer not alive for {} s (last step {})",
+                      std::chrono::duration<double>(now - last_sign).count(), result.last_step);
+      return;
     }
     if (now >= deadline) {
       result.outcome = RunOutcome::kWorldTimeout;
@@ -172,6 +172,7 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
     }
     for (const protocol::Admission& a : admissions_->take()) {
       if (a.agent_id != config_.agent_id || a.session != config_.session || !asked) continue;
+      sign_since_check = true;
       if (!a.accepted) {
         result.outcome = RunOutcome::kRefused;
         result.message = "the world no longer counts this agent in: " + a.reason;
@@ -185,7 +186,7 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
         continue;
       }
       ++result.frames;
-      frame_since_check = true;
+      sign_since_check = true;
       last_frame_at = Clock::now();
       if (asked) spdlog::info("agent {}: frames again at step {}", config_.agent_id, frame.step);
       asked = false;

@@ -9,6 +9,9 @@
 #   determinism                                                      2 Cyclone runs + 1 Fast DDS run: same sha256
 #   rogue                                                            a misbehaving agent is rejected, run completes
 #   resume                                                           world killed 3 times and resumed: same terrain
+#   torn-tail                                                        resume cuts a torn record at run.log's end
+#   agent-restart                                                    SIGKILL an agent, restart it: it takes over
+#   drop-rejoin                                                      an agent paused 7 s is dropped, then re-admitted
 #   kill                                                             SIGKILL one of 3 agents mid-run, others finish
 #   pause                                                            SIGSTOP the world, then an agent, 3 s each: the
 #                                                                    run loses nothing (same sha256 as unpaused)
@@ -23,7 +26,7 @@ bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 scenario="$root/deploy/scenarios/ramp.pbtxt"
 
 work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-it-$case_name.XXXXXX")"
-trap 'rm -rf "$work"' EXIT
+trap '[ -n "${MARSALA_KEEP_WORK:-}" ] || rm -rf "$work"' EXIT  # MARSALA_KEEP_WORK=1 keeps the logs
 
 fail() { echo "FAIL ($case_name): $*" >&2; exit 1; }
 . "$root/tests/integration/lib.sh"  # field, is_png
@@ -178,6 +181,70 @@ case "$case_name" in
     grep -h "resumed at step" "$out"/logs/world-resume-*.log | sed 's/^[^:]*: //'
     echo "ok: world killed 3 times, resumed; completed in $(field steps "$s") steps on the uninterrupted terrain;" \
       "replay agrees"
+    ;;
+  torn-tail)
+    # A crash in the middle of writing a record leaves a torn one at the end of run.log: --resume reports and cuts
+    # it, never applies it, and the run ends on the uninterrupted terrain.
+    reference=$(run_spawn reference 3 cyclone)
+    start_run "$work/torn-tail"
+    for _ in $(seq 1 3000); do grep -q "^step 1[0-9][0-9] " "$out/events.log" 2>/dev/null && break; sleep 0.01; done
+    kill -KILL "$world"
+    wait "$world" 2>/dev/null || true
+    # A frame that promises 200 payload bytes, then 7 of them.
+    printf '\310\000\000\000\001\002\003\004torn!!!' >>"$out/run.log"
+    "$bin/marsala-world" --resume "$out" --dds cyclone --domain "$domain" >"$out/logs/world-resume.log" 2>&1 &
+    world=$!
+    wait "$world" || { tail -30 "$out/logs/world-resume.log"; fail "the resumed world exited non-zero"; }
+    for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero (see $out/logs)"; done
+    grep -q "cut run.log's damaged tail: .*truncated record at byte [0-9]* (7 of 200 payload bytes)" \
+      "$out/logs/world-resume.log" || { tail -30 "$out/logs/world-resume.log"; fail "the torn record was not reported"; }
+    s="$out/summary.json"
+    expect_completed "$s" 3
+    [ "$(field terrain_sha256 "$s")" = "$(field terrain_sha256 "$reference")" ] ||
+      fail "ended on $(field terrain_sha256 "$s"), uninterrupted on $(field terrain_sha256 "$reference")"
+    [ "$("$bin/marsala-monitor" replay "$out" | tail -1)" = "terrain_sha256 $(field terrain_sha256 "$s")" ] ||
+      fail "the replay of the continued log differs"
+    echo "ok: a torn record was cut, never applied; completed on the uninterrupted terrain"
+    ;;
+  agent-restart)
+    # SIGKILL of an agent, restarted at once with a new session: it waits for the old session's liveliness to lapse,
+    # takes its slot over (pose and material as the world kept them), and the run completes.
+    start_run "$work/agent-restart"
+    for _ in $(seq 1 3000); do grep -q "agent 2 deposited" "$out/events.log" 2>/dev/null && break; sleep 0.02; done
+    grep -q "agent 2 deposited" "$out/events.log" || fail "agent 2 never deposited (see $out/logs)"
+    kill -KILL "${pids[1]}"
+    wait "${pids[1]}" 2>/dev/null || true
+    "$bin/marsala-agent" --scenario "$scenario" --id 2 --dds cyclone --domain "$domain" \
+      >"$out/logs/agent-2-restarted.log" 2>&1 &
+    pids[1]=$!
+    wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
+    for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero (see $out/logs)"; done
+    s="$out/summary.json"
+    expect_completed "$s" 3
+    grep -q "agent 2 admitted: .*takes over from" "$out/events.log" || fail "no takeover of slot 2 in events.log"
+    ! grep -Eq "agent [0-9]+ dropped" "$out/events.log" || fail "an agent was dropped: $(grep -E "agent [0-9]+ dropped" "$out/events.log")"
+    after=$(awk '/agent 2 admitted: .*takes over/ { on = 1 } on && /agent 2 deposited/ { n++ } END { print n + 0 }' \
+      "$out/events.log")
+    [ "$after" -gt 0 ] || fail "the restarted agent 2 never deposited"
+    echo "ok: agent 2 killed and restarted; took its slot over, deposited $after times after, run completed in" \
+      "$(field steps "$s") steps"
+    ;;
+  drop-rejoin)
+    # An agent paused past the world's 6 s grace is dropped; when it runs again it asks the world (no frame for 2 s),
+    # is re-admitted with the state the world kept, and the run completes with it.
+    start_run "$work/drop-rejoin"
+    for _ in $(seq 1 3000); do grep -q "agent 3 deposited" "$out/events.log" 2>/dev/null && break; sleep 0.02; done
+    kill -STOP "${pids[2]}"
+    for _ in $(seq 1 150); do grep -q "agent 3 dropped" "$out/events.log" 2>/dev/null && break; sleep 0.1; done
+    grep -q "agent 3 dropped" "$out/events.log" || { kill -CONT "${pids[2]}"; fail "agent 3 was not dropped while paused"; }
+    kill -CONT "${pids[2]}"
+    wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
+    for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero (see $out/logs)"; done
+    s="$out/summary.json"
+    expect_completed "$s" 3
+    grep -q "agent 3 admitted: .*(re-admitted, 1 of 3)" "$out/events.log" || fail "agent 3 was not re-admitted"
+    [ "$(field readmissions "$s")" = "1" ] || fail "summary says $(field readmissions "$s") readmissions"
+    echo "ok: agent 3 dropped while paused, re-admitted; run completed in $(field steps "$s") steps"
     ;;
   world-kill)
     start_run "$work/world-kill"

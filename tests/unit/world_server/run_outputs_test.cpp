@@ -216,6 +216,14 @@ TEST_F(OutputFiles, ARunNeverWritesIntoAnotherRunsFolderAndLeavesNoTemporaries) 
               std::string::npos)
         << e.what();
   }
+  // --replace: the run's files (and a leftover temporary) go, everything else stays.
+  std::ofstream(dir_ / "run.log.tmp") << "torn";
+  clear_run_files(dir_.string());
+  EXPECT_EQ(run_files_in(dir_.string()), std::vector<std::string>{});
+  EXPECT_FALSE(fs::exists(dir_ / "run.log.tmp"));
+  EXPECT_TRUE(fs::exists(dir_ / "spawn.log"));
+  EXPECT_TRUE(fs::exists(dir_ / "logs"));
+  EXPECT_NO_THROW(check_fresh_output_dir(dir_.string()));
 }
 
 TEST_F(OutputFiles, AnEventLogThatCannotBeWrittenIsAnErrorNotASilentLoss) {
