@@ -480,6 +480,14 @@ void fill_nodata(Heightmap& map) {
         }
       });
       values[k] = sum / count;
+      if (!std::isfinite(values[k])) {
+        // Heights near the double limits overflow the sum; scaled by 1/8 (exact) they cannot, and the mean is the same.
+        sum = 0.0;
+        for_neighbours(layer[k], [&](long long j) {
+          if (state[j] == 0) sum += h[j] * 0.125;
+        });
+        values[k] = sum / count * 8.0;
+      }
     }
     for (std::size_t k = 0; k < layer.size(); ++k) h[layer[k]] = values[k];
     for (long long i : layer) state[i] = 0;

@@ -388,6 +388,30 @@ TEST(FillNodata, StaysWithinTheValidRangeAndReproducesConstants) {
   for (long long i = 0; i < constant.size(); ++i) EXPECT_EQ(constant.data()[i], 2.75);
 }
 
+TEST(FillNodata, MeansOfHeightsNearTheDoubleLimitsStayFinite) {
+  // Found by tests/fuzz/asc_fuzz_test.cpp: the sum of two neighbours of -1e308 overflowed to -inf, so a file of
+  // finite heights loaded with --fill-nodata held an infinite height.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Heightmap row(GridGeometry{1, 3, 0.0, 0.0, 1.0});
+  row(0, 0) = -1e308;
+  row(0, 1) = nan;
+  row(0, 2) = -1e308;
+  fill_nodata(row);
+  EXPECT_EQ(row(0, 1), -1e308);
+  const double max = std::numeric_limits<double>::max();
+  Heightmap square(GridGeometry{3, 3, 0.0, 0.0, 1.0}, max);
+  square(1, 1) = nan;
+  square(0, 0) = 0.0;
+  fill_nodata(square);
+  EXPECT_DOUBLE_EQ(square(1, 1), 0.875 * max);  // the mean of seven max and one 0
+  std::istringstream in(
+      "ncols 3\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n"
+      "1e308 -9999 1e308\n");
+  AscReadOptions fill;
+  fill.fill_nodata = true;
+  EXPECT_EQ(parse_asc(in, "limits.asc", fill)(0, 1), 1e308);
+}
+
 TEST(FillNodata, AllMissingIsInvalid) {
   Heightmap map(GridGeometry{2, 2, 0.0, 0.0, 1.0}, std::numeric_limits<double>::quiet_NaN());
   EXPECT_THROW(fill_nodata(map), InvalidArgument);
