@@ -159,6 +159,18 @@ TEST(AscReadErrors, BadCellsize) {
   expect_parse_error(head + "cellsize 1e999\n1\n", 5, "out of range");
 }
 
+TEST(AscReadErrors, CornerBeyondTheDoubles) {
+  // Found by tests/fuzz/asc_fuzz_test.cpp: a finite centre half a cell from the double limits made an infinite
+  // corner, and the Heightmap's InvalidArgument ("grid corner must be finite") escaped without the file's name.
+  expect_parse_error("ncols 1\nnrows 1\nxllcenter -1.7976931348623157e308\nyllcorner 0\ncellsize 1e308\n5\n", 3,
+                     "'xllcenter' puts the grid's lower-left corner half a cell beyond the range of doubles");
+  expect_parse_error("ncols 1\nnrows 1\nxllcorner 0\nyllcenter -1.7e308\ncellsize 1e308\n5\n", 4, "'yllcenter'");
+  // The same corner as a corner is fine, and so is a centre with a cell that keeps it in range.
+  EXPECT_EQ(parse("ncols 1\nnrows 1\nxllcorner -1.7e308\nyllcenter 0\ncellsize 1e308\n5\n").geometry().xll_m, -1.7e308);
+  EXPECT_EQ(parse("ncols 1\nnrows 1\nxllcenter -1.7e308\nyllcorner 0\ncellsize 2\n5\n").geometry().xll_m,
+            -1.7e308 - 1.0);
+}
+
 TEST(AscReadErrors, TooFewOrTooManyValuesOnARow) {
   expect_parse_error(std::string(kHeader3x2) + "1 2 3\n4 5\n", 7, "too few values on data row 2: got 2, expected 3");
   expect_parse_error(std::string(kHeader3x2) + "1 2 3 4\n5 6 7\n", 6, "too many values on data row 1");
