@@ -34,9 +34,10 @@ function(marsala_library name)
   target_compile_features(${target} ${scope} cxx_std_17)
 endfunction()
 
-# marsala_add_test(NAME SOURCE [LIBS ...]): one GoogleTest executable, registered with ctest.
+# marsala_add_test(NAME SOURCE [LIBS ...] [LABELS ...]): one GoogleTest executable, registered with ctest; its cases
+# carry the ctest LABELS (e.g. "fuzz", so that `ctest -L fuzz` runs them alone).
 function(marsala_add_test name source)
-  cmake_parse_arguments(ARG "" "" "LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "LIBS;LABELS" ${ARGN})
   add_executable(${name} ${source})
   target_compile_features(${name} PRIVATE cxx_std_17)
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main)
@@ -44,8 +45,12 @@ function(marsala_add_test name source)
   target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   marsala_warnings(${name})
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  set(labels)
+  if(ARG_LABELS)
+    set(labels LABELS "${ARG_LABELS}")
+  endif()
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
-                       PROPERTIES ENVIRONMENT "MARSALA_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+                       PROPERTIES ENVIRONMENT "MARSALA_SOURCE_DIR=${PROJECT_SOURCE_DIR}" ${labels})
 endfunction()
 
 # marsala_add_unit_tests(PART LIBS ... [BINARIES name=target ...]): one test executable per

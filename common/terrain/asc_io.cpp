@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string_view>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "marsala/core/error.hpp"
@@ -307,6 +308,11 @@ class AscParser {
     geometry.cell_size_m = cell_size;
     geometry.xll_m = header_[kXll].value - (header_[kXll].is_center ? 0.5 * cell_size : 0.0);
     geometry.yll_m = header_[kYll].value - (header_[kYll].is_center ? 0.5 * cell_size : 0.0);
+    // A centre near the double limits puts the corner half a cell beyond them.
+    for (const auto& [slot, corner] : {std::pair{kXll, geometry.xll_m}, std::pair{kYll, geometry.yll_m}})
+      if (!std::isfinite(corner))
+        fail(header_[slot].line, "header key " + quote(header_[slot].key) +
+                                     " puts the grid's lower-left corner half a cell beyond the range of doubles");
     Heightmap map(geometry, HeightMatrix(Eigen::Map<const HeightMatrix>(heights.data(), rows, cols)));
     if (nodata_cells > 0) {
       if (nodata_cells == announced) fail(0, "every cell is NODATA; there is nothing to fill from");
@@ -480,6 +486,14 @@ void fill_nodata(Heightmap& map) {
         }
       });
       values[k] = sum / count;
+      if (!std::isfinite(values[k])) {
+        // Heights near the double limits overflow the sum; scaled by 1/8 (exact) they cannot, and the mean is the same.
+        sum = 0.0;
+        for_neighbours(layer[k], [&](long long j) {
+          if (state[j] == 0) sum += h[j] * 0.125;
+        });
+        values[k] = sum / count * 8.0;
+      }
     }
     for (std::size_t k = 0; k < layer.size(); ++k) h[layer[k]] = values[k];
     for (long long i : layer) state[i] = 0;

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <new>
 #include <string_view>
 #include <system_error>
 #include <vector>
@@ -168,6 +169,15 @@ class GeoTiffReader {
            " (supported: float32, float64, int16, uint16, int32)");
     if (!TIFFIsCODECConfigured(compression))
       fail("compression scheme " + std::to_string(compression) + " is not supported by this libtiff");
+    // A damaged header can claim a raster of gigabytes in a file of a few bytes: uncompressed samples must fit in
+    // the file before their raster is allocated.
+    std::error_code ec;
+    const std::uintmax_t file_bytes = std::filesystem::file_size(path_, ec);
+    const std::uintmax_t raster_bytes = static_cast<std::uintmax_t>(width_) * height_ * sample_bytes(kind_);
+    if (compression == COMPRESSION_NONE && !ec && raster_bytes > file_bytes)
+      fail("the header declares " + std::to_string(width_) + " x " + std::to_string(height_) +
+           " uncompressed samples (" + std::to_string(raster_bytes) + " bytes) in a file of " +
+           std::to_string(file_bytes) + " bytes: truncated or damaged");
   }
 
   static std::string format_name(uint16_t format) {
@@ -345,7 +355,12 @@ class GeoTiffReader {
 }  // namespace
 
 Heightmap read_geotiff(const std::string& path, const GeoTiffOptions& options) {
-  return GeoTiffReader(path, options).read();
+  try {
+    return GeoTiffReader(path, options).read();
+  } catch (const std::bad_alloc&) {
+    // Compressed data can claim more than memory holds too; that is a problem of this file, not of the program.
+    throw ParseError(path, 0, "the raster does not fit in memory (damaged header?)");
+  }
 }
 
 }  // namespace marsala::terrain

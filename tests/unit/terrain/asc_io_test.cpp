@@ -159,6 +159,18 @@ TEST(AscReadErrors, BadCellsize) {
   expect_parse_error(head + "cellsize 1e999\n1\n", 5, "out of range");
 }
 
+TEST(AscReadErrors, CornerBeyondTheDoubles) {
+  // Found by tests/fuzz/asc_fuzz_test.cpp: a finite centre half a cell from the double limits made an infinite
+  // corner, and the Heightmap's InvalidArgument ("grid corner must be finite") escaped without the file's name.
+  expect_parse_error("ncols 1\nnrows 1\nxllcenter -1.7976931348623157e308\nyllcorner 0\ncellsize 1e308\n5\n", 3,
+                     "'xllcenter' puts the grid's lower-left corner half a cell beyond the range of doubles");
+  expect_parse_error("ncols 1\nnrows 1\nxllcorner 0\nyllcenter -1.7e308\ncellsize 1e308\n5\n", 4, "'yllcenter'");
+  // The same corner as a corner is fine, and so is a centre with a cell that keeps it in range.
+  EXPECT_EQ(parse("ncols 1\nnrows 1\nxllcorner -1.7e308\nyllcenter 0\ncellsize 1e308\n5\n").geometry().xll_m, -1.7e308);
+  EXPECT_EQ(parse("ncols 1\nnrows 1\nxllcenter -1.7e308\nyllcorner 0\ncellsize 2\n5\n").geometry().xll_m,
+            -1.7e308 - 1.0);
+}
+
 TEST(AscReadErrors, TooFewOrTooManyValuesOnARow) {
   expect_parse_error(std::string(kHeader3x2) + "1 2 3\n4 5\n", 7, "too few values on data row 2: got 2, expected 3");
   expect_parse_error(std::string(kHeader3x2) + "1 2 3 4\n5 6 7\n", 6, "too many values on data row 1");
@@ -386,6 +398,30 @@ TEST(FillNodata, StaysWithinTheValidRangeAndReproducesConstants) {
   constant(8, 8) = 2.75;
   fill_nodata(constant);
   for (long long i = 0; i < constant.size(); ++i) EXPECT_EQ(constant.data()[i], 2.75);
+}
+
+TEST(FillNodata, MeansOfHeightsNearTheDoubleLimitsStayFinite) {
+  // Found by tests/fuzz/asc_fuzz_test.cpp: the sum of two neighbours of -1e308 overflowed to -inf, so a file of
+  // finite heights loaded with --fill-nodata held an infinite height.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Heightmap row(GridGeometry{1, 3, 0.0, 0.0, 1.0});
+  row(0, 0) = -1e308;
+  row(0, 1) = nan;
+  row(0, 2) = -1e308;
+  fill_nodata(row);
+  EXPECT_EQ(row(0, 1), -1e308);
+  const double max = std::numeric_limits<double>::max();
+  Heightmap square(GridGeometry{3, 3, 0.0, 0.0, 1.0}, max);
+  square(1, 1) = nan;
+  square(0, 0) = 0.0;
+  fill_nodata(square);
+  EXPECT_DOUBLE_EQ(square(1, 1), 0.875 * max);  // the mean of seven max and one 0
+  std::istringstream in(
+      "ncols 3\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n"
+      "1e308 -9999 1e308\n");
+  AscReadOptions fill;
+  fill.fill_nodata = true;
+  EXPECT_EQ(parse_asc(in, "limits.asc", fill)(0, 1), 1e308);
 }
 
 TEST(FillNodata, AllMissingIsInvalid) {

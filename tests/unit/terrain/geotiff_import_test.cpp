@@ -365,8 +365,9 @@ TEST(GeoTiffErrors, NotATiff) {
 }
 
 // A little-endian float32 4 x 4 TIFF written byte by byte: one strip of 64 bytes right after the
-// directory, of which only `data_bytes` are present (a truncated download).
-std::string write_truncated_tiff(const std::string& name, std::size_t data_bytes) {
+// directory, of which only `data_bytes` are present (a truncated download). `side`: the width and length the
+// directory claims (a damaged header when not 4).
+std::string write_truncated_tiff(const std::string& name, std::size_t data_bytes, uint32_t side = 4) {
   std::string bytes = std::string("II*\0", 4);
   auto put16 = [&](uint16_t v) { bytes += static_cast<char>(v & 0xff), bytes += static_cast<char>(v >> 8); };
   auto put32 = [&](uint32_t v) { put16(static_cast<uint16_t>(v & 0xffff)), put16(static_cast<uint16_t>(v >> 16)); };
@@ -378,11 +379,11 @@ std::string write_truncated_tiff(const std::string& name, std::size_t data_bytes
     uint16_t tag, type;
     uint32_t value;
   };
-  const Entry directory[] = {{256, kLong, 4},   {257, kLong, 4},
-                             {258, kShort, 32}, {259, kShort, 1},
-                             {262, kShort, 1},  {273, kLong, data_offset},
-                             {277, kShort, 1},  {278, kLong, 4},
-                             {279, kLong, 64},  {339, kShort, SAMPLEFORMAT_IEEEFP}};
+  const Entry directory[] = {{256, kLong, side}, {257, kLong, side},
+                             {258, kShort, 32},  {259, kShort, 1},
+                             {262, kShort, 1},   {273, kLong, data_offset},
+                             {277, kShort, 1},   {278, kLong, side},
+                             {279, kLong, 64},   {339, kShort, SAMPLEFORMAT_IEEEFP}};
   put16(static_cast<uint16_t>(entries));
   for (const Entry& e : directory) {
     put16(e.tag);
@@ -415,6 +416,15 @@ TEST(GeoTiffErrors, TruncatedPixelData) {
   const std::string no_data = write_truncated_tiff("no_data.tif", 0);
   expect_parse_error(no_data, "cannot decode strip 0");
   for (const auto& p : {complete, truncated, no_data}) std::filesystem::remove(p);
+}
+
+TEST(GeoTiffErrors, AHeaderClaimingMoreThanTheFileHoldsIsRefusedBeforeAllocating) {
+  // Found while writing tests/fuzz/geotiff_fuzz_test.cpp: a 198-byte file claiming 20000 x 20000 float32 samples made
+  // the importer allocate (and zero) a 3.2 GB raster before finding the data missing; 40000 x 40000 threw
+  // std::bad_alloc.
+  const std::string path = write_truncated_tiff("claims_too_much.tif", 64, 20000);
+  expect_parse_error(path, "declares 20000 x 20000 uncompressed samples (1600000000 bytes) in a file of 198 bytes");
+  std::filesystem::remove(path);
 }
 
 TEST(GeoTiffErrors, TruncatedBeforeTheDirectory) {
