@@ -59,8 +59,9 @@ export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
 export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-lo.xml"
 
 # Without --domain: a random one (not derived from the PID, whose values repeat) on which no world answers
-# `marsala-monitor status` within 1 s. A world still admitting its agents publishes no status yet, so two runs
-# started at the same moment may still meet: give each its own --domain for certainty.
+# `marsala-monitor status` within 1 s (a world publishes its status from its start, while it admits). Two runs
+# started at the same moment may still pick one domain: the world itself then refuses to share it (the later one, or
+# the one still admitting, exits 1 naming the other; docs/runtime.md#one-world-per-domain).
 if [ -z "$domain" ]; then
   for _ in 1 2 3 4 5; do
     domain=$(( (RANDOM % 200) + 20 ))

@@ -77,6 +77,7 @@ std::string states_summary(const protocol::WorldStatus& status) {
 }
 
 std::string run_outcome(const protocol::WorldStatus& status) {
+  if (status.admitting) return "admitting";
   if (status.running) return "running";
   return status.completed ? "completed" : "stopped";
 }

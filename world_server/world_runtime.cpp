@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <random>
 #include <set>
 #include <utility>
 #include <vector>
@@ -223,6 +224,9 @@ struct WorldRuntime::Impl {
     admissions = participant.create_writer<protocol::Admission>({"", nullptr, bus::Durability::kVolatile, 64});
     status = participant.create_writer<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
     events = participant.create_writer<protocol::WorldEvent>({"", nullptr, bus::Durability::kVolatile, 256});
+    statuses = participant.create_reader<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 16});
+    std::random_device device;
+    while (world_id == 0) world_id = (static_cast<std::uint64_t>(device()) << 32) ^ device();
   }
 
   void emit(const protocol::WorldEvent& e) {
@@ -302,6 +306,11 @@ struct WorldRuntime::Impl {
     const Clock::time_point now = Clock::now();
     if (!now_please && now < next_hello_service) return;
     next_hello_service = now + kHelloInterval;
+    check_other_worlds();
+    if (!run_started && now >= next_admitting_status) {
+      publish_status(true, false, 0.0);
+      next_admitting_status = now + 500ms;
+    }
     for (const protocol::AgentHello& hello : hellos->take()) {
       ++hellos_taken;
       if (waits_for_takeover(hello, now)) continue;
@@ -451,8 +460,27 @@ struct WorldRuntime::Impl {
     return submissions;
   }
 
+  /// Refuses to go on beside another world on this domain (docs/runtime.md#one-world-per-domain): every world
+  /// publishes its status from the start, with a random world_id; of two that meet, the one still admitting yields
+  /// to one past admission, and of two admitting, the larger world_id yields. Throws Error naming the other run.
+  void check_other_worlds() {
+    for (const protocol::WorldStatus& other : statuses->take()) {
+      if (other.world_id == world_id || other.world_id == 0 || (!other.running && !other.admitting)) continue;
+      const bool me_admitting = !run_started;
+      const bool yield = me_admitting && (!other.admitting || other.world_id < world_id);
+      if (!yield) continue;
+      throw Error(
+          fmt::format("another marsala-world runs on DDS domain {} (run '{}', scenario '{}', {}): one world per "
+                      "domain; give this one another --domain",
+                      participant.domain_id(), other.run_id, other.scenario,
+                      other.admitting ? "admitting its agents" : "at step " + std::to_string(other.step)));
+    }
+  }
+
   void publish_status(bool running, bool completed, double wall_seconds) {
     protocol::WorldStatus s;
+    s.world_id = world_id;
+    s.admitting = running && !run_started;
     s.run_id = options.run_id;
     s.scenario = scenario.name;
     s.step = state.step;
@@ -719,6 +747,9 @@ struct WorldRuntime::Impl {
   std::unique_ptr<bus::Writer<protocol::Admission>> admissions;
   std::unique_ptr<bus::Writer<protocol::WorldStatus>> status;
   std::unique_ptr<bus::Writer<protocol::WorldEvent>> events;
+  std::unique_ptr<bus::Reader<protocol::WorldStatus>> statuses;  ///< other worlds' status on this domain
+  std::uint64_t world_id = 0;                                    ///< random, this process's
+  Clock::time_point next_admitting_status{};
   std::optional<EventLog> event_log;
   std::vector<std::string> last_rejection;  ///< [id - 1]: the rejection reason last logged at info level
   std::set<std::pair<std::uint32_t, std::uint64_t>> refused;  ///< (id, session) already reported as refused

@@ -99,6 +99,8 @@ struct WorldStatus {
   bool running = true;
   bool completed = false;
   std::vector<AgentStatus> agents;
+  std::uint64_t world_id = 0;  ///< random per world process: tells two worlds on one domain apart
+  bool admitting = false;      ///< the world is still admitting its agents (before its first step)
 };
 
 /// Kinds of world events, for the event stream and the monitor.

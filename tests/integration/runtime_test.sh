@@ -12,6 +12,8 @@
 #   torn-tail                                                        resume cuts a torn record at run.log's end
 #   agent-restart                                                    SIGKILL an agent, restart it: it takes over
 #   drop-rejoin                                                      an agent paused 7 s is dropped, then re-admitted
+#   full-disk                                                        the world's disk fills: exit 1, then --resume
+#   two-worlds                                                       a second world on a busy domain refuses
 #   kill                                                             SIGKILL one of 3 agents mid-run, others finish
 #   pause                                                            SIGSTOP the world, then an agent, 3 s each: the
 #                                                                    run loses nothing (same sha256 as unpaused)
@@ -245,6 +247,71 @@ case "$case_name" in
     grep -q "agent 3 admitted: .*(re-admitted, 1 of 3)" "$out/events.log" || fail "agent 3 was not re-admitted"
     [ "$(field readmissions "$s")" = "1" ] || fail "summary says $(field readmissions "$s") readmissions"
     echo "ok: agent 3 dropped while paused, re-admitted; run completed in $(field steps "$s") steps"
+    ;;
+  full-disk)
+    # The world's folder on a 200 kB tmpfs (a mount namespace of its own) fills mid-run: the world stops with an
+    # error naming the file and exits 1, run.log ends at a whole record; on a larger disk --resume completes the
+    # run on the uninterrupted terrain. Skipped (77) where mount namespaces are not permitted.
+    disk="$work/disk"
+    mkdir -p "$disk"
+    unshare -m --propagation private true 2>/dev/null || { echo "SKIP: no mount namespaces here (unshare -m)"; exit 77; }
+    reference=$(run_spawn reference 3 cyclone)
+    unshare -m --propagation private sh -c "mount -t tmpfs -o size=200k tmpfs '$disk' && exec sleep 600" &
+    holder=$!
+    in_disk() { nsenter -t "$holder" -m -- "$@"; }
+    for _ in $(seq 1 100); do in_disk mountpoint -q "$disk" 2>/dev/null && break; sleep 0.05; done
+    in_disk mountpoint -q "$disk" || { kill "$holder"; echo "SKIP: cannot mount a tmpfs here"; exit 77; }
+    trap 'kill "$holder" 2>/dev/null; [ -n "${MARSALA_KEEP_WORK:-}" ] || rm -rf "$work"' EXIT
+    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+    out="$disk/run"
+    logs="$work/logs"
+    mkdir -p "$logs"
+    rc=0
+    in_disk "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
+      >"$logs/world.log" 2>&1 &
+    world=$!
+    pids=()
+    for id in 1 2 3; do
+      "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" >"$logs/agent-$id.log" 2>&1 &
+      pids+=($!)
+    done
+    wait "$world" || rc=$?
+    [ "$rc" -eq 1 ] || { tail -20 "$logs/world.log"; fail "the world exited $rc on a full disk, not 1"; }
+    grep -q "No space left on device" "$logs/world.log" || { tail -5 "$logs/world.log"; fail "no 'No space left' error"; }
+    error=$(grep "marsala-world: error" "$logs/world.log")
+    in_disk test ! -e "$out/summary.json" || fail "a summary.json was written by a run that failed"
+    in_disk "$bin/marsala-monitor" replay "$out" >"$logs/replay-full.txt" 2>"$logs/replay-full.err" ||
+      { cat "$logs/replay-full.err"; fail "the log of the full disk does not replay"; }
+    ! grep -q "damaged\|truncated" "$logs/replay-full.err" || fail "run.log was left with a torn record: $(cat "$logs/replay-full.err")"
+    steps_full="$(awk '$1 == "steps" { print $2 + 0 }' "$logs/replay-full.txt") steps"
+    in_disk mount -o remount,size=4m "$disk"
+    in_disk "$bin/marsala-world" --resume "$out" --dds cyclone --domain "$domain" >"$logs/world-resume.log" 2>&1 &
+    world=$!
+    wait "$world" || { tail -20 "$logs/world-resume.log"; fail "the resumed world exited non-zero"; }
+    for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero (see $logs)"; done
+    in_disk cat "$out/summary.json" >"$work/summary.json"
+    s="$work/summary.json"
+    expect_completed "$s" 3
+    [ "$(field terrain_sha256 "$s")" = "$(field terrain_sha256 "$reference")" ] ||
+      fail "ended on $(field terrain_sha256 "$s"), uninterrupted on $(field terrain_sha256 "$reference")"
+    echo "ok: the disk filled after $steps_full ($error); resumed on a larger disk, completed on the uninterrupted terrain"
+    ;;
+  two-worlds)
+    # One world per domain: a second marsala-world started on the domain of a running one refuses to go on (exit 1,
+    # naming the other run) and the first run completes undisturbed; a monitor sees the first one admitting.
+    start_run "$work/two-worlds"
+    for _ in $(seq 1 3000); do grep -q "agent 1 deposited" "$out/events.log" 2>/dev/null && break; sleep 0.02; done
+    rc=0
+    "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$work/second" \
+      --admit-timeout 20 >"$work/second.log" 2>&1 || rc=$?
+    [ "$rc" -eq 1 ] || { tail -5 "$work/second.log"; fail "the second world exited $rc, not 1"; }
+    grep -q "another marsala-world runs on DDS domain $domain (run 'ramp-d$domain', scenario 'ramp', at step" \
+      "$work/second.log" || { tail -5 "$work/second.log"; fail "the second world did not name the first"; }
+    wait "$world" || { tail -30 "$out/logs/world.log"; fail "the first world exited non-zero"; }
+    for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero (see $out/logs)"; done
+    expect_completed "$out/summary.json" 3
+    echo "ok: the second world refused ($(grep -o "another marsala-world.*" "$work/second.log" | head -c 120)...)," \
+      "the first completed"
     ;;
   world-kill)
     start_run "$work/world-kill"

@@ -254,6 +254,8 @@ marsala_wire_WorldStatus to_msg(const WorldStatus& in, Storage& storage) {
   out.progress = in.progress;
   out.running = in.running;
   out.completed = in.completed;
+  out.world_id = in.world_id;
+  out.admitting = in.admitting;
   storage.agents.clear();
   for (const AgentStatus& a : in.agents) {
     marsala_wire_AgentStatus agent{};
@@ -286,6 +288,8 @@ WorldStatus from_msg(const marsala_wire_WorldStatus& in) {
   out.progress = in.progress;
   out.running = in.running;
   out.completed = in.completed;
+  out.world_id = in.world_id;
+  out.admitting = in.admitting;
   out.agents.reserve(in.agents._length);
   for (std::uint32_t i = 0; i < in.agents._length; ++i) {
     const marsala_wire_AgentStatus& a = in.agents._buffer[i];

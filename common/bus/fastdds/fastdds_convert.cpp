@@ -226,6 +226,8 @@ wire::WorldStatus to_msg(const WorldStatus& in) {
   out.progress(in.progress);
   out.running(in.running);
   out.completed(in.completed);
+  out.world_id(in.world_id);
+  out.admitting(in.admitting);
   out.agents().reserve(in.agents.size());
   for (const AgentStatus& a : in.agents) {
     wire::AgentStatus agent;
@@ -257,6 +259,8 @@ WorldStatus from_msg(const wire::WorldStatus& in) {
   out.progress = in.progress();
   out.running = in.running();
   out.completed = in.completed();
+  out.world_id = in.world_id();
+  out.admitting = in.admitting();
   out.agents.reserve(in.agents().size());
   for (const wire::AgentStatus& a : in.agents()) {
     AgentStatus agent;
