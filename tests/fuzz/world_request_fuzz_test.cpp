@@ -242,20 +242,40 @@ const protocol::ActionRequest* answer_of(const AgentRecord& agent, std::uint64_t
   return nullptr;
 }
 
-/// The requests on `agent`'s partition that it must count as rejected besides its answer: foreign identities, future
-/// steps and duplicates (docs/runtime.md#lockstep).
-std::uint32_t extra_rejections(const AgentRecord& agent, std::uint64_t step,
+/// The rejections charged to `agent` in `step` besides a rejected answer (docs/runtime.md#duplicates-and-stale-steps):
+/// on its own partition, requests for future steps and duplicates that differ from its answer (an identical repeat is
+/// ignored); on any live agent's partition, requests that carry `agent`'s admitted identity but not the partition
+/// owner's (charged to their sender, never to the owner).
+std::uint32_t extra_rejections(const WorldState& before, const AgentRecord& agent, std::uint64_t step,
                                const std::vector<Submission>& submissions) {
   std::uint32_t n = 0;
-  bool answered = false;
+  const protocol::ActionRequest* first = nullptr;
   for (const Submission& s : submissions) {
+    if (!before.has_agent(s.channel_id) || !before.agent(s.channel_id).alive) continue;
+    if (!carries_identity_of(before.agent(s.channel_id), s.request)) {
+      if (agent.admitted && carries_identity_of(agent, s.request)) ++n;
+      continue;
+    }
     if (s.channel_id != agent.id) continue;
-    if (!carries_identity_of(agent, s.request) || s.request.step > step) {
+    if (s.request.step > step) {
       ++n;
     } else if (s.request.step == step) {
-      n += answered ? 1 : 0;
-      answered = true;
+      if (first && !protocol::same_request(*first, s.request)) ++n;
+      if (!first) first = &s.request;
     }
+  }
+  return n;
+}
+
+/// Requests on live partitions that carry no admitted identity at all: counted in unattributed_rejections.
+std::uint32_t unattributed(const WorldState& before, const std::vector<Submission>& submissions) {
+  std::uint32_t n = 0;
+  for (const Submission& s : submissions) {
+    if (!before.has_agent(s.channel_id) || !before.agent(s.channel_id).alive) continue;
+    if (carries_identity_of(before.agent(s.channel_id), s.request)) continue;
+    const bool known = before.has_agent(s.request.agent_id) && before.agent(s.request.agent_id).admitted &&
+                       before.agent(s.request.agent_id).session == s.request.session;
+    n += known ? 0 : 1;
   }
   return n;
 }
@@ -330,7 +350,8 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
         << report();
     if (!was.alive) {
       ASSERT_EQ(now.accepted, was.accepted) << report();
-      ASSERT_EQ(now.rejected, was.rejected) << report();
+      ASSERT_EQ(now.rejected - was.rejected, extra_rejections(before, was, before.step, submissions)) << report();
+      rejected += now.rejected - was.rejected;
       ASSERT_TRUE(now.x_m == was.x_m && now.y_m == was.y_m && now.material_m3 == was.material_m3) << report();
       continue;
     }
@@ -339,7 +360,7 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
     ASSERT_LE(took, 1u) << report();
     ASSERT_TRUE(took == 0 || answer) << "agent " << was.id << " accepted without an answer\n" << report();
     ASSERT_EQ(now.rejected - was.rejected,
-              extra_rejections(was, before.step, submissions) + (answer && took == 0 ? 1 : 0))
+              extra_rejections(before, was, before.step, submissions) + (answer && took == 0 ? 1 : 0))
         << "agent " << was.id << "\n"
         << report();
     ASSERT_EQ(now.missed - was.missed, answer ? 0u : 1u) << report();
@@ -371,7 +392,9 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
     ASSERT_NEAR(now.deposited_m3 - was.deposited_m3, volume, 1e-12) << report();
   }
   ASSERT_EQ(outcome.accepted, accepted) << report();
-  ASSERT_EQ(outcome.rejected, rejected) << report();
+  ASSERT_EQ(state.unattributed_rejections - before.unattributed_rejections, unattributed(before, submissions))
+      << report();
+  ASSERT_EQ(outcome.rejected, rejected + unattributed(before, submissions)) << report();
   ASSERT_EQ(outcome.missed, missed) << report();
 
   // The terrain changed exactly at the accepted cells, by exactly their heights, and stays finite.

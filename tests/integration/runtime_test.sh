@@ -39,11 +39,12 @@ run_spawn() {  # run_spawn OUT_NAME AGENTS DDS [AGENT_DDS]
   [ -f "$out/summary.json" ] || fail "no summary.json in $out"
   echo "$out/summary.json"
 }
-start_run() {  # start_run OUT: marsala-world and agents 1..3 on Cyclone in the background; sets out, world, pids
+start_run() {  # start_run OUT [WORLD ARGS]: world and agents 1..3 on Cyclone in the background; sets out, world, pids
   export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
   out="$1"
+  shift
   mkdir -p "$out/logs"
-  "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
+  "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" "$@" \
     >"$out/logs/world.log" 2>&1 &
   world=$!
   pids=()
@@ -157,7 +158,7 @@ case "$case_name" in
     # run ends on the uninterrupted run's terrain, and a replay of its run.log gives the same digest.
     reference=$(run_spawn reference 3 cyclone)
     expect_completed "$reference" 3
-    start_run "$work/resume"
+    start_run "$work/resume" --snapshot-every 50
     step_reached() {  # step_reached N: events.log (written live) holds a line of step N or later
       awk -v n="$1" '$1 == "step" && $2 + 0 >= n { found = 1 } END { exit !found }' "$out/events.log" 2>/dev/null
     }
@@ -168,7 +169,8 @@ case "$case_name" in
       kill -KILL "$world"
       wait "$world" 2>/dev/null || true
       resumes=$((resumes + 1))
-      "$bin/marsala-world" --resume "$out" --dds cyclone --domain "$domain" >"$out/logs/world-resume-$resumes.log" 2>&1 &
+      "$bin/marsala-world" --resume "$out" --dds cyclone --domain "$domain" --snapshot-every 50 \
+        >"$out/logs/world-resume-$resumes.log" 2>&1 &
       world=$!
     done
     wait "$world" || { tail -30 "$out/logs/world-resume-$resumes.log"; fail "the resumed world exited non-zero"; }
@@ -180,7 +182,9 @@ case "$case_name" in
       fail "resumed run ended on $(field terrain_sha256 "$s"), uninterrupted on $(field terrain_sha256 "$reference")"
     replayed=$("$bin/marsala-monitor" replay "$out" | tail -1)
     [ "$replayed" = "terrain_sha256 $(field terrain_sha256 "$s")" ] || fail "replay printed '$replayed'"
-    grep -h "resumed at step" "$out"/logs/world-resume-*.log | sed 's/^[^:]*: //'
+    grep -h "resumed at step" "$out"/logs/world-resume-*.log | sed 's/^[^ ]* [^ ]* world: //'
+    [ "$(grep -l "resumed at step .* after the snapshot of step" "$out"/logs/world-resume-*.log | wc -l)" -eq 3 ] ||
+      fail "not every resume started from a snapshot"
     echo "ok: world killed 3 times, resumed; completed in $(field steps "$s") steps on the uninterrupted terrain;" \
       "replay agrees"
     ;;

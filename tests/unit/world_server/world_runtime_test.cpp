@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <unistd.h>
 #include <chrono>
 #include <cmath>
@@ -171,7 +173,17 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   EXPECT_EQ(latest[0].progress, 1.0);
   ASSERT_EQ(latest[0].agents.size(), 2u);
   EXPECT_EQ(latest[0].agents[0].state, "walking");
-  EXPECT_EQ(statuses->take().size(), kStepsToGoal + 2);  // before step 0, after each step, the final one
+  // While admitting (every 0.5 s, at least once), before step 0, after each step, the final one.
+  const std::vector<protocol::WorldStatus> all = statuses->take();
+  const auto admitting = static_cast<std::size_t>(
+      std::count_if(all.begin(), all.end(), [](const protocol::WorldStatus& st) { return st.admitting; }));
+  EXPECT_GE(admitting, 1u);
+  EXPECT_EQ(all.size() - admitting, kStepsToGoal + 2);
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    EXPECT_EQ(all[i].admitting, i < admitting) << i;  // admitting first, then never again
+    EXPECT_EQ(all[i].world_id, all.front().world_id);
+    EXPECT_NE(all[i].world_id, 0u);
+  }
   int admitted = 0, refused = 0, deposited = 0, run_over = 0;
   for (const protocol::WorldEvent& e : events->take()) {
     admitted += e.kind == protocol::EventKind::kAdmitted;
