@@ -16,6 +16,7 @@
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/render/png_writer.hpp"
+#include "marsala/runlog/atomic_file.hpp"
 #include "marsala/runlog/run_log.hpp"
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/terrain/asc_io.hpp"
@@ -27,6 +28,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+using runlog::write_atomically;
 
 /// Agreement of the log's deposited volume with the replay's: the world sums the same terms in the same order, so
 /// they agree bit for bit unless the log lies; the tolerance only forgives a writer that rounds differently.
@@ -34,27 +36,6 @@ constexpr double kVolumeRelativeTolerance = 1e-9;
 constexpr double kVolumeAbsoluteToleranceM3 = 1e-12;
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-/// Writes `path` through write(tmp) into "<path>.tmp", then renames it over `path`, as the world writes its outputs
-/// (world_server/run_outputs.cpp): nobody ever sees a half-written file under the final name.
-template <typename Write>
-void write_atomically(const std::string& path, Write&& write) {
-  const std::string tmp = path + ".tmp";
-  try {
-    write(tmp);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw;
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw IoError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
-  }
-}
 
 /// A record's kind as messages name it.
 const char* record_kind(const proto::LogRecord& record) {

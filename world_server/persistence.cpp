@@ -8,6 +8,7 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
+#include "marsala/runlog/atomic_file.hpp"
 #include "marsala/runlog/crc32c.hpp"
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/world_server/completion.hpp"
@@ -202,14 +203,10 @@ proto::Snapshot read_snapshot(const std::string& path) {
 }
 
 void write_snapshot(const std::string& path, const proto::Snapshot& snapshot) {
-  const std::string tmp = path + ".tmp";
-  {
+  runlog::write_atomically(path, [&](const std::string& tmp) {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out || !snapshot.SerializeToOstream(&out) || !out.flush()) throw IoError(tmp + ": cannot write the snapshot");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw IoError(path + ": cannot rename the snapshot into place: " + ec.message());
+  });
 }
 
 void restore_snapshot(WorldState& state, const proto::Snapshot& s, const std::string& file) {

@@ -13,6 +13,7 @@
 #include "marsala/core/format.hpp"
 #include "marsala/render/png_writer.hpp"
 #include "marsala/render/terrain_renderer.hpp"
+#include "marsala/runlog/atomic_file.hpp"
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/terrain/asc_io.hpp"
 
@@ -20,6 +21,7 @@ namespace marsala::world_server {
 namespace {
 
 namespace fs = std::filesystem;
+using runlog::write_atomically;
 
 void make_dir(const std::string& dir) {
   std::error_code ec;
@@ -28,27 +30,6 @@ void make_dir(const std::string& dir) {
 }
 
 std::string path_in(const std::string& dir, const char* name) { return (fs::path(dir) / name).string(); }
-
-/// Writes `path` through write(tmp) into "<path>.tmp", then renames it over `path`: a reader (or a crash, or a full
-/// disk) never sees a half-written file under the final name. Throws IoError; the temporary is removed.
-template <typename Write>
-void write_atomically(const std::string& path, Write&& write) {
-  const std::string tmp = path + ".tmp";
-  try {
-    write(tmp);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw;
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw IoError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
-  }
-}
 
 constexpr render::Rgb kWhite{255, 255, 255};
 constexpr render::Rgb kPathYellow{255, 214, 0};

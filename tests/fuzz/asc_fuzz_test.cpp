@@ -223,12 +223,7 @@ TEST(AscFuzz, EveryInputLoadsOrThrowsAParseErrorAndLoadedGridsRoundTrip) {
     }
     if (::testing::Test::HasFailure()) return;
     // Accepted mutants are kept as seeds, so later mutations reach beyond the header checks.
-    if (input.size() < 4096) {
-      if (corpus.size() < kMaxCorpus)
-        corpus.push_back(input);
-      else
-        corpus[fixed_seeds + mutator.below(kMaxCorpus - fixed_seeds)] = input;
-    }
+    if (input.size() < 4096) mutator.keep(corpus, input, fixed_seeds, kMaxCorpus);
   }
   std::filesystem::remove(file);
   // The fuzzer must reach the data: a run where (almost) nothing loads tests only the header checks.

@@ -167,6 +167,14 @@ class Mutator {
 
   std::mt19937_64& rng() { return rng_; }
   /// Uniform in [0, n); 0 when n is 0.
+  /// Keeps an accepted `input` as a seed, so that later mutations reach beyond the header checks: appended while the
+  /// corpus holds fewer than `max` entries, else in place of a random entry after the first `fixed` ones.
+  void keep(std::vector<std::string>& corpus, const std::string& input, std::size_t fixed, std::size_t max) {
+    if (corpus.size() < max)
+      corpus.push_back(input);
+    else
+      corpus[fixed + below(max - fixed)] = input;
+  }
   std::size_t below(std::size_t n) { return n == 0 ? 0 : std::uniform_int_distribution<std::size_t>(0, n - 1)(rng_); }
   bool chance(double p) { return std::uniform_real_distribution<double>(0.0, 1.0)(rng_) < p; }
   template <typename T>

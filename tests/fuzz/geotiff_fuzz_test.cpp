@@ -294,10 +294,7 @@ TEST(GeoTiffFuzz, EveryFileLoadsOrThrowsATypedErrorAndLoadedGridsAreWhatTheFileD
     check_loaded(*map, path, report);
     if (::testing::Test::HasFailure()) return;
     if (input.size() > 16384 || map->size() > 100000) continue;  // small seeds keep the budget
-    if (corpus.size() < kMaxCorpus)
-      corpus.push_back(input);
-    else
-      corpus[fixed_seeds + mutator.below(kMaxCorpus - fixed_seeds)] = input;
+    mutator.keep(corpus, input, fixed_seeds, kMaxCorpus);
   }
   std::filesystem::remove(path);
   EXPECT_GT(loaded, iterations / 50) << "only " << loaded << " of " << iterations << " files loaded";
