@@ -55,6 +55,13 @@ constexpr std::size_t kMaxRefusalKeys = 1024;
 // still alive, for up to this long: its liveliness lapses within the 1 s DDS lease when the old process died, and
 // the new session then takes the slot over. Still alive after this: refused (two processes with one id).
 constexpr auto kTakeoverWait = 3s;
+// A session is admitted (first, re-admission, takeover) only on a hello repeated at least this long after its first:
+// agents repeat theirs every 200 ms, a flood of random sessions never does. Hellos are remembered for up to two
+// generations of kHelloMemory.
+constexpr auto kHelloConfirmation = 100ms;
+constexpr auto kHelloMemory = 1s;
+// Refusals answered per round of hellos (every 20 ms) at most.
+constexpr int kMaxRefusalAnswers = 16;
 // Requests taken from one partition in one step beyond this many are counted (surplus) and never applied.
 constexpr std::size_t kMaxRequestsPerPartition = 8;
 // A live agent that has not answered its frame after this long gets the same frame again (its reader may have
@@ -279,6 +286,7 @@ struct WorldRuntime::Impl {
     if (!state.has_agent(hello.agent_id)) return false;
     const AgentRecord& a = state.agent(hello.agent_id);
     if (!a.alive || a.session == hello.session || !holder_connected(hello.agent_id)) return false;
+    if (!persistent(hello, now)) return true;  // a sender that said hello once (a flood) is not even logged
     if (takeover_since.size() >= kMaxRefusalKeys) takeover_since.clear();
     const auto [it, first] = takeover_since.try_emplace({hello.agent_id, hello.session}, now);
     if (first)
@@ -288,6 +296,23 @@ struct WorldRuntime::Impl {
           hello.agent_id, hello.session, a.session,
           std::chrono::duration_cast<std::chrono::seconds>(kTakeoverWait).count());
     return now - it->second < kTakeoverWait;
+  }
+
+  /// True when (id, session) said hello before, at least kHelloConfirmation ago (and within the last two generations of
+  /// kHelloMemory). A real agent repeats its hello every 200 ms until answered; a flood of random sessions never does,
+  /// so it never takes a slot. Bounded: a generation holds at most the hellos taken in kHelloMemory (64 per 20 ms).
+  bool persistent(const protocol::AgentHello& hello, Clock::time_point now) {
+    if (now - seen_rotated >= kHelloMemory) {
+      seen_previous = std::move(seen_current);
+      seen_current.clear();
+      seen_rotated = now;
+    }
+    const auto key = std::make_pair(hello.agent_id, hello.session);
+    Clock::time_point first = now;
+    if (const auto it = seen_previous.find(key); it != seen_previous.end()) first = it->second;
+    const auto [it, fresh] = seen_current.try_emplace(key, first);
+    if (!fresh) first = std::min(first, it->second);
+    return now - first >= kHelloConfirmation;
   }
 
   /// True when (id, session) may be answered now: each at most every kAnswerInterval (bounded bookkeeping).
@@ -311,11 +336,13 @@ struct WorldRuntime::Impl {
       publish_status(true, false, 0.0);
       next_admitting_status = now + 500ms;
     }
+    int refusal_answers = 0;
     for (const protocol::AgentHello& hello : hellos->take()) {
       ++hellos_taken;
       if (waits_for_takeover(hello, now)) continue;
       const AdmissionDecision decision = decide_admission(state, hello, run_started, holder_connected(hello.agent_id));
       if (decision.accepted && decision.kind != AdmissionKind::kRepeat) {
+        if (!persistent(hello, now)) continue;  // answered when it says hello again
         const std::uint64_t previous = state.agent(hello.agent_id).session;
         if (admit(state, hello, decision.kind)) {
           record(admitted_record(state, hello.agent_id, decision.kind));
@@ -342,6 +369,9 @@ struct WorldRuntime::Impl {
           emit(make_event(hello.agent_id, protocol::EventKind::kRefused, decision.reason));
         }
       }
+      // Refusals are answered at most kMaxRefusalAnswers per round: a flood of hellos must not become a flood of
+      // admissions.
+      if (!decision.accepted && ++refusal_answers > kMaxRefusalAnswers) continue;
       if (may_answer(hello, now))
         write_logged(*admissions, admission_message(state, hello, decision, options.run_id), "an admission");
     }
@@ -430,12 +460,17 @@ struct WorldRuntime::Impl {
         std::vector<protocol::ActionRequest> received = links[a.id - 1].requests->take();
         if (!a.alive) continue;  // a dropped agent's requests are read only to be discarded
         for (protocol::ActionRequest& r : received) {
-          if (taken[a.id - 1] >= kMaxRequestsPerPartition) {
+          // The owner's answer for this step is always taken; the limit applies to everything else, so a flood on
+          // an agent's partition never displaces its own request.
+          const bool answer = !answered[a.id - 1] && r.step == state.step && carries_identity_of(a, r);
+          if (!answer && taken[a.id - 1] >= kMaxRequestsPerPartition) {
             ++surplus;
             continue;
           }
-          ++taken[a.id - 1];
-          if (r.step == state.step && carries_identity_of(a, r)) answered[a.id - 1] = true;
+          if (answer)
+            answered[a.id - 1] = true;
+          else
+            ++taken[a.id - 1];
           submissions.push_back({a.id, std::move(r)});
         }
       }
@@ -756,6 +791,8 @@ struct WorldRuntime::Impl {
   std::map<std::pair<std::uint32_t, std::uint64_t>, Clock::time_point> answered_at;  ///< last answer per sender
   std::map<std::pair<std::uint32_t, std::uint64_t>, Clock::time_point>
       takeover_since;  ///< first hello of a new session
+  std::map<std::pair<std::uint32_t, std::uint64_t>, Clock::time_point> seen_current, seen_previous;  ///< persistent()
+  Clock::time_point seen_rotated{};
   std::uint64_t hellos_taken = 0;
   std::uint64_t refusals = 0;
   Clock::time_point next_hello_service{};

@@ -14,6 +14,7 @@
 #   drop-rejoin                                                      an agent paused 7 s is dropped, then re-admitted
 #   full-disk                                                        the world's disk fills: exit 1, then --resume
 #   two-worlds                                                       a second world on a busy domain refuses
+#   flood                                                            hello and request floods: bounded, same terrain
 #   kill                                                             SIGKILL one of 3 agents mid-run, others finish
 #   pause                                                            SIGSTOP the world, then an agent, 3 s each: the
 #                                                                    run loses nothing (same sha256 as unpaused)
@@ -316,6 +317,49 @@ case "$case_name" in
     expect_completed "$out/summary.json" 3
     echo "ok: the second world refused ($(grep -o "another marsala-world.*" "$work/second.log" | head -c 120)...)," \
       "the first completed"
+    ;;
+  flood)
+    # Floods of hellos (random ids and sessions) and of forged requests on every agent partition (a wildcard), both
+    # as fast as a process can write them, for the whole run: it completes on the unflooded digest, nobody dropped,
+    # the honest agents charged nothing, the flood counted; the world's memory and logs stay within stated bounds
+    # (docs/runtime.md#load-limits).
+    reference=$(run_spawn reference 3 cyclone)
+    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+    mkdir -p "$work/logs"
+    "$bin/marsala-flooder" hellos 12 "$scenario" cyclone "$domain" >"$work/logs/flood-hellos.txt" 2>&1 &
+    f1=$!
+    "$bin/marsala-flooder" requests 12 "$scenario" cyclone "$domain" >"$work/logs/flood-requests.txt" 2>&1 &
+    f2=$!
+    sleep 1
+    start_run "$work/flood"
+    peak=0
+    while kill -0 "$world" 2>/dev/null; do
+      rss=$(awk '/^VmRSS/ { print $2 }' "/proc/$world/status" 2>/dev/null || echo 0)
+      [ "${rss:-0}" -gt "$peak" ] && peak=$rss
+      sleep 0.25
+    done
+    wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero under the flood"; }
+    for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero under the flood (see $out/logs)"; done
+    wait "$f1" "$f2" || fail "a flooder failed: $(cat "$work"/logs/flood-*.txt)"
+    s="$out/summary.json"
+    expect_completed "$s" 3
+    [ "$(field terrain_sha256 "$s")" = "$(field terrain_sha256 "$reference")" ] ||
+      fail "flooded run ended on $(field terrain_sha256 "$s"), unflooded on $(field terrain_sha256 "$reference")"
+    ! grep -Eq "agent [0-9]+ dropped" "$out/events.log" || fail "the flood dropped an agent"
+    for id in 1 2 3; do
+      rej=$(tr -d '\n ' <"$s" | grep -o "{\"agent_id\":$id,[^}]*}" | grep -o '"rejected":[0-9]*' | cut -d: -f2)
+      [ "$rej" = "0" ] || fail "honest agent $id was charged $rej rejections"
+    done
+    [ "$(field surplus_requests "$s")" -gt 0 ] || fail "the request flood was not counted (surplus_requests 0)"
+    events=$(stat -c %s "$out/events.log")
+    world_log=$(stat -c %s "$out/logs/world.log")
+    [ "$peak" -lt 153600 ] || fail "world peak RSS $peak kB exceeds the 150 MB bound"
+    [ "$events" -lt 2097152 ] || fail "events.log grew to $events bytes under the flood (bound 2 MB)"
+    [ "$world_log" -lt 2097152 ] || fail "the world's log grew to $world_log bytes under the flood (bound 2 MB)"
+    echo "ok: $(cat "$work/logs/flood-hellos.txt") and $(cat "$work/logs/flood-requests.txt"); completed in" \
+      "$(field steps "$s") steps ($(field wall_seconds "$s") s, unflooded $(field wall_seconds "$reference") s) on" \
+      "the unflooded terrain; world peak RSS $peak kB; events.log $events B, world log $world_log B;" \
+      "surplus $(field surplus_requests "$s"), unattributed $(field unattributed_rejections "$s"), honest agents 0"
     ;;
   world-kill)
     start_run "$work/world-kill"
