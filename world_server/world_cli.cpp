@@ -57,6 +57,9 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       ->capture_default_str();
   app.add_option("--max-steps", options.max_steps, "override the scenario's max_steps")
       ->check(CLI::Range(1ull, 1ull << 40));
+  app.add_option("--step-deadline", options.step_deadline_s,
+                 "override the scenario's step_deadline_s: how long a step waits for a dead or hung agent [s]")
+      ->check(CLI::Range(0.001, 3600.0));
   std::uint64_t seed = 0;
   const CLI::Option* seed_option =
       app.add_option("--seed", seed, "override the scenario's seed (start jitter); summary.json reports the seed used");
@@ -108,6 +111,9 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
     return 1;
   } catch (const std::bad_alloc&) {
     err << "marsala-world: error: out of memory\n";
+    return 1;
+  } catch (const std::exception& e) {  // a library's own exception: still one line and exit 1, never an abort
+    err << "marsala-world: error: " << e.what() << "\n";
     return 1;
   }
   return 0;

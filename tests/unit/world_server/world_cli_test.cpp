@@ -29,8 +29,24 @@ TEST_F(WorldCliTest, UsageErrorsExitWith2) {
   EXPECT_EQ(run({"--scenario", ok, "--agents", "0"}), 2);
   EXPECT_EQ(run({"--scenario", ok, "--dds", "opensplice"}), 2);
   EXPECT_EQ(run({"--scenario", ok, "--domain", "300"}), 2);
+  EXPECT_EQ(run({"--scenario", ok, "--step-deadline", "0"}), 2);
+  EXPECT_EQ(run({"--resume", "somewhere", "--scenario", ok}), 2);  // a resume takes its scenario from the log
   EXPECT_EQ(run({"--help"}), 0);
   EXPECT_NE(out_.str().find("--admit-timeout"), std::string::npos);
+}
+
+// --step-deadline overrides the scenario's, as the world's own start-up check reports it.
+TEST_F(WorldCliTest, StepDeadlineOverridesTheScenarios) {
+  const std::string ok = write("ok.pbtxt", testing::small_scenario_text());
+  EXPECT_EQ(run({"--check", "--json", "--step-deadline", "2.5", ok}), 0) << err_.str();
+  EXPECT_NE(out_.str().find("\"step_deadline_s\": 2.5"), std::string::npos) << out_.str();
+}
+
+// --resume of a folder without a run log: one line naming it, exit 1.
+TEST_F(WorldCliTest, ResumingAFolderWithoutARunLogIsAnError) {
+  const std::string folder = std::filesystem::path(write("readme.txt", "no run here")).parent_path().string();
+  EXPECT_EQ(run({"--resume", folder}), 1);
+  EXPECT_NE(err_.str().find("no run.log there"), std::string::npos) << err_.str();
 }
 
 TEST_F(WorldCliTest, BadScenariosExitWith1OnOneLineNamingFileAndLine) {
