@@ -26,14 +26,13 @@ extern "C" void on_signal(int) { g_stop = true; }
 int main(int argc, char** argv) {
   using namespace marsala;
   CLI::App app{"marsala-agent: one robot of a MARSala run (body and behaviour from its scenario slot)"};
-  std::string scenario_file, dds = "cyclone", log_level = "info";
+  std::string scenario_file, log_level = "info";
+  marsala::cli::DdsOptions dds;
   std::uint32_t id = 0;
-  int domain = 0;
   double admit_timeout_s = 60.0, world_timeout_s = 60.0;
   app.add_option("--scenario", scenario_file, "scenario file (protobuf text format)")->required();
   app.add_option("--id", id, "agent id: the scenario slot, 1..N")->required()->check(CLI::Range(1u, 1000000u));
-  app.add_option("--dds", dds, "DDS vendor")->check(CLI::IsMember({"cyclone", "fastdds", "inprocess"}));
-  app.add_option("--domain", domain, "DDS domain id")->check(CLI::Range(0, 232));
+  marsala::cli::add_dds_options(app, dds);
   std::optional<std::uint64_t> seed;
   app.add_option("--seed", seed, "override the scenario's seed (marsala-world must get the same)");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, off")
@@ -67,7 +66,7 @@ int main(int argc, char** argv) {
     config.admit_timeout = std::chrono::milliseconds(static_cast<long long>(admit_timeout_s * 1000.0));
     config.world_timeout = std::chrono::milliseconds(static_cast<long long>(world_timeout_s * 1000.0));
 
-    const auto participant = bus::make_participant({bus::vendor_from_string(dds), domain});
+    const auto participant = bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile});
     agent::runtime::AgentRuntime agent(*participant, config);
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);

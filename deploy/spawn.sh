@@ -7,8 +7,8 @@
 #                        [--quiet]
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
 #                 folder that holds another run's files, unless --replace removes them (and logs/) first
-#   --dds         vendor of every process (default cyclone); --agent-dds overrides it for the agents (mixed runs)
-#   --domain      DDS domain id (default: a random one on which no world answers within 1 s)
+#   --dds         vendor of every process (default $MARSALA_DDS, else cyclone); --agent-dds overrides it for the agents
+#   --domain      DDS domain id (default $MARSALA_DOMAIN, else a random one on which no world answers within 1 s)
 #   --monitor     also run `marsala-monitor tail` in the foreground output
 #   --timeout     give up (and stop everything) after S seconds of wall time (default 1800)
 #   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
@@ -19,7 +19,7 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
-scenario="" agents="" dds="cyclone" agent_dds="" out="" domain="" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0
+scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0
 replace=0
 usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do

@@ -52,14 +52,8 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       "marsala-monitor"};
   app.require_subcommand(1);
 
-  std::string dds = "cyclone";
-  int domain = 0;
-  auto add_bus_options = [&](CLI::App& cmd) {
-    cmd.add_option("--dds", dds, "DDS vendor: cyclone, fastdds, or inprocess (tests only)")
-        ->check(CLI::IsMember({"cyclone", "fastdds", "inprocess"}))
-        ->capture_default_str();
-    cmd.add_option("--domain", domain, "DDS domain id")->check(CLI::Range(0, 232))->capture_default_str();
-  };
+  cli::DdsOptions dds;
+  auto add_bus_options = [&](CLI::App& cmd) { cli::add_dds_options(cmd, dds); };
 
   TailOptions tail_options;
   double tail_timeout_s = 0.0;
@@ -117,7 +111,7 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       out << format_replay_report(report);
       return 0;
     }
-    auto participant = bus::make_participant({bus::vendor_from_string(dds), domain});
+    auto participant = bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile});
     if (*tail) {
       if (tail_timeout->count() > 0) tail_options.timeout = std::chrono::duration<double>(tail_timeout_s);
       return run_tail(*participant, tail_options, stop, out, err);

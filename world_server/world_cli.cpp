@@ -29,9 +29,9 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       "marsala-world --resume DIR continues the run in DIR with its agents (docs/runtime.md#resume).\n"
       "Exit codes: 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 1 error, 2 usage.",
       "marsala-world"};
-  std::string scenario_path, check_path, resume_dir, dds = "cyclone";
+  std::string scenario_path, check_path, resume_dir;
+  cli::DdsOptions dds;
   RuntimeOptions options;
-  int domain = 0;
   bool quiet = false, check = false, json = false;
   CLI::Option* scenario_option =
       app.add_option("--scenario", scenario_path, "scenario file (protobuf text format); required but with --check");
@@ -46,10 +46,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       ->excludes(scenario_option);
   app.add_option("--agents", options.agents, "agents to wait for, ids 1..N (default: every slot of the scenario)")
       ->check(CLI::Range(1u, 100000u));
-  app.add_option("--dds", dds, "DDS vendor")
-      ->check(CLI::IsMember({"cyclone", "fastdds", "inprocess"}))
-      ->capture_default_str();
-  app.add_option("--domain", domain, "DDS domain id")->check(CLI::Range(0, 232))->capture_default_str();
+  cli::add_dds_options(app, dds);
   app.add_option("--out", options.out_dir, "output folder")->capture_default_str();
   app.add_option("--run-id", options.run_id, "run id, the prefix of every agent partition");
   app.add_option("--admit-timeout", options.admit_timeout_s, "seconds to wait for all agents")
@@ -86,20 +83,20 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
 
   if (seed_option->count() > 0) options.seed = seed;
   if (check)
-    return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, domain, json, out, err);
+    return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, dds.domain, json, out, err);
   spdlog::set_pattern("%H:%M:%S.%e %^%l%$ world: %v");
   spdlog::set_level(quiet ? spdlog::level::warn : spdlog::level::info);
   try {
     WorldStart start;
     if (!resume_dir.empty()) {
-      start = prepare_resume(resume_dir, options, domain);
+      start = prepare_resume(resume_dir, options, dds.domain);
     } else {
       options.scenario_text = scenario::read_scenario_text(scenario_path);
       if (options.replace) clear_run_files(options.out_dir);
       const scenario::Scenario scenario = scenario::parse_scenario(options.scenario_text, scenario_path);
-      start = prepare_world_start(scenario, scenario::build_terrain(scenario), options, domain);
+      start = prepare_world_start(scenario, scenario::build_terrain(scenario), options, dds.domain);
     }
-    const auto participant = bus::make_participant({bus::vendor_from_string(dds), domain});
+    const auto participant = bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile});
     WorldRuntime runtime(std::move(start), *participant);
     const RunResult result = runtime.run(stop);
     out << "run " << runtime.run_id() << ": " << to_string(result.end_reason) << " after " << result.steps << " steps"

@@ -1,5 +1,10 @@
 #include "marsala/bus/bus.hpp"
 
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
 #include "marsala/bus/detail/backends.hpp"
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
@@ -34,9 +39,64 @@ bool Signal::wait_until(std::chrono::steady_clock::time_point deadline) {
   return notified;
 }
 
+namespace {
+
+const char* profile_variable(Vendor vendor) {
+  return vendor == Vendor::kCyclone ? "CYCLONEDDS_URI" : "FASTRTPS_DEFAULT_PROFILES_FILE";
+}
+
+/// The folder of the running executable, or empty.
+std::filesystem::path executable_dir() {
+  std::error_code ec;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::path() : self.parent_path();
+}
+
+/// Throws InvalidArgument unless `path` is a readable profile document of `vendor`.
+void check_profile(Vendor vendor, const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InvalidArgument("DDS profile '" + path + "' (--dds-config / MARSALA_DDS_CONFIG) cannot be read");
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  const bool cyclone = head.find("<CycloneDDS") != std::string::npos;
+  const bool fastdds = head.find("<dds") != std::string::npos || head.find("<profiles") != std::string::npos;
+  if (vendor == Vendor::kCyclone && !cyclone)
+    throw InvalidArgument("DDS profile '" + path + "' is not a Cyclone DDS profile (no <CycloneDDS> element)" +
+                          (fastdds ? ": it is a Fast DDS one; use --dds fastdds or a cyclone-*.xml" : ""));
+  if (vendor == Vendor::kFastDds && !fastdds)
+    throw InvalidArgument("DDS profile '" + path + "' is not a Fast DDS profile (no <dds> or <profiles> element)" +
+                          (cyclone ? ": it is a Cyclone DDS one; use --dds cyclone or a fastdds-*.xml" : ""));
+}
+
+}  // namespace
+
+std::string resolve_profile(Vendor vendor, const std::string& given) {
+  if (vendor == Vendor::kInProcess) return {};
+  if (!given.empty()) {
+    check_profile(vendor, given);
+    return std::filesystem::absolute(given).string();
+  }
+  if (const char* set = std::getenv(profile_variable(vendor)); set != nullptr && *set != '\0') return {};
+  const std::string name = std::string(vendor == Vendor::kCyclone ? "cyclone" : "fastdds") + "-lo.xml";
+  std::vector<std::filesystem::path> candidates;
+  if (const std::filesystem::path exe = executable_dir(); !exe.empty())
+    candidates.push_back(exe.parent_path() / "share" / "marsala" / "dds" / name);
+  candidates.push_back(std::filesystem::path(MARSALA_SOURCE_DIR) / "deploy" / "dds" / name);
+  for (const std::filesystem::path& c : candidates) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(c, ec)) return c.string();
+  }
+  return {};
+}
+
 std::unique_ptr<Participant> make_participant(const BusConfig& config) {
   if (config.domain_id < 0 || config.domain_id > 232)
     throw InvalidArgument("DDS domain id must be in 0..232, got " + std::to_string(config.domain_id));
+  if (const std::string profile = resolve_profile(config.vendor, config.profile); !profile.empty()) {
+    const std::string value = config.vendor == Vendor::kCyclone ? "file://" + profile : profile;
+    ::setenv(profile_variable(config.vendor), value.c_str(), 1);
+  }
   switch (config.vendor) {
     case Vendor::kInProcess: return detail::make_inprocess_participant(config.domain_id);
     case Vendor::kCyclone: return detail::make_cyclone_participant(config.domain_id);

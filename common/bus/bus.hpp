@@ -17,6 +17,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "marsala/protocol/messages.hpp"
@@ -119,13 +120,27 @@ class Participant {
 
 /// How to make a participant.
 struct BusConfig {
+  BusConfig() = default;
+  BusConfig(Vendor v, int domain, std::string profile_file = {})
+      : vendor(v), domain_id(domain), profile(std::move(profile_file)) {}
+
   Vendor vendor = Vendor::kCyclone;
-  int domain_id = 0;  ///< 0..232
+  int domain_id = 0;    ///< 0..232
+  std::string profile;  ///< a profile file of the vendor; empty: resolve_profile()'s default
 };
 
-/// Creates a participant of the chosen vendor; throws BusError naming vendor and domain on failure.
-/// Loopback configuration comes from the environment (CYCLONEDDS_URI, FASTRTPS_DEFAULT_PROFILES_FILE);
-/// deploy/ sets them for local runs.
+/// The profile file a participant of `vendor` uses (docs/runtime.md#dds-profiles): `given` when not empty (it must
+/// exist and be a profile of that vendor: a <CycloneDDS> or a Fast DDS <dds>/<profiles> document, else
+/// InvalidArgument naming it); else empty when the vendor's own variable (CYCLONEDDS_URI,
+/// FASTRTPS_DEFAULT_PROFILES_FILE) is set, which then applies; else the shipped loopback profile
+/// (deploy/dds/<vendor>-lo.xml: share/marsala/dds beside the executable's folder, or the source tree it was built
+/// from), so that processes started alone on one machine find each other; empty when none is found. Always empty
+/// for kInProcess.
+std::string resolve_profile(Vendor vendor, const std::string& given);
+
+/// Creates a participant of the chosen vendor with the profile resolve_profile() gives (set into the vendor's
+/// variable before the vendor reads it); throws BusError naming vendor and domain on failure, InvalidArgument for a
+/// bad domain or profile.
 std::unique_ptr<Participant> make_participant(const BusConfig& config);
 
 }  // namespace marsala::bus

@@ -18,6 +18,30 @@ namespace marsala::cli {
 /// Exit code of a usage error (unknown option, bad value, missing argument).
 inline constexpr int kExitUsage = 2;
 
+/// Where a process meets the others: vendor, domain and profile, from flags or the environment.
+struct DdsOptions {
+  std::string vendor = "cyclone";  ///< cyclone, fastdds (or inprocess, in tests)
+  int domain = 0;                  ///< 0..232
+  std::string profile;             ///< a profile file of the vendor; empty: bus::resolve_profile()'s default
+};
+
+/// Adds --dds, --domain and --dds-config to `app`, each also read from the environment (MARSALA_DDS,
+/// MARSALA_DOMAIN, MARSALA_DDS_CONFIG) when the flag is not given: flags win (docs/runtime.md#dds-profiles).
+inline void add_dds_options(CLI::App& app, DdsOptions& options) {
+  app.add_option("--dds", options.vendor, "DDS vendor: cyclone, fastdds (inprocess: tests only)")
+      ->check(CLI::IsMember({"cyclone", "fastdds", "inprocess"}))
+      ->envname("MARSALA_DDS")
+      ->capture_default_str();
+  app.add_option("--domain", options.domain, "DDS domain id")
+      ->check(CLI::Range(0, 232))
+      ->envname("MARSALA_DOMAIN")
+      ->capture_default_str();
+  app.add_option("--dds-config", options.profile,
+                 "a DDS profile file of that vendor, e.g. deploy/dds/cyclone-lan.xml for a network (default: the\n"
+                 "vendor's CYCLONEDDS_URI / FASTRTPS_DEFAULT_PROFILES_FILE, else the shipped loopback profile)")
+      ->envname("MARSALA_DDS_CONFIG");
+}
+
 /// Parses argv into `app`; returns nullopt when the program should go on, else the exit code to return now.
 inline std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const* argv,
                                              const std::string& program, std::ostream& out, std::ostream& err) {
