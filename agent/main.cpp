@@ -23,15 +23,38 @@ extern "C" void on_signal(int) { g_stop = true; }
 
 }  // namespace
 
+/// The robot type an `--id auto` agent declares: `name` (one of the scenario's slots' types), or the type of every
+/// slot when they share one. Throws InvalidArgument listing the slots' types otherwise.
+const marsala::RobotType& any_slot_type(const marsala::scenario::Scenario& s, const std::string& name) {
+  std::vector<std::string> names;
+  const marsala::RobotType* found = nullptr;
+  for (const marsala::scenario::AgentSlot& slot : s.slots) {
+    const marsala::RobotType& t = s.robot_for(slot.id);
+    if (std::find(names.begin(), names.end(), t.name) == names.end()) names.push_back(t.name);
+    if (t.name == name || (name.empty() && !found)) found = &t;
+  }
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  if (found && (!name.empty() || names.size() == 1)) return *found;
+  throw marsala::InvalidArgument(
+      name.empty() ? "--id auto: the scenario's slots have several robot types (" + list + "): give --robot-type"
+                   : "--robot-type '" + name + "' is no slot's type; the slots have: " + list);
+}
+
 int main(int argc, char** argv) {
   using namespace marsala;
   CLI::App app{"marsala-agent: one robot of a MARSala run (body and behaviour from its scenario slot)"};
   std::string scenario_file, log_level = "info";
   marsala::cli::DdsOptions dds;
-  std::uint32_t id = 0;
+  std::string id_text, robot_type;
   double admit_timeout_s = 60.0, world_timeout_s = 60.0;
   app.add_option("--scenario", scenario_file, "scenario file (protobuf text format)")->required();
-  app.add_option("--id", id, "agent id: the scenario slot, 1..N")->required()->check(CLI::Range(1u, 1000000u));
+  app.add_option("--id", id_text,
+                 "agent id: the scenario slot, 1..N, or `auto`: the world assigns the lowest free slot of the robot\n"
+                 "type (--robot-type, or the scenario's only type)")
+      ->required()
+      ->check(CLI::IsMember({"auto"}) | CLI::Range(1u, 1000000u));
+  app.add_option("--robot-type", robot_type, "with --id auto: the robot type whose slot to take");
   marsala::cli::add_dds_options(app, dds);
   std::optional<std::uint64_t> seed;
   app.add_option("--seed", seed, "override the scenario's seed (marsala-world must get the same)");
@@ -49,7 +72,8 @@ int main(int argc, char** argv) {
   spdlog::set_level(spdlog::level::from_str(log_level));
   try {
     const scenario::Scenario s = scenario::load_scenario(scenario_file);
-    const RobotType& type = s.robot_for(id);
+    const std::uint32_t id = id_text == "auto" ? 0u : static_cast<std::uint32_t>(std::stoul(id_text));
+    const RobotType& type = id != 0 ? s.robot_for(id) : any_slot_type(s, robot_type);
     // Keep-out around neighbours: the largest body and step of the whole team (bodies may differ per slot).
     double max_delta = 0.0, max_step = 0.0;
     for (const scenario::AgentSlot& slot : s.slots) {
@@ -58,7 +82,7 @@ int main(int argc, char** argv) {
     }
     agent::runtime::RuntimeConfig config;
     config.agent_id = id;
-    config.name = type.name + "-" + std::to_string(id);
+    if (id != 0) config.name = type.name + "-" + std::to_string(id);
     config.type = type;
     config.neighbour_keep_out_m = agent::neighbour_keep_out_m(max_delta, max_step);
     config.seed = seed.value_or(s.seed);

@@ -34,12 +34,37 @@ std::string body_difference(const RobotBody& got, const RobotBody& want) {
 
 }  // namespace
 
+namespace {
+
+AdmissionDecision decide_any_slot(const WorldState& state, const protocol::AgentHello& hello, bool run_started) {
+  const auto refuse = [](std::string reason) {
+    return AdmissionDecision{false, "any slot: " + std::move(reason), AdmissionKind::kRefused, kAnySlot};
+  };
+  for (const AgentRecord& a : state.agents)
+    if (a.admitted && a.session == hello.session) return {true, {}, AdmissionKind::kRepeat, a.id};
+  const std::string problem = body_problem(hello.body);
+  if (!problem.empty()) return refuse("invalid body: " + problem);
+  if (run_started) return refuse("the run has already started");
+  std::size_t of_type = 0;
+  for (const AgentRecord& a : state.agents) {
+    if (!body_difference(hello.body, a.type.body).empty() || a.type.behaviour != hello.behaviour) continue;
+    ++of_type;
+    if (!a.admitted && !a.dropped) return {true, {}, AdmissionKind::kFirst, a.id};
+  }
+  if (of_type == 0)
+    return refuse("no slot of this run has a robot type with this body and behaviour '" + hello.behaviour + "'");
+  return refuse(fmt::format("all {} slots of this robot type are taken", of_type));
+}
+
+}  // namespace
+
 AdmissionDecision decide_admission(const WorldState& state, const protocol::AgentHello& hello, bool run_started,
                                    bool holder_connected) {
-  const auto refuse = [](std::string reason) {
-    return AdmissionDecision{false, std::move(reason), AdmissionKind::kRefused};
+  const auto refuse = [&](std::string reason) {
+    return AdmissionDecision{false, std::move(reason), AdmissionKind::kRefused, hello.agent_id};
   };
-  const auto accept = [](AdmissionKind kind) { return AdmissionDecision{true, {}, kind}; };
+  const auto accept = [&](AdmissionKind kind) { return AdmissionDecision{true, {}, kind, hello.agent_id}; };
+  if (hello.agent_id == kAnySlot) return decide_any_slot(state, hello, run_started);
   const std::string who = "agent " + std::to_string(hello.agent_id);
   if (!state.has_agent(hello.agent_id))
     return refuse("unknown agent id " + std::to_string(hello.agent_id) + ": this run has agents 1.." +
@@ -97,7 +122,7 @@ bool admit(WorldState& state, const protocol::AgentHello& hello, AdmissionKind k
 protocol::Admission admission_message(const WorldState& state, const protocol::AgentHello& hello,
                                       const AdmissionDecision& decision, const std::string& run_id) {
   protocol::Admission m;
-  m.agent_id = hello.agent_id;
+  m.agent_id = decision.agent_id != kAnySlot ? decision.agent_id : hello.agent_id;
   m.session = hello.session;
   m.accepted = decision.accepted;
   m.reason = decision.reason;
@@ -107,8 +132,8 @@ protocol::Admission admission_message(const WorldState& state, const protocol::A
   m.assignment.tile_size = state.tile_size;
   m.assignment.base = {state.base.x_m, state.base.y_m};
   m.assignment.base_radius_m = state.base.radius_m;
-  if (state.has_agent(hello.agent_id)) {
-    const AgentRecord& a = state.agent(hello.agent_id);
+  if (state.has_agent(m.agent_id)) {
+    const AgentRecord& a = state.agent(m.agent_id);
     m.assignment.start = {a.start_x_m, a.start_y_m};
     m.assignment.target = {a.target_x_m, a.target_y_m};
   }

@@ -27,13 +27,20 @@ struct AdmissionDecision {
   bool accepted = false;
   std::string reason;  ///< why not, when refused
   AdmissionKind kind = AdmissionKind::kRefused;
+  std::uint32_t agent_id = 0;  ///< the slot it admits: the hello's, or the one assigned to an "any slot" hello
 };
+
+/// The agent id of a hello that asks for any free slot of its robot type (marsala-agent --id auto).
+inline constexpr std::uint32_t kAnySlot = 0;
 
 /// Decides on `hello` (docs/runtime.md#refusal-reasons): refused for an unknown id (no slot in this run), a body with
 /// non-finite or absurd values, a body that differs from the slot's robot type, an agent dropped kMaxReadmissions
 /// times already, an id admitted with another session that is still connected (`holder_connected`: the slot's
 /// request writer is alive), or (when `run_started`) an agent not admitted before the start. A dropped agent is
 /// re-admitted; a live slot whose session is no longer connected is taken over by the new session.
+/// A hello with agent_id kAnySlot (docs/runtime.md#any-slot) gets the slot its session already holds (kRepeat), else
+/// before the start the lowest never-admitted slot whose robot type has the hello's body and behaviour (kFirst),
+/// else a refusal; decision.agent_id names the slot.
 AdmissionDecision decide_admission(const WorldState& state, const protocol::AgentHello& hello, bool run_started,
                                    bool holder_connected = true);
 

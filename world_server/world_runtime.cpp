@@ -342,21 +342,23 @@ struct WorldRuntime::Impl {
       if (waits_for_takeover(hello, now)) continue;
       const AdmissionDecision decision = decide_admission(state, hello, run_started, holder_connected(hello.agent_id));
       if (decision.accepted && decision.kind != AdmissionKind::kRepeat) {
+        protocol::AgentHello slot = hello;  // an "any slot" hello takes the slot the decision names
+        slot.agent_id = decision.agent_id;
         if (!persistent(hello, now)) continue;  // answered when it says hello again
-        const std::uint64_t previous = state.agent(hello.agent_id).session;
-        if (admit(state, hello, decision.kind)) {
-          record(admitted_record(state, hello.agent_id, decision.kind));
-          AgentRecord& a = state.agent(hello.agent_id);
-          if (decision.kind != AdmissionKind::kFirst && a.session != previous) sensing->forget(hello.agent_id);
-          open_link(hello.agent_id);
-          links[hello.agent_id - 1].not_alive_since.reset();
+        const std::uint64_t previous = state.agent(slot.agent_id).session;
+        if (admit(state, slot, decision.kind)) {
+          record(admitted_record(state, slot.agent_id, decision.kind));
+          AgentRecord& a = state.agent(slot.agent_id);
+          if (decision.kind != AdmissionKind::kFirst && a.session != previous) sensing->forget(slot.agent_id);
+          open_link(slot.agent_id);
+          links[slot.agent_id - 1].not_alive_since.reset();
           std::string detail = a.name;
           if (decision.kind == AdmissionKind::kReadmission)
             detail += fmt::format(" (re-admitted, {} of {})", a.readmissions, kMaxReadmissions);
           if (decision.kind == AdmissionKind::kTakeover)
             detail += fmt::format(" (session {:016x} takes over from {:016x})", a.session, previous);
-          spdlog::info("admitted agent {}: {}", hello.agent_id, detail);
-          emit(make_event(hello.agent_id, protocol::EventKind::kAdmitted, detail));
+          spdlog::info("admitted agent {}: {}", slot.agent_id, detail);
+          emit(make_event(slot.agent_id, protocol::EventKind::kAdmitted, detail));
         }
       } else if (!decision.accepted) {
         ++refusals;

@@ -44,11 +44,17 @@ std::uint64_t random_session() {
 
 AgentRuntime::AgentRuntime(bus::Participant& participant, RuntimeConfig config)
     : participant_(participant), config_(std::move(config)) {
-  if (config_.agent_id == 0) throw InvalidArgument("agent id must be >= 1");
   if (config_.hello_period.count() <= 0 || config_.admit_timeout.count() <= 0 || config_.world_timeout.count() <= 0)
     throw InvalidArgument("agent " + std::to_string(config_.agent_id) + ": hello period and timeouts must be positive");
   if (config_.session == 0) config_.session = random_session();
-  if (config_.name.empty()) config_.name = "agent-" + std::to_string(config_.agent_id);
+  // Made at once, so that an unknown behaviour fails before any traffic; an agent that asks for any slot (agent_id
+  // 0) makes it again once its admission names the slot.
+  make_behaviour();
+}
+
+void AgentRuntime::make_behaviour() {
+  if (config_.name.empty() && config_.agent_id != 0)
+    config_.name = (config_.type.name.empty() ? "agent" : config_.type.name) + "-" + std::to_string(config_.agent_id);
   AgentContext context;
   context.agent_id = config_.agent_id;
   context.session = config_.session;
@@ -83,7 +89,7 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
   protocol::AgentHello& hello = hello_;
   hello.agent_id = config_.agent_id;
   hello.session = config_.session;
-  hello.name = config_.name;
+  hello.name = config_.agent_id != 0 ? config_.name : config_.name.empty() ? config_.type.name + "-any" : config_.name;
   hello.behaviour = config_.type.behaviour;
   hello.body = config_.type.body;
   spdlog::info("agent {} ({}, {}): saying hello, session {:016x}", config_.agent_id, config_.name,
@@ -105,11 +111,18 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
     }
     signal->wait_until(std::min({next_hello, deadline, now + kStopPoll}));
     for (const protocol::Admission& a : admissions->take()) {
-      if (a.agent_id != config_.agent_id || a.session != config_.session) continue;  // someone else's answer
+      const bool any_slot = config_.agent_id == 0;
+      if (a.session != config_.session || (!any_slot && a.agent_id != config_.agent_id)) continue;  // not ours
       if (!a.accepted) {
         result.outcome = RunOutcome::kRefused;
         result.message = "refused by the world: " + a.reason;
         return false;
+      }
+      if (any_slot) {
+        config_.agent_id = a.agent_id;
+        hello.agent_id = a.agent_id;  // later hellos speak for the slot
+        make_behaviour();
+        spdlog::info("agent: assigned slot {} ({})", a.agent_id, config_.name);
       }
       admission = a;
       result.run_id = a.run_id;

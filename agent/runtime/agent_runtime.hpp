@@ -27,7 +27,7 @@ namespace marsala::agent::runtime {
 
 /// Who the agent is and how patient it is.
 struct RuntimeConfig {
-  std::uint32_t agent_id = 0;                        ///< >= 1: the scenario slot
+  std::uint32_t agent_id = 0;                        ///< the scenario slot; 0: any free slot of `type` (--id auto)
   std::string name;                                  ///< human-readable, e.g. "husky-3"
   RobotType type;                                    ///< its slot's robot type; the hello declares its body
   std::uint64_t session = 0;                         ///< 0: a random one (random_session())
@@ -76,6 +76,7 @@ class AgentRuntime {
 
  private:
   bool admit(const std::atomic<bool>& stop, RunResult& result, protocol::Admission& admission);
+  void make_behaviour();
   void lockstep(const std::atomic<bool>& stop, const protocol::Admission& admission, RunResult& result);
 
   bus::Participant& participant_;

@@ -15,6 +15,7 @@
 #   full-disk                                                        the world's disk fills: exit 1, then --resume
 #   two-worlds                                                       a second world on a busy domain refuses
 #   flood                                                            hello and request floods: bounded, same terrain
+#   auto-ids                                                         three --id auto agents: same terrain as fixed ids
 #   kill                                                             SIGKILL one of 3 agents mid-run, others finish
 #   pause                                                            SIGSTOP the world, then an agent, 3 s each: the
 #                                                                    run loses nothing (same sha256 as unpaused)
@@ -360,6 +361,29 @@ case "$case_name" in
       "$(field steps "$s") steps ($(field wall_seconds "$s") s, unflooded $(field wall_seconds "$reference") s) on" \
       "the unflooded terrain; world peak RSS $peak kB; events.log $events B, world log $world_log B;" \
       "surplus $(field surplus_requests "$s"), unattributed $(field unattributed_rejections "$s"), honest agents 0"
+    ;;
+  auto-ids)
+    # --id auto: three agents without ids take slots 1..3 in arrival order and end on the fixed-id run's terrain.
+    reference=$(run_spawn reference 3 cyclone)
+    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+    out="$work/auto"
+    mkdir -p "$out/logs"
+    "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
+      >"$out/logs/world.log" 2>&1 &
+    world=$!
+    pids=()
+    for i in 1 2 3; do
+      "$bin/marsala-agent" --scenario "$scenario" --id auto --dds cyclone --domain "$domain" >"$out/logs/agent-$i.log" 2>&1 &
+      pids+=($!)
+    done
+    wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
+    for pid in "${pids[@]}"; do wait "$pid" || fail "an auto agent exited non-zero (see $out/logs)"; done
+    expect_completed "$out/summary.json" 3
+    slots=$(grep -ho "assigned slot [0-9]*" "$out"/logs/agent-*.log | awk '{ print $3 }' | sort | tr '\n' ' ')
+    [ "$slots" = "1 2 3 " ] || fail "the auto agents got slots '$slots', not 1 2 3"
+    [ "$(field terrain_sha256 "$out/summary.json")" = "$(field terrain_sha256 "$reference")" ] ||
+      fail "auto ids ended on $(field terrain_sha256 "$out/summary.json"), fixed ids on $(field terrain_sha256 "$reference")"
+    echo "ok: three --id auto agents took slots $slots and ended on the fixed-id terrain"
     ;;
   world-kill)
     start_run "$work/world-kill"

@@ -62,8 +62,8 @@ TEST_F(AdmissionTest, Refusals) {
   protocol::AgentHello h = hello_for(state_, 1, 5);
   h.agent_id = 3;  // slot 3 exists in the scenario, but this run has two agents
   expect_refused(h, "unknown agent id 3");
-  h.agent_id = 0;
-  expect_refused(h, "unknown agent id 0");
+  h.agent_id = 1000;
+  expect_refused(h, "unknown agent id 1000");
 
   h = hello_for(state_, 1, 5);
   h.body.navigability.kappa = 0.31;
@@ -130,6 +130,40 @@ TEST_F(AdmissionTest, ReadmissionKeepsTheWorldsRecordOfTheRobot) {
   // The re-admitted session repeats its hello: nothing changes.
   EXPECT_EQ(decide_admission(state_, back, true).kind, AdmissionKind::kRepeat);
   EXPECT_FALSE(admit(state_, back, AdmissionKind::kRepeat));
+}
+
+// --id auto: the lowest never-admitted slot of the hello's type; the same slot again for a repeated hello of the
+// session; refusals when the run started, the body fits no slot, or every such slot is taken.
+TEST_F(AdmissionTest, AnySlotTakesTheLowestFreeSlotOfItsType) {
+  protocol::AgentHello any = hello_for(state_, 1, 500);
+  any.agent_id = kAnySlot;
+  const AdmissionDecision first = decide_admission(state_, any, false);
+  ASSERT_TRUE(first.accepted) << first.reason;
+  EXPECT_EQ(first.kind, AdmissionKind::kFirst);
+  EXPECT_EQ(first.agent_id, 1u);
+  protocol::AgentHello slot = any;
+  slot.agent_id = first.agent_id;
+  ASSERT_TRUE(admit(state_, slot, first.kind));
+  EXPECT_EQ(admission_message(state_, any, first, "r").agent_id, 1u);  // the answer names the slot
+
+  const AdmissionDecision again = decide_admission(state_, any, false);
+  EXPECT_EQ(again.kind, AdmissionKind::kRepeat);
+  EXPECT_EQ(again.agent_id, 1u);
+
+  protocol::AgentHello other = any;
+  other.session = 501;
+  const AdmissionDecision second = decide_admission(state_, other, false);
+  ASSERT_TRUE(second.accepted);
+  EXPECT_EQ(second.agent_id, 2u);
+  slot = other;
+  slot.agent_id = 2;
+  admit(state_, slot, second.kind);
+
+  other.session = 502;
+  expect_refused(other, "any slot: all 2 slots of this robot type are taken");
+  EXPECT_NE(decide_admission(state_, other, true).reason.find("already started"), std::string::npos);
+  other.body.navigability.kappa = 0.31;
+  expect_refused(other, "no slot of this run has a robot type with this body");
 }
 
 }  // namespace

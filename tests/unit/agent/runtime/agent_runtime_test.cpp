@@ -235,7 +235,8 @@ TEST(AgentRuntime, StopsWhenAsked) {
 
 TEST(AgentRuntime, RejectsBadConfigurationBeforeAnyTraffic) {
   auto participant = bus::make_participant({bus::Vendor::kInProcess, 106});
-  EXPECT_THROW(AgentRuntime(*participant, config(0)), InvalidArgument);
+  EXPECT_NO_THROW(AgentRuntime(*participant, config(0)));  // 0: any slot (--id auto), assigned at admission
+  EXPECT_THROW(AgentRuntime(*participant, config(0, "dancer")), InvalidArgument);
   EXPECT_THROW(AgentRuntime(*participant, config(1, "dancer")), InvalidArgument);
   RuntimeConfig c = config(1);
   c.world_timeout = 0ms;
