@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Installs every Debian package MARSala needs to build, test and run. Idempotent: does nothing when all are present,
 # otherwise runs `apt-get update` once and installs what is missing.
+# --containers: also podman, runc, podman-compose and mmdebstrap, for docker/run.sh and the container test.
 set -euo pipefail
+containers=0
+[ "${1:-}" = "--containers" ] && containers=1
 
 packages=(
   cmake make g++ pkg-config python3
@@ -18,6 +21,8 @@ packages=(
   # deploy/sweep.py (the sweep), jq for spawn.sh/demo.sh (marsala-world --check --json), the scalability plot
   python3 jq gnuplot-nox
 )
+
+[ "$containers" -eq 1 ] && packages+=(podman runc podman-compose mmdebstrap)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Real containers: docker/run.sh builds the image with podman and runs docker/docker-compose.yml (the world, three
+# `--id auto` agents and a monitor, each container a host of its own on the compose network, LAN profiles) inside a
+# private network namespace; the run must end on the terrain_sha256 of the same run on loopback.
+# Exits 77 (skipped) where podman cannot run containers.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+export MARSALA_BUILD_DIR="${MARSALA_BUILD_DIR:-$root/build}"
+fail() { echo "FAIL (container): $*" >&2; exit 1; }
+for tool in podman podman-compose unshare; do
+  command -v "$tool" >/dev/null || { echo "SKIP: $tool is not installed (deploy/install-deps.sh --containers)"; exit 77; }
+done
+export CONTAINERS_CONF="$root/docker/podman/containers.conf"
+podman info >/dev/null 2>&1 || { echo "SKIP: podman cannot run here ($(podman info 2>&1 | tail -1))"; exit 77; }
+work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-container.XXXXXX")"
+trap 'rm -rf "$work"' EXIT
+
+unshare -n sh -c "ip link set lo up; '$root/deploy/spawn.sh' --scenario '$root/deploy/scenarios/ramp.pbtxt' \
+  --agents 3 --out '$work/loopback' --quiet" >/dev/null || fail "the loopback reference run failed"
+reference=$(grep -o '"terrain_sha256": *"[0-9a-f]*"' "$work/loopback/summary.json" | cut -d'"' -f4)
+
+start=$SECONDS
+rc=0
+"$root/docker/run.sh" --scenario ramp --agents 3 --out "$work/containers" >"$work/run.txt" 2>&1 || rc=$?
+[ "$rc" -eq 0 ] || { tail -30 "$work/run.txt"; tail -20 "$work/containers/world.log" 2>/dev/null; fail "docker/run.sh exited $rc"; }
+summary="$work/containers/run/summary.json"
+[ -f "$summary" ] || fail "no summary.json from the containers"
+grep -q '"completed": *true' "$summary" || fail "the containers' run did not complete"
+sha=$(grep -o '"terrain_sha256": *"[0-9a-f]*"' "$summary" | cut -d'"' -f4)
+[ "$sha" = "$reference" ] || fail "containers ended on $sha, loopback on $reference"
+echo "ok: world, 3 --id auto agents and a monitor in containers completed in $((SECONDS - start)) s (image build" \
+  "included) on the loopback terrain $sha; image $(podman image ls --format '{{.Size}}' localhost/marsala:latest)"
