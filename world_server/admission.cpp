@@ -119,6 +119,15 @@ bool admit(WorldState& state, const protocol::AgentHello& hello, AdmissionKind k
   return true;
 }
 
+protocol::AgentHello slot_hello(const WorldState& state, const protocol::AgentHello& hello,
+                                const AdmissionDecision& decision) {
+  protocol::AgentHello slot = hello;
+  slot.agent_id = decision.agent_id;
+  if (hello.agent_id == kAnySlot && state.has_agent(slot.agent_id))
+    slot.name = state.agent(slot.agent_id).type.name + "-" + std::to_string(slot.agent_id);
+  return slot;
+}
+
 protocol::Admission admission_message(const WorldState& state, const protocol::AgentHello& hello,
                                       const AdmissionDecision& decision, const std::string& run_id) {
   protocol::Admission m;

@@ -50,6 +50,12 @@ AdmissionDecision decide_admission(const WorldState& state, const protocol::Agen
 /// Returns true when the slot's session changed or it became live (its endpoints must be opened).
 bool admit(WorldState& state, const protocol::AgentHello& hello, AdmissionKind kind = AdmissionKind::kFirst);
 
+/// The hello as the slot `decision` admits it: agent_id = decision.agent_id; an "any slot" hello (kAnySlot) is
+/// also named `<robot type>-<id>`, the name a fixed-id agent of that slot gives, so run.log, events and statuses
+/// tell auto-assigned agents apart.
+protocol::AgentHello slot_hello(const WorldState& state, const protocol::AgentHello& hello,
+                                const AdmissionDecision& decision);
+
 /// The Admission message for `hello` and `decision`; geometry, start, target and base are filled for known ids.
 protocol::Admission admission_message(const WorldState& state, const protocol::AgentHello& hello,
                                       const AdmissionDecision& decision, const std::string& run_id);

@@ -342,9 +342,8 @@ struct WorldRuntime::Impl {
       if (waits_for_takeover(hello, now)) continue;
       const AdmissionDecision decision = decide_admission(state, hello, run_started, holder_connected(hello.agent_id));
       if (decision.accepted && decision.kind != AdmissionKind::kRepeat) {
-        protocol::AgentHello slot = hello;  // an "any slot" hello takes the slot the decision names
-        slot.agent_id = decision.agent_id;
-        if (!persistent(hello, now)) continue;  // answered when it says hello again
+        const protocol::AgentHello slot = slot_hello(state, hello, decision);  // "any slot": the one assigned
+        if (!persistent(hello, now)) continue;                                 // answered when it says hello again
         const std::uint64_t previous = state.agent(slot.agent_id).session;
         if (admit(state, slot, decision.kind)) {
           record(admitted_record(state, slot.agent_id, decision.kind));

@@ -119,9 +119,11 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
         return false;
       }
       if (any_slot) {
+        if (a.agent_id == 0) throw Error("an admission for any slot names no slot (agent_id 0)");
         config_.agent_id = a.agent_id;
-        hello.agent_id = a.agent_id;  // later hellos speak for the slot
         make_behaviour();
+        hello.agent_id = a.agent_id;  // later hellos speak for the slot, under the name the world gave it
+        hello.name = config_.name;
         spdlog::info("agent: assigned slot {} ({})", a.agent_id, config_.name);
       }
       admission = a;

@@ -145,6 +145,13 @@ TEST_F(AdmissionTest, AnySlotTakesTheLowestFreeSlotOfItsType) {
   slot.agent_id = first.agent_id;
   ASSERT_TRUE(admit(state_, slot, first.kind));
   EXPECT_EQ(admission_message(state_, any, first, "r").agent_id, 1u);  // the answer names the slot
+  // The world records it under the slot's id and the name a fixed-id agent of that slot gives.
+  any.name = "tester-any";
+  const protocol::AgentHello as_slot = slot_hello(state_, any, first);
+  EXPECT_EQ(as_slot.agent_id, 1u);
+  EXPECT_EQ(as_slot.name, "tester-1");
+  EXPECT_EQ(as_slot.session, 500u);
+  EXPECT_EQ(slot_hello(state_, hello_for(state_, 2, 9), {true, {}, AdmissionKind::kFirst, 2}).name, "tester-2");
 
   const AdmissionDecision again = decide_admission(state_, any, false);
   EXPECT_EQ(again.kind, AdmissionKind::kRepeat);
@@ -164,6 +171,34 @@ TEST_F(AdmissionTest, AnySlotTakesTheLowestFreeSlotOfItsType) {
   EXPECT_NE(decide_admission(state_, other, true).reason.find("already started"), std::string::npos);
   other.body.navigability.kappa = 0.31;
   expect_refused(other, "no slot of this run has a robot type with this body");
+  other = any;
+  other.session = 503;
+  other.behaviour = "idle";  // the body of the slots' type, another behaviour: no slot of that type
+  expect_refused(other, "no slot of this run has a robot type with this body and behaviour 'idle'");
+}
+
+// Two "any slot" hellos decided in one round take different slots, and the repeated hello of each keeps its own.
+TEST_F(AdmissionTest, TwoAnySlotHellosTakeDifferentSlotsAndKeepThem) {
+  std::vector<std::uint32_t> taken;
+  for (std::uint64_t session : {600u, 601u}) {
+    protocol::AgentHello any = hello_for(state_, 1, session);
+    any.agent_id = kAnySlot;
+    const AdmissionDecision d = decide_admission(state_, any, false);
+    ASSERT_TRUE(d.accepted) << d.reason;
+    ASSERT_TRUE(admit(state_, slot_hello(state_, any, d), d.kind));
+    taken.push_back(d.agent_id);
+  }
+  EXPECT_EQ(taken, (std::vector<std::uint32_t>{1, 2}));
+  for (std::size_t i = 0; i < 2; ++i) {
+    protocol::AgentHello again = hello_for(state_, 1, 600 + i);
+    again.agent_id = kAnySlot;
+    const AdmissionDecision d = decide_admission(state_, again, true);  // also after the start: idempotent
+    EXPECT_TRUE(d.accepted);
+    EXPECT_EQ(d.kind, AdmissionKind::kRepeat);
+    EXPECT_EQ(d.agent_id, taken[i]);
+    EXPECT_EQ(admission_message(state_, again, d, "r").agent_id, taken[i]);
+  }
+  EXPECT_EQ(state_.agent(2).name, "tester-2");
 }
 
 }  // namespace

@@ -10,8 +10,8 @@
 #include <future>
 #include <thread>
 
-#include "unit/agent/agent_test_support.hpp"
 #include "marsala/core/error.hpp"
+#include "unit/agent/agent_test_support.hpp"
 
 namespace marsala::agent::runtime {
 namespace {
@@ -73,7 +73,9 @@ struct ScriptedWorld {
     auto admissions = p.create_writer<protocol::Admission>();
     const protocol::AgentHello hello = wait_hello(*hellos, *hello_signal);
     const protocol::Admission a = answer(hello);
-    const std::string partition = protocol::partition_for(a.run_id, id, a.session);
+    // The slot the admission names: `id`, or the one assigned to an "any slot" hello (id 0).
+    const std::uint32_t slot = a.agent_id;
+    const std::string partition = protocol::partition_for(a.run_id, slot, a.session);
     auto signal = std::make_shared<bus::Signal>();
     auto frames = p.create_writer<protocol::SensorFrame>({partition, nullptr});
     auto requests = p.create_reader<protocol::ActionRequest>({partition, signal});
@@ -86,7 +88,7 @@ struct ScriptedWorld {
     const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
     for (int step = 0; step <= steps; ++step) {
       protocol::SensorFrame f;
-      f.agent_id = id;
+      f.agent_id = slot;
       f.step = static_cast<std::uint64_t>(step);
       f.x_m = 0.55 + 0.0;
       f.y_m = 1.05;
@@ -202,6 +204,74 @@ TEST(AgentRuntime, RepeatsHellosAndIgnoresOtherSessions) {
   EXPECT_EQ(got[0].session, 1234u);
   EXPECT_EQ(got[0].behaviour, "idle");
   EXPECT_EQ(got[0].body.reach_m, 1.5);
+}
+
+// --id auto: the hello asks for any slot (agent_id 0) under the name "<type>-any"; the agent takes the admission
+// of its own session whatever slot it names, and from then on is that slot: partition, frames, requests, name.
+TEST(AgentRuntime, AnySlotTakesTheAssignedIdFromItsAdmission) {
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, 107});
+  RuntimeConfig c = config(0, "ramp_builder");
+  c.type.name = "husky";
+  AgentRuntime agent(*participant, c);
+  std::atomic<bool> stop{false};
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 107});
+  ScriptedWorld world{*world_participant, 0};
+  const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+  protocol::AgentHello asked;
+  const auto requests = world.run(
+      [&](const protocol::AgentHello& hello) {
+        asked = hello;
+        protocol::Admission a = admission_for(hello, h);
+        a.agent_id = 5;  // the world's choice
+        return a;
+      },
+      3);
+  const RunResult r = running.get();
+  EXPECT_EQ(r.outcome, RunOutcome::kRunOver) << r.message;
+  EXPECT_EQ(asked.agent_id, 0u);
+  EXPECT_EQ(asked.name, "husky-any");
+  EXPECT_EQ(asked.behaviour, "ramp_builder");
+  EXPECT_EQ(agent.config().agent_id, 5u);
+  EXPECT_EQ(agent.config().name, "husky-5");
+  ASSERT_EQ(requests.size(), 3u);
+  for (const protocol::ActionRequest& q : requests) {
+    EXPECT_EQ(q.agent_id, 5u);
+    EXPECT_EQ(q.session, agent.config().session);
+  }
+}
+
+// An "any slot" agent ignores answers to other sessions (whatever slot they name) and ends on a refusal of its own.
+TEST(AgentRuntime, AnySlotRefusalEndsTheRunWithTheWorldsReason) {
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, 108});
+  AgentRuntime agent(*participant, config(0));
+  std::atomic<bool> stop{false};
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 108});
+  auto signal = std::make_shared<bus::Signal>();
+  auto hellos = world_participant->create_reader<protocol::AgentHello>({"", signal});
+  auto admissions = world_participant->create_writer<protocol::Admission>();
+  bool answered = false;
+  for (const auto deadline = Clock::now() + 5s; !answered && Clock::now() < deadline;) {
+    signal->wait_for(20ms);
+    for (const auto& hello : hellos->take()) {
+      protocol::Admission other;  // accepted, for another session: not this agent's
+      other.agent_id = 2;
+      other.session = hello.session + 1;
+      other.accepted = true;
+      admissions->write(other);
+      protocol::Admission no;
+      no.agent_id = 0;
+      no.session = hello.session;
+      no.reason = "any slot: all 3 slots of this robot type are taken";
+      admissions->write(no);
+      answered = true;
+    }
+  }
+  const RunResult r = running.get();
+  EXPECT_EQ(r.outcome, RunOutcome::kRefused);
+  EXPECT_NE(r.message.find("all 3 slots of this robot type are taken"), std::string::npos) << r.message;
+  EXPECT_EQ(agent.config().agent_id, 0u);
 }
 
 TEST(AgentRuntime, WorldSilenceAfterAdmissionTimesOut) {
