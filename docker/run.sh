@@ -2,19 +2,23 @@
 # Builds the MARSala image with podman and runs docker/docker-compose.yml: the world, AGENTS agents and a monitor,
 # inside a private network namespace (nothing leaves this machine), then prints the summary and exits with the
 # world's exit code (0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 1 error).
-# Usage: docker/run.sh [--scenario NAME] [--agents N] [--dds cyclone|fastdds] [--out DIR]
+# Usage: docker/run.sh [--scenario NAME] [--agents N] [--dds cyclone|fastdds] [--domain D] [--out DIR] [--image TAG]
+#   --image  the image tag to build and run (default $MARSALA_IMAGE, else localhost/marsala:latest); give each checkout
+#            its own when several may run at once on one machine, so that none runs another's binaries
 # Needs podman, runc, podman-compose and, without an image registry, mmdebstrap for the base image
 # (deploy/install-deps.sh --containers). docs: ../shared/notes/CONTAINERS.md recipe, README "Containers".
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-scenario=ramp agents=3 dds=cyclone out="$root/out/containers"
+scenario=ramp agents=3 dds=cyclone domain=0 out="$root/out/containers" image="${MARSALA_IMAGE:-localhost/marsala:latest}"
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
     --agents) agents="$2"; shift 2 ;;
     --dds) dds="$2"; shift 2 ;;
+    --domain) domain="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
-    -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
+    --image) image="$2"; shift 2 ;;
+    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
     *) echo "run.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -24,34 +28,42 @@ done
 export CONTAINERS_CONF="$root/docker/podman/containers.conf"
 
 # The base image from Debian's packages when no registry is reachable (cached by podman between runs).
+t0=$SECONDS
 if ! podman image exists docker.io/library/debian:bookworm-slim; then
   command -v mmdebstrap >/dev/null || { echo "run.sh: no debian:bookworm-slim image and no mmdebstrap" >&2; exit 1; }
-  tar="$(mktemp -d)/base.tar"
+  tmp="$(mktemp -d)"
   echo "run.sh: building the debian:bookworm-slim base image with mmdebstrap"
-  mmdebstrap --quiet --variant=minbase bookworm "$tar"
-  podman import -q "$tar" docker.io/library/debian:bookworm-slim >/dev/null
-  rm -rf "$(dirname "$tar")"
+  mmdebstrap --quiet --variant=minbase bookworm "$tmp/base.tar"
+  podman import -q "$tmp/base.tar" docker.io/library/debian:bookworm-slim >/dev/null
+  rm -rf "$tmp"
+  echo "run.sh: base image built in $((SECONDS - t0)) s"
 fi
-echo "run.sh: building localhost/marsala:latest"
-podman build --pull=never -q -t localhost/marsala:latest -f "$root/docker/Dockerfile" "$root" >/dev/null
+t1=$SECONDS
+echo "run.sh: building $image"
+podman build --pull=never -q -t "$image" -f "$root/docker/Dockerfile" "$root" >/dev/null
+echo "run.sh: image built in $((SECONDS - t1)) s ($(podman image ls --format '{{.Size}}' "$image" | head -1))"
 
 mkdir -p "$out"
 chmod 777 "$out"  # the containers' user (uid 1000) writes there
 rm -rf "$out/run"
+# One project per run: its containers and network are its own, and removed at the end (podman-compose 1.0.3's `down`
+# leaves the network, whose /24 of podman's pool would otherwise stay taken).
 project="marsala$$"
-inner=$(cat <<INNER
-set -e
-ip link set lo up
-export SCENARIO=$scenario AGENTS=$agents DDS=$dds OUT=$out CONTAINERS_CONF=$CONTAINERS_CONF
-podman-compose -p $project -f $root/docker/docker-compose.yml up -d >$out/compose.log 2>&1
-rc=\$(podman wait ${project}_world_1)
-podman logs ${project}_world_1 > $out/world.log 2>&1 || true
-podman-compose -p $project -f $root/docker/docker-compose.yml down -t 2 >/dev/null 2>&1 || true
-exit \$rc
-INNER
-)
+compose="$root/docker/docker-compose.yml"
+t2=$SECONDS
 rc=0
-unshare -n sh -c "$inner" || rc=$?
+SCENARIO="$scenario" AGENTS="$agents" DDS="$dds" DOMAIN="$domain" OUT="$out" MARSALA_IMAGE="$image" \
+  unshare -n sh -c '
+    ip link set lo up
+    podman-compose -p "$1" -f "$2" up -d >"$3/compose.log" 2>&1 || { cat "$3/compose.log" >&2; exit 1; }
+    rc=$(podman wait "$1_world_1") || rc=1
+    podman logs "$1_world_1" >"$3/world.log" 2>&1 || true
+    for c in $(podman ps -a --format "{{.Names}}" | grep "^$1_" | grep -v "^$1_world_"); do
+      podman logs "$c" >"$3/${c#"$1"_}.log" 2>&1 || true
+    done
+    podman-compose -p "$1" -f "$2" down -t 2 >/dev/null 2>&1 || true
+    podman network rm -f "$1_default" >/dev/null 2>&1 || true
+    exit "$rc"' sh "$project" "$compose" "$out" || rc=$?
 [ -f "$out/run/summary.json" ] && cat "$out/run/summary.json"
-echo "run.sh: the world exited $rc (its log: $out/world.log)"
+echo "run.sh: the world exited $rc after $((SECONDS - t2)) s of compose run (its log: $out/world.log)"
 exit "$rc"

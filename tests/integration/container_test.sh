@@ -12,6 +12,10 @@ for tool in podman podman-compose unshare; do
 done
 export CONTAINERS_CONF="$root/docker/podman/containers.conf"
 podman info >/dev/null 2>&1 || { echo "SKIP: podman cannot run here ($(podman info 2>&1 | tail -1))"; exit 77; }
+unshare -n true 2>/dev/null || { echo "SKIP: cannot make a private network namespace (unshare -n needs root)"; exit 77; }
+# An image tag of this checkout's own: a test of another checkout running at the same time on this machine (a CI
+# clone beside a worktree) rebuilds its own tag and never makes this one run its binaries.
+image="localhost/marsala:test-$(printf '%s' "$root" | sha256sum | cut -c1-12)"
 work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-container.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 
@@ -21,12 +25,19 @@ reference=$(grep -o '"terrain_sha256": *"[0-9a-f]*"' "$work/loopback/summary.jso
 
 start=$SECONDS
 rc=0
-"$root/docker/run.sh" --scenario ramp --agents 3 --out "$work/containers" >"$work/run.txt" 2>&1 || rc=$?
+"$root/docker/run.sh" --scenario ramp --agents 3 --domain 7 --image "$image" --out "$work/containers" \
+  >"$work/run.txt" 2>&1 || rc=$?
 [ "$rc" -eq 0 ] || { tail -30 "$work/run.txt"; tail -20 "$work/containers/world.log" 2>/dev/null; fail "docker/run.sh exited $rc"; }
+grep -E '^run.sh: .* (in|after) [0-9]+ s' "$work/run.txt" || true  # the build and run times
 summary="$work/containers/run/summary.json"
 [ -f "$summary" ] || fail "no summary.json from the containers"
 grep -q '"completed": *true' "$summary" || fail "the containers' run did not complete"
 sha=$(grep -o '"terrain_sha256": *"[0-9a-f]*"' "$summary" | cut -d'"' -f4)
 [ "$sha" = "$reference" ] || fail "containers ended on $sha, loopback on $reference"
+# Three auto agents took the three slots, each under its slot's name.
+for id in 1 2 3; do
+  grep -q "admitted agent $id: husky-$id\$" "$work/containers/world.log" ||
+    fail "the world's log names no auto admission of slot $id as husky-$id"
+done
 echo "ok: world, 3 --id auto agents and a monitor in containers completed in $((SECONDS - start)) s (image build" \
-  "included) on the loopback terrain $sha; image $(podman image ls --format '{{.Size}}' localhost/marsala:latest)"
+  "included) on the loopback terrain $sha; image $image $(podman image ls --format '{{.Size}}' "$image" | head -1)"
