@@ -15,12 +15,33 @@
 #include <iterator>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
+#include <type_traits>
+#include <typeinfo>
 #include <vector>
 
 namespace marsala::fuzz {
+
+/// Runs load() on one fuzzed input: what it loaded, or nullopt when it refused the input with an `Expected` (whose
+/// message `check` examines). Anything else thrown is a failure: readers answer bad input with the project's typed
+/// errors only. `expected` names the type in the failure message.
+template <typename Expected, typename Load, typename Check, typename Report>
+auto load_or_refuse(Load&& load, Check&& check, const char* expected, const Report& report)
+    -> std::optional<std::decay_t<decltype(load())>> {
+  try {
+    return load();
+  } catch (const Expected& e) {
+    check(e);
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "not a " << expected << ": " << typeid(e).name() << ": " << e.what() << "\n" << report();
+  } catch (...) {
+    ADD_FAILURE() << "a non-exception was thrown\n" << report();
+  }
+  return std::nullopt;
+}
 
 /// MARSALA_SOURCE_DIR (set by ctest), else ".".
 inline std::string source_dir() {

@@ -273,20 +273,16 @@ TEST(GeoTiffFuzz, EveryFileLoadsOrThrowsATypedErrorAndLoadedGridsAreWhatTheFileD
     GeoTiffOptions options;
     options.fill_nodata = i < static_cast<int>(fixed_seeds) || mutator.chance(0.5);
     const Report report = [&] { return fuzz::failure_report("geotiff", seed, i, input, ".tif"); };
-    std::optional<Heightmap> map;
     watchdog.arm(std::chrono::seconds(5), "geotiff seed " + std::to_string(seed) + " iteration " + std::to_string(i),
                  input, fuzz::failure_path("geotiff", seed, i, ".tif"));
-    try {
-      map = read_geotiff(path, options);
-    } catch (const Error& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find(path), std::string::npos) << "the message does not name the file: " << what << "\n"
-                                                    << report();
-    } catch (const std::exception& e) {
-      ADD_FAILURE() << "not a marsala::Error: " << typeid(e).name() << ": " << e.what() << "\n" << report();
-    } catch (...) {
-      ADD_FAILURE() << "a non-exception was thrown\n" << report();
-    }
+    const std::optional<Heightmap> map = fuzz::load_or_refuse<Error>(
+        [&] { return read_geotiff(path, options); },
+        [&](const Error& e) {
+          const std::string what = e.what();
+          EXPECT_NE(what.find(path), std::string::npos) << "the message does not name the file: " << what << "\n"
+                                                        << report();
+        },
+        "marsala::Error", report);
     watchdog.disarm();
     if (::testing::Test::HasFailure()) return;
     if (!map) continue;

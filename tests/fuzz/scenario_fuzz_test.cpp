@@ -240,22 +240,18 @@ TEST(ScenarioFuzz, EveryTextLoadsOrThrowsATypedErrorAndLoadedScenariosKeepTheirP
     const std::string input =
         i < static_cast<int>(fixed_seeds) ? corpus[i] : mutator.mutate_text(pick_seed(corpus, mutator), corpus);
     const Report report = [&] { return fuzz::failure_report("scenario", seed, i, input, ".pbtxt"); };
-    std::optional<Scenario> s;
     watchdog.arm(std::chrono::seconds(5), "scenario seed " + std::to_string(seed) + " iteration " + std::to_string(i),
                  input, fuzz::failure_path("scenario", seed, i, ".pbtxt"));
-    try {
-      s = parse_scenario(input, kSource);
-    } catch (const Error& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find(kSource), std::string::npos) << "the message does not name the source: " << what << "\n"
-                                                       << report();
-      const bool typed = dynamic_cast<const ParseError*>(&e) || dynamic_cast<const InvalidArgument*>(&e);
-      EXPECT_TRUE(typed) << "neither ParseError nor InvalidArgument: " << what << "\n" << report();
-    } catch (const std::exception& e) {
-      ADD_FAILURE() << "not a marsala::Error: " << typeid(e).name() << ": " << e.what() << "\n" << report();
-    } catch (...) {
-      ADD_FAILURE() << "a non-exception was thrown\n" << report();
-    }
+    const std::optional<Scenario> s = fuzz::load_or_refuse<Error>(
+        [&] { return parse_scenario(input, kSource); },
+        [&](const Error& e) {
+          const std::string what = e.what();
+          EXPECT_NE(what.find(kSource), std::string::npos) << "the message does not name the source: " << what << "\n"
+                                                           << report();
+          const bool typed = dynamic_cast<const ParseError*>(&e) || dynamic_cast<const InvalidArgument*>(&e);
+          EXPECT_TRUE(typed) << "neither ParseError nor InvalidArgument: " << what << "\n" << report();
+        },
+        "marsala::Error", report);
     if (!::testing::Test::HasFailure() && s) {
       ++loaded;
       check_loaded(*s, report);
