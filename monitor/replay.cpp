@@ -306,7 +306,7 @@ render::RenderOptions replay_picture_options(const TerrainReplayer& replayer) {
 
 ReplayReport replay_run(const std::string& dir, const ReplayOptions& options) {
   const auto start = Clock::now();
-  const std::string log_path = (fs::path(dir) / "run.log").string();
+  const std::string log_path = (fs::path(dir) / runlog::kRunLogFile).string();
   const std::string terrain_path = (fs::path(dir) / "terrain_initial.asc").string();
   ReplayReport report;
   report.log_path = log_path;

@@ -18,8 +18,8 @@
 
 namespace marsala::world_server {
 
-/// Files of a run's output folder that persistence writes.
-inline constexpr const char* kRunLogFile = "run.log";
+/// The snapshot's name in a run's output folder (the log's is runlog::kRunLogFile).
+using runlog::kRunLogFile;
 inline constexpr const char* kSnapshotFile = "snapshot.pb";
 
 /// What a run starts from, as the log's header records it.

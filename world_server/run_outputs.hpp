@@ -27,6 +27,7 @@
 #include "marsala/world_server/completion.hpp"
 #include "marsala/world_server/end_reason.hpp"
 #include "marsala/world_server/occupancy_cache.hpp"
+#include "marsala/world_server/persistence.hpp"
 #include "marsala/world_server/world_state.hpp"
 
 namespace marsala::world_server {
@@ -89,12 +90,10 @@ void write_final_outputs(const std::string& dir, const WorldState& state, const 
 /// One event as a log line: "step 12 agent 2 deposited 0.000125 m3: 1 cells".
 std::string format_event(const protocol::WorldEvent& event);
 
-/// events.log: appends one line per event or note, flushed at once so that a crash keeps what happened; a line that
-/// cannot be written throws IoError (the run then ends with an error).
 /// The files a run writes into its output folder (docs/runtime.md#outputs).
 inline constexpr const char* kRunFiles[] = {"summary.json",        "events.log", "terrain_initial.asc",
                                             "terrain_final.asc",   "final.png",  "final_zoom.png",
-                                            "goal_vector_map.png", "run.log",    "snapshot.pb"};
+                                            "goal_vector_map.png", kRunLogFile,  kSnapshotFile};
 
 /// The kRunFiles present in `dir` (none when it does not exist).
 std::vector<std::string> run_files_in(const std::string& dir);
@@ -105,6 +104,8 @@ void check_fresh_output_dir(const std::string& dir);
 /// Removes the kRunFiles (and their temporary .tmp names) from `dir` (marsala-world --replace); throws IoError.
 void clear_run_files(const std::string& dir);
 
+/// events.log: appends one line per event or note, flushed at once so that a crash keeps what happened; a line that
+/// cannot be written throws IoError (the run then ends with an error).
 class EventLog {
  public:
   /// Creates (truncates) the file, or with `append` continues it (a resumed run); throws IoError.

@@ -338,7 +338,6 @@ struct WorldRuntime::Impl {
     }
     int refusal_answers = 0;
     for (const protocol::AgentHello& hello : hellos->take()) {
-      ++hellos_taken;
       if (waits_for_takeover(hello, now)) continue;
       const AdmissionDecision decision = decide_admission(state, hello, run_started, holder_connected(hello.agent_id));
       if (decision.accepted && decision.kind != AdmissionKind::kRepeat) {
@@ -794,7 +793,6 @@ struct WorldRuntime::Impl {
       takeover_since;  ///< first hello of a new session
   std::map<std::pair<std::uint32_t, std::uint64_t>, Clock::time_point> seen_current, seen_previous;  ///< persistent()
   Clock::time_point seen_rotated{};
-  std::uint64_t hellos_taken = 0;
   std::uint64_t refusals = 0;
   Clock::time_point next_hello_service{};
   bool run_started = false;

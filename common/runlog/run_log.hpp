@@ -12,6 +12,8 @@
 
 namespace marsala::runlog {
 
+/// The log's name in a run's output folder.
+inline constexpr const char* kRunLogFile = "run.log";
 /// The file's first eight bytes.
 inline constexpr char kMagic[] = "MARSLOG1";
 inline constexpr std::uint64_t kMagicBytes = 8;
