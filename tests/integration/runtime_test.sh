@@ -41,18 +41,21 @@ run_spawn() {  # run_spawn OUT_NAME AGENTS DDS [AGENT_DDS]
   [ -f "$out/summary.json" ] || fail "no summary.json in $out"
   echo "$out/summary.json"
 }
-start_run() {  # start_run OUT [WORLD ARGS]: world and agents 1..3 on Cyclone in the background; sets out, world, pids
+# start_run OUT [WORLD ARGS]: world and agents 1..3 on Cyclone in the background; sets out, logs, world, pids.
+# Optional: logs_dir (default OUT/logs), world_wrap (a command the world runs under), agent_ids=auto (--id auto).
+start_run() {
   export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
   out="$1"
   shift
-  mkdir -p "$out/logs"
-  "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" "$@" \
-    >"$out/logs/world.log" 2>&1 &
+  logs="${logs_dir:-$out/logs}"
+  mkdir -p "$logs"
+  ${world_wrap:-} "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" \
+    --out "$out" "$@" >"$logs/world.log" 2>&1 &
   world=$!
   pids=()
   for id in 1 2 3; do
-    "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" \
-      >"$out/logs/agent-$id.log" 2>&1 &
+    "$bin/marsala-agent" --scenario "$scenario" --id "${agent_ids:-$id}" --dds cyclone --domain "$domain" \
+      >"$logs/agent-$id.log" 2>&1 &
     pids+=($!)
   done
 }
@@ -268,19 +271,8 @@ case "$case_name" in
     for _ in $(seq 1 100); do in_disk mountpoint -q "$disk" 2>/dev/null && break; sleep 0.05; done
     in_disk mountpoint -q "$disk" || { kill "$holder"; echo "SKIP: cannot mount a tmpfs here"; exit 77; }
     trap 'kill "$holder" 2>/dev/null; [ -n "${MARSALA_KEEP_WORK:-}" ] || rm -rf "$work"' EXIT
-    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
-    out="$disk/run"
-    logs="$work/logs"
-    mkdir -p "$logs"
+    logs_dir="$work/logs" world_wrap=in_disk start_run "$disk/run"  # the world's folder on the small disk
     rc=0
-    in_disk "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
-      >"$logs/world.log" 2>&1 &
-    world=$!
-    pids=()
-    for id in 1 2 3; do
-      "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" >"$logs/agent-$id.log" 2>&1 &
-      pids+=($!)
-    done
     wait "$world" || rc=$?
     [ "$rc" -eq 1 ] || { tail -20 "$logs/world.log"; fail "the world exited $rc on a full disk, not 1"; }
     grep -q "No space left on device" "$logs/world.log" || { tail -5 "$logs/world.log"; fail "no 'No space left' error"; }
@@ -365,17 +357,7 @@ case "$case_name" in
   auto-ids)
     # --id auto: three agents without ids take slots 1..3 in arrival order and end on the fixed-id run's terrain.
     reference=$(run_spawn reference 3 cyclone)
-    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
-    out="$work/auto"
-    mkdir -p "$out/logs"
-    "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
-      >"$out/logs/world.log" 2>&1 &
-    world=$!
-    pids=()
-    for i in 1 2 3; do
-      "$bin/marsala-agent" --scenario "$scenario" --id auto --dds cyclone --domain "$domain" >"$out/logs/agent-$i.log" 2>&1 &
-      pids+=($!)
-    done
+    agent_ids=auto start_run "$work/auto"
     wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
     for pid in "${pids[@]}"; do wait "$pid" || fail "an auto agent exited non-zero (see $out/logs)"; done
     expect_completed "$out/summary.json" 3
