@@ -90,7 +90,8 @@ int main(int argc, char** argv) {
     config.admit_timeout = std::chrono::milliseconds(static_cast<long long>(admit_timeout_s * 1000.0));
     config.world_timeout = std::chrono::milliseconds(static_cast<long long>(world_timeout_s * 1000.0));
 
-    const auto participant = bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile});
+    const auto participant = bus::make_participant(
+        {bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kClient});
     agent::runtime::AgentRuntime agent(*participant, config);
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);

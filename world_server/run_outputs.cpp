@@ -101,11 +101,17 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_wall_seconds(info.wall_seconds);
   s.set_step_wall_median_ms(info.step_wall_median_ms);
   s.set_step_wall_p90_ms(info.step_wall_p90_ms);
+  s.set_step_world_median_ms(info.step_world_median_ms);
+  s.set_step_world_p90_ms(info.step_world_p90_ms);
+  s.set_world_cpu_ms_per_step(info.world_cpu_ms_per_step);
+  s.set_admit_seconds(info.admit_seconds);
+  s.set_connected(info.connected);
   s.set_deposited_volume_m3(state.deposited_volume_m3);
   s.set_agents(static_cast<std::uint32_t>(state.agents.size()));
-  std::uint32_t admitted = 0, missed = 0, rejected = 0;
+  std::uint32_t admitted = 0, dropped = 0, missed = 0, rejected = 0;
   for (const AgentRecord& a : state.agents) {
     admitted += a.admitted ? 1 : 0;
+    dropped += a.dropped ? 1 : 0;
     missed += a.missed;
     rejected += a.rejected;
     proto::AgentSummary* p = s.add_per_agent();
@@ -126,6 +132,7 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
     p->set_material_m3(a.material_m3);
   }
   s.set_admitted(admitted);
+  s.set_dropped(dropped);
   s.set_missed_deadlines(missed);
   s.set_rejected_requests(rejected);
   s.set_terrain_sha256(runlog::terrain_sha256(state.terrain));

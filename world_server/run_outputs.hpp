@@ -44,6 +44,11 @@ struct RunInfo {
   double wall_seconds = 0.0;                  ///< [s]
   double step_wall_median_ms = 0.0;           ///< median wall time of one lockstep step [ms]
   double step_wall_p90_ms = 0.0;              ///< its 90th percentile [ms]
+  double step_world_median_ms = 0.0;  ///< median of the world's own part of a step (the step less its waits) [ms]
+  double step_world_p90_ms = 0.0;     ///< its 90th percentile [ms]
+  double world_cpu_ms_per_step = 0.0;  ///< the world process's CPU time (all threads) over the steps / steps [ms]
+  double admit_seconds = 0.0;          ///< from the start of admission to the first frame [s]
+  std::uint32_t connected = 0;         ///< agents admitted and connected when the first frame went out
   double start_jitter_m = 0.0;                ///< the scenario's start jitter [m]
   /// The scenario's goal vector map, drawn into goal_vector_map.png when set.
   std::optional<GoalVectorMapSpec> goal_vector_map;

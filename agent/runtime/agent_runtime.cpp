@@ -3,7 +3,9 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <ctime>
 #include <random>
+#include <vector>
 
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
@@ -12,6 +14,28 @@ namespace marsala::agent::runtime {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// CPU time of the calling thread so far [ms]: what a decision costs, apart from the other processes' share of the
+/// cores while it ran.
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
+/// CPU time of this process so far, every thread's (DDS's too) [ms].
+double process_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
 /// The longest a wait lasts before the stop flag is looked at again.
 constexpr std::chrono::milliseconds kStopPoll{100};
 // How long the world's frame writer may stay not alive before the agent concludes that the world is gone: longer
@@ -157,6 +181,8 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
   // DDS status query on the per-step path.
   bool world_seen = false;
   bool sign_since_check = false;
+  std::vector<double> decision_cpu_ms;  // CPU time of each decision [ms]
+  double cpu_at_first_frame = 0.0;      // process CPU time when the first decision began [ms]
   Clock::time_point last_sign = Clock::now();
   while (!stop.load()) {
     const Clock::time_point now = Clock::now();
@@ -215,8 +241,13 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
         behaviour_->decide(frame);
         result.outcome = RunOutcome::kRunOver;
         result.message = "run over at step " + std::to_string(frame.step);
-        spdlog::info("agent {}: {} ({} requests, {} rejected)", config_.agent_id, result.message, result.requests,
-                     result.rejected);
+        result.decision_cpu_median_ms = median(decision_cpu_ms);
+        if (result.requests > 0)
+          result.cpu_ms_per_step = (process_cpu_ms() - cpu_at_first_frame) / static_cast<double>(result.requests);
+        spdlog::info("agent {}: {} ({} requests, {} rejected; decision CPU median {:.3f} ms, process CPU {:.3f} ms "
+                     "per step)",
+                     config_.agent_id, result.message, result.requests, result.rejected,
+                     result.decision_cpu_median_ms, result.cpu_ms_per_step);
         return;
       }
       if (answered_any && frame.step == last_answered) {
@@ -230,7 +261,10 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
         continue;
       }
       const std::string before = behaviour_->state_name();
+      if (!answered_any) cpu_at_first_frame = process_cpu_ms();
+      const double decision_began = thread_cpu_ms();
       last_request = behaviour_->decide(frame);
+      decision_cpu_ms.push_back(thread_cpu_ms() - decision_began);
       requests->write(last_request);
       ++result.requests;
       answered_any = true;

@@ -54,6 +54,9 @@ struct RunResult {
   std::uint64_t rejected = 0;   ///< frames reporting the previous request rejected [count]
   std::uint64_t last_step = 0;  ///< step of the last frame
   std::string final_state;      ///< the behaviour's state at the end
+  double decision_cpu_median_ms = 0.0;  ///< median CPU time of the behaviour's decision of one step [ms]
+  double cpu_ms_per_step = 0.0;  ///< the process's CPU time (all threads, DDS's too) from its first decision to the
+                                 ///< run-over frame, per request sent [ms]
 };
 
 /// A non-zero random session id (std::random_device): tells a restarted agent process apart.

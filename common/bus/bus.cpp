@@ -99,8 +99,8 @@ std::unique_ptr<Participant> make_participant(const BusConfig& config) {
   }
   switch (config.vendor) {
     case Vendor::kInProcess: return detail::make_inprocess_participant(config.domain_id);
-    case Vendor::kCyclone: return detail::make_cyclone_participant(config.domain_id);
-    case Vendor::kFastDds: return detail::make_fastdds_participant(config.domain_id);
+    case Vendor::kCyclone: return detail::make_cyclone_participant(config.domain_id, config.role);
+    case Vendor::kFastDds: return detail::make_fastdds_participant(config.domain_id, config.role);
   }
   throw InvalidArgument("unknown DDS vendor");
 }

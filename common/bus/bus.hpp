@@ -118,15 +118,30 @@ class Participant {
 #undef MARSALA_BUS_ENDPOINTS
 };
 
+/// Where a participant sits in the run's discovery star (docs/runtime.md#discovery-star). Agents talk only to the
+/// world (and are watched by monitors), so an agent's participant need not know any other agent's: with every
+/// participant discovering every other, a run of N agents pays N^2 discovery and liveliness messages (at 120
+/// agents on 2 cores that alone saturated the machine and admission stalled at 44 of 120).
+enum class Role {
+  kServer,  ///< world, monitor, tools: takes a participant index below kServerIndices when one is free, and finds
+            ///< every participant on the domain (the profile's whole unicast probe range)
+  kClient,  ///< agent: finds only the participants at indices 0..kServerIndices-1 and the ones that find it; takes
+            ///< no index there (Cyclone: ParticipantIndex none; Fast DDS: ports from index kServerIndices up)
+};
+
+/// Participant indices kept for servers: a client announces itself to these only.
+inline constexpr int kServerIndices = 4;
+
 /// How to make a participant.
 struct BusConfig {
   BusConfig() = default;
-  BusConfig(Vendor v, int domain, std::string profile_file = {})
-      : vendor(v), domain_id(domain), profile(std::move(profile_file)) {}
+  BusConfig(Vendor v, int domain, std::string profile_file = {}, Role r = Role::kServer)
+      : vendor(v), domain_id(domain), profile(std::move(profile_file)), role(r) {}
 
   Vendor vendor = Vendor::kCyclone;
   int domain_id = 0;    ///< 0..232
   std::string profile;  ///< a profile file of the vendor; empty: resolve_profile()'s default
+  Role role = Role::kServer;
 };
 
 /// The profile file a participant of `vendor` uses (docs/runtime.md#dds-profiles): `given` when not empty (it must

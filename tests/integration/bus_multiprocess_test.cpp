@@ -1,7 +1,8 @@
 // The bus across processes: marsala-bus-probe processes of either vendor, per vendor pair. Frames travel bit for
 // bit and only within their partition; a SIGKILLed writer process is seen as not alive within a few seconds (and an
-// idle live one never is); an idle agent's participant stays small. Run under run_isolated.sh (private network
-// namespace) with the loopback configs in the environment (CMakeLists.txt). Domains 180..188.
+// idle live one never is); two clients of the discovery star never find each other; an idle agent's participant
+// stays small. Run under run_isolated.sh (private network namespace) with the loopback configs in the environment
+// (CMakeLists.txt). Domains 160..163, 180..188.
 
 #include <gtest/gtest.h>
 #include <poll.h>
@@ -175,6 +176,33 @@ TEST_P(BusAcrossProcesses, AKilledWriterProcessIsSoonNotAlive) {
   RecordProperty("detected_ms", static_cast<int>(detected_ms));
   EXPECT_LT(detected_ms, 4000);
   EXPECT_EQ(watcher.wait_exit(10s), 0);
+}
+
+// The discovery star (bus.hpp Role): a client's frames reach a server's reader, never another client's reader in the
+// same partition, which would receive them (transient-local, so even a late match would deliver them) if the two
+// clients ever discovered each other.
+TEST_P(BusAcrossProcesses, ClientsFindTheServerButNotEachOther) {
+  const int domain = 160 + GetParam().index;
+  Child server(probe("read", GetParam().reader, domain,
+                     {"--partition", "run-s/agent-1", "--count", "10", "--timeout-s", "30"}));
+  Child client(probe("read", GetParam().reader, domain,
+                     {"--role", "client", "--partition", "run-s/agent-1", "--count", "0", "--timeout-s", "60"}));
+  ASSERT_TRUE(server.expect_line("ready", 10s));
+  ASSERT_TRUE(client.expect_line("ready", 10s));
+  Child writer(probe("write", GetParam().writer, domain,
+                     {"--role", "client", "--partition", "run-s/agent-1", "--count", "10", "--readers", "1"}));
+  ASSERT_TRUE(writer.expect_line("matched", 20s)) << writer.last_line();
+  ASSERT_TRUE(writer.expect_line("written 10", 10s)) << writer.last_line();
+  EXPECT_EQ(server.wait_exit(30s), 0) << "server: " << server.last_line();
+  EXPECT_EQ(server.last_line(), "received 10");
+  // Clients announce themselves every second at most: three seconds are several chances to meet.
+  std::optional<std::string> leak = client.next_line(3s);
+  EXPECT_FALSE(leak.has_value()) << "a client received another client's frame: " << *leak;
+  client.send(SIGTERM);
+  EXPECT_EQ(client.wait_exit(10s), 0) << "client: " << client.last_line();
+  EXPECT_EQ(client.last_line(), "received 0");
+  writer.send(SIGTERM);
+  EXPECT_EQ(writer.wait_exit(10s), 0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Pairs, BusAcrossProcesses,

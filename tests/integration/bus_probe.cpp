@@ -9,6 +9,7 @@
 //          none received. Lines: "ready", "received N". Exit 1: a wrong or unexpected frame; 2: timeout.
 //   alive  --dds V --domain D --partition P [--timeout-s S]
 //          follows alive_writers(); exits 0 once it dropped back to 0. Lines: "alive N".
+//   Every mode takes --role server|client (default server): the participant's place in the discovery star (bus.hpp).
 //   idle   --dds V --domain D
 //          an idle agent's endpoints (hello writer, admission reader, frame reader, request writer); prints
 //          "created <ms>" and, after 2 s, "rss_kb <VmRSS>"; holds until SIGTERM.
@@ -172,7 +173,11 @@ int main(int argc, char** argv) {
   try {
     const Args args = parse(argc, argv);
     const auto start = Clock::now();
-    auto participant = make_participant({vendor_from_string(args.get("dds", "cyclone")), args.number("domain", 0)});
+    const std::string role = args.get("role", "server");
+    if (role != "server" && role != "client")
+      throw marsala::InvalidArgument("unknown --role '" + role + "'; valid: server, client");
+    auto participant = make_participant({vendor_from_string(args.get("dds", "cyclone")), args.number("domain", 0), {},
+                                         role == "client" ? Role::kClient : Role::kServer});
     if (args.mode == "write") return run_write(*participant, args);
     if (args.mode == "read") return run_read(*participant, args);
     if (args.mode == "alive") return run_alive(*participant, args);

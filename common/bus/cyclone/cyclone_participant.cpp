@@ -5,6 +5,7 @@
 #include <dds/dds.h>
 #include <spdlog/spdlog.h>
 
+#include <cstdlib>
 #include <map>
 #include <mutex>
 #include <string>
@@ -75,18 +76,42 @@ class Qos {
 /// participant outlives its endpoints whatever order the caller destroys them in.
 class Context {
  public:
-  explicit Context(int domain_id) : domain_id_(domain_id) {
+  Context(int domain_id, Role role) : domain_id_(domain_id) {
+    if (role == Role::kClient) create_client_domain();
     participant_ = dds_create_participant(static_cast<dds_domainid_t>(domain_id), nullptr, nullptr);
-    if (participant_ < 0)
+    if (participant_ < 0) {
+      if (domain_ > 0) dds_delete(domain_);
       throw BusError(failure("creating a participant in domain " + std::to_string(domain_id), participant_));
+    }
   }
-  ~Context() { dds_delete(participant_); }
+  ~Context() {
+    dds_delete(participant_);
+    if (domain_ > 0) dds_delete(domain_);
+  }
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
   dds_entity_t participant() const { return participant_; }
   int domain_id() const { return domain_id_; }
 
+ private:
+  /// A client's domain: the profile (CYCLONEDDS_URI) with the client's discovery on top of it. No participant
+  /// index, so no other participant's unicast probes reach this one; probes of its own only to the servers' indices
+  /// 0..kServerIndices-1 (Cyclone probes the indices below MaxAutoParticipantIndex); its SPDP every second, so a
+  /// world that restarts finds its agents within a second (they announce; the world cannot probe them).
+  void create_client_domain() {
+    const char* uri = std::getenv("CYCLONEDDS_URI");
+    std::string config = uri != nullptr && *uri != '\0' ? std::string(uri) + "," : std::string();
+    config += "<Discovery><ParticipantIndex>none</ParticipantIndex><MaxAutoParticipantIndex>" +
+              std::to_string(kServerIndices) + "</MaxAutoParticipantIndex><SPDPInterval>1s</SPDPInterval></Discovery>";
+    const dds_entity_t domain = dds_create_domain(static_cast<dds_domainid_t>(domain_id_), config.c_str());
+    // Another participant of this process made the domain already: this one shares its configuration.
+    if (domain == DDS_RETCODE_PRECONDITION_NOT_MET) return;
+    if (domain < 0) throw BusError(failure("creating domain " + std::to_string(domain_id_) + " for an agent", domain));
+    domain_ = domain;
+  }
+
+ public:
   /// The topic of message type T, created on first use.
   template <typename T>
   dds_entity_t topic() {
@@ -102,6 +127,7 @@ class Context {
 
  private:
   int domain_id_;
+  dds_entity_t domain_ = 0;  ///< a client's own domain entity; 0 when the participant uses the default one
   dds_entity_t participant_;
   std::mutex mutex_;
   std::map<std::string, dds_entity_t> topics_;
@@ -271,7 +297,7 @@ class CycloneParticipant final : public ParticipantBase<CycloneParticipant> {
   friend class ParticipantBase<CycloneParticipant>;
 
  public:
-  explicit CycloneParticipant(int domain_id) : context_(std::make_shared<Context>(domain_id)) {
+  CycloneParticipant(int domain_id, Role role) : context_(std::make_shared<Context>(domain_id, role)) {
     spdlog::debug("bus: Cyclone DDS participant in domain {}", domain_id);
   }
   Vendor vendor() const override { return Vendor::kCyclone; }
@@ -293,8 +319,8 @@ class CycloneParticipant final : public ParticipantBase<CycloneParticipant> {
 
 }  // namespace
 
-std::unique_ptr<Participant> make_cyclone_participant(int domain_id) {
-  return std::make_unique<CycloneParticipant>(domain_id);
+std::unique_ptr<Participant> make_cyclone_participant(int domain_id, Role role) {
+  return std::make_unique<CycloneParticipant>(domain_id, role);
 }
 
 }  // namespace marsala::bus::detail

@@ -4,6 +4,7 @@
 // DDS's listener thread, convert them and queue them (detail::ReaderQueue). Participants of one process talk over
 // loopback like participants of different processes (intraprocess delivery off, see configure_library()).
 
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastrtps/attributes/LibrarySettingsAttributes.h>
 #include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <spdlog/spdlog.h>
@@ -101,10 +102,12 @@ void configure_library() {
 /// participant outlives its endpoints whatever order the caller destroys them in.
 class Context {
  public:
-  explicit Context(int domain_id) : domain_id_(domain_id) {
+  Context(int domain_id, Role role) : domain_id_(domain_id) {
     configure_library();
     auto* factory = dds::DomainParticipantFactory::get_instance();
-    participant_ = factory->create_participant(static_cast<dds::DomainId_t>(domain_id), dds::PARTICIPANT_QOS_DEFAULT);
+    dds::DomainParticipantQos qos = factory->get_default_participant_qos();
+    if (role == Role::kClient) make_client(qos);
+    participant_ = factory->create_participant(static_cast<dds::DomainId_t>(domain_id), qos);
     if (participant_ == nullptr)
       throw BusError("Fast DDS: creating a participant in domain " + std::to_string(domain_id) +
                      " failed (see the Fast DDS log above; is FASTRTPS_DEFAULT_PROFILES_FILE valid?)");
@@ -119,6 +122,26 @@ class Context {
   dds::DomainParticipant* participant() const { return participant_; }
   int domain_id() const { return domain_id_; }
 
+ private:
+  /// A client's participant (the profile's, with the client's discovery on top): its ports start at participant
+  /// index kServerIndices (the next free one from there), so no server index is taken and no other client's probes
+  /// reach it; its initial peers are probed at the servers' indices 0..kServerIndices-1 only.
+  static void make_client(dds::DomainParticipantQos& qos) {
+    qos.wire_protocol().participant_id = kServerIndices;
+    // Fast DDS moves a busy port up one index at a time, 100 times by default: the 101st client of a host would get
+    // no discovery port at all and be found by nobody (measured: agents 102..120 of a 120-agent run never admitted).
+    qos.wire_protocol().builtin.mutation_tries = 1000;
+    for (std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface>& transport :
+         qos.transport().user_transports) {
+      const auto udp = std::dynamic_pointer_cast<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(transport);
+      if (!udp) continue;
+      auto client = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(*udp);
+      client->maxInitialPeersRange = std::min<std::uint32_t>(client->maxInitialPeersRange, kServerIndices);
+      transport = client;
+    }
+  }
+
+ public:
   /// The topic of message type T, its type registered and the topic created on first use.
   template <typename T>
   dds::Topic* topic() {
@@ -306,7 +329,7 @@ class FastDdsParticipant final : public ParticipantBase<FastDdsParticipant> {
   friend class ParticipantBase<FastDdsParticipant>;
 
  public:
-  explicit FastDdsParticipant(int domain_id) : context_(std::make_shared<Context>(domain_id)) {
+  FastDdsParticipant(int domain_id, Role role) : context_(std::make_shared<Context>(domain_id, role)) {
     spdlog::debug("bus: Fast DDS participant in domain {}", domain_id);
   }
   Vendor vendor() const override { return Vendor::kFastDds; }
@@ -328,8 +351,8 @@ class FastDdsParticipant final : public ParticipantBase<FastDdsParticipant> {
 
 }  // namespace
 
-std::unique_ptr<Participant> make_fastdds_participant(int domain_id) {
-  return std::make_unique<FastDdsParticipant>(domain_id);
+std::unique_ptr<Participant> make_fastdds_participant(int domain_id, Role role) {
+  return std::make_unique<FastDdsParticipant>(domain_id, role);
 }
 
 }  // namespace marsala::bus::detail
