@@ -12,6 +12,7 @@
 #include <condition_variable>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <mutex>
 #include <ostream>
 #include <thread>
@@ -334,6 +335,7 @@ struct LiveServer::Impl {
         const std::optional<CellIndex> cell = r.terrain().geometry().cell_at(*a.position);
         if (cell && r.terrain().contains(*cell)) as.z_m = r.terrain()(cell->row, cell->col);
       }
+      as.material_m3 = std::numeric_limits<double>::quiet_NaN();  // not in the log: the page shows "-"
       as.deposited_m3 = a.deposited_m3;
       as.accepted = static_cast<std::uint32_t>(a.accepted);
       as.rejected = static_cast<std::uint32_t>(a.rejected);

@@ -26,8 +26,10 @@ let terrainLoading = 0;    // version being fetched
 const trails = new Map();  // agent id -> [[x, y], ...]
 let trailRun = '';
 let view = null;           // {x0, y0, x1, y1, scale, ox, oy}: world box and its placement on the canvas
+let framing = 'action';    // 'action': what is going on (robots, base, targets, goal); 'terrain': all of it;
+let custom = null;         // 'custom': this world box, after a wheel zoom or a drag
 
-function fmt(v, digits) { return (v === undefined || v === null) ? '-' : Number(v).toFixed(digits); }
+function fmt(v, digits) { return (v === undefined || v === null || Number.isNaN(v)) ? '-' : Number(v).toFixed(digits); }
 function text(id, value) { const e = $(id); if (e.textContent !== String(value)) e.textContent = value; }
 function paletteColour(id) {
   const p = (state && state.palette && state.palette.length) ? state.palette : ['#e6194b'];
@@ -151,16 +153,48 @@ function updateScene(s) {
 
 // ---- drawing --------------------------------------------------------------------------------------------------
 
-function worldBox() {
+function terrainBox() {
   const m = state && state.map;
-  if (m) return { x0: m.xll, y0: m.yll, x1: m.xll + m.width_m, y1: m.yll + m.height_m };
-  // No terrain: the robots' box with a margin.
-  const agents = (state && state.agents) || [];
-  if (!agents.length) return { x0: 0, y0: 0, x1: 20, y1: 20 };
+  return m ? { x0: m.xll, y0: m.yll, x1: m.xll + m.width_m, y1: m.yll + m.height_m } : null;
+}
+
+// Robots, base, targets, goal, site and payload, with a margin: where the run happens.
+function actionBox() {
+  const pts = [];
+  for (const a of (state && state.agents) || []) pts.push([a.x, a.y]);
+  const scene = state && state.map && state.map.scene;
+  if (scene) {
+    const b = scene.base;
+    pts.push([b.x - b.r, b.y - b.r], [b.x + b.r, b.y + b.r]);
+    for (const t of scene.targets) pts.push([t.x, t.y]);
+    for (const r of [scene.goal, scene.site]) if (r) pts.push([r.x0, r.y0], [r.x1, r.y1]);
+    if (scene.payload) pts.push(scene.payload.from, scene.payload.to);
+  }
+  if (!pts.length) return null;
   let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
-  for (const a of agents) { x0 = Math.min(x0, a.x); y0 = Math.min(y0, a.y); x1 = Math.max(x1, a.x); y1 = Math.max(y1, a.y); }
-  const margin = Math.max(5, 0.2 * Math.max(x1 - x0, y1 - y0));
+  for (const [x, y] of pts) { x0 = Math.min(x0, x); y0 = Math.min(y0, y); x1 = Math.max(x1, x); y1 = Math.max(y1, y); }
+  const margin = Math.max(4, 0.25 * Math.max(x1 - x0, y1 - y0));
   return { x0: x0 - margin, y0: y0 - margin, x1: x1 + margin, y1: y1 + margin };
+}
+
+function worldBox() {
+  if (framing === 'custom' && custom) return custom;
+  const whole = terrainBox();
+  const action = actionBox();
+  if (!whole) return action || { x0: 0, y0: 0, x1: 20, y1: 20 };
+  if (framing === 'terrain' || !action) return whole;
+  // Zoom in only when what happens covers a small part of the terrain.
+  const area = (b) => (b.x1 - b.x0) * (b.y1 - b.y0);
+  if (area(action) > 0.35 * area(whole)) return whole;
+  return { x0: Math.max(whole.x0, action.x0), y0: Math.max(whole.y0, action.y0),
+           x1: Math.min(whole.x1, action.x1), y1: Math.min(whole.y1, action.y1) };
+}
+
+function setFraming(f) {
+  framing = f;
+  if (f !== 'custom') custom = null;
+  for (const b of document.querySelectorAll('#framing button')) b.classList.toggle('on', b.dataset.framing === f);
+  draw();
 }
 
 function toCanvas(x, y) { return [view.ox + (x - view.x0) * view.scale, view.oy + (view.y1 - y) * view.scale]; }
@@ -181,15 +215,21 @@ function draw() {
   view = { x0: box.x0, y0: box.y0, x1: box.x1, y1: box.y1, scale: scale,
            ox: (w - scale * (box.x1 - box.x0)) / 2, oy: (h - scale * (box.y1 - box.y0)) / 2 };
   const m = state.map;
+  ctx.save();
+  ctx.beginPath();
+  ctx.rect(view.ox, view.oy, scale * (box.x1 - box.x0), scale * (box.y1 - box.y0));
+  ctx.clip();
   if (m && terrain) {
-    ctx.imageSmoothingEnabled = scale * m.cell_size_m < 2;  // crisp cells when zoomed in
-    ctx.drawImage(terrain.image, view.ox, view.oy, scale * m.width_m, scale * m.height_m);
+    ctx.imageSmoothingEnabled = scale * m.cell_size_m * m.cols / m.image_width_px < 3;  // crisp cells when zoomed in
+    const [ix, iy] = toCanvas(m.xll, m.yll + m.height_m);
+    ctx.drawImage(terrain.image, ix, iy, scale * m.width_m, scale * m.height_m);
   } else {
     drawGrid(box);
   }
   if (m && m.scene) drawScene(m.scene);
   drawTrails();
   drawRobots();
+  ctx.restore();
   drawScaleBar(w, h);
 }
 
@@ -308,5 +348,30 @@ canvas.addEventListener('mousemove', (ev) => {
   const y = view.y1 - (ev.clientY - r.top - view.oy) / view.scale;
   $('hover').textContent = 'x ' + x.toFixed(2) + ' m, y ' + y.toFixed(2) + ' m';
 });
+// Wheel: zoom about the pointer; drag: pan; double click: back to the action.
+canvas.addEventListener('wheel', (ev) => {
+  if (!view) return;
+  ev.preventDefault();
+  const r = canvas.getBoundingClientRect();
+  const x = view.x0 + (ev.clientX - r.left - view.ox) / view.scale;
+  const y = view.y1 - (ev.clientY - r.top - view.oy) / view.scale;
+  const k = Math.exp(ev.deltaY * 0.0015);
+  const b = worldBox();
+  custom = { x0: x + (b.x0 - x) * k, y0: y + (b.y0 - y) * k, x1: x + (b.x1 - x) * k, y1: y + (b.y1 - y) * k };
+  setFraming('custom');
+}, { passive: false });
+let dragging = null;
+canvas.addEventListener('mousedown', (ev) => { dragging = [ev.clientX, ev.clientY]; });
+window.addEventListener('mouseup', () => { dragging = null; });
+window.addEventListener('mousemove', (ev) => {
+  if (!dragging || !view) return;
+  const dx = (ev.clientX - dragging[0]) / view.scale, dy = (ev.clientY - dragging[1]) / view.scale;
+  dragging = [ev.clientX, ev.clientY];
+  const b = worldBox();
+  custom = { x0: b.x0 - dx, y0: b.y0 + dy, x1: b.x1 - dx, y1: b.y1 + dy };
+  setFraming('custom');
+});
+canvas.addEventListener('dblclick', () => setFraming('action'));
+for (const b of document.querySelectorAll('#framing button')) b.addEventListener('click', () => setFraming(b.dataset.framing));
 window.addEventListener('resize', draw);
 poll();
