@@ -417,7 +417,14 @@ int LiveServer::run(bus::Participant* participant, const StopSource& stop, std::
   std::thread http_thread([&impl] { impl.http.listen_after_bind(); });
   std::thread follower;
   const std::string dir = o.replay_dir.empty() ? o.run_dir : o.replay_dir;
-  if (!dir.empty()) follower = std::thread([&impl, dir, replay = !o.replay_dir.empty()] { impl.follow(dir, replay); });
+  if (!dir.empty())
+    follower = std::thread([&impl, dir, replay = !o.replay_dir.empty()] {
+      try {
+        impl.follow(dir, replay);
+      } catch (const std::exception& e) {  // nothing escapes the thread: the page says why the terrain stopped
+        impl.set_note(std::string("stopped following the run folder: ") + e.what());
+      }
+    });
 
   const std::string host = o.bind_address.find(':') == std::string::npos ? o.bind_address : "[" + o.bind_address + "]";
   out << "marsala-monitor: live view on http://" << host << ":" << o.port << "/ ("
