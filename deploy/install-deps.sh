@@ -2,9 +2,16 @@
 # Installs every Debian package MARSala needs to build, test and run. Idempotent: does nothing when all are present,
 # otherwise runs `apt-get update` once and installs what is missing.
 # --containers: also podman, runc, podman-compose and mmdebstrap, for docker/run.sh and the container test.
+# --browser: also chromium, for the live view's browser test (tests/integration/live_view_test.sh; skipped without).
 set -euo pipefail
-containers=0
-[ "${1:-}" = "--containers" ] && containers=1
+containers=0 browser=0
+for arg in "$@"; do
+  case "$arg" in
+    --containers) containers=1 ;;
+    --browser) browser=1 ;;
+    *) echo "install-deps: unknown option '$arg' (known: --containers, --browser)" >&2; exit 2 ;;
+  esac
+done
 
 packages=(
   cmake make g++ pkg-config python3
@@ -16,6 +23,8 @@ packages=(
   libprotobuf-dev protobuf-compiler libspdlog-dev libfmt-dev
   # common/bus: both DDS vendors (fastddsgen runs at build time)
   cyclonedds-dev cyclonedds-tools libfastrtps-dev libfastcdr-dev fastddsgen
+  # marsala-monitor serve: HTTP server and JSON (header-only / small libraries)
+  libcpp-httplib-dev nlohmann-json3-dev
   # multi-process tests run inside a private network namespace (unshare -n, ip link set lo up)
   iproute2 util-linux
   # deploy/sweep.py (the sweep), jq for spawn.sh/demo.sh (marsala-world --check --json), the scalability plot
@@ -23,6 +32,7 @@ packages=(
 )
 
 [ "$containers" -eq 1 ] && packages+=(podman runc podman-compose mmdebstrap)
+[ "$browser" -eq 1 ] && packages+=(chromium)
 
 missing=()
 for p in "${packages[@]}"; do

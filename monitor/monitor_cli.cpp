@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <exception>
+#include <memory>
 #include <new>
 #include <ostream>
 #include <string>
@@ -14,11 +15,13 @@
 #include "marsala/core/error.hpp"
 #include "marsala/monitor/follow.hpp"
 #include "marsala/monitor/replay.hpp"
+#include "marsala/monitor/serve.hpp"
 
 namespace marsala::monitor {
 namespace {
 
 constexpr int kExitError = 1;
+constexpr int kExitUsage = 2;
 
 constexpr const char* kTailLegend =
     "Columns: step; live agents/all; mat = material on board of the live agents [m3]; dep = volume deposited\n"
@@ -32,6 +35,14 @@ constexpr const char* kReplayFooter =
     "run end's terrain SHA-256 against the replay. A damaged tail (a crash of the world) is reported on stderr and\n"
     "not applied. Prints a summary; the last line is \"terrain_sha256 <hex>\". Exit 0 ok, 1 the log and the replay\n"
     "disagree or a file is missing or bad, 2 usage. With ffmpeg on PATH the frames also become timelapse.mp4.";
+
+constexpr const char* kServeFooter =
+    "Serves a page that shows the run as it goes: the terrain (from --run-dir's run.log) with every raised cell\n"
+    "tinted by the robot that deposited it, the robots coloured by role (active, following, returning, done,\n"
+    "dropped), the base, targets, goal, site or payload, and a side panel with step, steps/s, progress and the\n"
+    "agents' table. Live data comes from the world's WorldStatus and WorldEvent over DDS (read only); --replay DIR\n"
+    "plays a run folder back instead, without DDS. Many browsers may watch: each gets the newest state when it asks.\n"
+    "Exit 0 on Ctrl-C, 2 for a bad option or a port that cannot be listened on.";
 
 /// A whole number >= 1 (CLI11's PositiveNumber explains a 0 with a range of 300 digits).
 const CLI::Validator kAtLeastOne(
@@ -99,7 +110,56 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       ->needs(replay_frames);
   replay->footer(kReplayFooter);
 
+  ServeOptions serve_options;
+  auto* serve = app.add_subcommand("serve", "serve a live view of the run to browsers (HTTP, loopback by default)");
+  add_bus_options(*serve);
+  serve->add_option("--port", serve_options.port, "TCP port to listen on")
+      ->check(CLI::Range(1, 65535))
+      ->capture_default_str();
+  serve->add_option("--bind", serve_options.bind_address, "numeric address to listen on (0.0.0.0: every interface)")
+      ->capture_default_str();
+  auto* serve_run_dir =
+      serve->add_option("--run-dir", serve_options.run_dir,
+                        "the run's --out folder: its run.log, followed as it grows, gives the terrain and deposits")
+          ->type_name("DIR");
+  auto* serve_replay =
+      serve->add_option("--replay", serve_options.replay_dir, "play this run folder back instead of following DDS")
+          ->type_name("DIR")
+          ->excludes(serve_run_dir);
+  serve->add_option("--speed", serve_options.replay_steps_per_s, "replay pace [steps/s]")
+      ->check(CLI::Range(1e-3, 1e9))
+      ->needs(serve_replay)
+      ->capture_default_str();
+  serve->add_option("--terrain-every", serve_options.terrain_interval_s,
+                    "shortest time between two terrain pictures [s]")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
+  serve->footer(kServeFooter);
+
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-monitor", out, err)) return *code;
+
+  if (*serve) {
+    try {
+      // Bound first: a bad port or address is a usage error, found before anything joins DDS.
+      LiveServer server(serve_options);
+      std::unique_ptr<bus::Participant> participant;
+      if (serve_options.replay_dir.empty())
+        participant = bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile});
+      return server.run(participant.get(), stop, out);
+    } catch (const ListenError& e) {
+      err << "marsala-monitor: serve: " << e.what() << "\n";
+      return kExitUsage;
+    } catch (const InvalidArgument& e) {
+      err << "marsala-monitor: serve: " << e.what() << "\n";
+      return kExitUsage;
+    } catch (const Error& e) {
+      err << "marsala-monitor: serve: " << e.what() << "\n";
+      return kExitError;
+    } catch (const std::exception& e) {
+      err << "marsala-monitor: serve: unexpected error: " << e.what() << "\n";
+      return kExitError;
+    }
+  }
 
   try {
     if (*replay) {

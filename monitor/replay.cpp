@@ -242,7 +242,11 @@ void TerrainReplayer::apply_step(const proto::StepRecord& step, const std::strin
   for (const proto::LoggedRequest& r : step.requests()) {
     ++requests_;
     if (!r.accepted()) {
-      if (r.channel_id() != 0) ++agent(r.channel_id()).rejected;
+      if (r.channel_id() != 0) {
+        ReplayedAgent& sender = agent(r.channel_id());
+        ++sender.rejected;
+        sender.state = r.state();
+      }
       continue;
     }
     ++accepted_requests_;
@@ -250,6 +254,7 @@ void TerrainReplayer::apply_step(const proto::StepRecord& step, const std::strin
     // needs (material, heights under the agents).
     ReplayedAgent& me = agent(r.agent_id());
     ++me.accepted;
+    me.state = r.state();
     if (r.move()) me.position = Position{r.target_x_m(), r.target_y_m()};
     double volume_m3 = 0.0;
     for (const proto::LoggedDeposition& d : r.depositions()) {

@@ -34,6 +34,7 @@ struct ReplayedAgent {
   std::uint64_t accepted = 0;        ///< accepted requests
   std::uint64_t rejected = 0;        ///< requests the world rejected
   double deposited_m3 = 0.0;         ///< volume of its accepted depositions [m^3]
+  std::string state;                 ///< the behaviour state of its latest logged request (accepted or not)
 };
 
 /// Throws ParseError naming `terrain_name` when `terrain` is not the initial terrain `header` describes: rows, cols,
