@@ -2,7 +2,8 @@
 # The README's test command: installs what is missing, builds (Release) and runs every test with ctest.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-"$root/deploy/install-deps.sh" --containers  # the container test runs real containers with podman
+# The container test runs real containers with podman; the live view's test drives a headless chromium.
+"$root/deploy/install-deps.sh" --containers --browser
 "$root/deploy/build.sh"
 cd "${MARSALA_BUILD_DIR:-$root/build}"
 ctest --output-on-failure -j"$(nproc)" --timeout 600
