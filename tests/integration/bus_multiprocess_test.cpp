@@ -133,28 +133,39 @@ std::vector<std::string> probe(const std::string& mode, Vendor vendor, int domai
 
 class BusAcrossProcesses : public ::testing::TestWithParam<Pair> {};
 
+/// Starts `reader` (expecting `count` frames) and `silent` (expecting none; any frame makes it exit 1 at once), then a
+/// writer with `writer_args` that writes `count` frames once one reader matched; checks that `reader` got them all and
+/// that `silent` got nothing within `leak_wait` after them.
+void expect_delivered_only_to(Child& reader, Child& silent, std::vector<std::string> writer_args, int count,
+                              Clock::duration leak_wait) {
+  ASSERT_TRUE(reader.expect_line("ready", 10s));
+  ASSERT_TRUE(silent.expect_line("ready", 10s));
+  Child writer(writer_args);
+  ASSERT_TRUE(writer.expect_line("matched", 20s)) << writer.last_line();
+  ASSERT_TRUE(writer.expect_line("written " + std::to_string(count), 10s)) << writer.last_line();
+  EXPECT_EQ(reader.wait_exit(30s), 0) << "reader: " << reader.last_line();
+  EXPECT_EQ(reader.last_line(), "received " + std::to_string(count));
+  std::optional<std::string> leak = silent.next_line(leak_wait);
+  EXPECT_FALSE(leak.has_value()) << "a frame reached the reader that must get none: " << *leak;
+  silent.send(SIGTERM);
+  EXPECT_EQ(silent.wait_exit(10s), 0) << "silent reader: " << silent.last_line();
+  EXPECT_EQ(silent.last_line(), "received 0");
+  writer.send(SIGTERM);
+  EXPECT_EQ(writer.wait_exit(10s), 0);
+}
+
 TEST_P(BusAcrossProcesses, FramesArriveBitForBitAndOnlyInTheirPartition) {
   const int domain = 180 + 2 * GetParam().index;
   Child reader(probe("read", GetParam().reader, domain,
                      {"--partition", "run-x/agent-1", "--count", "20", "--tiles", "40", "--timeout-s", "30"}));
   Child other(probe("read", GetParam().reader, domain,
                     {"--partition", "run-x/agent-2", "--count", "0", "--tiles", "40", "--timeout-s", "60"}));
-  ASSERT_TRUE(reader.expect_line("ready", 10s));
-  ASSERT_TRUE(other.expect_line("ready", 10s));
-  Child writer(probe("write", GetParam().writer, domain,
-                     {"--partition", "run-x/agent-1", "--count", "20", "--tiles", "40", "--readers", "1"}));
-  ASSERT_TRUE(writer.expect_line("matched", 20s)) << writer.last_line();
-  ASSERT_TRUE(writer.expect_line("written 20", 10s)) << writer.last_line();
-  EXPECT_EQ(reader.wait_exit(30s), 0) << "reader: " << reader.last_line();
-  EXPECT_EQ(reader.last_line(), "received 20");
-  // The reader of the other partition ran all along: a frame reaching it makes it exit 1 at once.
-  std::optional<std::string> leak = other.next_line(300ms);
-  EXPECT_FALSE(leak.has_value()) << *leak;
-  other.send(SIGTERM);
-  EXPECT_EQ(other.wait_exit(10s), 0) << "other partition: " << other.last_line();
-  EXPECT_EQ(other.last_line(), "received 0");
-  writer.send(SIGTERM);
-  EXPECT_EQ(writer.wait_exit(10s), 0);
+  // The reader of the other partition runs all along.
+  expect_delivered_only_to(
+      reader, other,
+      probe("write", GetParam().writer, domain,
+            {"--partition", "run-x/agent-1", "--count", "20", "--tiles", "40", "--readers", "1"}),
+      20, 300ms);
 }
 
 TEST_P(BusAcrossProcesses, AKilledWriterProcessIsSoonNotAlive) {
@@ -187,22 +198,12 @@ TEST_P(BusAcrossProcesses, ClientsFindTheServerButNotEachOther) {
                      {"--partition", "run-s/agent-1", "--count", "10", "--timeout-s", "30"}));
   Child client(probe("read", GetParam().reader, domain,
                      {"--role", "client", "--partition", "run-s/agent-1", "--count", "0", "--timeout-s", "60"}));
-  ASSERT_TRUE(server.expect_line("ready", 10s));
-  ASSERT_TRUE(client.expect_line("ready", 10s));
-  Child writer(probe("write", GetParam().writer, domain,
-                     {"--role", "client", "--partition", "run-s/agent-1", "--count", "10", "--readers", "1"}));
-  ASSERT_TRUE(writer.expect_line("matched", 20s)) << writer.last_line();
-  ASSERT_TRUE(writer.expect_line("written 10", 10s)) << writer.last_line();
-  EXPECT_EQ(server.wait_exit(30s), 0) << "server: " << server.last_line();
-  EXPECT_EQ(server.last_line(), "received 10");
   // Clients announce themselves every second at most: three seconds are several chances to meet.
-  std::optional<std::string> leak = client.next_line(3s);
-  EXPECT_FALSE(leak.has_value()) << "a client received another client's frame: " << *leak;
-  client.send(SIGTERM);
-  EXPECT_EQ(client.wait_exit(10s), 0) << "client: " << client.last_line();
-  EXPECT_EQ(client.last_line(), "received 0");
-  writer.send(SIGTERM);
-  EXPECT_EQ(writer.wait_exit(10s), 0);
+  expect_delivered_only_to(
+      server, client,
+      probe("write", GetParam().writer, domain,
+            {"--role", "client", "--partition", "run-s/agent-1", "--count", "10", "--readers", "1"}),
+      10, 3s);
 }
 
 INSTANTIATE_TEST_SUITE_P(Pairs, BusAcrossProcesses,
