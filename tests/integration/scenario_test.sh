@@ -11,6 +11,16 @@
 #   site   tests/integration/scenarios/site_small.pbtxt, 3 levellers on a goal vector map (Fast DDS): every cell of
 #          the site, cropped from terrain_final.asc, is occupiable at kappa 0.1 and all are connected; it was not
 #          so on terrain_initial.asc; goal_vector_map.png and final.png written
+#
+# Usage: scenario_test.sh shipped DOMAIN NAME AGENTS DDS
+#   shipped deploy/scenarios/NAME.pbtxt as shipped, AGENTS agents on DDS, to its end: completed, no request rejected,
+#          the summary's volume equals the terrain's change, and its completion re-checked with marsala-terrain on
+#          terrain_final.asc from what `marsala-world --check --json` says of the scenario: payload_path, the payload
+#          navigable from base to target (and not before); level_site, every site cell occupiable and connected (and
+#          not before); agents_at_goal, every agent inside the goal box at least min_height_m high. Exit 77 (skipped)
+#          when the scenario's terrain file is absent (../shared/data).
+#   crowd  deploy/scenarios/crowd_120.pbtxt with 120 agents on DDS (arg 3), 100 steps: all 120 admitted and connected
+#          at the first frame, none dropped, no deadline missed, every step applied.
 set -euo pipefail
 case_name="$1"
 domain="$2"
@@ -101,5 +111,97 @@ case "$case_name" in
     echo "ok: site: level at kappa 0.1 after $(field steps "$s") steps ($occ0 of $total0 cells before)," \
       "$(field deposited_volume_m3 "$s") m^3"
     ;;
-  *) echo "usage: scenario_test.sh path|site DOMAIN" >&2; exit 2 ;;
+  shipped)
+    name="$3" agents="$4" dds="$5"
+    scenario="$root/deploy/scenarios/$name.pbtxt"
+    check="$work/check.json"
+    if ! "$bin/marsala-world" --check --json "$scenario" >"$check" 2>"$work/check.err"; then
+      if grep -q "shared/data" "$work/check.err" && grep -qi "not found\|no such\|cannot open\|missing" "$work/check.err"; then
+        echo "SKIP: $name needs a terrain from ../shared/data, absent here: $(head -1 "$work/check.err")"
+        exit 77
+      fi
+      cat "$work/check.err" >&2
+      fail "marsala-world --check refuses $name"
+    fi
+    j() { jq -r "$1" "$check"; }
+    s=$(run_spawn "$scenario" "$agents" "$dds")
+    expect_completed "$s" "$agents"
+    out="$(dirname "$s")"
+    cs=$(j .terrain.cell_size_m) rows=$(j .terrain.rows) x0=$(j .terrain.x0_m) y0=$(j .terrain.y0_m)
+    # Conservation: the summary's volume is the terrain's change, and no cell went down.
+    awk -v v="$(field deposited_volume_m3 "$s")" -v area="$(awk -v c="$cs" 'BEGIN { print c * c }')" '
+      FNR <= 6 { next }
+      NR == FNR { for (i = 1; i <= NF; i++) h[FNR, i] = $i; next }
+      { for (i = 1; i <= NF; i++) { d = $i - h[FNR, i]; if (d < -1e-9) neg++; sum += d } }
+      END { sum *= area; if (neg || sum < v - 1e-6 || sum > v + 1e-6) { print "terrain change " sum " m^3, summary " v " m^3, " neg + 0 " cells lowered"; exit 1 } }
+    ' "$out/terrain_initial.asc" "$out/terrain_final.asc" || fail "deposited volume does not match the terrain"
+    cell() {  # cell X Y: "ROW COL" of the cell holding (X, Y) m (row 0 = north)
+      awk -v x="$1" -v y="$2" -v x0="$x0" -v y0="$y0" -v c="$cs" -v r="$rows" \
+        'BEGIN { printf "%d %d\n", r - 1 - int((y - y0) / c), int((x - x0) / c) }'
+    }
+    case "$(j .completion)" in
+      payload_path)
+        read -r fr fc <<<"$(cell "$(j .payload_path.from.x_m)" "$(j .payload_path.from.y_m)")"
+        read -r tr tc <<<"$(cell "$(j .payload_path.to.x_m)" "$(j .payload_path.to.y_m)")"
+        for t in initial final; do
+          "$bin/marsala-terrain" navigable --kappa "$(j .payload_path.kappa)" --delta "$(j .payload_path.delta_m)" \
+            --eps "$(j .payload_path.eps_m)" --origin-cell "$fr" "$fc" "$out/terrain_$t.asc" -o "$work/nav_$t.asc" >/dev/null
+        done
+        [ "$(asc_cell "$work/nav_initial.asc" "$tr" "$tc")" = "0" ] || fail "the target was navigable before any construction"
+        [ "$(asc_cell "$work/nav_final.asc" "$tr" "$tc")" = "1" ] ||
+          fail "marsala-terrain finds no payload path from base to target on terrain_final.asc"
+        what="payload path from ($fr, $fc) to ($tr, $tc)"
+        ;;
+      level_site)
+        sx0=$(j .site.x0_m) sy0=$(j .site.y0_m)
+        w=$(awk -v a="$sx0" -v b="$(j .site.x1_m)" 'BEGIN { print b - a }')
+        h=$(awk -v a="$sy0" -v b="$(j .site.y1_m)" 'BEGIN { print b - a }')
+        for t in initial final; do
+          "$bin/marsala-terrain" import "$out/terrain_$t.asc" --crop "$sx0" "$sy0" "$w" "$h" -o "$work/site_$t.asc" >/dev/null
+          occ=$("$bin/marsala-terrain" navigable --occupiable --kappa "$(j .site.kappa)" --delta "$(j .site.delta_m)" \
+            --eps "$(j .site.eps_m)" "$work/site_$t.asc" -o "$work/occ_$t.asc")
+          read -r n total <<<"$(echo "$occ" | awk '{ print $2, $4 }')"
+          eval "occ_$t=$n total_$t=$total"
+        done
+        [ "$total_final" = "$(j .site.cells)" ] || fail "the cropped site has $total_final cells, the world counts $(j .site.cells)"
+        [ "$occ_initial" -lt "$total_initial" ] || fail "the site was level before any construction"
+        [ "$occ_final" = "$total_final" ] || fail "$occ_final of $total_final site cells occupiable on terrain_final.asc"
+        # All occupiable: connected = navigable from one cell reaches them all.
+        nav=$("$bin/marsala-terrain" navigable --kappa "$(j .site.kappa)" --delta "$(j .site.delta_m)" \
+          --eps "$(j .site.eps_m)" --origin-cell 0 0 "$work/site_final.asc" -o "$work/nav_site.asc" | awk '{ print $5 }')
+        [ "$nav" = "$total_final" ] || fail "$nav of $total_final site cells connected on terrain_final.asc"
+        what="site level ($occ_initial of $total_initial cells before)"
+        ;;
+      agents_at_goal)
+        paste <(agent_fields x_m "$s") <(agent_fields y_m "$s") <(agent_fields z_m "$s") |
+          awk -v a="$(j .goal.x0_m)" -v b="$(j .goal.y0_m)" -v c="$(j .goal.x1_m)" -v d="$(j .goal.y1_m)" \
+            -v zmin="$(j '.goal.min_height_m // 0')" '
+            { n++; if ($1 < a || $1 > c || $2 < b || $2 > d || $3 < zmin - 1e-9) { print "agent " n " ends at (" $1 ", " $2 ", " $3 ")"; bad++ } }
+            END { exit bad > 0 }' || fail "an agent ends outside the goal box"
+        what="every agent in the goal box"
+        ;;
+      *) fail "unknown completion '$(j .completion)'" ;;
+    esac
+    echo "ok: $name, $agents agents ($dds): $what after $(field steps "$s") steps," \
+      "$(field deposited_volume_m3 "$s") m^3, terrain_sha256 $(field terrain_sha256 "$s" | cut -c1-8)"
+    ;;
+  crowd)
+    dds="$3"
+    out="$work/run"
+    "$root/deploy/spawn.sh" --scenario "$root/deploy/scenarios/crowd_120.pbtxt" --agents 120 --dds "$dds" \
+      --domain "$domain" --out "$out" --max-steps 100 --quiet --timeout 600 >&2 && rc=0 || rc=$?
+    s="$out/summary.json"
+    [ "$rc" = 3 ] || fail "spawn.sh exit $rc, expected 3 (max_steps); logs: $out/logs"
+    top() { jq -r ".$1" "$s"; }  # a top-level field (per_agent entries have some of the same names)
+    for f in admitted connected; do
+      [ "$(top "$f")" = 120 ] || { cat "$s"; fail "$f: $(top "$f") of 120"; }
+    done
+    for f in dropped missed_deadlines rejected_requests; do
+      [ "$(top "$f")" = 0 ] || { cat "$s"; fail "$f: $(top "$f"), expected 0"; }
+    done
+    [ "$(top steps)" = 100 ] || fail "steps: $(top steps), expected 100"
+    echo "ok: crowd: 120 agents ($dds) admitted and connected in $(top admit_seconds) s, 100 steps," \
+      "step median $(top step_wall_median_ms) ms"
+    ;;
+  *) echo "usage: scenario_test.sh path|site DOMAIN | shipped DOMAIN NAME AGENTS DDS | crowd DOMAIN DDS" >&2; exit 2 ;;
 esac

@@ -225,9 +225,10 @@ TEST(DeployScenarios, EachBuildsItsTerrainAndNeedsConstruction) {
   EXPECT_GE(payload + static_cast<int>(skipped.size()), 2);  // path_gale (or skipped) and path_generated
   EXPECT_GE(sites, 1);
   if (!skipped.empty()) {
+    // Every other scenario was checked above (a failure there still fails the test); ctest shows the skip.
     std::string names;
     for (const std::string& n : skipped) names += " " + n;
-    std::cout << "[ SKIPPED  ] data under ../shared/data absent for:" << names << " (" << built << " built)\n";
+    GTEST_SKIP() << "data under ../shared/data absent for:" << names << " (" << built << " others built and checked)";
   }
 }
 
