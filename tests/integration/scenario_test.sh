@@ -17,7 +17,7 @@
 #          the summary's volume equals the terrain's change, and its completion re-checked with marsala-terrain on
 #          terrain_final.asc from what `marsala-world --check --json` says of the scenario: payload_path, the payload
 #          navigable from base to target (and not before); level_site, every site cell occupiable and connected (and
-#          not before); agents_at_goal, every agent inside the goal box at least min_height_m high. Exit 77 (skipped)
+#          not before) and no cell raised above the terrain's MARS bound at the site's kappa; agents_at_goal, every agent inside the goal box at least min_height_m high. Exit 77 (skipped)
 #          when the scenario's terrain file is absent (../shared/data).
 #   crowd  deploy/scenarios/crowd_120.pbtxt with 120 agents on DDS (arg 3), 100 steps: all 120 admitted and connected
 #          at the first frame, none dropped, no deadline missed, every step applied.
@@ -170,7 +170,16 @@ case "$case_name" in
         nav=$("$bin/marsala-terrain" navigable --kappa "$(j .site.kappa)" --delta "$(j .site.delta_m)" \
           --eps "$(j .site.eps_m)" --origin-cell 0 0 "$work/site_final.asc" -o "$work/nav_site.asc" | awk '{ print $5 }')
         [ "$nav" = "$total_final" ] || fail "$nav of $total_final site cells connected on terrain_final.asc"
-        what="site level ($occ_initial of $total_initial cells before)"
+        # Robots fill the MARS gap of their own map's window, never more than the terrain's MARS bound at the site's
+        # kappa (the shipped sites build at that kappa): no cell rises above it.
+        "$bin/marsala-terrain" mars --kappa "$(j .site.kappa)" --gap "$out/terrain_initial.asc" -o "$work/gap.asc" >/dev/null
+        awk 'FNR <= 6 { next }
+             FILENAME == ARGV[1] { for (i = 1; i <= NF; i++) h0[FNR, i] = $i; next }
+             FILENAME == ARGV[2] { for (i = 1; i <= NF; i++) gap[FNR, i] = $i; next }
+             { for (i = 1; i <= NF; i++) { over = $i - h0[FNR, i] - gap[FNR, i]; if (over > 1e-6) { n++; v += over } } }
+             END { if (n) { printf "%d cells above the MARS bound, %.4f m of excess in all\n", n, v; exit 1 } }' \
+          "$out/terrain_initial.asc" "$work/gap.asc" "$out/terrain_final.asc" || fail "deposits above the MARS bound"
+        what="site level ($occ_initial of $total_initial cells before), nothing above the MARS bound"
         ;;
       agents_at_goal)
         paste <(agent_fields x_m "$s") <(agent_fields y_m "$s") <(agent_fields z_m "$s") |
