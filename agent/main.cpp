@@ -90,8 +90,13 @@ int main(int argc, char** argv) {
     config.admit_timeout = std::chrono::milliseconds(static_cast<long long>(admit_timeout_s * 1000.0));
     config.world_timeout = std::chrono::milliseconds(static_cast<long long>(world_timeout_s * 1000.0));
 
-    const auto participant = bus::make_participant(
-        {bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kClient});
+    if (!dds.security.empty() && id == 0 && dds.identity.empty())
+      throw InvalidArgument(
+          "--id auto with --security needs --identity: the identity cannot follow a slot not yet "
+          "assigned");
+    const auto participant =
+        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kClient,
+                               bus::Security::of(dds.security, dds.identity, "agent-" + std::to_string(id))});
     agent::runtime::AgentRuntime agent(*participant, config);
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);

@@ -29,6 +29,8 @@ packages=(
   iproute2 util-linux
   # deploy/sweep.py (the sweep), jq for spawn.sh/demo.sh (marsala-world --check --json), the scalability plot
   python3 jq gnuplot-nox
+  # DDS Security identities (deploy/security/make-identities.sh, spawn.sh --secure)
+  openssl
 )
 
 [ "$containers" -eq 1 ] && packages+=(podman runc podman-compose mmdebstrap)

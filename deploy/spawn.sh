@@ -4,7 +4,7 @@
 #
 # Usage: deploy/spawn.sh --scenario FILE --agents N [--dds cyclone|fastdds] [--agent-dds cyclone|fastdds]
 #                        [--out DIR [--replace]] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N]
-#                        [--quiet]
+#                        [--quiet] [--secure]
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
 #                 folder that holds another run's files, unless --replace removes them (and logs/) first
 #   --dds         vendor of every process (default $MARSALA_DDS, else cyclone); --agent-dds overrides it for the agents
@@ -12,6 +12,8 @@
 #   --monitor     also run `marsala-monitor tail` in the foreground output
 #   --timeout     give up (and stop everything) after S seconds of wall time (default 1800)
 #   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
+#   --secure      DDS Security: a CA and an identity per process in OUT/security (deploy/security/make-identities.sh,
+#                 made anew each run), every process authenticated, access-controlled and encrypted (domain <= 230)
 # Exit codes: marsala-world's for a run that ended: 0 completed, 3 max_steps, 4 no_live_agents, 5 stopped by a
 #             signal (the summary is written in every case); 1 the world failed or wrote no summary or the binaries
 #             are missing; 2 usage error or a run that `marsala-world --check` rejects (nothing started); 130 stopped.
@@ -20,8 +22,8 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
 scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0
-replace=0
-usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; }
+replace=0 secure=0
+usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -36,6 +38,7 @@ while [ $# -gt 0 ]; do
     --seed) seed="$2"; shift 2 ;;
     --quiet) quiet=1; shift ;;
     --replace) replace=1; shift ;;
+    --secure) secure=1; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "spawn.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
@@ -75,7 +78,16 @@ fi
 # that run's files itself (marsala-world --replace knows the list), and the agents' old logs go here.
 [ "$replace" -eq 1 ] && [ -d "$out" ] && rm -rf -- "$out/logs"
 
-world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$domain" --out "$out")
+# Secured: identities made anew for this run's processes (docs/runtime.md#security).
+sec_args=()
+if [ "$secure" -eq 1 ]; then
+  [ "$domain" -le 230 ] || { echo "spawn.sh: --secure needs a domain <= 230, got $domain" >&2; exit 2; }
+  rm -rf -- "$out/security"
+  "$root/deploy/security/make-identities.sh" --out "$out/security" --agents "$agents" >/dev/null
+  sec_args=(--security "$out/security")
+fi
+
+world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$domain" --out "$out" "${sec_args[@]}")
 [ "$replace" -eq 1 ] && world_args+=(--replace)
 [ -n "$max_steps" ] && world_args+=(--max-steps "$max_steps")
 [ "$quiet" -eq 1 ] && world_args+=(--quiet)
@@ -109,13 +121,13 @@ world_pid=$!
 pids+=("$world_pid")
 for id in $(seq 1 "$agents"); do
   "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds "$agent_dds" --domain "$domain" \
-    "${seed_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
+    "${seed_args[@]}" "${sec_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
   pids+=("$!")
 done
 [ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain; logs in $out/logs"
 
 if [ "$monitor" -eq 1 ] && [ -x "$bin/marsala-monitor" ]; then
-  "$bin/marsala-monitor" tail --dds "$dds" --domain "$domain" &
+  "$bin/marsala-monitor" tail --dds "$dds" --domain "$domain" "${sec_args[@]}" &
   pids+=("$!")
 fi
 

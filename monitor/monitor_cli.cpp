@@ -119,8 +119,9 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
   serve->add_option("--bind", serve_options.bind_address, "numeric address to listen on (0.0.0.0: every interface)")
       ->capture_default_str();
   auto* serve_run_dir =
-      serve->add_option("--run-dir", serve_options.run_dir,
-                        "the run's --out folder: its run.log, followed as it grows, gives the terrain and deposits")
+      serve
+          ->add_option("--run-dir", serve_options.run_dir,
+                       "the run's --out folder: its run.log, followed as it grows, gives the terrain and deposits")
           ->type_name("DIR");
   auto* serve_replay =
       serve->add_option("--replay", serve_options.replay_dir, "play this run folder back instead of following DDS")
@@ -130,8 +131,9 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       ->check(CLI::Range(1e-3, 1e9))
       ->needs(serve_replay)
       ->capture_default_str();
-  serve->add_option("--terrain-every", serve_options.terrain_interval_s,
-                    "shortest time between two terrain pictures [s]")
+  serve
+      ->add_option("--terrain-every", serve_options.terrain_interval_s,
+                   "shortest time between two terrain pictures [s]")
       ->check(CLI::Range(0.0, 3600.0))
       ->capture_default_str();
   serve->footer(kServeFooter);
@@ -144,7 +146,9 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       LiveServer server(serve_options);
       std::unique_ptr<bus::Participant> participant;
       if (serve_options.replay_dir.empty())
-        participant = bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile});
+        participant =
+            bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,
+                                   bus::Security::of(dds.security, dds.identity, "monitor")});
       return server.run(participant.get(), stop, out);
     } catch (const ListenError& e) {
       err << "marsala-monitor: serve: " << e.what() << "\n";
@@ -171,7 +175,9 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       out << format_replay_report(report);
       return 0;
     }
-    auto participant = bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile});
+    auto participant =
+        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,
+                               bus::Security::of(dds.security, dds.identity, "monitor")});
     if (*tail) {
       if (tail_timeout->count() > 0) tail_options.timeout = std::chrono::duration<double>(tail_timeout_s);
       return run_tail(*participant, tail_options, stop, out, err);

@@ -96,7 +96,9 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       const scenario::Scenario scenario = scenario::parse_scenario(options.scenario_text, scenario_path);
       start = prepare_world_start(scenario, scenario::build_terrain(scenario), options, dds.domain);
     }
-    const auto participant = bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile});
+    const auto participant =
+        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,
+                               bus::Security::of(dds.security, dds.identity, "world")});
     WorldRuntime runtime(std::move(start), *participant);
     const RunResult result = runtime.run(stop);
     out << "run " << runtime.run_id() << ": " << to_string(result.end_reason) << " after " << result.steps << " steps"

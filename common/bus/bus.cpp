@@ -90,7 +90,23 @@ std::string resolve_profile(Vendor vendor, const std::string& given) {
   return {};
 }
 
+void check_security(const Security& security) {
+  if (!security.enabled()) return;
+  if (security.identity.empty()) throw InvalidArgument("DDS Security: no identity given for " + security.dir);
+  for (const std::string& name : {std::string("ca.pem"), std::string("governance.p7s"), std::string("permissions.p7s"),
+                                  security.identity + ".pem", security.identity + ".key"}) {
+    const std::filesystem::path file = std::filesystem::path(security.dir) / name;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec))
+      throw InvalidArgument("DDS Security: " + file.string() +
+                            " not found (make the folder with deploy/security/make-identities.sh)");
+  }
+}
+
 std::unique_ptr<Participant> make_participant(const BusConfig& config) {
+  if (config.vendor == Vendor::kInProcess && config.security.enabled())
+    throw InvalidArgument("DDS Security needs a DDS vendor (cyclone or fastdds), not inprocess");
+  check_security(config.security);
   if (config.domain_id < 0 || config.domain_id > 232)
     throw InvalidArgument("DDS domain id must be in 0..232, got " + std::to_string(config.domain_id));
   if (const std::string profile = resolve_profile(config.vendor, config.profile); !profile.empty()) {
@@ -99,8 +115,8 @@ std::unique_ptr<Participant> make_participant(const BusConfig& config) {
   }
   switch (config.vendor) {
     case Vendor::kInProcess: return detail::make_inprocess_participant(config.domain_id);
-    case Vendor::kCyclone: return detail::make_cyclone_participant(config.domain_id, config.role);
-    case Vendor::kFastDds: return detail::make_fastdds_participant(config.domain_id, config.role);
+    case Vendor::kCyclone: return detail::make_cyclone_participant(config);
+    case Vendor::kFastDds: return detail::make_fastdds_participant(config);
   }
   throw InvalidArgument("unknown DDS vendor");
 }

@@ -132,16 +132,34 @@ enum class Role {
 /// Participant indices kept for servers: a client announces itself to these only.
 inline constexpr int kServerIndices = 4;
 
+/// DDS Security for a participant (docs/runtime.md#security): the folder deploy/security/make-identities.sh made
+/// and the identity to take from it. Empty dir: unsecured.
+struct Security {
+  std::string dir;       ///< holds ca.pem, governance.p7s, permissions.p7s and <identity>.pem/.key
+  std::string identity;  ///< file stem of the certificate and key: world, monitor, agent-<id>
+  bool enabled() const { return !dir.empty(); }
+
+  /// Security with `dir` (empty: off) and `identity`, or `fallback` when `identity` is empty.
+  static Security of(const std::string& dir, const std::string& identity, const std::string& fallback) {
+    if (dir.empty()) return {};
+    return {dir, identity.empty() ? fallback : identity};
+  }
+};
+
+/// The files of `security`, checked: throws InvalidArgument naming the first one missing.
+void check_security(const Security& security);
+
 /// How to make a participant.
 struct BusConfig {
   BusConfig() = default;
-  BusConfig(Vendor v, int domain, std::string profile_file = {}, Role r = Role::kServer)
-      : vendor(v), domain_id(domain), profile(std::move(profile_file)), role(r) {}
+  BusConfig(Vendor v, int domain, std::string profile_file = {}, Role r = Role::kServer, Security sec = {})
+      : vendor(v), domain_id(domain), profile(std::move(profile_file)), role(r), security(std::move(sec)) {}
 
   Vendor vendor = Vendor::kCyclone;
   int domain_id = 0;    ///< 0..232
   std::string profile;  ///< a profile file of the vendor; empty: resolve_profile()'s default
   Role role = Role::kServer;
+  Security security;  ///< DDS Security; off when its dir is empty
 };
 
 /// The profile file a participant of `vendor` uses (docs/runtime.md#dds-profiles): `given` when not empty (it must

@@ -23,6 +23,8 @@ struct DdsOptions {
   std::string vendor = "cyclone";  ///< cyclone, fastdds (or inprocess, in tests)
   int domain = 0;                  ///< 0..232
   std::string profile;             ///< a profile file of the vendor; empty: bus::resolve_profile()'s default
+  std::string security;            ///< DDS Security folder (deploy/security/make-identities.sh); empty: unsecured
+  std::string identity;            ///< the identity in it; empty: the program's own (world, monitor, agent-<id>)
 };
 
 /// Adds --dds, --domain and --dds-config to `app`, each also read from the environment (MARSALA_DDS,
@@ -40,6 +42,14 @@ inline void add_dds_options(CLI::App& app, DdsOptions& options) {
                  "a DDS profile file of that vendor, e.g. deploy/dds/cyclone-lan.xml for a network (default: the\n"
                  "vendor's CYCLONEDDS_URI / FASTRTPS_DEFAULT_PROFILES_FILE, else the shipped loopback profile)")
       ->envname("MARSALA_DDS_CONFIG");
+  app.add_option("--security", options.security,
+                 "DDS Security: a folder made by deploy/security/make-identities.sh (authentication, access control,\n"
+                 "encryption; every process of the run must use one; docs/runtime.md#security)")
+      ->envname("MARSALA_SECURITY");
+  app.add_option(
+         "--identity", options.identity,
+         "with --security: the identity to use (file stem in the folder; default: world, monitor or agent-<id>)")
+      ->envname("MARSALA_IDENTITY");
 }
 
 /// Parses argv into `app`; returns nullopt when the program should go on, else the exit code to return now.

@@ -9,7 +9,10 @@
 //          none received. Lines: "ready", "received N". Exit 1: a wrong or unexpected frame; 2: timeout.
 //   alive  --dds V --domain D --partition P [--timeout-s S]
 //          follows alive_writers(); exits 0 once it dropped back to 0. Lines: "alive N".
-//   Every mode takes --role server|client (default server): the participant's place in the discovery star (bus.hpp).
+//   open-request --dds V --domain D --partition P
+//          opens an ActionRequest writer on P; prints "opened" and holds it until SIGTERM (exit 3: refused).
+//   Every mode takes --role server|client (default server): the participant's place in the discovery star (bus.hpp),
+//   and --security DIR --identity NAME: DDS Security with DIR/NAME.pem (deploy/security/make-identities.sh).
 //   idle   --dds V --domain D
 //          an idle agent's endpoints (hello writer, admission reader, frame reader, request writer); prints
 //          "created <ms>" and, after 2 s, "rss_kb <VmRSS>"; holds until SIGTERM.
@@ -105,6 +108,16 @@ int run_write(Participant& participant, const Args& args) {
   return 0;
 }
 
+// Opens an ActionRequest writer on --partition (what an agent opens on its session's partition) and holds it until
+// SIGTERM: prints "opened"; exit 3 when the participant may not (DDS Security refuses it).
+int run_open_request(Participant& participant, const Args& args) {
+  auto writer = participant.create_writer<ActionRequest>({args.get("partition", ""), nullptr});
+  say("opened");
+  Signal idle;
+  while (!g_stop) idle.wait_for(50ms);
+  return 0;
+}
+
 int run_read(Participant& participant, const Args& args) {
   const int count = args.number("count", 10);
   const int tiles = args.number("tiles", 40);
@@ -176,13 +189,17 @@ int main(int argc, char** argv) {
     const std::string role = args.get("role", "server");
     if (role != "server" && role != "client")
       throw marsala::InvalidArgument("unknown --role '" + role + "'; valid: server, client");
-    auto participant = make_participant({vendor_from_string(args.get("dds", "cyclone")), args.number("domain", 0), {},
-                                         role == "client" ? Role::kClient : Role::kServer});
+    auto participant = make_participant({vendor_from_string(args.get("dds", "cyclone")),
+                                         args.number("domain", 0),
+                                         {},
+                                         role == "client" ? Role::kClient : Role::kServer,
+                                         {args.get("security", ""), args.get("identity", "")}});
     if (args.mode == "write") return run_write(*participant, args);
     if (args.mode == "read") return run_read(*participant, args);
     if (args.mode == "alive") return run_alive(*participant, args);
     if (args.mode == "idle") return run_idle(*participant, args, start);
-    throw marsala::InvalidArgument("unknown mode '" + args.mode + "'; valid: write, read, alive, idle");
+    if (args.mode == "open-request") return run_open_request(*participant, args);
+    throw marsala::InvalidArgument("unknown mode '" + args.mode + "'; valid: write, read, alive, idle, open-request");
   } catch (const std::exception& e) {
     std::cerr << "marsala-bus-probe: " << e.what() << std::endl;
     return 3;

@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <string>
@@ -76,8 +77,8 @@ class Qos {
 /// participant outlives its endpoints whatever order the caller destroys them in.
 class Context {
  public:
-  Context(int domain_id, Role role) : domain_id_(domain_id) {
-    if (role == Role::kClient) create_client_domain();
+  Context(int domain_id, Role role, const Security& security) : domain_id_(domain_id) {
+    if (role == Role::kClient || security.enabled()) create_domain(role, security);
     participant_ = dds_create_participant(static_cast<dds_domainid_t>(domain_id), nullptr, nullptr);
     if (participant_ < 0) {
       if (domain_ > 0) dds_delete(domain_);
@@ -95,19 +96,34 @@ class Context {
   int domain_id() const { return domain_id_; }
 
  private:
-  /// A client's domain: the profile (CYCLONEDDS_URI) with the client's discovery on top of it. No participant
-  /// index, so no other participant's unicast probes reach this one; probes of its own only to the servers' indices
+  /// The domain with this participant's settings on top of the profile (CYCLONEDDS_URI). A client: no participant
+  /// index, so no other participant's unicast probes reach it; probes of its own only to the servers' indices
   /// 0..kServerIndices-1 (Cyclone probes the indices below MaxAutoParticipantIndex); its SPDP every second, so a
-  /// world that restarts finds its agents within a second (they announce; the world cannot probe them).
-  void create_client_domain() {
+  /// world that restarts finds its agents within a second (they announce; the world cannot probe them). Secured:
+  /// the three DDS Security plugins Debian ships with libddsc, with the identity's files.
+  void create_domain(Role role, const Security& security) {
     const char* uri = std::getenv("CYCLONEDDS_URI");
-    std::string config = uri != nullptr && *uri != '\0' ? std::string(uri) + "," : std::string();
-    config += "<Discovery><ParticipantIndex>none</ParticipantIndex><MaxAutoParticipantIndex>" +
-              std::to_string(kServerIndices) + "</MaxAutoParticipantIndex><SPDPInterval>1s</SPDPInterval></Discovery>";
+    std::string config = uri != nullptr && *uri != '\0' ? std::string(uri) : std::string();
+    const auto add = [&config](const std::string& fragment) { config += (config.empty() ? "" : ",") + fragment; };
+    if (role == Role::kClient)
+      add("<Discovery><ParticipantIndex>none</ParticipantIndex><MaxAutoParticipantIndex>" +
+          std::to_string(kServerIndices) + "</MaxAutoParticipantIndex><SPDPInterval>1s</SPDPInterval></Discovery>");
+    if (security.enabled())
+      add(fmt::format(
+          R"(<Security><Authentication><Library path="dds_security_auth" initFunction="init_authentication" )"
+          R"(finalizeFunction="finalize_authentication"/><IdentityCA>{0}ca.pem</IdentityCA>)"
+          R"(<IdentityCertificate>{0}{1}.pem</IdentityCertificate><PrivateKey>{0}{1}.key</PrivateKey></Authentication>)"
+          R"(<AccessControl><Library path="dds_security_ac" initFunction="init_access_control" )"
+          R"(finalizeFunction="finalize_access_control"/><PermissionsCA>{0}ca.pem</PermissionsCA>)"
+          R"(<Governance>{0}governance.p7s</Governance><Permissions>{0}permissions.p7s</Permissions></AccessControl>)"
+          R"(<Cryptographic><Library path="dds_security_crypto" initFunction="init_crypto" )"
+          R"(finalizeFunction="finalize_crypto"/></Cryptographic></Security>)",
+          "file:" + std::filesystem::absolute(security.dir).string() + "/", security.identity));
     const dds_entity_t domain = dds_create_domain(static_cast<dds_domainid_t>(domain_id_), config.c_str());
     // Another participant of this process made the domain already: this one shares its configuration.
     if (domain == DDS_RETCODE_PRECONDITION_NOT_MET) return;
-    if (domain < 0) throw BusError(failure("creating domain " + std::to_string(domain_id_) + " for an agent", domain));
+    if (domain < 0)
+      throw BusError(failure("creating domain " + std::to_string(domain_id_) + " with its settings", domain));
     domain_ = domain;
   }
 
@@ -297,8 +313,10 @@ class CycloneParticipant final : public ParticipantBase<CycloneParticipant> {
   friend class ParticipantBase<CycloneParticipant>;
 
  public:
-  CycloneParticipant(int domain_id, Role role) : context_(std::make_shared<Context>(domain_id, role)) {
-    spdlog::debug("bus: Cyclone DDS participant in domain {}", domain_id);
+  explicit CycloneParticipant(const BusConfig& config)
+      : context_(std::make_shared<Context>(config.domain_id, config.role, config.security)) {
+    spdlog::debug("bus: Cyclone DDS participant in domain {}{}", config.domain_id,
+                  config.security.enabled() ? ", secured as " + config.security.identity : std::string());
   }
   Vendor vendor() const override { return Vendor::kCyclone; }
   int domain_id() const override { return context_->domain_id(); }
@@ -319,8 +337,8 @@ class CycloneParticipant final : public ParticipantBase<CycloneParticipant> {
 
 }  // namespace
 
-std::unique_ptr<Participant> make_cyclone_participant(int domain_id, Role role) {
-  return std::make_unique<CycloneParticipant>(domain_id, role);
+std::unique_ptr<Participant> make_cyclone_participant(const BusConfig& config) {
+  return std::make_unique<CycloneParticipant>(config);
 }
 
 }  // namespace marsala::bus::detail

@@ -8,7 +8,7 @@
 namespace marsala::bus::detail {
 
 std::unique_ptr<Participant> make_inprocess_participant(int domain_id);
-std::unique_ptr<Participant> make_cyclone_participant(int domain_id, Role role);
-std::unique_ptr<Participant> make_fastdds_participant(int domain_id, Role role);
+std::unique_ptr<Participant> make_cyclone_participant(const BusConfig& config);
+std::unique_ptr<Participant> make_fastdds_participant(const BusConfig& config);
 
 }  // namespace marsala::bus::detail

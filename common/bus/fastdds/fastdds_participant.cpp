@@ -20,6 +20,7 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
 #include <algorithm>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <string>
@@ -102,11 +103,12 @@ void configure_library() {
 /// participant outlives its endpoints whatever order the caller destroys them in.
 class Context {
  public:
-  Context(int domain_id, Role role) : domain_id_(domain_id) {
+  Context(int domain_id, Role role, const Security& security) : domain_id_(domain_id) {
     configure_library();
     auto* factory = dds::DomainParticipantFactory::get_instance();
     dds::DomainParticipantQos qos = factory->get_default_participant_qos();
     if (role == Role::kClient) make_client(qos);
+    if (security.enabled()) secure(qos, security);
     participant_ = factory->create_participant(static_cast<dds::DomainId_t>(domain_id), qos);
     if (participant_ == nullptr)
       throw BusError("Fast DDS: creating a participant in domain " + std::to_string(domain_id) +
@@ -139,6 +141,25 @@ class Context {
       client->maxInitialPeersRange = std::min<std::uint32_t>(client->maxInitialPeersRange, kServerIndices);
       transport = client;
     }
+  }
+
+  /// DDS Security with the builtin plugins Fast DDS is built with, the identity's files.
+  static void secure(dds::DomainParticipantQos& qos, const Security& security) {
+    // Fast DDS takes file://<absolute path> (a bare file:<path> is "Unsupported URI format").
+    const std::string dir = "file://" + std::filesystem::absolute(security.dir).string() + "/";
+    auto& properties = qos.properties().properties();
+    const auto set = [&properties](const std::string& name, const std::string& value) {
+      properties.emplace_back(name, value);
+    };
+    set("dds.sec.auth.plugin", "builtin.PKI-DH");
+    set("dds.sec.auth.builtin.PKI-DH.identity_ca", dir + "ca.pem");
+    set("dds.sec.auth.builtin.PKI-DH.identity_certificate", dir + security.identity + ".pem");
+    set("dds.sec.auth.builtin.PKI-DH.private_key", dir + security.identity + ".key");
+    set("dds.sec.access.plugin", "builtin.Access-Permissions");
+    set("dds.sec.access.builtin.Access-Permissions.permissions_ca", dir + "ca.pem");
+    set("dds.sec.access.builtin.Access-Permissions.governance", dir + "governance.p7s");
+    set("dds.sec.access.builtin.Access-Permissions.permissions", dir + "permissions.p7s");
+    set("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
   }
 
  public:
@@ -329,8 +350,10 @@ class FastDdsParticipant final : public ParticipantBase<FastDdsParticipant> {
   friend class ParticipantBase<FastDdsParticipant>;
 
  public:
-  FastDdsParticipant(int domain_id, Role role) : context_(std::make_shared<Context>(domain_id, role)) {
-    spdlog::debug("bus: Fast DDS participant in domain {}", domain_id);
+  explicit FastDdsParticipant(const BusConfig& config)
+      : context_(std::make_shared<Context>(config.domain_id, config.role, config.security)) {
+    spdlog::debug("bus: Fast DDS participant in domain {}{}", config.domain_id,
+                  config.security.enabled() ? ", secured as " + config.security.identity : std::string());
   }
   Vendor vendor() const override { return Vendor::kFastDds; }
   int domain_id() const override { return context_->domain_id(); }
@@ -351,8 +374,8 @@ class FastDdsParticipant final : public ParticipantBase<FastDdsParticipant> {
 
 }  // namespace
 
-std::unique_ptr<Participant> make_fastdds_participant(int domain_id, Role role) {
-  return std::make_unique<FastDdsParticipant>(domain_id, role);
+std::unique_ptr<Participant> make_fastdds_participant(const BusConfig& config) {
+  return std::make_unique<FastDdsParticipant>(config);
 }
 
 }  // namespace marsala::bus::detail
