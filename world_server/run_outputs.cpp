@@ -11,6 +11,7 @@
 #include "idl/run_summary.pb.h"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
+#include "marsala/render/perspective.hpp"
 #include "marsala/render/png_writer.hpp"
 #include "marsala/render/terrain_renderer.hpp"
 #include "marsala/runlog/atomic_file.hpp"
@@ -304,6 +305,17 @@ render::RenderOptions goal_vector_map_picture_options(const WorldState& state, c
   return o;
 }
 
+render::PerspectiveOptions perspective_options(const WorldState& state, const RunInfo& info, const CellRect& window) {
+  render::PerspectiveOptions o;
+  Heightmap built(state.terrain.window(window.first, window.rows, window.cols).geometry());
+  for (int r = 0; r < window.rows; ++r)
+    for (int c = 0; c < window.cols; ++c)
+      built(r, c) = state.depositor(window.first.row + r, window.first.col + c) > 0 ? 1.0 : 0.0;
+  o.deposit = std::move(built);
+  o.title = info.scenario + ": step " + std::to_string(state.step) + ", built material in orange";
+  return o;
+}
+
 void write_initial_outputs(const std::string& dir, const Heightmap& terrain) {
   make_dir(dir);
   write_atomically(path_in(dir, "terrain_initial.asc"), [&](const std::string& p) { terrain::write_asc(terrain, p); });
@@ -318,12 +330,20 @@ void write_final_outputs(const std::string& dir, const WorldState& state, const 
   write_atomically(path_in(dir, "final.png"), [&](const std::string& p) {
     render::write_png(render::render_terrain(state.terrain, final_picture_options(state, info, report.route)), p);
   });
-  if (const auto window = zoom_window(state, report.route))
+  const std::optional<CellRect> window = zoom_window(state, report.route);
+  const CellRect window3d = window.value_or(CellRect{CellIndex{0, 0}, state.terrain.rows(), state.terrain.cols()});
+  if (window)
     write_atomically(path_in(dir, "final_zoom.png"), [&](const std::string& p) {
       render::write_png(render::render_terrain(state.terrain.window(window->first, window->rows, window->cols),
                                                final_picture_options(state, info, report.route, window)),
                         p);
     });
+
+  write_atomically(path_in(dir, "final_3d.png"), [&](const std::string& p) {
+    render::write_png(render::render_perspective(state.terrain.window(window3d.first, window3d.rows, window3d.cols),
+                                                 perspective_options(state, info, window3d)),
+                      p);
+  });
 
   const std::string summary = summary_text(state, info, report);
   write_atomically(path_in(dir, "summary.json"), [&](const std::string& p) {

@@ -1,7 +1,8 @@
 #pragma once
 // What a run leaves in its output folder: summary.json (protobuf RunSummary as JSON, proto field names),
 // terrain_initial.asc, terrain_final.asc, final.png, final_zoom.png (when zoom_window() finds a close-up),
-// goal_vector_map.png (scenarios with a goal vector map) and events.log (one text line per event). IO at the edge.
+// final_3d.png, goal_vector_map.png (scenarios with a goal vector map) and events.log (one text line per event). IO at
+// the edge.
 //
 // final.png: the hillshaded final terrain; every cell raised by a deposition tinted with its depositor's colour
 // (render::default_palette(): agent id k -> entry (k - 1) mod 12: 1 red, 2 blue, 3 green, 4 orange, 5 purple, 6 cyan,
@@ -13,6 +14,9 @@
 // final_zoom.png: the same picture of the zoom window only (what was built, the payload's path and ends, the site and
 // the base, with a margin), so that a 24 m path on a 160 m terrain fills the picture; titled
 // "<scenario>: close-up x X0..X1 m, y Y0..Y1 m". Not written when the window would hold more than half the terrain.
+//
+// final_3d.png: a perspective view (render::render_perspective, from the south-west, 35 deg up) of the zoom window,
+// or of the whole terrain when there is none, every cell a deposition raised tinted orange.
 
 #include <cstdint>
 #include <fstream>
@@ -44,12 +48,12 @@ struct RunInfo {
   double wall_seconds = 0.0;                  ///< [s]
   double step_wall_median_ms = 0.0;           ///< median wall time of one lockstep step [ms]
   double step_wall_p90_ms = 0.0;              ///< its 90th percentile [ms]
-  double step_world_median_ms = 0.0;  ///< median of the world's own part of a step (the step less its waits) [ms]
-  double step_world_p90_ms = 0.0;     ///< its 90th percentile [ms]
+  double step_world_median_ms = 0.0;   ///< median of the world's own part of a step (the step less its waits) [ms]
+  double step_world_p90_ms = 0.0;      ///< its 90th percentile [ms]
   double world_cpu_ms_per_step = 0.0;  ///< the world process's CPU time (all threads) over the steps / steps [ms]
   double admit_seconds = 0.0;          ///< from the start of admission to the first frame [s]
   std::uint32_t connected = 0;         ///< agents admitted and connected when the first frame went out
-  double start_jitter_m = 0.0;                ///< the scenario's start jitter [m]
+  double start_jitter_m = 0.0;         ///< the scenario's start jitter [m]
   /// The scenario's goal vector map, drawn into goal_vector_map.png when set.
   std::optional<GoalVectorMapSpec> goal_vector_map;
   Heightmap initial_terrain;  ///< the terrain before the run (for goal_vector_map.png); empty = use the final
@@ -85,20 +89,19 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
 render::RenderOptions goal_vector_map_picture_options(const WorldState& state, const RunInfo& info,
                                                       const GoalVectorMap& map);
 
-/// Writes summary.json, terrain_final.asc, final.png, final_zoom.png when zoom_window() gives a window and, when
-/// info.goal_vector_map is set, goal_vector_map.png (on info.initial_terrain, or the final terrain when that is empty)
-/// into `dir`; the payload's path is computed once.
-/// Throws IoError; a goal vector map that does not fit the grid throws InvalidArgument after the other files are
-/// written.
+/// Writes summary.json, terrain_final.asc, final.png, final_zoom.png when zoom_window() gives a window, final_3d.png
+/// and, when info.goal_vector_map is set, goal_vector_map.png (on info.initial_terrain, or the final terrain when that
+/// is empty) into `dir`; the payload's path is computed once. Throws IoError; a goal vector map that does not fit the
+/// grid throws InvalidArgument after the other files are written.
 void write_final_outputs(const std::string& dir, const WorldState& state, const RunInfo& info);
 
 /// One event as a log line: "step 12 agent 2 deposited 0.000125 m3: 1 cells".
 std::string format_event(const protocol::WorldEvent& event);
 
 /// The files a run writes into its output folder (docs/runtime.md#outputs).
-inline constexpr const char* kRunFiles[] = {"summary.json",        "events.log", "terrain_initial.asc",
-                                            "terrain_final.asc",   "final.png",  "final_zoom.png",
-                                            "goal_vector_map.png", kRunLogFile,  kSnapshotFile};
+inline constexpr const char* kRunFiles[] = {
+    "summary.json",   "events.log",   "terrain_initial.asc", "terrain_final.asc", "final.png",
+    "final_zoom.png", "final_3d.png", "goal_vector_map.png", kRunLogFile,         kSnapshotFile};
 
 /// The kRunFiles present in `dir` (none when it does not exist).
 std::vector<std::string> run_files_in(const std::string& dir);

@@ -17,6 +17,7 @@
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/mars_processor.hpp"
 #include "marsala/core/navigability_processor.hpp"
+#include "marsala/render/perspective.hpp"
 #include "marsala/render/png_writer.hpp"
 #include "marsala/render/terrain_renderer.hpp"
 #include "marsala/terrain/asc_io.hpp"
@@ -207,6 +208,30 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       ->capture_default_str();
   render->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
 
+  // render3d
+  render::PerspectiveOptions view;
+  std::string deposits_from;
+  std::pair<int, int> view_size{1200, 800};
+  auto* render3d = app.add_subcommand(
+      "render3d", "write a perspective view of a terrain (built material tinted with --deposits-from) as a PNG");
+  render3d->add_option("input", in_path, "input .asc or .tif (e.g. a run's terrain_final.asc)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  render3d->add_option("-o,--output", out_path, "output .png")->required();
+  render3d
+      ->add_option("--deposits-from", deposits_from,
+                   "the terrain before construction (e.g. terrain_initial.asc): cells raised since are tinted")
+      ->check(CLI::ExistingFile);
+  render3d
+      ->add_option("--azimuth", view.azimuth_deg, "where the camera stands, from the centre: 0 north, 90 east [deg]")
+      ->capture_default_str();
+  render3d->add_option("--elevation", view.elevation_deg, "camera height above the horizon, (0, 90] [deg]")
+      ->capture_default_str();
+  render3d->add_option("--exaggeration", view.vertical_exaggeration, "vertical exaggeration")->capture_default_str();
+  render3d->add_option("--size", view_size, "picture size WIDTH HEIGHT [px]")->capture_default_str();
+  render3d->add_option("--title", view.title, "title drawn in the top-left corner");
+  render3d->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
+
   if (const auto code = parse_command_line(app, argc, argv, "marsala-terrain", out, err)) return *code;
 
   try {
@@ -291,6 +316,29 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       if (render_gap) options.gap = MarsProcessor(render_params.kappa).gap(map);
       render::write_png(render::render_terrain(map, options), out_path);
       out << "rendered " << map.rows() << " x " << map.cols() << " -> " << out_path << "\n";
+    } else if (*render3d) {
+      const Heightmap map = load_terrain(in_path, fill_nodata);
+      double built_m3 = 0.0;
+      if (!deposits_from.empty()) {
+        const Heightmap before = load_terrain(deposits_from, fill_nodata);
+        if (before.rows() != map.rows() || before.cols() != map.cols())
+          throw UsageError("--deposits-from " + deposits_from + " is " + std::to_string(before.rows()) + " x " +
+                           std::to_string(before.cols()) + " cells, " + in_path + " " + std::to_string(map.rows()) +
+                           " x " + std::to_string(map.cols()));
+        Heightmap deposit(map.geometry());
+        for (int r = 0; r < map.rows(); ++r)
+          for (int c = 0; c < map.cols(); ++c) {
+            deposit(r, c) = std::max(0.0, map(r, c) - before(r, c));
+            built_m3 += deposit(r, c) * map.cell_size_m() * map.cell_size_m();
+          }
+        view.deposit = std::move(deposit);
+      }
+      view.width_px = view_size.first;
+      view.height_px = view_size.second;
+      render::write_png(render::render_perspective(map, view), out_path);
+      out << "rendered a perspective view of " << map.rows() << " x " << map.cols() << " cells";
+      if (view.deposit) out << " (" << built_m3 << " m^3 built, tinted)";
+      out << " -> " << out_path << "\n";
     }
   } catch (const UsageError& e) {
     err << "marsala-terrain: " << e.what() << " (run with --help for usage)\n";
