@@ -9,6 +9,7 @@
 #include "marsala/core/format.hpp"
 #include "marsala/core/iterators.hpp"
 #include "marsala/core/navigability_processor.hpp"
+#include "marsala/core/segment_cells.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -113,10 +114,18 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
     if (!cell)
       return reject("target (" + fmt::format("{}", r.target_x_m) + ", " + fmt::format("{}", r.target_y_m) +
                     ") is off the grid");
-    if (!cell_occupiable(
-            terrain, *cell,
-            {me.type.body.navigability.kappa, me.type.body.navigability.delta_m, me.type.body.navigability.eps_m}))
+    const NavigabilityParams body = me.type.body.navigability;
+    if (!cell_occupiable(terrain, *cell, body))
       return reject("target cell " + fmt::format("{}", *cell) + " is not occupiable for this body");
+    // The body must be on occupiable terrain all along the way: every cell the segment passes through, except the
+    // one it leaves (a robot whose own cell stopped being occupiable may still drive out of it).
+    const std::vector<CellIndex> swept = cells_on_segment(terrain.geometry(), {x, y}, {r.target_x_m, r.target_y_m});
+    for (std::size_t i = 1; i + 1 < swept.size(); ++i) {
+      if (swept[i] == swept.front()) continue;
+      if (!terrain.contains(swept[i]) || !cell_occupiable(terrain, swept[i], body))
+        return reject("motion passes through cell " + fmt::format("{}", swept[i]) +
+                      ", not occupiable for this body");
+    }
     x = r.target_x_m;
     y = r.target_y_m;
   }

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/segment_cells.hpp"
 
 namespace marsala::agent::executive {
 namespace {
@@ -12,6 +13,19 @@ double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y
 
 /// Below this a robot counts as standing on its cell's centre [m].
 constexpr double kCentredM = 1e-9;
+
+/// True when every cell the straight motion from `from` to `to` passes through, other than the one it leaves, is in
+/// the map and set in `mask`: the world accepts a motion only when each of them is occupiable
+/// (docs/runtime.md#rule-2-motion), and the mask holds no cell the agent does not believe occupiable.
+bool sweep_clear(const deliberative::LocalMap& map, const CellMask& mask, Position from, Position to) {
+  const std::vector<CellIndex> cells = cells_on_segment(map.world, from, to);
+  for (std::size_t i = 1; i < cells.size(); ++i) {
+    if (cells[i] == cells.front()) continue;
+    const CellIndex local = map.to_local(cells[i]);
+    if (!map.contains(local) || mask(local.row, local.col) == 0) return false;
+  }
+  return true;
+}
 
 }  // namespace
 
@@ -39,7 +53,7 @@ std::optional<Motion> ActionManager::advance(const deliberative::LocalMap& map, 
     if (!map.contains(cell) || mask(cell.row, cell.col) == 0) break;
     const Position centre = map.center(cell);
     const double d = distance(centre, robot);
-    if (d <= max_step_m_) best = Motion{cell, centre, i, d};
+    if (d <= max_step_m_ && sweep_clear(map, mask, robot, centre)) best = Motion{cell, centre, i, d};
   }
   if (best) return best;
   // The next cell is navigable but out of range from where the robot stands: first step onto its own centre.
@@ -53,7 +67,8 @@ std::optional<Motion> ActionManager::advance(const deliberative::LocalMap& map, 
   const double f = max_step_m_ * (1.0 - 1e-9) / d_next;
   const Position partial{robot.x + (aim.x - robot.x) * f, robot.y + (aim.y - robot.y) * f};
   const auto cell = map.cell_at(partial);
-  if (!cell || *cell == path[0] || mask(cell->row, cell->col) == 0) return std::nullopt;  // a new cell, or no motion
+  if (!cell || *cell == path[0] || mask(cell->row, cell->col) == 0 || !sweep_clear(map, mask, robot, partial))
+    return std::nullopt;  // a new cell it may reach, or no motion
   return Motion{*cell, partial, *cell == next ? std::size_t{1} : std::size_t{0}, distance(partial, robot)};
 }
 

@@ -1,8 +1,9 @@
 #pragma once
 // Action manager (paper §III, executive layer): the motion of one step. It advances along a planned path to the
 // farthest path cell that is navigable now (on the local map before this step's depositions: the world applies
-// the motion first) and within the distance threshold, and targets that cell's centre, so the world (which
-// checks the distance and that the target cell is occupiable) never has a reason to reject it.
+// the motion first) and within the distance threshold, whose straight way from the robot passes through navigable
+// cells only, and targets that cell's centre, so the world (which checks the distance and that every cell the
+// motion passes through is occupiable: cells_on_segment) never has a reason to reject it.
 
 #include <optional>
 #include <vector>
@@ -28,12 +29,13 @@ class ActionManager {
   double max_step_m() const { return max_step_m_; }
 
   /// The farthest cell of `path` (path[0] = the robot's cell) reachable along the path through cells navigable
-  /// now, with its centre within max_step of `robot` [m]; when the robot's own cell is not occupiable, occupiable
-  /// cells stand in for navigable ones (a way out). If the path is the robot's own cell alone, or only that cell's
-  /// centre is in range, and the robot is off the centre, the motion centres the robot; if the robot is centred and
-  /// the next cell's centre is beyond a step (a diagonal when the step is shorter than a cell's diagonal), it goes a
-  /// step's length towards that centre, when the point it reaches lies in another cell it may move to. nullopt when
-  /// no progress is possible.
+  /// now, with its centre within max_step of `robot` [m] and every cell on the straight way there (but the robot's
+  /// own) navigable; when the robot's own cell is not occupiable, occupiable cells stand in for navigable ones (a
+  /// way out). If the path is the robot's own cell alone, or only that cell's centre is in range, and the robot is
+  /// off the centre, the motion centres the robot; if the robot is centred and the next cell's centre is beyond a
+  /// step (a diagonal when the step is shorter than a cell's diagonal), it goes a step's length towards that centre,
+  /// when the point it reaches lies in another cell it may move to along a clear way. nullopt when no progress is
+  /// possible.
   std::optional<Motion> advance(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
                                 Position robot) const;
 

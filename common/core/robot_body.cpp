@@ -34,6 +34,11 @@ std::string body_problem(const RobotBody& b) {
         check("sensing_range_m", b.sensing_range_m, false, "m"),
         check("proximity_range_m", b.proximity_range_m, false, "m"), check("cube_size_m", b.cube_size_m, true, "m")})
     if (!problem.empty()) return problem;
+  // The world judges a motion by the cells the robot's centre passes through, each standing for the body's ball;
+  // a step of at most half the body keeps the balls at its two ends overlapping.
+  if (b.max_step_m > 0.5 * n.delta_m + 1e-9)
+    return fmt::format("max_step_m = {}: exceeds half the body length (delta_m / 2 = {} m) [m]", b.max_step_m,
+                       0.5 * n.delta_m);
   return {};
 }
 

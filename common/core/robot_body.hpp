@@ -29,8 +29,8 @@ struct RobotBody {
 inline constexpr double kMaxMagnitude = 1e6;
 
 /// Empty when every field of `body` is finite, below kMaxMagnitude in magnitude and in its range (kappa, delta_m,
-/// max_step_m, max_deposit_m3, cube_size_m > 0; the other fields >= 0); otherwise the first problem, e.g.
-/// "kappa = nan: must be finite, > 0 and < 1e6 [m/m]". Scenario validation and the world's admission both use it.
+/// max_step_m, max_deposit_m3, cube_size_m > 0; the other fields >= 0) and max_step_m <= delta_m / 2 (+1e-9 m);
+/// otherwise the first problem, e.g. "kappa = nan: must be finite, > 0 and < 1e6 [m/m]". Scenario validation and the world's admission both use it.
 std::string body_problem(const RobotBody& body);
 
 /// Height of one cube spread over a cell, q = cube^3 / cs^2 [m]: depositions are whole multiples of it. Agent and

@@ -16,6 +16,7 @@
 
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/navigability_processor.hpp"
+#include "marsala/core/segment_cells.hpp"
 #include "marsala/protocol/messages.hpp"
 
 namespace marsala::agent::test {
@@ -145,6 +146,10 @@ class MiniWorld {
       const CellMask occ = NavigabilityProcessor({b.navigability.kappa, b.navigability.delta_m, b.navigability.eps_m})
                                .occupiable(terrain_);
       if (occ(cell->row, cell->col) == 0) return "motion target cell not occupiable";
+      const std::vector<CellIndex> swept = cells_on_segment(terrain_.geometry(), r.pos, t);
+      for (std::size_t i = 1; i < swept.size(); ++i)
+        if (swept[i] != swept.front() && occ(swept[i].row, swept[i].col) == 0)
+          return "motion passes through a cell not occupiable";
       pos = t;
     }
     const double q_layer = b.cube_size_m * b.cube_size_m * b.cube_size_m / (cs * cs);

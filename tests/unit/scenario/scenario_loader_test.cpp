@@ -185,6 +185,12 @@ TEST(ScenarioLoader, BadValuesNameTheField) {
   EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { max_step_m: 2e6 } }"))
                 .find("max_step_m"),
             std::string::npos);
+  // A step longer than half the body (delta 1 m) could carry it over a wall: refused, naming the bound.
+  EXPECT_NE(invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { max_step_m: 3 } }"))
+                .find("max_step_m = 3: exceeds half the body length (delta_m / 2 = 0.5 m)"),
+            std::string::npos);
+  EXPECT_NO_THROW(parse_scenario(
+      edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" body { max_step_m: 0.5 } }"), "t.pbtxt"));
   // Zero agents, no robot types.
   const std::string no_agents =
       edit("agent { robot_type: \"bot\" start { x_m: 1 y_m: 1 } target { x_m: 10 y_m: 5 } }", "");

@@ -2,12 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/navigability_processor.hpp"
+#include "marsala/core/robot_body.hpp"
 #include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {
@@ -140,6 +142,44 @@ TEST_F(ArbiterTest, MotionOntoANonOccupiableCellIsRejected) {
   // (2.45, 2.05): the ball stops at x = 2.95, all ground.
   EXPECT_TRUE(check(move_to(state_, 1, 2.45, 2.05)).accepted);
   EXPECT_TRUE(check(move_to(state_, 1, 2.15, 2.05)).accepted);
+}
+
+TEST_F(ArbiterTest, MotionAcrossANonOccupiableCellIsRejected) {
+  // A thin wall: a slope of 0.353 m/m over columns 15..25 and flat ground either side. Only column 20's ball spans
+  // the whole slope: its end cells, 1.0 m apart, differ by 0.353 m > eps + kappa 1.0 m = 0.35 m; the balls of
+  // columns 19 and 21 span 0.9 m of it (0.318 m <= 0.35 m).
+  for (int r = 0; r < 40; ++r)
+    for (int c = 0; c < 40; ++c) state_.terrain(r, c) = 0.0353 * std::clamp(c - 15, 0, 10);
+  const NavigabilityParams body{0.3, 1.0, 0.05};
+  ASSERT_TRUE(cell_occupiable(state_.terrain, {20, 19}, body));
+  ASSERT_FALSE(cell_occupiable(state_.terrain, {20, 20}, body));
+  ASSERT_TRUE(cell_occupiable(state_.terrain, {20, 21}, body));
+  state_.agent(1).x_m = 1.95;  // column 19
+  state_.agent(1).y_m = 1.95;  // row 20
+  // 0.2 m east, from column 19 to column 21, across column 20: its end cell is occupiable, its way is not.
+  expect_rejected(move_to(state_, 1, 2.15, 1.95), "motion passes through cell (20, 20), not occupiable");
+  // Onto the wall, named as the target.
+  expect_rejected(move_to(state_, 1, 2.05, 1.95), "target cell (20, 20) is not occupiable");
+  // Along it (north, in column 19), fine.
+  EXPECT_TRUE(check(move_to(state_, 1, 1.95, 2.15)).accepted);
+  // A robot standing on the wall may leave it: its own cell is not part of the way.
+  state_.agent(1).x_m = 2.05;
+  EXPECT_TRUE(check(move_to(state_, 1, 2.15, 1.95)).accepted);
+  EXPECT_TRUE(check(move_to(state_, 1, 1.95, 1.95)).accepted);
+}
+
+TEST_F(ArbiterTest, ALongStepCannotJumpAWall) {
+  // A 1 m wall over x in [2.0, 2.5): cells within delta/2 of it are not occupiable, x in [1.5, 3.0).
+  for (int r = 0; r < 40; ++r)
+    for (int c = 20; c < 25; ++c) state_.terrain(r, c) = 1.0;
+  // A body the scenario validator would refuse (max_step_m 3 > delta/2), put into the state by hand: the world
+  // still judges its way cell by cell.
+  state_.agent(1).type.body.max_step_m = 3.0;
+  state_.agent(1).x_m = 0.55;
+  state_.agent(1).y_m = 1.95;
+  ASSERT_TRUE(cell_occupiable(state_.terrain, *state_.terrain.cell_at({3.55, 1.95}), {0.3, 1.0, 0.05}));
+  expect_rejected(move_to(state_, 1, 3.55, 1.95), "motion passes through cell (20, 15), not occupiable");
+  EXPECT_FALSE(body_problem(state_.agent(1).type.body).empty());
 }
 
 TEST_F(ArbiterTest, DepositionRules) {

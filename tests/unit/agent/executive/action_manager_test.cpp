@@ -83,6 +83,35 @@ TEST(ActionManager, StopsBeforeTheFirstCellThatIsNotNavigable) {
   EXPECT_FALSE(am.advance(map, {{7, 3}}, kGrid.cell_center({7, 3})).has_value());
 }
 
+TEST(ActionManager, NeverCutsThroughACellItMayNotEnter) {
+  // The path goes round (7, 4), which is not navigable: (7, 3) -> (6, 4) -> (7, 5). (7, 5) is 0.2 m away, within the
+  // step, but the straight way there runs through (7, 4), which the world would reject
+  // (docs/runtime.md#rule-2-motion): the motion stops at (6, 4), whose diagonal only touches (7, 4)'s corner.
+  deliberative::LocalMap map = flat_map({7, 3});
+  map.navigable(7, 4) = 0;
+  const ActionManager am(0.2);
+  const std::vector<CellIndex> detour{{7, 3}, {6, 4}, {7, 5}, {7, 6}};
+  const auto m = am.advance(map, detour, kGrid.cell_center({7, 3}));
+  ASSERT_TRUE(m.has_value());
+  EXPECT_EQ(m->cell, (CellIndex{6, 4}));
+  EXPECT_EQ(m->path_index, 1u);
+  // From (6, 4) the way to (7, 5) is a diagonal again, and (7, 6) is 0.22 m away: the motion takes (7, 5).
+  const auto next = am.advance(map, {{6, 4}, {7, 5}, {7, 6}}, kGrid.cell_center({6, 4}));
+  ASSERT_TRUE(next.has_value());
+  EXPECT_EQ(next->cell, (CellIndex{7, 5}));
+  // With (7, 4) navigable the robot goes straight to (7, 5).
+  const auto straight = am.advance(flat_map({7, 3}), detour, kGrid.cell_center({7, 3}));
+  ASSERT_TRUE(straight.has_value());
+  EXPECT_EQ(straight->cell, (CellIndex{7, 5}));
+  // Off centre, south of (7, 3)'s centre, the way to (6, 4) runs through (7, 4): no path cell is reachable, and the
+  // robot centres itself first.
+  const Position low{kGrid.cell_center({7, 3}).x + 0.03, kGrid.cell_center({7, 3}).y - 0.04};
+  const auto centre = am.advance(map, detour, low);
+  ASSERT_TRUE(centre.has_value());
+  EXPECT_EQ(centre->cell, (CellIndex{7, 3}));
+  EXPECT_EQ(centre->path_index, 0u);
+}
+
 TEST(ActionManager, CentresAnOffCentreRobotWhenTheNextCellIsOutOfRange) {
   const deliberative::LocalMap map = flat_map({7, 3});
   const Position off{kGrid.cell_center({7, 3}).x - 0.04, kGrid.cell_center({7, 3}).y};
