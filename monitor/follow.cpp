@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "marsala/monitor/world_gate.hpp"
+
 namespace marsala::monitor {
 namespace {
 
@@ -147,15 +149,17 @@ int run_tail(bus::Participant& participant, const TailOptions& options, const St
       << (options.run_id.empty() ? "" : ", run " + printable(options.run_id)) << "; Ctrl-C stops" << std::endl;
 
   TailPrinter printer(options, out, err);
+  WorldGate gate(err);  // only the run's own world speaks for it
   std::optional<Clock::time_point> deadline;
   if (options.timeout) deadline = Clock::now() + to_clock(*options.timeout);
   for (;;) {
     // Statuses before events: every event published before a taken status is then taken too.
-    std::vector<protocol::WorldStatus> status_batch = statuses->take();
+    std::vector<protocol::WorldStatus> status_batch = gate.statuses(statuses->take_received());
     // In step order: a transient-local replay may be overtaken by a newer live sample.
     std::stable_sort(status_batch.begin(), status_batch.end(),
                      [](const auto& a, const auto& b) { return a.step < b.step; });
-    std::vector<protocol::WorldEvent> event_batch = events ? events->take() : std::vector<protocol::WorldEvent>{};
+    std::vector<protocol::WorldEvent> event_batch =
+        events ? gate.events(events->take_received()) : std::vector<protocol::WorldEvent>{};
     const bool got_status = printer.print(status_batch, event_batch);
     if (printer.final_status()) break;
     if (stop.stop_requested()) {  // after the take: what arrived before the stop is printed
@@ -179,7 +183,7 @@ int run_tail(bus::Participant& participant, const TailOptions& options, const St
     const Clock::time_point drain_until = Clock::now() + to_clock(options.drain);
     while (!printer.run_over_seen() && !stop.stop_requested() && Clock::now() < drain_until) {
       signal->wait_until(drain_until);
-      printer.add_late_events(events->take());
+      printer.add_late_events(gate.events(events->take_received()));
     }
   }
   printer.print_final();

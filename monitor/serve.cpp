@@ -22,6 +22,7 @@
 #include "marsala/monitor/png_bytes.hpp"
 #include "marsala/monitor/replay.hpp"
 #include "marsala/monitor/web_assets.hpp"
+#include "marsala/monitor/world_gate.hpp"
 #include "marsala/render/terrain_renderer.hpp"
 #include "marsala/runlog/run_log.hpp"
 #include "marsala/scenario/scenario.hpp"
@@ -435,11 +436,12 @@ int LiveServer::run(bus::Participant* participant, const StopSource& stop, std::
   const auto publish_interval =
       std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.publish_interval_s));
   Clock::time_point last_publish = Clock::now();
+  WorldGate gate(out);  // only a run's own world speaks for it
   while (!stop.stop_requested()) {
     if (statuses) {
-      std::vector<protocol::WorldStatus> batch = statuses->take();
+      std::vector<protocol::WorldStatus> batch = gate.statuses(statuses->take_received());
       std::stable_sort(batch.begin(), batch.end(), [](const auto& a, const auto& b) { return a.step < b.step; });
-      std::vector<protocol::WorldEvent> event_batch = events->take();
+      std::vector<protocol::WorldEvent> event_batch = gate.events(events->take_received());
       if (!batch.empty() || !event_batch.empty()) {
         const Clock::time_point now = Clock::now();
         std::lock_guard<std::mutex> lock(impl.model_mutex);

@@ -26,22 +26,28 @@ void MappingSystem::integrate(const std::vector<TerrainTile>& tiles, Position po
   record_pose(pose);
 }
 
+std::string tile_problem(const TerrainTile& tile, const GridGeometry& world, int tile_size) {
+  const long long row0 = static_cast<long long>(tile.tile_row) * tile_size;
+  const long long col0 = static_cast<long long>(tile.tile_col) * tile_size;
+  const bool placed = tile.tile_row >= 0 && tile.tile_col >= 0 && row0 < world.rows && col0 < world.cols;
+  // A tile is tile_size x tile_size, cut short only by the grid edge.
+  const bool sized = placed && tile.rows == std::min<long long>(tile_size, world.rows - row0) &&
+                     tile.cols == std::min<long long>(tile_size, world.cols - col0);
+  if (!sized)
+    return describe(tile) + " does not fit the " + std::to_string(world.rows) + " x " + std::to_string(world.cols) +
+           " grid in " + std::to_string(tile_size) + "-cell tiles";
+  if (tile.heights.size() != static_cast<std::size_t>(tile.rows) * static_cast<std::size_t>(tile.cols))
+    return describe(tile) + " carries " + std::to_string(tile.heights.size()) + " heights";
+  for (double h : tile.heights)
+    if (!std::isfinite(h) || std::abs(h) >= kMaxMagnitude) return describe(tile) + " has a non-finite or huge height";
+  return {};
+}
+
 void MappingSystem::integrate_tile(const TerrainTile& tile) {
+  const std::string problem = tile_problem(tile, heights_.geometry(), tile_size_);
+  if (!problem.empty()) throw InvalidArgument("sensor frame: " + problem);
   const long long row0 = static_cast<long long>(tile.tile_row) * tile_size_;
   const long long col0 = static_cast<long long>(tile.tile_col) * tile_size_;
-  const bool placed = tile.tile_row >= 0 && tile.tile_col >= 0 && row0 < heights_.rows() && col0 < heights_.cols();
-  // A tile is tile_size x tile_size, cut short only by the grid edge.
-  const bool sized = placed && tile.rows == std::min<long long>(tile_size_, heights_.rows() - row0) &&
-                     tile.cols == std::min<long long>(tile_size_, heights_.cols() - col0);
-  if (!sized)
-    throw InvalidArgument("sensor frame: " + describe(tile) + " does not fit the " + std::to_string(heights_.rows()) +
-                          " x " + std::to_string(heights_.cols()) + " grid in " + std::to_string(tile_size_) +
-                          "-cell tiles");
-  if (tile.heights.size() != static_cast<std::size_t>(tile.rows) * static_cast<std::size_t>(tile.cols))
-    throw InvalidArgument("sensor frame: " + describe(tile) + " carries " + std::to_string(tile.heights.size()) +
-                          " heights");
-  for (double h : tile.heights)
-    if (!std::isfinite(h)) throw InvalidArgument("sensor frame: " + describe(tile) + " has a non-finite height");
   for (int r = 0; r < tile.rows; ++r)
     for (int c = 0; c < tile.cols; ++c) {
       const int row = static_cast<int>(row0) + r, col = static_cast<int>(col0) + c;

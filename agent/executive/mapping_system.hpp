@@ -3,12 +3,18 @@
 // tiles of its sensor frames, and its trajectory. The agent never sees the global terrain: a cell it has not
 // sensed stays unknown.
 
+#include <string>
 #include <vector>
 
 #include "marsala/core/heightmap.hpp"
+#include "marsala/core/robot_body.hpp"
 #include "marsala/core/types.hpp"
 
 namespace marsala::agent::executive {
+
+/// Empty when `tile` fits the world grid cut in tile_size-cell tiles (its place, its size, as many heights as cells,
+/// each finite and below kMaxMagnitude); otherwise the problem, naming the tile.
+std::string tile_problem(const TerrainTile& tile, const GridGeometry& world, int tile_size);
 
 /// The agent's map: heights [m] of the world grid with a known-mask, and the cells it stood on.
 class MappingSystem {

@@ -3,10 +3,12 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <ctime>
 #include <random>
 #include <vector>
 
+#include "marsala/agent/executive/mapping_system.hpp"
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 
@@ -36,6 +38,38 @@ double median(std::vector<double> values) {
   std::nth_element(values.begin(), mid, values.end());
   return *mid;
 }
+/// A frame further ahead of the last step answered is not the world's: no run goes on for a million steps while an
+/// agent waits for its next frame.
+constexpr std::uint64_t kMaxStepsAhead = 1000000;
+
+/// Empty when a frame addressed to this agent can be trusted to describe the world of `assignment`: a finite pose on
+/// the grid, finite height and material, tiles that fit the grid, finite neighbours; otherwise the problem. A frame
+/// with a problem is ignored whole, before any of it reaches the behaviour (which would throw half-way through).
+std::string frame_problem(const protocol::SensorFrame& f, const Assignment& assignment) {
+  const auto sane = [](double v) { return std::isfinite(v) && std::abs(v) < kMaxMagnitude; };
+  if (!sane(f.x_m) || !sane(f.y_m) || !assignment.world.cell_at({f.x_m, f.y_m}))
+    return fmt::format("pose ({}, {}) m is not on the grid", f.x_m, f.y_m);
+  if (!sane(f.z_m) || !sane(f.material_m3) || f.material_m3 < 0.0)
+    return fmt::format("height {} m or material {} m^3 is not a finite amount", f.z_m, f.material_m3);
+  for (const TerrainTile& tile : f.tiles) {
+    const std::string problem = executive::tile_problem(tile, assignment.world, assignment.tile_size);
+    if (!problem.empty()) return problem;
+  }
+  for (const Neighbour& n : f.neighbours)
+    if (!sane(n.x_m) || !sane(n.y_m) || !sane(n.z_m))
+      return fmt::format("neighbour {} at ({}, {}, {}) m is not finite", n.agent_id, n.x_m, n.y_m, n.z_m);
+  return {};
+}
+
+/// Logs an ignored frame: the 1st, 10th, 100th, ... of a run, so a flood stays a few lines.
+void log_ignored(std::uint32_t agent_id, std::uint64_t count, const std::string& why) {
+  for (std::uint64_t n = 1; n <= count; n *= 10)
+    if (n == count) {
+      spdlog::warn("agent {}: ignoring a frame ({} so far): {}", agent_id, count, why);
+      return;
+    }
+}
+
 /// The longest a wait lasts before the stop flag is looked at again.
 constexpr std::chrono::milliseconds kStopPoll{100};
 // How long the world's frame writer may stay not alive before the agent concludes that the world is gone: longer
@@ -134,7 +168,8 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
       next_hello = now + config_.hello_period;
     }
     signal->wait_until(std::min({next_hello, deadline, now + kStopPoll}));
-    for (const protocol::Admission& a : admissions->take()) {
+    for (const bus::Received<protocol::Admission>& received : admissions->take_received()) {
+      const protocol::Admission& a = received.sample;
       const bool any_slot = config_.agent_id == 0;
       if (a.session != config_.session || (!any_slot && a.agent_id != config_.agent_id)) continue;  // not ours
       if (!a.accepted) {
@@ -151,10 +186,13 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
         spdlog::info("agent: assigned slot {} ({})", a.agent_id, config_.name);
       }
       admission = a;
+      world_ = received.from;
+      assignment_ = a.assignment;
       result.run_id = a.run_id;
       behaviour_->on_admission(a);
-      spdlog::info("agent {}: admitted to run '{}' ({} x {} cells of {} m)", config_.agent_id, a.run_id,
-                   a.assignment.world.rows, a.assignment.world.cols, a.assignment.world.cell_size_m);
+      spdlog::info("agent {}: admitted to run '{}' ({} x {} cells of {} m) by the world at participant {}",
+                   config_.agent_id, a.run_id, a.assignment.world.rows, a.assignment.world.cols,
+                   a.assignment.world.cell_size_m, world_.to_string());
       return true;
     }
   }
@@ -211,8 +249,17 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
       asked = true;
       next_hello = now + config_.hello_period;
     }
-    for (const protocol::Admission& a : admissions_->take()) {
+    for (const bus::Received<protocol::Admission>& received : admissions_->take_received()) {
+      const protocol::Admission& a = received.sample;
       if (a.agent_id != config_.agent_id || a.session != config_.session || !asked) continue;
+      // Another participant answering: the world was restarted from its log (docs/runtime.md#resume), and frames now
+      // come from it; or a stranger, which only a stop of the world's frames lets in (asked), and only for this run.
+      if (received.from != world_) {
+        if (!a.accepted || a.run_id != admission.run_id) continue;
+        spdlog::info("agent {}: the world of run '{}' answers from participant {} now (was {})", config_.agent_id,
+                     a.run_id, received.from.to_string(), world_.to_string());
+        world_ = received.from;
+      }
       sign_since_check = true;
       if (!a.accepted) {
         result.outcome = RunOutcome::kRefused;
@@ -221,9 +268,22 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
       }
     }
     signal->wait_until(std::min({deadline, now + kStopPoll, asked ? next_hello : now + kStopPoll}));
-    for (const protocol::SensorFrame& frame : frames->take()) {
-      if (frame.agent_id != config_.agent_id) {
-        spdlog::warn("agent {}: ignoring a frame addressed to agent {}", config_.agent_id, frame.agent_id);
+    for (const bus::Received<protocol::SensorFrame>& received : frames->take_received()) {
+      const protocol::SensorFrame& frame = received.sample;
+      // Only the world that admitted this agent speaks for the run; what it sends must make sense.
+      std::string why;
+      if (received.from != world_)
+        why = "written by participant " + received.from.to_string() + ", not by the world this agent was admitted "
+              "to (" + world_.to_string() + ")";
+      else if (frame.agent_id != config_.agent_id)
+        why = "addressed to agent " + std::to_string(frame.agent_id);
+      else if (answered_any && frame.step > last_answered && frame.step - last_answered > kMaxStepsAhead)
+        why = fmt::format("step {} is more than {} steps ahead of the last one answered ({})", frame.step,
+                          kMaxStepsAhead, last_answered);
+      else
+        why = frame_problem(frame, assignment_);
+      if (!why.empty()) {
+        log_ignored(config_.agent_id, ++result.ignored_frames, why);
         continue;
       }
       ++result.frames;
@@ -244,9 +304,9 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
         result.decision_cpu_median_ms = median(decision_cpu_ms);
         if (result.requests > 0)
           result.cpu_ms_per_step = (process_cpu_ms() - cpu_at_first_frame) / static_cast<double>(result.requests);
-        spdlog::info("agent {}: {} ({} requests, {} rejected; decision CPU median {:.3f} ms, process CPU {:.3f} ms "
-                     "per step)",
-                     config_.agent_id, result.message, result.requests, result.rejected,
+        spdlog::info("agent {}: {} ({} requests, {} rejected, {} frames ignored; decision CPU median {:.3f} ms, "
+                     "process CPU {:.3f} ms per step)",
+                     config_.agent_id, result.message, result.requests, result.rejected, result.ignored_frames,
                      result.decision_cpu_median_ms, result.cpu_ms_per_step);
         return;
       }

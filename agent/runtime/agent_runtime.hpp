@@ -53,6 +53,7 @@ struct RunResult {
   std::uint64_t requests = 0;   ///< requests sent [count]
   std::uint64_t rejected = 0;   ///< frames reporting the previous request rejected [count]
   std::uint64_t last_step = 0;  ///< step of the last frame
+  std::uint64_t ignored_frames = 0;  ///< frames not from the world it was admitted to, or inconsistent [count]
   std::string final_state;      ///< the behaviour's state at the end
   double decision_cpu_median_ms = 0.0;  ///< median CPU time of the behaviour's decision of one step [ms]
   double cpu_ms_per_step = 0.0;  ///< the process's CPU time (all threads, DDS's too) from its first decision to the
@@ -88,6 +89,8 @@ class AgentRuntime {
   std::shared_ptr<bus::Signal> admission_signal_;
   std::unique_ptr<bus::Writer<protocol::AgentHello>> hellos_;
   std::unique_ptr<bus::Reader<protocol::Admission>> admissions_;
+  bus::WriterId world_;  ///< the participant whose admission let this agent in: frames come from it alone
+  Assignment assignment_;
   std::unique_ptr<reactive::Behaviour> behaviour_;
 };
 

@@ -18,6 +18,17 @@ constexpr EnumName<Vendor> kVendorNames[] = {
 
 std::string to_string(Vendor v) { return enum_to_string(kVendorNames, v); }
 
+std::string WriterId::to_string() const {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string text;
+  text.reserve(2 * prefix.size());
+  for (std::uint8_t b : prefix) {
+    text += kHex[b >> 4];
+    text += kHex[b & 0xf];
+  }
+  return text;
+}
+
 Vendor vendor_from_string(const std::string& name) { return enum_from_string(kVendorNames, name, "DDS vendor"); }
 
 void Signal::notify() {

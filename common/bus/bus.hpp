@@ -11,6 +11,7 @@
 // Threads: backends deliver on their own threads; readers queue samples and notify the endpoint's Signal.
 // Nothing escapes a backend callback. take() and write() may be called from any thread.
 
+#include <array>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -78,13 +79,45 @@ class Writer {
   virtual int matched_readers() const = 0;
 };
 
+/// The participant that wrote a sample: its RTPS GUID prefix, which every vendor sees alike (a Fast DDS reader and
+/// a Cyclone reader name the same writer by the same 12 bytes). Through a DDS API a process cannot write under
+/// another participant's prefix, so a receiver that pins the prefix of the world it was admitted to ignores what
+/// anyone else sends in the world's name (docs/runtime.md#who-wrote-it). All zero: unknown.
+struct WriterId {
+  std::array<std::uint8_t, 12> prefix{};
+  bool known() const {
+    for (std::uint8_t b : prefix)
+      if (b != 0) return true;
+    return false;
+  }
+  friend bool operator==(const WriterId& a, const WriterId& b) { return a.prefix == b.prefix; }
+  friend bool operator!=(const WriterId& a, const WriterId& b) { return !(a == b); }
+  /// 24 hex digits, e.g. "0110d5a2c3e1f00100000000".
+  std::string to_string() const;
+};
+
+/// A sample and the participant that wrote it.
+template <typename T>
+struct Received {
+  T sample;
+  WriterId from;
+};
+
 /// Receives samples of one message type.
 template <typename T>
 class Reader {
  public:
   virtual ~Reader() = default;
+  /// Every sample received since the last take, in arrival order, with who wrote it.
+  virtual std::vector<Received<T>> take_received() = 0;
   /// Every sample received since the last take, in arrival order.
-  virtual std::vector<T> take() = 0;
+  std::vector<T> take() {
+    std::vector<Received<T>> received = take_received();
+    std::vector<T> samples;
+    samples.reserve(received.size());
+    for (Received<T>& r : received) samples.push_back(std::move(r.sample));
+    return samples;
+  }
   /// Matched writers whose liveliness is currently asserted [count]; drops when a writer's process dies
   /// (after its liveliness lease, about 1 s).
   virtual int alive_writers() const = 0;
@@ -100,6 +133,8 @@ class Participant {
   virtual ~Participant() = default;
   virtual Vendor vendor() const = 0;
   virtual int domain_id() const = 0;
+  /// How readers name this participant's samples (Received::from).
+  virtual WriterId id() const = 0;
 
   template <typename T>
   std::unique_ptr<Writer<T>> create_writer(const EndpointOptions& options = {}) {

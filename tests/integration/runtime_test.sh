@@ -22,6 +22,8 @@
 #   world-kill                                                       SIGKILL the world mid-run: every agent learns that
 #                                                                    it is gone within 15 s and exits 1 saying so
 #   monitor                                                          marsala-monitor tail follows a run to its end
+#   impostor                                                         a participant forging frames, a status and an
+#                                                                    event in the world's name changes nothing
 set -euo pipefail
 case_name="$1"
 domain="$2"
@@ -394,6 +396,46 @@ case "$case_name" in
     lines=$(wc -l <"$work/tail.txt")
     [ "$lines" -ge 10 ] || { cat "$work/tail.txt"; fail "tail printed only $lines lines"; }
     echo "ok: monitor followed the run ($lines lines) and saw it complete"
+    ;;
+  impostor)
+    # A Fast DDS participant speaks in the name of a Cyclone world: to every agent admitted, a "run over" frame, a
+    # frame for step 2^62 and a malformed one; to monitors, "completed at step 999999". Nothing of it is believed.
+    export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+    mkdir -p "$work/run/logs"
+    "$bin/marsala-monitor" tail --dds cyclone --domain "$domain" --events --timeout 120 >"$work/tail.txt" 2>&1 &
+    monitor=$!
+    "$bin/marsala-impostor" fastdds "$domain" 3 120 >"$work/impostor.log" 2>&1 &
+    impostor=$!
+    # The world first, then the impostor hears its admissions, then the agents come: it sees every admission.
+    out="$work/run"
+    logs="$out/logs"
+    "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
+      >"$logs/world.log" 2>&1 &
+    world=$!
+    for _ in $(seq 1 600); do grep -q "impostor ready" "$work/impostor.log" && break; sleep 0.05; done
+    grep -q "impostor ready" "$work/impostor.log" || { cat "$work/impostor.log"; fail "the impostor never heard the world"; }
+    sleep 1.5  # the impostor matched the world's writer; give the world time to match the impostor's reader too
+    pids=()
+    for id in 1 2 3; do
+      "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" \
+        >"$logs/agent-$id.log" 2>&1 &
+      pids+=($!)
+    done
+    wait "$world" || { tail -30 "$logs/world.log"; fail "world exited non-zero"; }
+    for p in "${pids[@]}"; do wait "$p" || fail "an agent exited non-zero (see $logs)"; done
+    wait "$impostor" || { cat "$work/impostor.log"; fail "the impostor did not forge for 3 agents"; }
+    wait "$monitor" || { cat "$work/tail.txt"; fail "monitor tail exited non-zero"; }
+    s="$out/summary.json"
+    expect_completed "$s" 3
+    steps=$(field steps "$s")
+    for id in 1 2 3; do
+      grep -q "run over at step $steps (.*, 3 frames ignored;" "$logs/agent-$id.log" ||
+        { tail -5 "$logs/agent-$id.log"; fail "agent $id did not ignore exactly the 3 forged frames"; }
+    done
+    grep -q "completed at step $steps" "$work/tail.txt" || { cat "$work/tail.txt"; fail "no true final line"; }
+    ! grep -q "999999" "$work/tail.txt" || { cat "$work/tail.txt"; fail "the monitor believed the forged status"; }
+    grep -q "ignoring statuses from participant" "$work/tail.txt" || fail "the monitor did not say what it ignored"
+    echo "ok: 9 forged frames ignored, forged status and event ignored; the run completed at step $steps"
     ;;
   *) echo "unknown case '$case_name'" >&2; exit 2 ;;
 esac

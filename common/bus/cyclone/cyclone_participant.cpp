@@ -5,11 +5,13 @@
 #include <dds/dds.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <mutex>
 #include <string>
+#include <unordered_map>
 
 #include "marsala/bus/cyclone/cyclone_convert.hpp"
 #include "marsala/bus/detail/backends.hpp"
@@ -239,7 +241,7 @@ class CycloneReader final : public Reader<T> {
   // Cyclone waits for a running listener callback to return before the reader is gone.
   ~CycloneReader() override { dds_delete(subscriber_); }
 
-  std::vector<T> take() override { return queue_.take(); }
+  std::vector<Received<T>> take_received() override { return queue_.take(); }
 
   int alive_writers() const override {
     dds_liveliness_changed_status_t status{};
@@ -260,8 +262,23 @@ class CycloneReader final : public Reader<T> {
     }
   };
 
+  /// The participant behind a matched writer: Cyclone names the writer of a sample by a local instance handle; its
+  /// GUID comes from the matched publication's built-in data, asked once per writer.
+  WriterId writer_of(dds_entity_t reader, dds_instance_handle_t handle) {
+    const auto known = writers_.find(handle);
+    if (known != writers_.end()) return known->second;
+    WriterId id;
+    if (dds_builtintopic_endpoint_t* endpoint = dds_get_matched_publication_data(reader, handle)) {
+      std::copy_n(endpoint->key.v, id.prefix.size(), id.prefix.begin());  // a GUID = the prefix + an entity id
+      dds_builtintopic_free_endpoint(endpoint);
+      if (writers_.size() >= kMaxRememberedWriters) writers_.clear();
+      writers_.emplace(handle, id);
+    }
+    return id;
+  }
+
   void drain(dds_entity_t reader) {
-    std::vector<T> received;
+    std::vector<Received<T>> received;
     for (;;) {
       void* samples[kBatch] = {};
       dds_sample_info_t infos[kBatch];
@@ -271,7 +288,10 @@ class CycloneReader final : public Reader<T> {
       for (dds_return_t i = 0; i < n; ++i)
         if (infos[i].valid_data && filter_.passes(infos[i].source_timestamp))
           convert_sample(
-              [&] { return cyclone::from_msg(*static_cast<const typename CycloneType<T>::Msg*>(samples[i])); },
+              [&] {
+                return Received<T>{cyclone::from_msg(*static_cast<const typename CycloneType<T>::Msg*>(samples[i])),
+                                   writer_of(reader, infos[i].publication_handle)};
+              },
               received, malformed_,
               [](const std::string& what, std::uint64_t total) {
                 spdlog::warn("bus (cyclone): dropped a malformed sample of {} ({} so far): {}", TopicName<T>::value,
@@ -304,6 +324,8 @@ class CycloneReader final : public Reader<T> {
   std::shared_ptr<Context> context_;
   VolatileFilter filter_;
   MalformedSamples malformed_;  // touched on Cyclone's listener thread only (drain)
+  static constexpr std::size_t kMaxRememberedWriters = 4096;
+  std::unordered_map<dds_instance_handle_t, WriterId> writers_;  // listener thread only (drain)
   ReaderQueue<T> queue_;
   dds_entity_t subscriber_ = 0;
   dds_entity_t reader_ = 0;
@@ -320,6 +342,13 @@ class CycloneParticipant final : public ParticipantBase<CycloneParticipant> {
   }
   Vendor vendor() const override { return Vendor::kCyclone; }
   int domain_id() const override { return context_->domain_id(); }
+  WriterId id() const override {
+    WriterId id;
+    dds_guid_t guid;
+    if (dds_get_guid(context_->participant(), &guid) == DDS_RETCODE_OK)
+      std::copy_n(guid.v, id.prefix.size(), id.prefix.begin());
+    return id;
+  }
 
  protected:
   template <typename T>

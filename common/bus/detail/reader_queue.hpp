@@ -39,22 +39,22 @@ class ReaderQueue {
   explicit ReaderQueue(std::shared_ptr<Signal> signal) : signal_(std::move(signal)) {}
 
   /// Appends samples in arrival order and wakes the waiter (nothing to append = no wake-up).
-  void push(std::vector<T>&& samples) {
+  void push(std::vector<Received<T>>&& samples) {
     if (samples.empty()) return;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (queue_.empty()) {
         queue_ = std::move(samples);
       } else {
-        for (T& s : samples) queue_.push_back(std::move(s));
+        for (Received<T>& s : samples) queue_.push_back(std::move(s));
       }
     }
     notify();
   }
   /// Everything queued since the last take.
-  std::vector<T> take() {
+  std::vector<Received<T>> take() {
     std::lock_guard<std::mutex> lock(mutex_);
-    std::vector<T> out;
+    std::vector<Received<T>> out;
     out.swap(queue_);
     return out;
   }
@@ -66,7 +66,7 @@ class ReaderQueue {
  private:
   std::shared_ptr<Signal> signal_;
   std::mutex mutex_;
-  std::vector<T> queue_;
+  std::vector<Received<T>> queue_;
 };
 
 }  // namespace marsala::bus::detail

@@ -40,6 +40,14 @@ namespace {
 namespace dds = eprosima::fastdds::dds;
 using eprosima::fastrtps::Duration_t;
 
+/// Readers name a sample's writer by its participant's GUID prefix (bus::WriterId).
+WriterId prefix_of(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
+  WriterId id;
+  std::copy_n(prefix.value, id.prefix.size(), id.prefix.begin());
+  return id;
+}
+WriterId writer_of(const dds::SampleInfo& info) { return prefix_of(info.sample_identity.writer_guid().guidPrefix); }
+
 /// The C++ type and its type support that fastddsgen generated for a bus message.
 template <typename T>
 struct FastDdsType;
@@ -286,7 +294,7 @@ class FastDdsReader final : public Reader<T> {
     context_->participant()->delete_subscriber(subscriber_);
   }
 
-  std::vector<T> take() override { return listener_.queue.take(); }
+  std::vector<Received<T>> take_received() override { return listener_.queue.take(); }
 
   // Matched writers not (yet) found dead: Fast DDS counts a writer alive only once its first liveliness assertion
   // arrives (up to 0.8 s after the match for a Cyclone writer), Cyclone from the match on; this counts like Cyclone.
@@ -308,12 +316,12 @@ class FastDdsReader final : public Reader<T> {
 
     void on_data_available(dds::DataReader* reader) override {
       try {
-        std::vector<T> received;
+        std::vector<Received<T>> received;
         typename FastDdsType<T>::Msg msg;
         dds::SampleInfo info;
         while (reader->take_next_sample(&msg, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
           if (info.valid_data && filter.passes(info.source_timestamp.to_ns()))
-            convert_sample([&] { return fastdds::from_msg(msg); }, received, malformed,
+            convert_sample([&] { return Received<T>{fastdds::from_msg(msg), writer_of(info)}; }, received, malformed,
                            [](const std::string& what, std::uint64_t total) {
                              spdlog::warn("bus (fastdds): dropped a malformed sample of {} ({} so far): {}",
                                           TopicName<T>::value, total, what);
@@ -357,6 +365,7 @@ class FastDdsParticipant final : public ParticipantBase<FastDdsParticipant> {
   }
   Vendor vendor() const override { return Vendor::kFastDds; }
   int domain_id() const override { return context_->domain_id(); }
+  WriterId id() const override { return prefix_of(context_->participant()->guid().guidPrefix); }
 
  protected:
   template <typename T>

@@ -4,6 +4,7 @@
 // destroyed no longer counts as alive.
 
 #include <algorithm>
+#include <atomic>
 #include <map>
 #include <mutex>
 #include <tuple>
@@ -23,15 +24,15 @@ class InProcessReader final : public Reader<T> {
   InProcessReader(std::shared_ptr<Hub<T>> hub, EndpointOptions options) : hub_(std::move(hub)), options_(options) {}
   ~InProcessReader() override { hub_->remove_reader(this); }
 
-  std::vector<T> take() override {
+  std::vector<Received<T>> take_received() override {
     std::lock_guard<std::mutex> lock(mutex_);
-    std::vector<T> out;
+    std::vector<Received<T>> out;
     out.swap(queue_);
     return out;
   }
   int alive_writers() const override { return hub_->writers_in(options_.partition); }
 
-  void deliver(const T& sample) {
+  void deliver(const Received<T>& sample) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       queue_.push_back(sample);
@@ -47,21 +48,23 @@ class InProcessReader final : public Reader<T> {
   std::shared_ptr<Hub<T>> hub_;
   EndpointOptions options_;
   std::mutex mutex_;
-  std::vector<T> queue_;
+  std::vector<Received<T>> queue_;
 };
 
 template <typename T>
 class InProcessWriter final : public Writer<T> {
  public:
-  InProcessWriter(std::shared_ptr<Hub<T>> hub, EndpointOptions options) : hub_(std::move(hub)), options_(options) {}
+  InProcessWriter(std::shared_ptr<Hub<T>> hub, EndpointOptions options, WriterId from)
+      : hub_(std::move(hub)), options_(options), from_(from) {}
   ~InProcessWriter() override { hub_->remove_writer(this); }
-  void write(const T& sample) override { hub_->publish(this, sample); }
+  void write(const T& sample) override { hub_->publish(this, Received<T>{sample, from_}); }
   int matched_readers() const override { return hub_->readers_in(options_.partition); }
   const EndpointOptions& options() const { return options_; }
 
  private:
   std::shared_ptr<Hub<T>> hub_;
   EndpointOptions options_;
+  WriterId from_;
 };
 
 /// All endpoints of one message type in one domain.
@@ -92,7 +95,7 @@ class Hub {
     latest_.erase(writer);
     notify_partition(writer->options().partition);
   }
-  void publish(InProcessWriter<T>* writer, const T& sample) {
+  void publish(InProcessWriter<T>* writer, const Received<T>& sample) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (writer->options().durability == Durability::kTransientLocal) latest_[writer] = sample;
     for (InProcessReader<T>* reader : readers_)
@@ -118,7 +121,7 @@ class Hub {
   mutable std::mutex mutex_;
   std::vector<InProcessReader<T>*> readers_;
   std::vector<InProcessWriter<T>*> writers_;
-  std::map<InProcessWriter<T>*, T> latest_;
+  std::map<InProcessWriter<T>*, Received<T>> latest_;
 };
 
 /// One hub per message type for one domain.
@@ -146,15 +149,16 @@ class InProcessParticipant final : public ParticipantBase<InProcessParticipant> 
   friend class ParticipantBase<InProcessParticipant>;
 
  public:
-  explicit InProcessParticipant(int domain_id) : domain_id_(domain_id), domain_(domain(domain_id)) {}
+  explicit InProcessParticipant(int domain_id) : domain_id_(domain_id), domain_(domain(domain_id)), id_(next_id()) {}
   Vendor vendor() const override { return Vendor::kInProcess; }
   int domain_id() const override { return domain_id_; }
+  WriterId id() const override { return id_; }
 
  protected:
   template <typename T>
   std::unique_ptr<Writer<T>> writer(const EndpointOptions& options) {
     auto hub = std::get<std::shared_ptr<Hub<T>>>(domain_->hubs);
-    auto w = std::make_unique<InProcessWriter<T>>(hub, options);
+    auto w = std::make_unique<InProcessWriter<T>>(hub, options, id_);
     hub->add_writer(w.get());
     return w;
   }
@@ -167,8 +171,19 @@ class InProcessParticipant final : public ParticipantBase<InProcessParticipant> 
   }
 
  private:
+  /// A prefix no other participant of this process has: 0x01, then a counter.
+  static WriterId next_id() {
+    static std::atomic<std::uint64_t> counter{0};
+    const std::uint64_t n = ++counter;
+    WriterId id;
+    id.prefix[0] = 0x01;
+    for (int i = 0; i < 8; ++i) id.prefix[4 + i] = static_cast<std::uint8_t>(n >> (8 * (7 - i)));
+    return id;
+  }
+
   int domain_id_;
   std::shared_ptr<Domain> domain_;
+  WriterId id_;
 };
 
 }  // namespace

@@ -310,6 +310,7 @@ class ReadOnlySpy final : public bus::Participant {
   explicit ReadOnlySpy(int domain_id) : inner_(bus::make_participant({bus::Vendor::kInProcess, domain_id})) {}
   bus::Vendor vendor() const override { return inner_->vendor(); }
   int domain_id() const override { return inner_->domain_id(); }
+  bus::WriterId id() const override { return inner_->id(); }
 
   int writers_requested = 0;
   std::vector<std::pair<std::string, bus::EndpointOptions>> readers;  ///< message type and options, in order

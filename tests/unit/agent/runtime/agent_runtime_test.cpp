@@ -52,6 +52,8 @@ struct ScriptedWorld {
   bus::Participant& p;
   std::uint32_t id;
   std::uint64_t hellos_seen = 0;
+  /// Called before the frame of each step is written, with the agent's partition and the world's frame writer.
+  std::function<void(int step, const std::string& partition, bus::Writer<protocol::SensorFrame>& frames)> before_frame;
 
   protocol::AgentHello wait_hello(bus::Reader<protocol::AgentHello>& hellos, bus::Signal& signal) {
     const auto deadline = Clock::now() + 5s;
@@ -101,6 +103,7 @@ struct ScriptedWorld {
         f.last_result = protocol::ActionResult::kRejected;
         f.last_reason = "scripted rejection";
       }
+      if (before_frame) before_frame(step, partition, *frames);
       frames->write(f);
       if (f.run_over) break;
       const auto deadline = Clock::now() + 5s;
@@ -143,6 +146,52 @@ TEST(AgentRuntime, HelloAdmissionLockstepAndRunOver) {
   }
   EXPECT_NE(agent.config().session, 0u);
   EXPECT_EQ(agent.config().name, "agent-4");
+}
+
+TEST(AgentRuntime, IgnoresFramesNotFromItsWorldOrThatMakeNoSense) {
+  // An impostor on the domain writes on the agent's partition (partition names are no secret): a "run over" frame,
+  // a frame for step 2^62 and a malformed one. The world itself once sends a frame whose tile does not fit the grid.
+  // The agent ignores all four and runs to the world's own end, answering every step once.
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, 109});
+  AgentRuntime agent(*participant, config(4, "ramp_builder"));
+  std::atomic<bool> stop{false};
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 109});
+  auto impostor = bus::make_participant({bus::Vendor::kInProcess, 109});
+  std::unique_ptr<bus::Writer<protocol::SensorFrame>> forged;
+  ScriptedWorld world{*world_participant, 4};
+  world.before_frame = [&](int step, const std::string& partition, bus::Writer<protocol::SensorFrame>& frames) {
+    protocol::SensorFrame f;
+    f.agent_id = 4;
+    f.x_m = 0.55;
+    f.y_m = 1.05;
+    if (step == 1) {
+      forged = impostor->create_writer<protocol::SensorFrame>({partition, nullptr});
+      f.step = 1;
+      f.run_over = true;
+      forged->write(f);
+      f.run_over = false;
+      f.step = std::uint64_t{1} << 62;
+      forged->write(f);
+      f.step = 1;
+      f.tiles.push_back({0, 0, 3, 3, {0.0}});  // 1 height for 9 cells
+      forged->write(f);
+    }
+    if (step == 3) {
+      f.step = 3;
+      f.tiles.push_back({7, 7, 16, 16, std::vector<double>(256, 0.0)});  // off the 20 x 40 grid
+      frames.write(f);
+    }
+  };
+  const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+  const auto requests = world.run([&](const protocol::AgentHello& hello) { return admission_for(hello, h); }, 5);
+  const RunResult r = running.get();
+  EXPECT_EQ(r.outcome, RunOutcome::kRunOver) << r.message;
+  EXPECT_EQ(r.last_step, 5u);
+  EXPECT_EQ(r.requests, 5u);
+  EXPECT_EQ(r.ignored_frames, 4u);
+  ASSERT_EQ(requests.size(), 5u);
+  for (std::size_t i = 0; i < requests.size(); ++i) EXPECT_EQ(requests[i].step, i);
 }
 
 TEST(AgentRuntime, RefusalEndsTheRunWithTheWorldsReason) {
