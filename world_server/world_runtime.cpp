@@ -539,6 +539,7 @@ struct WorldRuntime::Impl {
     s.wall_seconds = wall_seconds;
     s.deposited_volume_m3 = state.deposited_volume_m3;
     s.progress = progress(state);
+    s.progress_detail = progress_detail(state);
     s.running = running;
     s.completed = completed;
     for (const AgentRecord& a : state.agents) {
@@ -624,8 +625,8 @@ struct WorldRuntime::Impl {
       for (std::uint32_t id : outcome.dropped) send_frame(id, true);
       publish_status(true, outcome.completed, elapsed_s(start));
       if (state.step % kProgressEvery == 0)
-        spdlog::info("step {}: {} live agents, {:.6f} m3 deposited, progress {:.2f}", state.step,
-                     state.live_ids().size(), state.deposited_volume_m3, progress(state));
+        spdlog::info("step {}: {} live agents, {:.6f} m3 deposited, progress {:.3f}: {}", state.step,
+                     state.live_ids().size(), state.deposited_volume_m3, progress(state), progress_detail(state));
     }
   }
 
