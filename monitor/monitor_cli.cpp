@@ -3,8 +3,12 @@
 // CLI11 2.1's option conversions trip a false -Wmaybe-uninitialized at -O2; keep our own warnings on.
 #include "marsala/cli/command_line.hpp"
 
+#include <sys/ioctl.h>
+#include <unistd.h>
+
 #include <cstdint>
 #include <cstdlib>
+#include <iostream>
 #include <exception>
 #include <memory>
 #include <new>
@@ -14,7 +18,9 @@
 #include "marsala/bus/bus.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/monitor/follow.hpp"
+#include "marsala/monitor/progress.hpp"
 #include "marsala/monitor/replay.hpp"
+#include "marsala/monitor/run_report.hpp"
 #include "marsala/monitor/serve.hpp"
 
 namespace marsala::monitor {
@@ -25,9 +31,10 @@ constexpr int kExitUsage = 2;
 
 constexpr const char* kTailLegend =
     "Columns: step; live agents/all; mat = material on board of the live agents [m3]; dep = volume deposited\n"
-    "in the run [m3]; goal = agents at their goal [%]; then each agent's behaviour state in id order\n"
-    "(* at its goal, -- dropped, ? no state yet). Beyond what fits the width, live agents are counted per\n"
-    "state. Event lines: step > agent kind [volume] detail.";
+    "in the run [m3]; prog = the run's progress [%] (agents at the goal, share of the payload route's MARS gap\n"
+    "filled, or level fraction of the site); then each agent's behaviour state in id order (* at its goal, --\n"
+    "dropped, ? no state yet). Beyond what fits the width, live agents are counted per state. Event lines:\n"
+    "step > agent kind [volume] detail. The last line gives the progress in words.";
 
 constexpr const char* kReplayFooter =
     "Rebuilds the terrain from DIR/run.log on DIR/terrain_initial.asc (its SHA-256 must match the log's header),\n"
@@ -54,6 +61,13 @@ const CLI::Validator kAtLeastOne(
     },
     ">= 1");
 
+/// Columns of the terminal on stdout, 80 when it does not say.
+int terminal_columns() {
+  winsize size{};
+  if (ioctl(STDOUT_FILENO, TIOCGWINSZ, &size) == 0 && size.ws_col > 0) return size.ws_col;
+  return 80;
+}
+
 }  // namespace
 
 int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err, const StopSource& stop) {
@@ -78,7 +92,40 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
   tail->add_option("--width", tail_options.format.width, "longest line [columns]; 0 = no limit")
       ->check(CLI::Range(0, 10000))
       ->capture_default_str();
+  tail->add_option("--every", tail_options.every_steps,
+                   "print a step line only when the step passes a multiple of N (and the last one)")
+      ->check(kAtLeastOne)
+      ->type_name("N");
+  double tail_interval_s = 0.0;
+  tail->add_option("--interval", tail_interval_s, "print at most one step line every S seconds (and the last one)")
+      ->check(CLI::Range(1e-3, 86400.0))
+      ->type_name("S");
   tail->footer(kTailLegend);
+
+  ProgressOptions progress_options;
+  double progress_interval_s = progress_options.interval.count();
+  double progress_timeout_s = 0.0;
+  bool progress_in_place = false, progress_lines = false;
+  auto* progress = app.add_subcommand(
+      "progress", "one line with the step, progress, steps/s and ETA, kept up to date, until the run ends");
+  add_bus_options(*progress);
+  progress->add_option("--run-id", progress_options.run_id, "follow this run only (default: the first run seen)");
+  progress->add_option("--interval", progress_interval_s, "shortest time between two updates [s]")
+      ->check(CLI::Range(1e-3, 86400.0))
+      ->capture_default_str();
+  auto* progress_timeout =
+      progress->add_option("--timeout", progress_timeout_s, "exit 1 after this long without a world status [s]")
+          ->check(CLI::Range(1e-3, 1e6));
+  auto* in_place_flag = progress->add_flag(
+      "--in-place", progress_in_place, "rewrite one line in place (the default when stdout is a terminal)");
+  progress->add_flag("--lines", progress_lines, "print a new line at each update (the default otherwise)")
+      ->excludes(in_place_flag);
+  progress->add_option("--width", progress_options.width, "longest line [columns]; 0 = the terminal's width or none")
+      ->check(CLI::Range(0, 10000));
+
+  std::string summary_dir;
+  auto* summary = app.add_subcommand("summary", "a short account of a finished run, from DIR/summary.json");
+  summary->add_option("DIR", summary_dir, "the run's output folder")->required();
 
   StatusOptions status_options;
   double status_timeout_s = status_options.timeout.count();
@@ -166,6 +213,10 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
   }
 
   try {
+    if (*summary) {
+      out << run_report(summary_dir);
+      return 0;
+    }
     if (*replay) {
       if (replay_to_step->count() > 0) replay_options.to_step = to_step;
       if (const char* path = std::getenv("PATH")) replay_options.search_path = path;
@@ -180,7 +231,17 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
                                bus::Security::of(dds.security, dds.identity, "monitor")});
     if (*tail) {
       if (tail_timeout->count() > 0) tail_options.timeout = std::chrono::duration<double>(tail_timeout_s);
+      tail_options.interval = std::chrono::duration<double>(tail_interval_s);
       return run_tail(*participant, tail_options, stop, out, err);
+    }
+    if (*progress) {
+      // In place only on a terminal (or when asked): anything else, a file or a pipe, gets whole lines.
+      const bool terminal = &out == &std::cout && isatty(STDOUT_FILENO) == 1;
+      progress_options.in_place = progress_in_place || (terminal && !progress_lines);
+      if (progress_options.width == 0 && terminal) progress_options.width = terminal_columns() - 1;
+      progress_options.interval = std::chrono::duration<double>(progress_interval_s);
+      if (progress_timeout->count() > 0) progress_options.timeout = std::chrono::duration<double>(progress_timeout_s);
+      return run_progress(*participant, progress_options, stop, out, err);
     }
     status_options.timeout = std::chrono::duration<double>(status_timeout_s);
     return run_status(*participant, status_options, stop, out, err);

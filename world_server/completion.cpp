@@ -231,7 +231,7 @@ std::string progress_detail(const WorldState& state) {
   switch (state.completion) {
     case scenario::CompletionKind::kPayloadPath:
       if (state.check.met) return "the payload's path is navigable";
-      return fmt::format("{:.2f} of {:.2f} m3 of MARS gap left on the payload's route", state.check.route_gap_m3,
+      return fmt::format("{:.2f} of {:.2f} m3 of MARS gap left on the route", state.check.route_gap_m3,
                          state.check.route.initial_m3);
     case scenario::CompletionKind::kLevelSite:
       return fmt::format("site {:.1f} % level ({:.1f} % needed)", 100.0 * state.check.level_fraction,

@@ -70,7 +70,7 @@ RouteGap plan_route_gap(const Heightmap& terrain, const scenario::PayloadPath& p
 /// max(0, bound - height) times the cell area [m^3].
 double route_gap_m3(const Heightmap& terrain, const RouteGap& route);
 
-/// A one-line account of the progress for people, e.g. "12.31 of 21.30 m3 of MARS gap left on the payload's route",
+/// A one-line account of the progress for people, e.g. "12.31 of 21.30 m3 of MARS gap left on the route",
 /// "site 83.2 % level (100.0 % needed)", "2 of 3 live agents at the goal".
 std::string progress_detail(const WorldState& state);
 

@@ -152,6 +152,8 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_path_length_m(report.route ? report.route->length_m : 0.0);
   s.set_site_level_fraction(report.site_fraction);
   s.set_completion_checks(state.check.evaluations);
+  s.set_progress(progress(state));
+  s.set_progress_detail(progress_detail(state));
   s.set_start_jitter_m(info.start_jitter_m);
 
   google::protobuf::util::JsonPrintOptions options;

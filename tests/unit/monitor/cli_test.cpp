@@ -135,7 +135,7 @@ TEST(MonitorCli, TailFollowsARunToItsEnd) {
   const Result r = tail.get();
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out,
-            "  step  live mat[m3]  dep[m3] goal | 1\n"
+            "  step  live mat[m3]  dep[m3] prog | 1\n"
             "     3   1/1    0.00    0.000   0% | build\n"
             "     4 > world    run_over  max_steps reached\n"
             "     4   1/1    0.00    0.000   0% | build\n"

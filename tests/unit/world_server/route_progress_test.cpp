@@ -123,7 +123,7 @@ TEST(RouteGap, ProgressIsTheShareOfTheRoutesGapFilledAndOneWhenThePathIsFound) {
   EXPECT_GT(initial, 0.0);
   EXPECT_EQ(w.check.route_gap_m3, initial);
   EXPECT_EQ(progress(w), 0.0);
-  EXPECT_NE(progress_detail(w).find(" m3 of MARS gap left on the payload's route"), std::string::npos)
+  EXPECT_NE(progress_detail(w).find(" m3 of MARS gap left on the route"), std::string::npos)
       << progress_detail(w);
 
   // Fill the band in four passes, a quarter of each cell's initial gap each time; the check after each pass.
