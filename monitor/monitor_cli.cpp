@@ -2,6 +2,7 @@
 
 // CLI11 2.1's option conversions trip a false -Wmaybe-uninitialized at -O2; keep our own warnings on.
 #include "marsala/cli/command_line.hpp"
+#include "marsala/cli/logging.hpp"
 
 #include <sys/ioctl.h>
 #include <unistd.h>
@@ -12,6 +13,7 @@
 #include <exception>
 #include <memory>
 #include <new>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -70,7 +72,8 @@ int terminal_columns() {
 
 }  // namespace
 
-int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err, const StopSource& stop) {
+int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& usage_err,
+                    const StopSource& stop) {
   CLI::App app{
       "marsala-monitor: watch a running MARSala system (world status, agents, events), or replay a run from its\n"
       "output folder. It only reads: it joins and leaves a running system without disturbing it.",
@@ -185,7 +188,19 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       ->capture_default_str();
   serve->footer(kServeFooter);
 
-  if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-monitor", out, err)) return *code;
+  cli::LogOptions log_options;
+  cli::add_log_options(app, log_options);
+  app.fallthrough();  // --log-format and --log-level also after the subcommand
+  if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-monitor", out, usage_err)) return *code;
+  // The monitor's diagnostics are lines on a stream; in json each becomes one log record (common/cli/logging.hpp).
+  const cli::LoggingScope logging("monitor", 0, log_options, &usage_err);
+  std::optional<cli::LogLineStream> json_err;
+  if (cli::log_format() == cli::LogFormat::kJson)
+    json_err.emplace("marsala-monitor: ", [](const std::string& line) {
+      // Everything the monitor says on stderr is why it fails, except a replay's note on a damaged tail it skipped.
+      return line.rfind("replayed the ", 0) == 0 ? "warn" : "error";
+    });
+  std::ostream& err = json_err ? static_cast<std::ostream&>(*json_err) : usage_err;
 
   if (*serve) {
     try {

@@ -1,11 +1,10 @@
 #include "marsala/world_server/world_cli.hpp"
 
-#include <spdlog/spdlog.h>
-
 #include <ostream>
 
 #include "marsala/bus/bus.hpp"
 #include "marsala/cli/command_line.hpp"
+#include "marsala/cli/logging.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
@@ -73,7 +72,9 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   app.add_flag("--replace", options.replace,
                "remove a previous run's files from --out before starting (without it such a folder is refused)")
       ->excludes(resume_option);
-  app.add_flag("--quiet", quiet, "log warnings and errors only");
+  app.add_flag("--quiet", quiet, "log warnings and errors only (--log-level warn)");
+  cli::LogOptions log_options;
+  cli::add_log_options(app, log_options);
   app.callback([&] {
     // --scenario is required of a run; a check takes its file either way; a resume reads it from the log.
     if (scenario_option->count() == 0 && check_path.empty() && resume_option->count() == 0)
@@ -84,8 +85,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   if (seed_option->count() > 0) options.seed = seed;
   if (check)
     return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, dds.domain, json, out, err);
-  spdlog::set_pattern("%H:%M:%S.%e %^%l%$ world: %v");
-  spdlog::set_level(quiet ? spdlog::level::warn : spdlog::level::info);
+  if (quiet && app.get_option("--log-level")->count() == 0) log_options.level = "warn";
+  const cli::LoggingScope logging("world", 0, log_options);
   try {
     WorldStart start;
     if (!resume_dir.empty()) {
@@ -106,13 +107,13 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
         << result.admitted << " agents, terrain sha256 " << result.terrain_sha256 << "\n";
     return exit_code(result.end_reason);
   } catch (const Error& e) {
-    err << "marsala-world: error: " << e.what() << "\n";
+    cli::write_exit_error(err, std::string("marsala-world: error: ") + e.what());
     return 1;
   } catch (const std::bad_alloc&) {
-    err << "marsala-world: error: out of memory\n";
+    cli::write_exit_error(err, "marsala-world: error: out of memory");
     return 1;
   } catch (const std::exception& e) {  // a library's own exception: still one line and exit 1, never an abort
-    err << "marsala-world: error: " << e.what() << "\n";
+    cli::write_exit_error(err, std::string("marsala-world: error: ") + e.what());
     return 1;
   }
   return 0;

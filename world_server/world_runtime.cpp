@@ -249,9 +249,9 @@ struct WorldRuntime::Impl {
     while (world_id == 0) world_id = (static_cast<std::uint64_t>(device()) << 32) ^ device();
   }
 
-  void emit(const protocol::WorldEvent& e) {
+  void emit(const protocol::WorldEvent& e, const std::vector<Deposition>& cells = {}) {
     write_logged(*events, e, "a world event");
-    if (event_log) event_log->append(e);
+    if (event_log) event_log->append(e, cells);
   }
 
   void note(const std::string& text) {
@@ -582,6 +582,16 @@ struct WorldRuntime::Impl {
   }
 
   /// Runs steps until an end condition; returns the end reason.
+  /// The cells the accepted request of `agent` set in this step (for its deposition in events.log).
+  static const std::vector<Deposition>& deposited_cells(const std::vector<Submission>& submissions,
+                                                        const StepOutcome& outcome, std::uint32_t agent) {
+    static const std::vector<Deposition> none;
+    for (std::size_t i = 0; i < submissions.size(); ++i)
+      if (outcome.accepted_submissions[i] && submissions[i].channel_id == agent)
+        return submissions[i].request.depositions;
+    return none;
+  }
+
   EndReason lockstep(const std::atomic<bool>& stop, Clock::time_point start) {
     for (;;) {
       if (stop) return EndReason::kSignal;
@@ -617,7 +627,8 @@ struct WorldRuntime::Impl {
           spdlog::warn("step {}: agent {} {}: {}", e.step, e.agent_id, protocol::to_string(e.kind), e.detail);
         else if (e.kind == protocol::EventKind::kAtGoal)
           spdlog::info("step {}: agent {} reached the goal", e.step, e.agent_id);
-        emit(e);
+        emit(e, e.kind == protocol::EventKind::kDeposited ? deposited_cells(submissions, outcome, e.agent_id)
+                                                          : std::vector<Deposition>{});
       }
       for (const AgentRecord& a : state.agents)
         if (a.last_result != protocol::ActionResult::kRejected) last_rejection[a.id - 1].clear();

@@ -1,7 +1,8 @@
 #pragma once
 // How every MARSala executable parses its command line: --help (on the program or a subcommand) prints help and
-// exits 0; a usage error prints one line "<program>: <reason> (run with --help for usage)" and exits 2.
-// Header-only; include it only from files that link CLI11::CLI11.
+// exits 0; --version prints "<program> <version> (git <revision>)" (version.hpp) and exits 0; a usage error prints
+// one line "<program>: <reason> (run with --help for usage)" and exits 2.
+// Include it only from files that link marsala::cli.
 
 #include <optional>
 #include <ostream>
@@ -12,6 +13,8 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <CLI/CLI.hpp>
 #pragma GCC diagnostic pop
+
+#include "marsala/cli/version.hpp"
 
 namespace marsala::cli {
 
@@ -55,9 +58,13 @@ inline void add_dds_options(CLI::App& app, DdsOptions& options) {
 /// Parses argv into `app`; returns nullopt when the program should go on, else the exit code to return now.
 inline std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const* argv,
                                              const std::string& program, std::ostream& out, std::ostream& err) {
+  app.set_version_flag("--version", version_text(program), "print the version and the git revision, then exit");
   try {
     app.parse(argc, argv);
     return std::nullopt;
+  } catch (const CLI::CallForVersion& e) {
+    out << e.what() << "\n";
+    return 0;
   } catch (const CLI::CallForAllHelp&) {
     out << app.help("", CLI::AppFormatMode::All);
     return 0;

@@ -236,6 +236,25 @@ TEST_F(OutputFiles, AnEventLogThatCannotBeWrittenIsAnErrorNotASilentLoss) {
   EXPECT_THROW(log.note(3, "a note"), IoError);
 }
 
+TEST(EventLogLines, AreJsonObjectsWithTheDepositedCells) {
+  protocol::WorldEvent e;
+  e.step = 42;
+  e.agent_id = 3;
+  e.kind = protocol::EventKind::kDeposited;
+  e.volume_m3 = 0.000125;
+  e.detail = "2 cells";
+  EXPECT_EQ(event_json(e, {{10, 11, 0.05}, {10, 12, 0.1}}),
+            "{\"step\":42,\"agent\":3,\"kind\":\"deposited\",\"volume_m3\":0.000125,\"detail\":\"2 cells\","
+            "\"cells\":[[10,11,0.050000000000000003],[10,12,0.10000000000000001]]}");
+  protocol::WorldEvent over;
+  over.step = 7;
+  over.kind = protocol::EventKind::kRunOver;
+  over.detail = "a \"quoted\"\nreason";
+  EXPECT_EQ(event_json(over), "{\"step\":7,\"agent\":0,\"kind\":\"run_over\",\"detail\":\"a \\\"quoted\\\"\\nreason\"}");
+  EXPECT_EQ(note_json(5, "agent 2: request for past step 4 dropped"),
+            "{\"step\":5,\"kind\":\"note\",\"detail\":\"agent 2: request for past step 4 dropped\"}");
+}
+
 TEST_F(OutputFiles, GoalVectorMapPictureOnlyWhenTheScenarioHasOne) {
   const WorldState s = admitted_state(scenario_with(site_block()), flat_terrain(), 1);
   RunInfo info = info_for("small", false);
