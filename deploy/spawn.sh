@@ -6,7 +6,7 @@
 #
 # Usage: deploy/spawn.sh --scenario FILE --agents N [--dds cyclone|fastdds] [--agent-dds cyclone|fastdds]
 #                        [--out DIR [--replace]] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N]
-#                        [--quiet] [--secure]
+#                        [--quiet] [--secure] [--frames-every K]
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
 #                 folder that holds another run's files, unless --replace removes them (and logs/) first
 #   --dds         vendor of every process (default $MARSALA_DDS, else cyclone); --agent-dds overrides it for the agents
@@ -14,6 +14,8 @@
 #   --monitor     also run `marsala-monitor tail` in the foreground output (instead of the progress line)
 #   --quiet       print nothing but errors (no progress line, no account at the end)
 #   --timeout     give up (and stop everything) after S seconds of wall time (default 1800)
+#   --frames-every a time-lapse: marsala-world draws OUT/frames/frame_<step>.png every K steps and the last, and
+#                 OUT/frames/timelapse.mp4 when ffmpeg is installed
 #   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
 #   --secure      DDS Security: a CA and an identity per process in OUT/security (deploy/security/make-identities.sh,
 #                 made anew each run), every process authenticated, access-controlled and encrypted (domain <= 230)
@@ -24,7 +26,7 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
-scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0
+scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0 frames_every=""
 replace=0 secure=0
 usage() { sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
@@ -37,6 +39,7 @@ while [ $# -gt 0 ]; do
     --domain) domain="$2"; shift 2 ;;
     --monitor) monitor=1; shift ;;
     --max-steps) max_steps="$2"; shift 2 ;;
+    --frames-every) frames_every="$2"; shift 2 ;;
     --timeout) timeout_s="$2"; shift 2 ;;
     --seed) seed="$2"; shift 2 ;;
     --quiet) quiet=1; shift ;;
@@ -93,6 +96,7 @@ fi
 world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$domain" --out "$out" "${sec_args[@]}")
 [ "$replace" -eq 1 ] && world_args+=(--replace)
 [ -n "$max_steps" ] && world_args+=(--max-steps "$max_steps")
+[ -n "$frames_every" ] && world_args+=(--frames-every "$frames_every")  # the world checks K (exit 2 when bad)
 [ "$quiet" -eq 1 ] && world_args+=(--quiet)
 seed_args=()
 [ -n "$seed" ] && seed_args=(--seed "$seed")

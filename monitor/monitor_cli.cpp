@@ -53,16 +53,6 @@ constexpr const char* kServeFooter =
     "plays a run folder back instead, without DDS. Many browsers may watch: each gets the newest state when it asks.\n"
     "Exit 0 on Ctrl-C, 2 for a bad option or a port that cannot be listened on.";
 
-/// A whole number >= 1 (CLI11's PositiveNumber explains a 0 with a range of 300 digits).
-const CLI::Validator kAtLeastOne(
-    [](std::string& text) {
-      const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
-      return digits && text.find_first_not_of('0') != std::string::npos
-                 ? std::string()
-                 : "must be a whole number of at least 1, not " + text;
-    },
-    ">= 1");
-
 /// Columns of the terminal on stdout, 80 when it does not say.
 int terminal_columns() {
   winsize size{};
@@ -97,7 +87,7 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       ->capture_default_str();
   tail->add_option("--every", tail_options.every_steps,
                    "print a step line only when the step passes a multiple of N (and the last one)")
-      ->check(kAtLeastOne)
+      ->check(cli::at_least_one())
       ->type_name("N");
   double tail_interval_s = 0.0;
   tail->add_option("--interval", tail_interval_s, "print at most one step line every S seconds (and the last one)")
@@ -151,7 +141,7 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
           ->type_name("N");
   auto* replay_frames =
       replay->add_option("--frames-every", replay_options.frames_every, "write a PNG frame every K steps and the last")
-          ->check(kAtLeastOne)
+          ->check(cli::at_least_one())
           ->type_name("K");
   replay
       ->add_option("--out", replay_options.frames_dir,

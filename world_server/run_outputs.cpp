@@ -428,6 +428,21 @@ void clear_run_files(const std::string& dir) {
       fs::remove(fs::path(dir) / file, ec);
       if (ec) throw IoError("cannot remove '" + (fs::path(dir) / file).string() + "' (--replace): " + ec.message());
     }
+  // The time-lapse of --frames-every: its frames and video only, then the folder when nothing else is in it.
+  const fs::path frames = fs::path(dir) / "frames";
+  std::error_code ec;
+  if (!fs::is_directory(frames, ec)) return;
+  std::vector<fs::path> doomed;
+  for (const fs::directory_entry& e : fs::directory_iterator(frames, ec)) {
+    const std::string name = e.path().filename().string();
+    if ((name.rfind("frame_", 0) == 0 && e.path().extension() == ".png") || name == "timelapse.mp4")
+      doomed.push_back(e.path());
+  }
+  for (const fs::path& p : doomed) {
+    fs::remove(p, ec);
+    if (ec) throw IoError("cannot remove '" + p.string() + "' (--replace): " + ec.message());
+  }
+  fs::remove(frames, ec);  // fails, and is meant to, when the folder holds anything else
 }
 
 void check_fresh_output_dir(const std::string& dir) {

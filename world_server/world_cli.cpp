@@ -1,5 +1,6 @@
 #include "marsala/world_server/world_cli.hpp"
 
+#include <cstdlib>
 #include <ostream>
 
 #include "marsala/bus/bus.hpp"
@@ -69,6 +70,11 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   app.add_option("--snapshot-every", options.snapshot_every, "write snapshot.pb after every N steps (0: never)")
       ->check(CLI::Range(0ull, 1ull << 40))
       ->capture_default_str();
+  app.add_option("--frames-every", options.frames_every,
+                 "a time-lapse: a PNG frame every K steps and the last into OUT/frames (frame_<step>.png), and\n"
+                 "OUT/frames/timelapse.mp4 of them when ffmpeg is on PATH")
+      ->check(cli::at_least_one())
+      ->type_name("K");
   app.add_flag("--replace", options.replace,
                "remove a previous run's files from --out before starting (without it such a folder is refused)")
       ->excludes(resume_option);
@@ -83,6 +89,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-world", out, err)) return *code;
 
   if (seed_option->count() > 0) options.seed = seed;
+  if (const char* path = std::getenv("PATH")) options.search_path = path;
   if (check)
     return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, dds.domain, json, out, err);
   if (quiet && app.get_option("--log-level")->count() == 0) log_options.level = "warn";

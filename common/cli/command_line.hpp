@@ -55,6 +55,18 @@ inline void add_dds_options(CLI::App& app, DdsOptions& options) {
       ->envname("MARSALA_IDENTITY");
 }
 
+/// A whole number >= 1, e.g. a "every K steps" (CLI11's PositiveNumber explains a 0 with a range of 300 digits).
+inline CLI::Validator at_least_one() {
+  return CLI::Validator(
+      [](std::string& text) {
+        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+        return digits && text.find_first_not_of('0') != std::string::npos
+                   ? std::string()
+                   : "must be a whole number of at least 1, not " + text;
+      },
+      ">= 1");
+}
+
 /// Parses argv into `app`; returns nullopt when the program should go on, else the exit code to return now.
 inline std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const* argv,
                                              const std::string& program, std::ostream& out, std::ostream& err) {
