@@ -66,6 +66,17 @@ bool is_completed(const WorldState& state) {
   return any;
 }
 
+/// The live agents and how many of them are at the goal.
+static std::pair<int, int> live_agents_at_goal(const WorldState& state) {
+  int live = 0, done = 0;
+  for (const AgentRecord& a : state.agents) {
+    if (!a.alive) continue;
+    ++live;
+    done += at_goal(state, a) ? 1 : 0;
+  }
+  return {live, done};
+}
+
 double progress(const WorldState& state) {
   switch (state.completion) {
     case scenario::CompletionKind::kPayloadPath: {
@@ -77,12 +88,7 @@ double progress(const WorldState& state) {
     case scenario::CompletionKind::kLevelSite: return state.check.level_fraction;
     case scenario::CompletionKind::kAgentsAtGoal: break;
   }
-  int live = 0, done = 0;
-  for (const AgentRecord& a : state.agents) {
-    if (!a.alive) continue;
-    ++live;
-    done += at_goal(state, a) ? 1 : 0;
-  }
+  const auto [live, done] = live_agents_at_goal(state);
   return live == 0 ? 0.0 : static_cast<double>(done) / live;
 }
 
@@ -238,12 +244,7 @@ std::string progress_detail(const WorldState& state) {
                          100.0 * state.site.min_fraction);
     case scenario::CompletionKind::kAgentsAtGoal: break;
   }
-  int live = 0, done = 0;
-  for (const AgentRecord& a : state.agents) {
-    if (!a.alive) continue;
-    ++live;
-    done += at_goal(state, a) ? 1 : 0;
-  }
+  const auto [live, done] = live_agents_at_goal(state);
   return fmt::format("{} of {} live agents at the goal", done, live);
 }
 

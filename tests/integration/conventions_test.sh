@@ -10,12 +10,9 @@ set -euo pipefail
 case_name="$1"
 domain="$2"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-root="$(cd "$here/../.." && pwd)"
-bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
-work="$(mktemp -d "${TMPDIR:-/tmp}/marsala_conventions_${case_name}.XXXXXX")"
-trap 'rm -rf "$work"' EXIT
-fail() { echo "FAIL ($case_name): $*" >&2; exit 1; }
-export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
+# shellcheck source=lib.sh
+. "$here/lib.sh"
+test_workspace conventions
 
 case "$case_name" in
   version)
