@@ -69,6 +69,9 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       "output folder. It only reads: it joins and leaves a running system without disturbing it.",
       "marsala-monitor"};
   app.require_subcommand(1);
+  cli::LogOptions log_options;
+  cli::add_log_options(app, log_options);
+  app.fallthrough();  // before the subcommands, which inherit it: --log-format and --log-level also after one
 
   cli::DdsOptions dds;
   auto add_bus_options = [&](CLI::App& cmd) { cli::add_dds_options(cmd, dds); };
@@ -178,9 +181,6 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       ->capture_default_str();
   serve->footer(kServeFooter);
 
-  cli::LogOptions log_options;
-  cli::add_log_options(app, log_options);
-  app.fallthrough();  // --log-format and --log-level also after the subcommand
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-monitor", out, usage_err)) return *code;
   // The monitor's diagnostics are lines on a stream; in json each becomes one log record (common/cli/logging.hpp).
   const cli::LoggingScope logging("monitor", 0, log_options, &usage_err);

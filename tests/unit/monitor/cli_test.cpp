@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <future>
 #include <sstream>
@@ -115,6 +116,25 @@ TEST(MonitorCli, StatusWithoutAWorldExitsOne) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_EQ(r.out, "");
   EXPECT_EQ(r.err, "marsala-monitor: no world server on domain 81 (inprocess): no world status within 0.1 s\n");
+}
+
+TEST(MonitorCli, JsonLogFormatMakesTheErrorOneRecordWhereverTheOptionStands) {
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--log-format", "json", "status", "--dds", "inprocess", "--domain", "81", "--timeout",
+                                 "0.1"},
+        std::vector<std::string>{"status", "--dds", "inprocess", "--domain", "81", "--timeout", "0.1", "--log-format",
+                                 "json"}}) {
+    const Result r = run_cli(args);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.err.find("marsala-monitor: "), std::string::npos) << r.err;  // the prefix gives way to the record's
+    EXPECT_EQ(r.err.front(), '{') << r.err;
+    EXPECT_EQ(r.err.substr(r.err.size() - 2), "}\n") << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("\"level\":\"error\",\"process\":\"monitor\",\"agent_id\":null,"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\"msg\":\"no world server on domain 81 (inprocess): no world status within 0.1 s\"}"),
+              std::string::npos)
+        << r.err;
+  }
 }
 
 TEST(MonitorCli, TailFollowsARunToItsEnd) {
