@@ -86,6 +86,18 @@ std::string run_report(const std::string& dir) {
   });
   std::sort(others.begin(), others.end());
   if (!pictures.empty()) out += "  pictures in " + dir + ": " + join(pictures) + "\n";
+  // The time-lapse of --frames-every, when the run drew one.
+  const fs::path frames_dir = fs::path(dir) / "frames";
+  std::size_t frames = 0;
+  bool video = false;
+  for (const fs::directory_entry& e : fs::directory_iterator(frames_dir, ec)) {
+    const std::string name = e.path().filename().string();
+    frames += name.rfind("frame_", 0) == 0 && e.path().extension() == ".png" ? 1 : 0;
+    video = video || name == "timelapse.mp4";
+  }
+  if (frames > 0)
+    out += "  time-lapse in " + frames_dir.string() + ": " + std::to_string(frames) + " frame" +
+           (frames == 1 ? "" : "s") + (video ? ", timelapse.mp4" : "") + "\n";
   out += "  everything else in " + dir + ": " + join(others) + "\n";
   return out;
 }

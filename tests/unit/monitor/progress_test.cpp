@@ -248,6 +248,20 @@ TEST_F(RunReport, ACompletedPathRun) {
             "  everything else in " + d + ": events.log, logs/, run.log, summary.json\n");
 }
 
+TEST_F(RunReport, SaysWhereTheTimeLapseIs) {
+  write_summary(R"({"scenario": "ramp", "completed": true, "end_reason": "completed", "steps": 275,
+    "wall_seconds": 2.0, "agents": 3, "admitted": 3, "completion": "agents_at_goal", "progress": 1})");
+  std::filesystem::create_directories(dir_ / "frames");
+  for (const char* name : {"frame_000000.png", "frame_000100.png", "frame_000275.png", "timelapse.mp4"})
+    std::ofstream(dir_ / "frames" / name) << "x";
+  const std::string report = run_report(dir_.string());
+  EXPECT_NE(report.find("\n  time-lapse in " + (dir_ / "frames").string() + ": 3 frames, timelapse.mp4\n"),
+            std::string::npos)
+      << report;
+  std::filesystem::remove(dir_ / "frames" / "timelapse.mp4");
+  EXPECT_NE(run_report(dir_.string()).find(": 3 frames\n"), std::string::npos);
+}
+
 TEST_F(RunReport, ARunThatDidNotCompleteSaysWhy) {
   write_summary(R"json({"scenario": "site_prep", "completed": false, "end_reason": "max_steps", "steps": 500,
     "wall_seconds": 2.0, "deposited_volume_m3": 10.5, "agents": 11, "admitted": 11, "dropped": 1,
