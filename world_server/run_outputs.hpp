@@ -1,8 +1,8 @@
 #pragma once
 // What a run leaves in its output folder: summary.json (protobuf RunSummary as JSON, proto field names),
 // terrain_initial.asc, terrain_final.asc, final.png, final_zoom.png (when zoom_window() finds a close-up),
-// final_3d.png, goal_vector_map.png (scenarios with a goal vector map) and events.log (one text line per event). IO at
-// the edge.
+// final_3d.png, goal_vector_map.png (scenarios with a goal vector map) and events.log (JSON Lines, one object per event or
+// note). IO at the edge.
 //
 // final.png: the hillshaded final terrain; every cell raised by a deposition tinted with its depositor's colour
 // (render::default_palette(): agent id k -> entry (k - 1) mod 12: 1 red, 2 blue, 3 green, 4 orange, 5 purple, 6 cyan,
@@ -106,7 +106,8 @@ std::vector<std::string> run_files_in(const std::string& dir);
 /// Throws IoError naming them when `dir` holds any of a run's files: a run never mixes its outputs with another's.
 void check_fresh_output_dir(const std::string& dir);
 
-/// Removes the kRunFiles (and their temporary .tmp names) from `dir` (marsala-world --replace); throws IoError.
+/// Removes the kRunFiles (and their temporary .tmp names) from `dir`, and the frames and timelapse.mp4 of dir/frames
+/// (--frames-every; the folder too when nothing else is in it) (marsala-world --replace); throws IoError.
 void clear_run_files(const std::string& dir);
 
 /// One events.log line (without its newline): a JSON object (docs/runtime.md#outputs), e.g.

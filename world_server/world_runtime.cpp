@@ -19,13 +19,13 @@
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/core/mars_processor.hpp"
+#include "marsala/render/terrain_renderer.hpp"
+#include "marsala/render/timelapse.hpp"
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/terrain/asc_io.hpp"
 #include "marsala/world_server/admission.hpp"
 #include "marsala/world_server/completion.hpp"
 #include "marsala/world_server/persistence.hpp"
-#include "marsala/render/terrain_renderer.hpp"
-#include "marsala/render/timelapse.hpp"
 #include "marsala/world_server/run_outputs.hpp"
 #include "marsala/world_server/sensing_service.hpp"
 #include "marsala/world_server/step.hpp"
@@ -583,7 +583,6 @@ struct WorldRuntime::Impl {
     last = e.detail;
   }
 
-  /// Runs steps until an end condition; returns the end reason.
   /// The cells the accepted request of `agent` set in this step (for its deposition in events.log).
   static const std::vector<Deposition>& deposited_cells(const std::vector<Submission>& submissions,
                                                         const StepOutcome& outcome, std::uint32_t agent) {
@@ -594,6 +593,7 @@ struct WorldRuntime::Impl {
     return none;
   }
 
+  /// Runs steps until an end condition; returns the end reason.
   EndReason lockstep(const std::atomic<bool>& stop, Clock::time_point start) {
     for (;;) {
       if (frames) frames->maybe_write(state.step, false, [this] { return frame_picture(false); });

@@ -227,6 +227,20 @@ TEST_F(OutputFiles, ARunNeverWritesIntoAnotherRunsFolderAndLeavesNoTemporaries) 
   EXPECT_NO_THROW(check_fresh_output_dir(dir_.string()));
 }
 
+TEST_F(OutputFiles, ReplaceRemovesTheTimeLapseButNothingElseInFrames) {
+  fs::create_directories(dir_ / "frames");
+  for (const char* name : {"frame_000000.png", "frame_000100.png", "timelapse.mp4"})
+    std::ofstream(dir_ / "frames" / name) << "x";
+  clear_run_files(dir_.string());
+  EXPECT_FALSE(fs::exists(dir_ / "frames"));  // emptied, then removed
+  fs::create_directories(dir_ / "frames");
+  std::ofstream(dir_ / "frames" / "frame_000007.png") << "x";
+  std::ofstream(dir_ / "frames" / "notes.txt") << "mine";
+  clear_run_files(dir_.string());
+  EXPECT_FALSE(fs::exists(dir_ / "frames" / "frame_000007.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "frames" / "notes.txt"));  // not the run's: kept, and the folder with it
+}
+
 TEST_F(OutputFiles, AnEventLogThatCannotBeWrittenIsAnErrorNotASilentLoss) {
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full here to play a full disk";
   EventLog log("/dev/full");  // opens, but every write fails with ENOSPC
