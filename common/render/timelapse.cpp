@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <utility>
 
 #include "marsala/core/error.hpp"
@@ -115,6 +116,25 @@ FrameWriter::FrameWriter(std::string dir, std::uint64_t every) : dir_(std::move(
   std::error_code ec;
   fs::create_directories(dir_, ec);
   if (ec) throw IoError("cannot create frames folder '" + dir_ + "': " + ec.message());
+  // Frames already there (a resumed run's) belong to the same time-lapse: in step order (the names sort so), and
+  // their sizes count for the video's.
+  for (const fs::directory_entry& e : fs::directory_iterator(dir_, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() != frame_file_name(0).size() || name.rfind("frame_", 0) != 0 || e.path().extension() != ".png")
+      continue;
+    names_.push_back(name);
+    std::ifstream in(e.path(), std::ios::binary);
+    unsigned char header[24] = {};
+    if (in.read(reinterpret_cast<char*>(header), sizeof header)) {  // PNG: IHDR's width and height, big-endian
+      const auto be32 = [&](int at) {
+        return static_cast<int>((header[at] << 24) | (header[at + 1] << 16) | (header[at + 2] << 8) | header[at + 3]);
+      };
+      width_px_ = std::max(width_px_, be32(16));
+      height_px_ = std::max(height_px_, be32(20));
+    }
+  }
+  if (ec) throw IoError("cannot list frames folder '" + dir_ + "': " + ec.message());
+  std::sort(names_.begin(), names_.end());
 }
 
 void FrameWriter::maybe_write(std::uint64_t step, bool last, const std::function<Image()>& draw) {
@@ -124,7 +144,7 @@ void FrameWriter::maybe_write(std::uint64_t step, bool last, const std::function
   const Image image = draw();
   const std::string name = frame_file_name(step);
   runlog::write_atomically((fs::path(dir_) / name).string(), [&](const std::string& tmp) { write_png(image, tmp); });
-  names_.push_back(name);
+  if (std::find(names_.begin(), names_.end(), name) == names_.end()) names_.push_back(name);  // redrawn: once
   width_px_ = std::max(width_px_, image.width);
   height_px_ = std::max(height_px_, image.height);
   written_ = step;

@@ -36,7 +36,8 @@ struct TimelapseResult {
 };
 
 /// Writes the frames of one time-lapse into a folder it creates: one every `every` steps (>= 1) and the last, each
-/// step at most once, each file written to "<name>.tmp" and renamed.
+/// step at most once, each file written to "<name>.tmp" and renamed. Frames already in the folder (a resumed run's)
+/// are part of it: in names() and in timelapse.mp4; one drawn again replaces its file.
 class FrameWriter {
  public:
   /// Creates `dir` (throws IoError when it cannot).

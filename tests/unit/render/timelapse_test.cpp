@@ -53,6 +53,19 @@ TEST_F(Timelapse, ALastStepThatIsDueIsNotWrittenTwice) {
   EXPECT_EQ(frames.names().size(), 3u);
 }
 
+TEST_F(Timelapse, AResumedTimeLapseContinuesTheFramesAlreadyThere) {
+  {
+    FrameWriter before(dir_.string(), 2);
+    for (std::uint64_t step = 0; step <= 4; ++step) before.maybe_write(step, false, tiny);
+  }
+  std::ofstream(dir_ / "notes.txt") << "not a frame";
+  FrameWriter after(dir_.string(), 2);
+  EXPECT_EQ(after.names(), (std::vector<std::string>{"frame_000000.png", "frame_000002.png", "frame_000004.png"}));
+  for (std::uint64_t step = 4; step <= 7; ++step) after.maybe_write(step, step == 7, tiny);  // 4 is drawn again
+  EXPECT_EQ(after.names(), (std::vector<std::string>{"frame_000000.png", "frame_000002.png", "frame_000004.png",
+                                                     "frame_000006.png", "frame_000007.png"}));
+}
+
 TEST_F(Timelapse, KZeroIsRefused) { EXPECT_THROW(FrameWriter(dir_.string(), 0), InvalidArgument); }
 
 TEST_F(Timelapse, AFolderWithFramesIsRefusedNamingThem) {
