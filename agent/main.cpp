@@ -2,7 +2,6 @@
 // to marsala-world over DDS, then answers every sensor frame with one action request until the run is over.
 // Exit codes: 0 run over (or stopped by a signal), 1 error (one line on stderr), 2 usage.
 
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -14,6 +13,7 @@
 
 #include "marsala/agent/runtime/agent_runtime.hpp"
 #include "marsala/cli/command_line.hpp"
+#include "marsala/cli/logging.hpp"
 #include "marsala/scenario/scenario.hpp"
 
 namespace {
@@ -44,7 +44,8 @@ const marsala::RobotType& any_slot_type(const marsala::scenario::Scenario& s, co
 int main(int argc, char** argv) {
   using namespace marsala;
   CLI::App app{"marsala-agent: one robot of a MARSala run (body and behaviour from its scenario slot)"};
-  std::string scenario_file, log_level = "info";
+  std::string scenario_file;
+  marsala::cli::LogOptions log_options;
   marsala::cli::DdsOptions dds;
   std::string id_text, robot_type;
   double admit_timeout_s = 60.0, world_timeout_s = 60.0;
@@ -58,8 +59,7 @@ int main(int argc, char** argv) {
   marsala::cli::add_dds_options(app, dds);
   std::optional<std::uint64_t> seed;
   app.add_option("--seed", seed, "override the scenario's seed (marsala-world must get the same)");
-  app.add_option("--log-level", log_level, "trace, debug, info, warn, error, off")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+  marsala::cli::add_log_options(app, log_options);
   app.add_option("--admit-timeout", admit_timeout_s, "give up when not admitted within this [s]")
       ->check(CLI::PositiveNumber);
   app.add_option("--world-timeout", world_timeout_s, "give up when no frame comes for this long [s]")
@@ -67,12 +67,10 @@ int main(int argc, char** argv) {
   if (const auto code = marsala::cli::parse_command_line(app, argc, argv, "marsala-agent", std::cout, std::cerr))
     return *code;
 
-  auto logger = spdlog::stderr_color_mt("marsala-agent");
-  spdlog::set_default_logger(logger);
-  spdlog::set_level(spdlog::level::from_str(log_level));
+  const std::uint32_t id = id_text == "auto" ? 0u : static_cast<std::uint32_t>(std::stoul(id_text));
+  marsala::cli::setup_logging("agent", id, log_options);
   try {
     const scenario::Scenario s = scenario::load_scenario(scenario_file);
-    const std::uint32_t id = id_text == "auto" ? 0u : static_cast<std::uint32_t>(std::stoul(id_text));
     const RobotType& type = id != 0 ? s.robot_for(id) : any_slot_type(s, robot_type);
     // Keep-out around neighbours: the largest body and step of the whole team (bodies may differ per slot).
     double max_delta = 0.0, max_step = 0.0;
@@ -82,6 +80,7 @@ int main(int argc, char** argv) {
     }
     agent::runtime::RuntimeConfig config;
     config.agent_id = id;
+    config.on_assigned = [](std::uint32_t assigned) { marsala::cli::set_log_agent_id(assigned); };
     if (id != 0) config.name = type.name + "-" + std::to_string(id);
     config.type = type;
     config.neighbour_keep_out_m = agent::neighbour_keep_out_m(max_delta, max_step);
@@ -106,10 +105,10 @@ int main(int argc, char** argv) {
       spdlog::info("agent {}: {}", id, result.message);
       return 0;
     }
-    std::cerr << "marsala-agent: agent " << id << ": " << result.message << "\n";
+    marsala::cli::write_exit_error(std::cerr, "marsala-agent: agent " + std::to_string(id) + ": " + result.message);
     return 1;
   } catch (const std::exception& e) {
-    std::cerr << "marsala-agent: " << e.what() << "\n";
+    marsala::cli::write_exit_error(std::cerr, std::string("marsala-agent: ") + e.what());
     return 1;
   }
 }

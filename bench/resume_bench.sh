@@ -12,7 +12,7 @@ export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
 work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-resume.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 rss() { awk '/^VmRSS/ { print $2 }' "/proc/$1/status" 2>/dev/null || echo 0; }
-last_step() { awk '$1 == "step" { s = $2 } END { print s + 0 }' "$1"; }
+last_step() { sed -n 's/^{"step":\([0-9]*\),.*/\1/p' "$1" | awk '{ s = $1 } END { print s + 0 }'; }  # events.log: JSON Lines
 for run in $(seq 1 "$runs"); do
   out="$work/run-$run"
   mkdir -p "$out/logs"

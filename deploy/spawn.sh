@@ -1,16 +1,21 @@
 #!/usr/bin/env bash
 # Runs a scenario as real processes: one marsala-world and N marsala-agent processes on a fresh DDS domain with the
-# loopback configuration, waits for the end, prints the summary, and stops every child it started on exit or Ctrl-C.
+# loopback configuration, waits for the end, prints a short account of the run (summary.json holds everything), and
+# stops every child it started on exit or Ctrl-C. On a terminal it keeps one line up to date while the run goes:
+# step, progress, steps/s and the estimated time left (marsala-monitor progress).
 #
 # Usage: deploy/spawn.sh --scenario FILE --agents N [--dds cyclone|fastdds] [--agent-dds cyclone|fastdds]
 #                        [--out DIR [--replace]] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N]
-#                        [--quiet] [--secure]
+#                        [--quiet] [--secure] [--frames-every K]
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
 #                 folder that holds another run's files, unless --replace removes them (and logs/) first
 #   --dds         vendor of every process (default $MARSALA_DDS, else cyclone); --agent-dds overrides it for the agents
 #   --domain      DDS domain id (default $MARSALA_DOMAIN, else a random one on which no world answers within 1 s)
-#   --monitor     also run `marsala-monitor tail` in the foreground output
+#   --monitor     also run `marsala-monitor tail` in the foreground output (instead of the progress line)
+#   --quiet       print nothing but errors (no progress line, no account at the end)
 #   --timeout     give up (and stop everything) after S seconds of wall time (default 1800)
+#   --frames-every a time-lapse: marsala-world draws OUT/frames/frame_<step>.png every K steps and the last, and
+#                 OUT/frames/timelapse.mp4 when ffmpeg is installed
 #   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
 #   --secure      DDS Security: a CA and an identity per process in OUT/security (deploy/security/make-identities.sh,
 #                 made anew each run), every process authenticated, access-controlled and encrypted (domain <= 230)
@@ -21,9 +26,9 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
-scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0
+scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0 frames_every=""
 replace=0 secure=0
-usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -34,6 +39,7 @@ while [ $# -gt 0 ]; do
     --domain) domain="$2"; shift 2 ;;
     --monitor) monitor=1; shift ;;
     --max-steps) max_steps="$2"; shift 2 ;;
+    --frames-every) frames_every="$2"; shift 2 ;;
     --timeout) timeout_s="$2"; shift 2 ;;
     --seed) seed="$2"; shift 2 ;;
     --quiet) quiet=1; shift ;;
@@ -90,6 +96,7 @@ fi
 world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$domain" --out "$out" "${sec_args[@]}")
 [ "$replace" -eq 1 ] && world_args+=(--replace)
 [ -n "$max_steps" ] && world_args+=(--max-steps "$max_steps")
+[ -n "$frames_every" ] && world_args+=(--frames-every "$frames_every")  # the world checks K (exit 2 when bad)
 [ "$quiet" -eq 1 ] && world_args+=(--quiet)
 seed_args=()
 [ -n "$seed" ] && seed_args=(--seed "$seed")
@@ -126,9 +133,15 @@ for id in $(seq 1 "$agents"); do
 done
 [ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain; logs in $out/logs"
 
+progress_pid=""
 if [ "$monitor" -eq 1 ] && [ -x "$bin/marsala-monitor" ]; then
   "$bin/marsala-monitor" tail --dds "$dds" --domain "$domain" "${sec_args[@]}" &
   pids+=("$!")
+elif [ "$quiet" -eq 0 ] && [ -t 1 ] && [ -x "$bin/marsala-monitor" ]; then
+  # One line, rewritten in place, on a terminal only: a log file or a pipe gets nothing extra.
+  "$bin/marsala-monitor" progress --in-place --dds "$dds" --domain "$domain" "${sec_args[@]}" 2>/dev/null &
+  progress_pid=$!
+  pids+=("$progress_pid")
 fi
 
 # Wait for the world to finish, or give up after the timeout.
@@ -143,6 +156,12 @@ while kill -0 "$world_pid" 2>/dev/null; do
 done
 world_rc=0
 wait "$world_pid" || world_rc=$?
+if [ -n "$progress_pid" ]; then
+  # It ends by itself on the world's last status; a world that died without one leaves it waiting: stop it.
+  for _ in $(seq 1 20); do kill -0 "$progress_pid" 2>/dev/null || break; sleep 0.1; done
+  kill -TERM "$progress_pid" 2>/dev/null || true
+  wait "$progress_pid" 2>/dev/null || true
+fi
 # 0 completed, 3 max_steps, 4 no_live_agents, 5 signal: the run ended and wrote its outputs (docs/runtime.md).
 case "$world_rc" in
   0|3|4|5) ;;
@@ -151,12 +170,17 @@ case "$world_rc" in
     tail -n 20 "$out/logs/world.log" >&2
     exit "$world_rc" ;;
 esac
-if [ -f "$out/summary.json" ]; then
-  [ "$quiet" -eq 1 ] || { echo "Summary ($out/summary.json):"; cat "$out/summary.json"; echo; }
-else
+if [ ! -f "$out/summary.json" ]; then
   echo "spawn.sh: the world wrote no summary in $out" >&2
   exit 1
 fi
-[ "$quiet" -eq 1 ] || { echo "Pictures:"; ls -1 "$out"/*.png 2>/dev/null | sed 's/^/  /'; }
-[ "$world_rc" -eq 0 ] || echo "spawn.sh: the run ended without completing ($(jq -r .end_reason "$out/summary.json" 2>/dev/null || echo "exit $world_rc")); exit $world_rc" >&2
+if [ "$quiet" -eq 0 ]; then
+  # The account for people; summary.json keeps every figure.
+  if [ -x "$bin/marsala-monitor" ]; then
+    "$bin/marsala-monitor" summary "$out" || echo "spawn.sh: see $out/summary.json"
+  else
+    echo "spawn.sh: the run is over; see $out/summary.json and the pictures in $out"
+  fi
+fi
+[ "$world_rc" -eq 0 ] || echo "spawn.sh: the run ended without completing; exit $world_rc" >&2
 exit "$world_rc"

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "marsala/monitor/progress.hpp"
 #include "marsala/monitor/world_gate.hpp"
 
 namespace marsala::monitor {
@@ -35,7 +36,11 @@ std::string where(const bus::Participant& participant) {
 class TailPrinter {
  public:
   TailPrinter(const TailOptions& options, std::ostream& out, std::ostream& err)
-      : options_(options), run_id_(options.run_id), out_(out), err_(err) {}
+      : options_(options),
+        run_id_(options.run_id),
+        out_(out),
+        err_(err),
+        pacing_(options.every_steps, options.interval) {}
 
   /// Prints a batch in step order: each status after the events of its step and earlier (the world
   /// publishes a step's events before its status; statuses are taken before events, so the events of a
@@ -52,7 +57,7 @@ class TailPrinter {
         break;
       }
       while (next_event < events.size() && events[next_event].step <= status.step) print_event(events[next_event++]);
-      print_status(status);
+      if (pacing_.take(status.step, Clock::now())) print_status(status);
     }
     for (; next_event < events.size(); ++next_event) {
       if (final_)
@@ -132,6 +137,7 @@ class TailPrinter {
   std::vector<std::uint32_t> header_ids_;
   std::vector<protocol::WorldEvent> late_events_;
   std::set<std::string> ignored_runs_;
+  LinePacing pacing_;  ///< which step lines are printed (--every, --interval); the final one always is
   bool run_over_printed_ = false;
 };
 

@@ -4,6 +4,7 @@
 // Statuses are read transient-local: a monitor that starts late sees the latest step at once.
 
 #include <chrono>
+#include <cstdint>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -22,6 +23,8 @@ struct TailOptions {
   /// How long to wait for late events (up to kRunOver) once the final status arrived [s].
   std::chrono::duration<double> drain = std::chrono::milliseconds(500);
   FormatOptions format;
+  std::uint64_t every_steps = 0;            ///< a step line whenever the step crosses a multiple of this; 0 = all
+  std::chrono::duration<double> interval{};  ///< at most a step line this often [s]; zero = no limit
 };
 
 /// Options of `status`.

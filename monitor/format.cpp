@@ -110,7 +110,7 @@ int agent_column_text_width(std::size_t agent_count, const FormatOptions& option
 }
 
 std::string format_step_header(const protocol::WorldStatus& status, const FormatOptions& options) {
-  std::string line = printf_string("%6s %5s %7s %8s %4s |", "step", "live", "mat[m3]", "dep[m3]", "goal");
+  std::string line = printf_string("%6s %5s %7s %8s %4s |", "step", "live", "mat[m3]", "dep[m3]", "prog");
   const int text_width = agent_column_text_width(status.agents.size(), options);
   if (status.agents.empty()) {
     line += " no agents";
@@ -149,12 +149,15 @@ std::string format_run_summary(const protocol::WorldStatus& status) {
     rejected += a.rejected;
     missed += a.missed;
   }
-  return printf_string(
+  std::string line = printf_string(
       "run %s %s at step %llu (%.1f s) | live %zu/%zu, at goal %zu | dep %.3f m3 | acc %llu rej %llu "
       "miss %llu",
       printable(status.run_id).c_str(), run_outcome(status).c_str(), static_cast<unsigned long long>(status.step),
       status.wall_seconds, count_alive(status), status.agents.size(), count_at_goal(status), status.deposited_volume_m3,
       accepted, rejected, missed);
+  if (!status.progress_detail.empty())
+    line += printf_string(" | progress %.1f%%: %s", 100.0 * status.progress, printable(status.progress_detail).c_str());
+  return line;
 }
 
 std::string format_event(const protocol::WorldEvent& event, const FormatOptions& options) {
@@ -176,6 +179,7 @@ std::vector<std::string> format_status_table(const protocol::WorldStatus& status
                                 printable(status.run_id).c_str(), printable(status.scenario).c_str(),
                                 static_cast<unsigned long long>(status.step), status.wall_seconds,
                                 run_outcome(status).c_str(), 100.0 * status.progress, status.deposited_volume_m3));
+  if (!status.progress_detail.empty()) lines.back() += "  (" + printable(status.progress_detail) + ")";
   lines.push_back(
       trim_right(printf_string("%3s %-12s %-11s %8s %8s %7s %7s %7s %5s %4s %4s %-5s %-4s", "id", "name", "state",
                                "x[m]", "y[m]", "z[m]", "mat[m3]", "dep[m3]", "acc", "rej", "miss", "alive", "goal")));

@@ -3,11 +3,11 @@
 //
 // tail, one line per step, under a column header (printed again whenever the team's ids change):
 //
-//     step  live mat[m3]  dep[m3] goal | 1           2           3
+//     step  live mat[m3]  dep[m3] prog | 1           2           3
 //       42   2/3    3.75    0.125  33% | build       refill*     --
 //
-//   mat = material on board of the live agents, dep = volume deposited in the run, goal = agents at their
-//   goal [%]; then one column per agent in id order: its behaviour state ("*" at its goal, "--" dropped,
+//   mat = material on board of the live agents, dep = volume deposited in the run, prog = the run's progress
+//   [%] (WorldStatus.progress: agents at the goal, the payload route's gap filled, the site's level); then one column per agent in id order: its behaviour state ("*" at its goal, "--" dropped,
 //   "?" no state yet), cut to the column width. When the agents do not fit the line width (more than 12 at
 //   100 columns), the columns give way to a count of live agents per state: "| build 9, refill 3".
 // tail --events, one line per WorldEvent:   "    42 > agent 3  deposited 0.000125 m3 5 cells"

@@ -137,6 +137,7 @@ std::string LiveModel::state_json(Clock::time_point now) const {
                 {"step", s.step},
                 {"wall_s", s.wall_seconds},
                 {"progress", s.progress},
+                {"progress_detail", printable(s.progress_detail)},
                 {"phase", run_phase(s)},
                 {"running", s.running},
                 {"completed", s.completed},

@@ -1,9 +1,6 @@
 #include "marsala/monitor/replay.hpp"
 
 #include <fmt/format.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -15,20 +12,16 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
-#include "marsala/render/png_writer.hpp"
-#include "marsala/runlog/atomic_file.hpp"
+#include "marsala/render/timelapse.hpp"
 #include "marsala/runlog/run_log.hpp"
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/terrain/asc_io.hpp"
-
-extern char** environ;
 
 namespace marsala::monitor {
 namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-using runlog::write_atomically;
 
 /// Agreement of the log's deposited volume with the replay's: the world sums the same terms in the same order, so
 /// they agree bit for bit unless the log lies; the tolerance only forgives a writer that rounds differently.
@@ -50,124 +43,6 @@ const char* record_kind(const proto::LogRecord& record) {
   }
   return "empty";
 }
-
-std::string frame_name(std::uint64_t step) { return fmt::format("frame_{:06}.png", step); }
-
-/// Throws IoError when `dir` already holds a replay's frames or timelapse: two replays never mix.
-void check_fresh_frames_dir(const std::string& dir) {
-  std::error_code ec;
-  if (!fs::exists(dir, ec)) return;
-  if (!fs::is_directory(dir, ec)) throw IoError("frames folder '" + dir + "' is not a folder");
-  std::vector<std::string> found;
-  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
-    const std::string name = e.path().filename().string();
-    const bool frame = name.size() > 10 && name.rfind("frame_", 0) == 0 && name.substr(name.size() - 4) == ".png";
-    if (frame || name == "timelapse.mp4") found.push_back(name);
-  }
-  if (ec) throw IoError("cannot list frames folder '" + dir + "': " + ec.message());
-  if (found.empty()) return;
-  std::sort(found.begin(), found.end());
-  throw IoError(
-      fmt::format("frames folder '{}' already holds a replay ({} file{}, e.g. {}); give another --out or "
-                  "empty it",
-                  dir, found.size(), found.size() == 1 ? "" : "s", found.front()));
-}
-
-/// The first executable "ffmpeg" in the colon-separated `search_path`, or empty.
-std::string find_ffmpeg(const std::string& search_path) {
-  std::size_t begin = 0;
-  while (begin <= search_path.size() && !search_path.empty()) {
-    const std::size_t end = std::min(search_path.find(':', begin), search_path.size());
-    const std::string dir = search_path.substr(begin, end - begin);
-    if (!dir.empty()) {
-      const std::string candidate = (fs::path(dir) / "ffmpeg").string();
-      if (::access(candidate.c_str(), X_OK) == 0) return candidate;
-    }
-    begin = end + 1;
-  }
-  return {};
-}
-
-/// Runs argv[0] with argv, its output on ours; returns its exit status (128 + signal when killed).
-int run_program(const std::vector<std::string>& args) {
-  std::vector<char*> argv;
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (::posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0)
-    throw IoError("cannot start '" + args[0] + "'");
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) throw IoError("cannot wait for '" + args[0] + "'");
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
-/// Assembles frames_dir/timelapse.mp4 from `frames` (names in step order) with ffmpeg at 10 frames/s. The frames'
-/// step numbers are not consecutive, so ffmpeg reads numbered links to them from a scratch folder; frames of
-/// different sizes (a legend that grew) are padded to the largest, even-sized.
-void write_timelapse(const std::string& ffmpeg, const std::string& frames_dir, const std::vector<std::string>& frames,
-                     int width_px, int height_px) {
-  const fs::path scratch = fs::path(frames_dir) / ".timelapse_frames";
-  std::error_code ec;
-  fs::remove_all(scratch, ec);
-  fs::create_directories(scratch, ec);
-  if (ec) throw IoError("cannot create '" + scratch.string() + "': " + ec.message());
-  for (std::size_t k = 0; k < frames.size(); ++k) {
-    fs::create_symlink(fs::path("..") / frames[k], scratch / fmt::format("{:06}.png", k), ec);
-    if (ec) throw IoError("cannot link '" + frames[k] + "' in '" + scratch.string() + "': " + ec.message());
-  }
-  const std::string out = (fs::path(frames_dir) / "timelapse.mp4").string();
-  int status = 0;
-  try {
-    write_atomically(out, [&](const std::string& tmp) {
-      status = run_program({ffmpeg, "-y", "-loglevel", "error", "-framerate", "10", "-i",
-                            (scratch / "%06d.png").string(), "-pix_fmt", "yuv420p", "-vf",
-                            fmt::format("pad={}:{}:0:0:white", width_px + width_px % 2, height_px + height_px % 2),
-                            "-f", "mp4", tmp});
-      if (status != 0) throw IoError(fmt::format("ffmpeg failed (exit {}) making '{}'", status, out));
-    });
-  } catch (...) {
-    fs::remove_all(scratch, ec);
-    throw;
-  }
-  fs::remove_all(scratch, ec);
-}
-
-/// Frames of a replay: one every `every` steps and the last, each written once.
-class FrameWriter {
- public:
-  FrameWriter(std::string dir, std::uint64_t every) : dir_(std::move(dir)), every_(every) {}
-
-  /// Draws the replay's current state when its step is due (or `last`) and not drawn yet.
-  void maybe_write(const TerrainReplayer& replayer, bool last) {
-    const std::uint64_t step = replayer.steps();
-    if (written_ && *written_ == step) return;
-    if (!last && step % every_ != 0) return;
-    const auto start = Clock::now();
-    const render::Image image = render::render_terrain(replayer.terrain(), replay_picture_options(replayer));
-    const std::string name = frame_name(step);
-    write_atomically((fs::path(dir_) / name).string(), [&](const std::string& tmp) { render::write_png(image, tmp); });
-    names_.push_back(name);
-    width_px_ = std::max(width_px_, image.width);
-    height_px_ = std::max(height_px_, image.height);
-    written_ = step;
-    seconds_ += seconds_since(start);
-  }
-
-  const std::vector<std::string>& names() const { return names_; }
-  int width_px() const { return width_px_; }
-  int height_px() const { return height_px_; }
-  double seconds() const { return seconds_; }
-
- private:
-  std::string dir_;
-  std::uint64_t every_;
-  std::optional<std::uint64_t> written_;
-  std::vector<std::string> names_;
-  int width_px_ = 0;
-  int height_px_ = 0;
-  double seconds_ = 0.0;
-};
 
 }  // namespace
 
@@ -316,10 +191,10 @@ ReplayReport replay_run(const std::string& dir, const ReplayOptions& options) {
   ReplayReport report;
   report.log_path = log_path;
 
-  std::optional<FrameWriter> frames;
+  std::optional<render::FrameWriter> frames;
   if (options.frames_every > 0) {
     report.frames_dir = options.frames_dir.empty() ? (fs::path(dir) / "replay").string() : options.frames_dir;
-    check_fresh_frames_dir(report.frames_dir);
+    render::check_fresh_frames_dir(report.frames_dir, "a replay");
   }
 
   runlog::RunLogReader reader(log_path);
@@ -328,19 +203,17 @@ ReplayReport replay_run(const std::string& dir, const ReplayOptions& options) {
   check_initial_terrain(header, initial, terrain_path);
   TerrainReplayer replayer(header, std::move(initial), log_path);
 
-  if (options.frames_every > 0) {
-    std::error_code ec;
-    fs::create_directories(report.frames_dir, ec);
-    if (ec) throw IoError("cannot create frames folder '" + report.frames_dir + "': " + ec.message());
-    frames.emplace(report.frames_dir, options.frames_every);
-  }
+  if (options.frames_every > 0) frames.emplace(report.frames_dir, options.frames_every);
+  const auto draw = [&replayer] {
+    return render::render_terrain(replayer.terrain(), replay_picture_options(replayer));
+  };
 
   proto::LogRecord record;
   for (std::uint64_t at = reader.offset(); reader.next(record); at = reader.offset()) {
     if (record.has_step()) {
       // The state the world had when it awaited this step: drawn before the step, and the place --to-step stops.
       if (options.to_step && replayer.steps() == *options.to_step) break;
-      if (frames) frames->maybe_write(replayer, false);
+      if (frames) frames->maybe_write(replayer.steps(), false, draw);
     }
     replayer.apply(record, at);
   }
@@ -348,7 +221,7 @@ ReplayReport replay_run(const std::string& dir, const ReplayOptions& options) {
   if (options.to_step && replayer.steps() < *options.to_step)
     throw InvalidArgument(fmt::format("{} holds {} steps{}; --to-step {} is beyond it", log_path, replayer.steps(),
                                       report.tail_problem.empty() ? "" : " before its damaged tail", *options.to_step));
-  if (frames) frames->maybe_write(replayer, true);
+  if (frames) frames->maybe_write(replayer.steps(), true, draw);
 
   report.scenario = header.scenario();
   report.run_id = header.run_id();
@@ -369,15 +242,10 @@ ReplayReport replay_run(const std::string& dir, const ReplayOptions& options) {
   if (frames) {
     report.frames = frames->names().size();
     report.frame_seconds = frames->seconds();
-    const std::string ffmpeg = find_ffmpeg(options.search_path);
-    if (ffmpeg.empty()) {
-      report.timelapse_note = "skipped timelapse.mp4: ffmpeg is not installed (not on PATH)";
-    } else {
-      const auto video_start = Clock::now();
-      write_timelapse(ffmpeg, report.frames_dir, frames->names(), frames->width_px(), frames->height_px());
-      report.timelapse_seconds = seconds_since(video_start);
-      report.timelapse = (fs::path(report.frames_dir) / "timelapse.mp4").string();
-    }
+    const render::TimelapseResult video = frames->finish(options.search_path);
+    report.timelapse = video.path;
+    report.timelapse_note = video.note;
+    report.timelapse_seconds = video.seconds;
   }
   report.replay_seconds = seconds_since(start) - report.frame_seconds - report.timelapse_seconds;
   return report;

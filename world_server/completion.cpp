@@ -11,6 +11,8 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
+#include "marsala/core/iterators.hpp"
+#include "marsala/core/mars_processor.hpp"
 #include "marsala/core/navigability_processor.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
 #include "marsala/world_server/arbiter.hpp"
@@ -64,18 +66,29 @@ bool is_completed(const WorldState& state) {
   return any;
 }
 
-double progress(const WorldState& state) {
-  switch (state.completion) {
-    case scenario::CompletionKind::kPayloadPath: return state.check.met ? 1.0 : 0.0;
-    case scenario::CompletionKind::kLevelSite: return state.check.level_fraction;
-    case scenario::CompletionKind::kAgentsAtGoal: break;
-  }
+/// The live agents and how many of them are at the goal.
+static std::pair<int, int> live_agents_at_goal(const WorldState& state) {
   int live = 0, done = 0;
   for (const AgentRecord& a : state.agents) {
     if (!a.alive) continue;
     ++live;
     done += at_goal(state, a) ? 1 : 0;
   }
+  return {live, done};
+}
+
+double progress(const WorldState& state) {
+  switch (state.completion) {
+    case scenario::CompletionKind::kPayloadPath: {
+      const CompletionCheck& check = state.check;
+      if (check.met) return 1.0;
+      if (!(check.route.initial_m3 > 0.0)) return 0.0;
+      return std::clamp(1.0 - check.route_gap_m3 / check.route.initial_m3, 0.0, 1.0);
+    }
+    case scenario::CompletionKind::kLevelSite: return state.check.level_fraction;
+    case scenario::CompletionKind::kAgentsAtGoal: break;
+  }
+  const auto [live, done] = live_agents_at_goal(state);
   return live == 0 ? 0.0 : static_cast<double>(done) / live;
 }
 
@@ -90,6 +103,7 @@ void start_completion_check(WorldState& state) {
       check.to = cell_of(state.terrain, p.to_x_m, p.to_y_m, "payload_path.to");
       check.occupancy =
           OccupancyCache(state.terrain, {{0, 0}, state.terrain.rows(), state.terrain.cols()}, p.navigability);
+      check.route = plan_route_gap(state.terrain, p);
       break;
     }
     case scenario::CompletionKind::kLevelSite:
@@ -107,6 +121,7 @@ void evaluate_completion(WorldState& state) {
   const CellMask& mask = check.occupancy.occupiable();
   if (state.completion == scenario::CompletionKind::kPayloadPath) {
     check.met = connected(mask, check.from, check.to);
+    check.route_gap_m3 = route_gap_m3(state.terrain, check.route);
   } else {
     check.level_fraction =
         static_cast<double>(largest_component(mask)) / static_cast<double>(check.occupancy.area().size());
@@ -177,6 +192,60 @@ double site_level_fraction(const Heightmap& terrain, const scenario::Site& site)
   const CellMask mask =
       NavigabilityProcessor(site.navigability).occupiable(terrain.window(rect.first, rect.rows, rect.cols));
   return static_cast<double>(largest_component(mask)) / static_cast<double>(rect.size());
+}
+
+RouteGap plan_route_gap(const Heightmap& terrain, const scenario::PayloadPath& path) {
+  const CellIndex from = cell_of(terrain, path.from_x_m, path.from_y_m, "payload_path.from");
+  const CellIndex to = cell_of(terrain, path.to_x_m, path.to_y_m, "payload_path.to");
+  const NavigabilityParams& body = path.navigability;
+  const double cs = terrain.cell_size_m();
+  const Heightmap ceiling = MarsProcessor(body.kappa).project(terrain);
+  Heightmap gap(terrain.geometry(), (ceiling.heights() - terrain.heights()).cwiseMax(0.0));
+  // The route the agents' own planner would choose with the whole terrain known: the shortest path that weighs the
+  // gap its footprint must fill against its length; every cell is allowed, since filling the gap makes it passable.
+  const NavigablePathPlanner planner(default_planner_params(body.delta_m, cs));
+  const CellMask everywhere = CellMask::Ones(terrain.rows(), terrain.cols());
+  PlannerResult plan = planner.plan(gap, everywhere, from, to);
+  if (!plan.found) throw Error(fmt::format("payload route from {} to {}: the planner found none", from, to));
+  RouteGap out;
+  out.route = std::move(plan.path);
+  CellMask band = CellMask::Zero(terrain.rows(), terrain.cols());
+  const std::vector<CellIndex> ball = disc_offsets(body.delta_m / (2.0 * cs));
+  for (const CellIndex& c : out.route)
+    for (const CellIndex& o : ball) {
+      const CellIndex n{c.row + o.row, c.col + o.col};
+      if (terrain.contains(n)) band(n.row, n.col) = 1;
+    }
+  for (int r = 0; r < terrain.rows(); ++r)
+    for (int c = 0; c < terrain.cols(); ++c)
+      if (band(r, c) != 0) {
+        out.cells.push_back(static_cast<std::int64_t>(r) * terrain.cols() + c);
+        out.ceiling_m.push_back(ceiling(r, c));
+      }
+  out.initial_m3 = route_gap_m3(terrain, out);
+  return out;
+}
+
+double route_gap_m3(const Heightmap& terrain, const RouteGap& route) {
+  const double* h = terrain.data();
+  double sum = 0.0;
+  for (std::size_t i = 0; i < route.cells.size(); ++i) sum += std::max(0.0, route.ceiling_m[i] - h[route.cells[i]]);
+  return sum * terrain.cell_size_m() * terrain.cell_size_m();
+}
+
+std::string progress_detail(const WorldState& state) {
+  switch (state.completion) {
+    case scenario::CompletionKind::kPayloadPath:
+      if (state.check.met) return "the payload's path is navigable";
+      return fmt::format("{:.2f} of {:.2f} m3 of MARS gap left on the route", state.check.route_gap_m3,
+                         state.check.route.initial_m3);
+    case scenario::CompletionKind::kLevelSite:
+      return fmt::format("site {:.1f} % level ({:.1f} % needed)", 100.0 * state.check.level_fraction,
+                         100.0 * state.site.min_fraction);
+    case scenario::CompletionKind::kAgentsAtGoal: break;
+  }
+  const auto [live, done] = live_agents_at_goal(state);
+  return fmt::format("{} of {} live agents at the goal", done, live);
 }
 
 std::optional<PayloadRoute> shortest_path(const CellMask& passable, CellIndex from, CellIndex to, double cell_size_m) {

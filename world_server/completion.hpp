@@ -10,6 +10,7 @@
 // apply_step evaluates on its schedule and is_completed reads.
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "marsala/core/heightmap.hpp"
@@ -28,7 +29,8 @@ bool at_goal(const WorldState& state, const AgentRecord& agent);
 bool is_completed(const WorldState& state);
 
 /// agents_at_goal: fraction of the live agents at the goal (0 when none is live); payload_path: 1 when the latest
-/// check found the path, else 0; level_site: the latest level fraction. In [0, 1].
+/// check found the path, else the part of the route's initial MARS gap filled at that check (1 - gap left / initial
+/// gap, 0 when the route had no gap); level_site: the latest level fraction. In [0, 1] (docs/runtime.md#progress).
 double progress(const WorldState& state);
 
 /// Sets up the terrain check of a payload_path or level_site state (its cache on the current terrain) and evaluates
@@ -57,6 +59,20 @@ bool payload_path_navigable(const Heightmap& terrain, const scenario::PayloadPat
 /// The site's level fraction on `terrain`: largest 8-connected component of the crop's occupiable cells (balls cut
 /// at the crop's edge) / cells of the crop, in [0, 1]. Throws InvalidArgument when the site holds no cell of the grid.
 double site_level_fraction(const Heightmap& terrain, const scenario::Site& site);
+
+/// The payload's route on `terrain` and its band (docs/runtime.md#progress): the agents' planner (paper eq. 4-5,
+/// default_planner_params for the payload's delta_m) from the cell of `from` to the cell of `to` through every cell,
+/// priced by the MARS gap at the payload's kappa; the band is every cell within delta_m / 2 of a route cell (the
+/// disc_offsets ball), each with its MARS bound. Throws InvalidArgument when `from` or `to` is off the grid.
+RouteGap plan_route_gap(const Heightmap& terrain, const scenario::PayloadPath& path);
+
+/// The MARS gap left over the route's band on `terrain` (the grid it was planned on): the sum over its cells of
+/// max(0, bound - height) times the cell area [m^3].
+double route_gap_m3(const Heightmap& terrain, const RouteGap& route);
+
+/// A one-line account of the progress for people, e.g. "12.31 of 21.30 m3 of MARS gap left on the route",
+/// "site 83.2 % level (100.0 % needed)", "2 of 3 live agents at the goal".
+std::string progress_detail(const WorldState& state);
 
 /// A path of cells and its length.
 struct PayloadRoute {

@@ -151,6 +151,7 @@ proto::Snapshot make_snapshot(const WorldState& state, const std::string& run_id
   s.set_check_met(state.check.met);
   s.set_check_level_fraction(state.check.level_fraction);
   s.set_check_evaluations(state.check.evaluations);
+  s.set_check_route_gap_m3(state.check.route_gap_m3);
   if (state.completion != scenario::CompletionKind::kAgentsAtGoal)
     for (const CellIndex& c : state.check.occupancy.pending_changes()) {
       s.add_check_pending_cells(c.row);
@@ -275,6 +276,7 @@ void restore_snapshot(WorldState& state, const proto::Snapshot& s, const std::st
   state.check.met = s.check_met();
   state.check.level_fraction = s.check_level_fraction();
   state.check.evaluations = s.check_evaluations();
+  state.check.route_gap_m3 = s.check_route_gap_m3();
 }
 
 void apply_record(WorldState& state, const proto::LogRecord& record, const std::string& where) {

@@ -6,9 +6,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <cerrno>
+#include <cstring>
 #include <limits>
 
 #include "idl/run_summary.pb.h"
+#include "marsala/cli/logging.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/render/perspective.hpp"
@@ -152,6 +155,8 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_path_length_m(report.route ? report.route->length_m : 0.0);
   s.set_site_level_fraction(report.site_fraction);
   s.set_completion_checks(state.check.evaluations);
+  s.set_progress(progress(state));
+  s.set_progress_detail(progress_detail(state));
   s.set_start_jitter_m(info.start_jitter_m);
 
   google::protobuf::util::JsonPrintOptions options;
@@ -362,16 +367,29 @@ void write_final_outputs(const std::string& dir, const WorldState& state, const 
   }
 }
 
-std::string format_event(const protocol::WorldEvent& e) {
-  std::string line =
-      "step " + std::to_string(e.step) + " agent " + std::to_string(e.agent_id) + " " + protocol::to_string(e.kind);
+std::string event_json(const protocol::WorldEvent& e, const std::vector<Deposition>& cells) {
+  std::string line = "{\"step\":" + std::to_string(e.step) + ",\"agent\":" + std::to_string(e.agent_id) +
+                     ",\"kind\":" + cli::json_string(protocol::to_string(e.kind));
+  char buf[64];
   if (e.kind == protocol::EventKind::kDeposited) {
-    char buf[40];
-    std::snprintf(buf, sizeof buf, " %.9g m3", e.volume_m3);
+    std::snprintf(buf, sizeof buf, ",\"volume_m3\":%.9g", e.volume_m3);
     line += buf;
   }
-  if (!e.detail.empty()) line += ": " + e.detail;
-  return line;
+  if (!e.detail.empty()) line += ",\"detail\":" + cli::json_string(e.detail);
+  if (e.kind == protocol::EventKind::kDeposited) {
+    line += ",\"cells\":[";
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      std::snprintf(buf, sizeof buf, "%s[%d,%d,%.17g]", i == 0 ? "" : ",", cells[i].row, cells[i].col,
+                    cells[i].height_m);
+      line += buf;
+    }
+    line += "]";
+  }
+  return line + "}";
+}
+
+std::string note_json(std::uint64_t step, const std::string& text) {
+  return "{\"step\":" + std::to_string(step) + ",\"kind\":\"note\",\"detail\":" + cli::json_string(text) + "}";
 }
 
 EventLog::EventLog(const std::string& path, bool append) : path_(path) {
@@ -380,15 +398,18 @@ EventLog::EventLog(const std::string& path, bool append) : path_(path) {
   if (!out_) throw IoError("cannot write '" + path + "'");
 }
 
-void EventLog::append(const protocol::WorldEvent& event) { write_line(format_event(event)); }
-
-void EventLog::note(std::uint64_t step, const std::string& text) {
-  write_line("step " + std::to_string(step) + " note: " + text);
+void EventLog::append(const protocol::WorldEvent& event, const std::vector<Deposition>& cells) {
+  write_line(event_json(event, cells));
 }
 
+void EventLog::note(std::uint64_t step, const std::string& text) { write_line(note_json(step, text)); }
+
 void EventLog::write_line(const std::string& line) {
+  errno = 0;
   out_ << line << std::endl;
-  if (!out_) throw IoError("cannot write '" + path_ + "' (disk full or the file gone?): the run's record is lost");
+  if (!out_)
+    throw IoError("cannot write '" + path_ + "': " + (errno != 0 ? std::strerror(errno) : "disk full or the file gone?") +
+                  "; the run's record is lost");
 }
 
 std::vector<std::string> run_files_in(const std::string& dir) {
@@ -407,6 +428,21 @@ void clear_run_files(const std::string& dir) {
       fs::remove(fs::path(dir) / file, ec);
       if (ec) throw IoError("cannot remove '" + (fs::path(dir) / file).string() + "' (--replace): " + ec.message());
     }
+  // The time-lapse of --frames-every: its frames and video only, then the folder when nothing else is in it.
+  const fs::path frames = fs::path(dir) / "frames";
+  std::error_code ec;
+  if (!fs::is_directory(frames, ec)) return;
+  std::vector<fs::path> doomed;
+  for (const fs::directory_entry& e : fs::directory_iterator(frames, ec)) {
+    const std::string name = e.path().filename().string();
+    if ((name.rfind("frame_", 0) == 0 && e.path().extension() == ".png") || name == "timelapse.mp4")
+      doomed.push_back(e.path());
+  }
+  for (const fs::path& p : doomed) {
+    fs::remove(p, ec);
+    if (ec) throw IoError("cannot remove '" + p.string() + "' (--replace): " + ec.message());
+  }
+  fs::remove(frames, ec);  // fails, and is meant to, when the folder holds anything else
 }
 
 void check_fresh_output_dir(const std::string& dir) {

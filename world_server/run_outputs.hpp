@@ -1,8 +1,8 @@
 #pragma once
 // What a run leaves in its output folder: summary.json (protobuf RunSummary as JSON, proto field names),
 // terrain_initial.asc, terrain_final.asc, final.png, final_zoom.png (when zoom_window() finds a close-up),
-// final_3d.png, goal_vector_map.png (scenarios with a goal vector map) and events.log (one text line per event). IO at
-// the edge.
+// final_3d.png, goal_vector_map.png (scenarios with a goal vector map) and events.log (JSON Lines, one object per event or
+// note). IO at the edge.
 //
 // final.png: the hillshaded final terrain; every cell raised by a deposition tinted with its depositor's colour
 // (render::default_palette(): agent id k -> entry (k - 1) mod 12: 1 red, 2 blue, 3 green, 4 orange, 5 purple, 6 cyan,
@@ -95,9 +95,6 @@ render::RenderOptions goal_vector_map_picture_options(const WorldState& state, c
 /// grid throws InvalidArgument after the other files are written.
 void write_final_outputs(const std::string& dir, const WorldState& state, const RunInfo& info);
 
-/// One event as a log line: "step 12 agent 2 deposited 0.000125 m3: 1 cells".
-std::string format_event(const protocol::WorldEvent& event);
-
 /// The files a run writes into its output folder (docs/runtime.md#outputs).
 inline constexpr const char* kRunFiles[] = {
     "summary.json",   "events.log",   "terrain_initial.asc", "terrain_final.asc", "final.png",
@@ -109,17 +106,26 @@ std::vector<std::string> run_files_in(const std::string& dir);
 /// Throws IoError naming them when `dir` holds any of a run's files: a run never mixes its outputs with another's.
 void check_fresh_output_dir(const std::string& dir);
 
-/// Removes the kRunFiles (and their temporary .tmp names) from `dir` (marsala-world --replace); throws IoError.
+/// Removes the kRunFiles (and their temporary .tmp names) from `dir`, and the frames and timelapse.mp4 of dir/frames
+/// (--frames-every; the folder too when nothing else is in it) (marsala-world --replace); throws IoError.
 void clear_run_files(const std::string& dir);
 
-/// events.log: appends one line per event or note, flushed at once so that a crash keeps what happened; a line that
-/// cannot be written throws IoError (the run then ends with an error).
+/// One events.log line (without its newline): a JSON object (docs/runtime.md#outputs), e.g.
+///   {"step":42,"agent":3,"kind":"deposited","volume_m3":0.000125,"detail":"2 cells","cells":[[10,11,0.05],[10,12,0.05]]}
+/// `cells` (row, col, new height [m], heights to 17 digits) only for a deposition; agent 0 = the world.
+std::string event_json(const protocol::WorldEvent& event, const std::vector<Deposition>& cells = {});
+/// A note as an events.log line: {"step":7,"kind":"note","detail":"agent 2: request for past step 5 dropped"}.
+std::string note_json(std::uint64_t step, const std::string& text);
+
+/// events.log, JSON Lines: appends one object per event or note, flushed at once so that a crash keeps what happened;
+/// a line that cannot be written throws IoError (the run then ends with an error).
 class EventLog {
  public:
   /// Creates (truncates) the file, or with `append` continues it (a resumed run); throws IoError.
   explicit EventLog(const std::string& path, bool append = false);
-  void append(const protocol::WorldEvent& event);
-  /// A line that is not an event, e.g. "step 7 note: agent 2: request for past step 5 dropped".
+  /// An event; for a deposition `cells` are the cells it set.
+  void append(const protocol::WorldEvent& event, const std::vector<Deposition>& cells = {});
+  /// A line that is not an event, e.g. a request for a past step dropped.
   void note(std::uint64_t step, const std::string& text);
 
  private:

@@ -1,11 +1,11 @@
 #include "marsala/world_server/world_cli.hpp"
 
-#include <spdlog/spdlog.h>
-
+#include <cstdlib>
 #include <ostream>
 
 #include "marsala/bus/bus.hpp"
 #include "marsala/cli/command_line.hpp"
+#include "marsala/cli/logging.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
@@ -70,10 +70,17 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   app.add_option("--snapshot-every", options.snapshot_every, "write snapshot.pb after every N steps (0: never)")
       ->check(CLI::Range(0ull, 1ull << 40))
       ->capture_default_str();
+  app.add_option("--frames-every", options.frames_every,
+                 "a time-lapse: a PNG frame every K steps and the last into OUT/frames (frame_<step>.png), and\n"
+                 "OUT/frames/timelapse.mp4 of them when ffmpeg is on PATH")
+      ->check(cli::at_least_one())
+      ->type_name("K");
   app.add_flag("--replace", options.replace,
                "remove a previous run's files from --out before starting (without it such a folder is refused)")
       ->excludes(resume_option);
-  app.add_flag("--quiet", quiet, "log warnings and errors only");
+  app.add_flag("--quiet", quiet, "log warnings and errors only (--log-level warn)");
+  cli::LogOptions log_options;
+  cli::add_log_options(app, log_options);
   app.callback([&] {
     // --scenario is required of a run; a check takes its file either way; a resume reads it from the log.
     if (scenario_option->count() == 0 && check_path.empty() && resume_option->count() == 0)
@@ -82,10 +89,11 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-world", out, err)) return *code;
 
   if (seed_option->count() > 0) options.seed = seed;
+  if (const char* path = std::getenv("PATH")) options.search_path = path;
   if (check)
     return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, dds.domain, json, out, err);
-  spdlog::set_pattern("%H:%M:%S.%e %^%l%$ world: %v");
-  spdlog::set_level(quiet ? spdlog::level::warn : spdlog::level::info);
+  if (quiet && app.get_option("--log-level")->count() == 0) log_options.level = "warn";
+  const cli::LoggingScope logging("world", 0, log_options);
   try {
     WorldStart start;
     if (!resume_dir.empty()) {
@@ -106,13 +114,13 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
         << result.admitted << " agents, terrain sha256 " << result.terrain_sha256 << "\n";
     return exit_code(result.end_reason);
   } catch (const Error& e) {
-    err << "marsala-world: error: " << e.what() << "\n";
+    cli::write_exit_error(err, std::string("marsala-world: error: ") + e.what());
     return 1;
   } catch (const std::bad_alloc&) {
-    err << "marsala-world: error: out of memory\n";
+    cli::write_exit_error(err, "marsala-world: error: out of memory");
     return 1;
   } catch (const std::exception& e) {  // a library's own exception: still one line and exit 1, never an abort
-    err << "marsala-world: error: " << e.what() << "\n";
+    cli::write_exit_error(err, std::string("marsala-world: error: ") + e.what());
     return 1;
   }
   return 0;

@@ -19,6 +19,8 @@
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/core/mars_processor.hpp"
+#include "marsala/render/terrain_renderer.hpp"
+#include "marsala/render/timelapse.hpp"
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/terrain/asc_io.hpp"
 #include "marsala/world_server/admission.hpp"
@@ -249,9 +251,9 @@ struct WorldRuntime::Impl {
     while (world_id == 0) world_id = (static_cast<std::uint64_t>(device()) << 32) ^ device();
   }
 
-  void emit(const protocol::WorldEvent& e) {
+  void emit(const protocol::WorldEvent& e, const std::vector<Deposition>& cells = {}) {
     write_logged(*events, e, "a world event");
-    if (event_log) event_log->append(e);
+    if (event_log) event_log->append(e, cells);
   }
 
   void note(const std::string& text) {
@@ -539,6 +541,7 @@ struct WorldRuntime::Impl {
     s.wall_seconds = wall_seconds;
     s.deposited_volume_m3 = state.deposited_volume_m3;
     s.progress = progress(state);
+    s.progress_detail = progress_detail(state);
     s.running = running;
     s.completed = completed;
     for (const AgentRecord& a : state.agents) {
@@ -580,9 +583,20 @@ struct WorldRuntime::Impl {
     last = e.detail;
   }
 
+  /// The cells the accepted request of `agent` set in this step (for its deposition in events.log).
+  static const std::vector<Deposition>& deposited_cells(const std::vector<Submission>& submissions,
+                                                        const StepOutcome& outcome, std::uint32_t agent) {
+    static const std::vector<Deposition> none;
+    for (std::size_t i = 0; i < submissions.size(); ++i)
+      if (outcome.accepted_submissions[i] && submissions[i].channel_id == agent)
+        return submissions[i].request.depositions;
+    return none;
+  }
+
   /// Runs steps until an end condition; returns the end reason.
   EndReason lockstep(const std::atomic<bool>& stop, Clock::time_point start) {
     for (;;) {
+      if (frames) frames->maybe_write(state.step, false, [this] { return frame_picture(false); });
       if (stop) return EndReason::kSignal;
       if (is_completed(state)) return EndReason::kCompleted;
       if (state.step >= options.max_steps) return EndReason::kMaxSteps;
@@ -616,7 +630,8 @@ struct WorldRuntime::Impl {
           spdlog::warn("step {}: agent {} {}: {}", e.step, e.agent_id, protocol::to_string(e.kind), e.detail);
         else if (e.kind == protocol::EventKind::kAtGoal)
           spdlog::info("step {}: agent {} reached the goal", e.step, e.agent_id);
-        emit(e);
+        emit(e, e.kind == protocol::EventKind::kDeposited ? deposited_cells(submissions, outcome, e.agent_id)
+                                                          : std::vector<Deposition>{});
       }
       for (const AgentRecord& a : state.agents)
         if (a.last_result != protocol::ActionResult::kRejected) last_rejection[a.id - 1].clear();
@@ -624,8 +639,8 @@ struct WorldRuntime::Impl {
       for (std::uint32_t id : outcome.dropped) send_frame(id, true);
       publish_status(true, outcome.completed, elapsed_s(start));
       if (state.step % kProgressEvery == 0)
-        spdlog::info("step {}: {} live agents, {:.6f} m3 deposited, progress {:.2f}", state.step,
-                     state.live_ids().size(), state.deposited_volume_m3, progress(state));
+        spdlog::info("step {}: {} live agents, {:.6f} m3 deposited, progress {:.3f}: {}", state.step,
+                     state.live_ids().size(), state.deposited_volume_m3, progress(state), progress_detail(state));
     }
   }
 
@@ -710,6 +725,28 @@ struct WorldRuntime::Impl {
                  fmt::join(missing, ", "));
   }
 
+  /// A time-lapse frame: the terrain now, drawn like final_zoom.png (depositors' colours, agents, base, target; no
+  /// route, which would cost a payload plan per frame) on the window fixed at the start, or like final.png without one.
+  render::Image frame_picture(bool last) const {
+    RunInfo info;
+    info.scenario = fmt::format("{}, step {}", scenario.name, state.step);  // the close-up's title names no step
+    info.completed = last && is_completed(state);
+    if (!frame_window) return render::render_terrain(state.terrain, final_picture_options(state, info, std::nullopt));
+    const CellRect& w = *frame_window;
+    return render::render_terrain(state.terrain.window(w.first, w.rows, w.cols),
+                                  final_picture_options(state, info, std::nullopt, w));
+  }
+
+  /// The last frame and timelapse.mp4 (ffmpeg); a time-lapse that cannot be finished is an error of the run.
+  void finish_frames() {
+    if (!frames) return;
+    frames->maybe_write(state.step, true, [this] { return frame_picture(true); });
+    const render::TimelapseResult video = frames->finish(options.search_path);
+    spdlog::info("time-lapse: {} frames in {} ({:.3f} s drawing){}", frames->names().size(), frames->dir(),
+                 frames->seconds(),
+                 video.path.empty() ? "; " + video.note : fmt::format(", {} ({:.3f} s)", video.path, video.seconds));
+  }
+
   RunResult run(const std::atomic<bool>& stop) {
     const Clock::time_point admit_start = Clock::now();
     if (resume) {
@@ -717,6 +754,15 @@ struct WorldRuntime::Impl {
     } else {
       write_initial_outputs(options.out_dir, state.terrain);
       event_log.emplace((std::filesystem::path(options.out_dir) / "events.log").string());
+    }
+    if (options.frames_every > 0) {
+      // A resumed run goes on adding frames to its folder; a fresh one never mixes its frames with another's.
+      const std::string dir = (std::filesystem::path(options.out_dir) / "frames").string();
+      if (!resume) render::check_fresh_frames_dir(dir, "another run's time-lapse");
+      frames.emplace(dir, options.frames_every);
+      // One window for every frame, so that the time-lapse does not jump: the close-up of the base and the payload
+      // ends or the site (and what was built before a resume), as final_zoom.png frames them.
+      frame_window = zoom_window(state, std::nullopt);
     }
     open_run_log();
     open_endpoints();
@@ -791,6 +837,7 @@ struct WorldRuntime::Impl {
     info.admit_seconds = admit_seconds;
     info.connected = connected;
     write_final_outputs(options.out_dir, state, info);
+    finish_frames();
     for (const AgentRecord& a : state.agents) result.admitted += a.admitted ? 1 : 0;
     result.terrain_sha256 = runlog::terrain_sha256(state.terrain);
     if (resume) result.resumed_at_step = resume_step;
@@ -820,6 +867,8 @@ struct WorldRuntime::Impl {
   std::uint64_t world_id = 0;                                    ///< random, this process's
   Clock::time_point next_admitting_status{};
   std::optional<EventLog> event_log;
+  std::optional<render::FrameWriter> frames;  ///< --frames-every
+  std::optional<CellRect> frame_window;       ///< the frames' close-up; none = the whole terrain
   std::vector<std::string> last_rejection;  ///< [id - 1]: the rejection reason last logged at info level
   std::set<std::pair<std::uint32_t, std::uint64_t>> refused;  ///< (id, session) already reported as refused
   std::map<std::pair<std::uint32_t, std::uint64_t>, Clock::time_point> answered_at;  ///< last answer per sender

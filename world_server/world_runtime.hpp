@@ -33,6 +33,8 @@ struct RuntimeOptions {
   double linger_s = 2.0;                ///< after the run_over frames, wait up to this long for agents to leave [s]
   std::optional<std::uint64_t> seed;    ///< overrides the scenario's seed (start jitter; reported in summary.json)
   std::uint64_t snapshot_every = 1000;  ///< write snapshot.pb after every this many steps; 0 = never
+  std::uint64_t frames_every = 0;       ///< a PNG frame every this many steps and the last in out_dir/frames; 0 = none
+  std::string search_path;              ///< where to look for ffmpeg (the timelapse.mp4 of the frames); empty = none
   std::string scenario_text;  ///< the scenario file's text, recorded in run.log so that --resume needs no file
   bool replace = false;       ///< out_dir may hold another run's files: the caller clears them (clear_run_files())
 };

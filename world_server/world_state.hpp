@@ -56,6 +56,17 @@ inline bool carries_identity_of(const AgentRecord& agent, const protocol::Action
 /// Per-cell agent ids, row-major like the terrain (0 = none).
 using AgentIdGrid = Eigen::Matrix<std::uint32_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
+/// The payload's route as planned on the initial terrain and what it takes to build it (docs/runtime.md#progress): the
+/// cells the payload covers along it (its band) and the MARS bound of the initial terrain at the payload's kappa on
+/// each. Filling the band up to that bound makes every route cell occupiable for the payload, so the gap left there
+/// falls to 0 as the path is built, and no later than the path is found.
+struct RouteGap {
+  std::vector<CellIndex> route;       ///< from the cell of `from` to the cell of `to`, 8-connected
+  std::vector<std::int64_t> cells;    ///< the band: cells within delta/2 of a route cell, row-major indexes, ascending
+  std::vector<double> ceiling_m;      ///< per band cell: P_kappa of the initial terrain [m]
+  double initial_m3 = 0.0;            ///< the gap over the band on the initial terrain [m^3]
+};
+
 /// The terrain check of payload-path and level-site runs (completion.hpp): its cache and its latest answer.
 struct CompletionCheck {
   OccupancyCache occupancy;  ///< payload: the whole grid for the payload's body; site: the site's cells
@@ -64,6 +75,8 @@ struct CompletionCheck {
   bool met = false;               ///< the latest evaluation found the payload's path / a level site
   double level_fraction = 0.0;    ///< site: the latest level fraction [0, 1]
   std::uint32_t evaluations = 0;  ///< evaluations run, the initial one included
+  RouteGap route;                 ///< payload: its route on the initial terrain and the MARS bound over its band
+  double route_gap_m3 = 0.0;      ///< payload: the MARS gap left on the route's band at the latest evaluation [m^3]
 };
 
 /// Everything the step function reads and changes.

@@ -183,6 +183,7 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
         make_behaviour();
         hello.agent_id = a.agent_id;  // later hellos speak for the slot, under the name the world gave it
         hello.name = config_.name;
+        if (config_.on_assigned) config_.on_assigned(a.agent_id);
         spdlog::info("agent: assigned slot {} ({})", a.agent_id, config_.name);
       }
       admission = a;

@@ -15,6 +15,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -37,6 +38,7 @@ struct RuntimeConfig {
   std::chrono::milliseconds hello_period{200};       ///< between hellos until admitted
   std::chrono::milliseconds admit_timeout{60000};    ///< give up when not admitted by then
   std::chrono::milliseconds world_timeout{60000};    ///< give up when no frame comes for this long
+  std::function<void(std::uint32_t)> on_assigned;    ///< called with the slot an --id auto agent was given (logging)
 };
 
 /// Why run() returned.

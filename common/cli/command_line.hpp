@@ -1,7 +1,8 @@
 #pragma once
 // How every MARSala executable parses its command line: --help (on the program or a subcommand) prints help and
-// exits 0; a usage error prints one line "<program>: <reason> (run with --help for usage)" and exits 2.
-// Header-only; include it only from files that link CLI11::CLI11.
+// exits 0; --version prints "<program> <version> (git <revision>)" (version.hpp) and exits 0; a usage error prints
+// one line "<program>: <reason> (run with --help for usage)" and exits 2.
+// Include it only from files that link marsala::cli.
 
 #include <optional>
 #include <ostream>
@@ -12,6 +13,8 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <CLI/CLI.hpp>
 #pragma GCC diagnostic pop
+
+#include "marsala/cli/version.hpp"
 
 namespace marsala::cli {
 
@@ -52,12 +55,28 @@ inline void add_dds_options(CLI::App& app, DdsOptions& options) {
       ->envname("MARSALA_IDENTITY");
 }
 
+/// A whole number >= 1, e.g. a "every K steps" (CLI11's PositiveNumber explains a 0 with a range of 300 digits).
+inline CLI::Validator at_least_one() {
+  return CLI::Validator(
+      [](std::string& text) {
+        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+        return digits && text.find_first_not_of('0') != std::string::npos
+                   ? std::string()
+                   : "must be a whole number of at least 1, not " + text;
+      },
+      ">= 1");
+}
+
 /// Parses argv into `app`; returns nullopt when the program should go on, else the exit code to return now.
 inline std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const* argv,
                                              const std::string& program, std::ostream& out, std::ostream& err) {
+  app.set_version_flag("--version", version_text(program), "print the version and the git revision, then exit");
   try {
     app.parse(argc, argv);
     return std::nullopt;
+  } catch (const CLI::CallForVersion& e) {
+    out << e.what() << "\n";
+    return 0;
   } catch (const CLI::CallForAllHelp&) {
     out << app.help("", CLI::AppFormatMode::All);
     return 0;

@@ -95,12 +95,13 @@ struct WorldStatus {
   std::uint64_t step = 0;
   double wall_seconds = 0.0;
   double deposited_volume_m3 = 0.0;
-  double progress = 0.0;  ///< [0, 1]: agents at goal (fraction), payload path (0/1), site (level fraction)
+  double progress = 0.0;  ///< [0, 1]: agents at goal (fraction), payload route's gap filled, site level fraction
   bool running = true;
   bool completed = false;
   std::vector<AgentStatus> agents;
   std::uint64_t world_id = 0;  ///< random per world process: tells two worlds on one domain apart
   bool admitting = false;      ///< the world is still admitting its agents (before its first step)
+  std::string progress_detail;  ///< the progress in words, e.g. "12.31 of 21.30 m3 of MARS gap left on the route"
 };
 
 /// Kinds of world events, for the event stream and the monitor.

@@ -71,6 +71,7 @@ function update(s) {
     text('progress-label', s.replay ? 'replayed' : 'progress');
     text('progress', fmt(100 * run.progress, 0) + ' %');
     $('progress-bar').style.width = (100 * Math.max(0, Math.min(1, run.progress))) + '%';
+    text('progress-detail', run.progress_detail || '');
     document.title = 'MARSala · ' + run.scenario + ' · step ' + run.step;
   }
   updateAgents(s.agents || []);

@@ -123,8 +123,8 @@ case "$case_name" in
   kill)
     start_run "$work/kill"
     # Kill agent 2 without warning as soon as it has deposited (events.log is written live): mid-run for sure.
-    for _ in $(seq 1 3000); do grep -q "agent 2 deposited" "$out/events.log" 2>/dev/null && break; sleep 0.02; done
-    grep -q "agent 2 deposited" "$out/events.log" || fail "agent 2 never deposited (see $out/logs)"
+    for _ in $(seq 1 3000); do grep -q '"agent":2,"kind":"deposited"' "$out/events.log" 2>/dev/null && break; sleep 0.02; done
+    grep -q '"agent":2,"kind":"deposited"' "$out/events.log" || fail "agent 2 never deposited (see $out/logs)"
     kill -KILL "${pids[1]}"
     wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
     s="$out/summary.json"
@@ -146,16 +146,16 @@ case "$case_name" in
       fail "no '$1' in events.log (see $out/logs)"
     }
     # Mid-run for sure: pause the world for 3 s (longer than the 1 s DDS liveliness lease), then agent 3.
-    wait_for_event "agent 2 deposited"
+    wait_for_event '"agent":2,"kind":"deposited"'
     kill -STOP "$world"; sleep 3; kill -CONT "$world"
-    wait_for_event "agent 1 deposited"
+    wait_for_event '"agent":1,"kind":"deposited"'
     kill -STOP "${pids[2]}"; sleep 3; kill -CONT "${pids[2]}"
     wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
     for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero after the pauses (see $out/logs)"; done
     s="$out/summary.json"
     expect_completed "$s" 3
-    ! grep -Eq "agent [0-9]+ dropped" "$out/events.log" ||
-      { grep -E "agent [0-9]+ dropped" "$out/events.log"; fail "a pause dropped an agent"; }
+    ! grep -q '"kind":"dropped"' "$out/events.log" ||
+      { grep '"kind":"dropped"' "$out/events.log"; fail "a pause dropped an agent"; }
     [ "$(field terrain_sha256 "$s")" = "$(field terrain_sha256 "$reference")" ] ||
       fail "paused run ended on $(field terrain_sha256 "$s"), unpaused on $(field terrain_sha256 "$reference")"
     echo "ok: world and agent paused 3 s each; completed in $(field steps "$s") steps on the unpaused terrain"
@@ -167,7 +167,7 @@ case "$case_name" in
     expect_completed "$reference" 3
     start_run "$work/resume" --snapshot-every 50
     step_reached() {  # step_reached N: events.log (written live) holds a line of step N or later
-      awk -v n="$1" '$1 == "step" && $2 + 0 >= n { found = 1 } END { exit !found }' "$out/events.log" 2>/dev/null
+      sed -n 's/^{"step":\([0-9]*\),.*/\1/p' "$out/events.log" 2>/dev/null | awk -v n="$1" '$1 + 0 >= n { found = 1 } END { exit !found }'
     }
     resumes=0
     for at in 40 120 200; do
@@ -200,7 +200,7 @@ case "$case_name" in
     # it, never applies it, and the run ends on the uninterrupted terrain.
     reference=$(run_spawn reference 3 cyclone)
     start_run "$work/torn-tail"
-    for _ in $(seq 1 3000); do grep -q "^step 1[0-9][0-9] " "$out/events.log" 2>/dev/null && break; sleep 0.01; done
+    for _ in $(seq 1 3000); do grep -q '^{"step":1[0-9][0-9],' "$out/events.log" 2>/dev/null && break; sleep 0.01; done
     kill -KILL "$world"
     wait "$world" 2>/dev/null || true
     # A frame that promises 200 payload bytes, then 7 of them.
@@ -223,8 +223,8 @@ case "$case_name" in
     # SIGKILL of an agent, restarted at once with a new session: it waits for the old session's liveliness to lapse,
     # takes its slot over (pose and material as the world kept them), and the run completes.
     start_run "$work/agent-restart"
-    for _ in $(seq 1 3000); do grep -q "agent 2 deposited" "$out/events.log" 2>/dev/null && break; sleep 0.02; done
-    grep -q "agent 2 deposited" "$out/events.log" || fail "agent 2 never deposited (see $out/logs)"
+    for _ in $(seq 1 3000); do grep -q '"agent":2,"kind":"deposited"' "$out/events.log" 2>/dev/null && break; sleep 0.02; done
+    grep -q '"agent":2,"kind":"deposited"' "$out/events.log" || fail "agent 2 never deposited (see $out/logs)"
     kill -KILL "${pids[1]}"
     wait "${pids[1]}" 2>/dev/null || true
     "$bin/marsala-agent" --scenario "$scenario" --id 2 --dds cyclone --domain "$domain" \
@@ -234,9 +234,9 @@ case "$case_name" in
     for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero (see $out/logs)"; done
     s="$out/summary.json"
     expect_completed "$s" 3
-    grep -q "agent 2 admitted: .*takes over from" "$out/events.log" || fail "no takeover of slot 2 in events.log"
-    ! grep -Eq "agent [0-9]+ dropped" "$out/events.log" || fail "an agent was dropped: $(grep -E "agent [0-9]+ dropped" "$out/events.log")"
-    after=$(awk '/agent 2 admitted: .*takes over/ { on = 1 } on && /agent 2 deposited/ { n++ } END { print n + 0 }' \
+    grep -q '"agent":2,"kind":"admitted","detail":"[^"]*takes over from' "$out/events.log" || fail "no takeover of slot 2 in events.log"
+    ! grep -q '"kind":"dropped"' "$out/events.log" || fail "an agent was dropped: $(grep '"kind":"dropped"' "$out/events.log")"
+    after=$(awk '/"agent":2,"kind":"admitted","detail":"[^"]*takes over/ { on = 1 } on && /"agent":2,"kind":"deposited"/ { n++ } END { print n + 0 }' \
       "$out/events.log")
     [ "$after" -gt 0 ] || fail "the restarted agent 2 never deposited"
     echo "ok: agent 2 killed and restarted; took its slot over, deposited $after times after, run completed in" \
@@ -246,16 +246,16 @@ case "$case_name" in
     # An agent paused past the world's 6 s grace is dropped; when it runs again it asks the world (no frame for 2 s),
     # is re-admitted with the state the world kept, and the run completes with it.
     start_run "$work/drop-rejoin"
-    for _ in $(seq 1 3000); do grep -q "agent 3 deposited" "$out/events.log" 2>/dev/null && break; sleep 0.02; done
+    for _ in $(seq 1 3000); do grep -q '"agent":3,"kind":"deposited"' "$out/events.log" 2>/dev/null && break; sleep 0.02; done
     kill -STOP "${pids[2]}"
-    for _ in $(seq 1 150); do grep -q "agent 3 dropped" "$out/events.log" 2>/dev/null && break; sleep 0.1; done
-    grep -q "agent 3 dropped" "$out/events.log" || { kill -CONT "${pids[2]}"; fail "agent 3 was not dropped while paused"; }
+    for _ in $(seq 1 150); do grep -q '"agent":3,"kind":"dropped"' "$out/events.log" 2>/dev/null && break; sleep 0.1; done
+    grep -q '"agent":3,"kind":"dropped"' "$out/events.log" || { kill -CONT "${pids[2]}"; fail "agent 3 was not dropped while paused"; }
     kill -CONT "${pids[2]}"
     wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
     for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero (see $out/logs)"; done
     s="$out/summary.json"
     expect_completed "$s" 3
-    grep -q "agent 3 admitted: .*(re-admitted, 1 of 3)" "$out/events.log" || fail "agent 3 was not re-admitted"
+    grep -q '"agent":3,"kind":"admitted","detail":"[^"]*(re-admitted, 1 of 3)' "$out/events.log" || fail "agent 3 was not re-admitted"
     [ "$(field readmissions "$s")" = "1" ] || fail "summary says $(field readmissions "$s") readmissions"
     echo "ok: agent 3 dropped while paused, re-admitted; run completed in $(field steps "$s") steps"
     ;;
@@ -300,7 +300,7 @@ case "$case_name" in
     # One world per domain: a second marsala-world started on the domain of a running one refuses to go on (exit 1,
     # naming the other run) and the first run completes undisturbed; a monitor sees the first one admitting.
     start_run "$work/two-worlds"
-    for _ in $(seq 1 3000); do grep -q "agent 1 deposited" "$out/events.log" 2>/dev/null && break; sleep 0.02; done
+    for _ in $(seq 1 3000); do grep -q '"agent":1,"kind":"deposited"' "$out/events.log" 2>/dev/null && break; sleep 0.02; done
     rc=0
     "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$work/second" \
       --admit-timeout 20 >"$work/second.log" 2>&1 || rc=$?
@@ -340,7 +340,7 @@ case "$case_name" in
     expect_completed "$s" 3
     [ "$(field terrain_sha256 "$s")" = "$(field terrain_sha256 "$reference")" ] ||
       fail "flooded run ended on $(field terrain_sha256 "$s"), unflooded on $(field terrain_sha256 "$reference")"
-    ! grep -Eq "agent [0-9]+ dropped" "$out/events.log" || fail "the flood dropped an agent"
+    ! grep -q '"kind":"dropped"' "$out/events.log" || fail "the flood dropped an agent"
     for id in 1 2 3; do
       rej=$(tr -d '\n ' <"$s" | grep -o "{\"agent_id\":$id,[^}]*}" | grep -o '"rejected":[0-9]*' | cut -d: -f2)
       [ "$rej" = "0" ] || fail "honest agent $id was charged $rej rejections"
@@ -371,8 +371,8 @@ case "$case_name" in
     ;;
   world-kill)
     start_run "$work/world-kill"
-    for _ in $(seq 1 3000); do grep -q "agent 1 deposited" "$out/events.log" 2>/dev/null && break; sleep 0.02; done
-    grep -q "agent 1 deposited" "$out/events.log" || fail "agent 1 never deposited (see $out/logs)"
+    for _ in $(seq 1 3000); do grep -q '"agent":1,"kind":"deposited"' "$out/events.log" 2>/dev/null && break; sleep 0.02; done
+    grep -q '"agent":1,"kind":"deposited"' "$out/events.log" || fail "agent 1 never deposited (see $out/logs)"
     kill -KILL "$world"
     killed=$SECONDS
     for id in 1 2 3; do

@@ -228,6 +228,7 @@ wire::WorldStatus to_msg(const WorldStatus& in) {
   out.completed(in.completed);
   out.world_id(in.world_id);
   out.admitting(in.admitting);
+  out.progress_detail(in.progress_detail);
   out.agents().reserve(in.agents.size());
   for (const AgentStatus& a : in.agents) {
     wire::AgentStatus agent;
@@ -261,6 +262,7 @@ WorldStatus from_msg(const wire::WorldStatus& in) {
   out.completed = in.completed();
   out.world_id = in.world_id();
   out.admitting = in.admitting();
+  out.progress_detail = in.progress_detail();
   out.agents.reserve(in.agents().size());
   for (const wire::AgentStatus& a : in.agents()) {
     AgentStatus agent;

@@ -154,6 +154,7 @@ void expect_same(const WorldStatus& a, const WorldStatus& b) {
   EXPECT_SAME_DOUBLE(a.progress, b.progress);
   EXPECT_EQ(a.running, b.running);
   EXPECT_EQ(a.completed, b.completed);
+  EXPECT_EQ(a.progress_detail, b.progress_detail);
   ASSERT_EQ(a.agents.size(), b.agents.size());
   for (std::size_t i = 0; i < a.agents.size(); ++i) {
     const AgentStatus& x = a.agents[i];
@@ -281,6 +282,7 @@ WorldStatus filled_status(Filler& f) {
   s.progress = f.real();
   s.running = false;
   s.completed = true;
+  s.progress_detail = "12.31 of 21.30 m3 left " + kUtf8;
   for (int i = 0; i < 3; ++i) {
     AgentStatus a;
     a.agent_id = f.u32();

@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <future>
 #include <sstream>
@@ -117,6 +118,25 @@ TEST(MonitorCli, StatusWithoutAWorldExitsOne) {
   EXPECT_EQ(r.err, "marsala-monitor: no world server on domain 81 (inprocess): no world status within 0.1 s\n");
 }
 
+TEST(MonitorCli, JsonLogFormatMakesTheErrorOneRecordWhereverTheOptionStands) {
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--log-format", "json", "status", "--dds", "inprocess", "--domain", "81", "--timeout",
+                                 "0.1"},
+        std::vector<std::string>{"status", "--dds", "inprocess", "--domain", "81", "--timeout", "0.1", "--log-format",
+                                 "json"}}) {
+    const Result r = run_cli(args);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.err.find("marsala-monitor: "), std::string::npos) << r.err;  // the prefix gives way to the record's
+    EXPECT_EQ(r.err.front(), '{') << r.err;
+    EXPECT_EQ(r.err.substr(r.err.size() - 2), "}\n") << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("\"level\":\"error\",\"process\":\"monitor\",\"agent_id\":null,"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\"msg\":\"no world server on domain 81 (inprocess): no world status within 0.1 s\"}"),
+              std::string::npos)
+        << r.err;
+  }
+}
+
 TEST(MonitorCli, TailFollowsARunToItsEnd) {
   FakeWorld world(82);
   auto tail = std::async(std::launch::async, [] {
@@ -135,7 +155,7 @@ TEST(MonitorCli, TailFollowsARunToItsEnd) {
   const Result r = tail.get();
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out,
-            "  step  live mat[m3]  dep[m3] goal | 1\n"
+            "  step  live mat[m3]  dep[m3] prog | 1\n"
             "     3   1/1    0.00    0.000   0% | build\n"
             "     4 > world    run_over  max_steps reached\n"
             "     4   1/1    0.00    0.000   0% | build\n"

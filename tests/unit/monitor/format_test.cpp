@@ -35,7 +35,7 @@ protocol::WorldStatus three_agents() {
 
 TEST(Format, StepHeaderAndLineWithFewAgents) {
   const protocol::WorldStatus s = three_agents();
-  EXPECT_EQ(format_step_header(s), "  step  live mat[m3]  dep[m3] goal | 1           2           3");
+  EXPECT_EQ(format_step_header(s), "  step  live mat[m3]  dep[m3] prog | 1           2           3");
   // mat counts the live agents only (1.5 + 2.25); agent 2 at its goal, agent 3 dropped.
   EXPECT_EQ(format_step_line(s), "    42   2/3    3.75    0.125  33% | build       refill*     --");
 }
@@ -51,7 +51,7 @@ TEST(Format, TwelveAgentsFitOneHundredColumns) {
   s.agents[11] = agent(12, "navigate_to_site");
   EXPECT_EQ(agent_column_text_width(12), 4);
   EXPECT_EQ(format_step_header(s),
-            "  step  live mat[m3]  dep[m3] goal | 1    2    3    4    5    6    7    8    9    10   11   12");
+            "  step  live mat[m3]  dep[m3] prog | 1    2    3    4    5    6    7    8    9    10   11   12");
   const std::string line = format_step_line(s);
   EXPECT_EQ(line, "     7 11/12   11.00    0.000   8% | buil buil cli* buil --   buil ?    buil buil buil buil navi");
   EXPECT_LE(line.size(), 100u);
@@ -66,7 +66,7 @@ TEST(Format, BeyondTwelveAgentsCountsLiveAgentsPerState) {
     s.agents.push_back(agent(id, state, 0.25, id != 12));
   }
   EXPECT_EQ(agent_column_text_width(13), 0);
-  EXPECT_EQ(format_step_header(s), "  step  live mat[m3]  dep[m3] goal | live agents by state");
+  EXPECT_EQ(format_step_header(s), "  step  live mat[m3]  dep[m3] prog | live agents by state");
   // Most frequent first, ties by name; the dropped "follow" is not counted.
   EXPECT_EQ(format_step_line(s), "     3 12/13    3.00    2.500   0% | build 6, refill 4, climb 1, follow 1");
 
@@ -90,7 +90,7 @@ TEST(Format, LongLinesEndInEllipsisAtTheWidth) {
 
 TEST(Format, NoAgents) {
   protocol::WorldStatus s;
-  EXPECT_EQ(format_step_header(s), "  step  live mat[m3]  dep[m3] goal | no agents");
+  EXPECT_EQ(format_step_header(s), "  step  live mat[m3]  dep[m3] prog | no agents");
   EXPECT_EQ(format_step_line(s), "     0   0/0    0.00    0.000   0% | no agents");
 }
 

@@ -30,6 +30,7 @@ protocol::WorldStatus status_at(std::uint64_t step, double wall_s) {
   s.step = step;
   s.wall_seconds = wall_s;
   s.progress = 0.25;
+  s.progress_detail = "3.00 of 4.00 m3 of MARS gap left on the route\x1b";
   s.world_id = 7;
   for (std::uint32_t id : {2u, 1u}) {
     protocol::AgentStatus a;
@@ -92,6 +93,7 @@ TEST(LiveModel, StateDocumentForThePage) {
   EXPECT_EQ(j["run"]["step"], 5);
   EXPECT_EQ(j["run"]["phase"], "running");
   EXPECT_EQ(j["run"]["scenario"], "ramp");
+  EXPECT_EQ(j["run"]["progress_detail"], "3.00 of 4.00 m3 of MARS gap left on the route?");
   EXPECT_NEAR(j["run"]["status_age_s"].get<double>(), 2.0, 1e-6);
   ASSERT_EQ(j["agents"].size(), 2u);
   EXPECT_EQ(j["agents"][0]["id"], 1);  // in id order

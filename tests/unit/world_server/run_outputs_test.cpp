@@ -227,6 +227,20 @@ TEST_F(OutputFiles, ARunNeverWritesIntoAnotherRunsFolderAndLeavesNoTemporaries) 
   EXPECT_NO_THROW(check_fresh_output_dir(dir_.string()));
 }
 
+TEST_F(OutputFiles, ReplaceRemovesTheTimeLapseButNothingElseInFrames) {
+  fs::create_directories(dir_ / "frames");
+  for (const char* name : {"frame_000000.png", "frame_000100.png", "timelapse.mp4"})
+    std::ofstream(dir_ / "frames" / name) << "x";
+  clear_run_files(dir_.string());
+  EXPECT_FALSE(fs::exists(dir_ / "frames"));  // emptied, then removed
+  fs::create_directories(dir_ / "frames");
+  std::ofstream(dir_ / "frames" / "frame_000007.png") << "x";
+  std::ofstream(dir_ / "frames" / "notes.txt") << "mine";
+  clear_run_files(dir_.string());
+  EXPECT_FALSE(fs::exists(dir_ / "frames" / "frame_000007.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "frames" / "notes.txt"));  // not the run's: kept, and the folder with it
+}
+
 TEST_F(OutputFiles, AnEventLogThatCannotBeWrittenIsAnErrorNotASilentLoss) {
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full here to play a full disk";
   EventLog log("/dev/full");  // opens, but every write fails with ENOSPC
@@ -234,6 +248,25 @@ TEST_F(OutputFiles, AnEventLogThatCannotBeWrittenIsAnErrorNotASilentLoss) {
   e.kind = protocol::EventKind::kDeposited;
   EXPECT_THROW(log.append(e), IoError);
   EXPECT_THROW(log.note(3, "a note"), IoError);
+}
+
+TEST(EventLogLines, AreJsonObjectsWithTheDepositedCells) {
+  protocol::WorldEvent e;
+  e.step = 42;
+  e.agent_id = 3;
+  e.kind = protocol::EventKind::kDeposited;
+  e.volume_m3 = 0.000125;
+  e.detail = "2 cells";
+  EXPECT_EQ(event_json(e, {{10, 11, 0.05}, {10, 12, 0.1}}),
+            "{\"step\":42,\"agent\":3,\"kind\":\"deposited\",\"volume_m3\":0.000125,\"detail\":\"2 cells\","
+            "\"cells\":[[10,11,0.050000000000000003],[10,12,0.10000000000000001]]}");
+  protocol::WorldEvent over;
+  over.step = 7;
+  over.kind = protocol::EventKind::kRunOver;
+  over.detail = "a \"quoted\"\nreason";
+  EXPECT_EQ(event_json(over), "{\"step\":7,\"agent\":0,\"kind\":\"run_over\",\"detail\":\"a \\\"quoted\\\"\\nreason\"}");
+  EXPECT_EQ(note_json(5, "agent 2: request for past step 4 dropped"),
+            "{\"step\":5,\"kind\":\"note\",\"detail\":\"agent 2: request for past step 4 dropped\"}");
 }
 
 TEST_F(OutputFiles, GoalVectorMapPictureOnlyWhenTheScenarioHasOne) {

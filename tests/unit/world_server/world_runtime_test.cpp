@@ -215,9 +215,20 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   EXPECT_EQ(terrain::read_asc((out_ / "terrain_initial.asc").string()).max_height(), 0.0);
   EXPECT_GT(fs::file_size(out_ / "final.png"), 1000u);
   const std::string log = read_text(out_ / "events.log");
-  for (const char* line : {"step 0 agent 1 admitted", "agent 3 refused: unknown agent id 3", "step 0 agent 1 deposited",
-                           "step 10 agent 1 at_goal", "step 11 agent 0 run_over: completed"})
-    EXPECT_NE(log.find(line), std::string::npos) << line << " not in\n" << log;
+  // JSON Lines: every line one object; the deposition carries its cells (row, col, height).
+  std::istringstream lines(log);
+  for (std::string line; std::getline(lines, line);)
+    EXPECT_TRUE(line.size() > 2 && line.front() == '{' && line.back() == '}') << "not a JSON object: " << line;
+  for (const char* text : {"{\"step\":0,\"agent\":1,\"kind\":\"admitted\"",
+                           "{\"step\":0,\"agent\":3,\"kind\":\"refused\",\"detail\":\"unknown agent id 3",
+                           "{\"step\":0,\"agent\":1,\"kind\":\"deposited\",\"volume_m3\":",
+                           "{\"step\":10,\"agent\":1,\"kind\":\"at_goal\"",
+                           "{\"step\":11,\"agent\":0,\"kind\":\"run_over\",\"detail\":\"completed\"}"})
+    EXPECT_NE(log.find(text), std::string::npos) << text << " not in\n" << log;
+  const std::size_t deposition = log.find("\"kind\":\"deposited\"");
+  ASSERT_NE(deposition, std::string::npos);
+  EXPECT_NE(log.substr(deposition, log.find('\n', deposition) - deposition).find("\"cells\":[["), std::string::npos)
+      << "the deposition names no cells:\n" << log;
 }
 
 TEST_F(RuntimeTest, AnAgentThatMissesThreeDeadlinesIsDroppedTheOthersContinue) {
