@@ -206,13 +206,14 @@ TEST_F(OutputFiles, ARunNeverWritesIntoAnotherRunsFolderAndLeavesNoTemporaries) 
   for (const auto& entry : fs::directory_iterator(dir_))
     EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();  // every file was renamed into place
   EXPECT_EQ(run_files_in(dir_.string()),
-            (std::vector<std::string>{"summary.json", "terrain_initial.asc", "terrain_final.asc", "final.png"}));
+            (std::vector<std::string>{"summary.json", "terrain_initial.asc", "terrain_final.asc", "final.png",
+                                      "final_3d.png"}));
   try {
     check_fresh_output_dir(dir_.string());
     FAIL() << "no throw";
   } catch (const IoError& e) {
     EXPECT_NE(std::string(e.what()).find("holds another run (summary.json, terrain_initial.asc, terrain_final.asc, "
-                                         "final.png)"),
+                                         "final.png, final_3d.png)"),
               std::string::npos)
         << e.what();
   }
