@@ -50,7 +50,9 @@ bool at_goal(const WorldState& state, const AgentRecord& agent) {
       agent.x_m >= g.x0_m - tol && agent.x_m <= g.x1_m + tol && agent.y_m >= g.y0_m - tol && agent.y_m <= g.y1_m + tol;
   if (!inside) return false;
   const double h = height_under(state.terrain, agent.x_m, agent.y_m);
-  return h >= g.min_height_m - tol;  // false for NaN (off the grid)
+  if (!(h >= g.min_height_m - tol)) return false;  // also for NaN (off the grid)
+  return g.target_radius_m <= 0.0 ||
+         std::hypot(agent.x_m - agent.target_x_m, agent.y_m - agent.target_y_m) <= g.target_radius_m + tol;
 }
 
 bool is_completed(const WorldState& state) {

@@ -1,6 +1,7 @@
 #pragma once
 // Completion, checked on the authoritative terrain, in one of three kinds (scenario::CompletionKind):
-//   agents_at_goal  every live agent (at least one) stands inside the goal rectangle at >= the goal's min_height_m;
+//   agents_at_goal  every live agent (at least one) stands inside the goal rectangle at >= the goal's min_height_m
+//                   and, when the goal has a target_radius_m, within that distance of its own target;
 //   payload_path    the payload (kappa, delta, eps of PayloadPath) has a navigable path from the cell of `from` to
 //                   the cell of `to`: 8-connected through occupiable cells of the whole grid (paper §V-A);
 //   level_site      the terrain cropped to the site (cells whose centres lie inside) has an 8-connected component
@@ -19,8 +20,9 @@
 
 namespace marsala::world_server {
 
-/// True when `agent`'s centre lies in the goal rectangle (closed, +1e-9 m) and the height under it is at least
-/// goal.min_height_m - 1e-9 m.
+/// True when `agent`'s centre lies in the goal rectangle (closed, +1e-9 m), the height under it is at least
+/// goal.min_height_m - 1e-9 m and, when goal.target_radius_m > 0, it is within target_radius_m + 1e-9 m of its own
+/// target.
 bool at_goal(const WorldState& state, const AgentRecord& agent);
 
 /// agents_at_goal: at least one agent is live and every live agent is at the goal. payload_path, level_site: the

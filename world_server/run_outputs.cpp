@@ -234,6 +234,12 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
       const auto cell = t.cell_at({0.5 * (g.x0_m + g.x1_m), 0.5 * (g.y0_m + g.y1_m)});
       if (cell && area.contains(*cell)) o.markers.push_back({cell->row - area.first.row, cell->col - area.first.col});
       o.legend_entries.push_back({"goal", kWhite, render::LegendSwatch::kOutline});
+      if (g.target_radius_m > 0.0) {  // each agent's own target: the ring it must end in
+        for (const AgentRecord& a : state.agents)
+          if (a.admitted) o.circles.push_back({{a.target_x_m, a.target_y_m}, g.target_radius_m, kToGreen, 0.0});
+        o.legend_entries.push_back(
+            {"targets (" + format_number("%g", g.target_radius_m) + " m)", kToGreen, render::LegendSwatch::kRing});
+      }
       break;
     }
     case scenario::CompletionKind::kPayloadPath: {

@@ -93,6 +93,7 @@ proto::ScenarioCheck to_message(const WorldStart& start) {
       goal->set_x1_m(state.goal.x1_m);
       goal->set_y1_m(state.goal.y1_m);
       goal->set_min_height_m(state.goal.min_height_m);
+      goal->set_target_radius_m(state.goal.target_radius_m);
       break;
     }
     case scenario::CompletionKind::kPayloadPath: {
@@ -179,7 +180,10 @@ std::string scenario_check_text(const WorldStart& start) {
   switch (state.completion) {
     case scenario::CompletionKind::kAgentsAtGoal:
       out << ", goal " << box(state.goal.x0_m, state.goal.y0_m, state.goal.x1_m, state.goal.y1_m) << ", min_height_m "
-          << number(state.goal.min_height_m) << "\n";
+          << number(state.goal.min_height_m);
+      if (state.goal.target_radius_m > 0.0)
+        out << ", each agent within " << number(state.goal.target_radius_m) << " m of its target";
+      out << "\n";
       break;
     case scenario::CompletionKind::kPayloadPath: {
       const scenario::PayloadPath& p = state.payload_path;

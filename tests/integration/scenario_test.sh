@@ -17,7 +17,9 @@
 #          the summary's volume equals the terrain's change, and its completion re-checked with marsala-terrain on
 #          terrain_final.asc from what `marsala-world --check --json` says of the scenario: payload_path, the payload
 #          navigable from base to target (and not before); level_site, every site cell occupiable and connected (and
-#          not before) and no cell raised above the terrain's MARS bound at the site's kappa; agents_at_goal, every agent inside the goal box at least min_height_m high. Exit 77 (skipped)
+#          not before) and no cell raised above the terrain's MARS bound at the site's kappa; agents_at_goal, every agent inside the goal box at least min_height_m high
+#          and, with a goal.target_radius_m, each within it of its own target, on a cell of terrain_final.asc at least
+#          min_height_m high, its target navigable for its body from its start on terrain_final.asc (not before). Exit 77 (skipped)
 #          when the scenario's terrain file is absent (../shared/data).
 #   crowd  deploy/scenarios/crowd_120.pbtxt with 120 agents on DDS (arg 3), 100 steps: all 120 admitted and connected
 #          at the first frame, none dropped, no deadline missed, every step applied.
@@ -188,6 +190,37 @@ case "$case_name" in
             { n++; if ($1 < a || $1 > c || $2 < b || $2 > d || $3 < zmin - 1e-9) { print "agent " n " ends at (" $1 ", " $2 ", " $3 ")"; bad++ } }
             END { exit bad > 0 }' || fail "an agent ends outside the goal box"
         what="every agent in the goal box"
+        radius=$(j '.goal.target_radius_m // 0')
+        if awk -v r="$radius" 'BEGIN { exit !(r > 0) }'; then
+          # Each robot at its own target, on the final terrain: within the radius of the slot's target, on a cell of
+          # terrain_final.asc at least min_height_m high, and that target navigable for the robot's body from its
+          # start on terrain_final.asc (it drove there over what was built) and not on terrain_initial.asc.
+          zmin=$(j '.goal.min_height_m // 0')
+          for i in $(seq 0 $((agents - 1))); do
+            x=$(agent_fields x_m "$s" | sed -n "$((i + 1))p") y=$(agent_fields y_m "$s" | sed -n "$((i + 1))p")
+            tx=$(j ".slots[$i].target.x_m") ty=$(j ".slots[$i].target.y_m")
+            type=$(j ".slots[$i].robot_type")
+            awk -v x="$x" -v y="$y" -v tx="$tx" -v ty="$ty" -v r="$radius" \
+              'BEGIN { exit !(sqrt((x - tx) ^ 2 + (y - ty) ^ 2) <= r + 1e-9) }' ||
+              fail "agent $((i + 1)) ends at ($x, $y), farther than $radius m from its target ($tx, $ty)"
+            read -r ar ac <<<"$(cell "$x" "$y")"
+            z=$(asc_cell "$out/terrain_final.asc" "$ar" "$ac")
+            awk -v z="$z" -v m="$zmin" 'BEGIN { exit !(z >= m - 1e-9) }' ||
+              fail "agent $((i + 1)) stands on a cell $z m high on terrain_final.asc, below min_height_m $zmin"
+            read -r sr sc <<<"$(cell "$(j ".slots[$i].world_start.x_m")" "$(j ".slots[$i].world_start.y_m")")"
+            read -r tr tc <<<"$(cell "$tx" "$ty")"
+            body() { j ".robot_types[] | select(.name == \"$type\") | .$1"; }
+            for t in initial final; do
+              "$bin/marsala-terrain" navigable --kappa "$(body kappa)" --delta "$(body delta_m)" --eps "$(body eps_m)" \
+                --origin-cell "$sr" "$sc" "$out/terrain_$t.asc" -o "$work/nav_$t.asc" >/dev/null
+            done
+            [ "$(asc_cell "$work/nav_initial.asc" "$tr" "$tc")" = "0" ] ||
+              fail "agent $((i + 1))'s target was navigable from its start before any construction"
+            [ "$(asc_cell "$work/nav_final.asc" "$tr" "$tc")" = "1" ] ||
+              fail "agent $((i + 1))'s target is not navigable from its start on terrain_final.asc"
+          done
+          what="every agent on the goal's top at its own target (within $radius m), reached over what was built"
+        fi
         ;;
       *) fail "unknown completion '$(j .completion)'" ;;
     esac
