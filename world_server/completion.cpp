@@ -92,6 +92,8 @@ void start_completion_check(WorldState& state) {
       check.to = cell_of(state.terrain, p.to_x_m, p.to_y_m, "payload_path.to");
       check.occupancy =
           OccupancyCache(state.terrain, {{0, 0}, state.terrain.rows(), state.terrain.cols()}, p.navigability);
+      check.target_initial_m = state.terrain(check.to.row, check.to.col);
+      check.max_target_rise_m = largest_cube_layer_m(state);
       break;
     }
     case scenario::CompletionKind::kLevelSite:
@@ -108,13 +110,36 @@ void evaluate_completion(WorldState& state) {
   check.occupancy.update(state.terrain);
   const CellMask& mask = check.occupancy.occupiable();
   if (state.completion == scenario::CompletionKind::kPayloadPath) {
-    check.met = connected(mask, check.from, check.to);
+    check.path_found = connected(mask, check.from, check.to);
+    check.met = check.path_found && target_rise_m(state) <= check.max_target_rise_m + arbiter_tolerance::kLengthM;
   } else {
     check.level_fraction =
         static_cast<double>(largest_component(mask)) / static_cast<double>(check.occupancy.area().size());
     check.met = check.level_fraction >= state.site.min_fraction;
   }
   ++check.evaluations;
+}
+
+double target_rise_m(const WorldState& state) {
+  return state.terrain(state.check.to.row, state.check.to.col) - state.check.target_initial_m;
+}
+
+std::string payload_completion_detail(const WorldState& state, bool found) {
+  if (state.completion != scenario::CompletionKind::kPayloadPath) return {};
+  if (!found) return "no payload path from base to target";
+  const double rise = target_rise_m(state), allowed = state.check.max_target_rise_m;
+  if (rise > allowed + arbiter_tolerance::kLengthM)
+    return fmt::format("payload path found, but the target's cell stands {:.4g} m above its initial height (at most "
+                       "{:.4g} m allowed)",
+                       rise, allowed);
+  return fmt::format("payload path found, target's cell within {:.4g} m of its initial height", allowed);
+}
+
+double largest_cube_layer_m(const WorldState& state) {
+  double layer = 0.0;
+  for (const AgentRecord& a : state.agents)
+    layer = std::max(layer, cube_layer_m(a.type.body.cube_size_m, state.terrain.cell_size_m()));
+  return layer;
 }
 
 CellRect site_cells(const GridGeometry& grid, const scenario::Site& site) {

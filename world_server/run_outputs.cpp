@@ -17,6 +17,7 @@
 #include "marsala/runlog/atomic_file.hpp"
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/terrain/asc_io.hpp"
+#include "marsala/world_server/arbiter.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -151,6 +152,11 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_path_found(report.route.has_value());
   s.set_path_length_m(report.route ? report.route->length_m : 0.0);
   s.set_site_level_fraction(report.site_fraction);
+  if (state.completion == scenario::CompletionKind::kPayloadPath) {
+    s.set_target_rise_m(target_rise_m(state));
+    s.set_max_target_rise_m(state.check.max_target_rise_m);
+    s.set_completion_detail(payload_completion_detail(state, report.route.has_value()));
+  }
   s.set_completion_checks(state.check.evaluations);
   s.set_start_jitter_m(info.start_jitter_m);
 
@@ -253,6 +259,9 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
         o.legend_entries.push_back(
             {"payload path " + format_number("%.2f m", route->length_m), kPathYellow, render::LegendSwatch::kLine});
         outcome += ", path " + format_number("%.2f m", route->length_m);
+        const double rise = target_rise_m(state);
+        if (rise > state.check.max_target_rise_m + arbiter_tolerance::kLengthM)
+          outcome += ", target raised " + format_number("%.2f m", rise);
       } else {
         outcome += ", no payload path";
       }

@@ -6,7 +6,8 @@
 #
 # Usage: scenario_test.sh CASE DOMAIN
 #   path   tests/integration/scenarios/path_small.pbtxt, 3 path builders (Cyclone DDS): the payload (kappa 0.2,
-#          body 1.5 m) reaches the target on terrain_final.asc and did not on terrain_initial.asc; builders refilled
+#          body 1.5 m) reaches the target on terrain_final.asc and did not on terrain_initial.asc, the target's cell
+#          at most one cube layer higher; builders refilled
 #          (each carries 0.5 m^3); the summary's volume equals the terrain's change
 #   site   tests/integration/scenarios/site_small.pbtxt, 3 levellers on a goal vector map (Fast DDS): every cell of
 #          the site, cropped from terrain_final.asc, is occupiable at kappa 0.1 and all are connected; it was not
@@ -16,7 +17,8 @@
 #   shipped deploy/scenarios/NAME.pbtxt as shipped, AGENTS agents on DDS, to its end: completed, no request rejected,
 #          the summary's volume equals the terrain's change, and its completion re-checked with marsala-terrain on
 #          terrain_final.asc from what `marsala-world --check --json` says of the scenario: payload_path, the payload
-#          navigable from base to target (and not before); level_site, every site cell occupiable and connected (and
+#          navigable from base to target (and not before), the target's cell at most one cube layer above its
+#          initial height, and at least 90 % of the target's initial region navigable from the base; level_site, every site cell occupiable and connected (and
 #          not before) and no cell raised above the terrain's MARS bound at the site's kappa; agents_at_goal, every agent inside the goal box at least min_height_m high
 #          and, with a goal.target_radius_m, each within it of its own target, on a cell of terrain_final.asc at least
 #          min_height_m high, its target navigable for its body from its start on terrain_final.asc (not before). Exit 77 (skipped)
@@ -73,6 +75,9 @@ case "$case_name" in
     [ "$(asc_cell "$work/nav_initial.asc" 23 72)" = "0" ] || fail "the target was navigable before any construction"
     [ "$(asc_cell "$work/nav_final.asc" 23 72)" = "1" ] ||
       fail "marsala-terrain finds no payload path to the target on terrain_final.asc"
+    # The target on its own ground: at most one cube layer (0.1^3 / 0.25^2 = 0.016 m) above its initial height.
+    awk -v a="$(asc_cell "$out/terrain_initial.asc" 23 72)" -v b="$(asc_cell "$out/terrain_final.asc" 23 72)" \
+      'BEGIN { exit !(b - a <= 0.016 + 1e-9) }' || fail "the target's cell rose more than one cube layer"
     # Material: 0.5 m^3 per trip; a builder that deposited more refilled at the base.
     refilled=$(agent_fields deposited_m3 "$s" | awk '$1 > 0.5 + 1e-9 { n++ } END { print n + 0 }')
     [ "$refilled" -ge 2 ] || { cat "$s"; fail "only $refilled builders deposited more than one load (0.5 m^3)"; }
@@ -152,7 +157,23 @@ case "$case_name" in
         [ "$(asc_cell "$work/nav_initial.asc" "$tr" "$tc")" = "0" ] || fail "the target was navigable before any construction"
         [ "$(asc_cell "$work/nav_final.asc" "$tr" "$tc")" = "1" ] ||
           fail "marsala-terrain finds no payload path from base to target on terrain_final.asc"
-        what="payload path from ($fr, $fc) to ($tr, $tc)"
+        # The target on its own ground: its cell at most one cube layer (cube^3 / cs^2 of the largest cube of the
+        # robot types) above its initial height.
+        layer=$(jq -r --argjson cs "$cs" '[.robot_types[].cube_size_m] | max | . * . * . / ($cs * $cs)' "$check")
+        h0=$(asc_cell "$out/terrain_initial.asc" "$tr" "$tc") h1=$(asc_cell "$out/terrain_final.asc" "$tr" "$tc")
+        awk -v a="$h0" -v b="$h1" -v q="$layer" 'BEGIN { exit !(b - a <= q + 1e-9) }' ||
+          fail "the target's cell rose from $h0 m to $h1 m, more than one cube layer ($layer m)"
+        # The basin joined: of the cells navigable from the target on terrain_initial.asc (its own region), at least
+        # 90 % are navigable from the base on terrain_final.asc.
+        "$bin/marsala-terrain" navigable --kappa "$(j .payload_path.kappa)" --delta "$(j .payload_path.delta_m)" \
+          --eps "$(j .payload_path.eps_m)" --origin-cell "$tr" "$tc" "$out/terrain_initial.asc" -o "$work/region.asc" >/dev/null
+        joined=$(awk 'FNR <= 6 { next } NR == FNR { for (i = 1; i <= NF; i++) a[FNR, i] = $i; next }
+                      { for (i = 1; i <= NF; i++) if (a[FNR, i] == 1) { n++; if ($i == 1) m++ } }
+                      END { printf "%d %d\n", m, n }' "$work/region.asc" "$work/nav_final.asc")
+        read -r joined_cells region_cells <<<"$joined"
+        awk -v m="$joined_cells" -v n="$region_cells" 'BEGIN { exit !(m >= 0.9 * n) }' ||
+          fail "only $joined_cells of the target's $region_cells initial region cells are navigable from the base"
+        what="payload path from ($fr, $fc) to ($tr, $tc), the target's cell $h0 -> $h1 m, $joined_cells of its region's $region_cells cells joined"
         ;;
       level_site)
         sx0=$(j .site.x0_m) sy0=$(j .site.y0_m)
