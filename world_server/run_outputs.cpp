@@ -327,6 +327,11 @@ render::PerspectiveOptions perspective_options(const WorldState& state, const Ru
     for (int c = 0; c < window.cols; ++c)
       built(r, c) = state.depositor(window.first.row + r, window.first.col + c) > 0 ? 1.0 : 0.0;
   o.deposit = std::move(built);
+  // The robots where they ended, in their colours (as in final.png): a box 0.8 of the body long, 0.4 of it high.
+  for (const AgentRecord& a : state.agents)
+    if (a.admitted)
+      o.bodies.push_back({a.x_m, a.y_m, 0.8 * a.type.body.navigability.delta_m,
+                          0.4 * a.type.body.navigability.delta_m, render::label_colour(a.id)});
   o.title = info.scenario + ": step " + std::to_string(state.step) + ", built material in orange";
   return o;
 }
