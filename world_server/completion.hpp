@@ -34,7 +34,7 @@ bool at_goal(const WorldState& state, const AgentRecord& agent);
 bool is_completed(const WorldState& state);
 
 /// agents_at_goal: fraction of the live agents at the goal (0 when none is live); payload_path: 1 when the latest
-/// check found the path, else 0; level_site: the latest level fraction. In [0, 1].
+/// check found the path and the target's cell kept, else 0; level_site: the latest level fraction. In [0, 1].
 double progress(const WorldState& state);
 
 /// Sets up the terrain check of a payload_path or level_site state (its cache on the current terrain) and evaluates
