@@ -12,6 +12,9 @@
 #   site   tests/integration/scenarios/site_small.pbtxt, 3 levellers on a goal vector map (Fast DDS): every cell of
 #          the site, cropped from terrain_final.asc, is occupiable at kappa 0.1 and all are connected; it was not
 #          so on terrain_initial.asc; goal_vector_map.png and final.png written
+#   three_gaps tests/integration/scenarios/path_three_gaps.pbtxt, 3 path builders (Cyclone DDS): the payload reaches the
+#          target on terrain_final.asc (not before), the target's cell at most one cube layer higher, and what was
+#          built forms three separate sites, one past each cliff (found on terrain_initial.asc), natural ground between
 #
 # Usage: scenario_test.sh shipped DOMAIN NAME AGENTS DDS
 #   shipped deploy/scenarios/NAME.pbtxt as shipped, AGENTS agents on DDS, to its end: completed, no request rejected,
@@ -117,6 +120,44 @@ case "$case_name" in
     is_png "$out/final.png" || fail "final.png missing or not a PNG"
     echo "ok: site: level at kappa 0.1 after $(field steps "$s") steps ($occ0 of $total0 cells before)," \
       "$(field deposited_volume_m3 "$s") m^3"
+    ;;
+  three_gaps)
+    s=$(run_spawn "$scenarios/path_three_gaps.pbtxt" 3 cyclone)
+    expect_completed "$s" 3
+    out="$(dirname "$s")"
+    # Base (5.125, 5.125) m -> row 39 - 20 = 19, col 20; target (56.125, 5.125) m -> row 19, col 224.
+    nav() {
+      "$bin/marsala-terrain" navigable --kappa 0.2 --delta 1.5 --eps 0.05 --origin-cell 19 20 "$1" -o "$2" >/dev/null
+    }
+    nav "$out/terrain_initial.asc" "$work/nav_initial.asc"
+    nav "$out/terrain_final.asc" "$work/nav_final.asc"
+    [ "$(asc_cell "$work/nav_initial.asc" 19 224)" = "0" ] || fail "the target was navigable before any construction"
+    [ "$(asc_cell "$work/nav_final.asc" 19 224)" = "1" ] || fail "no payload path to the target on terrain_final.asc"
+    awk -v a="$(asc_cell "$out/terrain_initial.asc" 19 224)" -v b="$(asc_cell "$out/terrain_final.asc" 19 224)" \
+      'BEGIN { exit !(b - a <= 0.016 + 1e-9) }' || fail "the target's cell rose more than one cube layer"
+    # The sites, independently of the world: along the base-target row, the cliffs are where terrain_initial.asc
+    # drops by more than 0.5 m from one cell to the next; the built columns are those where any cell of rows
+    # 14..24 (the band) rose. Expected: exactly three runs of built columns, each starting within 0.5 m past a cliff
+    # and at most 0.8 / 0.2 + 1 = 5 m long, with unbuilt (natural) ground between them and before the target.
+    awk 'FNR <= 6 { next }
+         NR == FNR { r = FNR - 7; for (i = 1; i <= NF; i++) h0[r, i - 1] = $i; cols = NF; next }
+         { r = FNR - 7; if (r >= 14 && r <= 24) for (i = 1; i <= NF; i++) if ($i - h0[r, i - 1] > 1e-9) built[i - 1] = 1 }
+         END {
+           n = 0; n_cliffs = 0
+           for (c = 0; c + 1 < cols; c++) if (h0[19, c] - h0[19, c + 1] > 0.5) cliff[n_cliffs++] = c + 1
+           for (c = 0; c < cols; c++) {
+             if (built[c] && !(c > 0 && built[c - 1])) start[n] = c
+             if (built[c] && !(c + 1 < cols && built[c + 1])) end[n++] = c
+           }
+           printf "cliffs at columns"; for (k = 0; k < n_cliffs; k++) printf " %d", cliff[k]; printf "; built runs"
+           for (k = 0; k < n; k++) printf " [%d, %d]", start[k], end[k]; printf "\n"
+           if (n_cliffs != 3 || n != 3) exit 1
+           for (k = 0; k < 3; k++) if (start[k] < cliff[k] || start[k] > cliff[k] + 2 || end[k] - start[k] + 1 > 20) exit 1
+           if (end[2] >= 224) exit 1
+         }' "$out/terrain_initial.asc" "$out/terrain_final.asc" >"$work/sites.txt" ||
+      { cat "$work/sites.txt"; fail "not three separate construction sites, one past each cliff"; }
+    echo "ok: three_gaps: $(cat "$work/sites.txt"); payload path $(field path_length_m "$s") m after" \
+      "$(field steps "$s") steps, $(field deposited_volume_m3 "$s") m^3"
     ;;
   shipped)
     name="$3" agents="$4" dds="$5"
@@ -266,5 +307,5 @@ case "$case_name" in
     echo "ok: crowd: 120 agents ($dds) admitted and connected in $(top admit_seconds) s, 100 steps," \
       "step median $(top step_wall_median_ms) ms"
     ;;
-  *) echo "usage: scenario_test.sh path|site DOMAIN | shipped DOMAIN NAME AGENTS DDS | crowd DOMAIN DDS" >&2; exit 2 ;;
+  *) echo "usage: scenario_test.sh path|site|three_gaps DOMAIN | shipped DOMAIN NAME AGENTS DDS | crowd DOMAIN DDS" >&2; exit 2 ;;
 esac
