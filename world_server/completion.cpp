@@ -52,7 +52,9 @@ bool at_goal(const WorldState& state, const AgentRecord& agent) {
       agent.x_m >= g.x0_m - tol && agent.x_m <= g.x1_m + tol && agent.y_m >= g.y0_m - tol && agent.y_m <= g.y1_m + tol;
   if (!inside) return false;
   const double h = height_under(state.terrain, agent.x_m, agent.y_m);
-  return h >= g.min_height_m - tol;  // false for NaN (off the grid)
+  if (!(h >= g.min_height_m - tol)) return false;  // also for NaN (off the grid)
+  return g.target_radius_m <= 0.0 ||
+         std::hypot(agent.x_m - agent.target_x_m, agent.y_m - agent.target_y_m) <= g.target_radius_m + tol;
 }
 
 bool is_completed(const WorldState& state) {
@@ -83,7 +85,7 @@ double progress(const WorldState& state) {
       const CompletionCheck& check = state.check;
       if (check.met) return 1.0;
       if (!(check.route.initial_m3 > 0.0)) return 0.0;
-      return std::clamp(1.0 - check.route_gap_m3 / check.route.initial_m3, 0.0, 1.0);
+      return std::clamp(1.0 - check.route_gap_m3 / check.route.initial_m3, 0.0, 0.999);  // 1 is for completion
     }
     case scenario::CompletionKind::kLevelSite: return state.check.level_fraction;
     case scenario::CompletionKind::kAgentsAtGoal: break;
@@ -103,6 +105,8 @@ void start_completion_check(WorldState& state) {
       check.to = cell_of(state.terrain, p.to_x_m, p.to_y_m, "payload_path.to");
       check.occupancy =
           OccupancyCache(state.terrain, {{0, 0}, state.terrain.rows(), state.terrain.cols()}, p.navigability);
+      check.target_initial_m = state.terrain(check.to.row, check.to.col);
+      check.max_target_rise_m = largest_cube_layer_m(state);
       check.route = plan_route_gap(state.terrain, p);
       break;
     }
@@ -120,7 +124,8 @@ void evaluate_completion(WorldState& state) {
   check.occupancy.update(state.terrain);
   const CellMask& mask = check.occupancy.occupiable();
   if (state.completion == scenario::CompletionKind::kPayloadPath) {
-    check.met = connected(mask, check.from, check.to);
+    check.path_found = connected(mask, check.from, check.to);
+    check.met = check.path_found && target_rise_m(state) <= check.max_target_rise_m + arbiter_tolerance::kLengthM;
     check.route_gap_m3 = route_gap_m3(state.terrain, check.route);
   } else {
     check.level_fraction =
@@ -128,6 +133,28 @@ void evaluate_completion(WorldState& state) {
     check.met = check.level_fraction >= state.site.min_fraction;
   }
   ++check.evaluations;
+}
+
+double target_rise_m(const WorldState& state) {
+  return state.terrain(state.check.to.row, state.check.to.col) - state.check.target_initial_m;
+}
+
+std::string payload_completion_detail(const WorldState& state, bool found) {
+  if (state.completion != scenario::CompletionKind::kPayloadPath) return {};
+  if (!found) return "no payload path from base to target";
+  const double rise = target_rise_m(state), allowed = state.check.max_target_rise_m;
+  if (rise > allowed + arbiter_tolerance::kLengthM)
+    return fmt::format("payload path found, but the target's cell stands {:.4g} m above its initial height (at most "
+                       "{:.4g} m allowed)",
+                       rise, allowed);
+  return fmt::format("payload path found, target's cell within {:.4g} m of its initial height", allowed);
+}
+
+double largest_cube_layer_m(const WorldState& state) {
+  double layer = 0.0;
+  for (const AgentRecord& a : state.agents)
+    layer = std::max(layer, cube_layer_m(a.type.body.cube_size_m, state.terrain.cell_size_m()));
+  return layer;
 }
 
 CellRect site_cells(const GridGeometry& grid, const scenario::Site& site) {
@@ -237,6 +264,10 @@ std::string progress_detail(const WorldState& state) {
   switch (state.completion) {
     case scenario::CompletionKind::kPayloadPath:
       if (state.check.met) return "the payload's path is navigable";
+      if (state.check.path_found)
+        return fmt::format("the payload's path is navigable, but the target's cell stands {:.3f} m above its initial "
+                           "height",
+                           target_rise_m(state));
       return fmt::format("{:.2f} of {:.2f} m3 of MARS gap left on the route", state.check.route_gap_m3,
                          state.check.route.initial_m3);
     case scenario::CompletionKind::kLevelSite:

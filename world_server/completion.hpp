@@ -1,8 +1,12 @@
 #pragma once
 // Completion, checked on the authoritative terrain, in one of three kinds (scenario::CompletionKind):
-//   agents_at_goal  every live agent (at least one) stands inside the goal rectangle at >= the goal's min_height_m;
+//   agents_at_goal  every live agent (at least one) stands inside the goal rectangle at >= the goal's min_height_m
+//                   and, when the goal has a target_radius_m, within that distance of its own target;
 //   payload_path    the payload (kappa, delta, eps of PayloadPath) has a navigable path from the cell of `from` to
-//                   the cell of `to`: 8-connected through occupiable cells of the whole grid (paper §V-A);
+//                   the cell of `to`: 8-connected through occupiable cells of the whole grid (paper §V-A), and the
+//                   cell of `to` stands at most one cube layer above its initial height (the largest layer of the
+//                   run's robot types): the path reaches the target on its own ground, not on a structure raised
+//                   over it;
 //   level_site      the terrain cropped to the site (cells whose centres lie inside) has an 8-connected component
 //                   of cells occupiable for the site's kappa, delta, eps (balls cut at the crop's edge) covering at
 //                   least min_fraction of the crop's cells (paper §V-B).
@@ -20,8 +24,9 @@
 
 namespace marsala::world_server {
 
-/// True when `agent`'s centre lies in the goal rectangle (closed, +1e-9 m) and the height under it is at least
-/// goal.min_height_m - 1e-9 m.
+/// True when `agent`'s centre lies in the goal rectangle (closed, +1e-9 m), the height under it is at least
+/// goal.min_height_m - 1e-9 m and, when goal.target_radius_m > 0, it is within target_radius_m + 1e-9 m of its own
+/// target.
 bool at_goal(const WorldState& state, const AgentRecord& agent);
 
 /// agents_at_goal: at least one agent is live and every live agent is at the goal. payload_path, level_site: the
@@ -29,8 +34,9 @@ bool at_goal(const WorldState& state, const AgentRecord& agent);
 bool is_completed(const WorldState& state);
 
 /// agents_at_goal: fraction of the live agents at the goal (0 when none is live); payload_path: 1 when the latest
-/// check found the path, else the part of the route's initial MARS gap filled at that check (1 - gap left / initial
-/// gap, 0 when the route had no gap); level_site: the latest level fraction. In [0, 1] (docs/runtime.md#progress).
+/// check completed (the path found and the target's cell kept), else the part of the route's initial MARS gap filled
+/// at that check (1 - gap left / initial gap, 0 when the route had no gap), at most 0.999 while not completed;
+/// level_site: the latest level fraction. In [0, 1] (docs/runtime.md#progress).
 double progress(const WorldState& state);
 
 /// Sets up the terrain check of a payload_path or level_site state (its cache on the current terrain) and evaluates
@@ -39,8 +45,21 @@ double progress(const WorldState& state);
 void start_completion_check(WorldState& state);
 
 /// Evaluates the terrain check now: brings the cached occupiable mask up to date with the terrain changes recorded
-/// in it, then decides met (and the level fraction); counts the evaluation. Nothing for agents_at_goal.
+/// in it, then decides met (payload: path_found and the target kept; site: the level fraction); counts the
+/// evaluation. Nothing for agents_at_goal.
 void evaluate_completion(WorldState& state);
+
+/// payload_path: how far the cell of `to` stands above its initial height on the current terrain [m].
+double target_rise_m(const WorldState& state);
+
+/// payload_path: why the run is not complete, or what was met, in one sentence for summaries and logs ("no payload
+/// path from base to target", "payload path found, but the target's cell stands 1.98 m above its initial height
+/// (at most 0.016 m allowed)", "payload path found, target's cell within 0.016 m of its initial height"); found is
+/// whether the payload has its path on the current terrain. Empty for the other kinds.
+std::string payload_completion_detail(const WorldState& state, bool found);
+
+/// One cube layer of the largest cube among `state`'s agents' robot types on its grid [m] (cube_layer_m).
+double largest_cube_layer_m(const WorldState& state);
 
 /// The site's cells: those whose centres lie in [x0, x1] x [y0, y1] (closed, 1e-9 m tolerance); empty when none.
 CellRect site_cells(const GridGeometry& grid, const scenario::Site& site);

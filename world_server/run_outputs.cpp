@@ -20,6 +20,7 @@
 #include "marsala/runlog/atomic_file.hpp"
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/terrain/asc_io.hpp"
+#include "marsala/world_server/arbiter.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -154,6 +155,11 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_path_found(report.route.has_value());
   s.set_path_length_m(report.route ? report.route->length_m : 0.0);
   s.set_site_level_fraction(report.site_fraction);
+  if (state.completion == scenario::CompletionKind::kPayloadPath) {
+    s.set_target_rise_m(target_rise_m(state));
+    s.set_max_target_rise_m(state.check.max_target_rise_m);
+    s.set_completion_detail(payload_completion_detail(state, report.route.has_value()));
+  }
   s.set_completion_checks(state.check.evaluations);
   s.set_progress(progress(state));
   s.set_progress_detail(progress_detail(state));
@@ -239,6 +245,12 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
       const auto cell = t.cell_at({0.5 * (g.x0_m + g.x1_m), 0.5 * (g.y0_m + g.y1_m)});
       if (cell && area.contains(*cell)) o.markers.push_back({cell->row - area.first.row, cell->col - area.first.col});
       o.legend_entries.push_back({"goal", kWhite, render::LegendSwatch::kOutline});
+      if (g.target_radius_m > 0.0) {  // each agent's own target: the ring it must end in
+        for (const AgentRecord& a : state.agents)
+          if (a.admitted) o.circles.push_back({{a.target_x_m, a.target_y_m}, g.target_radius_m, kToGreen, 0.0});
+        o.legend_entries.push_back(
+            {"targets (" + format_number("%g", g.target_radius_m) + " m)", kToGreen, render::LegendSwatch::kRing});
+      }
       break;
     }
     case scenario::CompletionKind::kPayloadPath: {
@@ -252,6 +264,9 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
         o.legend_entries.push_back(
             {"payload path " + format_number("%.2f m", route->length_m), kPathYellow, render::LegendSwatch::kLine});
         outcome += ", path " + format_number("%.2f m", route->length_m);
+        const double rise = target_rise_m(state);
+        if (rise > state.check.max_target_rise_m + arbiter_tolerance::kLengthM)
+          outcome += ", target raised " + format_number("%.2f m", rise);
       } else {
         outcome += ", no payload path";
       }
@@ -317,6 +332,11 @@ render::PerspectiveOptions perspective_options(const WorldState& state, const Ru
     for (int c = 0; c < window.cols; ++c)
       built(r, c) = state.depositor(window.first.row + r, window.first.col + c) > 0 ? 1.0 : 0.0;
   o.deposit = std::move(built);
+  // The robots where they ended, in their colours (as in final.png): a box 0.8 of the body long, 0.4 of it high.
+  for (const AgentRecord& a : state.agents)
+    if (a.admitted)
+      o.bodies.push_back({a.x_m, a.y_m, 0.8 * a.type.body.navigability.delta_m,
+                          0.4 * a.type.body.navigability.delta_m, render::label_colour(a.id)});
   o.title = info.scenario + ": step " + std::to_string(state.step) + ", built material in orange";
   return o;
 }

@@ -93,6 +93,7 @@ proto::ScenarioCheck to_message(const WorldStart& start) {
       goal->set_x1_m(state.goal.x1_m);
       goal->set_y1_m(state.goal.y1_m);
       goal->set_min_height_m(state.goal.min_height_m);
+      goal->set_target_radius_m(state.goal.target_radius_m);
       break;
     }
     case scenario::CompletionKind::kPayloadPath: {
@@ -105,6 +106,8 @@ proto::ScenarioCheck to_message(const WorldStart& start) {
       set_point(path->mutable_to(), p.to_x_m, p.to_y_m);
       path->set_check_every_steps(p.check_every_steps);
       path->set_met_at_start(state.check.met);
+      path->set_target_height_m(state.check.target_initial_m);
+      path->set_max_target_rise_m(state.check.max_target_rise_m);
       break;
     }
     case scenario::CompletionKind::kLevelSite: {
@@ -179,13 +182,17 @@ std::string scenario_check_text(const WorldStart& start) {
   switch (state.completion) {
     case scenario::CompletionKind::kAgentsAtGoal:
       out << ", goal " << box(state.goal.x0_m, state.goal.y0_m, state.goal.x1_m, state.goal.y1_m) << ", min_height_m "
-          << number(state.goal.min_height_m) << "\n";
+          << number(state.goal.min_height_m);
+      if (state.goal.target_radius_m > 0.0)
+        out << ", each agent within " << number(state.goal.target_radius_m) << " m of its target";
+      out << "\n";
       break;
     case scenario::CompletionKind::kPayloadPath: {
       const scenario::PayloadPath& p = state.payload_path;
       out << ", payload kappa " << number(p.navigability.kappa) << ", delta_m " << number(p.navigability.delta_m)
           << ", eps_m " << number(p.navigability.eps_m) << ", from " << point(p.from_x_m, p.from_y_m) << " to "
-          << point(p.to_x_m, p.to_y_m) << ", checked every " << p.check_every_steps
+          << point(p.to_x_m, p.to_y_m) << " (its cell " << number(state.check.target_initial_m) << " m high, to end at most "
+          << number(state.check.max_target_rise_m) << " m higher), checked every " << p.check_every_steps
           << " steps; at start: " << (state.check.met ? "navigable (the run ends at once)" : "not navigable") << "\n";
       break;
     }

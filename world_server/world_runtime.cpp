@@ -653,6 +653,8 @@ struct WorldRuntime::Impl {
                      state.payload_path.from_x_m, state.payload_path.from_y_m, state.payload_path.to_x_m,
                      state.payload_path.to_y_m, state.payload_path.check_every_steps,
                      state.check.met ? "already navigable" : "not navigable yet");
+        spdlog::info("completion: the target's cell ({} m) may end at most {} m (one cube layer) higher",
+                     state.check.target_initial_m, state.check.max_target_rise_m);
         break;
       case scenario::CompletionKind::kLevelSite:
         spdlog::info("completion: level_site, checked every {} steps: level fraction {:.4f} of {:.4f} needed",

@@ -72,7 +72,10 @@ struct CompletionCheck {
   OccupancyCache occupancy;  ///< payload: the whole grid for the payload's body; site: the site's cells
   CellIndex from;            ///< payload: the cells of `from` and `to`
   CellIndex to;
-  bool met = false;               ///< the latest evaluation found the payload's path / a level site
+  bool met = false;               ///< the latest evaluation: completed (payload: path and target kept) / level site
+  bool path_found = false;        ///< payload: the latest evaluation found the payload's path
+  double target_initial_m = 0.0;  ///< payload: height of the cell of `to` on the initial terrain [m]
+  double max_target_rise_m = 0.0; ///< payload: how far that cell may end above it: one cube layer [m]
   double level_fraction = 0.0;    ///< site: the latest level fraction [0, 1]
   std::uint32_t evaluations = 0;  ///< evaluations run, the initial one included
   RouteGap route;                 ///< payload: its route on the initial terrain and the MARS bound over its band

@@ -192,6 +192,34 @@ Image render_perspective(const Heightmap& map, const PerspectiveOptions& options
       shade(r, c, r, c + 1, r + 1, c);
       shade(r + 1, c, r, c + 1, r + 1, c + 1);
     }
+  // Robots: boxes on the cell under their centre, their faces lit like the terrain's.
+  const auto project = [&](const Vec3& p) {
+    const Vec3 d = p - camera;
+    const double depth = d.dot(forward);
+    return Projected{offset_x + (d.dot(right) / depth - min_x) * scale,
+                     h - (offset_y + (d.dot(up) / depth - min_y) * scale), depth};
+  };
+  const GridGeometry& g = map.geometry();
+  for (const PerspectiveBody& b : options.bodies) {
+    const auto cell = map.cell_at({b.x_m, b.y_m});
+    if (!cell) continue;
+    const double x = b.x_m - g.xll_m, y = b.y_m - g.yll_m, half = b.side_m / 2.0;
+    const double z0 = map(cell->row, cell->col) * exaggeration, z1 = z0 + b.height_m * exaggeration;
+    const Vec3 corner[8] = {{x - half, y - half, z0}, {x + half, y - half, z0}, {x + half, y + half, z0},
+                            {x - half, y + half, z0}, {x - half, y - half, z1}, {x + half, y - half, z1},
+                            {x + half, y + half, z1}, {x - half, y + half, z1}};
+    // Faces as corner quadruples with their outward normals: bottom is never seen from above.
+    const int faces[5][4] = {{4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+    const Vec3 normals[5] = {{0, 0, 1}, {0, -1, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}};
+    for (int f = 0; f < 5; ++f) {
+      const double light = 0.35 + 0.65 * std::max(0.0, normals[f].dot(sun));
+      const Rgb colour = detail::to_rgb(Colour{b.colour.r * light, b.colour.g * light, b.colour.b * light});
+      const Projected q[4] = {project(corner[faces[f][0]]), project(corner[faces[f][1]]),
+                              project(corner[faces[f][2]]), project(corner[faces[f][3]])};
+      raster_triangle(image, zbuffer, q[0], q[1], q[2], colour);
+      raster_triangle(image, zbuffer, q[0], q[2], q[3], colour);
+    }
+  }
   if (!options.title.empty()) detail::draw_text(image, 12, 12, options.title, 2, Rgb{235, 235, 235});
   return image;
 }

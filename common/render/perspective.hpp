@@ -9,14 +9,24 @@
 // north-west, 45 deg up, plus ambient light) in the terrain colour map of render_terrain, with a z-buffer: nearer
 // surfaces hide farther ones. Cells whose `deposit` exceeds 1e-9 m are tinted orange, more strongly where more was
 // built. The picture is width x height pixels on a dark sky, the surface scaled to fill it with a small margin.
+// Robots (`bodies`) stand on the surface as boxes of their colour, flat-shaded like it and z-buffered with it.
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "marsala/core/heightmap.hpp"
 #include "marsala/render/image.hpp"
 
 namespace marsala::render {
+
+/// A robot drawn on the surface: an axis-aligned box of side side_m standing on the cell under its centre.
+struct PerspectiveBody {
+  double x_m = 0.0, y_m = 0.0;  ///< centre, in the map's world frame [m]; off the map: not drawn
+  double side_m = 0.8;          ///< footprint side [m]
+  double height_m = 0.4;        ///< above the terrain [m] (multiplied by the exaggeration like every height)
+  Rgb colour{255, 255, 255};
+};
 
 /// How to look at the terrain.
 struct PerspectiveOptions {
@@ -27,6 +37,7 @@ struct PerspectiveOptions {
   int height_px = 800;
   std::optional<Heightmap> deposit;  ///< built material per cell [m] (final - initial), same grid; tints it
   std::string title;                 ///< drawn in the top-left corner when not empty
+  std::vector<PerspectiveBody> bodies;  ///< robots standing on the surface
 };
 
 /// Renders `map` as seen with `options`. Throws InvalidArgument for an empty map, a non-finite height or deposit, a

@@ -38,10 +38,12 @@ struct AgentSlot {
   double target_x_m = 0.0, target_y_m = 0.0;
 };
 
-/// Completion: every live agent inside [x0, x1] x [y0, y1] [m] standing at >= min_height_m.
+/// Completion: every live agent inside [x0, x1] x [y0, y1] [m] standing at >= min_height_m and, when
+/// target_radius_m > 0, within target_radius_m of its own slot's target.
 struct Goal {
   double x0_m = 0.0, y0_m = 0.0, x1_m = 0.0, y1_m = 0.0;
   double min_height_m = -1e9;
+  double target_radius_m = 0.0;  ///< 0 = no target condition (the box alone) [m]
 };
 
 /// How the world decides that a run is complete.

@@ -232,6 +232,16 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     if (!(s.goal.x0_m < s.goal.x1_m) || !(s.goal.y0_m < s.goal.y1_m))
       check.fail("goal", "the rectangle needs x0_m < x1_m and y0_m < y1_m");
     if (p.goal().has_min_height_m()) s.goal.min_height_m = check.finite("goal.min_height_m", p.goal().min_height_m());
+    if (p.goal().has_target_radius_m())
+      s.goal.target_radius_m = check.positive("goal.target_radius_m", p.goal().target_radius_m());
+    // With a target condition every agent must be able to meet both: its target lies in the box.
+    if (s.goal.target_radius_m > 0.0)
+      for (const AgentSlot& slot : s.slots)
+        if (slot.target_x_m < s.goal.x0_m || slot.target_x_m > s.goal.x1_m || slot.target_y_m < s.goal.y0_m ||
+            slot.target_y_m > s.goal.y1_m)
+          check.fail("agent[" + std::to_string(slot.id - 1) + "] (agent " + std::to_string(slot.id) + ").target",
+                     "(" + fmt::format("{}", slot.target_x_m) + ", " + fmt::format("{}", slot.target_y_m) +
+                         ") lies outside the goal box, so the agent could never complete with goal.target_radius_m");
   }
   if (p.has_payload_path()) {
     s.completion = CompletionKind::kPayloadPath;

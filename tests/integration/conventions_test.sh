@@ -40,7 +40,7 @@ case "$case_name" in
     done
     wait "$world" || { tail -5 "$work/logs/world.log"; fail "the world exited non-zero"; }
     for pid in "${pids[@]}"; do wait "$pid" || fail "an agent exited non-zero (see $work/logs)"; done
-    grep -q "completed after 275 steps, 3 agents, terrain sha256 d008eb1c" "$work/world.out" ||
+    grep -q "completed after 298 steps, 3 agents, terrain sha256 d008eb1c" "$work/world.out" ||
       fail "not the reference ramp run: $(cat "$work/world.out")"
     # A monitor that finds no world (the run is over): its error, in json, is a record too.
     if "$bin/marsala-monitor" --log-format json status --dds cyclone --domain "$domain" --timeout 0.5 \

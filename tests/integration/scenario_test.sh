@@ -6,18 +6,25 @@
 #
 # Usage: scenario_test.sh CASE DOMAIN
 #   path   tests/integration/scenarios/path_small.pbtxt, 3 path builders (Cyclone DDS): the payload (kappa 0.2,
-#          body 1.5 m) reaches the target on terrain_final.asc and did not on terrain_initial.asc; builders refilled
+#          body 1.5 m) reaches the target on terrain_final.asc and did not on terrain_initial.asc, the target's cell
+#          at most one cube layer higher; builders refilled
 #          (each carries 0.5 m^3); the summary's volume equals the terrain's change
 #   site   tests/integration/scenarios/site_small.pbtxt, 3 levellers on a goal vector map (Fast DDS): every cell of
 #          the site, cropped from terrain_final.asc, is occupiable at kappa 0.1 and all are connected; it was not
 #          so on terrain_initial.asc; goal_vector_map.png and final.png written
+#   three_gaps tests/integration/scenarios/path_three_gaps.pbtxt, 3 path builders (Cyclone DDS): the payload reaches the
+#          target on terrain_final.asc (not before), the target's cell at most one cube layer higher, and what was
+#          built forms three separate sites, one past each cliff (found on terrain_initial.asc), natural ground between
 #
 # Usage: scenario_test.sh shipped DOMAIN NAME AGENTS DDS
 #   shipped deploy/scenarios/NAME.pbtxt as shipped, AGENTS agents on DDS, to its end: completed, no request rejected,
 #          the summary's volume equals the terrain's change, and its completion re-checked with marsala-terrain on
 #          terrain_final.asc from what `marsala-world --check --json` says of the scenario: payload_path, the payload
-#          navigable from base to target (and not before); level_site, every site cell occupiable and connected (and
-#          not before) and no cell raised above the terrain's MARS bound at the site's kappa; agents_at_goal, every agent inside the goal box at least min_height_m high. Exit 77 (skipped)
+#          navigable from base to target (and not before), the target's cell at most one cube layer above its
+#          initial height, and at least 90 % of the target's initial region navigable from the base; level_site, every site cell occupiable and connected (and
+#          not before) and no cell raised above the terrain's MARS bound at the site's kappa; agents_at_goal, every agent inside the goal box at least min_height_m high
+#          and, with a goal.target_radius_m, each within it of its own target, on a cell of terrain_final.asc at least
+#          min_height_m high, its target navigable for its body from its start on terrain_final.asc (not before). Exit 77 (skipped)
 #          when the scenario's terrain file is absent (../shared/data).
 #   crowd  deploy/scenarios/crowd_120.pbtxt with 120 agents on DDS (arg 3), 100 steps: all 120 admitted and connected
 #          at the first frame, none dropped, no deadline missed, every step applied.
@@ -71,6 +78,9 @@ case "$case_name" in
     [ "$(asc_cell "$work/nav_initial.asc" 23 72)" = "0" ] || fail "the target was navigable before any construction"
     [ "$(asc_cell "$work/nav_final.asc" 23 72)" = "1" ] ||
       fail "marsala-terrain finds no payload path to the target on terrain_final.asc"
+    # The target on its own ground: at most one cube layer (0.1^3 / 0.25^2 = 0.016 m) above its initial height.
+    awk -v a="$(asc_cell "$out/terrain_initial.asc" 23 72)" -v b="$(asc_cell "$out/terrain_final.asc" 23 72)" \
+      'BEGIN { exit !(b - a <= 0.016 + 1e-9) }' || fail "the target's cell rose more than one cube layer"
     # Material: 0.5 m^3 per trip; a builder that deposited more refilled at the base.
     refilled=$(agent_fields deposited_m3 "$s" | awk '$1 > 0.5 + 1e-9 { n++ } END { print n + 0 }')
     [ "$refilled" -ge 2 ] || { cat "$s"; fail "only $refilled builders deposited more than one load (0.5 m^3)"; }
@@ -111,6 +121,44 @@ case "$case_name" in
     echo "ok: site: level at kappa 0.1 after $(field steps "$s") steps ($occ0 of $total0 cells before)," \
       "$(field deposited_volume_m3 "$s") m^3"
     ;;
+  three_gaps)
+    s=$(run_spawn "$scenarios/path_three_gaps.pbtxt" 3 cyclone)
+    expect_completed "$s" 3
+    out="$(dirname "$s")"
+    # Base (5.125, 5.125) m -> row 39 - 20 = 19, col 20; target (56.125, 5.125) m -> row 19, col 224.
+    nav() {
+      "$bin/marsala-terrain" navigable --kappa 0.2 --delta 1.5 --eps 0.05 --origin-cell 19 20 "$1" -o "$2" >/dev/null
+    }
+    nav "$out/terrain_initial.asc" "$work/nav_initial.asc"
+    nav "$out/terrain_final.asc" "$work/nav_final.asc"
+    [ "$(asc_cell "$work/nav_initial.asc" 19 224)" = "0" ] || fail "the target was navigable before any construction"
+    [ "$(asc_cell "$work/nav_final.asc" 19 224)" = "1" ] || fail "no payload path to the target on terrain_final.asc"
+    awk -v a="$(asc_cell "$out/terrain_initial.asc" 19 224)" -v b="$(asc_cell "$out/terrain_final.asc" 19 224)" \
+      'BEGIN { exit !(b - a <= 0.016 + 1e-9) }' || fail "the target's cell rose more than one cube layer"
+    # The sites, independently of the world: along the base-target row, the cliffs are where terrain_initial.asc
+    # drops by more than 0.5 m from one cell to the next; the built columns are those where any cell of rows
+    # 14..24 (the band) rose. Expected: exactly three runs of built columns, each starting within 0.5 m past a cliff
+    # and at most 0.8 / 0.2 + 1 = 5 m long, with unbuilt (natural) ground between them and before the target.
+    awk 'FNR <= 6 { next }
+         NR == FNR { r = FNR - 7; for (i = 1; i <= NF; i++) h0[r, i - 1] = $i; cols = NF; next }
+         { r = FNR - 7; if (r >= 14 && r <= 24) for (i = 1; i <= NF; i++) if ($i - h0[r, i - 1] > 1e-9) built[i - 1] = 1 }
+         END {
+           n = 0; n_cliffs = 0
+           for (c = 0; c + 1 < cols; c++) if (h0[19, c] - h0[19, c + 1] > 0.5) cliff[n_cliffs++] = c + 1
+           for (c = 0; c < cols; c++) {
+             if (built[c] && !(c > 0 && built[c - 1])) start[n] = c
+             if (built[c] && !(c + 1 < cols && built[c + 1])) end[n++] = c
+           }
+           printf "cliffs at columns"; for (k = 0; k < n_cliffs; k++) printf " %d", cliff[k]; printf "; built runs"
+           for (k = 0; k < n; k++) printf " [%d, %d]", start[k], end[k]; printf "\n"
+           if (n_cliffs != 3 || n != 3) exit 1
+           for (k = 0; k < 3; k++) if (start[k] < cliff[k] || start[k] > cliff[k] + 2 || end[k] - start[k] + 1 > 20) exit 1
+           if (end[2] >= 224) exit 1
+         }' "$out/terrain_initial.asc" "$out/terrain_final.asc" >"$work/sites.txt" ||
+      { cat "$work/sites.txt"; fail "not three separate construction sites, one past each cliff"; }
+    echo "ok: three_gaps: $(cat "$work/sites.txt"); payload path $(field path_length_m "$s") m after" \
+      "$(field steps "$s") steps, $(field deposited_volume_m3 "$s") m^3"
+    ;;
   shipped)
     name="$3" agents="$4" dds="$5"
     scenario="$root/deploy/scenarios/$name.pbtxt"
@@ -150,7 +198,23 @@ case "$case_name" in
         [ "$(asc_cell "$work/nav_initial.asc" "$tr" "$tc")" = "0" ] || fail "the target was navigable before any construction"
         [ "$(asc_cell "$work/nav_final.asc" "$tr" "$tc")" = "1" ] ||
           fail "marsala-terrain finds no payload path from base to target on terrain_final.asc"
-        what="payload path from ($fr, $fc) to ($tr, $tc)"
+        # The target on its own ground: its cell at most one cube layer (cube^3 / cs^2 of the largest cube of the
+        # robot types) above its initial height.
+        layer=$(jq -r --argjson cs "$cs" '[.robot_types[].cube_size_m] | max | . * . * . / ($cs * $cs)' "$check")
+        h0=$(asc_cell "$out/terrain_initial.asc" "$tr" "$tc") h1=$(asc_cell "$out/terrain_final.asc" "$tr" "$tc")
+        awk -v a="$h0" -v b="$h1" -v q="$layer" 'BEGIN { exit !(b - a <= q + 1e-9) }' ||
+          fail "the target's cell rose from $h0 m to $h1 m, more than one cube layer ($layer m)"
+        # The basin joined: of the cells navigable from the target on terrain_initial.asc (its own region), at least
+        # 90 % are navigable from the base on terrain_final.asc.
+        "$bin/marsala-terrain" navigable --kappa "$(j .payload_path.kappa)" --delta "$(j .payload_path.delta_m)" \
+          --eps "$(j .payload_path.eps_m)" --origin-cell "$tr" "$tc" "$out/terrain_initial.asc" -o "$work/region.asc" >/dev/null
+        joined=$(awk 'FNR <= 6 { next } NR == FNR { for (i = 1; i <= NF; i++) a[FNR, i] = $i; next }
+                      { for (i = 1; i <= NF; i++) if (a[FNR, i] == 1) { n++; if ($i == 1) m++ } }
+                      END { printf "%d %d\n", m, n }' "$work/region.asc" "$work/nav_final.asc")
+        read -r joined_cells region_cells <<<"$joined"
+        awk -v m="$joined_cells" -v n="$region_cells" 'BEGIN { exit !(m >= 0.9 * n) }' ||
+          fail "only $joined_cells of the target's $region_cells initial region cells are navigable from the base"
+        what="payload path from ($fr, $fc) to ($tr, $tc), the target's cell $h0 -> $h1 m, $joined_cells of its region's $region_cells cells joined"
         ;;
       level_site)
         sx0=$(j .site.x0_m) sy0=$(j .site.y0_m)
@@ -188,6 +252,37 @@ case "$case_name" in
             { n++; if ($1 < a || $1 > c || $2 < b || $2 > d || $3 < zmin - 1e-9) { print "agent " n " ends at (" $1 ", " $2 ", " $3 ")"; bad++ } }
             END { exit bad > 0 }' || fail "an agent ends outside the goal box"
         what="every agent in the goal box"
+        radius=$(j '.goal.target_radius_m // 0')
+        if awk -v r="$radius" 'BEGIN { exit !(r > 0) }'; then
+          # Each robot at its own target, on the final terrain: within the radius of the slot's target, on a cell of
+          # terrain_final.asc at least min_height_m high, and that target navigable for the robot's body from its
+          # start on terrain_final.asc (it drove there over what was built) and not on terrain_initial.asc.
+          zmin=$(j '.goal.min_height_m // 0')
+          for i in $(seq 0 $((agents - 1))); do
+            x=$(agent_fields x_m "$s" | sed -n "$((i + 1))p") y=$(agent_fields y_m "$s" | sed -n "$((i + 1))p")
+            tx=$(j ".slots[$i].target.x_m") ty=$(j ".slots[$i].target.y_m")
+            type=$(j ".slots[$i].robot_type")
+            awk -v x="$x" -v y="$y" -v tx="$tx" -v ty="$ty" -v r="$radius" \
+              'BEGIN { exit !(sqrt((x - tx) ^ 2 + (y - ty) ^ 2) <= r + 1e-9) }' ||
+              fail "agent $((i + 1)) ends at ($x, $y), farther than $radius m from its target ($tx, $ty)"
+            read -r ar ac <<<"$(cell "$x" "$y")"
+            z=$(asc_cell "$out/terrain_final.asc" "$ar" "$ac")
+            awk -v z="$z" -v m="$zmin" 'BEGIN { exit !(z >= m - 1e-9) }' ||
+              fail "agent $((i + 1)) stands on a cell $z m high on terrain_final.asc, below min_height_m $zmin"
+            read -r sr sc <<<"$(cell "$(j ".slots[$i].world_start.x_m")" "$(j ".slots[$i].world_start.y_m")")"
+            read -r tr tc <<<"$(cell "$tx" "$ty")"
+            body() { j ".robot_types[] | select(.name == \"$type\") | .$1"; }
+            for t in initial final; do
+              "$bin/marsala-terrain" navigable --kappa "$(body kappa)" --delta "$(body delta_m)" --eps "$(body eps_m)" \
+                --origin-cell "$sr" "$sc" "$out/terrain_$t.asc" -o "$work/nav_$t.asc" >/dev/null
+            done
+            [ "$(asc_cell "$work/nav_initial.asc" "$tr" "$tc")" = "0" ] ||
+              fail "agent $((i + 1))'s target was navigable from its start before any construction"
+            [ "$(asc_cell "$work/nav_final.asc" "$tr" "$tc")" = "1" ] ||
+              fail "agent $((i + 1))'s target is not navigable from its start on terrain_final.asc"
+          done
+          what="every agent on the goal's top at its own target (within $radius m), reached over what was built"
+        fi
         ;;
       *) fail "unknown completion '$(j .completion)'" ;;
     esac
@@ -212,5 +307,5 @@ case "$case_name" in
     echo "ok: crowd: 120 agents ($dds) admitted and connected in $(top admit_seconds) s, 100 steps," \
       "step median $(top step_wall_median_ms) ms"
     ;;
-  *) echo "usage: scenario_test.sh path|site DOMAIN | shipped DOMAIN NAME AGENTS DDS | crowd DOMAIN DDS" >&2; exit 2 ;;
+  *) echo "usage: scenario_test.sh path|site|three_gaps DOMAIN | shipped DOMAIN NAME AGENTS DDS | crowd DOMAIN DDS" >&2; exit 2 ;;
 esac

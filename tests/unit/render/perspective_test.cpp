@@ -104,6 +104,43 @@ TEST(Perspective, OnlyBuiltCellsAreTinted) {
   EXPECT_LT(tinted, 400 * 300 / 4);
 }
 
+TEST(Perspective, BodiesStandWhereTheyAreAsBoxesOfTheirColour) {
+  PerspectiveOptions o;
+  o.elevation_deg = 90.0;  // straight above: about 552 / 19 = 29 px per metre, north up
+  o.width_px = 600;
+  o.height_px = 600;
+  const Heightmap map = flat(20, 20);
+  const Image bare = render_perspective(map, o);
+  o.bodies.push_back({5.5, 15.5, 4.0, 1.0, Rgb{255, 0, 0}});
+  const Image img = render_perspective(map, o);
+  const auto red = [&](int x, int y) {
+    const Pixel p = at(img, x, y);
+    return p.r > 150 && p.g < 30 && p.b < 30;
+  };
+  // Its top (lit 0.35 + 0.65 cos 45 deg) over x 3.5..7.5 m, y 13.5..17.5 m; the picture elsewhere unchanged.
+  const int cx = static_cast<int>(24 + 5.0 * 552.0 / 19.0), cy = static_cast<int>(24 + 4.0 * 552.0 / 19.0);
+  EXPECT_TRUE(red(cx, cy));
+  EXPECT_FALSE(red(static_cast<int>(24 + 14.0 * 552.0 / 19.0), cy));
+  EXPECT_FALSE(red(cx, static_cast<int>(24 + 14.0 * 552.0 / 19.0)));
+  int count = 0, changed = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      count += red(x, y) ? 1 : 0;
+      const Pixel a = at(img, x, y), b = at(bare, x, y);
+      changed += (a.r != b.r || a.g != b.g || a.b != b.b) ? 1 : 0;
+    }
+  const double side_px = 4.0 * 552.0 / 19.0;  // a little more: the top is 1 m nearer the camera
+  EXPECT_GT(count, 0.95 * side_px * side_px);
+  EXPECT_LT(count, 1.2 * side_px * side_px);
+  // Nothing else changed but the box: its top, and the sides the off-centre camera sees, darker.
+  EXPECT_GE(changed, count);
+  EXPECT_LT(changed, 1.1 * count);
+  // A body off the map is not drawn.
+  o.bodies = {{25.0, 5.0, 4.0, 1.0, Rgb{255, 0, 0}}};
+  const Image off = render_perspective(map, o);
+  EXPECT_EQ(off.rgb, bare.rgb);
+}
+
 TEST(Perspective, TheSameInputGivesTheSamePicture) {
   Heightmap map = flat(50, 70, 0.25);
   for (int r = 0; r < 50; ++r)

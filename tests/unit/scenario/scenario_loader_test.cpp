@@ -83,6 +83,7 @@ TEST(ScenarioLoader, TheRampScenarioLoadsWithEveryValue) {
   EXPECT_EQ(s.goal.y0_m, 3.0);
   EXPECT_EQ(s.goal.y1_m, 17.0);
   EXPECT_EQ(s.goal.min_height_m, 1.4);
+  EXPECT_EQ(s.goal.target_radius_m, 0.25);
   EXPECT_EQ(s.base.x_m, 3.05);
   EXPECT_EQ(s.base.radius_m, 1.5);
   EXPECT_EQ(s.max_steps, 4000u);
@@ -110,6 +111,7 @@ TEST(ScenarioLoader, DefaultsFillWhatIsLeftOut) {
   EXPECT_EQ(s.robot_types[0].body.material_capacity_m3, defaults.material_capacity_m3);
   EXPECT_EQ(s.terrain.seed, 1u);
   EXPECT_EQ(s.goal.min_height_m, -1e9);
+  EXPECT_EQ(s.goal.target_radius_m, 0.0);  // no target condition
   EXPECT_EQ(s.base.radius_m, 1.0);
   EXPECT_EQ(s.max_steps, 5000u);
   EXPECT_EQ(s.step_deadline_s, 10.0);
@@ -216,6 +218,13 @@ TEST(ScenarioLoader, BadValuesNameTheField) {
                 .find("not inside the terrain"),
             std::string::npos);
   EXPECT_NE(invalid(edit("goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }", "")).find("goal: give exactly one of"),
+            std::string::npos);
+  // A target radius must be > 0, and every agent's target must lie in the box it completes in.
+  EXPECT_NE(invalid(edit("y1_m: 6 }", "y1_m: 6 target_radius_m: 0 }")).find("goal.target_radius_m: 0 must be > 0"),
+            std::string::npos);
+  EXPECT_EQ(parse_scenario(edit("y1_m: 6 }", "y1_m: 6 target_radius_m: 0.5 }"), "t.pbtxt").goal.target_radius_m, 0.5);
+  EXPECT_NE(invalid(edit("x1_m: 11 y1_m: 6 }", "x1_m: 11 y1_m: 4.5 target_radius_m: 0.5 }"))
+                .find("agent[0] (agent 1).target: (10, 5) lies outside the goal box"),
             std::string::npos);
   EXPECT_NE(invalid(edit("name: \"mini\"", "name: \"a b\"")).find("name"), std::string::npos);
   EXPECT_NE(invalid(edit("name: \"mini\"", "")).find("name"), std::string::npos);

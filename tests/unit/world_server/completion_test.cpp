@@ -107,6 +107,56 @@ scenario::Site site(double x0, double y0, double x1, double y1, double kappa = 0
   return s;
 }
 
+/// A state of two agents on a 1 m platform (x >= 2 m) of a flat 0.1 m grid, the goal the platform top, each
+/// agent's target 1 m in from the platform's edge.
+WorldState platform_state(double target_radius_m) {
+  Heightmap h(GridGeometry{40, 40, 0.0, 0.0, 0.1});
+  for (int r = 0; r < 40; ++r)
+    for (int c = 20; c < 40; ++c) h(r, c) = 1.0;
+  WorldState state;
+  state.terrain = h;
+  state.goal = {2.0, 0.0, 4.0, 4.0, 0.9, target_radius_m};
+  for (std::uint32_t id = 1; id <= 2; ++id) {
+    AgentRecord a;
+    a.id = id;
+    a.admitted = a.alive = true;
+    a.target_x_m = 3.05;
+    a.target_y_m = id == 1 ? 1.05 : 3.05;
+    state.agents.push_back(a);
+  }
+  return state;
+}
+
+TEST(AgentsAtGoal, WithATargetRadiusEachAgentMustStandAtItsOwnTarget) {
+  WorldState state = platform_state(0.25);
+  AgentRecord& a = state.agents[0];
+  AgentRecord& b = state.agents[1];
+  // Both on the platform's edge, half the body over the ramp: inside the box and high enough, but 1 m short.
+  a.x_m = b.x_m = 2.05;
+  a.y_m = 1.05, b.y_m = 3.05;
+  EXPECT_FALSE(at_goal(state, a));
+  EXPECT_FALSE(is_completed(state));
+  EXPECT_DOUBLE_EQ(progress(state), 0.0);
+  // The box alone (no radius) took them as arrived: the old completion.
+  state.goal.target_radius_m = 0.0;
+  EXPECT_TRUE(is_completed(state));
+  state.goal.target_radius_m = 0.25;
+  // Agent 1 at 0.25 m from its target (a tie, inclusive); agent 2 on the other's target, 2 m from its own.
+  a.x_m = 2.80;
+  b.x_m = 3.05, b.y_m = 1.05;
+  EXPECT_TRUE(at_goal(state, a));
+  EXPECT_FALSE(at_goal(state, b));
+  EXPECT_DOUBLE_EQ(progress(state), 0.5);
+  EXPECT_FALSE(is_completed(state));
+  b.y_m = 2.85;  // 0.2 m from its own
+  EXPECT_TRUE(is_completed(state));
+  // On its target but below min_height_m (the cell under it sunk to 0.5 m): not at the goal.
+  a.x_m = 3.05;
+  EXPECT_TRUE(at_goal(state, a));
+  state.terrain(29, 30) = 0.5;  // (3.05, 1.05) m: row 39 - 10, col 30
+  EXPECT_FALSE(at_goal(state, a));
+}
+
 TEST(PayloadPath, NavigabilityAndShortestPathsMatchBruteForce) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> unit(0.0, 1.0), delta(0.2, 0.55);

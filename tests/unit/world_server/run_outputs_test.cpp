@@ -416,6 +416,27 @@ TEST(ZoomWindow, NothingToFrameWithoutDepositsRouteOrSite) {
   EXPECT_FALSE(zoom_window(WorldState{}, std::nullopt));  // no terrain at all
 }
 
+TEST(FinalPicture, AGoalWithATargetRadiusDrawsEachAdmittedAgentsTarget) {
+  WorldState s = flat_state(100, 100, 0.5, 0.0, 0.0, 46.0, 46.0, 1.0);
+  s.goal = {10.0, 10.0, 20.0, 20.0, -1e9, 0.25};
+  for (std::uint32_t id = 1; id <= 3; ++id) {
+    AgentRecord a;
+    a.id = id;
+    a.admitted = id != 2;  // slot 2 never joined: no ring for it
+    a.target_x_m = 15.0;
+    a.target_y_m = 10.0 + 2.0 * id;
+    s.agents.push_back(a);
+  }
+  const render::RenderOptions o = final_picture_options(s, info_for("targets", false), std::nullopt);
+  ASSERT_EQ(o.circles.size(), 3u);  // the base, then the targets of agents 1 and 3
+  EXPECT_EQ(o.circles[1].centre.y, 12.0);
+  EXPECT_EQ(o.circles[2].centre.y, 16.0);
+  EXPECT_EQ(o.circles[2].radius_m, 0.25);
+  EXPECT_TRUE(has_legend(o, "targets (0.25 m)", o.circles[1].colour));
+  s.goal.target_radius_m = 0.0;  // the box alone: no target rings
+  EXPECT_EQ(final_picture_options(s, info_for("targets", false), std::nullopt).circles.size(), 1u);
+}
+
 TEST(ZoomPicture, OptionsCropLabelsAndMarkersKeepWorldOverlaysAndSayCloseUp) {
   WorldState s = corner_state();
   s.goal = {47.0, 47.0, 48.5, 48.5, -1e9};  // centre (47.75, 47.75): cell (4, 95)

@@ -87,7 +87,8 @@ TEST_F(ScenarioCheckTest, TheRampScenarioIsValidAndReportedInFull) {
                 "  1 husky: start (5.05, 7.05) target (22.05, 7.05)\n"
                 "  2 husky: start (5.05, 10.05) target (22.05, 10.05)\n"
                 "  3 husky: start (5.05, 13.05) target (22.05, 13.05)\n"
-                "completion: agents_at_goal, goal x [18, 28] y [3, 17] m, min_height_m 1.4\n"
+                "completion: agents_at_goal, goal x [18, 28] y [3, 17] m, min_height_m 1.4, each agent within 0.25 m of its "
+                "target\n"
                 "base: (3.05, 10.05) m, radius 1.5 m\n"
                 "max_steps 4000, seed 1, start_jitter_m 0, step_deadline_s 10, tile_size 16, run id ramp-d0\n");
   // --scenario FILE works as well as the positional SCENARIO.

@@ -52,15 +52,16 @@ TEST(PayloadCompletion, AnAlreadyNavigablePayloadIsCompleteFromTheStart) {
 }
 
 TEST(PayloadCompletion, TheCheckRunsOnItsScheduleOnlyAfterChanges) {
-  // A 0.1 m hole under `to` (row 9, col 30) spoils it for the payload (ball 3 x 3, eps 0.05, kappa 0.2).
+  // A 0.1 m hole beside `to` (row 9, col 30), in its ball, spoils it for the payload (ball 3 x 3, eps 0.05, kappa
+  // 0.2). Beside, not under: filling a hole under `to` would raise the target's cell (next test).
   Heightmap terrain = flat_terrain();
-  const CellIndex hole{9, 30};
+  const CellIndex hole{9, 29};
   terrain(hole) = -8 * kLayer;
   WorldState s = admitted_state(scenario_with(payload_block(3)), terrain, 2);
   EXPECT_FALSE(is_completed(s));
   EXPECT_EQ(progress(s), 0.0);
   EXPECT_EQ(s.check.evaluations, 1u);
-  s.agent(1).x_m = 2.25;  // 0.8 m west of the hole: within reach, not over it
+  s.agent(1).x_m = 2.15;  // 0.8 m west of the hole: within reach, not over it
   s.agent(1).y_m = 3.05;
 
   // Step 0 fills the hole; no check at steps 0 and 1, the check at step 2 finds the path.
@@ -85,6 +86,41 @@ TEST(PayloadCompletion, TheCheckRunsOnItsScheduleOnlyAfterChanges) {
   // Steps 5, 8, ... would check, but nothing changes: no evaluation.
   idle_steps(s, 7);
   EXPECT_EQ(s.check.evaluations, 2u);
+}
+
+TEST(PayloadCompletion, APathOverARaisedTargetIsNoCompletion) {
+  // The payload has its path from the start (flat ground), so the check is met; then the target's cell is raised.
+  WorldState s = admitted_state(scenario_with(payload_block(3)), flat_terrain(), 2);
+  ASSERT_TRUE(is_completed(s));
+  const CellIndex to = s.check.to;
+  EXPECT_EQ(to, (CellIndex{9, 30}));
+  EXPECT_EQ(s.check.target_initial_m, 0.0);
+  EXPECT_EQ(s.check.max_target_rise_m, kLayer);  // one cube layer of the scenario's robot type
+  s.agent(1).x_m = 2.25;  // 0.8 m west of `to`
+  s.agent(1).y_m = 3.05;
+  // Two layers on the target's cell (0.025 m, less than eps: the payload still drives over it): a path, no completion.
+  StepOutcome o = apply_step(s, std::vector<protocol::ActionRequest>{deposit(s, 1, to, 2 * kLayer), request_for(s, 2)});
+  ASSERT_EQ(s.agent(1).last_result, protocol::ActionResult::kAccepted) << s.agent(1).last_reason;
+  idle_steps(s, 2);  // step 2 checks (every 3 steps)
+  EXPECT_TRUE(payload_path_navigable(s.terrain, s.payload_path));
+  EXPECT_TRUE(s.check.path_found);
+  EXPECT_FALSE(s.check.met);
+  EXPECT_FALSE(is_completed(s));
+  EXPECT_EQ(progress(s), 0.0);
+  EXPECT_DOUBLE_EQ(target_rise_m(s), 2 * kLayer);
+  EXPECT_EQ(payload_completion_detail(s, true),
+            "payload path found, but the target's cell stands 0.025 m above its initial height (at most 0.0125 m "
+            "allowed)");
+  EXPECT_EQ(payload_completion_detail(s, false), "no payload path from base to target");
+  // One layer is within the allowance: the same with a single layer completes.
+  WorldState t = admitted_state(scenario_with(payload_block(3)), flat_terrain(), 2);
+  t.agent(1).x_m = 2.25;
+  t.agent(1).y_m = 3.05;
+  o = apply_step(t, std::vector<protocol::ActionRequest>{deposit(t, 1, to, kLayer), request_for(t, 2)});
+  idle_steps(t, 2);
+  EXPECT_EQ(t.check.evaluations, 2u);
+  EXPECT_TRUE(is_completed(t));
+  EXPECT_EQ(payload_completion_detail(t, true), "payload path found, target's cell within 0.0125 m of its initial height");
 }
 
 TEST(PayloadCompletion, EndsOffTheGridAreRefusedWhenTheStateIsMade) {
