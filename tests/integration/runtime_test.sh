@@ -44,7 +44,8 @@ run_spawn() {  # run_spawn OUT_NAME AGENTS DDS [AGENT_DDS]
   echo "$out/summary.json"
 }
 # start_run OUT [WORLD ARGS]: world and agents 1..3 on Cyclone in the background; sets out, logs, world, pids.
-# Optional: logs_dir (default OUT/logs), world_wrap (a command the world runs under), agent_ids=auto (--id auto).
+# Optional: logs_dir (default OUT/logs), world_wrap (a command the world runs under), agent_ids=auto (--id auto),
+# world_only=1 (the agents later, with start_agents).
 start_run() {
   export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
   out="$1"
@@ -54,6 +55,10 @@ start_run() {
   ${world_wrap:-} "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" \
     --out "$out" "$@" >"$logs/world.log" 2>&1 &
   world=$!
+  [ -n "${world_only:-}" ] || start_agents
+}
+# start_agents: agents 1..3 of start_run's world (start_run with world_only=1 starts the world alone).
+start_agents() {
   pids=()
   for id in 1 2 3; do
     "$bin/marsala-agent" --scenario "$scenario" --id "${agent_ids:-$id}" --dds cyclone --domain "$domain" \
@@ -401,26 +406,16 @@ case "$case_name" in
     # A Fast DDS participant speaks in the name of a Cyclone world: to every agent admitted, a "run over" frame, a
     # frame for step 2^62 and a malformed one; to monitors, "completed at step 999999". Nothing of it is believed.
     export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
-    mkdir -p "$work/run/logs"
     "$bin/marsala-monitor" tail --dds cyclone --domain "$domain" --events --timeout 120 >"$work/tail.txt" 2>&1 &
     monitor=$!
     "$bin/marsala-impostor" fastdds "$domain" 3 120 >"$work/impostor.log" 2>&1 &
     impostor=$!
     # The world first, then the impostor hears its admissions, then the agents come: it sees every admission.
-    out="$work/run"
-    logs="$out/logs"
-    "$bin/marsala-world" --scenario "$scenario" --agents 3 --dds cyclone --domain "$domain" --out "$out" \
-      >"$logs/world.log" 2>&1 &
-    world=$!
+    world_only=1 start_run "$work/run"
     for _ in $(seq 1 600); do grep -q "impostor ready" "$work/impostor.log" && break; sleep 0.05; done
     grep -q "impostor ready" "$work/impostor.log" || { cat "$work/impostor.log"; fail "the impostor never heard the world"; }
     sleep 1.5  # the impostor matched the world's writer; give the world time to match the impostor's reader too
-    pids=()
-    for id in 1 2 3; do
-      "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" \
-        >"$logs/agent-$id.log" 2>&1 &
-      pids+=($!)
-    done
+    start_agents
     wait "$world" || { tail -30 "$logs/world.log"; fail "world exited non-zero"; }
     for p in "${pids[@]}"; do wait "$p" || fail "an agent exited non-zero (see $logs)"; done
     wait "$impostor" || { cat "$work/impostor.log"; fail "the impostor did not forge for 3 agents"; }
