@@ -18,6 +18,7 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
+#include "marsala/core/log_pacing.hpp"
 #include "marsala/core/mars_processor.hpp"
 #include "marsala/render/terrain_renderer.hpp"
 #include "marsala/render/timelapse.hpp"
@@ -135,12 +136,6 @@ struct AgentLink {
   std::optional<Clock::time_point> not_alive_since;  ///< when its seen writer was last found not alive
   std::optional<protocol::SensorFrame> frame;        ///< the current step's frame, for resends
 };
-
-/// True when `n` is 1, 10, 100, ...: bounded logging of repeated things.
-bool power_of_ten(std::uint64_t n) {
-  while (n >= 10 && n % 10 == 0) n /= 10;
-  return n == 1;
-}
 
 WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, RuntimeOptions options, int domain_id) {
   WorldStart start{s, std::move(options), {}, std::nullopt};

@@ -11,6 +11,7 @@
 #include "marsala/agent/executive/mapping_system.hpp"
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/log_pacing.hpp"
 
 namespace marsala::agent::runtime {
 namespace {
@@ -59,15 +60,6 @@ std::string frame_problem(const protocol::SensorFrame& f, const Assignment& assi
     if (!sane(n.x_m) || !sane(n.y_m) || !sane(n.z_m))
       return fmt::format("neighbour {} at ({}, {}, {}) m is not finite", n.agent_id, n.x_m, n.y_m, n.z_m);
   return {};
-}
-
-/// Logs an ignored frame: the 1st, 10th, 100th, ... of a run, so a flood stays a few lines.
-void log_ignored(std::uint32_t agent_id, std::uint64_t count, const std::string& why) {
-  for (std::uint64_t n = 1; n <= count; n *= 10)
-    if (n == count) {
-      spdlog::warn("agent {}: ignoring a frame ({} so far): {}", agent_id, count, why);
-      return;
-    }
 }
 
 /// The longest a wait lasts before the stop flag is looked at again.
@@ -284,7 +276,8 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
       else
         why = frame_problem(frame, assignment_);
       if (!why.empty()) {
-        log_ignored(config_.agent_id, ++result.ignored_frames, why);
+        if (power_of_ten(++result.ignored_frames))
+          spdlog::warn("agent {}: ignoring a frame ({} so far): {}", config_.agent_id, result.ignored_frames, why);
         continue;
       }
       ++result.frames;
