@@ -61,6 +61,14 @@ bool occupiable_by_window(const Heightmap& h, CellIndex cell, const Navigability
 
 }  // namespace
 
+double body_clearance_m(const AgentRecord& a, const AgentRecord& b) {
+  return 0.5 * (a.type.body.navigability.delta_m + b.type.body.navigability.delta_m);
+}
+
+bool bodies_overlap(const AgentRecord& a, double ax, double ay, const AgentRecord& b, double bx, double by) {
+  return distance(ax, ay, bx, by) < body_clearance_m(a, b) - tol::kLengthM;
+}
+
 double cube_layer_m(double cube_size_m, double cell_size_m) {
   return cube_size_m * cube_size_m * cube_size_m / (cell_size_m * cell_size_m);
 }
@@ -78,7 +86,8 @@ bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const Navigabilit
 }
 
 Verdict validate_request(const WorldState& state, std::uint32_t channel_id, const protocol::ActionRequest& r) {
-  const auto reject = [](std::string reason) { return Verdict{false, std::move(reason), 0.0}; };
+  int rule = 1;
+  const auto reject = [&rule](std::string reason) { return Verdict{false, std::move(reason), rule, 0.0}; };
 
   // 1. Envelope.
   if (r.agent_id != channel_id)
@@ -104,6 +113,7 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
     return reject(std::to_string(r.depositions.size()) + " depositions exceed the grid's cells");
 
   // 2. Motion.
+  rule = 2;
   double x = me.x_m, y = me.y_m;
   if (r.move) {
     const double d = distance(r.target_x_m, r.target_y_m, x, y);
@@ -131,6 +141,7 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
   }
 
   // 3. Depositions, from the position after the motion.
+  rule = 3;
   const double cs = terrain.cell_size_m();
   const double layer = cube_layer_m(me.type.body.cube_size_m, cs);
   std::vector<std::pair<int, int>> cells;
@@ -174,13 +185,14 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
                   fmt::format("{}", me.material_m3) + " m^3");
 
   // 4. Refill.
+  rule = 4;
   if (r.refill) {
     const double to_base = distance(x, y, state.base.x_m, state.base.y_m);
     if (!(to_base <= state.base.radius_m + tol::kLengthM))
       return reject("refill requested " + fmt::format("{}", to_base) + " m from the base station (radius " +
                     fmt::format("{}", state.base.radius_m) + " m)");
   }
-  return Verdict{true, {}, volume};
+  return Verdict{true, {}, 0, volume};
 }
 
 void apply_request(WorldState& state, const protocol::ActionRequest& r, const Verdict& verdict,

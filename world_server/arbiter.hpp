@@ -38,6 +38,7 @@ bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const Navigabilit
 struct Verdict {
   bool accepted = false;
   std::string reason;      ///< why not, when rejected
+  int rule = 0;            ///< the rule (1-4 of docs/runtime.md#validation) that rejected it; 0 when accepted
   double volume_m3 = 0.0;  ///< material the depositions place, when accepted [m^3]
 };
 
@@ -50,6 +51,11 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
 /// the request's agent), material, refill, counts. Appends the changed cells to `changed_cells`.
 void apply_request(WorldState& state, const protocol::ActionRequest& request, const Verdict& verdict,
                    std::vector<CellIndex>& changed_cells);
+
+/// Distance below which the bodies of `a` and `b` overlap: (delta_a + delta_b) / 2 [m] (docs/runtime.md#collisions).
+double body_clearance_m(const AgentRecord& a, const AgentRecord& b);
+/// True when the bodies of `a` at (ax, ay) and `b` at (bx, by) overlap: closer than body_clearance_m - 1e-9 m.
+bool bodies_overlap(const AgentRecord& a, double ax, double ay, const AgentRecord& b, double bx, double by);
 
 /// Thickness of one layer of cubes on a cell: cube_size^3 / cell_size^2 [m].
 double cube_layer_m(double cube_size_m, double cell_size_m);

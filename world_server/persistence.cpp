@@ -148,6 +148,9 @@ proto::Snapshot make_snapshot(const WorldState& state, const std::string& run_id
   for (std::uint64_t v : state.tile_versions) s.add_tile_versions(v);
   s.set_deposited_volume_m3(state.deposited_volume_m3);
   s.set_idle_steps(state.idle_steps);
+  s.set_close_passes(state.close_passes);
+  s.set_overlap_pair_steps(state.overlap_pair_steps);
+  s.set_rejected_motions(state.rejected_motions);
   s.set_check_met(state.check.met);
   s.set_check_level_fraction(state.check.level_fraction);
   s.set_check_evaluations(state.check.evaluations);
@@ -231,6 +234,9 @@ void restore_snapshot(WorldState& state, const proto::Snapshot& s, const std::st
     state.tile_versions[static_cast<std::size_t>(i)] = s.tile_versions(i);
   state.deposited_volume_m3 = s.deposited_volume_m3();
   state.idle_steps = s.idle_steps();
+  state.close_passes = s.close_passes();
+  state.overlap_pair_steps = s.overlap_pair_steps();
+  state.rejected_motions = s.rejected_motions();
   state.unattributed_rejections = s.unattributed_rejections();
   state.surplus_requests = s.surplus_requests();
   state.resumes = s.resumes();

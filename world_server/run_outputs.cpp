@@ -149,6 +149,9 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_unattributed_rejections(state.unattributed_rejections);
   s.set_surplus_requests(state.surplus_requests);
   s.set_resumes(state.resumes);
+  s.set_close_passes(state.close_passes);
+  s.set_overlap_pair_steps(state.overlap_pair_steps);
+  s.set_rejected_motions(state.rejected_motions);
   std::uint32_t readmissions = 0;
   for (const AgentRecord& a : state.agents) readmissions += a.readmissions;
   s.set_readmissions(readmissions);

@@ -85,6 +85,7 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
       agent.last_reason = verdict.reason;
       ++agent.rejected;
       ++out.rejected;
+      if (verdict.rule == 2) ++state.rejected_motions;
       out.events.push_back(event(step, agent.id, protocol::EventKind::kRejected, verdict.reason));
     }
   }
@@ -111,6 +112,20 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
   }
 }
 
+/// Pairs (lower id, higher id) of live agents whose bodies overlap where they stand, in id order.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_pairs(const WorldState& state) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  for (std::size_t i = 0; i < state.agents.size(); ++i) {
+    const AgentRecord& a = state.agents[i];
+    if (!a.alive) continue;
+    for (std::size_t j = i + 1; j < state.agents.size(); ++j) {
+      const AgentRecord& b = state.agents[j];
+      if (b.alive && bodies_overlap(a, a.x_m, a.y_m, b, b.x_m, b.y_m)) pairs.emplace_back(a.id, b.id);
+    }
+  }
+  return pairs;
+}
+
 }  // namespace
 
 StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submissions) {
@@ -130,9 +145,15 @@ StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submiss
   }
   std::vector<CellIndex> changed_cells;
   bool deposited = false;
+  const auto overlapping_before = overlapping_pairs(state);
   for (AgentRecord& agent : state.agents)
     if (agent.alive) apply_agent(state, agent, submissions, by_agent[agent.id - 1], changed_cells, out, deposited);
   if (!deposited) ++state.idle_steps;
+  // Collision statistics (docs/runtime.md#collisions): a close pass is a pair that overlaps now and did not before.
+  const auto overlapping_after = overlapping_pairs(state);
+  state.overlap_pair_steps += overlapping_after.size();
+  for (const auto& pair : overlapping_after)
+    if (!std::binary_search(overlapping_before.begin(), overlapping_before.end(), pair)) ++state.close_passes;
 
   const TileLayout tiles = state.tiles();
   for (const CellIndex& c : changed_cells) out.changed_tiles.push_back(tiles.index_of(c));

@@ -101,6 +101,9 @@ struct WorldState {
   std::uint32_t unattributed_rejections = 0;  ///< rejected requests carrying no admitted identity (forged)
   std::uint32_t surplus_requests = 0;         ///< requests beyond a partition's per-step limit, never applied (runtime)
   std::uint32_t resumes = 0;                  ///< times the world was resumed from its run log
+  std::uint64_t close_passes = 0;        ///< pairs of robots whose bodies began to overlap in a step [count]
+  std::uint64_t overlap_pair_steps = 0;  ///< (step, pair) with overlapping bodies after the step [count]
+  std::uint32_t rejected_motions = 0;    ///< requests rejected by a motion rule (docs/runtime.md#rule-2-motion)
 
   /// True when `id` names an agent slot of this run.
   bool has_agent(std::uint32_t id) const { return id >= 1 && id <= agents.size(); }
