@@ -136,6 +136,19 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
         return reject("motion passes through cell " + fmt::format("{}", swept[i]) +
                       ", not occupiable for this body");
     }
+    // Robot bodies may not overlap where the motion ends: the others stand where this step's lower ids left them
+    // and the higher ids where the step found them. Bodies that already overlap (jittered starts, a readmission)
+    // may move apart.
+    for (const AgentRecord& other : state.agents) {
+      if (!other.alive || other.id == me.id) continue;
+      if (!bodies_overlap(me, r.target_x_m, r.target_y_m, other, other.x_m, other.y_m)) continue;
+      const double after = distance(r.target_x_m, r.target_y_m, other.x_m, other.y_m);
+      if (bodies_overlap(me, x, y, other, other.x_m, other.y_m) && after >= distance(x, y, other.x_m, other.y_m))
+        continue;
+      return reject("motion ends " + fmt::format("{}", after) + " m from agent " + std::to_string(other.id) +
+                    ", whose body it would overlap (bodies need " + fmt::format("{}", body_clearance_m(me, other)) +
+                    " m)");
+    }
     x = r.target_x_m;
     y = r.target_y_m;
   }

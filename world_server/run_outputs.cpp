@@ -135,6 +135,7 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
     p->set_y_m(a.y_m);
     p->set_z_m(a.z_m);
     p->set_material_m3(a.material_m3);
+    p->set_state(a.state);
   }
   s.set_admitted(admitted);
   s.set_dropped(dropped);

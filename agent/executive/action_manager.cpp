@@ -39,12 +39,13 @@ const CellMask& ActionManager::moves_mask(const deliberative::LocalMap& map) con
 }
 
 std::optional<Motion> ActionManager::advance(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
-                                             Position robot) const {
+                                             Position robot, const std::vector<BodyClearance>& others) const {
   if (path.empty()) return std::nullopt;
   const CellMask& mask = moves_mask(map);
   const Position own = map.center(path[0]);
   const double d_own = distance(own, robot);
-  const bool can_centre = mask(path[0].row, path[0].col) != 0 && d_own > kCentredM && d_own <= max_step_m_;
+  const bool can_centre =
+      mask(path[0].row, path[0].col) != 0 && d_own > kCentredM && d_own <= max_step_m_ && clear_of(others, robot, own);
   // A path that ends on the robot's own cell: arrive on its centre (a partial diagonal move leaves a robot off it).
   if (path.size() == 1) return can_centre ? std::optional<Motion>(Motion{path[0], own, 0, d_own}) : std::nullopt;
   std::optional<Motion> best;
@@ -53,7 +54,8 @@ std::optional<Motion> ActionManager::advance(const deliberative::LocalMap& map, 
     if (!map.contains(cell) || mask(cell.row, cell.col) == 0) break;
     const Position centre = map.center(cell);
     const double d = distance(centre, robot);
-    if (d <= max_step_m_ && sweep_clear(map, mask, robot, centre)) best = Motion{cell, centre, i, d};
+    if (d <= max_step_m_ && sweep_clear(map, mask, robot, centre) && clear_of(others, robot, centre))
+      best = Motion{cell, centre, i, d};
   }
   if (best) return best;
   // The next cell is navigable but out of range from where the robot stands: first step onto its own centre.
@@ -67,7 +69,8 @@ std::optional<Motion> ActionManager::advance(const deliberative::LocalMap& map, 
   const double f = max_step_m_ * (1.0 - 1e-9) / d_next;
   const Position partial{robot.x + (aim.x - robot.x) * f, robot.y + (aim.y - robot.y) * f};
   const auto cell = map.cell_at(partial);
-  if (!cell || *cell == path[0] || mask(cell->row, cell->col) == 0 || !sweep_clear(map, mask, robot, partial))
+  if (!cell || *cell == path[0] || mask(cell->row, cell->col) == 0 || !sweep_clear(map, mask, robot, partial) ||
+      !clear_of(others, robot, partial))
     return std::nullopt;  // a new cell it may reach, or no motion
   return Motion{*cell, partial, *cell == next ? std::size_t{1} : std::size_t{0}, distance(partial, robot)};
 }

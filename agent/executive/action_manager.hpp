@@ -3,12 +3,14 @@
 // farthest path cell that is navigable now (on the local map before this step's depositions: the world applies
 // the motion first) and within the distance threshold, whose straight way from the robot passes through navigable
 // cells only, and targets that cell's centre, so the world (which checks the distance and that every cell the
-// motion passes through is occupiable: cells_on_segment) never has a reason to reject it.
+// motion passes through is occupiable: cells_on_segment) never has a reason to reject it. Every target also ends
+// clear of the other robots' bodies (body_clearance.hpp: the world's rule 2.5).
 
 #include <optional>
 #include <vector>
 
 #include "marsala/agent/deliberative/local_map_synthesizer.hpp"
+#include "marsala/agent/executive/body_clearance.hpp"
 #include "marsala/core/types.hpp"
 
 namespace marsala::agent::executive {
@@ -34,10 +36,10 @@ class ActionManager {
   /// way out). If the path is the robot's own cell alone, or only that cell's centre is in range, and the robot is
   /// off the centre, the motion centres the robot; if the robot is centred and the next cell's centre is beyond a
   /// step (a diagonal when the step is shorter than a cell's diagonal), it goes a step's length towards that centre,
-  /// when the point it reaches lies in another cell it may move to along a clear way. nullopt when no progress is
-  /// possible.
+  /// when the point it reaches lies in another cell it may move to along a clear way. Targets not clear_of `others`
+  /// are never chosen. nullopt when no progress is possible.
   std::optional<Motion> advance(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
-                                Position robot) const;
+                                Position robot, const std::vector<BodyClearance>& others = {}) const;
 
  private:
   const CellMask& moves_mask(const deliberative::LocalMap& map) const;

@@ -19,7 +19,8 @@ constexpr EnumName<PathState> kPathStateNames[] = {{PathState::kWaitAdmission, "
                                                    {PathState::kFollow, "follow"},
                                                    {PathState::kHold, "hold"},
                                                    {PathState::kBackOff, "back_off"},
-                                                   {PathState::kDone, "done"}};
+                                                   {PathState::kDone, "done"},
+                                                   {PathState::kYield, "yield"}};
 
 double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
@@ -40,16 +41,20 @@ PathState path_state_from_string(const std::string& name) {
   return enum_from_string(kPathStateNames, name, "path builder state");
 }
 
-PipelineParams pipeline_params(const Pipeline& pipeline) {
+PipelineParams pipeline_params(const Pipeline& pipeline, const RobotBody& body) {
   PipelineParams p;
   p.separation_m = pipeline.separation_m;
   p.back_off_margin_m = 0.25 * p.separation_m;
-  p.return_detect_m = 0.75 * p.separation_m;
+  // The active robot's retreat (back to fill where it stood: reach + body + a step) is not a return to the base.
+  p.return_detect_m =
+      std::max(0.75 * p.separation_m, body.reach_m + body.navigability.delta_m + body.max_step_m);
   return p;
 }
 
 PathBuilder::PathBuilder(const AgentContext& context, PathBuilderOptions options)
-    : steps_(context, std::move(options.planner)), pipeline_(pipeline_params(context.type.pipeline)) {}
+    : steps_(context, std::move(options.planner)), pipeline_(pipeline_params(context.type.pipeline, context.type.body)) {
+  steps_.set_lane(context.type.pipeline.lane_offset_m, construction_params(context.type).delta_m);
+}
 
 const executive::MappingSystem& PathBuilder::map() const {
   if (!steps_.admitted()) throw InvalidArgument("path builder: no map before admission");
@@ -74,6 +79,9 @@ protocol::ActionRequest PathBuilder::decide(const protocol::SensorFrame& frame) 
     state_ = PathState::kDone;
   } else {
     const BuildView view = steps_.look(frame, trace_);
+    const Position here{frame.x_m, frame.y_m};
+    still_steps_ = last_position_ && last_position_->x == here.x && last_position_->y == here.y ? still_steps_ + 1 : 0;
+    last_position_ = here;
     if (state_ == PathState::kSurvey) state_ = PathState::kAdvance;
     // On the local goal's cell (the target's, or the nearest to a target off the grid) the path has reached it:
     // back to the base, to come again.
@@ -96,6 +104,8 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
                                 protocol::ActionRequest& request) {
   const PipelinePlace place = pipeline_.place(view.robot, view.target);
   trace_.role = place.role;
+  if (place.role != PipelineRole::kActive)
+    if (const auto other = oncoming(view, frame)) return yield_step(view, *other, request);
   switch (place.role) {
     case PipelineRole::kActive:
       if (state_ == PathState::kRetreat) {
@@ -105,7 +115,12 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
       }
       return;
     case PipelineRole::kFollow: follow_step(view, {place.front->x_m, place.front->y_m}, request); return;
-    case PipelineRole::kHold: state_ = PathState::kHold; return;
+    case PipelineRole::kHold:
+      state_ = PathState::kHold;
+      // A front neighbour that stays put as long as this robot has waited may be waiting for it to make way (a
+      // robot on its way back that has not got far enough to be seen returning): step aside, off its line to the base.
+      if (still_steps_ >= kPatienceSteps) yield_step(view, *place.front, request);
+      return;
     case PipelineRole::kBackOff: back_off_step(view, {place.front->x_m, place.front->y_m}, request); return;
   }
 }
@@ -113,16 +128,61 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
 void PathBuilder::follow_step(const BuildView& view, Position front, protocol::ActionRequest& request) {
   state_ = PathState::kHold;
   if (!steps_.plan_path(view.local, trace_)) return;
-  const auto motion = steps_.advance(view.local, trace_.plan.path, view.robot);
+  const auto motion = steps_.advance(view.local, steps_.in_lane(view.local, trace_.plan.path), view.robot);
   if (!motion || distance(motion->target, front) < pipeline_.params().separation_m) return;
   steps_.move(*motion, trace_, request);
   state_ = PathState::kFollow;
 }
 
+std::optional<Neighbour> PathBuilder::oncoming(const BuildView& view, const protocol::SensorFrame& frame) const {
+  const double mine = distance(view.robot, view.target);
+  std::optional<Neighbour> nearest;
+  double nearest_d = pipeline_.params().separation_m;
+  for (const Neighbour& n : frame.neighbours) {
+    const Position p{n.x_m, n.y_m};
+    if (!pipeline_.returning(n.agent_id) || !(distance(p, view.target) < mine)) continue;
+    const double d = distance(p, view.robot);
+    if (d <= nearest_d) nearest_d = d, nearest = n;
+  }
+  return nearest;
+}
+
+void PathBuilder::yield_step(const BuildView& view, const Neighbour& other, protocol::ActionRequest& request) {
+  state_ = PathState::kYield;
+  // Off the line from the returning robot to the base: to whichever side gains most, one step at most.
+  const Position from{other.x_m, other.y_m};
+  const Position base = steps_.context().assignment.base;
+  const double dx = base.x - from.x, dy = base.y - from.y, length = std::hypot(dx, dy);
+  const auto off_line = [&](Position p) {
+    return length > 0.0 ? std::abs((p.x - from.x) * dy - (p.y - from.y) * dx) / length : distance(p, from);
+  };
+  std::optional<executive::Motion> best;
+  double best_off = off_line(view.robot) + 1e-9;
+  const CellIndex at = view.local.robot;
+  for (int dr = -1; dr <= 1; ++dr)
+    for (int dc = -1; dc <= 1; ++dc) {
+      const CellIndex next{at.row + dr, at.col + dc};
+      if ((dr == 0 && dc == 0) || !view.local.contains(next) || view.local.navigable(next.row, next.col) == 0)
+        continue;
+      const auto motion = steps_.advance(view.local, {at, next}, view.robot);
+      if (motion && off_line(motion->target) > best_off) best_off = off_line(motion->target), best = motion;
+    }
+  if (best) steps_.move(*best, trace_, request);
+}
+
 void PathBuilder::back_off_step(const BuildView& view, Position front, protocol::ActionRequest& request) {
   state_ = PathState::kBackOff;
   const auto motion = steps_.step_back(view.local, view.robot);
-  if (motion && distance(motion->target, front) > distance(view.robot, front)) steps_.move(*motion, trace_, request);
+  if (motion && distance(motion->target, front) > distance(view.robot, front)) {
+    steps_.move(*motion, trace_, request);
+    return;
+  }
+  // No way back (other robots behind it): make way to the side instead, off the front robot's line to the base.
+  Neighbour ahead;
+  ahead.x_m = front.x;
+  ahead.y_m = front.y;
+  yield_step(view, ahead, request);
+  if (request.move) state_ = PathState::kBackOff;
 }
 
 }  // namespace marsala::agent::reactive

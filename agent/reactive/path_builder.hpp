@@ -12,16 +12,22 @@
 //   any but kReturnToBase --material below one deposition threshold (not enough for a deposition task), or the
 //                    robot on the local goal's cell (the path is there: go back, refill, come again) -> kReturnToBase
 //   kReturnToBase  --retrace the trajectory through navigable cells; at the base: refill--------------> kAdvance
+//   not kActive, and a returning neighbour within the separation that has not passed the robot yet (it is nearer the
+//                    target): step aside, off the line from it to the base (the front robot builds on;
+//                    returning robots go round it) ---------------------------------------------------> kYield
 //   otherwise, by the pipeline role of this frame:
 //     kActive  -> the ramp builder's building steps: from kRetreat its retreat step, else its build step
 //                 (-> kAdvance / kBuild / kRetreat); no deposition path through known cells: the state stays
 //     kFollow  -> advance along the deposition path through navigable cells without depositing ------> kFollow
 //                 no motion, or it would end closer than the separation to the front neighbour -----> kHold
-//     kHold    -> stand still ---------------------------------------------------------------------> kHold
-//     kBackOff -> step back the way it came, if that takes it away from the front neighbour --------> kBackOff
+//     kHold    -> stand still; after kPatienceSteps frames in a row at the same position, a step aside off the
+//                 front neighbour's line to the base (it may be on its way back, blocked) -------------> kHold / kYield
+//     kBackOff -> step back the way it came, if that takes it away from the front neighbour; else, when
+//                 another robot blocks the way back, a step aside off the front neighbour's line to the base -> kBackOff
 // After a refill the robot is in kAdvance; its next frame's role decides whether it builds or follows.
-// Lanes: the band is wide enough for two, but robots do not yet keep to one side (lane_offset_m is not used yet);
-// the world does not model collisions between robots, so a returning robot passes a follower on the same line.
+// Lanes: followers and robots on their way back keep lane_offset_m to the right of the band's centre line
+// (executive/lane.hpp), so a returning robot passes followers in the other lane; the world rejects motions that
+// would make bodies overlap, and every route goes around the bodies the frame shows (ramp_steps.hpp).
 
 #include <cstdint>
 #include <optional>
@@ -48,9 +54,10 @@ enum class PathState : std::uint8_t {
   kHold = 7,
   kBackOff = 8,
   kDone = 9,
+  kYield = 10,
 };
 /// "wait_admission", "survey", "advance", "build", "retreat", "return_to_base", "follow", "hold", "back_off",
-/// "done".
+/// "done", "yield".
 std::string to_string(PathState state);
 /// The inverse of to_string; throws InvalidArgument listing the valid names.
 PathState path_state_from_string(const std::string& name);
@@ -68,9 +75,13 @@ struct PathBuilderTrace : BuildTrace {
   std::optional<PipelineRole> role;  ///< the pipeline role of this frame, when it was asked for
 };
 
-/// The pipeline's distances for a robot type's pipeline: separation_m = pipeline.separation_m, back_off_margin_m a
-/// quarter of it, return_detect_m three quarters of it [m].
-PipelineParams pipeline_params(const Pipeline& pipeline);
+/// Frames a holding robot waits at the same position before it makes way for its front neighbour.
+inline constexpr int kPatienceSteps = 40;
+
+/// The pipeline's distances for a robot type's pipeline and body: separation_m = pipeline.separation_m,
+/// back_off_margin_m a quarter of it, return_detect_m three quarters of it or, when longer, the active robot's
+/// retreat (reach + delta + max_step: it backs off to fill where it stood, which is no return to the base) [m].
+PipelineParams pipeline_params(const Pipeline& pipeline, const RobotBody& body);
 
 /// Builds a navigable path in the construction pipeline; see the transition table above.
 class PathBuilder final : public Behaviour {
@@ -94,9 +105,13 @@ class PathBuilder final : public Behaviour {
   void pipeline_step(const BuildView& view, const protocol::SensorFrame& frame, protocol::ActionRequest& request);
   void follow_step(const BuildView& view, Position front, protocol::ActionRequest& request);
   void back_off_step(const BuildView& view, Position front, protocol::ActionRequest& request);
+  std::optional<Neighbour> oncoming(const BuildView& view, const protocol::SensorFrame& frame) const;
+  void yield_step(const BuildView& view, const Neighbour& oncoming, protocol::ActionRequest& request);
 
   RampSteps steps_;
   PipelineTracker pipeline_;
+  std::optional<Position> last_position_;  // the previous frame's
+  int still_steps_ = 0;                    // frames in a row at the same position
   double return_below_m3_ = 0.0;  // less material than this (one deposition task) on board: back to the base [m^3]
   PathState state_ = PathState::kWaitAdmission;
   PathBuilderTrace trace_;

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "marsala/agent/executive/lane.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
@@ -94,6 +95,11 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
   const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
   const Position target = goal.value_or(robot);  // nothing left to build towards: stay
   BuildView view{modules_->synthesizer.synthesize(modules_->map, robot, target), robot, target};
+  const RobotBody& body = context_.type.body;
+  others_ = executive::body_clearances(frame.neighbours, context_.agent_id, 0.5 * body.navigability.delta_m,
+                                       body.max_step_m);
+  corridor_ = view.local.navigable;
+  executive::keep_clear(view.local, robot, others_);
   trace.window_offset = view.local.offset;
   trace.local_goal = view.local.goal;
   trace.local_origin = view.local.origin;
@@ -111,7 +117,17 @@ bool RampSteps::plan_path(const deliberative::LocalMap& local, BuildTrace& trace
 
 std::optional<executive::Motion> RampSteps::advance(const deliberative::LocalMap& local,
                                                     const std::vector<CellIndex>& path, Position robot) const {
-  return modules_->actions.advance(local, path, robot);
+  return modules_->actions.advance(local, path, robot, others_);
+}
+
+void RampSteps::set_lane(double offset_m, double corridor_width_m) {
+  lane_offset_m_ = offset_m;
+  corridor_width_m_ = corridor_width_m;
+}
+
+std::vector<CellIndex> RampSteps::in_lane(const deliberative::LocalMap& local, const std::vector<CellIndex>& path) const {
+  if (!(lane_offset_m_ > 0.0) || corridor_.rows() != local.rows() || corridor_.cols() != local.cols()) return path;
+  return executive::lane_path(local, corridor_, path, lane_offset_m_, corridor_width_m_);
 }
 
 void RampSteps::move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) const {
@@ -190,8 +206,14 @@ std::optional<executive::Motion> RampSteps::step_back(const deliberative::LocalM
   if (!anchor) anchor = oldest_navigable_trajectory_cell(local);
   if (!anchor) anchor = farthest_navigable_from_goal(local);
   if (!anchor) return std::nullopt;
-  const auto route = modules_->router.plan(local.gap, local.navigable, local.robot, *anchor);
-  if (!route.found) return std::nullopt;
+  auto route = modules_->router.plan(local.gap, local.navigable, local.robot, *anchor);
+  if (!route.found) {
+    // The way back is cut (another robot stands on it): back off to the reachable cell farthest from the goal.
+    const auto away = farthest_navigable_from_goal(local);
+    if (!away || *away == *anchor) return std::nullopt;
+    route = modules_->router.plan(local.gap, local.navigable, local.robot, *away);
+    if (!route.found) return std::nullopt;
+  }
   return advance(local, route.path, robot);
 }
 
@@ -232,7 +254,7 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
   trace.plan = modules_->router.plan(local.gap, local.navigable, local.robot, *goal);
   trace.planned = true;
   if (!trace.plan.found) return false;
-  if (const auto motion = advance(local, trace.plan.path, robot)) {
+  if (const auto motion = advance(local, in_lane(local, trace.plan.path), robot)) {
     move(*motion, trace, request);
     if (distance(motion->target, base) <= radius) {
       request.refill = trace.refill = true;

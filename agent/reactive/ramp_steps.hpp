@@ -4,14 +4,17 @@
 // Fig. 1 that RampSteps owns.
 //
 // Each frame a behaviour first calls look(): the mapping system takes the frame's tiles, the goal synthesizer gives
-// the target and the local map synthesizer builds the augmented local map. Then, by its state, one of:
+// the target and the local map synthesizer builds the augmented local map, from which the cells too near another
+// robot's body are taken out (executive/body_clearance.hpp): every route and motion then keeps clear of the
+// neighbours the frame shows. Then, by its state, one of:
 //   build_step()   plan a deposition path to the local goal (once per frame); a motion along it is possible -> move
 //                  and deposit ahead (kAdvance); blocked, but depositions within reach -> deposit in place (kBuild);
 //                  blocked and nothing to deposit (the gap left is under the robot) -> retreat_step() (kRetreat)
 //   retreat_step() depositions within reach -> deposit in place (kRetreat); after depositing (or after many idle
 //                  retreat moves) and a motion along the path is possible -> move and deposit ahead (kAdvance); else
 //                  step back the way the robot came and fill what comes into reach (kRetreat)
-//   return_step()  retrace the way to the base through navigable cells; at the base: refill (true)
+//   return_step()  retrace the way to the base through navigable cells, in its lane (set_lane); at the base: refill
+//                  (true)
 // Building thus runs from the top of the ramp down to its toe (the robot backs off to fill where it stood), then the
 // robot climbs, filling ahead of itself. The steps fill the request and the trace; which state follows is the
 // behaviour's.
@@ -26,6 +29,7 @@
 #include "marsala/agent/deliberative/goal_synthesizer.hpp"
 #include "marsala/agent/deliberative/local_map_synthesizer.hpp"
 #include "marsala/agent/executive/action_manager.hpp"
+#include "marsala/agent/executive/body_clearance.hpp"
 #include "marsala/agent/executive/deposition_manager.hpp"
 #include "marsala/agent/executive/mapping_system.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
@@ -88,11 +92,19 @@ class RampSteps {
   /// possible.
   std::optional<executive::Motion> advance(const deliberative::LocalMap& local, const std::vector<CellIndex>& path,
                                            Position robot) const;
+  /// Lanes for routes (executive/lane.hpp): offset_m to the right of a corridor's centre line, corridors up to
+  /// corridor_width_m [m] each side of the path; offset 0 (the default): no lanes.
+  void set_lane(double offset_m, double corridor_width_m);
+  /// `path` moved into this robot's lane on the last look()'s map (unchanged without lanes).
+  std::vector<CellIndex> in_lane(const deliberative::LocalMap& local, const std::vector<CellIndex>& path) const;
+  /// The other robots' bodies the last look() saw.
+  const std::vector<executive::BodyClearance>& others() const { return others_; }
   /// Requests `motion` and records it.
   void move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) const;
   /// A step back the way the robot came: towards the local origin, or the oldest navigable cell of the trajectory in
   /// the window when the robot stands on the origin, or (it has not moved yet) to the navigable cell farthest from
-  /// the local goal; nullopt when there is none or no route to it.
+  /// the local goal; when another robot cuts the way there, towards the navigable cell farthest from the local goal;
+  /// nullopt when there is none or no route to it.
   std::optional<executive::Motion> step_back(const deliberative::LocalMap& local, Position robot) const;
 
   /// Advance, build or start retreating (see the header); nullopt, with nothing requested, when no deposition path
@@ -120,6 +132,10 @@ class RampSteps {
   std::unique_ptr<Modules> modules_;  // made on admission, when the grid is known
   bool deposited_since_blocked_ = false;
   int idle_retreat_moves_ = 0;
+  std::vector<executive::BodyClearance> others_;  // the last frame's neighbours
+  CellMask corridor_;                             // the last local map's navigable cells, neighbours not taken out
+  double lane_offset_m_ = 0.0;
+  double corridor_width_m_ = 0.0;
 };
 
 }  // namespace marsala::agent::reactive

@@ -56,9 +56,12 @@ std::string frame_problem(const protocol::SensorFrame& f, const Assignment& assi
     const std::string problem = executive::tile_problem(tile, assignment.world, assignment.tile_size);
     if (!problem.empty()) return problem;
   }
-  for (const Neighbour& n : f.neighbours)
+  for (const Neighbour& n : f.neighbours) {
     if (!sane(n.x_m) || !sane(n.y_m) || !sane(n.z_m))
       return fmt::format("neighbour {} at ({}, {}, {}) m is not finite", n.agent_id, n.x_m, n.y_m, n.z_m);
+    if (!(n.radius_m >= 0.0 && n.radius_m <= 1e3))
+      return fmt::format("neighbour {} has a body radius of {} m, not in [0, 1000] m", n.agent_id, n.radius_m);
+  }
   return {};
 }
 

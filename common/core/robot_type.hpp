@@ -14,7 +14,9 @@ namespace marsala {
 /// The construction pipeline of the "path_builder" behaviour (paper §V-A, Fig. 4).
 struct Pipeline {
   double separation_m = 2.0;   ///< a follower keeps at least this far behind its front neighbour [m]
-  double lane_offset_m = 0.5;  ///< forward lane right of the path, backward lane left [m]
+  /// Each robot keeps this far right of a corridor's centre line in the direction it drives (agent/executive/lane.hpp);
+  /// 0: no lanes [m].
+  double lane_offset_m = 0.75;
 };
 
 /// A kind of robot.

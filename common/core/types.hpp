@@ -47,6 +47,7 @@ struct Neighbour {
   double x_m = 0.0;
   double y_m = 0.0;
   double z_m = 0.0;
+  double radius_m = 0.0;  ///< half its body length delta: proximity sensing sees the body's extent [m]
 };
 
 /// Raise one cell by `height_m` (> 0): additive construction only.

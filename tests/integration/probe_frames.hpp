@@ -37,7 +37,7 @@ inline protocol::SensorFrame frame(std::uint64_t step, int tiles) {
     for (double& h : tile.heights) h = any_bits();
     f.tiles.push_back(std::move(tile));
   }
-  for (std::uint32_t n = 2; n < 5; ++n) f.neighbours.push_back({n, any_bits(), any_bits(), any_bits()});
+  for (std::uint32_t n = 2; n < 5; ++n) f.neighbours.push_back({n, any_bits(), any_bits(), any_bits(), any_bits()});
   f.run_over = step % 2 == 1;
   return f;
 }
@@ -62,7 +62,8 @@ inline bool same(const protocol::SensorFrame& a, const protocol::SensorFrame& b)
   for (std::size_t i = 0; i < a.neighbours.size(); ++i) {
     const protocol::Neighbour& x = a.neighbours[i];
     const protocol::Neighbour& y = b.neighbours[i];
-    if (x.agent_id != y.agent_id || !same_bits(x.x_m, y.x_m) || !same_bits(x.y_m, y.y_m) || !same_bits(x.z_m, y.z_m))
+    if (x.agent_id != y.agent_id || !same_bits(x.x_m, y.x_m) || !same_bits(x.y_m, y.y_m) || !same_bits(x.z_m, y.z_m) ||
+        !same_bits(x.radius_m, y.radius_m))
       return false;
   }
   return true;

@@ -18,7 +18,8 @@
 #
 # Usage: scenario_test.sh shipped DOMAIN NAME AGENTS DDS
 #   shipped deploy/scenarios/NAME.pbtxt as shipped, AGENTS agents on DDS, to its end: completed, no request rejected,
-#          the summary's volume equals the terrain's change, and its completion re-checked with marsala-terrain on
+#          no close pass (bodies never came to overlap), the summary's volume equals the terrain's change, and its
+#          completion re-checked with marsala-terrain on
 #          terrain_final.asc from what `marsala-world --check --json` says of the scenario: payload_path, the payload
 #          navigable from base to target (and not before), the target's cell at most one cube layer above its
 #          initial height, and at least 90 % of the target's initial region navigable from the base; level_site, every site cell occupiable and connected (and
@@ -55,6 +56,9 @@ expect_completed() {  # expect_completed SUMMARY AGENTS
   [ "$(field end_reason "$1")" = "completed" ] || { cat "$1"; fail "end_reason is not 'completed'"; }
   [ "$(field agents "$1")" = "$2" ] || { cat "$1"; fail "expected $2 agents in the summary"; }
   [ "$(field rejected_requests "$1")" = "0" ] || { cat "$1"; fail "the world rejected requests"; }
+  # Rule 2.5: no two bodies came to overlap (docs/runtime.md#collisions), and the agents planned for it (no motion
+  # rejected above).
+  [ "$(field close_passes "$1")" = "0" ] || { cat "$1"; fail "robot bodies came to overlap"; }
 }
 asc_cell() {  # asc_cell FILE ROW COL: the value of one cell (row 0 = north)
   awk -v r="$2" -v c="$3" 'NR == 7 + r { print $(c + 1); exit }' "$1"

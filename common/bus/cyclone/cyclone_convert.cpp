@@ -158,6 +158,7 @@ marsala_wire_SensorFrame to_msg(const SensorFrame& in, Storage& storage) {
     neighbour.x_m = n.x_m;
     neighbour.y_m = n.y_m;
     neighbour.z_m = n.z_m;
+    neighbour.radius_m = n.radius_m;
     storage.neighbours.push_back(neighbour);
   }
   out.neighbours = borrow_seq<dds_sequence_marsala_wire_Neighbour>(storage.neighbours);
@@ -194,6 +195,7 @@ SensorFrame from_msg(const marsala_wire_SensorFrame& in) {
     neighbour.x_m = n.x_m;
     neighbour.y_m = n.y_m;
     neighbour.z_m = n.z_m;
+    neighbour.radius_m = n.radius_m;
     out.neighbours.push_back(neighbour);
   }
   out.run_over = in.run_over;

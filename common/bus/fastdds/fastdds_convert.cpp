@@ -135,6 +135,7 @@ wire::SensorFrame to_msg(const SensorFrame& in) {
     neighbour.x_m(n.x_m);
     neighbour.y_m(n.y_m);
     neighbour.z_m(n.z_m);
+    neighbour.radius_m(n.radius_m);
     out.neighbours().push_back(neighbour);
   }
   out.run_over(in.run_over);
@@ -168,6 +169,7 @@ SensorFrame from_msg(const wire::SensorFrame& in) {
     neighbour.x_m = n.x_m();
     neighbour.y_m = n.y_m();
     neighbour.z_m = n.z_m();
+    neighbour.radius_m = n.radius_m();
     out.neighbours.push_back(neighbour);
   }
   out.run_over = in.run_over();

@@ -46,7 +46,8 @@ inline executive::MappingSystem full_map(const Heightmap& h, int tile_size = 16)
 }
 
 /// A neighbour as a frame reports it: agent `id` standing at (x, y) [m] (height 0).
-inline Neighbour neighbour_at(std::uint32_t id, double x, double y) { return {id, x, y, 0.0}; }
+/// A neighbour with a 1 m body (radius 0.5 m) at (x, y) [m].
+inline Neighbour neighbour_at(std::uint32_t id, double x, double y) { return {id, x, y, 0.0, 0.5}; }
 
 /// A Husky-like body: delta 1 m, eps 5 cm, 20 cm steps, 0.02 m^3 per step, 1.5 m reach, 5 cm cubes.
 inline RobotBody husky(double kappa = 0.5) {

@@ -121,7 +121,8 @@ class MiniWorld {
       }
     for (const auto& [oid, o] : robots_)
       if (oid != id && std::hypot(o.pos.x - r.pos.x, o.pos.y - r.pos.y) <= r.body.proximity_range_m)
-        f.neighbours.push_back({oid, o.pos.x, o.pos.y, terrain_(*terrain_.cell_at(o.pos))});
+        f.neighbours.push_back(
+            {oid, o.pos.x, o.pos.y, terrain_(*terrain_.cell_at(o.pos)), o.body.navigability.delta_m / 2.0});
     return f;
   }
 
@@ -150,6 +151,14 @@ class MiniWorld {
       for (std::size_t i = 1; i < swept.size(); ++i)
         if (swept[i] != swept.front() && occ(swept[i].row, swept[i].col) == 0)
           return "motion passes through a cell not occupiable";
+      for (const auto& [oid, o] : robots_) {  // rule 2.5: bodies may not come to overlap
+        if (oid == q.agent_id) continue;
+        const double need = (b.navigability.delta_m + o.body.navigability.delta_m) / 2.0 - 1e-9;
+        const double after = std::hypot(t.x - o.pos.x, t.y - o.pos.y);
+        const double before = std::hypot(r.pos.x - o.pos.x, r.pos.y - o.pos.y);
+        if (after < need && !(before < need && after >= before))
+          return "motion ends overlapping robot " + std::to_string(oid);
+      }
       pos = t;
     }
     const double q_layer = b.cube_size_m * b.cube_size_m * b.cube_size_m / (cs * cs);

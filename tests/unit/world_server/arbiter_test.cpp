@@ -156,6 +156,8 @@ TEST_F(ArbiterTest, MotionAcrossANonOccupiableCellIsRejected) {
   ASSERT_TRUE(cell_occupiable(state_.terrain, {20, 21}, body));
   state_.agent(1).x_m = 1.95;  // column 19
   state_.agent(1).y_m = 1.95;  // row 20
+  state_.agent(2).x_m = 3.55;  // out of the way
+  state_.agent(2).y_m = 0.35;
   // 0.2 m east, from column 19 to column 21, across column 20: its end cell is occupiable, its way is not.
   expect_rejected(move_to(state_, 1, 2.15, 1.95), "motion passes through cell (20, 20), not occupiable");
   // Onto the wall, named as the target.
@@ -180,6 +182,40 @@ TEST_F(ArbiterTest, ALongStepCannotJumpAWall) {
   ASSERT_TRUE(cell_occupiable(state_.terrain, *state_.terrain.cell_at({3.55, 1.95}), {0.3, 1.0, 0.05}));
   expect_rejected(move_to(state_, 1, 3.55, 1.95), "motion passes through cell (20, 15), not occupiable");
   EXPECT_FALSE(body_problem(state_.agent(1).type.body).empty());
+}
+
+TEST_F(ArbiterTest, AMotionMayNotEndInsideAnotherRobotsBody) {
+  // Agent 1 at (1.05, 1.05), agent 2 at (2.55, 1.05): bodies of 1 m need 1 m between centres.
+  state_.agent(2).x_m = 2.15;  // 1.1 m east of agent 1
+  // 0.15 m east ends 0.95 m from agent 2: overlap.
+  expect_rejected(move_to(state_, 1, 1.20, 1.05), "whose body it would overlap");
+  const Verdict v = check(move_to(state_, 1, 1.20, 1.05));
+  EXPECT_EQ(v.rule, 2);
+  EXPECT_NE(v.reason.find("agent 2"), std::string::npos) << v.reason;
+  // 0.1 m east ends exactly 1 m away: bodies touch, allowed.
+  EXPECT_TRUE(check(move_to(state_, 1, 1.15, 1.05)).accepted);
+  // A dropped robot is off the field.
+  state_.agent(2).alive = false;
+  EXPECT_TRUE(check(move_to(state_, 1, 1.20, 1.05)).accepted);
+}
+
+TEST_F(ArbiterTest, OverlappingBodiesMayMoveApartButNotCloser) {
+  state_.agent(2).x_m = 1.65;  // 0.6 m east of agent 1: already overlapping (e.g. jittered starts)
+  EXPECT_TRUE(check(move_to(state_, 1, 0.90, 1.05)).accepted);   // away: 0.75 m
+  EXPECT_TRUE(check(move_to(state_, 1, 1.05, 1.10)).accepted);   // sideways, a little farther: 0.602 m
+  expect_rejected(move_to(state_, 1, 1.15, 1.05), "agent 2");     // closer: 0.5 m
+  EXPECT_TRUE(check(move_to(state_, 1, 1.05, 1.05)).accepted);   // a motion of 0 m keeps the distance
+}
+
+TEST(BodiesOverlap, IsSymmetricAndUsesBothBodies) {
+  AgentRecord a, b;
+  a.type.body.navigability.delta_m = 1.0;
+  b.type.body.navigability.delta_m = 2.0;
+  EXPECT_DOUBLE_EQ(body_clearance_m(a, b), 1.5);
+  EXPECT_TRUE(bodies_overlap(a, 0, 0, b, 1.49, 0));
+  EXPECT_TRUE(bodies_overlap(b, 1.49, 0, a, 0, 0));
+  EXPECT_FALSE(bodies_overlap(a, 0, 0, b, 1.5, 0));
+  EXPECT_FALSE(bodies_overlap(a, 0, 0, b, 0.9, 1.2));  // 1.5 m on a diagonal
 }
 
 TEST_F(ArbiterTest, DepositionRules) {

@@ -120,6 +120,82 @@ TEST(ApplyStep, ArrivalOrderAcrossAgentsNeverChangesTheResult) {
   }
 }
 
+TEST(ApplyStep, TheLowerIdTakesASpotTheHigherIdOnlyOneThatWasLeft) {
+  const scenario::Scenario s = small_scenario();
+  WorldState base = admitted_state(s, flat_terrain(), 2);
+  base.agent(2).x_m = 2.05;  // 1.0 m east of agent 1: touching
+  // Agent 2 moves east and agent 1 follows into the space: agent 1 is judged first, agent 2 has not moved yet.
+  const protocol::ActionRequest one = move_to(base, 1, 1.2, 1.05), two = move_to(base, 2, 2.2, 1.05);
+  WorldState w = base;
+  apply_step(w, std::vector<protocol::ActionRequest>{two, one});
+  EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kRejected);
+  EXPECT_EQ(w.agent(1).x_m, 1.05);
+  EXPECT_EQ(w.agent(2).x_m, 2.2);
+  EXPECT_EQ(w.rejected_motions, 1u);
+  // The other way round: agent 1 moves west and agent 2 follows in the same step.
+  w = base;
+  apply_step(w, std::vector<protocol::ActionRequest>{move_to(base, 2, 1.9, 1.05), move_to(base, 1, 0.9, 1.05)});
+  EXPECT_EQ(w.agent(1).x_m, 0.9);
+  EXPECT_EQ(w.agent(2).x_m, 1.9);
+  EXPECT_EQ(w.rejected_motions, 0u);
+}
+
+TEST(ApplyStep, RandomMotionsNeverMakeBodiesOverlap) {
+  // Three robots wander in a 4 x 4 m yard with 1 m bodies; whatever they ask, no pair that was apart ever overlaps
+  // after a step, and a pair that overlapped at the start (jittered starts) only moves apart.
+  const scenario::Scenario s = small_scenario();
+  WorldState w = admitted_state(s, flat_terrain(), 3);
+  w.agent(2).x_m = 1.6;  // 0.55 m from agent 1: the only overlap at the start
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> angle(0.0, 6.283185307179586);
+  std::uint64_t rejected = 0;
+  for (int step = 0; step < 400; ++step) {
+    const WorldState before = w;
+    std::vector<protocol::ActionRequest> requests;
+    for (std::uint32_t id = 1; id <= 3; ++id) {
+      const double t = angle(rng);
+      const double x = std::clamp(w.agent(id).x_m + 0.19 * std::cos(t), 0.01, 3.99);
+      const double y = std::clamp(w.agent(id).y_m + 0.19 * std::sin(t), 0.01, 3.99);
+      requests.push_back(move_to(w, id, x, y));
+    }
+    apply_step(w, requests);
+    for (std::uint32_t a = 1; a <= 3; ++a)
+      for (std::uint32_t b = a + 1; b <= 3; ++b) {
+        const auto gap = [&](const WorldState& st) {
+          return std::hypot(st.agent(a).x_m - st.agent(b).x_m, st.agent(a).y_m - st.agent(b).y_m);
+        };
+        if (gap(w) < 1.0 - 1e-9) {
+          ASSERT_LT(gap(before), 1.0 - 1e-9) << "agents " << a << ", " << b << " came to overlap at step " << step;
+          ASSERT_GE(gap(w), gap(before) - 1e-12) << "agents " << a << ", " << b << " came closer at step " << step;
+        }
+      }
+  }
+  rejected = w.rejected_motions;
+  EXPECT_GT(rejected, 0u);  // the yard is small: some motions were refused
+  EXPECT_EQ(w.close_passes, 0u);
+  EXPECT_GE(w.overlap_pair_steps, 1u);  // the starting overlap lasted at least its first step
+}
+
+TEST(ApplyStep, CountsOverlappingPairSteps) {
+  // On a state the rule cannot produce (positions set directly); close passes cannot happen under rule 2.5 at all
+  // (RandomMotionsNeverMakeBodiesOverlap), they are counted for runs of worlds without it.
+  const scenario::Scenario s = small_scenario();
+  WorldState w = admitted_state(s, flat_terrain(), 3);  // 1 (1.05, 1.05), 2 (2.55, 1.05), 3 (1.05, 3.05)
+  const auto stand_still = [&] {
+    apply_step(w, std::vector<protocol::ActionRequest>{request_for(w, 1), request_for(w, 2), request_for(w, 3)});
+  };
+  stand_still();
+  EXPECT_EQ(w.overlap_pair_steps, 0u);
+  w.agent(2).x_m = 1.55;  // overlaps agent 1 from now on
+  for (int i = 0; i < 3; ++i) stand_still();
+  EXPECT_EQ(w.overlap_pair_steps, 3u);
+  EXPECT_EQ(w.close_passes, 0u);  // the overlap was there before each step: no new pass
+  // A dropped robot is off the field: its overlap stops counting.
+  w.agent(1).alive = false;
+  apply_step(w, std::vector<protocol::ActionRequest>{request_for(w, 2), request_for(w, 3)});
+  EXPECT_EQ(w.overlap_pair_steps, 3u);
+}
+
 TEST(ApplyStep, DuplicatesPastAndFutureRequests) {
   const scenario::Scenario s = small_scenario();
   WorldState w = admitted_state(s, flat_terrain(), 2);
@@ -289,19 +365,21 @@ TEST(ApplyStep, OnlyChangedTilesGetANewVersion) {
 }
 
 TEST(ApplyStep, ReachingTheGoalCompletesTheRun) {
-  const scenario::Scenario s = small_scenario();  // goal [2.9, 3.2] x [1.9, 2.2]
+  // A goal box [2.0, 3.9] x [1.9, 3.9] that holds both bodies of 1 m side by side.
+  const scenario::Scenario s = scenario::parse_scenario(
+      testing::small_scenario_text_completing("goal { x0_m: 2.0 y0_m: 1.9 x1_m: 3.9 y1_m: 3.9 }"), "small.pbtxt");
   WorldState w = admitted_state(s, flat_terrain(), 2);
-  w.agent(1).x_m = 2.85;
+  w.agent(1).x_m = 1.85;
   w.agent(1).y_m = 2.05;
   w.agent(2).x_m = 3.05;
-  w.agent(2).y_m = 2.25;
+  w.agent(2).y_m = 1.75;
   EXPECT_FALSE(is_completed(w));
-  StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{move_to(w, 1, 3.05, 2.05), request_for(w, 2)});
+  StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{move_to(w, 1, 2.05, 2.05), request_for(w, 2)});
   EXPECT_EQ(count(o, protocol::EventKind::kAtGoal), 1);
   EXPECT_TRUE(w.agent(1).at_goal);
   EXPECT_FALSE(o.completed);
   EXPECT_DOUBLE_EQ(progress(w), 0.5);
-  o = apply_step(w, std::vector<protocol::ActionRequest>{request_for(w, 1), move_to(w, 2, 3.05, 2.15)});
+  o = apply_step(w, std::vector<protocol::ActionRequest>{request_for(w, 1), move_to(w, 2, 3.05, 1.95)});
   EXPECT_EQ(count(o, protocol::EventKind::kAtGoal), 1);  // agent 1 is not reported twice
   EXPECT_TRUE(o.completed);
   EXPECT_DOUBLE_EQ(progress(w), 1.0);

@@ -28,10 +28,12 @@ using testing::FakeAgent;
 using testing::FakeAgentConfig;
 using testing::FakeMode;
 
-// Walkers of the small scenario: agent 1 from (1.05, 1.05) and agent 2 from (2.55, 1.05) towards (3.05, 2.05), 0.2 m
-// per step. Agent 1 enters the goal [2.9, 3.2] x [1.9, 2.2] with its 11th move (x = 1.05 + 11 * 0.2 * 2 / sqrt 5 =
-// 3.018), agent 2 with its 5th: the run completes when step 10 has been applied, after 11 steps.
-constexpr std::uint64_t kStepsToGoal = 11;
+// Walkers of the small scenario with a goal box for two bodies of 1 m, [1.7, 3.9] x [1.3, 2.6]: agent 1 from
+// (1.05, 1.05) and agent 2 from (2.55, 1.05) towards (3.05, 2.05), 0.2 m per step. Agent 1 enters the goal with its
+// 4th move (x = 1.05 + 4 * 0.2 * 2 / sqrt 5 = 1.766, y = 1.408), agent 2 with its 2nd, and their bodies stay more than
+// 1 m apart all the way: the run completes when step 3 has been applied, after 4 steps.
+constexpr std::uint64_t kStepsToGoal = 4;
+const char* const kTwoBodyGoal = "goal { x0_m: 1.7 y0_m: 1.3 x1_m: 3.9 y1_m: 2.6 }";
 
 /// The number after the first "key": in a JSON text, or NaN when absent.
 double json_number(const std::string& json, const std::string& key) {
@@ -104,7 +106,8 @@ class RuntimeTest : public ::testing::Test {
     return {};
   }
 
-  scenario::Scenario scenario_ = testing::small_scenario();
+  scenario::Scenario scenario_ =
+      scenario::parse_scenario(testing::small_scenario_text_completing(kTwoBodyGoal), "small.pbtxt");
   fs::path out_;
 };
 
@@ -148,8 +151,8 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   const WorldState& s = runtime.state();
   EXPECT_EQ(s.agent(1).accepted, kStepsToGoal);
   EXPECT_EQ(s.agent(1).rejected + s.agent(1).missed + s.agent(2).rejected + s.agent(2).missed, 0u);
-  EXPECT_EQ(s.agent(2).x_m, 3.05);  // arrived at its target at step 5 and stood there
-  EXPECT_EQ(s.agent(2).y_m, 2.05);
+  EXPECT_NEAR(s.agent(2).x_m, 2.55 + 4 * 0.2 * 0.5 / std::sqrt(1.25), 1e-12);  // four moves towards (3.05, 2.05)
+  EXPECT_NEAR(s.agent(2).y_m, 1.05 + 4 * 0.2 * 1.0 / std::sqrt(1.25), 1e-12);
   const double volume = 2 * testing::kLayer * 0.1 * 0.1;
   EXPECT_EQ(s.deposited_volume_m3, volume);
   EXPECT_EQ(s.terrain(20, 5), 2 * testing::kLayer);
@@ -199,12 +202,12 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   // Outputs.
   const std::string summary = read_text(out_ / "summary.json");
   for (const std::string& field :
-       {std::string("\"completed\": true"), std::string("\"steps\": 11"), std::string("\"agents\": 2"),
+       {std::string("\"completed\": true"), std::string("\"steps\": 4"), std::string("\"agents\": 2"),
         std::string("\"admitted\": 2"), std::string("\"missed_deadlines\": 0"), std::string("\"dds\": \"inprocess\""),
         std::string("\"scenario\": \"small\""), std::string("\"seed\": \"1\""),
         std::string("\"end_reason\": \"completed\""),
         "\"terrain_sha256\": \"" + runlog::terrain_sha256(s.terrain) + "\"", std::string("\"per_agent\""),
-        std::string("\"accepted\": 11"), std::string("\"at_goal\": true"), std::string("\"dropped\": false"),
+        std::string("\"accepted\": 4"), std::string("\"at_goal\": true"), std::string("\"dropped\": false"),
         std::string("\"wall_seconds\"")})
     EXPECT_NE(summary.find(field), std::string::npos) << field << " not in\n" << summary;
   EXPECT_EQ(json_number(summary, "deposited_volume_m3"), s.deposited_volume_m3);  // printed to round-trip
@@ -222,8 +225,8 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   for (const char* text : {"{\"step\":0,\"agent\":1,\"kind\":\"admitted\"",
                            "{\"step\":0,\"agent\":3,\"kind\":\"refused\",\"detail\":\"unknown agent id 3",
                            "{\"step\":0,\"agent\":1,\"kind\":\"deposited\",\"volume_m3\":",
-                           "{\"step\":10,\"agent\":1,\"kind\":\"at_goal\"",
-                           "{\"step\":11,\"agent\":0,\"kind\":\"run_over\",\"detail\":\"completed\"}"})
+                           "{\"step\":3,\"agent\":1,\"kind\":\"at_goal\"",
+                           "{\"step\":4,\"agent\":0,\"kind\":\"run_over\",\"detail\":\"completed\"}"})
     EXPECT_NE(log.find(text), std::string::npos) << text << " not in\n" << log;
   const std::size_t deposition = log.find("\"kind\":\"deposited\"");
   ASSERT_NE(deposition, std::string::npos);
@@ -322,7 +325,8 @@ TEST_F(RuntimeTest, MaxStepsEndsAnUnfinishedRun) {
   auto participant = bus::make_participant({bus::Vendor::kInProcess, kDomain});
   RuntimeOptions o = options(1, 10.0);
   o.max_steps = 5;
-  WorldRuntime runtime(scenario_, testing::flat_terrain(), o, *participant);
+  // The small goal [2.9, 3.2] x [1.9, 2.2]: agent 1 needs 11 steps.
+  WorldRuntime runtime(testing::small_scenario(), testing::flat_terrain(), o, *participant);
   const RunResult result = run_with_one_walker(runtime, kDomain);
   EXPECT_EQ(result.end_reason, EndReason::kMaxSteps);
   EXPECT_FALSE(result.completed);

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <set>
@@ -55,7 +56,8 @@ TEST(PathState, NamesRoundTrip) {
                                                              {PathState::kFollow, "follow"},
                                                              {PathState::kHold, "hold"},
                                                              {PathState::kBackOff, "back_off"},
-                                                             {PathState::kDone, "done"}};
+                                                             {PathState::kDone, "done"},
+                                                             {PathState::kYield, "yield"}};
   for (const auto& [state, name] : names) {
     EXPECT_EQ(to_string(state), name);
     EXPECT_EQ(path_state_from_string(name), state);
@@ -65,7 +67,7 @@ TEST(PathState, NamesRoundTrip) {
     FAIL() << "expected InvalidArgument";
   } catch (const InvalidArgument& e) {
     EXPECT_NE(std::string(e.what()).find("unknown path builder state 'at_goal'; valid: wait_admission, survey, "
-                                         "advance, build, retreat, return_to_base, follow, hold, back_off, done"),
+                                         "advance, build, retreat, return_to_base, follow, hold, back_off, done, yield"),
               std::string::npos)
         << e.what();
   }
@@ -74,10 +76,13 @@ TEST(PathState, NamesRoundTrip) {
 TEST(PathBuilder, PipelineParamsFollowTheSeparation) {
   Pipeline pipeline;
   pipeline.separation_m = 4.0;
-  const PipelineParams p = pipeline_params(pipeline);
+  RobotBody body = test::husky();  // reach 1.5 m, delta 1 m, step 0.2 m
+  const PipelineParams p = pipeline_params(pipeline, body);
   EXPECT_EQ(p.separation_m, 4.0);
   EXPECT_EQ(p.back_off_margin_m, 1.0);
-  EXPECT_EQ(p.return_detect_m, 3.0);
+  EXPECT_EQ(p.return_detect_m, 3.0);  // three quarters of the separation: longer than a retreat (2.7 m)
+  body.reach_m = 3.0;
+  EXPECT_DOUBLE_EQ(pipeline_params(pipeline, body).return_detect_m, 4.2);  // a retreat of 3 + 1 + 0.2 m
   EXPECT_EQ(PathBuilder(context()).pipeline().params().separation_m, 2.0);
 }
 
@@ -194,18 +199,33 @@ TEST(PathBuilder, BacksOffAwayFromAFrontNeighbourTooNear) {
   EXPECT_TRUE(q.depositions.empty());
 }
 
-TEST(PathBuilder, ANeighbourTurnedBackIsNoLongerFollowed) {
-  const AgentContext c = context();
+TEST(PathBuilder, ANeighbourTurnedBackIsNoLongerFollowedAndPassesBy) {
+  const AgentContext c = context();  // return detection: reach 1.5 + delta 1 + step 0.2 = 2.7 m
   PathBuilder pb(c);
   pb.on_admission(admission(c, kTarget));
-  pb.decide(frame(c, 0, {4.85, 3.05}, 1.0, {test::neighbour_at(5, 7.65, 3.05)}));
+  const Neighbour front = test::neighbour_at(6, 8.0, 1.5);  // 3.33 m ahead: this robot follows it
+  pb.decide(frame(c, 0, kAtFoot, 1.0, {test::neighbour_at(5, 8.55, 3.05), front}));
   ASSERT_EQ(pb.state(), PathState::kFollow);
-  // It moved 1.55 m away from the target (at least the 1.5 m return detection): it is heading for the base, so this
-  // robot is the front of the pipeline now, though the neighbour is still ahead and nearer than the separation.
-  const protocol::ActionRequest q = pb.decide(frame(c, 1, kAtFoot, 1.0, {test::neighbour_at(5, 6.1, 3.05)}));
+  // It moved 2.75 m away from the target: it is heading for the base, still nearer the target than this robot and
+  // 1.63 m from it, within the separation. This robot makes way: a step off the line from it to the base
+  // (x = 0.55, y = 3.05), no deposition.
+  const Position oncoming{6.1, 4.3};
+  protocol::ActionRequest q =
+      pb.decide(frame(c, 1, kAtFoot, 1.0, {test::neighbour_at(5, oncoming.x, oncoming.y), front}));
+  EXPECT_TRUE(pb.pipeline().returning(5));
+  EXPECT_EQ(pb.state(), PathState::kYield);
+  EXPECT_TRUE(q.depositions.empty());
+  ASSERT_TRUE(q.move);
+  const auto off_line = [&](Position p) {
+    const double dx = 0.55 - oncoming.x, dy = 3.05 - oncoming.y;
+    return std::abs((p.x - oncoming.x) * dy - (p.y - oncoming.y) * dx) / std::hypot(dx, dy);
+  };
+  EXPECT_GT(off_line({q.target_x_m, q.target_y_m}), off_line(kAtFoot));
+  // Once it has passed (farther from the target than this robot) and the other has gone out of range, this robot is
+  // the front of the pipeline.
+  q = pb.decide(frame(c, 2, kAtFoot, 1.0, {test::neighbour_at(5, 4.0, 4.3)}));
   EXPECT_TRUE(pb.pipeline().returning(5));
   EXPECT_EQ(pb.last_trace().role, PipelineRole::kActive);
-  EXPECT_EQ(pb.last_trace().before, PathState::kFollow);
   EXPECT_TRUE(pb.state() == PathState::kAdvance || pb.state() == PathState::kBuild) << to_string(pb.state());
   EXPECT_FALSE(q.depositions.empty());
 }
@@ -337,7 +357,14 @@ TEST(PathBuilder, InAPipelineOnlyTheActiveRobotDeposits) {
   }
   std::set<PathState> states;
   std::set<std::uint32_t> builders;
-  for (int step = 0; step < 300; ++step) {
+  const std::vector<PathState> expected{PathState::kAdvance,      PathState::kBuild,  PathState::kRetreat,
+                                        PathState::kReturnToBase, PathState::kFollow, PathState::kHold,
+                                        PathState::kBackOff};
+  const auto all_seen = [&] {
+    return builders.size() == robots.size() &&
+           std::all_of(expected.begin(), expected.end(), [&](PathState s) { return states.count(s) == 1; });
+  };
+  for (int step = 0; step < 2000 && !all_seen(); ++step) {
     std::vector<protocol::ActionRequest> requests;
     for (std::uint32_t id = 1; id <= robots.size(); ++id) {
       PathBuilder& pb = *robots[id - 1];
@@ -353,9 +380,7 @@ TEST(PathBuilder, InAPipelineOnlyTheActiveRobotDeposits) {
       ASSERT_EQ(reasons[i], "") << "step " << step << ": robot " << i + 1 << " in " << requests[i].state;
   }
   EXPECT_EQ(builders.size(), robots.size());
-  for (PathState s : {PathState::kAdvance, PathState::kBuild, PathState::kRetreat, PathState::kReturnToBase,
-                      PathState::kFollow, PathState::kHold, PathState::kBackOff})
-    EXPECT_EQ(states.count(s), 1u) << to_string(s);
+  for (PathState s : expected) EXPECT_EQ(states.count(s), 1u) << to_string(s);
 }
 
 }  // namespace

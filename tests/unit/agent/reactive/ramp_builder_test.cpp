@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 #include <utility>
 #include <vector>
@@ -233,18 +234,24 @@ TEST(RampBuilder, StaysAtTheGoalOutOfMaterial) {
   EXPECT_FALSE(q.refill);
 }
 
-TEST(RampBuilder, BuildsOnWithANeighbourJustAheadOnItsWay) {
-  // No pipeline here: a neighbour 1 m ahead neither holds it back nor makes it step aside.
+TEST(RampBuilder, BuildsOnPastANeighbourButNeverIntoItsBody) {
+  // No pipeline here: a neighbour 1.5 m ahead neither holds it back nor makes it step aside.
   const AgentContext c = context();
   RampBuilder rb(c);
   rb.on_admission(admission(c, {8.0, 3.05}));
   protocol::SensorFrame f = frame(c, 0, {3.05, 3.05}, 1.0);
-  f.neighbours = {test::neighbour_at(4, 4.05, 3.05)};
-  const protocol::ActionRequest q = rb.decide(f);
+  f.neighbours = {test::neighbour_at(4, 4.55, 3.05)};
+  protocol::ActionRequest q = rb.decide(f);
   EXPECT_EQ(rb.state(), RampState::kAdvance);
   ASSERT_TRUE(q.move);
   EXPECT_GT(q.target_x_m, 3.05);
   EXPECT_NEAR(q.target_y_m, 3.05, 1e-12);
+  // Touching (1 m ahead, bodies of 1 m): no motion ends nearer to it than 1 m (docs/runtime.md#collisions).
+  RampBuilder touching(c);
+  touching.on_admission(admission(c, {8.0, 3.05}));
+  f.neighbours = {test::neighbour_at(4, 4.05, 3.05)};
+  q = touching.decide(f);
+  if (q.move) EXPECT_GE(std::hypot(q.target_x_m - 4.05, q.target_y_m - 3.05), 1.0 - 1e-9);
 }
 
 }  // namespace

@@ -1,0 +1,55 @@
+#include "marsala/agent/executive/body_clearance.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "marsala/core/navigability_processor.hpp"
+
+namespace marsala::agent::executive {
+namespace {
+
+double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+}  // namespace
+
+std::vector<BodyClearance> body_clearances(const std::vector<Neighbour>& neighbours, std::uint32_t self_id,
+                                           double radius_m, double max_step_m) {
+  std::vector<BodyClearance> out;
+  out.reserve(neighbours.size());
+  for (const Neighbour& n : neighbours) {
+    if (!std::isfinite(n.x_m) || !std::isfinite(n.y_m) || !std::isfinite(n.radius_m) || n.agent_id == self_id)
+      continue;
+    const double moves_first = n.agent_id < self_id ? max_step_m : 0.0;
+    out.push_back({n.agent_id, {n.x_m, n.y_m}, radius_m + std::max(0.0, n.radius_m) + moves_first});
+  }
+  return out;
+}
+
+bool clear_of(const std::vector<BodyClearance>& others, Position from, Position to) {
+  for (const BodyClearance& o : others) {
+    const double after = distance(to, o.centre);
+    if (after >= o.min_distance_m) continue;
+    const double before = distance(from, o.centre);
+    if (before < o.min_distance_m && after >= before) continue;  // already too close: moving apart is fine
+    return false;
+  }
+  return true;
+}
+
+long long keep_clear(deliberative::LocalMap& local, Position robot, const std::vector<BodyClearance>& others) {
+  if (others.empty()) return 0;
+  long long removed = 0;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      if (local.occupiable(r, c) == 0 || CellIndex{r, c} == local.robot) continue;
+      if (clear_of(others, robot, local.center({r, c}))) continue;
+      local.occupiable(r, c) = 0;
+      ++removed;
+    }
+  if (removed == 0) return 0;
+  // Navigable again: occupiable and 8-connected to the robot's cell, as the synthesizer makes it.
+  local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
+  return removed;
+}
+
+}  // namespace marsala::agent::executive

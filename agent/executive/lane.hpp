@@ -1,0 +1,43 @@
+#pragma once
+// Lanes (paper Fig. 4: a forward and a backward lane along the construction). Where a path runs in a corridor (a
+// band of navigable cells bounded on both sides, such as the built ramp), a robot keeps lane_offset_m to the right
+// of the corridor's centre line, seen in the direction it drives: robots going to the front keep to one side of the
+// band, robots coming back to the other, and they pass without their bodies meeting. On open ground there is no
+// centre line to keep to; the path stays as planned and robots go around each other (body_clearance.hpp).
+//
+//        left edge  ------------------------------------
+//                                 <-- backward lane (right of its direction)
+//        centre     - - - - - - - - - - - - - - - - - -
+//                   forward lane (right of its direction) -->
+//        right edge ------------------------------------
+//
+// The corridor is measured across the path at each of its cells, perpendicular to the path's direction there, on a
+// mask the caller gives (the navigable cells before other robots were taken out, so that a robot in the other lane
+// does not move the centre line); so the lane does not depend on where in the corridor the robot stands.
+
+#include <vector>
+
+#include "marsala/agent/deliberative/local_map_synthesizer.hpp"
+#include "marsala/core/types.hpp"
+
+namespace marsala::agent::executive {
+
+/// Cells each side of a path cell over which its direction is taken [cells]: a direction over 2 k + 1 cells follows
+/// the band, not the staircase of an 8-connected path.
+inline constexpr int kLaneDirectionSpan = 4;
+/// Path cells in a row that must lie in a corridor for it to count: a narrow spot between obstacles is not a band.
+inline constexpr int kMinCorridorCells = 2 * kLaneDirectionSpan + 1;
+
+/// `path` (local indices, path[0] the robot's cell) with every later cell moved into its lane: across the path at
+/// that cell (its direction from path[i - k] to path[i + k], k = kLaneDirectionSpan, clipped to the path), the
+/// corridor is the run of cells set in `corridor` through it, sampled every half cell up to corridor_width_m [m]
+/// each side; when the run ends on both sides within that, for at least kMinCorridorCells path cells in a row, the
+/// lane point is the corridor's centre plus offset_m to the right, kept within the run; elsewhere the path cell
+/// itself. The offset from the path changes by at most the distance between consecutive path cells, starting from 0
+/// at the robot (lanes are entered and left at 45 degrees at most). A lane point's cell replaces the path cell if it
+/// is navigable in `local`. Consecutive repeats are merged; path[0] stays. offset_m <= 0 or a path of one cell:
+/// unchanged.
+std::vector<CellIndex> lane_path(const deliberative::LocalMap& local, const CellMask& corridor,
+                                 const std::vector<CellIndex>& path, double offset_m, double corridor_width_m);
+
+}  // namespace marsala::agent::executive

@@ -1,0 +1,104 @@
+#include "marsala/agent/executive/body_clearance.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "marsala/agent/executive/action_manager.hpp"
+#include "unit/agent/agent_test_support.hpp"
+
+namespace marsala::agent::executive {
+namespace {
+
+const GridGeometry kGrid{40, 40, 0.0, 0.0, 0.1};  // 4 x 4 m
+const NavigabilityParams kNav{0.3, 0.4, 0.05};     // a small ball: every cell of the flat map is occupiable
+
+double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+TEST(BodyClearance, DiscsAreBothRadiiPlusAStepForALowerId) {
+  const std::vector<Neighbour> seen = {{2, 1.0, 1.0, 0.0, 0.5}, {7, 3.0, 1.0, 0.0, 0.75}};
+  const auto discs = body_clearances(seen, 5, 0.5, 0.25);
+  ASSERT_EQ(discs.size(), 2u);
+  EXPECT_DOUBLE_EQ(discs[0].min_distance_m, 0.5 + 0.5 + 0.25);  // id 2 moves before 5 in the step
+  EXPECT_DOUBLE_EQ(discs[1].min_distance_m, 0.5 + 0.75);        // id 7 moves after: where the frame shows it
+  // Itself and nonsense are skipped.
+  EXPECT_TRUE(body_clearances({{5, 1.0, 1.0, 0.0, 0.5}, {6, NAN, 1.0, 0.0, 0.5}}, 5, 0.5, 0.25).empty());
+}
+
+TEST(BodyClearance, ClearOfFollowsTheWorldsRule) {
+  const std::vector<BodyClearance> one = {{2, {2.0, 2.0}, 1.0}};
+  EXPECT_TRUE(clear_of(one, {0.5, 2.0}, {1.0, 2.0}));    // touching: 1.0 m
+  EXPECT_FALSE(clear_of(one, {0.5, 2.0}, {1.05, 2.0}));  // 0.95 m
+  // Already inside: moving apart or keeping the distance is fine, closer is not.
+  EXPECT_TRUE(clear_of(one, {1.4, 2.0}, {1.3, 2.0}));
+  EXPECT_TRUE(clear_of(one, {1.4, 2.0}, {1.4, 2.0}));
+  EXPECT_FALSE(clear_of(one, {1.4, 2.0}, {1.5, 2.0}));
+}
+
+TEST(BodyClearance, KeepClearTakesTheDiscsOutAndReconnects) {
+  // A robot at (0.55, 2.05) and a neighbour whose disc (1.0 m) blocks a wall-to-wall band 1.2 m high: a corridor of
+  // rows, with its ends open only through the disc.
+  Heightmap h(kGrid, 0.0);
+  for (int r = 0; r < 40; ++r)
+    for (int c = 0; c < 40; ++c)
+      if (r < 14 || r > 25) h(r, c) = 5.0;  // walls north and south of the corridor rows 14..25
+  deliberative::LocalMap map = test::make_local_map(h, Heightmap(kGrid, 0.0), kNav, {19, 5}, std::nullopt);
+  const Position robot = map.center(map.robot);
+  ASSERT_NE(map.navigable(19, 35), 0);
+  const std::vector<BodyClearance> others = {{3, {2.05, 2.05}, 1.0}};
+  const long long removed = keep_clear(map, robot, others);
+  EXPECT_GT(removed, 0);
+  long long inside = 0;
+  for (int r = 0; r < 40; ++r)
+    for (int c = 0; c < 40; ++c) {
+      const bool near = distance(map.center({r, c}), others[0].centre) < 1.0;
+      if (near) inside += 1;
+      if (near) EXPECT_EQ(map.occupiable(r, c), 0) << r << "," << c;
+      if (map.navigable(r, c) != 0) EXPECT_NE(map.occupiable(r, c), 0);
+    }
+  EXPECT_NE(map.navigable(19, 5), 0);  // its own cell stays
+  EXPECT_EQ(map.navigable(19, 35), 0);  // the far end is cut off: no route through the other robot
+  EXPECT_GT(inside, 0);
+}
+
+TEST(BodyClearance, TheActionManagerNeverChoosesATargetTheWorldWouldRefuse) {
+  // Random neighbours around a robot on flat ground: whatever path it follows, a motion the action manager returns
+  // ends clear of every disc (the world's rule 2.5 with a disc of both radii) and, for a higher-id neighbour, at
+  // least the two radii away.
+  deliberative::LocalMap map = test::make_local_map(Heightmap(kGrid, 0.0), Heightmap(kGrid, 0.0), kNav, {20, 20},
+                                                    std::nullopt);
+  const Position robot = map.center({20, 20});
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const ActionManager am(0.25);
+  int moved = 0, refused = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    std::vector<Neighbour> seen;
+    for (std::uint32_t id : {2u, 9u}) {
+      const double r = 0.9 + 0.6 * u(rng), t = 6.283185307179586 * u(rng);
+      seen.push_back({id, robot.x + r * std::cos(t), robot.y + r * std::sin(t), 0.0, 0.5});
+    }
+    const auto discs = body_clearances(seen, 5, 0.5, 0.25);
+    const int dr = static_cast<int>(std::floor(3 * u(rng))) - 1, dc = static_cast<int>(std::floor(3 * u(rng))) - 1;
+    std::vector<CellIndex> path;
+    for (int i = 0; i < 10; ++i) path.push_back({20 + i * dr, 20 + i * dc});
+    const auto m = am.advance(map, path, robot, discs);
+    if (!m) {
+      ++refused;
+      continue;
+    }
+    ++moved;
+    EXPECT_TRUE(clear_of(discs, robot, m->target));
+    for (const Neighbour& n : seen) {
+      const double d = distance(m->target, {n.x_m, n.y_m});
+      const double before = distance(robot, {n.x_m, n.y_m});
+      if (d < 1.0) EXPECT_GE(d, before) << "trial " << trial;  // never deeper into a body
+    }
+  }
+  EXPECT_GT(moved, 50);
+  EXPECT_GT(refused, 10);
+}
+
+}  // namespace
+}  // namespace marsala::agent::executive
