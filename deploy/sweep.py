@@ -38,13 +38,15 @@ Usage: deploy/sweep.sh [--scenario FILE] [--teams "1 3 5 9 12"] [--seeds N | --s
                the (team, seed) pairs missing from sweep.csv, so an interrupted sweep resumes
   --no-plot    skip OUT/sweep.png
 CSV columns: team_size,seed,completed,completion_steps,wall_seconds,deposited_m3,path_length_m,idle_steps,
-             idle_fraction,end_reason (idle_fraction = idle_steps / completion_steps).
+             idle_fraction,end_reason,sites,site_spans_m (idle_fraction = idle_steps / completion_steps; sites: the
+             construction sites along the payload's final path, site_spans_m their FROM-TO [m] along it, joined
+             by ';': summary.json's construction_sites).
 Exit codes: 0 ok, 1 a run failed (no summary) or the binaries are missing, 2 usage error (or a scenario that
             marsala-world --check rejects), 130 interrupted.
 """
 
 CSV_HEADER = ("team_size,seed,completed,completion_steps,wall_seconds,deposited_m3,path_length_m,idle_steps,"
-              "idle_fraction,end_reason")
+              "idle_fraction,end_reason,sites,site_spans_m")
 STATS_HEADER = ("# team_size,runs,completed,steps_mean,steps_min,steps_max,wall_mean,wall_min,wall_max,idle_mean,"
                 "idle_min,idle_max")
 # deploy/sweep.sh runs this program under its own name, so that messages read as they always did.
@@ -247,9 +249,9 @@ def tsv(value):
 
 
 def summary_values(path):
-    """completed, steps, wall seconds, volume, path length, idle steps and end reason of a summary.json as the CSV
-    holds them; fields a build may not have yet (idle_steps, path_length_m) read as 0. Raises ValueError or OSError
-    when the file is unreadable."""
+    """completed, steps, wall seconds, volume, path length, idle steps, end reason, the number of construction sites
+    and their spans of a summary.json as the CSV holds them; fields a build may not have yet (idle_steps,
+    path_length_m, construction_sites) read as 0 or none. Raises ValueError or OSError when the file is unreadable."""
     with open(path, "rb") as f:
         doc = json.loads(f.read().decode("utf-8"))
     if not isinstance(doc, dict):
@@ -261,7 +263,11 @@ def summary_values(path):
     values += [jq_tonumber(jq_or(doc.get(key), 0))
                for key in ("steps", "wall_seconds", "deposited_volume_m3", "path_length_m", "idle_steps")]
     values.append(re.sub(r"[,\s]", "_", reason))
-    return [tsv(v) for v in values]
+    sites = doc.get("construction_sites") or []
+    if not isinstance(sites, list) or not all(isinstance(s, dict) for s in sites):
+        raise ValueError("construction_sites is not a list of objects")
+    spans = ";".join("%.1f-%.1f" % (float(s.get("from_m", 0)), float(s.get("to_m", 0))) for s in sites)
+    return [tsv(v) for v in values] + [str(len(sites)), spans]
 
 
 def as_int(text):
@@ -536,7 +542,7 @@ class Sweep:
             self.failed += 1
             return
         try:
-            completed, steps, wall, volume, path, idle, reason = summary_values(summary)
+            completed, steps, wall, volume, path, idle, reason, sites, spans = summary_values(summary)
         except (OSError, ValueError, OverflowError):
             out(f"  team {team}, seed {seed}: FAILED (unreadable {summary})")
             self.failed += 1
@@ -549,7 +555,7 @@ class Sweep:
         steps_value = num(steps)
         idle_fraction = "%.6f" % (num(idle) / steps_value if steps_value > 0 else 0)
         self.put_row(team, seed, f"{team},{seed},{completed},{steps},{wall},{volume},{path},{idle},{idle_fraction},"
-                                 f"{reason}")
+                                 f"{reason},{sites},{spans}")
         state = "completed" if completed == "true" else f"NOT completed ({reason})"
         idle_percent = float("%.6g" % (100 * float(idle_fraction)))  # awk's print, then printf %.1f
         out("  team %3d, seed %s: %s in %d steps, %.2f s wall, %.3f m^3 deposited, idle %.1f%%"

@@ -44,14 +44,19 @@ constexpr render::Rgb kArrowRed{220, 30, 30};
 
 /// What the end of a run reports about the terrain, computed once.
 struct FinalTerrainReport {
-  std::optional<PayloadRoute> route;  ///< payload_path only
-  double site_fraction = 0.0;         ///< level_site only
+  std::optional<PayloadRoute> route;       ///< payload_path only
+  std::vector<ConstructionSite> sites;     ///< payload_path with a route and the initial terrain known
+  double site_fraction = 0.0;              ///< level_site only
 };
 
-FinalTerrainReport final_terrain_report(const WorldState& state) {
+FinalTerrainReport final_terrain_report(const WorldState& state, const RunInfo& info) {
   FinalTerrainReport report;
   if (state.completion == scenario::CompletionKind::kPayloadPath)
     report.route = payload_path(state.terrain, state.payload_path);
+  if (report.route && info.initial_terrain.rows() == state.terrain.rows() &&
+      info.initial_terrain.cols() == state.terrain.cols())
+    report.sites = construction_sites(info.initial_terrain, state.terrain, *report.route,
+                                      state.payload_path.navigability.delta_m);
   if (state.completion == scenario::CompletionKind::kLevelSite)
     report.site_fraction = site_level_fraction(state.terrain, state.site);
   return report;
@@ -159,6 +164,13 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_path_found(report.route.has_value());
   s.set_path_length_m(report.route ? report.route->length_m : 0.0);
   s.set_site_level_fraction(report.site_fraction);
+  for (const ConstructionSite& site : report.sites) {
+    proto::ConstructionSite* p = s.add_construction_sites();
+    p->set_from_m(site.from_m);
+    p->set_to_m(site.to_m);
+    p->set_volume_m3(site.volume_m3);
+    p->set_cells(static_cast<std::uint32_t>(site.cells));
+  }
   if (state.completion == scenario::CompletionKind::kPayloadPath) {
     s.set_target_rise_m(target_rise_m(state));
     s.set_max_target_rise_m(state.check.max_target_rise_m);
@@ -182,7 +194,7 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
 }  // namespace
 
 std::string summary_json(const WorldState& state, const RunInfo& info) {
-  return summary_text(state, info, final_terrain_report(state));
+  return summary_text(state, info, final_terrain_report(state, info));
 }
 
 std::optional<CellRect> zoom_window(const WorldState& state, const std::optional<PayloadRoute>& route) {
@@ -355,7 +367,7 @@ void write_final_outputs(const std::string& dir, const WorldState& state, const 
   write_atomically(path_in(dir, "terrain_final.asc"),
                    [&](const std::string& p) { terrain::write_asc(state.terrain, p); });
 
-  const FinalTerrainReport report = final_terrain_report(state);
+  const FinalTerrainReport report = final_terrain_report(state, info);
   write_atomically(path_in(dir, "final.png"), [&](const std::string& p) {
     render::write_png(render::render_terrain(state.terrain, final_picture_options(state, info, report.route)), p);
   });

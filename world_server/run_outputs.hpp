@@ -29,6 +29,7 @@
 #include "marsala/protocol/messages.hpp"
 #include "marsala/render/terrain_renderer.hpp"
 #include "marsala/world_server/completion.hpp"
+#include "marsala/world_server/construction_sites.hpp"
 #include "marsala/world_server/end_reason.hpp"
 #include "marsala/world_server/occupancy_cache.hpp"
 #include "marsala/world_server/persistence.hpp"
@@ -56,7 +57,9 @@ struct RunInfo {
   double start_jitter_m = 0.0;         ///< the scenario's start jitter [m]
   /// The scenario's goal vector map, drawn into goal_vector_map.png when set.
   std::optional<GoalVectorMapSpec> goal_vector_map;
-  Heightmap initial_terrain;  ///< the terrain before the run (for goal_vector_map.png); empty = use the final
+  /// The terrain before the run (goal_vector_map.png, payload_path's construction sites); empty = unknown (the
+  /// final one is drawn, no sites are reported).
+  Heightmap initial_terrain;
 };
 
 /// summary.json's text: every field present (zeros included); steps = state.step; terrain_sha256 of state.terrain;

@@ -226,7 +226,7 @@ struct WorldRuntime::Impl {
         resume(std::move(start.resume)),
         resume_step(state.step) {
     // make_world_state() keeps the terrain as given: the state's terrain is still the initial one, unless resumed.
-    if (scenario.has_goal_vector_map)
+    if (scenario.has_goal_vector_map || state.completion == scenario::CompletionKind::kPayloadPath)
       initial_terrain =
           resume ? terrain::read_asc((std::filesystem::path(options.out_dir) / "terrain_initial.asc").string())
                  : state.terrain;
@@ -819,10 +819,8 @@ struct WorldRuntime::Impl {
     info.dds = bus::to_string(participant.vendor());
     info.seed = scenario.seed;
     info.start_jitter_m = scenario.start_jitter_m;
-    if (scenario.has_goal_vector_map) {
-      info.goal_vector_map = scenario.goal_vector_map;
-      info.initial_terrain = std::move(initial_terrain);
-    }
+    if (scenario.has_goal_vector_map) info.goal_vector_map = scenario.goal_vector_map;
+    info.initial_terrain = std::move(initial_terrain);
     info.completed = result.completed;
     info.end_reason = end_reason;
     info.wall_seconds = result.wall_seconds;
@@ -855,7 +853,7 @@ struct WorldRuntime::Impl {
   std::vector<double> step_world_ms;  ///< the world's own part of each step: its wall time less its waits [ms]
   Clock::duration step_waited{};      ///< time the current step spent waiting for requests
   Clock::time_point next_liveliness_check{};  ///< collect() checks the agents' liveliness from then on
-  Heightmap initial_terrain;    ///< kept for goal_vector_map.png only
+  Heightmap initial_terrain;    ///< kept for goal_vector_map.png and payload_path's construction sites
   std::unique_ptr<bus::Reader<protocol::AgentHello>> hellos;
   std::unique_ptr<bus::Writer<protocol::Admission>> admissions;
   std::unique_ptr<bus::Writer<protocol::WorldStatus>> status;

@@ -160,8 +160,14 @@ case "$case_name" in
            if (end[2] >= 224) exit 1
          }' "$out/terrain_initial.asc" "$out/terrain_final.asc" >"$work/sites.txt" ||
       { cat "$work/sites.txt"; fail "not three separate construction sites, one past each cliff"; }
-    echo "ok: three_gaps: $(cat "$work/sites.txt"); payload path $(field path_length_m "$s") m after" \
-      "$(field steps "$s") steps, $(field deposited_volume_m3 "$s") m^3"
+    # The world's own account (summary.json construction_sites) agrees: three sites, and everything built lies in
+    # them (their volumes add up to what was deposited).
+    sites_json=$(jq -c '[.construction_sites[] | [.from_m, .to_m, .volume_m3]]' "$s")
+    jq -e '(.construction_sites | length) == 3 and
+           ((([.construction_sites[].volume_m3] | add) - .deposited_volume_m3) | fabs) < 1e-6' "$s" >/dev/null ||
+      fail "summary.json's construction_sites $sites_json: not three sites holding all $(field deposited_volume_m3 "$s") m^3"
+    echo "ok: three_gaps: $(cat "$work/sites.txt"); sites along the path (from, to, m^3) $sites_json;" \
+      "payload path $(field path_length_m "$s") m after $(field steps "$s") steps, $(field deposited_volume_m3 "$s") m^3"
     ;;
   shipped)
     name="$3" agents="$4" dds="$5"
