@@ -68,12 +68,14 @@ DepositionManager::DepositionManager(DepositionParams params) : params_(params),
       !positive_finite(params.cube_layer_m) || !positive_finite(params.max_height_m) ||
       !positive_finite(params.footprint_m) || !(params.neighbour_keep_out_m >= 0.0) ||
       !std::isfinite(params.neighbour_keep_out_m) || !(params.neighbour_step_m >= 0.0) ||
-      !std::isfinite(params.neighbour_step_m))
+      !std::isfinite(params.neighbour_step_m) || !(params.pad_radius_m >= 0.0) || !std::isfinite(params.pad_radius_m) ||
+      !std::isfinite(params.pad_centre.x) || !std::isfinite(params.pad_centre.y))
     throw InvalidArgument("deposition manager: reach (" + std::to_string(params.reach_m) + " m), max deposit (" +
                           std::to_string(params.max_deposit_m3) + " m^3), cube layer (" +
                           std::to_string(params.cube_layer_m) + " m) and max height (" +
                           std::to_string(params.max_height_m) +
-                          " m) must be finite and > 0, neighbour keep-out and step finite and >= 0");
+                          " m) must be finite and > 0, neighbour keep-out, step and pad radius (" +
+                          std::to_string(params.pad_radius_m) + " m) finite and >= 0");
 }
 
 std::vector<DepositionCandidate> DepositionManager::candidates(const deliberative::LocalMap& map,
@@ -108,6 +110,7 @@ std::vector<DepositionCandidate> DepositionManager::candidates(const deliberativ
       const double d = distance(centre, robot);
       if (d > params_.reach_m || d <= clear_m) continue;
       if (!in_territory(map, cell, centre, neighbours, self_cell)) continue;
+      if (params_.pad_radius_m > 0.0 && distance(centre, params_.pad_centre) <= params_.pad_radius_m) continue;
       const int fit = static_cast<int>(std::floor((budget_m3 - total_m3) / layer_volume + 1e-9));
       layers = std::min(layers, fit);
       if (layers < 1) return out;

@@ -4,7 +4,9 @@
 // towards its local MARS height P in whole cube layers q = cube^3 / cs^2, rounded down so that it never overshoots
 // P (rounding to nearest would let each built cell lift the bound of the next by up to q/2, and a ramp built cell
 // by cell would creep flatter and longer than kappa). Every rule the world checks is kept: reach, never under a
-// robot, at most 1 m per cell, total volume within the deposition threshold and the material on board. Finally
+// robot, at most 1 m per cell, total volume within the deposition threshold and the material on board; and never on
+// the base station's pad (cells whose centre lies within its radius), where robots refill and a payload starts.
+// Finally
 // the depositions are simulated on the local map: the robot's (new) cell must stay occupiable, connected to the
 // window's border and to the local origin, and so must every neighbour in the window that was connected;
 // depositions that would break that are dropped.
@@ -30,6 +32,8 @@ struct DepositionParams {
   double max_height_m = 1.0;          ///< largest single deposition [m]
   double neighbour_keep_out_m = 0.7;  ///< no deposition this close to a neighbour's centre [m]
   double neighbour_step_m = 0.2;      ///< how far a neighbour may move this step [m]
+  Position pad_centre;                ///< the base station's pad: nothing is built on it (refills, a payload's start)
+  double pad_radius_m = 0.0;          ///< its radius; 0: no pad [m]
 };
 
 /// The deposition parameters of a body on a grid of cell_size_m [m], with the team's keep-out [m]; the footprint is

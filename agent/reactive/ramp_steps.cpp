@@ -76,6 +76,10 @@ void RampSteps::admit(const protocol::Admission& admission) {
   const RobotBody& body = context_.type.body;
   const NavigabilityParams build = construction_params(context_.type);
   PlannerParams planner = planner_ ? *planner_ : default_planner_params(build.delta_m, world.cell_size_m);
+  executive::DepositionParams deposits =
+      executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m, build.delta_m);
+  deposits.pad_centre = context_.assignment.base;
+  deposits.pad_radius_m = context_.assignment.base_radius_m;
   PlannerParams router = planner;
   router.alpha = 0.0;
   router.beta = 1.0;
@@ -83,8 +87,7 @@ void RampSteps::admit(const protocol::Admission& admission) {
       Modules{executive::MappingSystem(world, context_.assignment.tile_size),
               deliberative::LocalMapSynthesizer(body.navigability, body.sensing_range_m, build.kappa),
               NavigablePathPlanner(planner), NavigablePathPlanner(router), executive::ActionManager(body.max_step_m),
-              executive::DepositionManager(
-                  executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m, build.delta_m)),
+              executive::DepositionManager(deposits),
               static_cast<int>(std::ceil((body.reach_m + body.navigability.delta_m) / body.max_step_m)) + 1});
   goal_ = deliberative::make_goal_synthesizer(context_.type.goal_synthesizer, context_);
 }
@@ -99,6 +102,7 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
   others_ = executive::body_clearances(frame.neighbours, context_.agent_id, 0.5 * body.navigability.delta_m,
                                        body.max_step_m);
   corridor_ = view.local.navigable;
+  terrain_occupiable_ = view.local.occupiable;
   executive::keep_clear(view.local, robot, others_);
   trace.window_offset = view.local.offset;
   trace.local_goal = view.local.goal;
@@ -143,7 +147,14 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
   const auto& path = trace.plan.path;
   const std::vector<CellIndex> ahead(path.begin() + static_cast<std::ptrdiff_t>(std::min(from, path.size())),
                                      path.end());
-  trace.deposition = modules_->depositions.plan(local, ahead, at, frame.material_m3, neighbourhood(frame));
+  // Depositions are judged on the terrain alone (what stays occupiable and connected), not on where the other
+  // robots stand this step: the masks before the neighbours were taken out.
+  deliberative::LocalMap terrain_only = local;
+  if (terrain_occupiable_.rows() == local.rows() && terrain_occupiable_.cols() == local.cols()) {
+    terrain_only.occupiable = terrain_occupiable_;
+    terrain_only.navigable = corridor_;
+  }
+  trace.deposition = modules_->depositions.plan(terrain_only, ahead, at, frame.material_m3, neighbourhood(frame));
   request.depositions = trace.deposition.depositions;
 }
 

@@ -6,7 +6,9 @@
 // Each frame a behaviour first calls look(): the mapping system takes the frame's tiles, the goal synthesizer gives
 // the target and the local map synthesizer builds the augmented local map, from which the cells too near another
 // robot's body are taken out (executive/body_clearance.hpp): every route and motion then keeps clear of the
-// neighbours the frame shows. Then, by its state, one of:
+// neighbours the frame shows. Depositions are judged on the terrain alone (the masks before the neighbours were
+// taken out: what stays occupiable and connected does not depend on where the others stand this step), and never
+// on the base station's pad. Then, by its state, one of:
 //   build_step()   plan a deposition path to the local goal (once per frame); a motion along it is possible -> move
 //                  and deposit ahead (kAdvance); blocked, but depositions within reach -> deposit in place (kBuild);
 //                  blocked and nothing to deposit (the gap left is under the robot) -> retreat_step() (kRetreat)
@@ -134,6 +136,7 @@ class RampSteps {
   int idle_retreat_moves_ = 0;
   std::vector<executive::BodyClearance> others_;  // the last frame's neighbours
   CellMask corridor_;                             // the last local map's navigable cells, neighbours not taken out
+  CellMask terrain_occupiable_;                   // and its occupiable cells
   double lane_offset_m_ = 0.0;
   double corridor_width_m_ = 0.0;
 };

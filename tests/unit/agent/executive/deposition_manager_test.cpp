@@ -209,6 +209,28 @@ TEST(DepositionManager, KeepsANeighboursWayBack) {
   EXPECT_GT(with.dropped_for_way_back, 0);
 }
 
+TEST(DepositionManager, NeverBuildsOnTheBasePad) {
+  // The same gap everywhere; a pad of radius 0.3 m on the path 0.4 m east of the robot: of the cells it would fill,
+  // those whose centres lie on the pad are left out.
+  const Heightmap gap(kGrid, 0.3);
+  const LocalMap map = make_map(Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, {{10, 0}});
+  DepositionParams p = params(0.4, 1.0);
+  p.pad_centre = kGrid.cell_center({10, 14});
+  p.pad_radius_m = 0.3;
+  const DepositionManager dm(p);
+  const Position robot = kGrid.cell_center({10, 10});
+  const auto plan = dm.plan(map, row_path(10, 10, 30), robot, 10.0, {1, robot, {}});  // over the pad
+  ASSERT_FALSE(plan.depositions.empty());
+  for (const auto& d : plan.depositions)
+    EXPECT_GT(dist(kGrid.cell_center({d.row, d.col}), p.pad_centre), 0.3) << d.row << ", " << d.col;
+  // Without the pad the same plan builds on it.
+  const auto bare = DepositionManager(params(0.4, 1.0)).plan(map, row_path(10, 10, 30), robot, 10.0, {1, robot, {}});
+  bool on_pad = false;
+  for (const auto& d : bare.depositions)
+    on_pad = on_pad || dist(kGrid.cell_center({d.row, d.col}), p.pad_centre) <= 0.3;
+  EXPECT_TRUE(on_pad);
+}
+
 TEST(DepositionManager, RejectsInvalidLimits) {
   DepositionParams p = params();
   p.reach_m = 0.0;
@@ -221,6 +243,9 @@ TEST(DepositionManager, RejectsInvalidLimits) {
   EXPECT_THROW(DepositionManager{p}, InvalidArgument);
   p = params();
   p.navigability.kappa = 0.0;
+  EXPECT_THROW(DepositionManager{p}, InvalidArgument);
+  p = params();
+  p.pad_radius_m = -1.0;
   EXPECT_THROW(DepositionManager{p}, InvalidArgument);
 }
 

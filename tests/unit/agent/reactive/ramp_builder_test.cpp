@@ -251,7 +251,9 @@ TEST(RampBuilder, BuildsOnPastANeighbourButNeverIntoItsBody) {
   touching.on_admission(admission(c, {8.0, 3.05}));
   f.neighbours = {test::neighbour_at(4, 4.05, 3.05)};
   q = touching.decide(f);
-  if (q.move) EXPECT_GE(std::hypot(q.target_x_m - 4.05, q.target_y_m - 3.05), 1.0 - 1e-9);
+  if (q.move) {
+    EXPECT_GE(std::hypot(q.target_x_m - 4.05, q.target_y_m - 3.05), 1.0 - 1e-9);
+  }
 }
 
 }  // namespace
