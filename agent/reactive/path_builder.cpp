@@ -127,11 +127,21 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
 
 void PathBuilder::follow_step(const BuildView& view, Position front, protocol::ActionRequest& request) {
   state_ = PathState::kHold;
-  if (!steps_.plan_path(view.local, trace_)) return;
-  const auto motion = steps_.advance(view.local, steps_.in_lane(view.local, trace_.plan.path), view.robot);
-  if (!motion || distance(motion->target, front) < pipeline_.params().separation_m) return;
-  steps_.move(*motion, trace_, request);
-  state_ = PathState::kFollow;
+  std::optional<executive::Motion> motion;
+  if (steps_.plan_path(view.local, trace_))
+    motion = steps_.advance(view.local, steps_.in_lane(view.local, trace_.plan.path), view.robot);
+  if (motion && distance(motion->target, front) >= pipeline_.params().separation_m) {
+    steps_.move(*motion, trace_, request);
+    state_ = PathState::kFollow;
+    return;
+  }
+  // Stuck as long as a holding robot's patience: make way, as kHold does.
+  if (still_steps_ >= kPatienceSteps) {
+    Neighbour ahead;
+    ahead.x_m = front.x;
+    ahead.y_m = front.y;
+    yield_step(view, ahead, request);
+  }
 }
 
 std::optional<Neighbour> PathBuilder::oncoming(const BuildView& view, const protocol::SensorFrame& frame) const {

@@ -20,6 +20,7 @@
 //                 (-> kAdvance / kBuild / kRetreat); no deposition path through known cells: the state stays
 //     kFollow  -> advance along the deposition path through navigable cells without depositing ------> kFollow
 //                 no motion, or it would end closer than the separation to the front neighbour -----> kHold
+//                 (after kPatienceSteps frames in a row at the same position: make way as kHold does)
 //     kHold    -> stand still; after kPatienceSteps frames in a row at the same position, a step aside off the
 //                 front neighbour's line to the base (it may be on its way back, blocked) -------------> kHold / kYield
 //     kBackOff -> step back the way it came, if that takes it away from the front neighbour; else, when
@@ -75,7 +76,8 @@ struct PathBuilderTrace : BuildTrace {
   std::optional<PipelineRole> role;  ///< the pipeline role of this frame, when it was asked for
 };
 
-/// Frames a holding robot waits at the same position before it makes way for its front neighbour.
+/// Frames a holding (or blocked following) robot waits at the same position before it makes way for its front
+/// neighbour.
 inline constexpr int kPatienceSteps = 40;
 
 /// The pipeline's distances for a robot type's pipeline and body: separation_m = pipeline.separation_m,

@@ -79,7 +79,7 @@ void RampSteps::admit(const protocol::Admission& admission) {
   executive::DepositionParams deposits =
       executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m, build.delta_m);
   deposits.pad_centre = context_.assignment.base;
-  deposits.pad_radius_m = context_.assignment.base_radius_m;
+  deposits.pad_radius_m = kPadFraction * context_.assignment.base_radius_m;
   PlannerParams router = planner;
   router.alpha = 0.0;
   router.beta = 1.0;
@@ -98,6 +98,7 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
   const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
   const Position target = goal.value_or(robot);  // nothing left to build towards: stay
   BuildView view{modules_->synthesizer.synthesize(modules_->map, robot, target), robot, target};
+  if (!getenv("PADGAP")) clear_pad_gap(view.local);
   const RobotBody& body = context_.type.body;
   others_ = executive::body_clearances(frame.neighbours, context_.agent_id, 0.5 * body.navigability.delta_m,
                                        body.max_step_m);
@@ -122,6 +123,14 @@ bool RampSteps::plan_path(const deliberative::LocalMap& local, BuildTrace& trace
 std::optional<executive::Motion> RampSteps::advance(const deliberative::LocalMap& local,
                                                     const std::vector<CellIndex>& path, Position robot) const {
   return modules_->actions.advance(local, path, robot, others_);
+}
+
+void RampSteps::clear_pad_gap(deliberative::LocalMap& local) const {
+  const Position base = context_.assignment.base;
+  const double radius = kPadFraction * context_.assignment.base_radius_m;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c)
+      if (std::hypot(local.center({r, c}).x - base.x, local.center({r, c}).y - base.y) <= radius) local.gap(r, c) = 0.0;
 }
 
 void RampSteps::set_lane(double offset_m, double corridor_width_m) {

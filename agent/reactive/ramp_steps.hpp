@@ -39,6 +39,11 @@
 
 namespace marsala::agent::reactive {
 
+/// The base station's pad, where nothing is built, is the inner part of its refill radius: this fraction of it. The
+/// middle of the base stays as it was (a payload's start, refills); the outer ring may be built on when the
+/// construction begins there.
+inline constexpr double kPadFraction = 0.5;
+
 /// What the building steps did: the robot moved along the path, deposited in place, or is backing off.
 enum class BuildPhase : std::uint8_t { kAdvance = 0, kBuild = 1, kRetreat = 2 };
 /// "advance", "build", "retreat".
@@ -126,6 +131,7 @@ class RampSteps {
   void deposit(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position at, std::size_t from,
                BuildTrace& trace, protocol::ActionRequest& request) const;
   std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
+  void clear_pad_gap(deliberative::LocalMap& local) const;  // no work on the base station's pad
   static std::optional<CellIndex> farthest_navigable_from_goal(const deliberative::LocalMap& local);
 
   AgentContext context_;
