@@ -71,6 +71,8 @@ constexpr std::chrono::milliseconds kStopPoll{100};
 // than the pauses a world must survive (5 s, docs/runtime.md#dropping-agents), so an agent learns of a dead world
 // within about 7 s (the 1 s DDS lease, then this) instead of world_timeout.
 constexpr std::chrono::seconds kWorldGrace{6};
+// A gap between two turns of the agent's loop this long means the process itself did not run.
+constexpr std::chrono::seconds kProcessPause{1};
 // How long without a frame before the agent says hello again: the world answers whether it still counts the agent
 // in (a pause longer than the world's grace dropped it; docs/runtime.md#re-admission), so a dropped agent learns it
 // within about this long after it runs again, and is re-admitted where the rules allow.
@@ -218,8 +220,14 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
   std::vector<double> decision_cpu_ms;  // CPU time of each decision [ms]
   double cpu_at_first_frame = 0.0;      // process CPU time when the first decision began [ms]
   Clock::time_point last_sign = Clock::now();
+  Clock::time_point last_turn = last_sign;
   while (!stop.load()) {
     const Clock::time_point now = Clock::now();
+    // A turn of this loop takes at most kStopPoll: a much longer gap means this process was not running (stopped,
+    // starved), and what it could not see is no sign that the world is gone; its DDS readers may still hold the
+    // world's writer as not alive until the next lease renewal, so the world gets a fresh grace period.
+    if (now - last_turn >= kProcessPause) last_sign = now;
+    last_turn = now;
     if (sign_since_check || frames->alive_writers() >= 1) {
       sign_since_check = false;
       world_seen = true;
