@@ -226,8 +226,10 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
     // A turn of this loop takes at most kStopPoll: a much longer gap means this process was not running (stopped,
     // starved), and what it could not see is no sign that the world is gone; its DDS readers may still hold the
     // world's writer as not alive until the next lease renewal, so the world gets a fresh grace period.
-    if (now - last_turn >= kProcessPause) last_sign = now;
-    last_turn = now;
+    // It also asks the world at once whether it still counts this agent in: frames queued before the pause may still
+    // arrive and look fresh, while the world may have dropped it meanwhile (docs/runtime.md#re-admission).
+    const bool was_paused = now - last_turn >= kProcessPause;
+    if (was_paused) last_sign = now;
     if (sign_since_check || frames->alive_writers() >= 1) {
       sign_since_check = false;
       world_seen = true;
@@ -245,6 +247,14 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
                                    result.last_step);
       return;
     }
+    if (was_paused) {
+      spdlog::info("agent {}: this process did not run for {} s; asking the world whether it still counts this agent in",
+                   config_.agent_id, std::chrono::duration<double>(now - last_turn).count());
+      hellos_->write(hello_);
+      asked = true;
+      next_hello = now + config_.hello_period;
+    }
+    last_turn = now;
     if (now - last_frame_at >= kRehelloAfter && now >= next_hello) {
       if (!asked)
         spdlog::info("agent {}: no frame for {} s; asking the world whether it still counts this agent in",
