@@ -105,7 +105,7 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
   const PipelinePlace place = pipeline_.place(view.robot, view.target);
   trace_.role = place.role;
   if (place.role != PipelineRole::kActive)
-    if (const auto other = oncoming(view, frame)) return yield_step(view, *other, request);
+    if (const auto other = oncoming(view, frame)) return yield_step(view, {other->x_m, other->y_m}, request);
   switch (place.role) {
     case PipelineRole::kActive:
       if (state_ == PathState::kRetreat) {
@@ -119,7 +119,7 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
       state_ = PathState::kHold;
       // A front neighbour that stays put as long as this robot has waited may be waiting for it to make way (a
       // robot on its way back that has not got far enough to be seen returning): step aside, off its line to the base.
-      if (still_steps_ >= kPatienceSteps) yield_step(view, *place.front, request);
+      if (still_steps_ >= kPatienceSteps) yield_step(view, {place.front->x_m, place.front->y_m}, request);
       return;
     case PipelineRole::kBackOff: back_off_step(view, {place.front->x_m, place.front->y_m}, request); return;
   }
@@ -136,12 +136,7 @@ void PathBuilder::follow_step(const BuildView& view, Position front, protocol::A
     return;
   }
   // Stuck as long as a holding robot's patience: make way, as kHold does.
-  if (still_steps_ >= kPatienceSteps) {
-    Neighbour ahead;
-    ahead.x_m = front.x;
-    ahead.y_m = front.y;
-    yield_step(view, ahead, request);
-  }
+  if (still_steps_ >= kPatienceSteps) yield_step(view, front, request);
 }
 
 std::optional<Neighbour> PathBuilder::oncoming(const BuildView& view, const protocol::SensorFrame& frame) const {
@@ -157,10 +152,9 @@ std::optional<Neighbour> PathBuilder::oncoming(const BuildView& view, const prot
   return nearest;
 }
 
-void PathBuilder::yield_step(const BuildView& view, const Neighbour& other, protocol::ActionRequest& request) {
+void PathBuilder::yield_step(const BuildView& view, Position from, protocol::ActionRequest& request) {
   state_ = PathState::kYield;
-  // Off the line from the returning robot to the base: to whichever side gains most, one step at most.
-  const Position from{other.x_m, other.y_m};
+  // Off the line from the other robot (at `from`) to the base: to whichever side gains most, one step at most.
   const Position base = steps_.context().assignment.base;
   const double dx = base.x - from.x, dy = base.y - from.y, length = std::hypot(dx, dy);
   const auto off_line = [&](Position p) {
@@ -188,10 +182,7 @@ void PathBuilder::back_off_step(const BuildView& view, Position front, protocol:
     return;
   }
   // No way back (other robots behind it): make way to the side instead, off the front robot's line to the base.
-  Neighbour ahead;
-  ahead.x_m = front.x;
-  ahead.y_m = front.y;
-  yield_step(view, ahead, request);
+  yield_step(view, front, request);
   if (request.move) state_ = PathState::kBackOff;
 }
 

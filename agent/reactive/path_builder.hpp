@@ -108,7 +108,7 @@ class PathBuilder final : public Behaviour {
   void follow_step(const BuildView& view, Position front, protocol::ActionRequest& request);
   void back_off_step(const BuildView& view, Position front, protocol::ActionRequest& request);
   std::optional<Neighbour> oncoming(const BuildView& view, const protocol::SensorFrame& frame) const;
-  void yield_step(const BuildView& view, const Neighbour& oncoming, protocol::ActionRequest& request);
+  void yield_step(const BuildView& view, Position from, protocol::ActionRequest& request);
 
   RampSteps steps_;
   PipelineTracker pipeline_;

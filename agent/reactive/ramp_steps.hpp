@@ -104,8 +104,6 @@ class RampSteps {
   void set_lane(double offset_m, double corridor_width_m);
   /// `path` moved into this robot's lane on the last look()'s map (unchanged without lanes).
   std::vector<CellIndex> in_lane(const deliberative::LocalMap& local, const std::vector<CellIndex>& path) const;
-  /// The other robots' bodies the last look() saw.
-  const std::vector<executive::BodyClearance>& others() const { return others_; }
   /// Requests `motion` and records it.
   void move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) const;
   /// A step back the way the robot came: towards the local origin, or the oldest navigable cell of the trajectory in
