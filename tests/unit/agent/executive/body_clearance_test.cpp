@@ -54,8 +54,12 @@ TEST(BodyClearance, KeepClearTakesTheDiscsOutAndReconnects) {
     for (int c = 0; c < 40; ++c) {
       const bool near = distance(map.center({r, c}), others[0].centre) < 1.0;
       if (near) inside += 1;
-      if (near) EXPECT_EQ(map.occupiable(r, c), 0) << r << "," << c;
-      if (map.navigable(r, c) != 0) EXPECT_NE(map.occupiable(r, c), 0);
+      if (near) {
+        EXPECT_EQ(map.occupiable(r, c), 0) << r << "," << c;
+      }
+      if (map.navigable(r, c) != 0) {
+        EXPECT_NE(map.occupiable(r, c), 0);
+      }
     }
   EXPECT_NE(map.navigable(19, 5), 0);  // its own cell stays
   EXPECT_EQ(map.navigable(19, 35), 0);  // the far end is cut off: no route through the other robot
@@ -93,7 +97,9 @@ TEST(BodyClearance, TheActionManagerNeverChoosesATargetTheWorldWouldRefuse) {
     for (const Neighbour& n : seen) {
       const double d = distance(m->target, {n.x_m, n.y_m});
       const double before = distance(robot, {n.x_m, n.y_m});
-      if (d < 1.0) EXPECT_GE(d, before) << "trial " << trial;  // never deeper into a body
+      if (d < 1.0) {  // never deeper into a body
+        EXPECT_GE(d, before) << "trial " << trial;
+      }
     }
   }
   EXPECT_GT(moved, 50);

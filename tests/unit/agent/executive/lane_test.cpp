@@ -43,12 +43,16 @@ TEST(Lane, KeepsRightOfTheCorridorsCentreWhereverTheRobotStands) {
     ASSERT_GE(lane.size(), 2u);
     EXPECT_EQ(lane.front(), (CellIndex{row, 5}));  // the robot's own cell stays
     for (std::size_t i = 1; i < lane.size(); ++i)
-      if (lane[i].col > 25 && lane[i].col < 65) EXPECT_EQ(lane[i].row, 47) << "from row " << row;
+      if (lane[i].col > 25 && lane[i].col < 65) {
+        EXPECT_EQ(lane[i].row, 47) << "from row " << row;
+      }
   }
   // Westwards, right is north: y = 4.75 m, row 32 (reached at 45 degrees from row 40: by column 62).
   const auto back = lane_path(map, map.navigable, row_path(40, 70, 5), 0.75, 3.0);
   for (const CellIndex& c : back)
-    if (c.col < 50 && c.col > 10) EXPECT_EQ(c.row, 32);
+    if (c.col < 50 && c.col > 10) {
+      EXPECT_EQ(c.row, 32);
+    }
   // The two lanes are 1.5 m apart: bodies of 1 m pass with 0.5 m to spare.
 }
 
@@ -56,7 +60,9 @@ TEST(Lane, ALaneBeyondTheCorridorStopsAtItsEdge) {
   const deliberative::LocalMap map = band_map({40, 5});
   const auto lane = lane_path(map, map.navigable, row_path(40, 5, 70), 1.5, 3.0);
   for (std::size_t i = 1; i < lane.size(); ++i)
-    if (lane[i].col > 25 && lane[i].col < 65) EXPECT_EQ(lane[i].row, 49);  // the last navigable row
+    if (lane[i].col > 25 && lane[i].col < 65) {  // the last navigable row
+      EXPECT_EQ(lane[i].row, 49);
+    }
 }
 
 TEST(Lane, IsEnteredAtFortyFiveDegreesAtMost) {
