@@ -10,6 +10,8 @@
 #include <exception>
 #include <iostream>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "marsala/agent/runtime/agent_runtime.hpp"
 #include "marsala/cli/command_line.hpp"
@@ -59,6 +61,11 @@ int main(int argc, char** argv) {
   marsala::cli::add_dds_options(app, dds);
   std::optional<std::uint64_t> seed;
   app.add_option("--seed", seed, "override the scenario's seed (marsala-world must get the same)");
+  std::vector<std::string> overrides;
+  app.add_option("--set", overrides,
+                 "change a field of the scenario, FIELD=VALUE, e.g. robot_type.body.sensing_range_m=5 (repeatable;\n"
+                 "marsala-world must get the same)")
+      ->type_name("FIELD=VALUE");
   marsala::cli::add_log_options(app, log_options);
   app.add_option("--admit-timeout", admit_timeout_s, "give up when not admitted within this [s]")
       ->check(CLI::PositiveNumber);
@@ -70,7 +77,7 @@ int main(int argc, char** argv) {
   const std::uint32_t id = id_text == "auto" ? 0u : static_cast<std::uint32_t>(std::stoul(id_text));
   marsala::cli::setup_logging("agent", id, log_options);
   try {
-    const scenario::Scenario s = scenario::load_scenario(scenario_file);
+    const scenario::Scenario s = scenario::load_scenario(scenario_file, overrides);
     const RobotType& type = id != 0 ? s.robot_for(id) : any_slot_type(s, robot_type);
     // Keep-out around neighbours: the largest body and step of the whole team (bodies may differ per slot).
     double max_delta = 0.0, max_step = 0.0;

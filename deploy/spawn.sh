@@ -6,7 +6,7 @@
 #
 # Usage: deploy/spawn.sh --scenario FILE --agents N [--dds cyclone|fastdds] [--agent-dds cyclone|fastdds]
 #                        [--out DIR [--replace]] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N]
-#                        [--quiet] [--secure] [--frames-every K]
+#                        [--quiet] [--secure] [--frames-every K] [--set FIELD=VALUE ...]
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
 #                 folder that holds another run's files, unless --replace removes them (and logs/) first
 #   --dds         vendor of every process (default $MARSALA_DDS, else cyclone); --agent-dds overrides it for the agents
@@ -17,6 +17,8 @@
 #   --frames-every a time-lapse: marsala-world draws OUT/frames/frame_<step>.png every K steps and the last, and
 #                 OUT/frames/timelapse.mp4 when ffmpeg is installed
 #   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
+#   --set         change a field of the scenario for this run, e.g. --set robot_type.body.sensing_range_m=5
+#                 (repeatable; passed to marsala-world and every marsala-agent; summary.json lists them)
 #   --secure      DDS Security: a CA and an identity per process in OUT/security (deploy/security/make-identities.sh,
 #                 made anew each run), every process authenticated, access-controlled and encrypted (domain <= 230)
 # Exit codes: marsala-world's for a run that ended: 0 completed, 3 max_steps, 4 no_live_agents, 5 stopped by a
@@ -27,8 +29,8 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
 scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0 frames_every=""
-replace=0 secure=0
-usage() { sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; }
+replace=0 secure=0 set_args=()
+usage() { sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -42,6 +44,7 @@ while [ $# -gt 0 ]; do
     --frames-every) frames_every="$2"; shift 2 ;;
     --timeout) timeout_s="$2"; shift 2 ;;
     --seed) seed="$2"; shift 2 ;;
+    --set) set_args+=(--set "$2"); shift 2 ;;
     --quiet) quiet=1; shift ;;
     --replace) replace=1; shift ;;
     --secure) secure=1; shift ;;
@@ -100,7 +103,7 @@ world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$do
 [ "$quiet" -eq 1 ] && world_args+=(--quiet)
 seed_args=()
 [ -n "$seed" ] && seed_args=(--seed "$seed")
-world_args+=("${seed_args[@]}")
+world_args+=("${seed_args[@]}" "${set_args[@]}")
 
 # The world's own start-up checks with the run's arguments (scenario, terrain, completion, slots, --agents), before
 # any process starts: a bad scenario fails here with the check's message (marsala-world --check, no DDS).
@@ -128,7 +131,7 @@ world_pid=$!
 pids+=("$world_pid")
 for id in $(seq 1 "$agents"); do
   "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds "$agent_dds" --domain "$domain" \
-    "${seed_args[@]}" "${sec_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
+    "${seed_args[@]}" "${set_args[@]}" "${sec_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
   pids+=("$!")
 done
 [ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain; logs in $out/logs"

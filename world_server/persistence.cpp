@@ -88,6 +88,7 @@ proto::LogHeader log_header(const scenario::Scenario& scenario, const LogStart& 
   h.set_scenario(scenario.name);
   h.set_scenario_file(scenario.source_path);
   h.set_scenario_text(start.scenario_text);
+  for (const std::string& o : scenario.overrides) h.add_overrides(o);
   h.set_run_id(start.run_id);
   h.set_seed(scenario.seed);
   h.set_agents(start.agents);

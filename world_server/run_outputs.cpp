@@ -102,6 +102,7 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   proto::RunSummary s;
   s.set_scenario(info.scenario);
   s.set_scenario_file(info.scenario_file);
+  for (const std::string& o : info.overrides) s.add_overrides(o);
   s.set_run_id(info.run_id);
   s.set_seed(info.seed);
   s.set_dds(info.dds);

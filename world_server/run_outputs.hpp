@@ -41,6 +41,7 @@ namespace marsala::world_server {
 struct RunInfo {
   std::string scenario;  ///< scenario name
   std::string scenario_file;
+  std::vector<std::string> overrides;  ///< --set FIELD=VALUE applied to the scenario file
   std::string run_id;
   std::string dds;  ///< cyclone, fastdds or inprocess
   std::uint64_t seed = 0;

@@ -143,7 +143,7 @@ proto::ScenarioCheck to_message(const WorldStart& start) {
 
 WorldStart check_scenario(const std::string& scenario_path, const RuntimeOptions& options, int domain_id) {
   // What run_world_cli() does before it makes a participant, then what WorldRuntime's constructor does.
-  const scenario::Scenario scenario = scenario::load_scenario(scenario_path);
+  const scenario::Scenario scenario = scenario::load_scenario(scenario_path, options.overrides);
   Heightmap terrain = scenario::build_terrain(scenario);
   try {
     return prepare_world_start(scenario, std::move(terrain), options, domain_id);

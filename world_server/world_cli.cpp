@@ -60,6 +60,10 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   std::uint64_t seed = 0;
   const CLI::Option* seed_option =
       app.add_option("--seed", seed, "override the scenario's seed (start jitter); summary.json reports the seed used");
+  app.add_option("--set", options.overrides,
+                 "change a field of the scenario, FIELD=VALUE, e.g. robot_type.body.sensing_range_m=5 (repeatable;\n"
+                 "every marsala-agent must get the same; recorded in run.log and summary.json)")
+      ->type_name("FIELD=VALUE");
   CLI::Option* resume_option =
       app.add_option(
              "--resume", resume_dir,
@@ -101,7 +105,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
     } else {
       options.scenario_text = scenario::read_scenario_text(scenario_path);
       if (options.replace) clear_run_files(options.out_dir);
-      const scenario::Scenario scenario = scenario::parse_scenario(options.scenario_text, scenario_path);
+      const scenario::Scenario scenario =
+          scenario::parse_scenario(options.scenario_text, scenario_path, options.overrides);
       start = prepare_world_start(scenario, scenario::build_terrain(scenario), options, dds.domain);
     }
     const auto participant =

@@ -181,7 +181,8 @@ WorldStart prepare_resume(const std::string& dir, RuntimeOptions options, int do
   const proto::LogHeader& h = reader.header();
   if (h.scenario_text().empty())
     throw Error(log_path + ": the header holds no scenario text (the run was started without a scenario file)");
-  const scenario::Scenario scenario = scenario::parse_scenario(h.scenario_text(), h.scenario_file());
+  const std::vector<std::string> overrides(h.overrides().begin(), h.overrides().end());
+  const scenario::Scenario scenario = scenario::parse_scenario(h.scenario_text(), h.scenario_file(), overrides);
   const std::string terrain_path = (fs::path(dir) / "terrain_initial.asc").string();
   Heightmap terrain = terrain::read_asc(terrain_path);
   if (terrain.rows() != h.rows() || terrain.cols() != h.cols() || terrain.cell_size_m() != h.cell_size_m() ||
@@ -194,6 +195,7 @@ WorldStart prepare_resume(const std::string& dir, RuntimeOptions options, int do
   if (options.max_steps == 0) options.max_steps = h.max_steps();
   options.step_deadline_s = h.step_deadline_s();
   options.scenario_text = h.scenario_text();
+  options.overrides = overrides;
   const std::string out_dir = dir;
   options.out_dir.clear();  // the folder holds this run's files: no freshness check
   WorldStart start = prepare_world_start(scenario, std::move(terrain), std::move(options), domain_id);
@@ -815,6 +817,7 @@ struct WorldRuntime::Impl {
     RunInfo info;
     info.scenario = scenario.name;
     info.scenario_file = scenario.source_path;
+    info.overrides = scenario.overrides;
     info.run_id = options.run_id;
     info.dds = bus::to_string(participant.vendor());
     info.seed = scenario.seed;

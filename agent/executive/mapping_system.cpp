@@ -50,7 +50,8 @@ void MappingSystem::integrate_tile(const TerrainTile& tile) {
   const long long col0 = static_cast<long long>(tile.tile_col) * tile_size_;
   for (int r = 0; r < tile.rows; ++r)
     for (int c = 0; c < tile.cols; ++c) {
-      const int row = static_cast<int>(row0) + r, col = static_cast<int>(col0) + c;
+      const int row = static_cast<int>(row0) + r + registration_.row, col = static_cast<int>(col0) + c + registration_.col;
+      if (!heights_.contains({row, col})) continue;
       heights_(row, col) = tile.heights[static_cast<std::size_t>(r) * tile.cols + c];
       if (known_(row, col) == 0) {
         known_(row, col) = 1;

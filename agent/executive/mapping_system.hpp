@@ -27,7 +27,12 @@ class MappingSystem {
   /// InvalidArgument when a tile does not fit the grid or the pose is off the grid (a broken contract by the sender).
   void integrate(const std::vector<TerrainTile>& tiles, Position pose);
   /// Writes one tile; throws InvalidArgument naming the tile when its place, size or heights are inconsistent.
+  /// Each cell goes to its world index moved by the registration offset; cells moved off the grid are dropped.
   void integrate_tile(const TerrainTile& tile);
+  /// Where the robot believes the terrain it senses lies: tiles integrated from now on write world cell (r, c) at
+  /// (r + offset.row, c + offset.col). A robot with localisation error registers what it senses at its believed pose
+  /// (docs/runtime.md#localisation-error); (0, 0), the default, is the world's registration.
+  void set_registration(CellIndex offset) { registration_ = offset; }
   /// Appends the cell under `pose` [m] to the trajectory (consecutive repeats are kept once); throws
   /// InvalidArgument when the pose is off the grid or not finite.
   void record_pose(Position pose);
@@ -50,6 +55,7 @@ class MappingSystem {
   CellMask known_;
   long long known_count_ = 0;
   int tile_size_;
+  CellIndex registration_{0, 0};
   std::vector<CellIndex> trajectory_;
 };
 

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "marsala/agent/reactive/idle_behaviour.hpp"
+#include "marsala/agent/reactive/noisy_localisation.hpp"
 #include "marsala/agent/reactive/path_builder.hpp"
 #include "marsala/agent/reactive/ramp_builder.hpp"
 #include "marsala/core/error.hpp"
@@ -23,6 +24,12 @@ std::unique_ptr<Behaviour> make_behaviour(const std::string& name, const AgentCo
   BehaviourRegistry registry = make_behaviour_registry();
   register_builtins(registry);
   return registry.make(name, context);
+}
+
+std::unique_ptr<Behaviour> make_robot_behaviour(const AgentContext& context) {
+  if (context.type.localisation.noise_sd_m > 0.0)
+    return std::make_unique<NoisyLocalisation>(context, context.type.behaviour);
+  return make_behaviour(context.type.behaviour, context);
 }
 
 protocol::ActionRequest empty_request(const AgentContext& context, const protocol::SensorFrame& frame,

@@ -32,6 +32,9 @@ class Behaviour {
   /// admission, for another agent's frame, or for a frame whose tiles do not fit the grid. On a run_over frame
   /// it returns an empty request and the behaviour is done.
   virtual protocol::ActionRequest decide(const protocol::SensorFrame& frame) = 0;
+  /// Where the robot believes the terrain of its next frames lies (executive::MappingSystem::set_registration);
+  /// behaviours without a map ignore it.
+  virtual void set_registration(CellIndex /*offset*/) {}
 };
 
 /// Behaviours by name; each is made from the agent's context (admission still empty).
@@ -43,6 +46,9 @@ BehaviourRegistry make_behaviour_registry();
 void register_builtins(BehaviourRegistry& registry);
 /// A built-in behaviour by name; throws InvalidArgument listing the valid names when unknown.
 std::unique_ptr<Behaviour> make_behaviour(const std::string& name, const AgentContext& context);
+/// The robot's behaviour: context.type.behaviour, acting on a noisy belief of its pose (noisy_localisation.hpp) when
+/// its robot type has localisation noise; throws as make_behaviour.
+std::unique_ptr<Behaviour> make_robot_behaviour(const AgentContext& context);
 
 /// An empty request answering `frame`: the envelope filled, no motion, no deposition, no refill.
 protocol::ActionRequest empty_request(const AgentContext& context, const protocol::SensorFrame& frame,

@@ -76,6 +76,7 @@ class RampBuilder final : public Behaviour {
   std::string name() const override { return "ramp_builder"; }
   std::string state_name() const override { return to_string(state_); }
   void on_admission(const protocol::Admission& admission) override;
+  void set_registration(CellIndex offset) override { steps_.set_registration(offset); }
   protocol::ActionRequest decide(const protocol::SensorFrame& frame) override;
 
   RampState state() const { return state_; }

@@ -92,7 +92,13 @@ void RampSteps::admit(const protocol::Admission& admission) {
   goal_ = deliberative::make_goal_synthesizer(context_.type.goal_synthesizer, context_);
 }
 
+void RampSteps::set_registration(CellIndex offset) {
+  registration_ = offset;
+  if (modules_) modules_->map.set_registration(offset);
+}
+
 BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace) {
+  modules_->map.set_registration(registration_);
   modules_->map.integrate(frame.tiles, {frame.x_m, frame.y_m});
   const Position robot{frame.x_m, frame.y_m};
   const std::optional<Position> goal = goal_->target({robot, frame.neighbours});

@@ -87,6 +87,9 @@ class RampSteps {
   bool admitted() const { return modules_ != nullptr; }
   /// The agent's own map; throws InvalidArgument before admission.
   const executive::MappingSystem& map() const;
+  /// Where the terrain of the next frames is registered (executive::MappingSystem::set_registration); kept across
+  /// admissions.
+  void set_registration(CellIndex offset);
 
   /// Integrates the frame into the map, asks the goal synthesizer for the target and synthesizes the local map;
   /// records the window in `trace`. Only after admission.
@@ -136,6 +139,7 @@ class RampSteps {
   std::optional<PlannerParams> planner_;
   std::unique_ptr<deliberative::GoalSynthesizer> goal_;
   std::unique_ptr<Modules> modules_;  // made on admission, when the grid is known
+  CellIndex registration_{0, 0};       // set_registration()
   bool deposited_since_blocked_ = false;
   int idle_retreat_moves_ = 0;
   std::vector<executive::BodyClearance> others_;  // the last frame's neighbours

@@ -120,7 +120,7 @@ void AgentRuntime::make_behaviour() {
           : neighbour_keep_out_m(config_.type.body.navigability.delta_m, config_.type.body.max_step_m);
   context.seed = config_.seed;
   context.goal_vector_map = config_.goal_vector_map;
-  behaviour_ = reactive::make_behaviour(config_.type.behaviour, context);
+  behaviour_ = reactive::make_robot_behaviour(context);
 }
 
 AgentRuntime::~AgentRuntime() = default;

@@ -19,6 +19,13 @@ struct Pipeline {
   double lane_offset_m = 0.75;
 };
 
+/// Localisation error (docs/runtime.md#localisation-error): the robot believes its pose off the true one by an error
+/// e_k per axis, e_k = a e_(k-1) + sqrt(1 - a^2) sd n_k with a = exp(-1 / correlation_steps), n_k standard normal.
+struct Localisation {
+  double noise_sd_m = 0.0;           ///< standard deviation of the error per axis; 0: exact [m]
+  double correlation_steps = 50.0;   ///< steps over which the error decorrelates to 1/e [steps]
+};
+
 /// A kind of robot.
 struct RobotType {
   std::string name;                        ///< e.g. "husky"
@@ -29,6 +36,7 @@ struct RobotType {
   std::optional<NavigabilityParams> construction;
   Pipeline pipeline;
   std::string goal_synthesizer = "fixed_target";  ///< goal synthesizer by name (agent registry)
+  Localisation localisation;                      ///< how wrong the robot's own pose estimate is
 };
 
 /// What `type` builds: its construction, or its own body's kappa, delta (as the band width) and eps.

@@ -80,6 +80,7 @@ struct BaseStation {
 struct Scenario {
   std::string name;
   std::string source_path;  ///< the file it was loaded from (for messages and relative paths)
+  std::vector<std::string> overrides;  ///< the "FIELD=VALUE" overrides applied to the file (load_scenario)
   TerrainSource terrain;
   std::vector<RobotType> robot_types;
   std::vector<AgentSlot> slots;  ///< slots[i].id == i + 1
@@ -103,10 +104,17 @@ struct Scenario {
 /// Loads and validates a scenario (protobuf text format). Throws ParseError with file and line for syntax
 /// errors and unknown fields, InvalidArgument naming the field for bad values (non-positive sizes, unknown
 /// robot type or generator, slots outside the terrain, NaN).
-Scenario load_scenario(const std::string& path);
+/// `overrides` ("FIELD=VALUE", marsala-world/marsala-agent --set) change fields of the file before validation: FIELD
+/// is a dot-separated path of field names of idl/scenario.proto's Scenario; a repeated field applies to every element,
+/// or to one with [i] (0-based, in file order), e.g. "robot_type.body.sensing_range_m=5",
+/// "robot_type[1].body.kappa=0.2", "max_steps=20000"; VALUE is a scalar in text format (number, bool, string without
+/// quotes). An override naming an unknown field (the valid ones are listed), a message, a map, a repeated value or an
+/// index out of range, or with a value of the wrong type, throws InvalidArgument naming it.
+Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides = {});
 /// The text of a scenario file; throws IoError when it cannot be read.
 std::string read_scenario_text(const std::string& path);
 /// Same from text; `source_name` names it in messages and anchors relative terrain paths.
-Scenario parse_scenario(const std::string& text, const std::string& source_name);
+Scenario parse_scenario(const std::string& text, const std::string& source_name,
+                        const std::vector<std::string>& overrides = {});
 
 }  // namespace marsala::scenario

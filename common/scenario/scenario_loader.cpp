@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "idl/scenario.pb.h"
@@ -186,6 +187,16 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     if (pp.has_lane_offset_m())
       t.pipeline.lane_offset_m = check.finite(field + ".pipeline.lane_offset_m", pp.lane_offset_m());
     if (t.pipeline.lane_offset_m < 0.0) check.fail(field + ".pipeline.lane_offset_m", "must be >= 0");
+    const proto::Localisation& lp = rp.localisation();
+    if (lp.has_noise_sd_m()) t.localisation.noise_sd_m = check.finite(field + ".localisation.noise_sd_m", lp.noise_sd_m());
+    if (t.localisation.noise_sd_m < 0.0 || t.localisation.noise_sd_m > 10.0)
+      check.fail(field + ".localisation.noise_sd_m", fmt::format("{} must be in [0, 10] m", t.localisation.noise_sd_m));
+    if (lp.has_correlation_steps())
+      t.localisation.correlation_steps =
+          check.finite(field + ".localisation.correlation_steps", lp.correlation_steps());
+    if (t.localisation.correlation_steps < 1.0 || t.localisation.correlation_steps > 1e5)
+      check.fail(field + ".localisation.correlation_steps",
+                 fmt::format("{} must be in [1, 1e5] steps", t.localisation.correlation_steps));
     if (rp.has_goal_synthesizer()) t.goal_synthesizer = rp.goal_synthesizer();
     if (t.goal_synthesizer.empty()) check.fail(field + ".goal_synthesizer", "must not be empty");
     if (t.goal_synthesizer == "goal_vector_map" && !p.has_goal_vector_map())
@@ -337,7 +348,9 @@ std::string to_string(CompletionKind kind) {
   return enum_to_string(kNames, kind);
 }
 
-Scenario parse_scenario(const std::string& text, const std::string& source_name) {
+namespace {
+
+proto::Scenario parse_message(const std::string& text, const std::string& source_name) {
   proto::Scenario message;
   google::protobuf::TextFormat::Parser parser;
   FirstErrorCollector errors;
@@ -347,7 +360,94 @@ Scenario parse_scenario(const std::string& text, const std::string& source_name)
     if (errors.has_error()) throw TextFormatError(source_name, errors.line(), errors.column(), errors.message());
     throw ParseError(source_name, 0, "not a valid scenario (protobuf text format)");
   }
-  return to_scenario(message, source_name);
+  return message;
+}
+
+/// The field names of `type`, joined for messages.
+std::string field_names(const google::protobuf::Descriptor& type) {
+  std::string names;
+  for (int i = 0; i < type.field_count(); ++i) names += (i == 0 ? "" : ", ") + type.field(i)->name();
+  return names;
+}
+
+/// Sets FIELD (the path's remaining parts from `part`) to `value` in `message` and every element it selects.
+void apply_override(google::protobuf::Message& message, const std::vector<std::string>& parts, std::size_t part,
+                    const std::string& value, const std::string& where) {
+  using google::protobuf::FieldDescriptor;
+  std::string name = parts[part];
+  std::optional<int> index;
+  if (const std::size_t open = name.find('['); open != std::string::npos) {
+    const std::string digits = name.substr(open + 1, name.size() - open - 2);
+    if (name.back() != ']' || digits.empty() || digits.size() > 6 ||
+        !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c) != 0; }))
+      throw InvalidArgument(where + ": '" + name + "' is not FIELD or FIELD[INDEX]");
+    index = std::stoi(digits);
+    name = name.substr(0, open);
+  }
+  const google::protobuf::Descriptor& type = *message.GetDescriptor();
+  const FieldDescriptor* field = type.FindFieldByName(name);
+  if (field == nullptr)
+    throw InvalidArgument(where + ": " + type.name() + " has no field '" + name + "'; valid: " + field_names(type));
+  const google::protobuf::Reflection& reflection = *message.GetReflection();
+  const bool last = part + 1 == parts.size();
+  const bool is_message = field->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE;
+  if (field->is_map()) throw InvalidArgument(where + ": '" + name + "' is a map; edit the scenario file instead");
+  if (last == is_message)
+    throw InvalidArgument(where + ": '" + name + "' is " + (is_message ? "a message: name one of its fields (" +
+                                                                             field_names(*field->message_type()) + ")"
+                                                                       : "a value: it has no fields"));
+  if (index && !field->is_repeated()) throw InvalidArgument(where + ": '" + name + "' is not repeated");
+  if (field->is_repeated()) {
+    const int size = reflection.FieldSize(message, field);
+    if (index && *index >= size)
+      throw InvalidArgument(where + ": " + name + "[" + std::to_string(*index) + "] does not exist (the scenario has " +
+                            std::to_string(size) + ")");
+    if (last) throw InvalidArgument(where + ": repeated values cannot be set; edit the scenario file instead");
+    for (int i = index.value_or(0); i < (index ? *index + 1 : size); ++i)
+      apply_override(*reflection.MutableRepeatedMessage(&message, field, i), parts, part + 1, value, where);
+    return;
+  }
+  if (!last) {
+    apply_override(*reflection.MutableMessage(&message, field), parts, part + 1, value, where);
+    return;
+  }
+  // A scalar: the text format's own parser, as if the file said `name: value` (strings may go without quotes).
+  std::string literal = value;
+  if (field->cpp_type() == FieldDescriptor::CPPTYPE_STRING && (literal.empty() || literal.front() != '"'))
+    literal = "\"" + literal + "\"";
+  google::protobuf::TextFormat::Parser parser;
+  FirstErrorCollector errors;  // keeps protobuf's own message off stderr: ours says it
+  parser.RecordErrorsTo(&errors);
+  if (!parser.ParseFieldValueFromString(literal, field, &message))
+    throw InvalidArgument(where + ": '" + value + "' is not a valid " + field->cpp_type_name() + " for '" + name + "'");
+}
+
+void apply_overrides(proto::Scenario& message, const std::vector<std::string>& overrides) {
+  for (const std::string& override : overrides) {
+    const std::string where = "--set '" + override + "'";
+    const std::size_t equals = override.find('=');
+    if (equals == std::string::npos || equals == 0) throw InvalidArgument(where + ": expected FIELD=VALUE");
+    const std::string path = override.substr(0, equals);
+    if (path.back() == '.') throw InvalidArgument(where + ": the field path ends with '.'");
+    std::vector<std::string> parts;
+    std::stringstream names(path);
+    for (std::string part; std::getline(names, part, '.');) {
+      if (part.empty()) throw InvalidArgument(where + ": empty field name in '" + path + "'");
+      parts.push_back(part);
+    }
+    apply_override(message, parts, 0, override.substr(equals + 1), where);
+  }
+}
+
+}  // namespace
+
+Scenario parse_scenario(const std::string& text, const std::string& source_name,
+                        const std::vector<std::string>& overrides) {
+  proto::Scenario message = parse_message(text, source_name);
+  apply_overrides(message, overrides);
+  Scenario s = to_scenario(message, source_name);
+  s.overrides = overrides;
+  return s;
 }
 
 std::string read_scenario_text(const std::string& path) {
@@ -359,6 +459,8 @@ std::string read_scenario_text(const std::string& path) {
   return text.str();
 }
 
-Scenario load_scenario(const std::string& path) { return parse_scenario(read_scenario_text(path), path); }
+Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides) {
+  return parse_scenario(read_scenario_text(path), path, overrides);
+}
 
 }  // namespace marsala::scenario

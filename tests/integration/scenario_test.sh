@@ -12,6 +12,9 @@
 #   site   tests/integration/scenarios/site_small.pbtxt, 3 levellers on a goal vector map (Fast DDS): every cell of
 #          the site, cropped from terrain_final.asc, is occupiable at kappa 0.1 and all are connected; it was not
 #          so on terrain_initial.asc; goal_vector_map.png and final.png written
+#   site_noisy the same site with localisation error (spawn.sh --set robot_type.localisation.noise_sd_m=0.1, Cyclone
+#          DDS): level as above, summary.json lists the override; a misspelt override is refused before anything runs
+#          (exit 2, naming the field and the valid ones)
 #   three_gaps tests/integration/scenarios/path_three_gaps.pbtxt, 3 path builders (Cyclone DDS): the payload reaches the
 #          target on terrain_final.asc (not before), the target's cell at most one cube layer higher, and what was
 #          built forms three separate sites, one past each cliff (found on terrain_initial.asc), natural ground between
@@ -44,10 +47,11 @@ fail() { echo "FAIL (scenario $case_name): $*" >&2; exit 1; }
 agent_fields() {  # agent_fields NAME FILE: NAME of every per_agent entry, one per line
   grep -o "\"$1\": *[^,}]*" "$2" | sed 's/^[^:]*: *//; s/"//g'
 }
+extra=()       # more spawn.sh arguments for run_spawn (--set ...)
 run_spawn() {  # run_spawn SCENARIO AGENTS DDS: runs it into $work/run, prints the summary's path
   local out="$work/run"
   "$root/deploy/spawn.sh" --scenario "$1" --agents "$2" --dds "$3" --domain "$domain" --out "$out" --quiet \
-    --timeout 300 >&2 || fail "spawn.sh failed (logs: $out/logs)"
+    --timeout 300 "${extra[@]}" >&2 || fail "spawn.sh failed (logs: $out/logs)"
   [ -f "$out/summary.json" ] || fail "no summary.json in $out"
   echo "$out/summary.json"
 }
@@ -99,8 +103,19 @@ case "$case_name" in
     echo "ok: path: payload path $(field path_length_m "$s") m after $(field steps "$s") steps," \
       "$(field deposited_volume_m3 "$s") m^3; $refilled builders refilled"
     ;;
-  site)
-    s=$(run_spawn "$scenarios/site_small.pbtxt" 3 fastdds)
+  site|site_noisy)
+    dds=fastdds
+    if [ "$case_name" = site_noisy ]; then
+      dds=cyclone
+      rc=0
+      "$root/deploy/spawn.sh" --scenario "$scenarios/site_small.pbtxt" --agents 3 --domain "$domain" --out "$work/bad" \
+        --quiet --set robot_type.localisation.noise=0.1 2>"$work/bad.err" || rc=$?
+      [ "$rc" = 2 ] || fail "a misspelt --set: spawn.sh exit $rc, expected 2"
+      grep -q "Localisation has no field 'noise'; valid: noise_sd_m, correlation_steps" "$work/bad.err" ||
+        fail "a misspelt --set: no clear message: $(cat "$work/bad.err")"
+      extra=(--set robot_type.localisation.noise_sd_m=0.1)
+    fi
+    s=$(run_spawn "$scenarios/site_small.pbtxt" 3 "$dds")
     expect_completed "$s" 3
     out="$(dirname "$s")"
     [ "$(field site_level_fraction "$s")" = "1" ] || { cat "$s"; fail "summary: site level fraction is not 1"; }
@@ -120,9 +135,13 @@ case "$case_name" in
     [ "$occ0" -lt "$total0" ] || fail "the site was level before any construction"
     [ "$occ1" = "$total1" ] || fail "$occ1 of $total1 site cells occupiable at kappa 0.1 on terrain_final.asc"
     [ "$nav1" = "$total1" ] || fail "$nav1 of $total1 site cells connected at kappa 0.1 on terrain_final.asc"
+    if [ "$case_name" = site_noisy ]; then
+      jq -e '.overrides == ["robot_type.localisation.noise_sd_m=0.1"]' "$s" >/dev/null ||
+        { cat "$s"; fail "summary.json does not list the override"; }
+    fi
     is_png "$out/goal_vector_map.png" || fail "goal_vector_map.png missing or not a PNG"
     is_png "$out/final.png" || fail "final.png missing or not a PNG"
-    echo "ok: site: level at kappa 0.1 after $(field steps "$s") steps ($occ0 of $total0 cells before)," \
+    echo "ok: $case_name: level at kappa 0.1 after $(field steps "$s") steps ($occ0 of $total0 cells before)," \
       "$(field deposited_volume_m3 "$s") m^3"
     ;;
   three_gaps)

@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 #include "marsala/core/error.hpp"
 
@@ -234,6 +235,80 @@ TEST(ScenarioLoader, BadValuesNameTheField) {
             std::string::npos);
   EXPECT_NE(invalid(std::string(kMinimal) + "robot_type { name: \"bot\" }").find("defined twice"), std::string::npos);
   EXPECT_NE(invalid(edit(" target { x_m: 10 y_m: 5 }", "")).find("target: missing"), std::string::npos);
+}
+
+// --set FIELD=VALUE (marsala-world and marsala-agent): fields of the file changed before validation.
+const char* const kTwoTypes = R"(
+name: "two"
+terrain { generator: "flat" rows: 20 cols: 30 cell_size_m: 0.5 }
+robot_type { name: "a" body { sensing_range_m: 3 } }
+robot_type { name: "b" body { kappa: 0.4 } }
+agent { robot_type: "a" start { x_m: 1 y_m: 1 } target { x_m: 10 y_m: 5 } }
+agent { robot_type: "b" start { x_m: 2 y_m: 1 } target { x_m: 10 y_m: 5 } }
+goal { x0_m: 9 y0_m: 4 x1_m: 11 y1_m: 6 }
+)";
+
+/// The message of the InvalidArgument that parsing kTwoTypes with `overrides` throws (fails the test when none).
+std::string invalid_override(const std::vector<std::string>& overrides) {
+  try {
+    parse_scenario(kTwoTypes, "t.pbtxt", overrides);
+  } catch (const InvalidArgument& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InvalidArgument for " << overrides.front();
+  return {};
+}
+
+TEST(ScenarioOverrides, ARepeatedFieldChangesInEveryElementOrInTheIndexedOne) {
+  const Scenario all = parse_scenario(kTwoTypes, "t.pbtxt", {"robot_type.body.sensing_range_m=5.5"});
+  EXPECT_EQ(all.robot_types[0].body.sensing_range_m, 5.5);
+  EXPECT_EQ(all.robot_types[1].body.sensing_range_m, 5.5);
+  EXPECT_EQ(all.robot_types[1].body.navigability.kappa, 0.4);  // the rest of the block is kept
+  EXPECT_EQ(all.overrides, std::vector<std::string>{"robot_type.body.sensing_range_m=5.5"});
+
+  const Scenario one = parse_scenario(kTwoTypes, "t.pbtxt", {"robot_type[1].body.kappa=0.2", "max_steps=123"});
+  EXPECT_EQ(one.robot_types[0].body.navigability.kappa, 0.3);  // the default, untouched
+  EXPECT_EQ(one.robot_types[1].body.navigability.kappa, 0.2);
+  EXPECT_EQ(one.max_steps, 123u);
+  EXPECT_TRUE(parse_scenario(kTwoTypes, "t.pbtxt").overrides.empty());
+}
+
+TEST(ScenarioOverrides, StringsNeedNoQuotesAndLaterOverridesWin) {
+  const Scenario s = parse_scenario(kTwoTypes, "t.pbtxt",
+                                    {"robot_type[0].behaviour=idle", "seed=7", "seed=9", "robot_type[1].behaviour=\"idle\""});
+  EXPECT_EQ(s.robot_types[0].behaviour, "idle");
+  EXPECT_EQ(s.robot_types[1].behaviour, "idle");
+  EXPECT_EQ(s.seed, 9u);
+}
+
+TEST(ScenarioOverrides, BadOverridesNameTheOverrideAndWhatIsWrong) {
+  const auto has = [](const std::string& message, const std::string& part) {
+    return message.find(part) != std::string::npos;
+  };
+  std::string m = invalid_override({"robot_type.body.sensing=5"});
+  EXPECT_TRUE(has(m, "--set 'robot_type.body.sensing=5'")) << m;
+  EXPECT_TRUE(has(m, "Body has no field 'sensing'; valid: kappa, delta_m")) << m;
+  m = invalid_override({"robot_type.body=5"});
+  EXPECT_TRUE(has(m, "'body' is a message: name one of its fields (kappa")) << m;
+  m = invalid_override({"robot_type[2].body.kappa=0.1"});
+  EXPECT_TRUE(has(m, "robot_type[2] does not exist (the scenario has 2)")) << m;
+  m = invalid_override({"robot_type.body.kappa=steep"});
+  EXPECT_TRUE(has(m, "'steep' is not a valid double for 'kappa'")) << m;
+  m = invalid_override({"max_steps[0]=5"});
+  EXPECT_TRUE(has(m, "'max_steps' is not repeated")) << m;
+  m = invalid_override({"terrain.params=5"});
+  EXPECT_TRUE(has(m, "'params' is a map")) << m;
+  m = invalid_override({"max_steps.x=5"});
+  EXPECT_TRUE(has(m, "'max_steps' is a value: it has no fields")) << m;
+  EXPECT_TRUE(has(invalid_override({"max_steps"}), "expected FIELD=VALUE"));
+  EXPECT_TRUE(has(invalid_override({"=5"}), "expected FIELD=VALUE"));
+  EXPECT_TRUE(has(invalid_override({"robot_type..body=5"}), "empty field name"));
+  EXPECT_TRUE(has(invalid_override({"robot_type[x].body.kappa=5"}), "is not FIELD or FIELD[INDEX]"));
+  // A well-formed override still meets the scenario's validation.
+  m = invalid_override({"robot_type[1].body.sensing_range_m=-1"});
+  EXPECT_TRUE(has(m, "robot_type[1].body")) << m;
+  m = invalid_override({"robot_type.body.kappa=nan"});
+  EXPECT_TRUE(has(m, "kappa = nan")) << m;
 }
 
 }  // namespace

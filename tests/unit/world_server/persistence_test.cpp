@@ -95,6 +95,25 @@ class PersistenceTest : public ::testing::Test {
   fs::path dir_;
 };
 
+TEST_F(PersistenceTest, TheHeaderKeepsTheOverridesSoThatAResumeAppliesThemAgain) {
+  const std::string text = small_scenario_text_completing(site_block(4, 1.0));
+  const std::vector<std::string> overrides{"max_steps=77", "robot_type.body.sensing_range_m=2.5"};
+  const scenario::Scenario changed = scenario::parse_scenario(text, "small.pbtxt", overrides);
+  LogStart start;
+  start.scenario_text = text;
+  const proto::LogHeader h = log_header(changed, start, flat_terrain());
+  ASSERT_EQ(h.overrides_size(), 2);
+  EXPECT_EQ(h.overrides(0), overrides[0]);
+  EXPECT_EQ(h.overrides(1), overrides[1]);
+  EXPECT_EQ(h.scenario_text(), text);  // the file as it was: the overrides apply on top of it
+  // What prepare_resume does with the header gives the scenario the run had.
+  const scenario::Scenario resumed = scenario::parse_scenario(
+      h.scenario_text(), h.scenario_file(), std::vector<std::string>(h.overrides().begin(), h.overrides().end()));
+  EXPECT_EQ(resumed.max_steps, 77u);
+  EXPECT_EQ(resumed.robot_types[0].body.sensing_range_m, 2.5);
+  EXPECT_NE(scenario_.robot_types[0].body.sensing_range_m, 2.5);
+}
+
 TEST_F(PersistenceTest, ReplayingTheLogRebuildsTheStateExactly) {
   const WorldState live = record(40);
   ASSERT_GT(live.deposited_volume_m3, 0.0);

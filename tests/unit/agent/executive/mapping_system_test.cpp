@@ -93,5 +93,27 @@ TEST(MappingSystem, TrajectoryKeepsTheCellsStoodOnOnce) {
   EXPECT_EQ(map.known_cells(), 9);
 }
 
+TEST(MappingSystem, RegistrationMovesTilesAndDropsWhatLeavesTheGrid) {
+  // A robot that believes itself one row north and two columns west of where it is registers what it senses there.
+  MappingSystem map(kWorld, 3);
+  map.set_registration({-1, -2});
+  const TerrainTile a = tile(1, 1, 2, 3, 7.0);  // world rows 3..4, cols 3..5 -> rows 2..3, cols 1..3
+  map.integrate_tile(a);
+  EXPECT_EQ(map.known_cells(), 6);
+  for (int r = 0; r < 2; ++r)
+    for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(map.heights()(2 + r, 1 + c), a.heights[r * 3 + c]));
+  EXPECT_FALSE(map.is_known({4, 3}));
+  EXPECT_FALSE(map.is_known({3, 4}));
+  // Moved past the grid's east edge: world col 6 one column east is col 7, off the 7-column grid: nothing lands.
+  map.set_registration({-1, 1});
+  map.integrate_tile(tile(0, 2, 3, 1, -2.0));
+  EXPECT_EQ(map.known_cells(), 6);
+  map.set_registration({1, 0});  // one row south: world row 4 leaves the grid
+  const TerrainTile b = tile(1, 0, 2, 3, 1.0);
+  map.integrate_tile(b);
+  EXPECT_EQ(map.known_cells(), 6 + 3);
+  for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(map.heights()(4, c), b.heights[c]));
+}
+
 }  // namespace
 }  // namespace marsala::agent::executive
