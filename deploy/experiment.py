@@ -33,15 +33,16 @@ Usage: deploy/experiment.sh --scenario FILE --vary FIELD --values "V1 V2 ..." [-
   --jobs       runs at a time (default 1; more share the cores, so wall times grow; results do not change)
   --label      the value's name on the plot (default: FIELD)
   --no-plot    skip OUT/experiment.png (it needs gnuplot)
-CSV columns: value,seed,completed,completion_steps,wall_seconds,deposited_m3,site_level_fraction,rejected_requests,
-             end_reason
+CSV columns: value,seed,completed,completion_steps,wall_seconds,deposited_m3,site_level_fraction,path_length_m,
+             rejected_requests,end_reason,completion (site_level_fraction: level_site runs; path_length_m: the
+             payload's constructed path, payload_path runs; the plot's third panel shows the one that applies)
 Exit codes: 0 every run ended (completed or not), 1 a run failed (no summary) or the binaries are missing, 2 usage
             error or a value marsala-world --check rejects, 130 interrupted.
 """
 
-CSV_HEADER = "value,seed,completed,completion_steps,wall_seconds,deposited_m3,site_level_fraction,rejected_requests," \
-             "end_reason"
-STATS_HEADER = "# value,runs,completed,steps_mean,steps_sd,volume_mean,volume_sd,level_mean,level_sd"
+CSV_HEADER = "value,seed,completed,completion_steps,wall_seconds,deposited_m3,site_level_fraction,path_length_m," \
+             "rejected_requests,end_reason,completion"
+STATS_HEADER = "# value,runs,completed,steps_mean,steps_sd,volume_mean,volume_sd,level_mean,level_sd,path_mean,path_sd"
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
@@ -153,7 +154,9 @@ def run_one(opts, value, seed, stop):
             "completion_steps": int(s.get("steps", 0)), "wall_seconds": float(s.get("wall_seconds", 0.0)),
             "deposited_m3": float(s.get("deposited_volume_m3", 0.0)),
             "site_level_fraction": float(s.get("site_level_fraction", 0.0)),
-            "rejected_requests": int(s.get("rejected_requests", 0)), "end_reason": s.get("end_reason", "")}
+            "path_length_m": float(s.get("path_length_m", 0.0)),
+            "rejected_requests": int(s.get("rejected_requests", 0)), "end_reason": s.get("end_reason", ""),
+            "completion": s.get("completion", "")}
 
 
 _slots = None
@@ -185,8 +188,8 @@ def write_outputs(opts, rows):
         f.write(CSV_HEADER + "\n")
         for r in rows:
             f.write(f"{r['value']},{r['seed']},{r['completed']},{r['completion_steps']},{r['wall_seconds']:.2f},"
-                    f"{r['deposited_m3']:.3f},{r['site_level_fraction']:.4f},{r['rejected_requests']},"
-                    f"{r['end_reason']}\n")
+                    f"{r['deposited_m3']:.3f},{r['site_level_fraction']:.4f},{r['path_length_m']:.2f},"
+                    f"{r['rejected_requests']},{r['end_reason']},{r['completion']}\n")
     stats = []
     for v in opts["values"]:
         mine = [r for r in rows if r["value"] == v]
@@ -194,31 +197,48 @@ def write_outputs(opts, rows):
         steps = mean_sd([r["completion_steps"] for r in done])
         vol = mean_sd([r["deposited_m3"] for r in mine])
         level = mean_sd([r["site_level_fraction"] for r in mine])
-        stats.append((v, len(mine), len(done), steps, vol, level))
+        path = mean_sd([r["path_length_m"] for r in done])
+        stats.append((v, len(mine), len(done), steps, vol, level, path))
     with open(os.path.join(opts["out"], "experiment_stats.csv"), "w", encoding="utf-8") as f:
         f.write(STATS_HEADER + "\n")
-        for v, n, c, st, vo, le in stats:
-            f.write(f"{v},{n},{c},{st[0]:.1f},{st[1]:.1f},{vo[0]:.3f},{vo[1]:.3f},{le[0]:.4f},{le[1]:.4f}\n")
+        for v, n, c, st, vo, le, pa in stats:
+            f.write(f"{v},{n},{c},{st[0]:.1f},{st[1]:.1f},{vo[0]:.3f},{vo[1]:.3f},{le[0]:.4f},{le[1]:.4f},"
+                    f"{pa[0]:.2f},{pa[1]:.2f}\n")
     label = opts["label"] or opts["vary"]
-    print(f"| {label} | completed | steps mean +- sd (completed runs) | m^3 mean +- sd | level fraction mean +- sd |")
-    print("| --- | --- | --- | --- | --- |")
-    for v, n, c, st, vo, le in stats:
+    third = third_measure(rows)
+    third_title = {"level": "site level fraction mean +- sd", "path": "path length [m] mean +- sd (completed runs)"}
+    print(f"| {label} | completed | steps mean +- sd (completed runs) | m^3 mean +- sd |"
+          + (f" {third_title[third]} |" if third else ""))
+    print("| --- | --- | --- | --- |" + (" --- |" if third else ""))
+    for v, n, c, st, vo, le, pa in stats:
         steps_text = f"{st[0]:.0f} +- {st[1]:.0f}" if c else "-"
-        print(f"| {v} | {c} of {n} | {steps_text} | {vo[0]:.1f} +- {vo[1]:.1f} | {le[0]:.3f} +- {le[1]:.3f} |")
-    return stats
+        extra = {"level": f" {le[0]:.3f} +- {le[1]:.3f} |", "path": f" {pa[0]:.1f} +- {pa[1]:.1f} |" if c else " - |",
+                 None: ""}[third]
+        print(f"| {v} | {c} of {n} | {steps_text} | {vo[0]:.1f} +- {vo[1]:.1f} |" + extra)
+    return third
 
 
-def plot(opts):
+def third_measure(rows):
+    """What the third column and panel show: "level" (level_site), "path" (payload_path) or None."""
+    kinds = {r["completion"] for r in rows}
+    if kinds == {"level_site"}:
+        return "level"
+    if kinds == {"payload_path"}:
+        return "path"
+    return None
+
+
+def plot(opts, third):
     if shutil.which("gnuplot") is None:
         print("experiment: gnuplot not found: no plot (install gnuplot-nox)", file=sys.stderr)
         return
     out = opts["out"]
     label = (opts["label"] or opts["vary"]).replace("'", "")
     script = f"""
-set terminal pngcairo size 1200,450 font ",11" noenhanced
+set terminal pngcairo size {1200 if third else 800},450 font ",11" noenhanced
 set output '{out}/experiment.png'
 set datafile separator ','
-set multiplot layout 1,3 title '{os.path.basename(opts["scenario"])}: {label}'
+set multiplot layout 1,{3 if third else 2} title '{os.path.basename(opts["scenario"])}: {label}'
 set key off
 set grid
 set offsets graph 0.08, graph 0.08, graph 0.08, graph 0.08
@@ -229,12 +249,21 @@ plot '{out}/experiment_stats.csv' using 1:4:5 with yerrorbars pt 7 lc rgb '#1f77
 set ylabel 'deposited volume [m^3]'
 plot '{out}/experiment_stats.csv' using 1:6:7 with yerrorbars pt 7 lc rgb '#d62728', \\
      '{out}/experiment.csv' using 1:6 every ::1 with points pt 1 lc rgb '#999999'
+"""
+    if third == "level":
+        script += f"""
 set ylabel 'site level fraction'
 set yrange [0:1.05]
 plot '{out}/experiment_stats.csv' using 1:8:9 with yerrorbars pt 7 lc rgb '#2ca02c', \\
      '{out}/experiment.csv' using 1:7 every ::1 with points pt 1 lc rgb '#999999'
-unset multiplot
 """
+    elif third == "path":
+        script += f"""
+set ylabel 'constructed path length [m]'
+plot '{out}/experiment_stats.csv' using 1:10:11 with yerrorbars pt 7 lc rgb '#2ca02c', \\
+     '{out}/experiment.csv' using 1:($3 == 1 ? $8 : 1/0) every ::1 with points pt 1 lc rgb '#999999'
+"""
+    script += "unset multiplot\n"
     r = subprocess.run(["gnuplot"], input=script, capture_output=True, text=True)
     if r.returncode != 0:
         print("experiment: gnuplot failed: " + r.stderr.strip(), file=sys.stderr)
@@ -280,12 +309,11 @@ def main(argv):
         t.start()
     for t in threads:
         t.join()
-    if rows:
-        write_outputs(opts, rows)
+    third = write_outputs(opts, rows) if rows else None
     if errors:
         raise errors[0]
     if opts["plot"]:
-        plot(opts)
+        plot(opts, third)
 
 
 if __name__ == "__main__":

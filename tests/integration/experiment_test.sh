@@ -41,7 +41,7 @@ out="$work/out"
   --label "noise [m]" >"$work/run.txt" 2>&1 || { cat "$work/run.txt"; fail "the experiment failed"; }
 csv="$out/experiment.csv"
 [ "$(head -1 "$csv")" = \
-  "value,seed,completed,completion_steps,wall_seconds,deposited_m3,site_level_fraction,rejected_requests,end_reason" ] ||
+  "value,seed,completed,completion_steps,wall_seconds,deposited_m3,site_level_fraction,path_length_m,rejected_requests,end_reason,completion" ] ||
   fail "unexpected CSV header: $(head -1 "$csv")"
 [ "$(tail -n +2 "$csv" | wc -l)" = 2 ] || { cat "$csv"; fail "expected 2 rows"; }
 for v in 0 0.1; do
@@ -49,7 +49,7 @@ for v in 0 0.1; do
   [ -f "$s" ] || fail "no summary for value $v"
   row="$(awk -F, -v v="$v" 'NR > 1 && $1 == v && $2 == 1' "$csv")"
   [ "$(echo "$row" | cut -d, -f4)" = "$(field steps "$s")" ] || fail "value $v: CSV steps differ from the summary"
-  [ "$(echo "$row" | cut -d, -f9)" = "$(field end_reason "$s")" ] || fail "value $v: CSV end_reason differs"
+  [ "$(echo "$row" | cut -d, -f10)" = "$(field end_reason "$s")" ] || fail "value $v: CSV end_reason differs"
   if [ "$v" = 0.1 ]; then
     jq -e --arg o "$vary=0.1" '.overrides == [$o]' "$s" >/dev/null || fail "value 0.1: the run was not given the override"
   else
