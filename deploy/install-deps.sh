@@ -29,6 +29,8 @@ packages=(
   iproute2 util-linux
   # deploy/sweep.py (the sweep), jq for spawn.sh/demo.sh (marsala-world --check --json), the scalability plot
   python3 jq gnuplot-nox
+  # the agent's OctoMap (agent/executive/mapping_system.cpp: scans of the laser and rgbd sensors)
+  liboctomap-dev
   # DDS Security identities (deploy/security/make-identities.sh, spawn.sh --secure)
   openssl
 )

@@ -113,6 +113,7 @@ bool admit(WorldState& state, const protocol::AgentHello& hello, AdmissionKind k
   a.name = hello.name.substr(0, kMaxNameChars);
   a.x_m = a.start_x_m;
   a.y_m = a.start_y_m;
+  a.heading_rad = initial_heading_rad(a);
   a.z_m = height_under(state.terrain, a.x_m, a.y_m);
   a.material_m3 = a.type.body.material_capacity_m3;
   a.at_goal = at_goal(state, a);

@@ -212,6 +212,9 @@ void apply_request(WorldState& state, const protocol::ActionRequest& r, const Ve
                    std::vector<CellIndex>& changed_cells) {
   AgentRecord& me = state.agent(r.agent_id);
   if (r.move) {
+    // docs/runtime.md#heading: the direction of the last motion of non-zero length.
+    const double dx = r.target_x_m - me.x_m, dy = r.target_y_m - me.y_m;
+    if (dx != 0.0 || dy != 0.0) me.heading_rad = std::atan2(dy, dx);
     me.x_m = r.target_x_m;
     me.y_m = r.target_y_m;
   }

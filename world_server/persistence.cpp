@@ -1,5 +1,6 @@
 #include "marsala/world_server/persistence.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -185,6 +186,7 @@ proto::Snapshot make_snapshot(const WorldState& state, const std::string& run_id
     p->set_state(a.state);
     p->set_last_result(static_cast<std::uint32_t>(a.last_result));
     p->set_last_reason(a.last_reason);
+    p->set_heading_rad(a.heading_rad);
   }
   s.set_unattributed_rejections(state.unattributed_rejections);
   s.set_surplus_requests(state.surplus_requests);
@@ -268,6 +270,9 @@ void restore_snapshot(WorldState& state, const proto::Snapshot& s, const std::st
     a.state = p.state();
     a.last_result = static_cast<protocol::ActionResult>(p.last_result());
     a.last_reason = p.last_reason();
+    if (p.has_heading_rad() && !std::isfinite(p.heading_rad()))
+      throw bad("agent " + std::to_string(a.id) + ": heading " + std::to_string(p.heading_rad()) + " is not finite");
+    a.heading_rad = p.has_heading_rad() ? p.heading_rad() : initial_heading_rad(a);
   }
   if (state.completion != scenario::CompletionKind::kAgentsAtGoal) {
     // The cache on the snapshot's terrain, with the changes its last evaluation has not seen yet: from here it

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "marsala/core/ray_caster.hpp"
 #include "marsala/world_server/arbiter.hpp"
 
 namespace marsala::world_server {
@@ -15,20 +16,8 @@ void SensingService::forget(std::uint32_t id) {
   if (id >= 1 && id <= seen_.size()) std::fill(seen_[id - 1].begin(), seen_[id - 1].end(), kNever);
 }
 
-protocol::SensorFrame SensingService::frame_for(const WorldState& state, std::uint32_t id, bool run_over) {
-  const AgentRecord& me = state.agent(id);
-  protocol::SensorFrame f;
-  f.agent_id = id;
-  f.step = state.step;
-  f.x_m = me.x_m;
-  f.y_m = me.y_m;
-  f.z_m = me.z_m;
-  f.material_m3 = me.material_m3;
-  f.last_result = me.last_result;
-  f.last_reason = me.last_reason;
-  f.run_over = run_over;
-
-  std::vector<std::uint64_t>& seen = seen_[id - 1];
+void SensingService::add_tiles(const WorldState& state, const AgentRecord& me, protocol::SensorFrame& f) {
+  std::vector<std::uint64_t>& seen = seen_[me.id - 1];
   const Heightmap& terrain = state.terrain;
   for (int index : layout_.tiles_in_square({me.x_m, me.y_m}, me.type.body.sensing_range_m)) {
     const std::uint64_t version = state.tile_versions[static_cast<std::size_t>(index)];
@@ -44,6 +33,30 @@ protocol::SensorFrame SensingService::frame_for(const WorldState& state, std::ui
     for (int r = 0; r < t.rows; ++r)
       for (int c = 0; c < t.cols; ++c) tile.heights.push_back(terrain(t.first_cell.row + r, t.first_cell.col + c));
     f.tiles.push_back(std::move(tile));
+  }
+}
+
+protocol::SensorFrame SensingService::frame_for(const WorldState& state, std::uint32_t id, bool run_over) {
+  const AgentRecord& me = state.agent(id);
+  protocol::SensorFrame f;
+  f.agent_id = id;
+  f.step = state.step;
+  f.x_m = me.x_m;
+  f.y_m = me.y_m;
+  f.z_m = me.z_m;
+  f.material_m3 = me.material_m3;
+  f.last_result = me.last_result;
+  f.last_reason = me.last_reason;
+  f.run_over = run_over;
+
+  const SensorSpec& sensor = me.type.sensor;
+  if (!sensor.casts_rays()) {
+    add_tiles(state, me, f);
+  } else if (!run_over && state.step % static_cast<std::uint64_t>(sensor.scan_every_steps) == 0) {
+    // docs/runtime.md#sensing: a scan instead of tiles, every scan_every_steps steps, from the robot's pose.
+    f.scanned = true;
+    f.points = cast_scan(state.terrain, sensor_origin(state.terrain, me.x_m, me.y_m, sensor), me.heading_rad, sensor,
+                         scan_seed(state.seed, id, state.step));
   }
 
   for (const AgentRecord& other : state.agents) {

@@ -1,5 +1,6 @@
 #include "marsala/world_server/world_state.hpp"
 
+#include <cmath>
 #include <limits>
 
 #include "marsala/core/error.hpp"
@@ -35,6 +36,7 @@ WorldState make_world_state(const scenario::Scenario& scenario, Heightmap terrai
   s.goal = scenario.goal;
   s.base = scenario.base;
   s.tile_size = scenario.tile_size;
+  s.seed = scenario.seed;
   s.tile_versions.assign(static_cast<std::size_t>(s.tiles().tile_count()), 0);
   s.depositor = AgentIdGrid::Zero(s.terrain.rows(), s.terrain.cols());
   s.completion = scenario.completion;
@@ -54,10 +56,16 @@ WorldState make_world_state(const scenario::Scenario& scenario, Heightmap terrai
     a.x_m = start.x;
     a.y_m = start.y;
     a.z_m = height_under(s.terrain, a.x_m, a.y_m);
+    a.heading_rad = initial_heading_rad(a);
     s.agents.push_back(std::move(a));
   }
   start_completion_check(s);
   return s;
+}
+
+double initial_heading_rad(const AgentRecord& a) {
+  const double dx = a.target_x_m - a.start_x_m, dy = a.target_y_m - a.start_y_m;
+  return dx == 0.0 && dy == 0.0 ? 0.0 : std::atan2(dy, dx);
 }
 
 double height_under(const Heightmap& terrain, double x_m, double y_m) {

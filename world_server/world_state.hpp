@@ -33,6 +33,9 @@ struct AgentRecord {
   double x_m = 0.0, y_m = 0.0;  ///< position [m]
   double z_m = 0.0;             ///< terrain height of the cell under the centre [m]
   double material_m3 = 0.0;     ///< material on board [m^3]
+  /// Direction the robot faces [rad from east, counter-clockwise]: of its last accepted motion of non-zero length,
+  /// initially towards its target (docs/runtime.md#heading). The rgbd sensor looks along it.
+  double heading_rad = 0.0;
 
   std::uint32_t accepted = 0;  ///< requests accepted
   std::uint32_t rejected = 0;  ///< requests rejected (duplicates and future steps included)
@@ -46,6 +49,10 @@ struct AgentRecord {
   protocol::ActionResult last_result = protocol::ActionResult::kNone;  ///< for its next frame
   std::string last_reason;
 };
+
+/// The heading of a robot that has not moved yet: from its start towards its target, 0 (east) when they coincide
+/// [rad] (docs/runtime.md#heading).
+double initial_heading_rad(const AgentRecord& a);
 
 /// True when `r` carries the agent's admitted identity (id and session): only such a request can answer for it in a
 /// step. A request with another identity on its partition is forged or stale and never takes its slot.
@@ -87,6 +94,7 @@ struct WorldState {
   Heightmap terrain;                ///< authoritative heights [m]
   std::vector<AgentRecord> agents;  ///< agents[i].id == i + 1, one per expected agent
   std::uint64_t step = 0;           ///< the step whose requests are awaited
+  std::uint64_t seed = 1;           ///< the scenario's seed: seeds the sensors' noise (scan_seed())
   scenario::Goal goal;
   scenario::BaseStation base;
   int tile_size = 16;                        ///< [cells]

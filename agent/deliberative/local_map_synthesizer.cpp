@@ -81,12 +81,36 @@ LocalMap LocalMapSynthesizer::synthesize(const executive::MappingSystem& map, Po
       }
   }
 
+  // Ground the map only assumes (under and around the robot's body: executive/mapping_system.hpp) is no deposition
+  // target: building on it would never show in the map.
+  const auto assumed = map.assumed().block(w.top_left.row, w.top_left.col, w.rows, w.cols);
+  for (int r = 0; r < w.rows; ++r)
+    for (int c = 0; c < w.cols; ++c)
+      if (assumed(r, c) != 0) local.gap(r, c) = 0.0;
+
   local.robot = local.to_local(*map.geometry().cell_at(robot));
   local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
   local.origin = local_origin(local, map.trajectory(), robot, sensing_range_m_);
   const auto [goal, is_target] = local_goal(local, robot, target);
   local.goal = goal;
   local.goal_is_target = is_target;
+  if (!all_known && map.sensor().casts_rays()) {
+    // A scanning sensor's map has holes (between a laser's rings) and shadows (tiles always cover the window, so a
+    // ground-truth robot keeps waiting for its map to grow). A path runs through known cells only, so when the goal
+    // is not 8-connected to the robot through known cells, head for the reachable known cell nearest to it (ties:
+    // the first in row-major order): the robot moves, its next scans fill the holes ahead.
+    const CellMask reachable = NavigabilityProcessor::navigable_from(local.known, local.robot);
+    if (reachable(goal.row, goal.col) == 0) {
+      long long best = std::numeric_limits<long long>::max();
+      for (int r = 0; r < local.rows(); ++r)
+        for (int c = 0; c < local.cols(); ++c) {
+          if (reachable(r, c) == 0) continue;
+          const long long dr = r - goal.row, dc = c - goal.col, d = dr * dr + dc * dc;
+          if (d < best) best = d, local.goal = {r, c};
+        }
+      local.goal_is_target = false;
+    }
+  }
   return local;
 }
 

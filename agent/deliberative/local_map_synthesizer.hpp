@@ -37,7 +37,9 @@ struct LocalMap {
   CellMask navigable;               ///< occupiable cells 8-connected to the robot's cell
   CellIndex robot;                  ///< the robot's cell
   std::optional<CellIndex> origin;  ///< the local origin, when some trajectory cell in the window is occupiable
-  CellIndex goal;                   ///< the local goal
+  /// The local goal: local_goal(); for a scanning sensor's map, the reachable known cell nearest to it when it is not
+  /// reachable through known cells.
+  CellIndex goal;
   bool goal_is_target = false;      ///< true when the local goal is the target's own cell
 
   /// The window's geometry (world placement, cell size [m]).

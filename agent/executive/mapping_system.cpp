@@ -1,10 +1,13 @@
 #include "marsala/agent/executive/mapping_system.hpp"
 
+#include <octomap/OcTree.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 
 namespace marsala::agent::executive {
 namespace {
@@ -14,11 +17,64 @@ std::string describe(const TerrainTile& t) {
          " x " + std::to_string(t.cols) + " cells";
 }
 
+/// OctoMap keys are 16 bits around the origin: 32768 voxels each way.
+constexpr double kOctreeHalfVoxels = 32768.0;
+/// Voxels of one column a cell remembers hits in; more than a terrain column ever shows (ground, a wall's mixed hits).
+constexpr std::size_t kVoxelsPerCell = 8;
+/// Width of the band along each cell edge whose hits are left out [cells].
+constexpr double kEdgeBand = 0.1;
+
 }  // namespace
 
-MappingSystem::MappingSystem(const GridGeometry& world, int tile_size) : heights_(world, 0.0), tile_size_(tile_size) {
+/// The octree, in a frame shifted by the grid's lower-left corner so that voxel columns are exactly the grid's cells,
+/// and per cell the hits its voxels received: the octree says which voxels are occupied, the hits say where in the
+/// highest one the surface lies (docs/runtime.md#mapping).
+struct MappingSystem::Octree {
+  struct VoxelHits {
+    octomap::key_type key_z = 0;
+    double estimate_m = 0.0;  ///< surface height in this voxel, blended over scans [m]
+    bool has_estimate = false;
+    double scan_sum_m = 0.0;  ///< this scan's hits [m]
+    int scan_count = 0;
+  };
+
+  explicit Octree(double resolution_m) : tree(resolution_m) {
+    // The terrain rises under construction: a voxel carved free many times must turn occupied at its first hit
+    // (log-odds of a hit 0.85 > -log-odds of 0.4), not only after several scans as with OctoMap's default 0.12.
+    tree.setClampingThresMin(0.4);
+  }
+
+  octomap::OcTree tree;
+  std::vector<std::vector<VoxelHits>> hits;  ///< per cell (row-major)
+};
+
+MappingSystem::MappingSystem(const GridGeometry& world, int tile_size, SensorSpec sensor)
+    : heights_(world, 0.0), tile_size_(tile_size), sensor_(std::move(sensor)) {
   if (tile_size < 1) throw InvalidArgument("mapping system: tile size must be >= 1, got " + std::to_string(tile_size));
+  const std::string problem = sensor_problem(sensor_);
+  if (!problem.empty()) throw InvalidArgument("mapping system: sensor " + problem);
+  if (sensor_.casts_rays() && std::max(world.rows, world.cols) >= kOctreeHalfVoxels)
+    throw InvalidArgument(fmt::format("mapping system: a {} x {} grid is too large for the octree ({} cells a side)",
+                                      world.rows, world.cols, kOctreeHalfVoxels));
   known_ = CellMask::Zero(world.rows, world.cols);
+  assumed_ = CellMask::Zero(world.rows, world.cols);
+}
+
+MappingSystem::~MappingSystem() = default;
+MappingSystem::MappingSystem(MappingSystem&&) noexcept = default;
+MappingSystem& MappingSystem::operator=(MappingSystem&&) noexcept = default;
+MappingSystem::MappingSystem(const MappingSystem& other)
+    : heights_(other.heights_),
+      known_(other.known_),
+      assumed_(other.assumed_),
+      known_count_(other.known_count_),
+      tile_size_(other.tile_size_),
+      sensor_(other.sensor_),
+      trajectory_(other.trajectory_),
+      octree_(other.octree_ ? std::make_unique<Octree>(*other.octree_) : nullptr) {}
+MappingSystem& MappingSystem::operator=(const MappingSystem& other) {
+  if (this != &other) *this = MappingSystem(other);
+  return *this;
 }
 
 void MappingSystem::integrate(const std::vector<TerrainTile>& tiles, Position pose) {
@@ -43,6 +99,29 @@ std::string tile_problem(const TerrainTile& tile, const GridGeometry& world, int
   return {};
 }
 
+std::string scan_problem(const std::vector<ScanPoint>& points, const SensorSpec& sensor) {
+  if (static_cast<long long>(points.size()) > sensor.ray_count())
+    return fmt::format("a scan of {} points from a '{}' sensor of {} rays", points.size(), sensor.name,
+                       sensor.ray_count());
+  const double reach = sensor.max_range_m + std::max(1.0, 6.0 * sensor.noise_sd_at(sensor.max_range_m));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const ScanPoint& p = points[i];
+    const double x = p.x_m, y = p.y_m, z = p.z_m;
+    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z) || std::sqrt(x * x + y * y + z * z) > reach)
+      return fmt::format("scan point {} at ({}, {}, {}) m from the sensor is not finite or beyond its reach of {} m", i,
+                         x, y, z, reach);
+  }
+  return {};
+}
+
+void MappingSystem::mark_known(int row, int col) {
+  assumed_(row, col) = 0;
+  if (known_(row, col) == 0) {
+    known_(row, col) = 1;
+    ++known_count_;
+  }
+}
+
 void MappingSystem::integrate_tile(const TerrainTile& tile) {
   const std::string problem = tile_problem(tile, heights_.geometry(), tile_size_);
   if (!problem.empty()) throw InvalidArgument("sensor frame: " + problem);
@@ -53,12 +132,134 @@ void MappingSystem::integrate_tile(const TerrainTile& tile) {
       const int row = static_cast<int>(row0) + r + registration_.row, col = static_cast<int>(col0) + c + registration_.col;
       if (!heights_.contains({row, col})) continue;
       heights_(row, col) = tile.heights[static_cast<std::size_t>(r) * tile.cols + c];
-      if (known_(row, col) == 0) {
-        known_(row, col) = 1;
-        ++known_count_;
-      }
+      mark_known(row, col);
     }
 }
+
+void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 origin) {
+  const std::string problem = scan_problem(points, sensor_);
+  if (!problem.empty()) throw InvalidArgument("sensor frame: " + problem);
+  if (!std::isfinite(origin.x) || !std::isfinite(origin.y) || !std::isfinite(origin.z) ||
+      std::abs(origin.z) >= kMaxMagnitude)
+    throw InvalidArgument(
+        fmt::format("mapping system: sensor origin ({}, {}, {}) m is not finite", origin.x, origin.y, origin.z));
+  const GridGeometry& g = heights_.geometry();
+  const double cs = g.cell_size_m;
+  if (!octree_) {
+    octree_ = std::make_unique<Octree>(cs);
+    octree_->hits.resize(static_cast<std::size_t>(g.size()));
+  }
+  octomap::OcTree& tree = octree_->tree;
+  const double z_limit = 0.99 * kOctreeHalfVoxels * cs;
+  // The octree's frame: the grid's lower-left corner at x = y = 0, so voxel (i, j) is the cell of column i, row
+  // rows - 1 - j (a voxel boundary on every cell boundary).
+  const auto to_tree = [&](double x, double y, double z) {
+    return octomap::point3d(static_cast<float>(x - g.xll_m), static_cast<float>(y - g.yll_m), static_cast<float>(z));
+  };
+  const octomap::point3d tree_origin = to_tree(origin.x, origin.y, origin.z);
+  octomap::Pointcloud cloud;
+  cloud.reserve(points.size());
+  std::vector<std::size_t> touched;  // cells with hits in this scan
+  int min_row = g.rows, max_row = -1, min_col = g.cols, max_col = -1;
+  // A hit on a wall between two cells lies on their common edge, and range noise puts it on either side: in the
+  // lower cell's column it would read as a surface high above that cell. Hits within kEdgeBand of a cell edge are
+  // therefore left out; the cell's interior hits say where its surface is (docs/runtime.md#mapping).
+  const double band = kEdgeBand * cs;
+  for (const ScanPoint& p : points) {
+    const double x = origin.x + p.x_m, y = origin.y + p.y_m, z = origin.z + p.z_m;
+    const std::optional<CellIndex> cell = g.cell_at({x, y});
+    if (!cell || std::abs(z) >= z_limit) continue;
+    const double u = (x - g.xll_m) / cs, v = (y - g.yll_m) / cs;
+    const double fu = (u - std::floor(u)) * cs, fv = (v - std::floor(v)) * cs;
+    if (fu < band || fu > cs - band || fv < band || fv > cs - band) continue;
+    const octomap::point3d end = to_tree(x, y, z);
+    octomap::OcTreeKey key;
+    if (!tree.coordToKeyChecked(end, key)) continue;
+    cloud.push_back(end);
+    const std::size_t index = static_cast<std::size_t>(cell->row) * g.cols + cell->col;
+    std::vector<Octree::VoxelHits>& voxels = octree_->hits[index];
+    auto it = std::find_if(voxels.begin(), voxels.end(), [&](const auto& v) { return v.key_z == key[2]; });
+    if (it == voxels.end()) {
+      if (voxels.size() == kVoxelsPerCell) {  // forget the lowest voxel: the surface is the highest
+        voxels.erase(std::min_element(voxels.begin(), voxels.end(),
+                                      [](const auto& a, const auto& b) { return a.key_z < b.key_z; }));
+      }
+      voxels.push_back({key[2]});
+      it = voxels.end() - 1;
+    }
+    if (it->scan_count == 0) touched.push_back(index);
+    it->scan_sum_m += z;
+    ++it->scan_count;
+    min_row = std::min(min_row, cell->row);
+    max_row = std::max(max_row, cell->row);
+    min_col = std::min(min_col, cell->col);
+    max_col = std::max(max_col, cell->col);
+  }
+  // Rays carve free space up to each end voxel, which becomes more likely occupied (OctoMap's log-odds update).
+  // Lazy: inner nodes are brought up to date once, after the whole scan (OctoMap's own advice for batches).
+  tree.insertPointCloud(cloud, tree_origin, -1.0, true, true);
+  tree.updateInnerOccupancy();
+
+  // Fold this scan's hits into each voxel's estimate: half the old, half the new, so noise averages out over scans
+  // while a cell that rose (a deposit within the same voxel) is followed within a few scans.
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  for (std::size_t index : touched)
+    for (Octree::VoxelHits& v : octree_->hits[index]) {
+      if (v.scan_count == 0) continue;
+      const double mean = v.scan_sum_m / v.scan_count;
+      v.estimate_m = v.has_estimate ? 0.5 * (v.estimate_m + mean) : mean;
+      v.has_estimate = true;
+      v.scan_sum_m = 0.0;
+      v.scan_count = 0;
+    }
+
+  // Heights of every cell the scan reached (carving may have freed a voxel of a cell it did not hit): the estimate of
+  // the highest occupied voxel of the column.
+  if (max_row < 0) return;
+  for (int row = min_row; row <= max_row; ++row)
+    for (int col = min_col; col <= max_col; ++col) {
+      const std::vector<Octree::VoxelHits>& voxels = octree_->hits[static_cast<std::size_t>(row) * g.cols + col];
+      if (voxels.empty()) continue;
+      const Position centre = g.cell_center({row, col});
+      octomap::OcTreeKey key;
+      if (!tree.coordToKeyChecked(to_tree(centre.x, centre.y, 0.0), key)) continue;
+      const Octree::VoxelHits* top = nullptr;
+      for (const Octree::VoxelHits& v : voxels) {
+        if (!v.has_estimate || (top && v.key_z <= top->key_z)) continue;
+        key[2] = v.key_z;
+        const octomap::OcTreeNode* node = tree.search(key);
+        if (node && tree.isNodeOccupied(node)) top = &v;
+      }
+      if (!top) continue;  // every voxel it had was carved free since: keep what the map said
+      heights_(row, col) = top->estimate_m;
+      mark_known(row, col);
+    }
+}
+
+void MappingSystem::assume_ground(Position pose, double ground_z_m, double radius_m) {
+  if (!std::isfinite(ground_z_m) || std::abs(ground_z_m) >= kMaxMagnitude || !(radius_m >= 0.0))
+    throw InvalidArgument(fmt::format("mapping system: ground {} m within {} m is not a finite height and radius",
+                                      ground_z_m, radius_m));
+  const std::optional<CellIndex> centre =
+      std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;
+  if (!centre) throw InvalidArgument(fmt::format("mapping system: pose ({}, {}) m is off the grid", pose.x, pose.y));
+  const GridGeometry& g = heights_.geometry();
+  // The body's ball around the cell it stands on, with the project's tie tolerance (ARCHITECTURE.md, grid conventions).
+  const double radius_cells = radius_m / g.cell_size_m;
+  const int reach = static_cast<int>(std::ceil(radius_cells));
+  for (int row = std::max(0, centre->row - reach); row <= std::min(g.rows - 1, centre->row + reach); ++row)
+    for (int col = std::max(0, centre->col - reach); col <= std::min(g.cols - 1, centre->col + reach); ++col) {
+      if (known_(row, col) != 0) continue;
+      const double dr = row - centre->row, dc = col - centre->col;
+      if (dr * dr + dc * dc > radius_cells * radius_cells + 1e-9) continue;
+      heights_(row, col) = ground_z_m;
+      mark_known(row, col);
+      assumed_(row, col) = 1;
+    }
+}
+
+std::size_t MappingSystem::octree_leaves() const { return octree_ ? octree_->tree.getNumLeafNodes() : 0; }
 
 void MappingSystem::record_pose(Position pose) {
   const auto cell = std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;

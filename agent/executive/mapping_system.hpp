@@ -1,13 +1,18 @@
 #pragma once
-// Mapping system (paper §III, executive layer): the agent's own map of the world, built only from the terrain
-// tiles of its sensor frames, and its trajectory. The agent never sees the global terrain: a cell it has not
-// sensed stays unknown.
+// Mapping system (paper §III, executive layer): the agent's own map of the world, built only from its sensor frames,
+// and its trajectory. A ground-truth sensor's tiles are written as they are; a laser's or rgbd camera's scans go into
+// the robot's own OctoMap occupancy octree (voxels of the grid's cell size, aligned with its cells), from which the
+// heightmap of the deliberative layer is derived (OctoMap -> GridMap, docs/runtime.md#mapping). The agent never sees
+// the global terrain: a cell it has not sensed stays unknown. OctoMap stays inside mapping_system.cpp.
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "marsala/core/heightmap.hpp"
+#include "marsala/core/ray_caster.hpp"
 #include "marsala/core/robot_body.hpp"
+#include "marsala/core/sensor_spec.hpp"
 #include "marsala/core/types.hpp"
 
 namespace marsala::agent::executive {
@@ -16,12 +21,26 @@ namespace marsala::agent::executive {
 /// each finite and below kMaxMagnitude); otherwise the problem, naming the tile.
 std::string tile_problem(const TerrainTile& tile, const GridGeometry& world, int tile_size);
 
+/// Empty when `points` can be a scan of `sensor`: at most its ray count, each offset finite and no farther than
+/// its max range plus 6 noise standard deviations (and 1 m); otherwise the problem, naming the first bad point.
+std::string scan_problem(const std::vector<ScanPoint>& points, const SensorSpec& sensor);
+
+/// The sensor origin the agent believes [m]: its believed position, the terrain height under it, plus the mount.
+inline Point3 believed_sensor_origin(Position pose, double ground_z_m, const SensorSpec& sensor) {
+  return {pose.x, pose.y, ground_z_m + sensor.mount_height_m};
+}
+
 /// The agent's map: heights [m] of the world grid with a known-mask, and the cells it stood on.
 class MappingSystem {
  public:
-  /// An empty map of the world grid cut in tile_size x tile_size tiles; throws InvalidArgument on a bad geometry
-  /// or tile_size < 1.
-  MappingSystem(const GridGeometry& world, int tile_size);
+  /// An empty map of the world grid cut in tile_size x tile_size tiles, for a robot sensing with `sensor`; throws
+  /// InvalidArgument on a bad geometry, tile_size < 1, or a grid too large for the octree (32768 cells a side).
+  MappingSystem(const GridGeometry& world, int tile_size, SensorSpec sensor = {});
+  ~MappingSystem();
+  MappingSystem(const MappingSystem& other);
+  MappingSystem& operator=(const MappingSystem& other);
+  MappingSystem(MappingSystem&&) noexcept;
+  MappingSystem& operator=(MappingSystem&&) noexcept;
 
   /// Writes one sensing's tiles (heights copied bit for bit) and records the pose it was taken from [m]; throws
   /// InvalidArgument when a tile does not fit the grid or the pose is off the grid (a broken contract by the sender).
@@ -33,15 +52,26 @@ class MappingSystem {
   /// (r + offset.row, c + offset.col). A robot with localisation error registers what it senses at its believed pose
   /// (docs/runtime.md#localisation-error); (0, 0), the default, is the world's registration.
   void set_registration(CellIndex offset) { registration_ = offset; }
+  /// Inserts one scan into the octree, rays from `sensor_origin` (where the agent believes its sensor was, [m]) to
+  /// each point (origin + offset): the end voxel is marked occupied, the voxels the ray crosses free. Then re-derives
+  /// the heights of the cells around (docs/runtime.md#mapping). Points off the grid are left out. Throws
+  /// InvalidArgument when scan_problem() finds one or the origin is not finite.
+  void integrate_scan(const std::vector<ScanPoint>& points, Point3 sensor_origin);
+  /// The ground under the robot's body: every still unknown cell within radius_m of the cell under `pose` (centre to centre) becomes
+  /// known at `ground_z_m`, the height under the robot's centre (it stands there; a scan sees no nearer than its
+  /// minimum range and the camera nothing behind it). A later scan's hits replace it. [m]
+  void assume_ground(Position pose, double ground_z_m, double radius_m);
   /// Appends the cell under `pose` [m] to the trajectory (consecutive repeats are kept once); throws
   /// InvalidArgument when the pose is off the grid or not finite.
   void record_pose(Position pose);
 
-  /// The map: known cells hold the world's heights [m], unknown cells 0.
+  /// The map: known cells hold the sensed heights [m], unknown cells 0.
   const Heightmap& heights() const { return heights_; }
   /// 1 where the cell has been sensed at least once.
   const CellMask& known() const { return known_; }
   bool is_known(CellIndex cell) const { return heights_.contains(cell) && known_(cell.row, cell.col) != 0; }
+  /// 1 where the cell is known only by assume_ground(): no sensor has observed it (never a deposition target).
+  const CellMask& assumed() const { return assumed_; }
   /// Number of known cells.
   long long known_cells() const { return known_count_; }
   /// Cells stood on, oldest first, consecutive repeats removed (global indices).
@@ -49,14 +79,23 @@ class MappingSystem {
   /// The world grid.
   const GridGeometry& geometry() const { return heights_.geometry(); }
   int tile_size() const { return tile_size_; }
+  const SensorSpec& sensor() const { return sensor_; }
+  /// Leaf voxels of the octree, 0 before the first scan (for benchmarks and tests).
+  std::size_t octree_leaves() const;
 
  private:
+  struct Octree;  // OctoMap's tree and the hits per cell, in mapping_system.cpp
+  void mark_known(int row, int col);  // observed by a sensor
+
   Heightmap heights_;
   CellMask known_;
+  CellMask assumed_;
   long long known_count_ = 0;
   int tile_size_;
   CellIndex registration_{0, 0};
+  SensorSpec sensor_;
   std::vector<CellIndex> trajectory_;
+  std::unique_ptr<Octree> octree_;  // made at the first scan
 };
 
 }  // namespace marsala::agent::executive

@@ -84,7 +84,7 @@ void RampSteps::admit(const protocol::Admission& admission) {
   router.alpha = 0.0;
   router.beta = 1.0;
   modules_ = std::make_unique<Modules>(
-      Modules{executive::MappingSystem(world, context_.assignment.tile_size),
+      Modules{executive::MappingSystem(world, context_.assignment.tile_size, context_.type.sensor),
               deliberative::LocalMapSynthesizer(body.navigability, body.sensing_range_m, build.kappa),
               NavigablePathPlanner(planner), NavigablePathPlanner(router), executive::ActionManager(body.max_step_m),
               executive::DepositionManager(deposits),
@@ -99,8 +99,14 @@ void RampSteps::set_registration(CellIndex offset) {
 
 BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace) {
   modules_->map.set_registration(registration_);
-  modules_->map.integrate(frame.tiles, {frame.x_m, frame.y_m});
   const Position robot{frame.x_m, frame.y_m};
+  modules_->map.integrate(frame.tiles, robot);
+  const SensorSpec& sensor = context_.type.sensor;
+  if (frame.scanned)
+    modules_->map.integrate_scan(frame.points, executive::believed_sensor_origin(robot, frame.z_m, sensor));
+  if (sensor.casts_rays())  // docs/runtime.md#mapping: the ground its body stands on and may step onto next
+    modules_->map.assume_ground(robot, frame.z_m,
+                                0.5 * context_.type.body.navigability.delta_m + context_.type.body.max_step_m);
   const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
   const Position target = goal.value_or(robot);  // nothing left to build towards: stay
   BuildView view{modules_->synthesizer.synthesize(modules_->map, robot, target), robot, target};

@@ -44,9 +44,10 @@ double median(std::vector<double> values) {
 constexpr std::uint64_t kMaxStepsAhead = 1000000;
 
 /// Empty when a frame addressed to this agent can be trusted to describe the world of `assignment`: a finite pose on
-/// the grid, finite height and material, tiles that fit the grid, finite neighbours; otherwise the problem. A frame
+/// the grid, finite height and material, tiles that fit the grid, a scan only for a scanning sensor with points within
+/// its reach, finite neighbours; otherwise the problem. A frame
 /// with a problem is ignored whole, before any of it reaches the behaviour (which would throw half-way through).
-std::string frame_problem(const protocol::SensorFrame& f, const Assignment& assignment) {
+std::string frame_problem(const protocol::SensorFrame& f, const Assignment& assignment, const SensorSpec& sensor) {
   const auto sane = [](double v) { return std::isfinite(v) && std::abs(v) < kMaxMagnitude; };
   if (!sane(f.x_m) || !sane(f.y_m) || !assignment.world.cell_at({f.x_m, f.y_m}))
     return fmt::format("pose ({}, {}) m is not on the grid", f.x_m, f.y_m);
@@ -56,6 +57,10 @@ std::string frame_problem(const protocol::SensorFrame& f, const Assignment& assi
     const std::string problem = executive::tile_problem(tile, assignment.world, assignment.tile_size);
     if (!problem.empty()) return problem;
   }
+  if (!f.scanned && !f.points.empty()) return fmt::format("{} scan points in a frame without a scan", f.points.size());
+  if (f.scanned && !sensor.casts_rays()) return "a scan for a robot whose sensor is '" + sensor.name + "'";
+  const std::string scan = executive::scan_problem(f.points, sensor);
+  if (!scan.empty()) return scan;
   for (const Neighbour& n : f.neighbours) {
     if (!sane(n.x_m) || !sane(n.y_m) || !sane(n.z_m))
       return fmt::format("neighbour {} at ({}, {}, {}) m is not finite", n.agent_id, n.x_m, n.y_m, n.z_m);
@@ -295,7 +300,7 @@ void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admis
         why = fmt::format("step {} is more than {} steps ahead of the last one answered ({})", frame.step,
                           kMaxStepsAhead, last_answered);
       else
-        why = frame_problem(frame, assignment_);
+        why = frame_problem(frame, assignment_, config_.type.sensor);
       if (!why.empty()) {
         if (power_of_ten(++result.ignored_frames))
           spdlog::warn("agent {}: ignoring a frame ({} so far): {}", config_.agent_id, result.ignored_frames, why);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "marsala/core/robot_body.hpp"
+#include "marsala/core/sensor_spec.hpp"
 #include "marsala/core/types.hpp"
 
 namespace marsala {
@@ -37,6 +38,7 @@ struct RobotType {
   Pipeline pipeline;
   std::string goal_synthesizer = "fixed_target";  ///< goal synthesizer by name (agent registry)
   Localisation localisation;                      ///< how wrong the robot's own pose estimate is
+  SensorSpec sensor;  ///< what it senses the terrain with (default ground truth tiles)
 };
 
 /// What `type` builds: its construction, or its own body's kappa, delta (as the band width) and eps.

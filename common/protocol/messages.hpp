@@ -13,12 +13,14 @@
 
 #include "marsala/core/assignment.hpp"
 #include "marsala/core/robot_body.hpp"
+#include "marsala/core/sensor_spec.hpp"
 
 namespace marsala::protocol {
 
 // Core vocabulary the messages carry as it is.
 using marsala::Deposition;
 using marsala::Neighbour;
+using marsala::ScanPoint;
 using marsala::TerrainTile;
 
 /// Agent -> world, repeated until admitted: who I am and what my body can do.
@@ -56,6 +58,11 @@ struct SensorFrame {
   std::vector<TerrainTile> tiles;     ///< tiles in sensing range that changed since this agent last got them
   std::vector<Neighbour> neighbours;  ///< robots within proximity range
   bool run_over = false;              ///< the run has ended: the agent should exit
+  /// A laser or rgbd scan was taken for this frame (its points may still be none: every ray missed).
+  bool scanned = false;
+  /// The scan: hits as offsets from the sensor origin (the robot's position, terrain height under it plus the
+  /// sensor's mount height) in world-aligned axes [m]; empty when not scanned.
+  std::vector<ScanPoint> points;
 };
 
 /// Agent -> world (its own partition only): what it wants to do in `step`.

@@ -134,6 +134,44 @@ RobotBody to_body(const proto::Body& p) {
   return b;
 }
 
+/// The named sensor's defaults with the file's values on top; every failure names the robot type's field.
+SensorSpec to_sensor(const proto::Sensor& p, const std::string& field, const Validator& check) {
+  const std::string name = p.has_name() ? p.name() : "ground_truth";
+  const std::vector<std::string> names = sensor_names();
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    std::string valid;
+    for (const auto& n : names) valid += (valid.empty() ? "" : ", ") + n;
+    check.fail(field + ".name", "unknown sensor '" + name + "'; valid: " + valid);
+  }
+  SensorSpec s = sensor_defaults(name);
+  if (p.has_mount_height_m()) s.mount_height_m = p.mount_height_m();
+  if (p.has_horizontal_fov_deg()) s.horizontal_fov_deg = p.horizontal_fov_deg();
+  if (p.has_horizontal_resolution_deg()) s.horizontal_resolution_deg = p.horizontal_resolution_deg();
+  if (p.has_vertical_min_deg()) s.vertical_min_deg = p.vertical_min_deg();
+  if (p.has_vertical_max_deg()) s.vertical_max_deg = p.vertical_max_deg();
+  if (p.has_vertical_resolution_deg()) s.vertical_resolution_deg = p.vertical_resolution_deg();
+  if (p.has_min_range_m()) s.min_range_m = p.min_range_m();
+  if (p.has_max_range_m()) s.max_range_m = p.max_range_m();
+  if (p.has_noise_sd_m()) s.noise_sd_m = p.noise_sd_m();
+  if (p.has_noise_sd_per_m2()) s.noise_sd_per_m2 = p.noise_sd_per_m2();
+  if (p.has_scan_every_steps())
+    s.scan_every_steps = static_cast<int>(std::min<std::uint32_t>(p.scan_every_steps(), 2000000000u));
+  const bool any_parameter = p.has_mount_height_m() || p.has_horizontal_fov_deg() ||
+                             p.has_horizontal_resolution_deg() || p.has_vertical_min_deg() ||
+                             p.has_vertical_max_deg() || p.has_vertical_resolution_deg() || p.has_min_range_m() ||
+                             p.has_max_range_m() || p.has_noise_sd_m() || p.has_noise_sd_per_m2() ||
+                             p.has_scan_every_steps();
+  if (!s.casts_rays() && any_parameter)
+    check.fail(field, "ground_truth takes no parameters (they apply to 'laser' and 'rgbd')");
+  const std::string problem = sensor_problem(s);
+  // sensor_problem() says "<field>: <problem>".
+  if (!problem.empty()) {
+    const std::size_t colon = problem.find(": ");
+    check.fail(field + "." + problem.substr(0, colon), problem.substr(colon + 2));
+  }
+  return s;
+}
+
 bool valid_name(const std::string& name) {
   if (name.empty()) return false;
   for (char c : name)
@@ -201,6 +239,7 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     if (t.goal_synthesizer.empty()) check.fail(field + ".goal_synthesizer", "must not be empty");
     if (t.goal_synthesizer == "goal_vector_map" && !p.has_goal_vector_map())
       check.fail(field + ".goal_synthesizer", "'goal_vector_map' needs the scenario's goal_vector_map block");
+    t.sensor = to_sensor(rp.sensor(), field + ".sensor", check);
     s.robot_types.push_back(std::move(t));
   }
 

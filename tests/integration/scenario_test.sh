@@ -30,6 +30,9 @@
 #          and, with a goal.target_radius_m, each within it of its own target, on a cell of terrain_final.asc at least
 #          min_height_m high, its target navigable for its body from its start on terrain_final.asc (not before). Exit 77 (skipped)
 #          when the scenario's terrain file is absent (../shared/data).
+#   sensors tests/integration/scenarios/slope_sensors.pbtxt, a laser robot and an RGB-D robot (Cyclone world, Fast DDS
+#          agents) climb a natural slope to their targets on maps from their own scans: completed, both at their
+#          targets, at most 16 cubes built (map noise), no frame refused; run twice, the same number of steps
 #   crowd  deploy/scenarios/crowd_120.pbtxt with 120 agents on DDS (arg 3), 100 steps: all 120 admitted and connected
 #          at the first frame, none dropped, no deadline missed, every step applied.
 set -euo pipefail
@@ -336,5 +339,25 @@ case "$case_name" in
     echo "ok: crowd: 120 agents ($dds) admitted and connected in $(top admit_seconds) s, 100 steps," \
       "step median $(top step_wall_median_ms) ms"
     ;;
-  *) echo "usage: scenario_test.sh path|site|three_gaps DOMAIN | shipped DOMAIN NAME AGENTS DDS | crowd DOMAIN DDS" >&2; exit 2 ;;
+  sensors)
+    # A Cyclone world, Fast DDS agents: the scans cross both vendors' converters. Twice: the same run.
+    for k in 1 2; do
+      "$root/deploy/spawn.sh" --scenario "$scenarios/slope_sensors.pbtxt" --agents 2 --dds cyclone \
+        --agent-dds fastdds --domain "$domain" --out "$work/run$k" --quiet --timeout 120 >&2 ||
+        fail "spawn.sh failed (logs: $work/run$k/logs)"
+      s="$work/run$k/summary.json"
+      expect_completed "$s" 2
+      # The slope is navigable as it is: at most a few cubes from the maps' noise (one cube: 0.000125 m^3).
+      awk -v v="$(field deposited_volume_m3 "$s")" 'BEGIN { exit !(v <= 0.002) }' ||
+        { cat "$s"; fail "the robots built $(field deposited_volume_m3 "$s") m^3 on a navigable slope"; }
+      [ "$(agent_fields at_goal "$s" | sort -u)" = "true" ] || { cat "$s"; fail "not every robot at its target"; }
+      ! grep -h "ignoring a frame" "$work/run$k"/logs/agent-*.log >&2 || fail "an agent refused a frame"
+    done
+    [ "$(field steps "$work/run1/summary.json")" = "$(field steps "$work/run2/summary.json")" ] ||
+      fail "two runs of the same scenario took $(field steps "$work/run1/summary.json") and" \
+        "$(field steps "$work/run2/summary.json") steps"
+    echo "ok: sensors: a laser robot and an RGB-D robot climbed to their targets in" \
+      "$(field steps "$work/run1/summary.json") steps on maps from their own scans, twice alike"
+    ;;
+  *) echo "usage: scenario_test.sh path|site|three_gaps|sensors DOMAIN | shipped DOMAIN NAME AGENTS DDS | crowd DOMAIN DDS" >&2; exit 2 ;;
 esac

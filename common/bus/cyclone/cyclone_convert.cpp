@@ -9,6 +9,7 @@ using protocol::AgentStatus;
 using protocol::Deposition;
 using protocol::EventKind;
 using protocol::Neighbour;
+using protocol::ScanPoint;
 using protocol::TerrainTile;
 
 namespace {
@@ -163,6 +164,11 @@ marsala_wire_SensorFrame to_msg(const SensorFrame& in, Storage& storage) {
   }
   out.neighbours = borrow_seq<dds_sequence_marsala_wire_Neighbour>(storage.neighbours);
   out.run_over = in.run_over;
+  out.scanned = in.scanned;
+  storage.points.clear();
+  storage.points.reserve(in.points.size());
+  for (const ScanPoint& p : in.points) storage.points.push_back({p.x_m, p.y_m, p.z_m});
+  out.points = borrow_seq<dds_sequence_marsala_wire_ScanPoint>(storage.points);
   return out;
 }
 
@@ -199,6 +205,12 @@ SensorFrame from_msg(const marsala_wire_SensorFrame& in) {
     out.neighbours.push_back(neighbour);
   }
   out.run_over = in.run_over;
+  out.scanned = in.scanned;
+  out.points.reserve(in.points._length);
+  for (std::uint32_t i = 0; i < in.points._length; ++i) {
+    const marsala_wire_ScanPoint& p = in.points._buffer[i];
+    out.points.push_back({p.x_m, p.y_m, p.z_m});
+  }
   return out;
 }
 

@@ -14,6 +14,7 @@ namespace marsala::bus::cyclone {
 struct Storage {
   std::vector<marsala_wire_TerrainTile> tiles;
   std::vector<marsala_wire_Neighbour> neighbours;
+  std::vector<marsala_wire_ScanPoint> points;
   std::vector<marsala_wire_Deposition> depositions;
   std::vector<marsala_wire_AgentStatus> agents;
 };

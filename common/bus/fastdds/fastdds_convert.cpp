@@ -6,6 +6,7 @@ using protocol::AgentStatus;
 using protocol::Deposition;
 using protocol::EventKind;
 using protocol::Neighbour;
+using protocol::ScanPoint;
 using protocol::TerrainTile;
 
 namespace {
@@ -139,6 +140,15 @@ wire::SensorFrame to_msg(const SensorFrame& in) {
     out.neighbours().push_back(neighbour);
   }
   out.run_over(in.run_over);
+  out.scanned(in.scanned);
+  out.points().reserve(in.points.size());
+  for (const ScanPoint& p : in.points) {
+    wire::ScanPoint point;
+    point.x_m(p.x_m);
+    point.y_m(p.y_m);
+    point.z_m(p.z_m);
+    out.points().push_back(point);
+  }
   return out;
 }
 
@@ -173,6 +183,9 @@ SensorFrame from_msg(const wire::SensorFrame& in) {
     out.neighbours.push_back(neighbour);
   }
   out.run_over = in.run_over();
+  out.scanned = in.scanned();
+  out.points.reserve(in.points().size());
+  for (const wire::ScanPoint& p : in.points()) out.points.push_back({p.x_m(), p.y_m(), p.z_m()});
   return out;
 }
 

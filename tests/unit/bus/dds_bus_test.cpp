@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
@@ -126,6 +127,11 @@ void expect_same(const SensorFrame& a, const SensorFrame& b) {
     EXPECT_SAME_DOUBLE(a.neighbours[i].z_m, b.neighbours[i].z_m);
   }
   EXPECT_EQ(a.run_over, b.run_over);
+  EXPECT_EQ(a.scanned, b.scanned);
+  ASSERT_EQ(a.points.size(), b.points.size());
+  // Bit for bit, in order.
+  EXPECT_EQ(0, a.points.empty() ? 0 : std::memcmp(a.points.data(), b.points.data(), a.points.size() * sizeof(ScanPoint)))
+      << "scan points differ";
 }
 
 void expect_same(const ActionRequest& a, const ActionRequest& b) {
@@ -255,6 +261,19 @@ SensorFrame filled_frame(Filler& f, int tiles) {
   s.tiles.push_back(f.tile(3, 7));  // an edge tile
   for (int i = 0; i < 5; ++i) s.neighbours.push_back({f.u32(), f.real(), f.real(), f.real()});
   s.run_over = true;
+  s.scanned = true;
+  // Scan points with arbitrary float bit patterns (NaN payloads excluded: they need not survive as they are).
+  for (int i = 0; i < 5000; ++i) {
+    ScanPoint p;
+    do {
+      const std::uint64_t bits = f.u64();
+      std::uint32_t x = static_cast<std::uint32_t>(bits), y = static_cast<std::uint32_t>(bits >> 32);
+      std::memcpy(&p.x_m, &x, sizeof x);
+      std::memcpy(&p.y_m, &y, sizeof y);
+      p.z_m = static_cast<float>(i) * -0.25F;
+    } while (std::isnan(p.x_m) || std::isnan(p.y_m));
+    s.points.push_back(p);
+  }
   return s;
 }
 

@@ -311,5 +311,61 @@ TEST(ScenarioOverrides, BadOverridesNameTheOverrideAndWhatIsWrong) {
   EXPECT_TRUE(has(m, "kappa = nan")) << m;
 }
 
+TEST(ScenarioLoader, SensorsTakeTheirNamedDefaultsAndTheFileOnTop) {
+  const Scenario plain = parse_scenario(kMinimal, "t.pbtxt");
+  EXPECT_EQ(plain.robot_types[0].sensor.name, "ground_truth");
+  EXPECT_FALSE(plain.robot_types[0].sensor.casts_rays());
+
+  const Scenario laser =
+      parse_scenario(edit("robot_type { name: \"bot\" }",
+                          "robot_type { name: \"bot\" sensor { name: \"laser\" max_range_m: 5 scan_every_steps: 3 } }"),
+                     "t.pbtxt");
+  const SensorSpec& l = laser.robot_types[0].sensor;
+  EXPECT_EQ(l.name, "laser");
+  EXPECT_EQ(l.max_range_m, 5.0);
+  EXPECT_EQ(l.scan_every_steps, 3);
+  EXPECT_EQ(l.horizontal_fov_deg, sensor_defaults("laser").horizontal_fov_deg);
+  EXPECT_EQ(l.vertical_min_deg, sensor_defaults("laser").vertical_min_deg);
+
+  const Scenario rgbd = parse_scenario(
+      edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" sensor { name: \"rgbd\" } }"), "t.pbtxt");
+  const SensorSpec& c = rgbd.robot_types[0].sensor;
+  EXPECT_EQ(c.name, "rgbd");
+  EXPECT_EQ(c.horizontal_fov_deg, 87.0);
+  EXPECT_EQ(c.ray_count(), 64 * 48);
+  EXPECT_GT(c.noise_sd_at(6.0), c.noise_sd_at(1.0));  // a depth camera's noise grows with range
+}
+
+TEST(ScenarioLoader, BadSensorsNameTheRobotTypeAndField) {
+  const auto with = [](const std::string& sensor) {
+    return invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" sensor { " + sensor + " } }"));
+  };
+  std::string what = with("name: \"sonar\"");
+  EXPECT_NE(what.find("robot_type[0].sensor.name: unknown sensor 'sonar'; valid: ground_truth, laser, rgbd"),
+            std::string::npos)
+      << what;
+  what = with("name: \"laser\" max_range_m: nan");
+  EXPECT_NE(what.find("robot_type[0].sensor.max_range_m: nan must be in (min_range_m, 10000] m"), std::string::npos)
+      << what;
+  what = with("name: \"laser\" min_range_m: 9");  // beyond the default max range of 8 m
+  EXPECT_NE(what.find("robot_type[0].sensor.max_range_m"), std::string::npos) << what;
+  what = with("name: \"rgbd\" noise_sd_m: -0.1");
+  EXPECT_NE(what.find("robot_type[0].sensor.noise_sd_m: -0.1 must be in [0, 10] m"), std::string::npos) << what;
+  what = with("name: \"laser\" horizontal_resolution_deg: 0");
+  EXPECT_NE(what.find("robot_type[0].sensor.horizontal_resolution_deg"), std::string::npos) << what;
+  what = with("name: \"laser\" vertical_min_deg: 20 vertical_max_deg: 10");
+  EXPECT_NE(what.find("robot_type[0].sensor.vertical_max_deg"), std::string::npos) << what;
+  what = with("name: \"laser\" vertical_min_deg: -91");
+  EXPECT_NE(what.find("robot_type[0].sensor.vertical_min_deg"), std::string::npos) << what;
+  what = with("name: \"laser\" scan_every_steps: 0");
+  EXPECT_NE(what.find("robot_type[0].sensor.scan_every_steps: 0 must be in [1, 1000000]"), std::string::npos) << what;
+  what = with("name: \"laser\" mount_height_m: inf");
+  EXPECT_NE(what.find("robot_type[0].sensor.mount_height_m"), std::string::npos) << what;
+  what = with("name: \"laser\" horizontal_resolution_deg: 0.01 vertical_resolution_deg: 0.01");
+  EXPECT_NE(what.find("robot_type[0].sensor.resolution"), std::string::npos) << what;
+  what = with("max_range_m: 3");
+  EXPECT_NE(what.find("robot_type[0].sensor: ground_truth takes no parameters"), std::string::npos) << what;
+}
+
 }  // namespace
 }  // namespace marsala::scenario

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -148,6 +149,23 @@ TEST_F(PersistenceTest, ASnapshotAndTheLogAfterItRebuildTheSameState) {
     }
     EXPECT_EQ(fingerprint(a), fingerprint(b)) << k;
   }
+}
+
+// The heading (docs/runtime.md#heading) is state: a snapshot and the log after it rebuild it, so a resumed run's
+// cameras look where an uninterrupted run's do.
+TEST_F(PersistenceTest, HeadingsSurviveASnapshotAndTheLogAfterIt) {
+  const WorldState live = record(40, 23);
+  // Agent 1 starts at (1.05, 1.05) facing its target (3.05, 2.05); the recorded moves go east.
+  EXPECT_NEAR(initial_heading_rad(live.agent(1)), std::atan2(1.0, 2.0), 1e-12);
+  runlog::RunLogReader reader(log_path());
+  const RebuiltState rebuilt = rebuild_state(dir_.string(), initial(), reader);
+  ASSERT_EQ(rebuilt.snapshot_step, 23u);
+  bool turned = false;
+  for (std::uint32_t id = 1; id <= 3; ++id) {
+    EXPECT_EQ(rebuilt.state.agent(id).heading_rad, live.agent(id).heading_rad) << "agent " << id;
+    turned = turned || live.agent(id).heading_rad != initial_heading_rad(live.agent(id));
+  }
+  EXPECT_TRUE(turned);  // some agent moved, so the heading is not merely the initial one
 }
 
 TEST_F(PersistenceTest, AnUnusableSnapshotIsReportedAndTheLogReplayedFromTheStart) {

@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <set>
 #include <utility>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/ray_caster.hpp"
 #include "marsala/world_server/step.hpp"
 #include "unit/world_server/world_fixtures.hpp"
 
@@ -125,6 +127,77 @@ TEST(SensingService, NeighboursWithinProximityRangeOnly) {
   ASSERT_EQ(f.neighbours.size(), 1u);
   EXPECT_EQ(f.neighbours[0].agent_id, 3u);
   EXPECT_THROW(sensing.frame_for(w, 4), InvalidArgument);
+}
+
+/// The small scenario on flat ground 0.2 m high, agent 1 with a sensor of its own, agents 2 and 3 ground truth.
+WorldState scanning_state(const SensorSpec& sensor) {
+  scenario::Scenario s = small_scenario(R"(robot_type { name: "scanner" })");
+  s.robot_types.back().sensor = sensor;
+  s.slots[0].robot_type = "scanner";
+  WorldState w = make_world_state(s, testing::flat_terrain(0.2), 3);
+  for (std::uint32_t id = 1; id <= 3; ++id) admit(w, testing::hello_for(w, id, 70 + id));
+  return w;
+}
+
+// A laser robot gets its scan instead of tiles, every scan_every_steps steps, the same points for the same seed,
+// agent and step; the others keep their tiles.
+TEST(SensingService, ALaserRobotGetsPointsInsteadOfTiles) {
+  SensorSpec laser = sensor_defaults("laser");
+  laser.scan_every_steps = 2;
+  WorldState w = scanning_state(laser);
+  SensingService sensing(w);
+  const protocol::SensorFrame f = sensing.frame_for(w, 1);
+  EXPECT_TRUE(f.scanned);
+  EXPECT_TRUE(f.tiles.empty());
+  ASSERT_FALSE(f.points.empty());
+  // Every point on the flat ground 0.2 m, seen from 0.5 m above it at the robot's start.
+  for (const ScanPoint& p : f.points) EXPECT_NEAR(f.z_m + laser.mount_height_m + p.z_m, 0.2, 0.08);
+  EXPECT_EQ(f.points, cast_scan(w.terrain, sensor_origin(w.terrain, f.x_m, f.y_m, laser), w.agent(1).heading_rad,
+                                laser, scan_seed(w.seed, 1, 0)));
+  const protocol::SensorFrame other = sensing.frame_for(w, 2);
+  EXPECT_FALSE(other.scanned);
+  EXPECT_TRUE(other.points.empty());
+  EXPECT_FALSE(other.tiles.empty());
+
+  apply_step(w, std::vector<protocol::ActionRequest>{});  // step 1: no scan
+  const protocol::SensorFrame odd = sensing.frame_for(w, 1);
+  EXPECT_FALSE(odd.scanned);
+  EXPECT_TRUE(odd.points.empty());
+  EXPECT_TRUE(odd.tiles.empty());
+  apply_step(w, std::vector<protocol::ActionRequest>{});  // step 2: a scan, with other noise
+  const protocol::SensorFrame even = sensing.frame_for(w, 1);
+  EXPECT_TRUE(even.scanned);
+  EXPECT_NE(even.points, f.points);
+  EXPECT_FALSE(sensing.frame_for(w, 1, true).scanned);  // run over: nothing to sense for
+}
+
+// The camera looks along the heading: towards the target at first, then along the last motion of non-zero length.
+TEST(SensingService, TheCameraLooksAlongTheRobotsHeading) {
+  WorldState w = scanning_state(sensor_defaults("rgbd"));
+  const AgentRecord& me = w.agent(1);
+  EXPECT_NEAR(me.heading_rad, std::atan2(2.05 - 1.05, 3.05 - 1.05), 1e-12);  // start (1.05, 1.05), target (3.05, 2.05)
+  SensingService sensing(w);
+  // Every point within half the field of view (43.5 deg) of the heading, and some near each edge of it.
+  const auto expect_facing = [](const protocol::SensorFrame& f, double heading) {
+    ASSERT_FALSE(f.points.empty());
+    double lowest = 1.0, highest = -1.0;
+    for (const ScanPoint& p : f.points) {
+      const double off = std::remainder(std::atan2(p.y_m, p.x_m) - heading, 2.0 * 3.14159265358979323846);
+      lowest = std::min(lowest, off);
+      highest = std::max(highest, off);
+    }
+    EXPECT_GE(lowest, -0.7593 - 1e-4);
+    EXPECT_LE(highest, 0.7593 + 1e-4);
+    EXPECT_LT(lowest, -0.6);
+    EXPECT_GT(highest, 0.6);
+  };
+  expect_facing(sensing.frame_for(w, 1), me.heading_rad);
+  // A move north: the heading turns north; a motion of zero length leaves it.
+  apply_step(w, std::vector<protocol::ActionRequest>{testing::move_to(w, 1, 1.05, 1.25)});
+  EXPECT_NEAR(w.agent(1).heading_rad, 0.5 * 3.14159265358979323846, 1e-12);
+  apply_step(w, std::vector<protocol::ActionRequest>{testing::move_to(w, 1, 1.05, 1.25)});
+  EXPECT_NEAR(w.agent(1).heading_rad, 0.5 * 3.14159265358979323846, 1e-12);
+  expect_facing(sensing.frame_for(w, 1), 0.5 * 3.14159265358979323846);
 }
 
 TEST(TileLayout, SizesAndSquaresAgreeWithABruteForceReference) {

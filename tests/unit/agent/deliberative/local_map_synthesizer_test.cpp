@@ -4,6 +4,9 @@
 
 #include "unit/agent/agent_test_support.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/iterators.hpp"
+#include "marsala/core/navigable_path_planner.hpp"
+#include "marsala/core/ray_caster.hpp"
 #include "support/mars_brute_force.hpp"
 #include "support/navigability_brute_force.hpp"
 
@@ -151,6 +154,52 @@ TEST(LocalMapSynthesizer, UnknownCellsAreNeverOccupiableNorTargets) {
   EXPECT_EQ(local.occupiable(10, 4), 1);
   // Unknown cells take the lowest known height (0.3): no MARS gap appears on flat known ground.
   EXPECT_EQ(local.gap.heights().maxCoeff(), 0.0);
+}
+
+// A map from one laser scan has holes everywhere (between the rings, behind the block): no unknown cell is ever
+// occupiable or navigable, nor any cell whose body ball holds one, and the planner routes around unknown cells and
+// never ends on one, even when unknown cells are the shorter way.
+TEST(LocalMapSynthesizer, ScannedMapsNeverLetTheRobotOntoUnknownCells) {
+  const Heightmap h = bumpy_terrain();
+  executive::MappingSystem map(kWorld, 16, sensor_defaults("laser"));
+  const Point3 origin = sensor_origin(h, kRobot.x, kRobot.y, map.sensor());
+  map.integrate_scan(cast_scan(h, origin, 0.0, map.sensor(), 3), origin);
+  map.assume_ground(kRobot, h(30, 40), 0.5 * kBody.delta_m);  // as the behaviours do: it stands there
+  map.record_pose(kRobot);
+  ASSERT_GT(map.known_cells(), 500);
+  ASSERT_LT(map.known_cells(), kWorld.size());
+  const LocalMapSynthesizer synthesizer(kBody, 2.5);
+  const LocalMap local = synthesizer.synthesize(map, kRobot, {7.0, 2.95});
+  const auto ball = disc_offsets(kBody.delta_m / (2.0 * kWorld.cell_size_m));
+  long long unknown = 0, navigable = 0;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      bool sees_unknown = false;
+      for (const CellIndex o : ball) {
+        const CellIndex q{r + o.row, c + o.col};
+        sees_unknown = sees_unknown || (local.contains(q) && local.known(q.row, q.col) == 0);
+      }
+      unknown += local.known(r, c) == 0;
+      navigable += local.navigable(r, c);
+      if (sees_unknown) {
+        EXPECT_EQ(local.occupiable(r, c), 0) << r << ", " << c;
+        EXPECT_EQ(local.navigable(r, c), 0) << r << ", " << c;
+      }
+    }
+  EXPECT_GT(unknown, 0);
+  EXPECT_GT(navigable, 0);
+
+  // The planner takes the known cells as its allowed cells: every path cell is known, and an unknown goal is
+  // never reached.
+  const NavigablePathPlanner planner(default_planner_params(kBody.delta_m, kWorld.cell_size_m));
+  for (int r = 0; r < local.rows(); r += 3)
+    for (int c = 0; c < local.cols(); c += 3) {
+      const PlannerResult plan = planner.plan(local.gap, local.known, local.robot, {r, c});
+      if (local.known(r, c) == 0) {
+        EXPECT_FALSE(plan.found) << r << ", " << c;
+      }
+      for (const CellIndex p : plan.path) EXPECT_EQ(local.known(p.row, p.col), 1) << r << ", " << c;
+    }
 }
 
 }  // namespace

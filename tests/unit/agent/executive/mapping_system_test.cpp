@@ -4,9 +4,14 @@
 
 #include <cmath>
 #include <cstring>
+#include <algorithm>
+#include <cstdio>
 #include <limits>
+#include <vector>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/ray_caster.hpp"
+#include "marsala/terrain/generators.hpp"
 
 namespace marsala::agent::executive {
 namespace {
@@ -113,6 +118,155 @@ TEST(MappingSystem, RegistrationMovesTilesAndDropsWhatLeavesTheGrid) {
   map.integrate_tile(b);
   EXPECT_EQ(map.known_cells(), 6 + 3);
   for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(map.heights()(4, c), b.heights[c]));
+}
+
+/// Errors of the known cells of `map` against `truth` [m]: sorted absolute differences.
+std::vector<double> known_errors(const MappingSystem& map, const Heightmap& truth) {
+  std::vector<double> errors;
+  for (int r = 0; r < truth.rows(); ++r)
+    for (int c = 0; c < truth.cols(); ++c)
+      if (map.is_known({r, c})) errors.push_back(std::abs(map.heights()(r, c) - truth(r, c)));
+  std::sort(errors.begin(), errors.end());
+  return errors;
+}
+
+double quantile(const std::vector<double>& sorted, double q) {
+  return sorted.empty() ? 0.0 : sorted[static_cast<std::size_t>(q * static_cast<double>(sorted.size() - 1))];
+}
+
+/// One scan of `truth` by `sensor` from (x, y), inserted from the true origin.
+void scan_into(MappingSystem& map, const Heightmap& truth, double x, double y, double heading, std::uint64_t seed) {
+  const Point3 origin = sensor_origin(truth, x, y, map.sensor());
+  map.integrate_scan(cast_scan(truth, origin, heading, map.sensor(), seed), origin);
+}
+
+// A laser robot scanning a generated 12 x 12 m terrain (0.1 m cells, relief ~0.5 m) from poses 1 m apart: the
+// derived heightmap converges to the true heights over its known cells, and the cells known after the first scan
+// get better as later scans average their noise. The numbers are printed for docs/runtime.md#mapping.
+TEST(MappingSystem, ALaserMapConvergesToTheTerrainAsScansAccumulate) {
+  terrain::GeneratorSpec spec;
+  spec.rows = 120;
+  spec.cols = 120;
+  spec.cell_size_m = 0.1;
+  spec.seed = 7;
+  const Heightmap truth = terrain::generate_terrain("mix", spec);
+  MappingSystem map(truth.geometry(), 16, sensor_defaults("laser"));
+
+  scan_into(map, truth, 2.05, 6.05, 0.0, 1);
+  const CellMask first_known = map.known();
+  const long long first_count = map.known_cells();
+  const auto first_errors = [&] {
+    double sum2 = 0.0;
+    for (int r = 0; r < truth.rows(); ++r)
+      for (int c = 0; c < truth.cols(); ++c)
+        if (first_known(r, c) != 0) sum2 += std::pow(map.heights()(r, c) - truth(r, c), 2);
+    return std::sqrt(sum2 / static_cast<double>(first_count));
+  };
+  const double rms_after_1 = first_errors();
+  std::vector<double> errors = known_errors(map, truth);
+  std::printf("scans 1: known %lld cells, median %.4f m, p95 %.4f m, rms (first cells) %.4f m\n", map.known_cells(),
+              quantile(errors, 0.5), quantile(errors, 0.95), rms_after_1);
+  long long known_before = map.known_cells();
+  for (int k = 2; k <= 8; ++k) {
+    scan_into(map, truth, 2.05 + (k - 1), 6.05, 0.0, k);
+    EXPECT_GE(map.known_cells(), known_before);
+    known_before = map.known_cells();
+    errors = known_errors(map, truth);
+    std::printf("scans %d: known %lld cells, median %.4f m, p95 %.4f m, rms (first cells) %.4f m\n", k,
+                map.known_cells(), quantile(errors, 0.5), quantile(errors, 0.95), first_errors());
+  }
+  const double rms_after_8 = first_errors();
+  EXPECT_LT(rms_after_8, rms_after_1);
+  EXPECT_LT(quantile(errors, 0.5), 0.01);  // the laser's noise is 1 cm sd
+  EXPECT_LT(quantile(errors, 0.95), 0.05);
+  EXPECT_GT(map.known_cells(), truth.size() / 3);
+  EXPECT_GT(map.octree_leaves(), 0u);
+  // Cells never hit stay unknown and at 0.
+  for (int r = 0; r < truth.rows(); ++r)
+    for (int c = 0; c < truth.cols(); ++c)
+      if (!map.is_known({r, c})) EXPECT_EQ(map.heights()(r, c), 0.0);
+}
+
+// A 0.3 m wall at x in [3.0, 3.2) before a camera 0.5 m up at x = 2.05: it shadows the ground up to x = 3.2 +
+// 0.3 * 1.15 / 0.2 = 4.925 m, which stays unknown (but for col 32: hits on the wall's edge that noise pushes past
+// it); the wall's top is known at its height, the ground before and beyond the shadow at 0.
+TEST(MappingSystem, OccludedCellsStayUnknown) {
+  Heightmap truth(GridGeometry{60, 100, 0.0, 0.0, 0.1}, 0.0);
+  for (int r = 0; r < 60; ++r)
+    for (int c = 30; c < 32; ++c) truth(r, c) = 0.3;
+  MappingSystem map(truth.geometry(), 16, sensor_defaults("rgbd"));
+  scan_into(map, truth, 2.05, 3.05, 0.0, 5);  // looking east
+  for (int r = 0; r < 60; ++r)
+    for (int c = 33; c < 49; ++c) EXPECT_FALSE(map.is_known({r, c})) << r << ", " << c;  // the shadow
+  int wall_known = 0;
+  for (int r = 25; r <= 35; ++r)
+    for (int c = 30; c <= 31; ++c)
+      if (map.is_known({r, c})) {
+        ++wall_known;
+        EXPECT_NEAR(map.heights()(r, c), 0.3, 0.04) << r << ", " << c;  // face hits mixed in: a few cm
+      }
+  EXPECT_GT(wall_known, 3);
+  EXPECT_TRUE(map.is_known({30, 25}));
+  EXPECT_NEAR(map.heights()(30, 25), 0.0, 0.02);
+  long long beyond = 0;
+  for (int r = 0; r < 60; ++r)
+    for (int c = 50; c < 100; ++c)
+      if (map.is_known({r, c})) {
+        ++beyond;
+        EXPECT_NEAR(map.heights()(r, c), 0.0, 0.05) << r << ", " << c;
+      }
+  EXPECT_GT(beyond, 30);
+  // Nothing behind the camera either.
+  EXPECT_FALSE(map.is_known({30, 10}));
+}
+
+// A cell rises (a deposit within the same voxel): the map follows within a few scans.
+TEST(MappingSystem, TheMapFollowsADeposit) {
+  Heightmap truth(GridGeometry{60, 60, 0.0, 0.0, 0.1}, 0.0);
+  SensorSpec laser = sensor_defaults("laser");
+  laser.noise_sd_m = 0.0;
+  MappingSystem map(truth.geometry(), 16, laser);
+  scan_into(map, truth, 3.05, 3.05, 0.0, 1);
+  ASSERT_TRUE(map.is_known({30, 40}));
+  EXPECT_NEAR(map.heights()(30, 40), 0.0, 1e-6);
+  for (int r = 28; r <= 32; ++r)
+    for (int c = 38; c <= 42; ++c) truth(r, c) = 0.05;
+  for (int k = 2; k <= 8; ++k) scan_into(map, truth, 3.05, 3.05, 0.0, k);
+  EXPECT_NEAR(map.heights()(30, 40), 0.05, 0.005);
+  // Raised by a voxel and more: the highest occupied voxel wins at once.
+  for (int r = 28; r <= 32; ++r)
+    for (int c = 38; c <= 42; ++c) truth(r, c) = 0.25;
+  scan_into(map, truth, 3.05, 3.05, 0.0, 9);
+  EXPECT_NEAR(map.heights()(30, 40), 0.25, 1e-5);
+}
+
+TEST(MappingSystem, RefusesAbsurdScans) {
+  const GridGeometry world{60, 60, 0.0, 0.0, 0.1};
+  MappingSystem map(world, 16, sensor_defaults("laser"));
+  const Point3 origin{3.05, 3.05, 0.5};  // a cell centre: hits near cell edges are left out
+  EXPECT_THROW(map.integrate_scan({{std::numeric_limits<float>::quiet_NaN(), 0.0F, 0.0F}}, origin), InvalidArgument);
+  EXPECT_THROW(map.integrate_scan({{0.0F, 0.0F, -1e9F}}, origin), InvalidArgument);
+  EXPECT_THROW(map.integrate_scan({{0.0F, 20.0F, 0.0F}}, origin), InvalidArgument);  // beyond 8 m + noise
+  EXPECT_THROW(map.integrate_scan({}, {std::nan(""), 3.0, 0.5}), InvalidArgument);
+  std::vector<ScanPoint> too_many(static_cast<std::size_t>(map.sensor().ray_count() + 1), ScanPoint{0.0F, 0.0F, -0.5F});
+  EXPECT_NE(scan_problem(too_many, map.sensor()), "");
+  EXPECT_EQ(map.known_cells(), 0);
+  // Points off the grid are left out, not an error.
+  map.integrate_scan({{-5.0F, 0.0F, -0.5F}, {0.0F, 0.0F, -0.5F}}, origin);
+  EXPECT_EQ(map.known_cells(), 1);
+  EXPECT_THROW(MappingSystem(GridGeometry{40000, 10, 0.0, 0.0, 0.1}, 16, sensor_defaults("laser")), InvalidArgument);
+}
+
+TEST(MappingSystem, AssumedGroundFillsOnlyUnknownCellsUnderTheBody) {
+  const GridGeometry world{60, 60, 0.0, 0.0, 0.1};
+  MappingSystem map(world, 16, sensor_defaults("rgbd"));
+  map.assume_ground({3.05, 3.05}, 0.7, 0.5);
+  // The disc of radius 0.5 m around cell (29, 30): 81 cell centres (a radius of 5 cells).
+  EXPECT_EQ(map.known_cells(), 81);
+  EXPECT_EQ(map.heights()(29, 30), 0.7);
+  EXPECT_EQ(map.heights()(29, 35), 0.7);
+  EXPECT_FALSE(map.is_known({29, 36}));
+  EXPECT_THROW(map.assume_ground({30.0, 3.0}, 0.7, 0.5), InvalidArgument);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <functional>
 #include <future>
+#include <limits>
 #include <thread>
 
 #include "marsala/core/error.hpp"
@@ -192,6 +193,62 @@ TEST(AgentRuntime, IgnoresFramesNotFromItsWorldOrThatMakeNoSense) {
   EXPECT_EQ(r.ignored_frames, 4u);
   ASSERT_EQ(requests.size(), 5u);
   for (std::size_t i = 0; i < requests.size(); ++i) EXPECT_EQ(requests[i].step, i);
+}
+
+TEST(AgentRuntime, IgnoresScansThatMakeNoSense) {
+  // A laser robot: frames with a non-finite point, a point far beyond its range, or points without a scan are
+  // ignored whole (a log line each, no crash); the run goes on to the world's end.
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, 113});
+  RuntimeConfig c = config(4, "ramp_builder");
+  c.type.sensor = sensor_defaults("laser");
+  AgentRuntime agent(*participant, c);
+  std::atomic<bool> stop{false};
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 113});
+  ScriptedWorld world{*world_participant, 4};
+  world.before_frame = [&](int step, const std::string&, bus::Writer<protocol::SensorFrame>& frames) {
+    protocol::SensorFrame f;
+    f.agent_id = 4;
+    f.step = static_cast<std::uint64_t>(step);
+    f.x_m = 0.55;
+    f.y_m = 1.05;
+    f.scanned = true;
+    f.points.push_back({0.3F, 0.0F, -0.5F});
+    if (step == 1) f.points.push_back({std::numeric_limits<float>::quiet_NaN(), 0.0F, -0.5F});
+    if (step == 2) f.points.push_back({100.0F, 0.0F, -0.5F});
+    if (step == 3) f.scanned = false;
+    if (step >= 1 && step <= 3) frames.write(f);
+  };
+  const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+  const auto requests = world.run([&](const protocol::AgentHello& hello) { return admission_for(hello, h); }, 5);
+  const RunResult r = running.get();
+  EXPECT_EQ(r.outcome, RunOutcome::kRunOver) << r.message;
+  EXPECT_EQ(r.requests, 5u);
+  EXPECT_EQ(r.ignored_frames, 3u);
+}
+
+TEST(AgentRuntime, AGroundTruthRobotIgnoresScans) {
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, 114});
+  AgentRuntime agent(*participant, config(4, "ramp_builder"));
+  std::atomic<bool> stop{false};
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 114});
+  ScriptedWorld world{*world_participant, 4};
+  world.before_frame = [&](int step, const std::string&, bus::Writer<protocol::SensorFrame>& frames) {
+    if (step != 2) return;
+    protocol::SensorFrame f;
+    f.agent_id = 4;
+    f.step = 2;
+    f.x_m = 0.55;
+    f.y_m = 1.05;
+    f.scanned = true;
+    frames.write(f);
+  };
+  const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+  world.run([&](const protocol::AgentHello& hello) { return admission_for(hello, h); }, 4);
+  const RunResult r = running.get();
+  EXPECT_EQ(r.outcome, RunOutcome::kRunOver) << r.message;
+  EXPECT_EQ(r.ignored_frames, 1u);
 }
 
 TEST(AgentRuntime, RefusalEndsTheRunWithTheWorldsReason) {

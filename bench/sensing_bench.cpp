@@ -1,0 +1,103 @@
+// The cost of ray-cast sensing and OctoMap mapping per robot step at the default resolutions (docs/runtime.md#sensing):
+//   scan:    the world's ray casting of one scan (common/core/ray_caster.hpp), laser and rgbd;
+//   insert:  the agent's OctoMap insertion of one scan and the heightmap derivation (MappingSystem::integrate_scan);
+//   step:    both, for a robot that moves 0.2 m per step along a line, scanning every step.
+// Terrain: the ramp scenario's platform (1.5 m high) on a 30 x 20 m grid of 0.1 m cells, and a generated "mix"
+// terrain of the same size; the robot 3 m before the platform, facing it. Medians of repetitions (bench/run.sh).
+
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+#include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/ray_caster.hpp"
+#include "marsala/terrain/generators.hpp"
+
+namespace {
+
+using namespace marsala;
+
+Heightmap terrain_named(int which) {
+  terrain::GeneratorSpec spec;
+  spec.rows = 200;
+  spec.cols = 300;
+  spec.cell_size_m = 0.1;
+  spec.seed = 1;
+  if (which == 0) {
+    spec.params = {{"height", 1.5}, {"width", 10.0}, {"depth", 14.0}, {"centre_x", 23.0}, {"centre_y", 10.0}};
+    return terrain::generate_terrain("platform", spec);
+  }
+  return terrain::generate_terrain("mix", spec);
+}
+
+const char* kTerrainNames[] = {"platform", "mix"};
+const char* kSensorNames[] = {"laser", "rgbd"};
+
+void BM_Scan(benchmark::State& state) {
+  const Heightmap terrain = terrain_named(static_cast<int>(state.range(1)));
+  const SensorSpec sensor = sensor_defaults(kSensorNames[state.range(0)]);
+  const Point3 origin = sensor_origin(terrain, 15.05, 10.05, sensor);
+  std::uint64_t step = 0;
+  std::size_t points = 0;
+  for (auto _ : state) {
+    const std::vector<ScanPoint> scan = cast_scan(terrain, origin, 0.0, sensor, scan_seed(1, 1, ++step));
+    points = scan.size();
+    benchmark::DoNotOptimize(scan.data());
+  }
+  state.counters["rays"] = static_cast<double>(sensor.ray_count());
+  state.counters["points"] = static_cast<double>(points);
+  state.SetLabel(std::string(kSensorNames[state.range(0)]) + " on " + kTerrainNames[state.range(1)]);
+}
+
+// One scan into a map that already holds the scans of the 10 steps before (a robot on its way).
+void BM_InsertAndDerive(benchmark::State& state) {
+  const Heightmap terrain = terrain_named(static_cast<int>(state.range(1)));
+  const SensorSpec sensor = sensor_defaults(kSensorNames[state.range(0)]);
+  agent::executive::MappingSystem warm(terrain.geometry(), 16, sensor);
+  for (int k = 0; k < 10; ++k) {
+    const Point3 o = sensor_origin(terrain, 13.05 + 0.2 * k, 10.05, sensor);
+    warm.integrate_scan(cast_scan(terrain, o, 0.0, sensor, scan_seed(1, 1, k)), o);
+  }
+  const Point3 origin = sensor_origin(terrain, 15.05, 10.05, sensor);
+  const std::vector<ScanPoint> scan = cast_scan(terrain, origin, 0.0, sensor, scan_seed(1, 1, 10));
+  for (auto _ : state) {
+    state.PauseTiming();
+    agent::executive::MappingSystem map = warm;
+    state.ResumeTiming();
+    map.integrate_scan(scan, origin);
+    benchmark::DoNotOptimize(map.heights().data());
+  }
+  state.counters["points"] = static_cast<double>(scan.size());
+  state.SetLabel(std::string(kSensorNames[state.range(0)]) + " on " + kTerrainNames[state.range(1)]);
+}
+
+// A robot step: the world's scan, then the agent's insertion and derivation, moving 0.2 m per step.
+void BM_RobotStep(benchmark::State& state) {
+  const Heightmap terrain = terrain_named(static_cast<int>(state.range(1)));
+  const SensorSpec sensor = sensor_defaults(kSensorNames[state.range(0)]);
+  agent::executive::MappingSystem map(terrain.geometry(), 16, sensor);
+  int k = 0;
+  for (auto _ : state) {
+    const Point3 o = sensor_origin(terrain, 6.05 + 0.2 * (k % 60), 10.05, sensor);
+    map.integrate_scan(cast_scan(terrain, o, 0.0, sensor, scan_seed(1, 1, static_cast<std::uint64_t>(k))), o);
+    ++k;
+  }
+  state.counters["known_cells"] = static_cast<double>(map.known_cells());
+  state.counters["octree_leaves"] = static_cast<double>(map.octree_leaves());
+  state.SetLabel(std::string(kSensorNames[state.range(0)]) + " on " + kTerrainNames[state.range(1)]);
+}
+
+void sensors_and_terrains(benchmark::internal::Benchmark* b) {
+  for (int sensor = 0; sensor < 2; ++sensor)
+    for (int terrain = 0; terrain < 2; ++terrain) b->Args({sensor, terrain});
+  b->Unit(benchmark::kMillisecond);
+}
+
+BENCHMARK(BM_Scan)->Apply(sensors_and_terrains);
+BENCHMARK(BM_InsertAndDerive)->Apply(sensors_and_terrains);
+BENCHMARK(BM_RobotStep)->Apply(sensors_and_terrains)->Iterations(100);
+
+}  // namespace
+
+BENCHMARK_MAIN();

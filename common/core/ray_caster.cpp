@@ -1,0 +1,113 @@
+#include "marsala/core/ray_caster.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "marsala/core/error.hpp"
+#include "marsala/core/random.hpp"
+
+namespace marsala {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// A standard normal deviate (Box-Muller on the portable generator; libm's log, sqrt and cos).
+double normal(random::Rng& rng) {
+  const double u1 = 1.0 - rng.uniform();  // (0, 1]: log stays finite
+  const double u2 = rng.uniform();
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
+}
+
+}  // namespace
+
+std::optional<double> first_hit(const Heightmap& terrain, Point3 origin, Point3 d, double max_range_m) {
+  const GridGeometry& g = terrain.geometry();
+  const double cs = g.cell_size_m;
+  // Grid coordinates: u east from the west edge, v north from the south edge [cells].
+  const double u0 = (origin.x - g.xll_m) / cs, v0 = (origin.y - g.yll_m) / cs;
+  long long iu = static_cast<long long>(std::floor(u0)), iv = static_cast<long long>(std::floor(v0));
+  const auto on_grid = [&](long long u, long long v) { return u >= 0 && u < g.cols && v >= 0 && v < g.rows; };
+  if (!on_grid(iu, iv)) return std::nullopt;
+  const int step_u = d.x > 0.0 ? 1 : -1, step_v = d.y > 0.0 ? 1 : -1;
+  // Distance along the ray [m] to the next vertical grid line in u and in v, and between two of them.
+  const double du = d.x / cs, dv = d.y / cs;  // cells per metre along the ray
+  double next_u = du != 0.0 ? ((step_u > 0 ? std::floor(u0) + 1.0 : std::floor(u0)) - u0) / du : kInf;
+  double next_v = dv != 0.0 ? ((step_v > 0 ? std::floor(v0) + 1.0 : std::floor(v0)) - v0) / dv : kInf;
+  const double delta_u = du != 0.0 ? std::abs(1.0 / du) : kInf;
+  const double delta_v = dv != 0.0 ? std::abs(1.0 / dv) : kInf;
+
+  double t_enter = 0.0;
+  for (;;) {
+    const double h = terrain(static_cast<int>(g.rows - 1 - iv), static_cast<int>(iu));
+    // Entering below this cell's top: the side face it came through (the start cell: the origin is inside it).
+    if (origin.z + d.z * t_enter <= h) return t_enter <= max_range_m ? std::optional<double>(t_enter) : std::nullopt;
+    const double t_exit = std::min(next_u, next_v);
+    // Coming down through the top face inside this cell.
+    if (d.z < 0.0) {
+      const double t_top = (h - origin.z) / d.z;
+      if (t_top <= t_exit) return t_top <= max_range_m ? std::optional<double>(t_top) : std::nullopt;
+    }
+    if (t_exit > max_range_m) return std::nullopt;  // also a vertical ray that rises: t_exit is infinite
+    if (next_u < next_v) {
+      iu += step_u;
+      next_u += delta_u;
+    } else {
+      iv += step_v;
+      next_v += delta_v;
+    }
+    t_enter = t_exit;
+    if (!on_grid(iu, iv)) return std::nullopt;
+  }
+}
+
+Point3 sensor_origin(const Heightmap& terrain, double x_m, double y_m, const SensorSpec& sensor) {
+  const std::optional<CellIndex> cell = terrain.cell_at({x_m, y_m});
+  if (!cell) throw InvalidArgument("ray caster: sensor position (" + std::to_string(x_m) + ", " + std::to_string(y_m) +
+                                   ") m is off the grid");
+  return {x_m, y_m, terrain(*cell) + sensor.mount_height_m};
+}
+
+std::uint64_t scan_seed(std::uint64_t run_seed, std::uint32_t agent_id, std::uint64_t step) {
+  return random::derive_seed(random::derive_seed(run_seed, 0x5ca11e55ULL + agent_id), step);
+}
+
+std::vector<ScanPoint> cast_scan(const Heightmap& terrain, Point3 origin, double heading_rad, const SensorSpec& sensor,
+                                 std::uint64_t seed) {
+  const std::string problem = sensor_problem(sensor);
+  if (!problem.empty()) throw InvalidArgument("ray caster: sensor " + problem);
+  if (!sensor.casts_rays()) return {};
+  const double deg = kPi / 180.0;
+  const bool wraps = sensor.horizontal_fov_deg >= 360.0;
+  const long long azimuths =
+      static_cast<long long>(std::floor(sensor.horizontal_fov_deg / sensor.horizontal_resolution_deg + 1e-9)) +
+      (wraps ? 0 : 1);
+  const long long elevations = static_cast<long long>(std::floor(
+                                   (sensor.vertical_max_deg - sensor.vertical_min_deg) / sensor.vertical_resolution_deg +
+                                   1e-9)) +
+                               1;
+  // The laser's azimuths start east; the camera's are centred on its heading.
+  const double azimuth0 = sensor.name == "rgbd" ? heading_rad - 0.5 * sensor.horizontal_fov_deg * deg : 0.0;
+  random::Rng rng(seed);
+  std::vector<ScanPoint> points;
+  points.reserve(static_cast<std::size_t>(azimuths * elevations / 2));
+  for (long long i = 0; i < azimuths; ++i) {
+    const double a = azimuth0 + static_cast<double>(i) * sensor.horizontal_resolution_deg * deg;
+    const double ca = std::cos(a), sa = std::sin(a);
+    for (long long j = 0; j < elevations; ++j) {
+      const double e = (sensor.vertical_min_deg + static_cast<double>(j) * sensor.vertical_resolution_deg) * deg;
+      const Point3 dir{std::cos(e) * ca, std::cos(e) * sa, std::sin(e)};
+      // One deviate per ray, hit or not, so a change of the terrain far away leaves the noise of other rays alone.
+      const double z = normal(rng);
+      const std::optional<double> hit = first_hit(terrain, origin, dir, sensor.max_range_m);
+      if (!hit || *hit < sensor.min_range_m) continue;
+      const double range = *hit + z * sensor.noise_sd_at(*hit);
+      if (!(range > 0.0)) continue;
+      points.push_back({static_cast<float>(dir.x * range), static_cast<float>(dir.y * range),
+                        static_cast<float>(dir.z * range)});
+    }
+  }
+  return points;
+}
+
+}  // namespace marsala
