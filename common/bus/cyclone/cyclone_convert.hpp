@@ -15,6 +15,7 @@ struct Storage {
   std::vector<marsala_wire_TerrainTile> tiles;
   std::vector<marsala_wire_Neighbour> neighbours;
   std::vector<marsala_wire_Deposition> depositions;
+  std::vector<marsala_wire_Deposit> deposits;
   std::vector<marsala_wire_AgentStatus> agents;
 };
 
