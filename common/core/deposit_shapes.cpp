@@ -163,10 +163,12 @@ DepositShape cone_pile_shape(const Heightmap& terrain, Position dump, double vol
     sum += cells[n].base_m;
     ++n;
     apex = (fill_m + sum) / static_cast<double>(n);
-    if (n == cells.size() || apex <= cells[n].base_m) break;
+    // A cell whose base the apex passes by less than kConeTieM stays as it is: built terrain sits exactly on slopes,
+    // so apex and base often tie, and rounding must not decide whether a cell (under a robot, off the grid) rises.
+    if (n == cells.size() || apex <= cells[n].base_m + kConeTieM) break;
   }
   std::vector<CellRise> rises;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < n; ++i) {  // the first n cells' bases lie below the apex (the first by any amount)
     const double rise = apex - cells[i].base_m;
     if (rise > 0.0) rises.push_back({cells[i].cell, rise});
   }

@@ -44,6 +44,9 @@ struct DepositShape {
 /// Tolerance of cone_pile_shape's volume: |volume_m3 - V| <= kConeVolumeRelTolerance * V (rounding only: the apex
 /// is solved exactly, not iterated).
 inline constexpr double kConeVolumeRelTolerance = 1e-9;
+/// A cell rises under a cone only when the apex clears its h(p) + tan(repose) |p - dump| by more than this [m]
+/// (ties are common on built terrain; see cone_pile_shape).
+inline constexpr double kConeTieM = 1e-9;
 
 /// A column of `cubes` cubes of side `side_m` [m] standing with its centre at `centre` [m] (any position): every
 /// cell the side x side footprint overlaps rises by cubes * side * (overlap area / cs^2), so the volume is
@@ -59,7 +62,8 @@ long long whole_cubes(double volume_m3, double side_m);
 /// `volume_m3` of granular material dumped at `dump` [m] settles as a cone at the angle of repose `repose_deg`
 /// [deg]: h'(p) = max(h(p), z - tan(repose) |p - dump|) (|.| from cell centres), with the apex height z solved
 /// exactly (cells sorted by h(p) + tan(repose) |p - dump|, filled like water from below) so that the added volume
-/// is `volume_m3` within kConeVolumeRelTolerance. on_grid is false when the dump point is off the grid or the pile
+/// is `volume_m3` within kConeVolumeRelTolerance; a cell the apex would clear by at most kConeTieM does not rise (the
+/// surface there may stand up to 1e-9 m above the cone). on_grid is false when the dump point is off the grid or the pile
 /// reaches a cell of the grid's outermost ring (it would spill over the edge). Throws InvalidArgument on a
 /// non-finite dump point, a volume that is not finite and >= 0, or an angle not in (0, 90).
 DepositShape cone_pile_shape(const Heightmap& terrain, Position dump, double volume_m3, double repose_deg);

@@ -257,6 +257,20 @@ TEST(ConePile, SmallVolumeStaysInTheDumpCell) {
   EXPECT_NEAR(s.rises[0].rise_m, 0.05, 1e-15);
 }
 
+TEST(ConePile, AnApexThatOnlyTiesANeighbourLeavesItAsItIs) {
+  // Flat ground: the dump cell alone takes material until the apex reaches tan(repose) 0.1 m, where its four
+  // neighbours start. Exactly that volume ties them: rounding must not decide, they stay (kConeTieM).
+  const Heightmap flat({9, 9, 0.0, 0.0, 0.1}, 0.0);
+  const double t = std::tan(34.0 * kPi / 180.0);
+  for (const double v : {t * 0.1 * 0.01, std::nextafter(t * 0.1 * 0.01, 1.0), std::nextafter(t * 0.1 * 0.01, 0.0)}) {
+    const DepositShape s = cone_pile_shape(flat, flat.cell_center({4, 4}), v, 34.0);
+    ASSERT_EQ(s.rises.size(), 1u) << v;
+    EXPECT_NEAR(s.rises[0].rise_m, t * 0.1, 1e-15);
+  }
+  // Clearly more: the four neighbours rise too.
+  EXPECT_EQ(cone_pile_shape(flat, flat.cell_center({4, 4}), t * 0.1 * 0.01 + 1e-9, 34.0).rises.size(), 5u);
+}
+
 TEST(ConePile, ReachingTheBorderOrDumpedOffTheGridIsFlagged) {
   const Heightmap flat({9, 9, 0.0, 0.0, 0.1}, 0.0);
   EXPECT_FALSE(cone_pile_shape(flat, flat.cell_center({1, 4}), 0.01, 34.0).on_grid);
