@@ -128,12 +128,15 @@ class ConeDepositor final : public Depositor {
         if (map.blind(r, c) == 0 && manager.may_raise(map, {r, c}, robot, neighbours))
           remaining[index({r, c})] = std::max(0.0, map.gap(r, c));
     const std::vector<WantedCell> wanted = manager.wanted(map, path, robot, neighbours);
+    std::vector<std::uint8_t> in_band(remaining.size(), 0);  // the cells the path's footprint wants
+    for (const WantedCell& w : wanted) in_band[index(w.cell)] = 1;
     Heightmap heights = map.heights;  // the piles chosen so far land on it
     double budget = budget_m3(manager, material_m3);
     std::vector<Placed> placed;
     for (int pile = 0; pile < kMaxConesPerStep && budget > kMinVolumeM3; ++pile) {
       struct Best {
         double fill_m3 = 0.0;
+        double band_m3 = 0.0;  // the part of fill_m3 on the path's footprint
         Position dump;
         double volume_m3 = 0.0;
         DepositShape shape;
@@ -152,7 +155,7 @@ class ConeDepositor final : public Depositor {
           if (!(v > kMinVolumeM3)) continue;
           DepositShape shape = cone_pile_shape(heights, dump, v, repose_deg_);
           if (!shape.on_grid) continue;  // the pile reaches the window's edge: beyond it the map is not known
-          double fill = 0.0;
+          double fill = 0.0, band = 0.0;
           bool ok = true;
           for (const CellRise& r : shape.rises) {
             const double may = remaining[index(r.cell)];
@@ -161,13 +164,23 @@ class ConeDepositor final : public Depositor {
               break;
             }
             fill += std::min(r.rise_m, may) * area;
+            if (in_band[index(r.cell)]) band += std::min(r.rise_m, may) * area;
           }
           // Most of the pile must land under the MARS height: material spent above it is lost to the structure.
-          if (!ok || fill < kMinFillFraction * v || !(fill > best.fill_m3 + 1e-12)) continue;
-          best = {fill, dump, v, std::move(shape)};
+          if (!ok || fill < kMinFillFraction * v || !(band > best.band_m3 + 1e-12)) continue;
+          // The world computes the pile on its own copy of the terrain, in its own frame: a cell at the pile's edge
+          // may rise there by rounding. A slightly bigger pile covers every cell this one could (the cells rising
+          // grow with the volume), so it must not reach a cell this robot may not raise either.
+          const DepositShape guard = cone_pile_shape(heights, dump, v * (1.0 + kGuardFraction), repose_deg_);
+          if (!guard.on_grid) continue;
+          bool guarded = true;
+          for (const CellRise& r : guard.rises)
+            if (remaining[index(r.cell)] < 0.0) guarded = false;
+          if (!guarded) continue;
+          best = {fill, band, dump, v, std::move(shape)};
         }
       }
-      if (!(best.fill_m3 > 0.0)) break;
+      if (!(best.band_m3 > 0.0)) break;
       Placed pile_placed{{best.dump.x, best.dump.y, best.volume_m3}, {}};
       for (const CellRise& r : best.shape.rises) {
         heights(r.cell) += r.rise_m;
@@ -184,6 +197,7 @@ class ConeDepositor final : public Depositor {
   static constexpr double kMinVolumeM3 = 1e-7;  // smaller piles are not worth a deposit [m^3]
   static constexpr std::size_t kVolumeHalvings = 6;  // volumes tried: the budget, half of it, ... 1/32 of it
   static constexpr double kMinFillFraction = 0.75;
+  static constexpr double kGuardFraction = 1e-6;  // the guard pile's extra volume, relative
   double repose_deg_;
 };
 

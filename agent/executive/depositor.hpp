@@ -6,9 +6,10 @@
 //   "cube":  columns of cubes of side s centred on wanted cells, in path order (contour crafting), each column as
 //            tall as every cell of its footprint still wants (never above the MARS height);
 //   "cone":  piles of granular material: among dump points on wanted cells within reach and a few volumes, the pile
-//            (predicted with the world's own cone_pile_shape on the local map) that fills most volume under the MARS
-//            height without raising any cell more than kConeOvershootFraction * eps above it or any cell it may not
-//            raise; up to kMaxConesPerStep piles a step.
+//            (predicted with the world's own cone_pile_shape on the local map) that puts most volume under the MARS
+//            height on the path's footprint, with at least 75 % of it under the MARS height anywhere, no cell more
+//            than kConeOvershootFraction * eps above it, and no cell it may not raise (checked on a pile 1e-6 bigger,
+//            so that rounding in the world's frame cannot reach one); up to kMaxConesPerStep piles a step.
 // Every depositor keeps the manager's way-back check (the longest prefix of its deposits that keeps it).
 // The behaviours see only DepositionPlan.
 
