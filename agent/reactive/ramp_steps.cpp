@@ -97,6 +97,11 @@ void RampSteps::admit(const protocol::Admission& admission) {
 }
 
 BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace) {
+  if (frame.last_result == protocol::ActionResult::kRejected && deposits_sent_ > 0)
+    deposit_limit_ = deposits_sent_ / 2;
+  else if (frame.last_result == protocol::ActionResult::kAccepted)
+    deposit_limit_ = -1;
+  deposits_sent_ = 0;
   modules_->map.integrate(frame.tiles, {frame.x_m, frame.y_m});
   const Position robot{frame.x_m, frame.y_m};
   const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
@@ -169,8 +174,15 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
   }
   trace.deposition = modules_->depositor->plan(modules_->depositions, terrain_only, ahead, at, frame.material_m3,
                                                neighbourhood(frame));
+  auto& deposits = trace.deposition.deposits;
+  if (deposit_limit_ >= 0 && deposits.size() > static_cast<std::size_t>(deposit_limit_)) {
+    deposits.resize(static_cast<std::size_t>(deposit_limit_));
+    trace.deposition.volume_m3 = 0.0;
+    for (const Deposit& d : deposits) trace.deposition.volume_m3 += d.volume_m3;
+  }
+  deposits_sent_ = static_cast<int>(deposits.size());
   request.depositions = trace.deposition.depositions;
-  request.deposits = trace.deposition.deposits;
+  request.deposits = deposits;
 }
 
 std::optional<BuildPhase> RampSteps::build_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,
