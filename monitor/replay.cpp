@@ -132,7 +132,9 @@ void TerrainReplayer::apply_step(const proto::StepRecord& step, const std::strin
     me.state = r.state();
     if (r.move()) me.position = Position{r.target_x_m(), r.target_y_m()};
     double volume_m3 = 0.0;
-    for (const proto::LoggedDeposition& d : r.depositions()) {
+    // A layer depositor's depositions say their cells; a cube or cone depositor's deposits were shaped by the world,
+    // which logged the cells it raised.
+    for (const proto::LoggedDeposition& d : r.depositions_size() > 0 ? r.depositions() : r.raised()) {
       if (!terrain_.contains({d.row(), d.col()}) || !std::isfinite(d.height_m()))
         throw ParseError(log_name_, 0,
                          fmt::format("{}: step {}: agent {} deposited {} m on cell {}, off the {} x {} grid or not a "

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <optional>
 #include <utility>
 
+#include "marsala/core/deposit_shapes.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/core/iterators.hpp"
@@ -18,6 +21,8 @@ namespace tol = arbiter_tolerance;
 
 // Balls above this many cells are checked by the processor on a window: the pair check is quadratic.
 constexpr std::size_t kMaxPairBallCells = 2000;
+// A bound on one cube column's count, far above any column within the 1 m per-cell limit: it keeps the count an int.
+constexpr long long kMaxCubesPerColumn = 1000000;
 
 double distance(double ax, double ay, double bx, double by) {
   const double dx = ax - bx, dy = ay - by;
@@ -59,6 +64,87 @@ bool occupiable_by_window(const Heightmap& h, CellIndex cell, const Navigability
   return NavigabilityProcessor(p).occupiable(window)(cell.row - r0, cell.col - c0) != 0;
 }
 
+/// Rule 4: a refill only at the base; nullopt when it passes.
+std::optional<Verdict> check_refill(const WorldState& state, const protocol::ActionRequest& r, double x, double y) {
+  if (!r.refill) return std::nullopt;
+  const double to_base = distance(x, y, state.base.x_m, state.base.y_m);
+  if (to_base <= state.base.radius_m + tol::kLengthM) return std::nullopt;
+  return Verdict{false,
+                 "refill requested " + fmt::format("{}", to_base) + " m from the base station (radius " +
+                     fmt::format("{}", state.base.radius_m) + " m)",
+                 4, 0.0, {}};
+}
+
+std::string where(const Deposit& d) { return "(" + fmt::format("{}", d.x_m) + ", " + fmt::format("{}", d.y_m) + ")"; }
+
+/// Rule 3 for a cube or cone depositor (docs/runtime.md#rule-3-deposits), judged from (x, y), the position after the
+/// motion. The volumes are checked before any shape is computed, so no request costs more than its volume allows.
+Verdict validate_deposits(const WorldState& state, const AgentRecord& me, double x, double y,
+                          const std::vector<Deposit>& deposits) {
+  const auto reject = [](std::string reason) { return Verdict{false, std::move(reason), 3, 0.0, {}}; };
+  const Heightmap& terrain = state.terrain;
+  const DepositorKind kind = depositor_kind(me.type.depositor.name);
+  const double side = depositor_cube_size_m(me.type);
+  double volume = 0.0;
+  for (const Deposit& d : deposits) {
+    const double from_me = distance(d.x_m, d.y_m, x, y);
+    if (!(from_me <= me.type.body.reach_m + tol::kLengthM))
+      return reject("deposit at " + where(d) + " is " + fmt::format("{}", from_me) + " m away, beyond reach_m " +
+                    fmt::format("{}", me.type.body.reach_m));
+    if (!(d.volume_m3 > 0.0))
+      return reject("deposit volume " + fmt::format("{}", d.volume_m3) + " m^3 at " + where(d) + " is not > 0");
+    if (kind == DepositorKind::kCube && whole_cubes(d.volume_m3, side) < 1)
+      return reject("deposit volume " + fmt::format("{}", d.volume_m3) + " m^3 at " + where(d) +
+                    " is not a whole number of cubes of side " + fmt::format("{}", side) + " m");
+    volume += d.volume_m3;
+  }
+  if (!(volume <= me.type.body.max_deposit_m3 + tol::kVolumeM3))
+    return reject("deposited volume " + fmt::format("{}", volume) + " m^3 exceeds max_deposit_m3 " +
+                  fmt::format("{}", me.type.body.max_deposit_m3));
+  if (!(volume <= me.material_m3 + tol::kVolumeM3))
+    return reject("deposited volume " + fmt::format("{}", volume) + " m^3 exceeds the material on board " +
+                  fmt::format("{}", me.material_m3) + " m^3");
+
+  // The shapes, in list order: a pile lands on the piles before it in the same request.
+  std::optional<Heightmap> after;
+  const bool layered = kind == DepositorKind::kCone && deposits.size() > 1;
+  if (layered) after = terrain;
+  std::map<std::pair<int, int>, double> raised;  // total rise of each cell in this request
+  Verdict ok{true, {}, 0, 0.0, {}};
+  const double cs = terrain.cell_size_m();
+  for (const Deposit& d : deposits) {
+    const long long cubes = kind == DepositorKind::kCube ? whole_cubes(d.volume_m3, side) : 0;
+    if (cubes > kMaxCubesPerColumn)
+      return reject("deposit at " + where(d) + " is a column of " + std::to_string(cubes) + " cubes, more than " +
+                    std::to_string(kMaxCubesPerColumn));
+    const DepositShape shape =
+        kind == DepositorKind::kCube
+            ? cube_column_shape(terrain.geometry(), {d.x_m, d.y_m}, side, static_cast<int>(cubes))
+            : cone_pile_shape(layered ? *after : terrain, {d.x_m, d.y_m}, d.volume_m3, me.type.depositor.repose_deg);
+    if (!shape.on_grid) return reject("deposit at " + where(d) + " would leave the grid");
+    for (const CellRise& c : shape.rises) {
+      const Position centre = terrain.cell_center(c.cell);
+      for (const AgentRecord& other : state.agents) {
+        if (!other.alive) continue;
+        const bool self = other.id == me.id;
+        const double gap = distance(centre.x, centre.y, self ? x : other.x_m, self ? y : other.y_m);
+        if (gap <= 0.5 * other.type.body.navigability.delta_m + tol::kLengthM)
+          return reject("deposit at " + where(d) + " raises cell " + fmt::format("{}", c.cell) + ", under agent " +
+                        std::to_string(other.id));
+      }
+      double& total = raised[{c.cell.row, c.cell.col}];
+      total += c.rise_m;
+      if (!(total <= tol::kMaxDepositionM + tol::kLengthM))
+        return reject("deposit at " + where(d) + " raises cell " + fmt::format("{}", c.cell) + " by " +
+                      fmt::format("{}", total) + " m in this request, more than 1 m");
+      if (layered) (*after)(c.cell) += c.rise_m;
+      ok.rises.push_back({c.cell.row, c.cell.col, c.rise_m});
+      ok.volume_m3 += c.rise_m * cs * cs;
+    }
+  }
+  return ok;
+}
+
 }  // namespace
 
 double body_clearance_m(const AgentRecord& a, const AgentRecord& b) {
@@ -83,6 +169,10 @@ bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const Navigabilit
     method = offsets.size() <= kMaxPairBallCells ? OccupancyMethod::kPairs : OccupancyMethod::kWindow;
   return method == OccupancyMethod::kPairs ? occupiable_by_pairs(terrain, cell, params, offsets)
                                            : occupiable_by_window(terrain, cell, params, offsets);
+}
+
+const std::vector<Deposition>& raised_cells(const protocol::ActionRequest& request, const Verdict& verdict) {
+  return request.depositions.empty() ? verdict.rises : request.depositions;
 }
 
 Verdict validate_request(const WorldState& state, std::uint32_t channel_id, const protocol::ActionRequest& r) {
@@ -111,6 +201,13 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
   const Heightmap& terrain = state.terrain;
   if (static_cast<long long>(r.depositions.size()) > terrain.size())
     return reject(std::to_string(r.depositions.size()) + " depositions exceed the grid's cells");
+  for (const Deposit& d : r.deposits)
+    if (!sane(d.x_m) || !sane(d.y_m) || !sane(d.volume_m3))
+      return reject("deposit at (" + fmt::format("{}", d.x_m) + ", " + fmt::format("{}", d.y_m) + ") of " +
+                    fmt::format("{}", d.volume_m3) + " m^3 is not finite or too large");
+  if (r.deposits.size() > tol::kMaxDeposits)
+    return reject(std::to_string(r.deposits.size()) + " deposits exceed the limit of " +
+                  std::to_string(tol::kMaxDeposits) + " per request");
 
   // 2. Motion.
   rule = 2;
@@ -153,8 +250,20 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
     y = r.target_y_m;
   }
 
-  // 3. Depositions, from the position after the motion.
+  // 3. Depositions, from the position after the motion, by the robot's own depositor.
   rule = 3;
+  const DepositorKind kind = depositor_kind(me.type.depositor.name);
+  if (kind == DepositorKind::kLayer && !r.deposits.empty())
+    return reject("robot type '" + me.type.name + "' has the layer depositor: it sends depositions, not deposits");
+  if (kind != DepositorKind::kLayer && !r.depositions.empty())
+    return reject("robot type '" + me.type.name + "' has the " + to_string(kind) +
+                  " depositor: it sends deposits, not depositions");
+  if (kind != DepositorKind::kLayer) {
+    Verdict deposits = validate_deposits(state, me, x, y, r.deposits);
+    if (!deposits.accepted) return deposits;
+    if (const auto refused = check_refill(state, r, x, y)) return *refused;
+    return deposits;
+  }
   const double cs = terrain.cell_size_m();
   const double layer = cube_layer_m(me.type.body.cube_size_m, cs);
   std::vector<std::pair<int, int>> cells;
@@ -197,15 +306,8 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
     return reject("deposited volume " + fmt::format("{}", volume) + " m^3 exceeds the material on board " +
                   fmt::format("{}", me.material_m3) + " m^3");
 
-  // 4. Refill.
-  rule = 4;
-  if (r.refill) {
-    const double to_base = distance(x, y, state.base.x_m, state.base.y_m);
-    if (!(to_base <= state.base.radius_m + tol::kLengthM))
-      return reject("refill requested " + fmt::format("{}", to_base) + " m from the base station (radius " +
-                    fmt::format("{}", state.base.radius_m) + " m)");
-  }
-  return Verdict{true, {}, 0, volume};
+  if (const auto refused = check_refill(state, r, x, y)) return *refused;
+  return Verdict{true, {}, 0, volume, {}};
 }
 
 void apply_request(WorldState& state, const protocol::ActionRequest& r, const Verdict& verdict,
@@ -218,11 +320,11 @@ void apply_request(WorldState& state, const protocol::ActionRequest& r, const Ve
     me.x_m = r.target_x_m;
     me.y_m = r.target_y_m;
   }
-  if (!r.depositions.empty() &&
+  if ((!r.depositions.empty() || !verdict.rises.empty()) &&
       (state.depositor.rows() != state.terrain.rows() || state.depositor.cols() != state.terrain.cols()))
     state.depositor =
         AgentIdGrid::Zero(state.terrain.rows(), state.terrain.cols());  // a state not made by make_world_state
-  for (const Deposition& d : r.depositions) {
+  for (const Deposition& d : raised_cells(r, verdict)) {
     state.terrain(d.row, d.col) += d.height_m;
     state.depositor(d.row, d.col) = r.agent_id;
     changed_cells.push_back({d.row, d.col});

@@ -19,7 +19,7 @@ namespace {
 
 constexpr std::uint32_t kSnapshotFormat = 1;
 
-proto::LoggedRequest logged(const Submission& s, bool accepted) {
+proto::LoggedRequest logged(const Submission& s, bool accepted, const std::vector<Deposition>* raised) {
   const protocol::ActionRequest& r = s.request;
   proto::LoggedRequest q;
   q.set_channel_id(s.channel_id);
@@ -35,6 +35,19 @@ proto::LoggedRequest logged(const Submission& s, bool accepted) {
     ld->set_col(d.col);
     ld->set_height_m(d.height_m);
   }
+  for (const Deposit& d : r.deposits) {
+    proto::LoggedDeposit* ld = q.add_deposits();
+    ld->set_x_m(d.x_m);
+    ld->set_y_m(d.y_m);
+    ld->set_volume_m3(d.volume_m3);
+  }
+  if (accepted && raised != nullptr && !r.deposits.empty())
+    for (const Deposition& d : *raised) {
+      proto::LoggedDeposition* ld = q.add_raised();
+      ld->set_row(d.row);
+      ld->set_col(d.col);
+      ld->set_height_m(d.height_m);
+    }
   q.set_refill(r.refill);
   q.set_state(r.state);
   q.set_accepted(accepted);
@@ -53,6 +66,8 @@ Submission submission(const proto::LoggedRequest& q) {
   r.target_y_m = q.target_y_m();
   r.depositions.reserve(static_cast<std::size_t>(q.depositions_size()));
   for (const proto::LoggedDeposition& d : q.depositions()) r.depositions.push_back({d.row(), d.col(), d.height_m()});
+  r.deposits.reserve(static_cast<std::size_t>(q.deposits_size()));
+  for (const proto::LoggedDeposit& d : q.deposits()) r.deposits.push_back({d.x_m(), d.y_m(), d.volume_m3()});
   r.refill = q.refill();
   r.state = q.state();
   return s;
@@ -130,9 +145,11 @@ proto::LogRecord step_record(const std::vector<Submission>& submissions, const S
   proto::StepRecord* r = record.mutable_step();
   r->set_step(outcome.step);
   r->mutable_requests()->Reserve(static_cast<int>(submissions.size()));
-  for (std::size_t i = 0; i < submissions.size(); ++i)
+  for (std::size_t i = 0; i < submissions.size(); ++i) {
+    const bool accepted = i < outcome.accepted_submissions.size() && outcome.accepted_submissions[i];
     *r->add_requests() =
-        logged(submissions[i], i < outcome.accepted_submissions.size() && outcome.accepted_submissions[i]);
+        logged(submissions[i], accepted, i < outcome.raised_cells.size() ? &outcome.raised_cells[i] : nullptr);
+  }
   r->set_deposited_volume_m3(after.deposited_volume_m3);
   r->set_surplus_requests(surplus);
   return record;

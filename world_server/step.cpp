@@ -73,13 +73,14 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
     if (verdict.accepted) {
       apply_request(state, *r, verdict, changed_cells);
       out.accepted_submissions[index] = true;
-      deposited = deposited || !r->depositions.empty();
+      out.raised_cells[index] = raised_cells(*r, verdict);
+      deposited = deposited || !out.raised_cells[index].empty();
       agent.last_result = protocol::ActionResult::kAccepted;
       agent.last_reason.clear();
       ++out.accepted;
       if (verdict.volume_m3 > 0.0)
         out.events.push_back(event(step, agent.id, protocol::EventKind::kDeposited,
-                                   std::to_string(r->depositions.size()) + " cells", verdict.volume_m3));
+                                   std::to_string(out.raised_cells[index].size()) + " cells", verdict.volume_m3));
     } else {
       agent.last_result = protocol::ActionResult::kRejected;
       agent.last_reason = verdict.reason;
@@ -134,6 +135,7 @@ StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submiss
   // Per partition, in arrival order; partitions in id order. The order across partitions never matters.
   std::vector<std::vector<std::size_t>> by_agent(state.agents.size());
   out.accepted_submissions.assign(submissions.size(), false);
+  out.raised_cells.assign(submissions.size(), {});
   for (std::size_t i = 0; i < submissions.size(); ++i) {
     const Submission& s = submissions[i];
     if (!state.has_agent(s.channel_id) || !state.agent(s.channel_id).alive) {

@@ -34,6 +34,7 @@ struct StepOutcome {
   std::vector<int> changed_tiles;            ///< TileLayout indices whose heights changed, ascending
   std::vector<std::uint32_t> dropped;        ///< agents dropped in this step (3 consecutive misses)
   std::vector<bool> accepted_submissions;    ///< [i]: submission i was accepted and applied
+  std::vector<std::vector<Deposition>> raised_cells;  ///< [i]: the cells accepted submission i raised, in order
   std::uint32_t accepted = 0;                ///< requests accepted
   std::uint32_t rejected = 0;                ///< requests rejected (including duplicates and future steps)
   std::uint32_t missed = 0;                  ///< live agents without a request for this step

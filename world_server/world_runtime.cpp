@@ -585,8 +585,7 @@ struct WorldRuntime::Impl {
                                                         const StepOutcome& outcome, std::uint32_t agent) {
     static const std::vector<Deposition> none;
     for (std::size_t i = 0; i < submissions.size(); ++i)
-      if (outcome.accepted_submissions[i] && submissions[i].channel_id == agent)
-        return submissions[i].request.depositions;
+      if (outcome.accepted_submissions[i] && submissions[i].channel_id == agent) return outcome.raised_cells[i];
     return none;
   }
 

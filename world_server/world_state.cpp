@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/world_server/completion.hpp"
 #include "marsala/world_server/start_jitter.hpp"
 
@@ -45,6 +46,13 @@ WorldState make_world_state(const scenario::Scenario& scenario, Heightmap terrai
   for (std::uint32_t id = 1; id <= agent_count; ++id) {
     const scenario::AgentSlot& slot = scenario.slots[id - 1];
     const RobotType& type = scenario.robot_for(id);
+    // docs/runtime.md#depositors: a cube narrower than a cell has no footprint of its own on the heightmap.
+    if (type.depositor.name == "cube" && depositor_cube_size_m(type) < s.terrain.cell_size_m() - 1e-12)
+      throw InvalidArgument("robot type '" + type.name + "': depositor.cube_size_m " +
+                            fmt::format("{}", depositor_cube_size_m(type)) + " m is smaller than the cell size " +
+                            fmt::format("{}", s.terrain.cell_size_m()) +
+                            " m; a cube narrower than a cell has no footprint of its own (use the layer depositor, "
+                            "or a cube at least a cell wide)");
     AgentRecord a;
     a.id = id;
     a.type = type;

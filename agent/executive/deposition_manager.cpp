@@ -122,6 +122,34 @@ std::vector<DepositionCandidate> DepositionManager::candidates(const deliberativ
   return out;
 }
 
+bool DepositionManager::may_raise(const deliberative::LocalMap& map, CellIndex cell, Position robot,
+                                  const Neighbourhood& neighbours) const {
+  if (!map.contains(cell) || map.known(cell.row, cell.col) == 0) return false;
+  const Position centre = map.center(cell);
+  if (distance(centre, robot) <= 0.5 * params_.navigability.delta_m + kUnderRobotMarginM) return false;
+  if (params_.pad_radius_m > 0.0 && distance(centre, params_.pad_centre) <= params_.pad_radius_m) return false;
+  return in_territory(map, cell, centre, neighbours, map.world.cell_at(neighbours.self));
+}
+
+std::vector<WantedCell> DepositionManager::wanted(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
+                                                  Position robot, const Neighbourhood& neighbours) const {
+  std::vector<WantedCell> out;
+  const double cs = map.geometry().cell_size_m;
+  const auto ball = sorted_ball(params_.footprint_m / (2.0 * cs));
+  std::vector<std::uint8_t> seen(static_cast<std::size_t>(map.rows()) * map.cols(), 0);
+  for (const CellIndex p : path)
+    for (const CellIndex o : ball) {
+      const CellIndex cell{p.row + o.row, p.col + o.col};
+      if (!map.contains(cell)) continue;
+      std::uint8_t& s = seen[static_cast<std::size_t>(cell.row) * map.cols() + cell.col];
+      if (s) continue;
+      s = 1;
+      if (!(map.gap(cell) > 0.0) || !may_raise(map, cell, robot, neighbours)) continue;
+      out.push_back({cell, map.gap(cell)});
+    }
+  return out;
+}
+
 namespace {
 
 bool reaches_border(const CellMask& reach) {

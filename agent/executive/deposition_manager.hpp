@@ -55,10 +55,19 @@ struct DepositionCandidate {
   double height_m = 0;  ///< layers * q [m]
 };
 
-/// This step's depositions.
+/// A cell the plan wants raised towards its MARS height (local index).
+struct WantedCell {
+  CellIndex cell;     ///< local index
+  double gap_m = 0;   ///< its MARS gap [m]
+};
+
+/// This step's depositions (layer depositor) or deposits (cube, cone: executive/depositor.hpp).
 struct DepositionPlan {
   std::vector<Deposition> depositions;  ///< world indices, in path order
-  double volume_m3 = 0.0;               ///< sum of height * cs^2 [m^3]
+  std::vector<Deposit> deposits;        ///< positions [m] and volumes [m^3], in the order they are applied
+  double volume_m3 = 0.0;               ///< sum of height * cs^2 (depositions) or of the deposits' volumes [m^3]
+  /// True when the plan deposits anything.
+  bool any() const { return !depositions.empty() || !deposits.empty(); }
   int candidates = 0;                   ///< candidates before the way-back check [count]
   int dropped_for_way_back = 0;         ///< candidates dropped to keep the way back [count]
 };
@@ -78,6 +87,15 @@ class DepositionManager {
   std::vector<DepositionCandidate> candidates(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
                                               Position robot, double material_m3,
                                               const Neighbourhood& neighbours) const;
+  /// The cells along `path` (each once, in path order, the footprint of the path cell nearest the robot first) a
+  /// depositor may raise, with their MARS gap > 0: known, and may_raise(). Unlike candidates(), no reach, rounding
+  /// or budget: the cube and cone depositors place whole shapes (executive/depositor.hpp).
+  std::vector<WantedCell> wanted(const deliberative::LocalMap& map, const std::vector<CellIndex>& path, Position robot,
+                                 const Neighbourhood& neighbours) const;
+  /// True when local `cell` may be raised at all by a robot standing at `robot` [m]: known, farther than delta / 2
+  /// from it, in its territory, beyond the keep-out of every neighbour, off the base station's pad.
+  bool may_raise(const deliberative::LocalMap& map, CellIndex cell, Position robot,
+                 const Neighbourhood& neighbours) const;
   /// candidates() reduced to the longest prefix that keeps the way back (keeps_way_back()).
   DepositionPlan plan(const deliberative::LocalMap& map, const std::vector<CellIndex>& path, Position robot,
                       double material_m3, const Neighbourhood& neighbours) const;

@@ -72,6 +72,10 @@ protocol::ActionRequest NoisyLocalisation::decide(const protocol::SensorFrame& f
     request.target_x_m += frame.x_m - pose.x;
     request.target_y_m += frame.y_m - pose.y;
   }
+  for (Deposit& d : request.deposits) {  // a cube or cone depositor's positions
+    d.x_m += frame.x_m - pose.x;
+    d.y_m += frame.y_m - pose.y;
+  }
   // Believed cell (r, c) is world cell (r - k.row, c - k.col).
   std::vector<Deposition> landed;
   landed.reserve(request.depositions.size());

@@ -6,7 +6,7 @@
 // sensing window (registered at k: set_registration; the world sends only tiles that changed, the sensor sees its
 // whole window, so tiles received earlier are registered again from a cache). Its actuators carry out what it asked
 // from where it truly is: a motion to believed target T goes to T - k cs, a deposition on believed cell c lands on
-// world cell c - k (dropped when off the grid).
+// world cell c - k (dropped when off the grid), a cube or cone deposit at believed point p at p - k cs.
 //
 // Within one frame pose, map and actions agree, as for a robot without error: what the error changes is where the
 // robot puts everything given in world coordinates (its target, the base station, the arrows of a goal vector map),

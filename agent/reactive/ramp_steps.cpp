@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "marsala/agent/executive/depositor.hpp"
 #include "marsala/agent/executive/lane.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/core/enum_names.hpp"
@@ -52,7 +53,8 @@ struct RampSteps::Modules {
   NavigablePathPlanner router;   // shortest routes through navigable cells (alpha = 0)
   executive::ActionManager actions;
   executive::DepositionManager depositions;
-  int max_idle_retreat_moves;  // retreat moves without work before trying to advance again
+  int max_idle_retreat_moves;
+  std::unique_ptr<executive::Depositor> depositor;  // turns the manager's wish into depositions or deposits  // retreat moves without work before trying to advance again
 };
 
 RampSteps::RampSteps(const AgentContext& context, std::optional<PlannerParams> planner)
@@ -61,6 +63,7 @@ RampSteps::RampSteps(const AgentContext& context, std::optional<PlannerParams> p
   (void)NavigabilityProcessor(context_.type.body.navigability);
   (void)NavigabilityProcessor(construction_params(context_.type));
   deliberative::require_goal_synthesizer(context_.type.goal_synthesizer);
+  (void)executive::make_depositor(context_.type);
 }
 
 RampSteps::~RampSteps() = default;
@@ -88,7 +91,8 @@ void RampSteps::admit(const protocol::Admission& admission) {
               deliberative::LocalMapSynthesizer(body.navigability, body.sensing_range_m, build.kappa),
               NavigablePathPlanner(planner), NavigablePathPlanner(router), executive::ActionManager(body.max_step_m),
               executive::DepositionManager(deposits),
-              static_cast<int>(std::ceil((body.reach_m + body.navigability.delta_m) / body.max_step_m)) + 1});
+              static_cast<int>(std::ceil((body.reach_m + body.navigability.delta_m) / body.max_step_m)) + 1,
+              executive::make_depositor(context_.type)});
   goal_ = deliberative::make_goal_synthesizer(context_.type.goal_synthesizer, context_);
 }
 
@@ -99,6 +103,11 @@ void RampSteps::set_registration(CellIndex offset) {
 
 BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace) {
   modules_->map.set_registration(registration_);
+  if (frame.last_result == protocol::ActionResult::kRejected && deposits_sent_ > 0)
+    deposit_limit_ = deposits_sent_ / 2;
+  else if (frame.last_result == protocol::ActionResult::kAccepted)
+    deposit_limit_ = -1;
+  deposits_sent_ = 0;
   const Position robot{frame.x_m, frame.y_m};
   modules_->map.integrate(frame.tiles, robot);
   const SensorSpec& sensor = context_.type.sensor;
@@ -175,8 +184,17 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
     terrain_only.occupiable = terrain_occupiable_;
     terrain_only.navigable = corridor_;
   }
-  trace.deposition = modules_->depositions.plan(terrain_only, ahead, at, frame.material_m3, neighbourhood(frame));
+  trace.deposition = modules_->depositor->plan(modules_->depositions, terrain_only, ahead, at, frame.material_m3,
+                                               neighbourhood(frame));
+  auto& deposits = trace.deposition.deposits;
+  if (deposit_limit_ >= 0 && deposits.size() > static_cast<std::size_t>(deposit_limit_)) {
+    deposits.resize(static_cast<std::size_t>(deposit_limit_));
+    trace.deposition.volume_m3 = 0.0;
+    for (const Deposit& d : deposits) trace.deposition.volume_m3 += d.volume_m3;
+  }
+  deposits_sent_ = static_cast<int>(deposits.size());
   request.depositions = trace.deposition.depositions;
+  request.deposits = deposits;
 }
 
 std::optional<BuildPhase> RampSteps::build_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,
@@ -189,7 +207,7 @@ std::optional<BuildPhase> RampSteps::build_step(const deliberative::LocalMap& lo
     return BuildPhase::kAdvance;
   }
   deposit(local, frame, robot, 0, trace, request);
-  if (!request.depositions.empty()) return BuildPhase::kBuild;
+  if (trace.deposition.any()) return BuildPhase::kBuild;
   deposited_since_blocked_ = false;
   idle_retreat_moves_ = 0;
   return retreat_step(local, frame, trace, request);
@@ -204,7 +222,7 @@ BuildPhase RampSteps::retreat_step(const deliberative::LocalMap& local, const pr
   }
   const auto& path = trace.plan.path;
   deposit(local, frame, robot, 0, trace, request);
-  if (!request.depositions.empty()) {
+  if (trace.deposition.any()) {
     deposited_since_blocked_ = true;
     idle_retreat_moves_ = 0;
     return BuildPhase::kRetreat;
@@ -225,7 +243,7 @@ BuildPhase RampSteps::retreat_step(const deliberative::LocalMap& local, const pr
   if (!motion) return BuildPhase::kRetreat;
   move(*motion, trace, request);
   deposit(local, frame, motion->target, 0, trace, request);
-  if (!request.depositions.empty()) {
+  if (trace.deposition.any()) {
     deposited_since_blocked_ = true;
     idle_retreat_moves_ = 0;
   }

@@ -142,6 +142,11 @@ class RampSteps {
   CellIndex registration_{0, 0};       // set_registration()
   bool deposited_since_blocked_ = false;
   int idle_retreat_moves_ = 0;
+  // The world gives deposits (cube, cone) their shape and may judge one the prediction passed: after a rejected
+  // request with deposits, the next ones carry at most half as many (none after one), until one is accepted, so a
+  // mismatch never repeats the same request forever. -1: no limit.
+  int deposit_limit_ = -1;
+  mutable int deposits_sent_ = 0;  // deposits in the request being built (the last deposit() call's)
   std::vector<executive::BodyClearance> others_;  // the last frame's neighbours
   CellMask corridor_;                             // the last local map's navigable cells, neighbours not taken out
   CellMask terrain_occupiable_;                   // and its occupiable cells

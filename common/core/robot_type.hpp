@@ -27,6 +27,17 @@ struct Localisation {
   double correlation_steps = 50.0;   ///< steps over which the error decorrelates to 1/e [steps]
 };
 
+/// What a robot's depositor does with material (docs/runtime.md#depositors): "layer" (the default) raises whole
+/// cells by whole cube layers (Deposition), "cube" places columns of cubes and "cone" dumps granular material that
+/// settles at its angle of repose, both at a position (Deposit; common/core/deposit_shapes.hpp).
+struct DepositorSpec {
+  std::string name = "layer";  ///< "layer", "cube" or "cone" (depositor_names())
+  /// cube: side of one cube [m]; unset: the body's cube_size_m. Must be >= the grid's cell size (the world refuses
+  /// to start otherwise): a narrower cube has no footprint of its own on the heightmap.
+  std::optional<double> cube_size_m;
+  double repose_deg = 34.0;  ///< cone: angle of repose of the material, in (0, 90) [deg]
+};
+
 /// A kind of robot.
 struct RobotType {
   std::string name;                        ///< e.g. "husky"
@@ -39,7 +50,13 @@ struct RobotType {
   std::string goal_synthesizer = "fixed_target";  ///< goal synthesizer by name (agent registry)
   Localisation localisation;                      ///< how wrong the robot's own pose estimate is
   SensorSpec sensor;  ///< what it senses the terrain with (default ground truth tiles)
+  DepositorSpec depositor;                        ///< how it deposits (scenario field 8)
 };
+
+/// The cube side of a "cube" depositor: its own, else the body's cube_size_m [m].
+inline double depositor_cube_size_m(const RobotType& type) {
+  return type.depositor.cube_size_m.value_or(type.body.cube_size_m);
+}
 
 /// What `type` builds: its construction, or its own body's kappa, delta (as the band width) and eps.
 inline NavigabilityParams construction_params(const RobotType& type) {

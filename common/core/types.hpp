@@ -57,6 +57,14 @@ struct Deposition {
   double height_m = 0.0;
 };
 
+/// Deposit `volume_m3` of material with its centre at (x_m, y_m) in the world frame: the robot's depositor gives it
+/// its physical shape (common/core/deposit_shapes.hpp: a column of cubes, a cone of granular material).
+struct Deposit {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double volume_m3 = 0.0;
+};
+
 /// Fixed tolerances every implementation shares (ARCHITECTURE.md, grid conventions).
 namespace tolerance {
 /// Added to (delta / (2 cs))^2 when deciding whether an offset lies in the ball [cells^2].

@@ -18,6 +18,7 @@
 namespace marsala::protocol {
 
 // Core vocabulary the messages carry as it is.
+using marsala::Deposit;
 using marsala::Deposition;
 using marsala::Neighbour;
 using marsala::ScanPoint;
@@ -73,7 +74,8 @@ struct ActionRequest {
   bool move = false;  ///< move to (target_x_m, target_y_m) this step
   double target_x_m = 0.0;
   double target_y_m = 0.0;
-  std::vector<Deposition> depositions;  ///< applied after the motion, within reach of the new position
+  std::vector<Deposition> depositions;  ///< applied after the motion, within reach of the new position (layer)
+  std::vector<Deposit> deposits;        ///< same, for a cube or cone depositor: the world gives them their shape
   bool refill = false;                  ///< top up material (only at the base station)
   std::string state;                    ///< the behaviour's state name, for the monitor
 };

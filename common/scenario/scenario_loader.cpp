@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "idl/scenario.pb.h"
+#include "marsala/core/deposit_shapes.hpp"
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
@@ -172,6 +173,29 @@ SensorSpec to_sensor(const proto::Sensor& p, const std::string& field, const Val
   return s;
 }
 
+DepositorSpec to_depositor(const proto::Depositor& p, const RobotBody& body, const std::string& field,
+                           const Validator& check) {
+  DepositorSpec d;
+  if (p.has_name()) d.name = p.name();
+  try {
+    depositor_kind(d.name);
+  } catch (const InvalidArgument& e) {
+    check.fail(field + ".name", e.what());
+  }
+  if (p.has_cube_size_m()) {
+    if (d.name != "cube") check.fail(field + ".cube_size_m", "applies to the 'cube' depositor only");
+    d.cube_size_m = check.positive(field + ".cube_size_m", p.cube_size_m());
+  }
+  if (d.name == "cube" && !(body.cube_size_m > 0.0)) check.fail(field + ".cube_size_m", "the body's must be > 0");
+  if (p.has_repose_deg()) {
+    if (d.name != "cone") check.fail(field + ".repose_deg", "applies to the 'cone' depositor only");
+    d.repose_deg = check.finite(field + ".repose_deg", p.repose_deg());
+    if (!(d.repose_deg > 0.0 && d.repose_deg < 90.0))
+      check.fail(field + ".repose_deg", fmt::format("{}", d.repose_deg) + " must be in (0, 90) degrees");
+  }
+  return d;
+}
+
 bool valid_name(const std::string& name) {
   if (name.empty()) return false;
   for (char c : name)
@@ -240,6 +264,7 @@ Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
     if (t.goal_synthesizer == "goal_vector_map" && !p.has_goal_vector_map())
       check.fail(field + ".goal_synthesizer", "'goal_vector_map' needs the scenario's goal_vector_map block");
     t.sensor = to_sensor(rp.sensor(), field + ".sensor", check);
+    t.depositor = to_depositor(rp.depositor(), t.body, field + " (" + t.name + ").depositor", check);
     s.robot_types.push_back(std::move(t));
   }
 

@@ -1,8 +1,10 @@
 // Fuzzes the world's request validation and step (world_server/arbiter.hpp validate_request, step.hpp apply_step):
 // small seeded worlds take runs of steps of plausible requests with mutated fields (NaN, infinite and huge doubles,
-// off-grid and duplicated cells, bad heights, forged ids, sessions and steps, huge lists). Properties, checked
-// against an oracle written here from docs/runtime.md rather than from arbiter.cpp: validation never throws; the
-// terrain changes exactly by the accepted depositions and the deposited volume by their volume; heights stay finite;
+// off-grid and duplicated cells, bad heights, forged ids, sessions and steps, huge lists; deposits of cube and cone
+// depositors with nasty positions and volumes, of the wrong kind, many of them). Properties, checked against an
+// oracle written here from docs/runtime.md rather than from arbiter.cpp: validation never throws; the terrain changes
+// exactly by the accepted depositions (and the deposits' shapes, from common/core/deposit_shapes.hpp) and the
+// deposited volume by their volume; heights stay finite;
 // material stays within [0, capacity]; agents stay on the grid and move at most max_step_m; an accepted request
 // obeys rules 1-4; rejected and unanswered agents change only their counts.
 
@@ -15,6 +17,7 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -23,6 +26,7 @@
 #include <vector>
 
 #include "fuzz/fuzz_support.hpp"
+#include "marsala/core/deposit_shapes.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/world_server/arbiter.hpp"
 #include "marsala/world_server/step.hpp"
@@ -54,8 +58,9 @@ class WorldFuzzer {
   WorldState make_world() {
     static const std::vector<std::string> kCompletions = {"goal { x0_m: 2.9 y0_m: 1.9 x1_m: 3.2 y1_m: 2.2 }",
                                                           payload_block(2), site_block(2, 0.5)};
-    const scenario::Scenario s =
-        scenario::parse_scenario(small_scenario_text_completing(mutator_.pick(kCompletions)), "fuzz.pbtxt");
+    std::string text = small_scenario_text_completing(mutator_.pick(kCompletions));
+    if (mutator_.chance(0.5)) text = with_depositors(text);
+    const scenario::Scenario s = scenario::parse_scenario(text, "fuzz.pbtxt");
     Heightmap terrain = flat_terrain();
     const bool blocky = mutator_.chance(0.3);
     for (long long i = 0; i < terrain.size(); ++i)
@@ -95,6 +100,34 @@ class WorldFuzzer {
   }
 
  private:
+  /// The small scenario with agent 2 a cube depositor (side 0.1 m or 0.15 m) and agent 3 a cone depositor.
+  std::string with_depositors(std::string text) {
+    const std::string cube = mutator_.chance(0.5) ? "0.1" : "0.15";
+    const std::string types = std::string(R"(
+robot_type {
+  name: "cuber"
+  behaviour: "scripted"
+  body { kappa: 0.3 delta_m: 1.0 eps_m: 0.05 max_step_m: 0.2 max_deposit_m3: 0.02 material_capacity_m3: 0.05
+         reach_m: 1.2 sensing_range_m: 1.0 proximity_range_m: 1.5 cube_size_m: 0.05 }
+  depositor { name: "cube" cube_size_m: )") + cube + R"( }
+}
+robot_type {
+  name: "piler"
+  behaviour: "scripted"
+  body { kappa: 0.3 delta_m: 1.0 eps_m: 0.05 max_step_m: 0.2 max_deposit_m3: 0.02 material_capacity_m3: 0.05
+         reach_m: 1.2 sensing_range_m: 1.0 proximity_range_m: 1.5 cube_size_m: 0.05 }
+  depositor { name: "cone" repose_deg: 30 }
+}
+)";
+    const std::size_t agents = text.find("agent {");
+    text.insert(agents, types);
+    const std::size_t second = text.find("robot_type: \"tester\"", text.find("agent {", agents + types.size()) + 1);
+    text.replace(second, 20, "robot_type: \"cuber\"");
+    const std::size_t third = text.find("robot_type: \"tester\"", second + 1);
+    text.replace(third, 20, "robot_type: \"piler\"");
+    return text;
+  }
+
   double uniform(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(mutator_.rng()); }
 
   std::uint32_t pick_id(const WorldState& state) {
@@ -148,7 +181,15 @@ class WorldFuzzer {
     }
     const auto centre = state.terrain.cell_at({x, y});
     const int reach = static_cast<int>(me.type.body.reach_m / state.terrain.cell_size_m()) + 1;
-    for (std::size_t n = mutator_.below(6); n > 0 && centre; --n) {
+    const DepositorKind kind = depositor_kind(me.type.depositor.name);
+    for (std::size_t n = kind == DepositorKind::kLayer ? 0 : mutator_.below(4); n > 0; --n) {
+      const double angle = uniform(0.0, 6.283185307179586), d = uniform(0.0, 1.1 * me.type.body.reach_m);
+      const double side = depositor_cube_size_m(me.type);
+      const double volume = kind == DepositorKind::kCube ? side * side * side * static_cast<double>(1 + mutator_.below(4))
+                                                         : uniform(0.0, 0.008);
+      r.deposits.push_back({x + d * std::cos(angle), y + d * std::sin(angle), volume});
+    }
+    for (std::size_t n = kind == DepositorKind::kLayer ? mutator_.below(6) : 0; n > 0 && centre; --n) {
       const int row = centre->row + static_cast<int>(mutator_.below(2 * reach + 1)) - reach;
       const int col = centre->col + static_cast<int>(mutator_.below(2 * reach + 1)) - reach;
       r.depositions.push_back({row, col, kLayer * static_cast<double>(1 + mutator_.below(4))});
@@ -161,7 +202,7 @@ class WorldFuzzer {
   void mutate(const WorldState& state, protocol::ActionRequest& r) {
     const int rows = state.terrain.rows(), cols = state.terrain.cols();
     for (std::size_t n = 1 + mutator_.below(3); n > 0; --n) {
-      switch (mutator_.below(13)) {
+      switch (mutator_.below(17)) {
         case 0: r.agent_id = pick_id(state); break;
         case 1: r.session = mutator_.chance(0.5) ? r.session + 1 : mutator_.rng()(); break;
         case 2: {
@@ -199,6 +240,34 @@ class WorldFuzzer {
         }
         case 10: r.refill = !r.refill; break;
         case 11: r.state.assign(mutator_.chance(0.5) ? 100000 : 3, '\xff'); break;
+        case 12: {  // a deposit's field nasty
+          if (r.deposits.empty()) r.deposits.push_back({r.target_x_m, r.target_y_m, 0.001});
+          Deposit& d = r.deposits[mutator_.below(r.deposits.size())];
+          const double nasty = mutator_.chance(0.5) ? mutator_.pick(fuzz::nasty_doubles()) : nasty_height();
+          (mutator_.chance(0.33) ? d.x_m : mutator_.chance(0.5) ? d.y_m : d.volume_m3) = nasty;
+          break;
+        }
+        case 13:  // the other kind: a deposit from a layer robot, a deposition from a cube or cone robot
+          if (mutator_.chance(0.5))
+            r.deposits.push_back({r.target_x_m, r.target_y_m, 0.001});
+          else
+            r.depositions.push_back({20, 20, kLayer});
+          break;
+        case 14:  // duplicates, at the grid's edge, or many
+          if (mutator_.chance(0.3)) {
+            r.deposits.assign(mutator_.chance(0.5) ? 256 : 257 + mutator_.below(3000), Deposit{2.0, 2.0, 1e-6});
+          } else if (!r.deposits.empty()) {
+            Deposit d = r.deposits[mutator_.below(r.deposits.size())];
+            if (mutator_.chance(0.5)) d.x_m = mutator_.chance(0.5) ? 0.01 : 3.99;
+            r.deposits.push_back(d);
+          }
+          break;
+        case 15:  // volumes around the limits: a cube and a half, just over the threshold, tiny
+          if (!r.deposits.empty()) {
+            const double volumes[] = {0.0015, 0.001 * (1 + 1e-9), 0.02, 0.02 + 1e-9, 1e-300, 0.0, -0.001, 0.05};
+            r.deposits[mutator_.below(r.deposits.size())].volume_m3 = volumes[mutator_.below(8)];
+          }
+          break;
         default:
           for (Deposition& d : r.depositions) d.height_m = mutator_.pick(fuzz::nasty_doubles());
           break;
@@ -215,7 +284,10 @@ std::string describe(const protocol::ActionRequest& r) {
   std::ostringstream out;
   out.precision(17);
   out << "{agent " << r.agent_id << " session " << r.session << " step " << r.step << " move " << r.move << " ("
-      << r.target_x_m << ", " << r.target_y_m << ") refill " << r.refill << " depositions " << r.depositions.size();
+      << r.target_x_m << ", " << r.target_y_m << ") refill " << r.refill << " depositions " << r.depositions.size()
+      << " deposits " << r.deposits.size();
+  for (std::size_t i = 0; i < r.deposits.size() && i < 12; ++i)
+    out << " {" << r.deposits[i].x_m << "," << r.deposits[i].y_m << " " << r.deposits[i].volume_m3 << "}";
   for (std::size_t i = 0; i < r.depositions.size() && i < 12; ++i)
     out << " [" << r.depositions[i].row << "," << r.depositions[i].col << " " << r.depositions[i].height_m << "]";
   out << "}";
@@ -308,6 +380,22 @@ void check_accepted_request(const WorldState& before, const AgentRecord& me, con
     ASSERT_LE(distance(c.x, c.y, x, y), body.reach_m + tol::kLengthM) << report();
     volume += d.height_m * cs * cs;
   }
+  const DepositorKind kind = depositor_kind(me.type.depositor.name);
+  ASSERT_TRUE(kind == DepositorKind::kLayer ? r.deposits.empty() : r.depositions.empty())
+      << "a request of the other depositor kind accepted\n"
+      << report();
+  ASSERT_LE(r.deposits.size(), tol::kMaxDeposits) << report();
+  for (const Deposit& d : r.deposits) {
+    ASSERT_TRUE(std::isfinite(d.x_m) && std::isfinite(d.y_m) && std::isfinite(d.volume_m3) && d.volume_m3 > 0.0)
+        << report();
+    ASSERT_LE(distance(d.x_m, d.y_m, x, y), body.reach_m + tol::kLengthM) << report();
+    if (kind == DepositorKind::kCube) {
+      const double side = depositor_cube_size_m(me.type), cubes = d.volume_m3 / (side * side * side);
+      ASSERT_NEAR(cubes, std::round(cubes), 1e-6) << report();
+      ASSERT_GE(std::round(cubes), 1.0) << report();
+    }
+    volume += d.volume_m3;
+  }
   ASSERT_LE(volume, body.max_deposit_m3 + tol::kVolumeM3) << report();
   ASSERT_LE(volume, me.material_m3 + tol::kVolumeM3) << report();
   if (r.refill) {
@@ -317,7 +405,7 @@ void check_accepted_request(const WorldState& before, const AgentRecord& me, con
 
 /// Runs one step on `state` and checks it against the oracle.
 void check_step(WorldState& state, const std::vector<Submission>& submissions,
-                const std::function<std::string()>& report) {
+                const std::function<std::string()>& report, long long& deposit_requests) {
   // Validation alone never throws, whatever arrives on whichever partition.
   for (const Submission& s : submissions) {
     try {
@@ -386,6 +474,29 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
       expected_depositor[static_cast<std::size_t>(d.row) * expected.cols() + d.col] = was.id;
       volume += d.height_m * expected.cell_size_m() * expected.cell_size_m();
     }
+    // Deposits: each shape on the terrain as the ones before it left it; on the grid, no cell under this robot,
+    // no cell raised more than 1 m by the request, the volume the deposit's within the cone's tolerance.
+    std::map<std::pair<int, int>, double> raised;
+    deposit_requests += r.deposits.empty() ? 0 : 1;
+    for (const Deposit& d : r.deposits) {
+      const bool cube = depositor_kind(was.type.depositor.name) == DepositorKind::kCube;
+      const double side = depositor_cube_size_m(was.type);
+      const DepositShape shape =
+          cube ? cube_column_shape(expected.geometry(), {d.x_m, d.y_m}, side,
+                                   static_cast<int>(std::round(d.volume_m3 / (side * side * side))))
+               : cone_pile_shape(expected, {d.x_m, d.y_m}, d.volume_m3, was.type.depositor.repose_deg);
+      ASSERT_TRUE(shape.on_grid) << report();
+      ASSERT_NEAR(shape.volume_m3, d.volume_m3, 1e-9 * d.volume_m3 + 1e-15) << report();
+      for (const CellRise& c : shape.rises) {
+        const Position p = expected.cell_center(c.cell);
+        ASSERT_GT(distance(p.x, p.y, now.x_m, now.y_m), 0.5 * body.navigability.delta_m) << report();
+        const double total = raised[std::make_pair(c.cell.row, c.cell.col)] += c.rise_m;
+        ASSERT_LE(total, 1.0 + tol::kLengthM) << report();
+        expected(c.cell) += c.rise_m;
+        expected_depositor[static_cast<std::size_t>(c.cell.row) * expected.cols() + c.cell.col] = was.id;
+        volume += c.rise_m * expected.cell_size_m() * expected.cell_size_m();
+      }
+    }
     added_volume += volume;
     const double material = r.refill ? body.material_capacity_m3 : std::max(0.0, was.material_m3 - volume);
     ASSERT_NEAR(now.material_m3, material, 1e-12) << report();
@@ -423,7 +534,7 @@ TEST(WorldRequestFuzz, ValidationNeverThrowsAndStepsChangeExactlyWhatTheyAccept)
   constexpr int kStepsPerWorld = 24;
   WorldFuzzer fuzzer(seed);
   fuzz::Watchdog watchdog;
-  long long accepted = 0, rejected = 0, deposited = 0;
+  long long accepted = 0, rejected = 0, deposited = 0, deposit_requests = 0;
   for (int w = 0; w < worlds; ++w) {
     WorldState state = fuzzer.make_world();
     for (int k = 0; k < kStepsPerWorld && !state.live_ids().empty(); ++k) {
@@ -434,7 +545,7 @@ TEST(WorldRequestFuzz, ValidationNeverThrowsAndStepsChangeExactlyWhatTheyAccept)
       const double volume = state.deposited_volume_m3;
       watchdog.arm(std::chrono::seconds(5), where, describe(state, submissions),
                    fuzz::failure_path("world", seed, w, ".txt"));
-      check_step(state, submissions, [&] { return where + ": " + describe(copy, submissions); });
+      check_step(state, submissions, [&] { return where + ": " + describe(copy, submissions); }, deposit_requests);
       watchdog.disarm();
       if (::testing::Test::HasFailure()) return;
       for (std::size_t i = 0; i < state.agents.size(); ++i) {
@@ -448,6 +559,8 @@ TEST(WorldRequestFuzz, ValidationNeverThrowsAndStepsChangeExactlyWhatTheyAccept)
   EXPECT_GT(accepted, worlds) << "accepted " << accepted;
   EXPECT_GT(deposited, worlds / 2) << "steps with depositions: " << deposited;
   EXPECT_GT(rejected, worlds) << "rejected " << rejected;
+  EXPECT_GT(deposit_requests, worlds / 4) << "accepted requests with cube or cone deposits: " << deposit_requests;
+  RecordProperty("deposit_requests", static_cast<int>(deposit_requests));
   RecordProperty("accepted", static_cast<int>(accepted));
   RecordProperty("rejected", static_cast<int>(rejected));
   RecordProperty("steps_with_depositions", static_cast<int>(deposited));

@@ -18,6 +18,13 @@
 #   three_gaps tests/integration/scenarios/path_three_gaps.pbtxt, 3 path builders (Cyclone DDS): the payload reaches the
 #          target on terrain_final.asc (not before), the target's cell at most one cube layer higher, and what was
 #          built forms three separate sites, one past each cliff (found on terrain_initial.asc), natural ground between
+#   depositors tests/integration/scenarios/ramp_depositors.pbtxt run three times, one robot with the "layer", "cube"
+#          (0.1 m cubes; Cyclone DDS) and "cone" (34 deg; Fast DDS) depositor: each completes (no request rejected),
+#          the summary's volume equals the terrain's change, the target is navigable for the body from the start on
+#          terrain_final.asc (not before), and `marsala-monitor replay` rebuilds the same terrain_sha256 from run.log;
+#          cube: every raised cell rose by whole cubes (a multiple of 0.1 m: columns on cell centres); cone: no
+#          raised cell stands above a neighbour by more than tan(34 deg) times their distance (the angle of repose).
+#          Prints steps and m^3 of each.
 #
 # Usage: scenario_test.sh shipped DOMAIN NAME AGENTS DDS
 #   shipped deploy/scenarios/NAME.pbtxt as shipped, AGENTS agents on DDS, to its end: completed, no request rejected,
@@ -190,6 +197,62 @@ case "$case_name" in
       fail "summary.json's construction_sites $sites_json: not three sites holding all $(field deposited_volume_m3 "$s") m^3"
     echo "ok: three_gaps: $(cat "$work/sites.txt"); sites along the path (from, to, m^3) $sites_json;" \
       "payload path $(field path_length_m "$s") m after $(field steps "$s") steps, $(field deposited_volume_m3 "$s") m^3"
+    ;;
+  depositors)
+    report=""
+    for kind in layer cube cone; do
+      dds=cyclone
+      [ "$kind" = cone ] && dds=fastdds
+      sed "s/depositor { name: \"layer\" }/depositor { name: \"$kind\" }/" "$scenarios/ramp_depositors.pbtxt" \
+        >"$work/ramp_$kind.pbtxt"
+      grep -q "name: \"$kind\" }" "$work/ramp_$kind.pbtxt" || fail "could not set the $kind depositor"
+      out="$work/run_$kind"
+      "$root/deploy/spawn.sh" --scenario "$work/ramp_$kind.pbtxt" --agents 1 --dds "$dds" --domain "$domain" \
+        --out "$out" --quiet --timeout 120 >&2 || fail "$kind: spawn.sh failed (logs: $out/logs)"
+      s="$out/summary.json"
+      [ -f "$s" ] || fail "$kind: no summary.json"
+      expect_completed "$s" 1
+      awk -v v="$(field deposited_volume_m3 "$s")" '
+        FNR <= 6 { next }
+        NR == FNR { for (i = 1; i <= NF; i++) h[FNR, i] = $i; next }
+        { for (i = 1; i <= NF; i++) { d = $i - h[FNR, i]; if (d < -1e-9) neg++; sum += d } }
+        END { sum *= 0.01; if (neg || sum < v - 1e-6 || sum > v + 1e-6) { print "terrain change " sum " m^3, summary " v " m^3, " neg + 0 " cells lowered"; exit 1 } }
+      ' "$out/terrain_initial.asc" "$out/terrain_final.asc" || fail "$kind: deposited volume does not match the terrain"
+      # Start (2.05, 3.05) m -> row 29, col 20; target (9.05, 3.05) m -> row 29, col 90 (60 rows of 0.1 m).
+      for t in initial final; do
+        "$bin/marsala-terrain" navigable --kappa 0.3 --delta 1 --eps 0.1 --origin-cell 29 20 "$out/terrain_$t.asc" \
+          -o "$work/nav_${kind}_$t.asc" >/dev/null
+      done
+      [ "$(asc_cell "$work/nav_${kind}_initial.asc" 29 90)" = "0" ] || fail "$kind: the target was navigable before"
+      [ "$(asc_cell "$work/nav_${kind}_final.asc" 29 90)" = "1" ] || fail "$kind: the target is not navigable after"
+      replayed=$("$bin/marsala-monitor" replay "$out" | awk '/^terrain_sha256/ { print $2 }')
+      [ "$replayed" = "$(field terrain_sha256 "$s")" ] ||
+        fail "$kind: replay rebuilt terrain $replayed, the run ended on $(field terrain_sha256 "$s")"
+      case "$kind" in
+        cube)
+          awk 'FNR <= 6 { next } NR == FNR { for (i = 1; i <= NF; i++) h[FNR, i] = $i; next }
+               { for (i = 1; i <= NF; i++) { d = $i - h[FNR, i]; k = d / 0.1
+                 if (d > 1e-9 && (k - int(k + 0.5) > 1e-6 || int(k + 0.5) - k > 1e-6)) { n++ } } }
+               END { if (n) { print n " cells rose by a fraction of a cube"; exit 1 } }' \
+            "$out/terrain_initial.asc" "$out/terrain_final.asc" || fail "cube: not whole cubes"
+          ;;
+        cone)
+          # Every raised cell against its 8 neighbours: at most tan(34 deg) = 0.6745 x distance higher (1e-6 m).
+          awk 'FNR <= 6 { next } NR == FNR { for (i = 1; i <= NF; i++) h0[FNR, i] = $i; next }
+               { for (i = 1; i <= NF; i++) h[FNR, i] = $i; rows = FNR; cols = NF }
+               END { t = 0.674508516842; for (r = 7; r <= rows; r++) for (c = 1; c <= cols; c++) {
+                       if (h[r, c] - h0[r, c] <= 1e-9) continue
+                       for (dr = -1; dr <= 1; dr++) for (dc = -1; dc <= 1; dc++) {
+                         if ((dr || dc) && (r + dr, c + dc) in h) {
+                           lim = t * 0.1 * sqrt(dr * dr + dc * dc) + 1e-6
+                           if (h[r, c] - h[r + dr, c + dc] > lim) n++ } } }
+                     if (n) { print n " raised cells steeper than the angle of repose"; exit 1 } }' \
+            "$out/terrain_initial.asc" "$out/terrain_final.asc" || fail "cone: steeper than the angle of repose"
+          ;;
+      esac
+      report="$report $kind: $(field steps "$s") steps, $(field deposited_volume_m3 "$s") m^3;"
+    done
+    echo "ok: depositors (ramp_depositors, one robot):$report"
     ;;
   shipped)
     name="$3" agents="$4" dds="$5"

@@ -6,6 +6,7 @@
 namespace marsala::bus::cyclone {
 using protocol::ActionResult;
 using protocol::AgentStatus;
+using protocol::Deposit;
 using protocol::Deposition;
 using protocol::EventKind;
 using protocol::Neighbour;
@@ -231,6 +232,15 @@ marsala_wire_ActionRequest to_msg(const ActionRequest& in, Storage& storage) {
     storage.depositions.push_back(deposition);
   }
   out.depositions = borrow_seq<dds_sequence_marsala_wire_Deposition>(storage.depositions);
+  storage.deposits.clear();
+  for (const Deposit& d : in.deposits) {
+    marsala_wire_Deposit deposit{};
+    deposit.x_m = d.x_m;
+    deposit.y_m = d.y_m;
+    deposit.volume_m3 = d.volume_m3;
+    storage.deposits.push_back(deposit);
+  }
+  out.deposits = borrow_seq<dds_sequence_marsala_wire_Deposit>(storage.deposits);
   out.refill = in.refill;
   out.state = borrow(in.state);
   return out;
@@ -252,6 +262,15 @@ ActionRequest from_msg(const marsala_wire_ActionRequest& in) {
     deposition.col = d.col;
     deposition.height_m = d.height_m;
     out.depositions.push_back(deposition);
+  }
+  out.deposits.reserve(in.deposits._length);
+  for (std::uint32_t i = 0; i < in.deposits._length; ++i) {
+    const marsala_wire_Deposit& d = in.deposits._buffer[i];
+    Deposit deposit;
+    deposit.x_m = d.x_m;
+    deposit.y_m = d.y_m;
+    deposit.volume_m3 = d.volume_m3;
+    out.deposits.push_back(deposit);
   }
   out.refill = in.refill;
   out.state = copy(in.state);

@@ -16,6 +16,7 @@ struct Storage {
   std::vector<marsala_wire_Neighbour> neighbours;
   std::vector<marsala_wire_ScanPoint> points;
   std::vector<marsala_wire_Deposition> depositions;
+  std::vector<marsala_wire_Deposit> deposits;
   std::vector<marsala_wire_AgentStatus> agents;
 };
 

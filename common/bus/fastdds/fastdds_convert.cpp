@@ -3,6 +3,7 @@
 namespace marsala::bus::fastdds {
 using protocol::ActionResult;
 using protocol::AgentStatus;
+using protocol::Deposit;
 using protocol::Deposition;
 using protocol::EventKind;
 using protocol::Neighbour;
@@ -205,6 +206,14 @@ wire::ActionRequest to_msg(const ActionRequest& in) {
     deposition.height_m(d.height_m);
     out.depositions().push_back(deposition);
   }
+  out.deposits().reserve(in.deposits.size());
+  for (const Deposit& d : in.deposits) {
+    wire::Deposit deposit;
+    deposit.x_m(d.x_m);
+    deposit.y_m(d.y_m);
+    deposit.volume_m3(d.volume_m3);
+    out.deposits().push_back(deposit);
+  }
   out.refill(in.refill);
   out.state(in.state);
   return out;
@@ -225,6 +234,14 @@ ActionRequest from_msg(const wire::ActionRequest& in) {
     deposition.col = d.col();
     deposition.height_m = d.height_m();
     out.depositions.push_back(deposition);
+  }
+  out.deposits.reserve(in.deposits().size());
+  for (const wire::Deposit& d : in.deposits()) {
+    Deposit deposit;
+    deposit.x_m = d.x_m();
+    deposit.y_m = d.y_m();
+    deposit.volume_m3 = d.volume_m3();
+    out.deposits.push_back(deposit);
   }
   out.refill = in.refill();
   out.state = in.state();

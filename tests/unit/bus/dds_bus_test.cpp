@@ -147,6 +147,12 @@ void expect_same(const ActionRequest& a, const ActionRequest& b) {
     EXPECT_EQ(a.depositions[i].col, b.depositions[i].col);
     EXPECT_SAME_DOUBLE(a.depositions[i].height_m, b.depositions[i].height_m);
   }
+  ASSERT_EQ(a.deposits.size(), b.deposits.size());
+  for (std::size_t i = 0; i < a.deposits.size(); ++i) {
+    EXPECT_SAME_DOUBLE(a.deposits[i].x_m, b.deposits[i].x_m);
+    EXPECT_SAME_DOUBLE(a.deposits[i].y_m, b.deposits[i].y_m);
+    EXPECT_SAME_DOUBLE(a.deposits[i].volume_m3, b.deposits[i].volume_m3);
+  }
   EXPECT_EQ(a.refill, b.refill);
   EXPECT_EQ(a.state, b.state);
 }
@@ -286,6 +292,7 @@ ActionRequest filled_request(Filler& f) {
   r.target_x_m = f.real();
   r.target_y_m = f.real();
   for (int i = 0; i < 7; ++i) r.depositions.push_back({f.i32(), f.i32(), f.real()});
+  for (int i = 0; i < 5; ++i) r.deposits.push_back({f.real(), f.real(), f.real()});
   r.refill = true;
   r.state = "climb_" + kUtf8;
   return r;

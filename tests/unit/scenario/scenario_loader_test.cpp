@@ -43,6 +43,53 @@ std::string invalid(const std::string& text) {
   return {};
 }
 
+TEST(ScenarioLoader, DepositorDefaultsToLayerAndReadsItsParameters) {
+  const Scenario plain = parse_scenario(kMinimal, "t.pbtxt");
+  EXPECT_EQ(plain.robot_types[0].depositor.name, "layer");
+  EXPECT_FALSE(plain.robot_types[0].depositor.cube_size_m);
+  const Scenario cube =
+      parse_scenario(edit("robot_type { name: \"bot\" }",
+                          "robot_type { name: \"bot\" body { cube_size_m: 0.5 } depositor { name: \"cube\" } }"),
+                     "t.pbtxt");
+  EXPECT_EQ(cube.robot_types[0].depositor.name, "cube");
+  EXPECT_EQ(depositor_cube_size_m(cube.robot_types[0]), 0.5);  // the body's
+  const Scenario own = parse_scenario(
+      edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" depositor { name: \"cube\" cube_size_m: 0.6 } }"),
+      "t.pbtxt");
+  EXPECT_EQ(depositor_cube_size_m(own.robot_types[0]), 0.6);
+  const Scenario cone = parse_scenario(
+      edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" depositor { name: \"cone\" repose_deg: 40 } }"),
+      "t.pbtxt");
+  EXPECT_EQ(cone.robot_types[0].depositor.name, "cone");
+  EXPECT_EQ(cone.robot_types[0].depositor.repose_deg, 40.0);
+  EXPECT_EQ(parse_scenario(edit("robot_type { name: \"bot\" }",
+                                "robot_type { name: \"bot\" depositor { name: \"cone\" } }"),
+                           "t.pbtxt")
+                .robot_types[0]
+                .depositor.repose_deg,
+            34.0);
+}
+
+TEST(ScenarioLoader, BadDepositorsNameTheFieldAndTheRobotType) {
+  const auto with = [](const std::string& depositor) {
+    return invalid(edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" depositor { " + depositor + " } }"));
+  };
+  EXPECT_EQ(with("name: \"shovel\""),
+            "scenario t.pbtxt: robot_type[0] (bot).depositor.name: unknown depositor 'shovel'; valid: cone, cube, layer");
+  EXPECT_EQ(with("name: \"cone\" repose_deg: nan"),
+            "scenario t.pbtxt: robot_type[0] (bot).depositor.repose_deg: nan must be finite and < 1e6 in magnitude");
+  EXPECT_EQ(with("name: \"cone\" repose_deg: 90"),
+            "scenario t.pbtxt: robot_type[0] (bot).depositor.repose_deg: 90 must be in (0, 90) degrees");
+  EXPECT_EQ(with("name: \"cone\" repose_deg: 0"),
+            "scenario t.pbtxt: robot_type[0] (bot).depositor.repose_deg: 0 must be in (0, 90) degrees");
+  EXPECT_EQ(with("name: \"cube\" cube_size_m: -0.1"),
+            "scenario t.pbtxt: robot_type[0] (bot).depositor.cube_size_m: -0.1 must be > 0");
+  EXPECT_EQ(with("name: \"cone\" cube_size_m: 0.1"),
+            "scenario t.pbtxt: robot_type[0] (bot).depositor.cube_size_m: applies to the 'cube' depositor only");
+  EXPECT_EQ(with("repose_deg: 30"),
+            "scenario t.pbtxt: robot_type[0] (bot).depositor.repose_deg: applies to the 'cone' depositor only");
+}
+
 TEST(ScenarioLoader, TheRampScenarioLoadsWithEveryValue) {
   const Scenario s = load_scenario(source_dir() + "/deploy/scenarios/ramp.pbtxt");
   EXPECT_EQ(s.name, "ramp");

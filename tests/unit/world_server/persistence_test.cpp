@@ -69,7 +69,9 @@ class PersistenceTest : public ::testing::Test {
         const bool in_site = random() % 2 == 0;
         const double x = in_site ? 2.5 + offset(random) * 0.8 : a.x_m + offset(random);
         const double y = in_site ? 2.1 + offset(random) * 0.15 : a.y_m + offset(random);
-        if (const std::optional<CellIndex> c = state.terrain.geometry().cell_at({x, y}))
+        if (a.type.depositor.name != "layer")  // a cube (0.1 m) or cone robot: whole cubes at (x, y)
+          r.deposits.push_back({x, y, (random() % 5 == 0 ? 12 : 1) * 0.001});
+        else if (const std::optional<CellIndex> c = state.terrain.geometry().cell_at({x, y}))
           r.depositions.push_back({c->row, c->col, (random() % 5 == 0 ? 40 : 1) * kLayer});
         if (random() % 3 == 0) {
           r.move = true;
@@ -131,6 +133,48 @@ TEST_F(PersistenceTest, ReplayingTheLogRebuildsTheStateExactly) {
 }
 
 // A snapshot in the middle, then the records after it: the same state, and each continues identically.
+TEST_F(PersistenceTest, CubeAndConeDepositsAreLoggedAndReplayedExactly) {
+  // Agent 2 builds with 0.1 m cubes, agent 3 with cones.
+  std::string text = small_scenario_text_completing(site_block(4, 1.0));
+  const std::string types = R"(
+robot_type { name: "cuber" behaviour: "scripted"
+  body { kappa: 0.3 delta_m: 1.0 eps_m: 0.05 max_step_m: 0.2 max_deposit_m3: 0.02 material_capacity_m3: 0.05
+         reach_m: 1.2 sensing_range_m: 1.0 proximity_range_m: 1.5 cube_size_m: 0.05 }
+  depositor { name: "cube" cube_size_m: 0.1 } }
+robot_type { name: "piler" behaviour: "scripted"
+  body { kappa: 0.3 delta_m: 1.0 eps_m: 0.05 max_step_m: 0.2 max_deposit_m3: 0.02 material_capacity_m3: 0.05
+         reach_m: 1.2 sensing_range_m: 1.0 proximity_range_m: 1.5 cube_size_m: 0.05 }
+  depositor { name: "cone" } }
+)";
+  text.insert(text.find("agent {"), types);
+  text.replace(text.find("robot_type: \"tester\" start { x_m: 2.55"), 20, "robot_type: \"cuber\"");
+  text.replace(text.find("robot_type: \"tester\" start { x_m: 1.05 y_m: 3.05"), 20, "robot_type: \"piler\"");
+  scenario_ = scenario::parse_scenario(text, "mixed.pbtxt");
+  ASSERT_EQ(initial().agent(2).type.depositor.name, "cube");
+  ASSERT_EQ(initial().agent(3).type.depositor.name, "cone");
+  const WorldState live = record(40);
+  // The log holds the deposits, and for accepted ones the cells the world raised.
+  runlog::RunLogReader scan(log_path());
+  int deposits = 0, raised = 0;
+  proto::LogRecord record;
+  while (scan.next(record))
+    if (record.has_step())
+      for (const proto::LoggedRequest& q : record.step().requests()) {
+        deposits += q.deposits_size();
+        raised += q.accepted() ? q.raised_size() : 0;
+        if (!q.accepted()) EXPECT_EQ(q.raised_size(), 0);
+      }
+  EXPECT_GT(deposits, 20);
+  EXPECT_GT(raised, 0);
+  runlog::RunLogReader reader(log_path());
+  const RebuiltState rebuilt = rebuild_state(dir_.string(), initial(), reader);
+  EXPECT_EQ(rebuilt.tail_problem, "");
+  EXPECT_EQ(runlog::terrain_sha256(rebuilt.state.terrain), runlog::terrain_sha256(live.terrain));
+  EXPECT_EQ(fingerprint(rebuilt.state), fingerprint(live));
+  EXPECT_GT(live.agent(2).deposited_m3, 0.0);
+  EXPECT_GT(live.agent(3).deposited_m3, 0.0);
+}
+
 TEST_F(PersistenceTest, ASnapshotAndTheLogAfterItRebuildTheSameState) {
   const WorldState live = record(40, 23);
   runlog::RunLogReader reader(log_path());

@@ -226,3 +226,41 @@ TEST(RampSteps, StepBackGoesAwayFromTheGoalBeforeTheRobotHasMoved) {
 
 }  // namespace
 }  // namespace marsala::agent::reactive
+
+namespace marsala::agent::reactive {
+namespace {
+
+TEST(RampSteps, AfterARejectedRequestWithDepositsTheNextCarriesAtMostHalfAsManyUntilOneIsAccepted) {
+  AgentContext c = test::agent_context(3, test::husky());
+  c.type.depositor.name = "cone";
+  RampSteps steps(c);
+  steps.admit(test::admission_on(c, test::platform_world().geometry(), kTarget, kBase));
+  const Position robot{6.45, 3.05};  // blocked at the foot of the platform: builds in place
+  const auto deposits_with = [&](protocol::ActionResult last) {
+    protocol::SensorFrame f = frame(steps, 0, robot);
+    f.last_result = last;
+    BuildTrace trace;
+    const BuildView view = steps.look(f, trace);
+    protocol::ActionRequest q = empty(steps, f);
+    steps.build_step(view.local, f, trace, q);
+    EXPECT_TRUE(q.depositions.empty());
+    EXPECT_EQ(q.deposits.size(), trace.deposition.deposits.size());
+    return q.deposits.size();
+  };
+  const std::size_t full = deposits_with(protocol::ActionResult::kNone);
+  ASSERT_GE(full, 2u);
+  const std::size_t half = deposits_with(protocol::ActionResult::kRejected);
+  EXPECT_EQ(half, full / 2);
+  std::size_t n = half;
+  for (int i = 0; i < 4 && n > 0; ++i) {
+    const std::size_t next = deposits_with(protocol::ActionResult::kRejected);
+    EXPECT_EQ(next, n / 2);
+    n = next;
+  }
+  EXPECT_EQ(n, 0u);  // no deposits now: the robot does something else, and the world judges something new
+  deposits_with(protocol::ActionResult::kAccepted);  // the request without deposits was accepted
+  EXPECT_EQ(deposits_with(protocol::ActionResult::kAccepted), full);
+}
+
+}  // namespace
+}  // namespace marsala::agent::reactive

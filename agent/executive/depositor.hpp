@@ -1,0 +1,49 @@
+#pragma once
+// Depositors (docs/runtime.md#depositors): the executive layer's small actuator interface that turns the deposition
+// manager's wish (cells and their MARS gaps along the path) into what the request carries. Chosen by name from the
+// robot type (scenario field depositor), through make_depositor():
+//   "layer": the manager's whole cube layers per cell (Deposition), as always;
+//   "cube":  columns of cubes of side s centred on wanted cells, in path order (contour crafting), each column as
+//            tall as every cell of its footprint still wants (never above the MARS height);
+//   "cone":  piles of granular material: among dump points on wanted cells within reach and a few volumes, the pile
+//            (predicted with the world's own cone_pile_shape on the local map) that puts most volume under the MARS
+//            height on the path's footprint, with at least 75 % of it under the MARS height anywhere, no cell more
+//            than kConeOvershootFraction * eps above it, and no cell it may not raise (checked on a pile 1e-6 bigger,
+//            so that rounding in the world's frame cannot reach one); up to kMaxConesPerStep piles a step.
+// Every depositor keeps the manager's way-back check (the longest prefix of its deposits that keeps it).
+// The behaviours see only DepositionPlan.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "marsala/agent/executive/deposition_manager.hpp"
+#include "marsala/core/robot_type.hpp"
+
+namespace marsala::agent::executive {
+
+/// A cone may overshoot the MARS height by at most this fraction of the construction's eps [1].
+inline constexpr double kConeOvershootFraction = 0.1;
+/// Most piles a cone depositor places in one step.
+inline constexpr int kMaxConesPerStep = 3;
+/// Dump points tried per pile: the first wanted cells within reach, in path order.
+inline constexpr int kConeDumpPoints = 12;
+
+/// Turns the deposition manager's wish into this step's depositions or deposits.
+class Depositor {
+ public:
+  virtual ~Depositor() = default;
+  /// "layer", "cube" or "cone".
+  virtual std::string name() const = 0;
+  /// What to deposit from `robot` [m] (after this step's motion) with `material_m3` on board, along `path` (local
+  /// indices, from where the robot will stand), within every rule the world checks.
+  virtual DepositionPlan plan(const DepositionManager& manager, const deliberative::LocalMap& map,
+                              const std::vector<CellIndex>& path, Position robot, double material_m3,
+                              const Neighbourhood& neighbours) const = 0;
+};
+
+/// The depositor of a robot type: its depositor spec and (for a cube without its own side) the body's cube size.
+/// Throws InvalidArgument listing the valid names when the name is unknown.
+std::unique_ptr<Depositor> make_depositor(const RobotType& type);
+
+}  // namespace marsala::agent::executive
