@@ -69,13 +69,15 @@ DepositionManager::DepositionManager(DepositionParams params) : params_(params),
       !positive_finite(params.footprint_m) || !(params.neighbour_keep_out_m >= 0.0) ||
       !std::isfinite(params.neighbour_keep_out_m) || !(params.neighbour_step_m >= 0.0) ||
       !std::isfinite(params.neighbour_step_m) || !(params.pad_radius_m >= 0.0) || !std::isfinite(params.pad_radius_m) ||
-      !std::isfinite(params.pad_centre.x) || !std::isfinite(params.pad_centre.y))
+      !std::isfinite(params.pad_centre.x) || !std::isfinite(params.pad_centre.y) || !(params.gap_margin_m >= 0.0) ||
+      !std::isfinite(params.gap_margin_m))
     throw InvalidArgument("deposition manager: reach (" + std::to_string(params.reach_m) + " m), max deposit (" +
                           std::to_string(params.max_deposit_m3) + " m^3), cube layer (" +
                           std::to_string(params.cube_layer_m) + " m) and max height (" +
                           std::to_string(params.max_height_m) +
                           " m) must be finite and > 0, neighbour keep-out, step and pad radius (" +
-                          std::to_string(params.pad_radius_m) + " m) finite and >= 0");
+                          std::to_string(params.pad_radius_m) + " m) finite and >= 0, gap margin (" +
+                          std::to_string(params.gap_margin_m) + " m) finite and >= 0");
 }
 
 std::vector<DepositionCandidate> DepositionManager::candidates(const deliberative::LocalMap& map,
@@ -104,7 +106,8 @@ std::vector<DepositionCandidate> DepositionManager::candidates(const deliberativ
       if (map.known(cell.row, cell.col) == 0) continue;
       // Whole layers, rounded down: never above the local MARS height (1e-9 absorbs rounding in gaps that are
       // exact multiples).
-      int layers = std::min(static_cast<int>(std::floor(map.gap(cell) / q + 1e-9)), max_layers);
+      int layers =
+          std::min(static_cast<int>(std::floor((map.gap(cell) - params_.gap_margin_m) / q + 1e-9)), max_layers);
       if (layers < 1) continue;
       const Position centre = map.center(cell);
       const double d = distance(centre, robot);

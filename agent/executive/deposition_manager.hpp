@@ -34,6 +34,10 @@ struct DepositionParams {
   double neighbour_step_m = 0.2;      ///< how far a neighbour may move this step [m]
   Position pad_centre;                ///< the base station's pad: nothing is built on it (refills, a payload's start)
   double pad_radius_m = 0.0;          ///< its radius; 0: no pad [m]
+  /// Depositions leave this much of each cell's gap unfilled: the noise of a map built from range scans, which the
+  /// robot must not chase (a cell read a little low filled, a cell read a little high lifts the MARS bound of its
+  /// neighbours: filled too, the bound rises again). 0 for exact maps [m].
+  double gap_margin_m = 0.0;
 };
 
 /// The deposition parameters of a body on a grid of cell_size_m [m], with the team's keep-out [m]; the footprint is

@@ -21,8 +21,10 @@ std::string describe(const TerrainTile& t) {
 constexpr double kOctreeHalfVoxels = 32768.0;
 /// Voxels of one column a cell remembers hits in; more than a terrain column ever shows (ground, a wall's mixed hits).
 constexpr std::size_t kVoxelsPerCell = 8;
-/// Width of the band along each cell edge whose hits are left out [cells].
+/// Width of the band along each cell edge whose hits are left out: at least this many cells, and at least
+/// kEdgeBandNoise range-noise spreads of the sensor (a wall's hits scatter that far across the edge) [cells], [1].
 constexpr double kEdgeBand = 0.1;
+constexpr double kEdgeBandNoise = 2.0;
 
 }  // namespace
 
@@ -32,10 +34,11 @@ constexpr double kEdgeBand = 0.1;
 struct MappingSystem::Octree {
   struct VoxelHits {
     octomap::key_type key_z = 0;
-    double estimate_m = 0.0;  ///< surface height in this voxel, blended over scans [m]
+    double estimate_m = 0.0;  ///< surface height in this voxel, from the latest scan that hit it [m]
     bool has_estimate = false;
     double scan_sum_m = 0.0;  ///< this scan's hits [m]
     int scan_count = 0;
+    bool hit_in_scan = false;  ///< hit by the scan being integrated
   };
 
   explicit Octree(double resolution_m) : tree(resolution_m) {
@@ -69,6 +72,8 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       assumed_(other.assumed_),
       known_count_(other.known_count_),
       tile_size_(other.tile_size_),
+      registration_(other.registration_),
+      built_(other.built_),
       sensor_(other.sensor_),
       trajectory_(other.trajectory_),
       octree_(other.octree_ ? std::make_unique<Octree>(*other.octree_) : nullptr) {}
@@ -164,7 +169,7 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   // A hit on a wall between two cells lies on their common edge, and range noise puts it on either side: in the
   // lower cell's column it would read as a surface high above that cell. Hits within kEdgeBand of a cell edge are
   // therefore left out; the cell's interior hits say where its surface is (docs/runtime.md#mapping).
-  const double band = kEdgeBand * cs;
+  const double band = std::min(0.3 * cs, std::max(kEdgeBand * cs, kEdgeBandNoise * sensor_.noise_sd_at(1.0)));
   for (const ScanPoint& p : points) {
     const double x = origin.x + p.x_m, y = origin.y + p.y_m, z = origin.z + p.z_m;
     const std::optional<CellIndex> cell = g.cell_at({x, y});
@@ -188,34 +193,40 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
       it = voxels.end() - 1;
     }
     if (it->scan_count == 0) touched.push_back(index);
-    it->scan_sum_m += z;
-    ++it->scan_count;
     min_row = std::min(min_row, cell->row);
     max_row = std::max(max_row, cell->row);
     min_col = std::min(min_col, cell->col);
     max_col = std::max(max_col, cell->col);
+    it->scan_sum_m += z;
+    ++it->scan_count;
   }
   // Rays carve free space up to each end voxel, which becomes more likely occupied (OctoMap's log-odds update).
   // Lazy: inner nodes are brought up to date once, after the whole scan (OctoMap's own advice for batches).
   tree.insertPointCloud(cloud, tree_origin, -1.0, true, true);
   tree.updateInnerOccupancy();
 
-  // Fold this scan's hits into each voxel's estimate: half the old, half the new, so noise averages out over scans
-  // while a cell that rose (a deposit within the same voxel) is followed within a few scans.
+  // This scan's hits replace each voxel's estimate: the surface changes as robots build, and a blend of old and new
+  // readings lags a deposit (a cell read half as raised as it is gets filled again, overshoots its MARS height and
+  // lifts its neighbours' bound: robots with scans built without end that way).
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-  for (std::size_t index : touched)
+  std::vector<std::uint8_t> hit_now(static_cast<std::size_t>(g.size()), 0);
+  for (std::size_t index : touched) {
+    hit_now[index] = 1;
     for (Octree::VoxelHits& v : octree_->hits[index]) {
       if (v.scan_count == 0) continue;
-      const double mean = v.scan_sum_m / v.scan_count;
-      v.estimate_m = v.has_estimate ? 0.5 * (v.estimate_m + mean) : mean;
+      v.estimate_m = v.scan_sum_m / v.scan_count;
       v.has_estimate = true;
+      v.hit_in_scan = true;
       v.scan_sum_m = 0.0;
       v.scan_count = 0;
     }
+  }
 
-  // Heights of every cell the scan reached (carving may have freed a voxel of a cell it did not hit): the estimate of
-  // the highest occupied voxel of the column.
+  // Heights of every cell the scan reached (carving may have freed a voxel of a cell it did not hit). A cell this scan
+  // hit: the highest voxel it hit (a ray grazing just above a surface inside its voxel carves that voxel free in the
+  // octree, so occupancy alone would lose freshly built tops); otherwise the highest occupied voxel of the column.
+  // Never below what the robot itself built there (record_built).
   if (max_row < 0) return;
   for (int row = min_row; row <= max_row; ++row)
     for (int col = min_col; col <= max_col; ++col) {
@@ -225,16 +236,33 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
       octomap::OcTreeKey key;
       if (!tree.coordToKeyChecked(to_tree(centre.x, centre.y, 0.0), key)) continue;
       const Octree::VoxelHits* top = nullptr;
+      const bool hit = hit_now[static_cast<std::size_t>(row) * g.cols + col] != 0;
       for (const Octree::VoxelHits& v : voxels) {
         if (!v.has_estimate || (top && v.key_z <= top->key_z)) continue;
+        if (hit) {
+          if (v.hit_in_scan) top = &v;
+          continue;
+        }
         key[2] = v.key_z;
         const octomap::OcTreeNode* node = tree.search(key);
         if (node && tree.isNodeOccupied(node)) top = &v;
       }
       if (!top) continue;  // every voxel it had was carved free since: keep what the map said
-      heights_(row, col) = top->estimate_m;
+      const auto built = built_.find(static_cast<long long>(row) * g.cols + col);
+      heights_(row, col) = built == built_.end() ? top->estimate_m : std::max(top->estimate_m, built->second);
       mark_known(row, col);
     }
+  for (std::size_t index : touched)
+    for (Octree::VoxelHits& v : octree_->hits[index]) v.hit_in_scan = false;
+}
+
+void MappingSystem::record_built(CellIndex cell, double rise_m) {
+  if (!heights_.contains(cell) || !std::isfinite(rise_m) || !(rise_m > 0.0)) return;
+  const long long index = static_cast<long long>(cell.row) * heights_.cols() + cell.col;
+  const double floor_m = heights_(cell) + rise_m;
+  double& built = built_.try_emplace(index, floor_m).first->second;
+  built = std::max(built, floor_m);
+  heights_(cell) = std::max(heights_(cell), built);
 }
 
 void MappingSystem::assume_ground(Position pose, double ground_z_m, double radius_m) {

@@ -7,6 +7,7 @@
 
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "marsala/core/heightmap.hpp"
@@ -61,6 +62,13 @@ class MappingSystem {
   /// known at `ground_z_m`, the height under the robot's centre (it stands there; a scan sees no nearer than its
   /// minimum range and the camera nothing behind it). A later scan's hits replace it. [m]
   void assume_ground(Position pose, double ground_z_m, double radius_m);
+  /// The robot's own construction: the world accepted its request to raise `cell` (world index, as the map registers
+  /// it) by rise_m [m]. Terrain only ever rises (depositions add material), so the cell is at least its map height
+  /// plus rise_m from now on, whatever a later scan reads there: a scan may not see the top of what the robot just
+  /// built beside it (a column above the sensor, its faces left out as wall hits) and would otherwise keep the old
+  /// height, and the robot would fill the same cell again without end. Ground-truth tiles are exact and replace it.
+  /// Off-grid cells and rises that are not finite and > 0 are ignored.
+  void record_built(CellIndex cell, double rise_m);
   /// Appends the cell under `pose` [m] to the trajectory (consecutive repeats are kept once); throws
   /// InvalidArgument when the pose is off the grid or not finite.
   void record_pose(Position pose);
@@ -93,6 +101,7 @@ class MappingSystem {
   long long known_count_ = 0;
   int tile_size_;
   CellIndex registration_{0, 0};
+  std::unordered_map<long long, double> built_;  ///< record_built(): the least height of a cell (row-major index) [m]
   SensorSpec sensor_;
   std::vector<CellIndex> trajectory_;
   std::unique_ptr<Octree> octree_;  // made at the first scan

@@ -9,6 +9,7 @@
 #include "marsala/agent/executive/depositor.hpp"
 #include "marsala/agent/executive/lane.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
+#include "marsala/core/deposit_shapes.hpp"
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/navigability_processor.hpp"
@@ -83,6 +84,9 @@ void RampSteps::admit(const protocol::Admission& admission) {
       executive::deposition_params(body, world.cell_size_m, context_.neighbour_keep_out_m, build.delta_m);
   deposits.pad_centre = context_.assignment.base;
   deposits.pad_radius_m = kPadFraction * context_.assignment.base_radius_m;
+  // A scanned map reads each surface within a few noise spreads at the manipulator's reach: leave that much unfilled.
+  if (context_.type.sensor.casts_rays())
+    deposits.gap_margin_m = kScanGapMargin * context_.type.sensor.noise_sd_at(body.reach_m + body.navigability.delta_m);
   PlannerParams router = planner;
   router.alpha = 0.0;
   router.beta = 1.0;
@@ -108,6 +112,19 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
   else if (frame.last_result == protocol::ActionResult::kAccepted)
     deposit_limit_ = -1;
   deposits_sent_ = 0;
+  // The robot's own construction, once accepted, is in its map even where its sensor cannot see it (a scanned map).
+  if (frame.last_result == protocol::ActionResult::kAccepted && context_.type.sensor.casts_rays()) {
+    for (const Deposition& d : sent_layers_) modules_->map.record_built({d.row, d.col}, d.height_m);
+    if (context_.type.depositor.name == "cube") {
+      const double side = depositor_cube_size_m(context_.type);
+      for (const Deposit& d : sent_deposits_)
+        for (const CellRise& r :
+             cube_column_shape(modules_->map.geometry(), {d.x_m, d.y_m}, side, static_cast<int>(whole_cubes(d.volume_m3, side))).rises)
+          modules_->map.record_built(r.cell, r.rise_m);
+    }
+  }
+  sent_layers_.clear();
+  sent_deposits_.clear();
   const Position robot{frame.x_m, frame.y_m};
   modules_->map.integrate(frame.tiles, robot);
   const SensorSpec& sensor = context_.type.sensor;
@@ -195,6 +212,8 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
   deposits_sent_ = static_cast<int>(deposits.size());
   request.depositions = trace.deposition.depositions;
   request.deposits = deposits;
+  sent_layers_ = request.depositions;
+  sent_deposits_ = request.deposits;
 }
 
 std::optional<BuildPhase> RampSteps::build_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,

@@ -43,6 +43,9 @@ namespace marsala::agent::reactive {
 /// middle of the base stays as it was (a payload's start, refills); the outer ring may be built on when the
 /// construction begins there.
 inline constexpr double kPadFraction = 0.5;
+/// A robot that maps with range scans leaves this many noise spreads (its sensor's sd at its reach plus a body
+/// length) of each cell's MARS gap unfilled (DepositionParams::gap_margin_m).
+inline constexpr double kScanGapMargin = 3.0;
 
 /// What the building steps did: the robot moved along the path, deposited in place, or is backing off.
 enum class BuildPhase : std::uint8_t { kAdvance = 0, kBuild = 1, kRetreat = 2 };
@@ -147,6 +150,9 @@ class RampSteps {
   // mismatch never repeats the same request forever. -1: no limit.
   int deposit_limit_ = -1;
   mutable int deposits_sent_ = 0;  // deposits in the request being built (the last deposit() call's)
+  // What the request being built deposits, for the map once the world accepts it (MappingSystem::record_built).
+  mutable std::vector<Deposition> sent_layers_;
+  mutable std::vector<Deposit> sent_deposits_;
   std::vector<executive::BodyClearance> others_;  // the last frame's neighbours
   CellMask corridor_;                             // the last local map's navigable cells, neighbours not taken out
   CellMask terrain_occupiable_;                   // and its occupiable cells
