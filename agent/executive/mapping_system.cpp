@@ -38,7 +38,7 @@ struct MappingSystem::Octree {
     bool has_estimate = false;
     double scan_sum_m = 0.0;  ///< this scan's hits [m]
     int scan_count = 0;
-    bool hit_in_scan = false;  ///< hit by the scan being integrated
+    int hits_in_scan = 0;  ///< hits of the scan being integrated
   };
 
   explicit Octree(double resolution_m) : tree(resolution_m) {
@@ -211,13 +211,15 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   std::vector<std::uint8_t> hit_now(static_cast<std::size_t>(g.size()), 0);
+  std::vector<int> hits_now(static_cast<std::size_t>(g.size()), 0);  // the cell's hits in this scan
   for (std::size_t index : touched) {
     hit_now[index] = 1;
     for (Octree::VoxelHits& v : octree_->hits[index]) {
       if (v.scan_count == 0) continue;
       v.estimate_m = v.scan_sum_m / v.scan_count;
       v.has_estimate = true;
-      v.hit_in_scan = true;
+      v.hits_in_scan = v.scan_count;
+      hits_now[index] += v.scan_count;
       v.scan_sum_m = 0.0;
       v.scan_count = 0;
     }
@@ -236,24 +238,31 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
       octomap::OcTreeKey key;
       if (!tree.coordToKeyChecked(to_tree(centre.x, centre.y, 0.0), key)) continue;
       const Octree::VoxelHits* top = nullptr;
-      const bool hit = hit_now[static_cast<std::size_t>(row) * g.cols + col] != 0;
+      const std::size_t index = static_cast<std::size_t>(row) * g.cols + col;
+      const bool hit = hit_now[index] != 0;
+      // A voxel a wall's scattered hits reached holds few of the cell's hits: the surface's voxel holds at least a
+      // fifth of them (and two), else the highest hit voxel is all there is.
+      const int enough = std::max(2, (hits_now[index] + 4) / 5);
+      const Octree::VoxelHits* top_any = nullptr;
       for (const Octree::VoxelHits& v : voxels) {
-        if (!v.has_estimate || (top && v.key_z <= top->key_z)) continue;
         if (hit) {
-          if (v.hit_in_scan) top = &v;
+          if (v.hits_in_scan > 0 && (!top_any || v.key_z > top_any->key_z)) top_any = &v;
+          if (v.hits_in_scan >= enough && (!top || v.key_z > top->key_z)) top = &v;
           continue;
         }
+        if (!v.has_estimate || (top && v.key_z <= top->key_z)) continue;
         key[2] = v.key_z;
         const octomap::OcTreeNode* node = tree.search(key);
         if (node && tree.isNodeOccupied(node)) top = &v;
       }
+      if (!top) top = top_any;
       if (!top) continue;  // every voxel it had was carved free since: keep what the map said
       const auto built = built_.find(static_cast<long long>(row) * g.cols + col);
       heights_(row, col) = built == built_.end() ? top->estimate_m : std::max(top->estimate_m, built->second);
       mark_known(row, col);
     }
   for (std::size_t index : touched)
-    for (Octree::VoxelHits& v : octree_->hits[index]) v.hit_in_scan = false;
+    for (Octree::VoxelHits& v : octree_->hits[index]) v.hits_in_scan = 0;
 }
 
 void MappingSystem::record_built(CellIndex cell, double rise_m) {
