@@ -125,6 +125,12 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
   }
   sent_layers_.clear();
   sent_deposits_.clear();
+  // A motion the world refused (its target not occupiable for this body, though the robot's map said it was: a
+  // scanned map's error) is not asked again for a while; the same frame would otherwise ask it again every step.
+  if (frame.last_result == protocol::ActionResult::kRejected && sent_motion_)
+    refused_[{sent_motion_->row, sent_motion_->col}] = frame.step + kRefusedMotionSteps;
+  sent_motion_.reset();
+  for (auto it = refused_.begin(); it != refused_.end();) it = it->second <= frame.step ? refused_.erase(it) : std::next(it);
   const Position robot{frame.x_m, frame.y_m};
   modules_->map.integrate(frame.tiles, robot);
   const SensorSpec& sensor = context_.type.sensor;
@@ -136,13 +142,20 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
   const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
   const Position target = goal.value_or(robot);  // nothing left to build towards: stay
   BuildView view{modules_->synthesizer.synthesize(modules_->map, robot, target), robot, target};
-  if (!getenv("PADGAP")) clear_pad_gap(view.local);
+  clear_pad_gap(view.local);
   const RobotBody& body = context_.type.body;
   others_ = executive::body_clearances(frame.neighbours, context_.agent_id, 0.5 * body.navigability.delta_m,
                                        body.max_step_m);
   corridor_ = view.local.navigable;
   terrain_occupiable_ = view.local.occupiable;
   executive::keep_clear(view.local, robot, others_);
+  if (!refused_.empty()) {
+    std::vector<executive::BodyClearance> refused;
+    const double cs = modules_->map.geometry().cell_size_m;
+    for (const auto& [cell, until] : refused_)
+      refused.push_back({0, modules_->map.geometry().cell_center({cell.first, cell.second}), 0.5 * cs});
+    executive::keep_clear(view.local, robot, refused);
+  }
   trace.window_offset = view.local.offset;
   trace.local_goal = view.local.goal;
   trace.local_origin = view.local.origin;
@@ -183,6 +196,7 @@ std::vector<CellIndex> RampSteps::in_lane(const deliberative::LocalMap& local, c
 
 void RampSteps::move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) const {
   trace.motion = motion;
+  sent_motion_ = modules_->map.geometry().cell_at(motion.target);
   request.move = true;
   request.target_x_m = motion.target.x;
   request.target_y_m = motion.target.y;

@@ -8,7 +8,9 @@
 // robot's body are taken out (executive/body_clearance.hpp): every route and motion then keeps clear of the
 // neighbours the frame shows. Depositions are judged on the terrain alone (the masks before the neighbours were
 // taken out: what stays occupiable and connected does not depend on where the others stand this step), and never
-// on the base station's pad. Then, by its state, one of:
+// on the base station's pad. A motion target the world refused is left out of the local map for kRefusedMotionSteps
+// (a scanned map can hold a cell occupiable that is not; without this the robot asked for it every step). Then, by
+// its state, one of:
 //   build_step()   plan a deposition path to the local goal (once per frame); a motion along it is possible -> move
 //                  and deposit ahead (kAdvance); blocked, but depositions within reach -> deposit in place (kBuild);
 //                  blocked and nothing to deposit (the gap left is under the robot) -> retreat_step() (kRetreat)
@@ -22,6 +24,7 @@
 // behaviour's.
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -46,6 +49,8 @@ inline constexpr double kPadFraction = 0.5;
 /// A robot that maps with range scans leaves this many noise spreads (its sensor's sd at its reach plus a body
 /// length) of each cell's MARS gap unfilled (DepositionParams::gap_margin_m).
 inline constexpr double kScanGapMargin = 3.0;
+/// A motion target the world refused is left out of the robot's local map for this many steps.
+inline constexpr std::uint64_t kRefusedMotionSteps = 40;
 
 /// What the building steps did: the robot moved along the path, deposited in place, or is backing off.
 enum class BuildPhase : std::uint8_t { kAdvance = 0, kBuild = 1, kRetreat = 2 };
@@ -150,6 +155,8 @@ class RampSteps {
   // mismatch never repeats the same request forever. -1: no limit.
   int deposit_limit_ = -1;
   mutable int deposits_sent_ = 0;  // deposits in the request being built (the last deposit() call's)
+  mutable std::optional<CellIndex> sent_motion_;  // the world cell the request being built moves to
+  std::map<std::pair<int, int>, std::uint64_t> refused_;  // motion targets the world refused, avoided until a step
   // What the request being built deposits, for the map once the world accepts it (MappingSystem::record_built).
   mutable std::vector<Deposition> sent_layers_;
   mutable std::vector<Deposit> sent_deposits_;

@@ -97,6 +97,39 @@ TEST(RampSteps, BuildStepAdvancesAlongThePathOnFlatGround) {
   EXPECT_TRUE(q.depositions.empty());
 }
 
+TEST(RampSteps, AMotionTheWorldRefusedIsLeftOutOfTheLocalMapForAWhile) {
+  const auto owned = admitted_steps();
+  RampSteps& steps = *owned;
+  BuildTrace trace;
+  const protocol::SensorFrame f0 = frame(steps, 0, {1.05, 3.05});
+  BuildView view = steps.look(f0, trace);
+  protocol::ActionRequest q = empty(steps, f0);
+  ASSERT_EQ(steps.build_step(view.local, f0, trace, q), BuildPhase::kAdvance);
+  const CellIndex refused = *steps.map().geometry().cell_at({q.target_x_m, q.target_y_m});
+  const auto local = [&](const BuildView& v) { return CellIndex{refused.row - v.local.offset.row, refused.col - v.local.offset.col}; };
+  EXPECT_NE(view.local.occupiable(local(view).row, local(view).col), 0);
+
+  // The world refused it: the robot (still where it was) leaves that cell out and goes elsewhere.
+  protocol::SensorFrame f1 = frame(steps, 1, {1.05, 3.05});
+  f1.last_result = protocol::ActionResult::kRejected;
+  trace = BuildTrace{};
+  view = steps.look(f1, trace);
+  EXPECT_EQ(view.local.occupiable(local(view).row, local(view).col), 0);
+  EXPECT_EQ(view.local.navigable(local(view).row, local(view).col), 0);
+  q = empty(steps, f1);
+  steps.build_step(view.local, f1, trace, q);
+  if (q.move) {
+    EXPECT_NE(*steps.map().geometry().cell_at({q.target_x_m, q.target_y_m}), refused);
+  }
+  // Until kRefusedMotionSteps have passed.
+  trace = BuildTrace{};
+  view = steps.look(frame(steps, 1 + kRefusedMotionSteps - 1, {1.05, 3.05}), trace);
+  EXPECT_EQ(view.local.occupiable(local(view).row, local(view).col), 0);
+  trace = BuildTrace{};
+  view = steps.look(frame(steps, 1 + kRefusedMotionSteps, {1.05, 3.05}), trace);
+  EXPECT_NE(view.local.occupiable(local(view).row, local(view).col), 0);
+}
+
 TEST(RampSteps, BuildStepBlockedAtTheFootBuildsInPlace) {
   const auto owned = admitted_steps();
   RampSteps& steps = *owned;
