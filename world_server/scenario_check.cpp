@@ -73,6 +73,9 @@ proto::ScenarioCheck to_message(const WorldStart& start) {
     r->set_max_step_m(type.body.max_step_m);
     r->set_cube_size_m(type.body.cube_size_m);
     r->set_goal_synthesizer(type.goal_synthesizer);
+    r->set_sensor(type.sensor.name);
+    r->set_depositor(type.depositor.name);
+    r->set_localisation_noise_sd_m(type.localisation.noise_sd_m);
   }
   for (const scenario::AgentSlot& slot : s.slots) {
     proto::SlotCheck* p = m.add_slots();
@@ -168,7 +171,10 @@ std::string scenario_check_text(const WorldStart& start) {
     out << "  " << t.name << ": behaviour " << t.behaviour << ", kappa " << number(t.body.navigability.kappa)
         << ", delta_m " << number(t.body.navigability.delta_m) << ", eps_m " << number(t.body.navigability.eps_m)
         << ", max_step_m " << number(t.body.max_step_m) << ", cube_size_m " << number(t.body.cube_size_m)
-        << ", goal_synthesizer " << t.goal_synthesizer << "\n";
+        << ", goal_synthesizer " << t.goal_synthesizer << ", sensor " << t.sensor.name << ", depositor "
+        << t.depositor.name
+        << (t.localisation.noise_sd_m > 0.0 ? ", localisation noise " + number(t.localisation.noise_sd_m) + " m" : "")
+        << "\n";
   out << "slots (" << s.slots.size() << "; the world waits for agents 1.." << state.agents.size() << "):\n";
   for (const scenario::AgentSlot& slot : s.slots) {
     out << "  " << slot.id << " " << slot.robot_type << ": start " << point(slot.start_x_m, slot.start_y_m)

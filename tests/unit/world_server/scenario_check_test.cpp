@@ -82,7 +82,7 @@ TEST_F(ScenarioCheckTest, TheRampScenarioIsValidAndReportedInFull) {
                 "terrain: 200 x 300 cells of 0.1 m, x [0, 30] y [0, 20] m, heights [0, 1.5] m (generator platform)\n"
                 "robot types (1):\n"
                 "  husky: behaviour ramp_builder, kappa 0.3, delta_m 1, eps_m 0.05, max_step_m 0.2, cube_size_m 0.05, "
-                "goal_synthesizer fixed_target\n"
+                "goal_synthesizer fixed_target, sensor ground_truth, depositor layer\n"
                 "slots (3; the world waits for agents 1..3):\n"
                 "  1 husky: start (5.05, 7.05) target (22.05, 7.05)\n"
                 "  2 husky: start (5.05, 10.05) target (22.05, 10.05)\n"
@@ -123,6 +123,8 @@ TEST_F(ScenarioCheckTest, JsonIsOneObjectWithEverySlot) {
   EXPECT_EQ(at(husky, "kappa").number_value(), 0.3);
   EXPECT_EQ(at(husky, "cube_size_m").number_value(), 0.05);
   EXPECT_EQ(at(husky, "goal_synthesizer").string_value(), "fixed_target");
+  EXPECT_EQ(at(husky, "sensor").string_value(), "ground_truth");
+  EXPECT_EQ(at(husky, "depositor").string_value(), "layer");
   EXPECT_EQ(at(check, "completion").string_value(), "agents_at_goal");
   EXPECT_EQ(at(at(check, "goal").struct_value(), "min_height_m").number_value(), 1.4);
   EXPECT_EQ(check.fields().count("payload_path"), 0u);
@@ -130,6 +132,27 @@ TEST_F(ScenarioCheckTest, JsonIsOneObjectWithEverySlot) {
   EXPECT_EQ(at(check, "agents").number_value(), 3);
   EXPECT_EQ(at(check, "max_steps").string_value(), "4000");  // 64-bit: a JSON string, as summary.json's seed
   EXPECT_EQ(at(check, "seed").string_value(), "1");
+}
+
+TEST_F(ScenarioCheckTest, SensorDepositorAndLocalisationAreReportedWithSetOverrides) {
+  const std::string ramp = shipped("ramp.pbtxt");
+  ASSERT_EQ(run({"--check", ramp, "--set", "robot_type.sensor.name=laser", "--set",
+                 "robot_type.localisation.noise_sd_m=0.1"}),
+            0)
+      << err_.str();
+  EXPECT_NE(out_.str().find("goal_synthesizer fixed_target, sensor laser, depositor layer, localisation noise 0.1 m\n"),
+            std::string::npos)
+      << out_.str();
+  ASSERT_EQ(run({"--check", "--json", ramp, "--set", "robot_type.depositor.name=cone"}), 0) << err_.str();
+  const Struct check = parse_json(out_.str());
+  const Struct& husky = at(check, "robot_types").list_value().values(0).struct_value();
+  EXPECT_EQ(at(husky, "depositor").string_value(), "cone");
+  EXPECT_EQ(at(husky, "sensor").string_value(), "ground_truth");
+  // A misspelt override is the scenario's error: exit 2, one line naming it.
+  EXPECT_EQ(run({"--check", ramp, "--set", "robot_type.sensor.nam=laser"}), kExitInvalidScenario);
+  EXPECT_NE(err_.str().find("--set 'robot_type.sensor.nam=laser': Sensor has no field 'nam'; valid: name,"),
+            std::string::npos)
+      << err_.str();
 }
 
 TEST_F(ScenarioCheckTest, CommandLineOverridesAreAppliedAsTheRunWouldApplyThem) {
