@@ -177,7 +177,7 @@ const std::vector<Deposition>& raised_cells(const protocol::ActionRequest& reque
 
 Verdict validate_request(const WorldState& state, std::uint32_t channel_id, const protocol::ActionRequest& r) {
   int rule = 1;
-  const auto reject = [&rule](std::string reason) { return Verdict{false, std::move(reason), rule, 0.0}; };
+  const auto reject = [&rule](std::string reason) { return Verdict{false, std::move(reason), rule, 0.0, {}}; };
 
   // 1. Envelope.
   if (r.agent_id != channel_id)

@@ -183,7 +183,7 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
     cloud.push_back(end);
     const std::size_t index = static_cast<std::size_t>(cell->row) * g.cols + cell->col;
     std::vector<Octree::VoxelHits>& voxels = octree_->hits[index];
-    auto it = std::find_if(voxels.begin(), voxels.end(), [&](const auto& v) { return v.key_z == key[2]; });
+    auto it = std::find_if(voxels.begin(), voxels.end(), [&](const auto& voxel) { return voxel.key_z == key[2]; });
     if (it == voxels.end()) {
       if (voxels.size() == kVoxelsPerCell) {  // forget the lowest voxel: the surface is the highest
         voxels.erase(std::min_element(voxels.begin(), voxels.end(),

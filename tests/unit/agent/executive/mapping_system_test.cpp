@@ -189,7 +189,9 @@ TEST(MappingSystem, ALaserMapConvergesToTheTerrainAsScansAccumulate) {
   // Cells never hit stay unknown and at 0.
   for (int r = 0; r < truth.rows(); ++r)
     for (int c = 0; c < truth.cols(); ++c)
-      if (!map.is_known({r, c})) EXPECT_EQ(map.heights()(r, c), 0.0);
+      if (!map.is_known({r, c})) {
+        EXPECT_EQ(map.heights()(r, c), 0.0);
+      }
 }
 
 // A 0.3 m wall at x in [3.0, 3.2) before a camera 0.5 m up at x = 2.05: it shadows the ground up to x = 3.2 +
