@@ -162,7 +162,9 @@ robot_type { name: "piler" behaviour: "scripted"
       for (const proto::LoggedRequest& q : record.step().requests()) {
         deposits += q.deposits_size();
         raised += q.accepted() ? q.raised_size() : 0;
-        if (!q.accepted()) EXPECT_EQ(q.raised_size(), 0);
+        if (!q.accepted()) {
+          EXPECT_EQ(q.raised_size(), 0);
+        }
       }
   EXPECT_GT(deposits, 20);
   EXPECT_GT(raised, 0);

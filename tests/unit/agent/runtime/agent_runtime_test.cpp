@@ -127,7 +127,7 @@ TEST(AgentRuntime, HelloAdmissionLockstepAndRunOver) {
   std::atomic<bool> stop{false};
   auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
   auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 101});
-  ScriptedWorld world{*world_participant, 4};
+  ScriptedWorld world{*world_participant, 4, 0, nullptr};
   const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
   const auto requests = world.run([&](const protocol::AgentHello& hello) { return admission_for(hello, h); }, 5);
   const RunResult r = running.get();
@@ -160,7 +160,7 @@ TEST(AgentRuntime, IgnoresFramesNotFromItsWorldOrThatMakeNoSense) {
   auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 109});
   auto impostor = bus::make_participant({bus::Vendor::kInProcess, 109});
   std::unique_ptr<bus::Writer<protocol::SensorFrame>> forged;
-  ScriptedWorld world{*world_participant, 4};
+  ScriptedWorld world{*world_participant, 4, 0, nullptr};
   world.before_frame = [&](int step, const std::string& partition, bus::Writer<protocol::SensorFrame>& frames) {
     protocol::SensorFrame f;
     f.agent_id = 4;
@@ -205,7 +205,7 @@ TEST(AgentRuntime, IgnoresScansThatMakeNoSense) {
   std::atomic<bool> stop{false};
   auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
   auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 113});
-  ScriptedWorld world{*world_participant, 4};
+  ScriptedWorld world{*world_participant, 4, 0, nullptr};
   world.before_frame = [&](int step, const std::string&, bus::Writer<protocol::SensorFrame>& frames) {
     protocol::SensorFrame f;
     f.agent_id = 4;
@@ -233,7 +233,7 @@ TEST(AgentRuntime, AGroundTruthRobotIgnoresScans) {
   std::atomic<bool> stop{false};
   auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
   auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 114});
-  ScriptedWorld world{*world_participant, 4};
+  ScriptedWorld world{*world_participant, 4, 0, nullptr};
   world.before_frame = [&](int step, const std::string&, bus::Writer<protocol::SensorFrame>& frames) {
     if (step != 2) return;
     protocol::SensorFrame f;
@@ -257,7 +257,7 @@ TEST(AgentRuntime, RefusalEndsTheRunWithTheWorldsReason) {
   std::atomic<bool> stop{false};
   auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
   auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 102});
-  ScriptedWorld world{*world_participant, 2};
+  ScriptedWorld world{*world_participant, 2, 0, nullptr};
   world.run(
       [](const protocol::AgentHello& hello) {
         protocol::Admission a;
@@ -322,7 +322,7 @@ TEST(AgentRuntime, AnySlotTakesTheAssignedIdFromItsAdmission) {
   std::atomic<bool> stop{false};
   auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
   auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 107});
-  ScriptedWorld world{*world_participant, 0};
+  ScriptedWorld world{*world_participant, 0, 0, nullptr};
   const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
   protocol::AgentHello asked;
   const auto requests = world.run(
@@ -388,7 +388,7 @@ TEST(AgentRuntime, WorldSilenceAfterAdmissionTimesOut) {
   std::atomic<bool> stop{false};
   auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
   auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 104});
-  ScriptedWorld world{*world_participant, 1};
+  ScriptedWorld world{*world_participant, 1, 0, nullptr};
   const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
   world.run([&](const protocol::AgentHello& hello) { return admission_for(hello, h); }, 0, false);
   const RunResult r = running.get();
