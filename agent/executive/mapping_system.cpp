@@ -210,16 +210,12 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   // lifts its neighbours' bound: robots with scans built without end that way).
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-  std::vector<std::uint8_t> hit_now(static_cast<std::size_t>(g.size()), 0);
-  std::vector<int> hits_now(static_cast<std::size_t>(g.size()), 0);  // the cell's hits in this scan
   for (std::size_t index : touched) {
-    hit_now[index] = 1;
     for (Octree::VoxelHits& v : octree_->hits[index]) {
       if (v.scan_count == 0) continue;
       v.estimate_m = v.scan_sum_m / v.scan_count;
       v.has_estimate = true;
       v.hits_in_scan = v.scan_count;
-      hits_now[index] += v.scan_count;
       v.scan_sum_m = 0.0;
       v.scan_count = 0;
     }
@@ -238,11 +234,13 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
       octomap::OcTreeKey key;
       if (!tree.coordToKeyChecked(to_tree(centre.x, centre.y, 0.0), key)) continue;
       const Octree::VoxelHits* top = nullptr;
-      const std::size_t index = static_cast<std::size_t>(row) * g.cols + col;
-      const bool hit = hit_now[index] != 0;
+      // The cell's hits in this scan (hits_in_scan is set for the touched cells only, until the end of this call).
+      int hits = 0;
+      for (const Octree::VoxelHits& v : voxels) hits += v.hits_in_scan;
+      const bool hit = hits > 0;
       // A voxel a wall's scattered hits reached holds few of the cell's hits: the surface's voxel holds at least a
       // fifth of them (and two), else the highest hit voxel is all there is.
-      const int enough = std::max(2, (hits_now[index] + 4) / 5);
+      const int enough = std::max(2, (hits + 4) / 5);
       const Octree::VoxelHits* top_any = nullptr;
       for (const Octree::VoxelHits& v : voxels) {
         if (hit) {

@@ -115,7 +115,7 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
   // The robot's own construction, once accepted, is in its map even where its sensor cannot see it (a scanned map).
   if (frame.last_result == protocol::ActionResult::kAccepted && context_.type.sensor.casts_rays()) {
     for (const Deposition& d : sent_layers_) modules_->map.record_built({d.row, d.col}, d.height_m);
-    if (context_.type.depositor.name == "cube") {
+    if (depositor_kind(context_.type.depositor.name) == DepositorKind::kCube) {
       const double side = depositor_cube_size_m(context_.type);
       for (const Deposit& d : sent_deposits_)
         for (const CellRise& r :
