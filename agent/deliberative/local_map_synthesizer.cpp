@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <string>
 
@@ -94,21 +95,30 @@ LocalMap LocalMapSynthesizer::synthesize(const executive::MappingSystem& map, Po
   const auto [goal, is_target] = local_goal(local, robot, target);
   local.goal = goal;
   local.goal_is_target = is_target;
+  local.passable = local.known;
   if (!all_known && map.sensor().casts_rays()) {
     // A scanning sensor's map has holes (between a laser's rings) and shadows (tiles always cover the window, so a
     // ground-truth robot keeps waiting for its map to grow). A path runs through known cells only, so when the goal
-    // is not 8-connected to the robot through known cells, head for the reachable known cell nearest to it (ties:
-    // the first in row-major order): the robot moves, its next scans fill the holes ahead.
-    const CellMask reachable = NavigabilityProcessor::navigable_from(local.known, local.robot);
-    if (reachable(goal.row, goal.col) == 0) {
-      long long best = std::numeric_limits<long long>::max();
-      for (int r = 0; r < local.rows(); ++r)
-        for (int c = 0; c < local.cols(); ++c) {
-          if (reachable(r, c) == 0) continue;
-          const long long dr = r - goal.row, dc = c - goal.col, d = dr * dr + dc * dc;
-          if (d < best) best = d, local.goal = {r, c};
-        }
-      local.goal_is_target = false;
+    // is not 8-connected to the robot through them, head for the reachable one nearest to it (ties: the first in
+    // row-major order): the robot moves, its next scans fill the holes ahead. Known cells that can be judged (not
+    // blind) first, and the path through them only: a path or goal on blind cells draws the robot along the edge of
+    // what it knows (a structure's side, whose shadow it never sees) instead of where its map is whole.
+    const CellMask judged = (local.known.array() != 0 && local.blind.array() == 0).cast<std::uint8_t>();
+    for (const CellMask* mask : std::initializer_list<const CellMask*>{&judged, &local.known}) {
+      if ((*mask)(local.robot.row, local.robot.col) == 0) continue;
+      const CellMask reachable = NavigabilityProcessor::navigable_from(*mask, local.robot);
+      if (reachable(goal.row, goal.col) == 0) {
+        long long best = std::numeric_limits<long long>::max();
+        for (int r = 0; r < local.rows(); ++r)
+          for (int c = 0; c < local.cols(); ++c) {
+            if (reachable(r, c) == 0) continue;
+            const long long dr = r - goal.row, dc = c - goal.col, d = dr * dr + dc * dc;
+            if (d < best) best = d, local.goal = {r, c};
+          }
+        local.goal_is_target = false;
+      }
+      local.passable = *mask;
+      break;
     }
   }
   return local;

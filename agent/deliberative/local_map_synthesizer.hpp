@@ -33,14 +33,16 @@ struct LocalMap {
   Heightmap gap;                    ///< MARS gap P_kappa[h] - h of the window at the construction kappa [m]; 0 on
                                     ///< unknown cells
   CellMask blind;                   ///< 1 where the cell's ball holds an unknown cell: it is never occupiable
+  CellMask passable;                ///< where a deposition path may run: known cells; on a scanned map known cells
+                                    ///< that are not blind, when they reach the local goal
   CellMask occupiable;              ///< occupiable cells; never a blind one
   CellMask navigable;               ///< occupiable cells 8-connected to the robot's cell
   CellIndex robot;                  ///< the robot's cell
   std::optional<CellIndex> origin;  ///< the local origin, when some trajectory cell in the window is occupiable
-  /// The local goal: local_goal(); for a scanning sensor's map, the reachable known cell nearest to it when it is not
-  /// reachable through known cells.
+  /// The local goal: local_goal(); for a scanning sensor's map, when it is not reachable through passable cells, the
+  /// reachable passable cell nearest to it.
   CellIndex goal;
-  bool goal_is_target = false;      ///< true when the local goal is the target's own cell
+  bool goal_is_target = false;  ///< true when the local goal is the target's own cell
 
   /// The window's geometry (world placement, cell size [m]).
   const GridGeometry& geometry() const { return heights.geometry(); }

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <string>
 
 #include "marsala/core/error.hpp"
@@ -21,10 +23,32 @@ std::string describe(const TerrainTile& t) {
 constexpr double kOctreeHalfVoxels = 32768.0;
 /// Voxels of one column a cell remembers hits in; more than a terrain column ever shows (ground, a wall's mixed hits).
 constexpr std::size_t kVoxelsPerCell = 8;
-/// Width of the band along each cell edge whose hits are left out: at least this many cells, and at least
-/// kEdgeBandNoise range-noise spreads of the sensor (a wall's hits scatter that far across the edge) [cells], [1].
+/// Width of the band along each cell edge whose hits are left out: at least kEdgeBand cells, and at least
+/// kEdgeBandNoise range-noise spreads at the hit's range (a wall's or a step's hits scatter that far across the
+/// edge) [cells], [1]. A hit whose band would be wider than kMaxEdgeBand cells is too noisy to say which cell it
+/// fell in and is left out (a depth camera's far hits) [cells].
 constexpr double kEdgeBand = 0.1;
-constexpr double kEdgeBandNoise = 2.0;
+constexpr double kEdgeBandNoise = 3.0;
+constexpr double kMaxEdgeBand = 0.3;
+
+/// Where a ray from `o` to `p` entered the column of `cell` (the cell holding p): the cell it crossed just before and
+/// the ray's height at the crossing [m]; nullopt when the ray starts inside that column.
+struct ColumnEntry {
+  CellIndex from;
+  double z_m;
+};
+std::optional<ColumnEntry> column_entry(const GridGeometry& g, Point3 o, Point3 p, CellIndex cell) {
+  const Position c = g.cell_center(cell);
+  const double half = 0.5 * g.cell_size_m, dx = p.x - o.x, dy = p.y - o.y;
+  double t_enter = -std::numeric_limits<double>::infinity();
+  if (dx != 0.0) t_enter = std::max(t_enter, std::min((c.x - half - o.x) / dx, (c.x + half - o.x) / dx));
+  if (dy != 0.0) t_enter = std::max(t_enter, std::min((c.y - half - o.y) / dy, (c.y + half - o.y) / dy));
+  if (!(t_enter > 0.0)) return std::nullopt;
+  const double back = t_enter - 1e-6 * g.cell_size_m / std::hypot(dx, dy);
+  const auto from = g.cell_at({o.x + back * dx, o.y + back * dy});
+  if (!from || *from == cell) return std::nullopt;
+  return ColumnEntry{*from, o.z + t_enter * (p.z - o.z)};
+}
 
 }  // namespace
 
@@ -71,6 +95,8 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       known_(other.known_),
       assumed_(other.assumed_),
       known_count_(other.known_count_),
+      scans_(other.scans_),
+      hit_scan_(other.hit_scan_),
       tile_size_(other.tile_size_),
       registration_(other.registration_),
       built_(other.built_),
@@ -134,7 +160,8 @@ void MappingSystem::integrate_tile(const TerrainTile& tile) {
   const long long col0 = static_cast<long long>(tile.tile_col) * tile_size_;
   for (int r = 0; r < tile.rows; ++r)
     for (int c = 0; c < tile.cols; ++c) {
-      const int row = static_cast<int>(row0) + r + registration_.row, col = static_cast<int>(col0) + c + registration_.col;
+      const int row = static_cast<int>(row0) + r + registration_.row,
+                col = static_cast<int>(col0) + c + registration_.col;
       if (!heights_.contains({row, col})) continue;
       heights_(row, col) = tile.heights[static_cast<std::size_t>(r) * tile.cols + c];
       mark_known(row, col);
@@ -150,6 +177,8 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
         fmt::format("mapping system: sensor origin ({}, {}, {}) m is not finite", origin.x, origin.y, origin.z));
   const GridGeometry& g = heights_.geometry();
   const double cs = g.cell_size_m;
+  ++scans_;
+  if (hit_scan_.empty()) hit_scan_.assign(static_cast<std::size_t>(g.rows) * g.cols, 0);
   if (!octree_) {
     octree_ = std::make_unique<Octree>(cs);
     octree_->hits.resize(static_cast<std::size_t>(g.size()));
@@ -169,14 +198,26 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   // A hit on a wall between two cells lies on their common edge, and range noise puts it on either side: in the
   // lower cell's column it would read as a surface high above that cell. Hits within kEdgeBand of a cell edge are
   // therefore left out; the cell's interior hits say where its surface is (docs/runtime.md#mapping).
-  const double band = std::min(0.3 * cs, std::max(kEdgeBand * cs, kEdgeBandNoise * sensor_.noise_sd_at(1.0)));
   for (const ScanPoint& p : points) {
     const double x = origin.x + p.x_m, y = origin.y + p.y_m, z = origin.z + p.z_m;
     const std::optional<CellIndex> cell = g.cell_at({x, y});
     if (!cell || std::abs(z) >= z_limit) continue;
+    const double range = std::sqrt(double{p.x_m} * p.x_m + double{p.y_m} * p.y_m + double{p.z_m} * p.z_m);
+    const double band = std::max(kEdgeBand * cs, kEdgeBandNoise * sensor_.noise_sd_at(range));
+    if (band > kMaxEdgeBand * cs + 1e-12) continue;
     const double u = (x - g.xll_m) / cs, v = (y - g.yll_m) / cs;
     const double fu = (u - std::floor(u)) * cs, fv = (v - std::floor(v)) * cs;
     if (fu < band || fu > cs - band || fv < band || fv > cs - band) continue;
+    // A hit just past a higher cell's edge, from a ray that crossed into this column at or below that cell's surface,
+    // is that edge's hit pushed over by range noise, not this cell's surface: in the shadow behind an edge nothing
+    // else lands, and a few such hits over many scans would raise the cell to the edge's height. Judged on the map
+    // before this scan; a cell that really rose to its neighbour's height reads so from a steeper ray.
+    if (const auto entry = column_entry(g, origin, {x, y, z}, *cell);
+        entry && known_(entry->from.row, entry->from.col) != 0) {
+      const double tol = kEdgeBandNoise * sensor_.noise_sd_at(range), edge = heights_(entry->from);
+      const bool lower = known_(cell->row, cell->col) == 0 || heights_(*cell) < edge - tol;
+      if (lower && entry->z_m <= edge + tol) continue;
+    }
     const octomap::point3d end = to_tree(x, y, z);
     octomap::OcTreeKey key;
     if (!tree.coordToKeyChecked(end, key)) continue;
@@ -238,6 +279,7 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
       int hits = 0;
       for (const Octree::VoxelHits& v : voxels) hits += v.hits_in_scan;
       const bool hit = hits > 0;
+      if (hit) hit_scan_[static_cast<std::size_t>(row) * g.cols + col] = scans_;
       // A voxel a wall's scattered hits reached holds few of the cell's hits: the surface's voxel holds at least a
       // fifth of them (and two), else the highest hit voxel is all there is.
       const int enough = std::max(2, (hits + 4) / 5);
@@ -263,6 +305,12 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
     for (Octree::VoxelHits& v : octree_->hits[index]) v.hits_in_scan = 0;
 }
 
+bool MappingSystem::hit_within(CellIndex cell, int scans) const {
+  if (hit_scan_.empty() || !heights_.contains(cell)) return false;
+  const int last = hit_scan_[static_cast<std::size_t>(cell.row) * heights_.cols() + cell.col];
+  return last > 0 && scans_ - last < scans;
+}
+
 void MappingSystem::record_built(CellIndex cell, double rise_m) {
   if (!heights_.contains(cell) || !std::isfinite(rise_m) || !(rise_m > 0.0)) return;
   const long long index = static_cast<long long>(cell.row) * heights_.cols() + cell.col;
@@ -274,8 +322,8 @@ void MappingSystem::record_built(CellIndex cell, double rise_m) {
 
 void MappingSystem::assume_ground(Position pose, double ground_z_m, double radius_m) {
   if (!std::isfinite(ground_z_m) || std::abs(ground_z_m) >= kMaxMagnitude || !(radius_m >= 0.0))
-    throw InvalidArgument(fmt::format("mapping system: ground {} m within {} m is not a finite height and radius",
-                                      ground_z_m, radius_m));
+    throw InvalidArgument(
+        fmt::format("mapping system: ground {} m within {} m is not a finite height and radius", ground_z_m, radius_m));
   const std::optional<CellIndex> centre =
       std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;
   if (!centre) throw InvalidArgument(fmt::format("mapping system: pose ({}, {}) m is off the grid", pose.x, pose.y));

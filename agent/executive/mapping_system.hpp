@@ -58,9 +58,9 @@ class MappingSystem {
   /// the heights of the cells around (docs/runtime.md#mapping). Points off the grid are left out. Throws
   /// InvalidArgument when scan_problem() finds one or the origin is not finite.
   void integrate_scan(const std::vector<ScanPoint>& points, Point3 sensor_origin);
-  /// The ground under the robot's body: every still unknown cell within radius_m of the cell under `pose` (centre to centre) becomes
-  /// known at `ground_z_m`, the height under the robot's centre (it stands there; a scan sees no nearer than its
-  /// minimum range and the camera nothing behind it). A later scan's hits replace it. [m]
+  /// The ground under the robot's body: every still unknown cell within radius_m of the cell under `pose` (centre to
+  /// centre) becomes known at `ground_z_m`, the height under the robot's centre (it stands there; a scan sees no nearer
+  /// than its minimum range and the camera nothing behind it). A later scan's hits replace it. [m]
   void assume_ground(Position pose, double ground_z_m, double radius_m);
   /// The robot's own construction: the world accepted its request to raise `cell` (world index, as the map registers
   /// it) by rise_m [m]. Terrain only ever rises (depositions add material), so the cell is at least its map height
@@ -82,6 +82,11 @@ class MappingSystem {
   const CellMask& assumed() const { return assumed_; }
   /// Number of known cells.
   long long known_cells() const { return known_count_; }
+  /// Scans integrated so far.
+  int scans() const { return scans_; }
+  /// True when one of the last `scans` scans hit the cell (its surface, not only rays through its column): what it
+  /// says there is current. Others may have built there since an older scan (docs/runtime.md#mapping).
+  bool hit_within(CellIndex cell, int scans) const;
   /// Cells stood on, oldest first, consecutive repeats removed (global indices).
   const std::vector<CellIndex>& trajectory() const { return trajectory_; }
   /// The world grid.
@@ -92,13 +97,15 @@ class MappingSystem {
   std::size_t octree_leaves() const;
 
  private:
-  struct Octree;  // OctoMap's tree and the hits per cell, in mapping_system.cpp
+  struct Octree;                      // OctoMap's tree and the hits per cell, in mapping_system.cpp
   void mark_known(int row, int col);  // observed by a sensor
 
   Heightmap heights_;
   CellMask known_;
   CellMask assumed_;
   long long known_count_ = 0;
+  int scans_ = 0;
+  std::vector<int> hit_scan_;  ///< per cell (row-major): the scan (1, 2, ...) that last hit it, 0 when none
   int tile_size_;
   CellIndex registration_{0, 0};
   std::unordered_map<long long, double> built_;  ///< record_built(): the least height of a cell (row-major index) [m]

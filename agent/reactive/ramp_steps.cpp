@@ -54,8 +54,8 @@ struct RampSteps::Modules {
   NavigablePathPlanner router;   // shortest routes through navigable cells (alpha = 0)
   executive::ActionManager actions;
   executive::DepositionManager depositions;
-  int max_idle_retreat_moves;
-  std::unique_ptr<executive::Depositor> depositor;  // turns the manager's wish into depositions or deposits  // retreat moves without work before trying to advance again
+  int max_idle_retreat_moves;                       // retreat moves without work before trying to advance again
+  std::unique_ptr<executive::Depositor> depositor;  // turns the manager's wish into depositions or deposits
 };
 
 RampSteps::RampSteps(const AgentContext& context, std::optional<PlannerParams> planner)
@@ -87,6 +87,8 @@ void RampSteps::admit(const protocol::Admission& admission) {
   // A scanned map reads each surface within a few noise spreads at the manipulator's reach: leave that much unfilled.
   if (context_.type.sensor.casts_rays())
     deposits.gap_margin_m = kScanGapMargin * context_.type.sensor.noise_sd_at(body.reach_m + body.navigability.delta_m);
+  gap_margin_m_ = deposits.gap_margin_m;
+  gap_streaks_.clear();
   PlannerParams router = planner;
   router.alpha = 0.0;
   router.beta = 1.0;
@@ -118,8 +120,9 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
     if (depositor_kind(context_.type.depositor.name) == DepositorKind::kCube) {
       const double side = depositor_cube_size_m(context_.type);
       for (const Deposit& d : sent_deposits_)
-        for (const CellRise& r :
-             cube_column_shape(modules_->map.geometry(), {d.x_m, d.y_m}, side, static_cast<int>(whole_cubes(d.volume_m3, side))).rises)
+        for (const CellRise& r : cube_column_shape(modules_->map.geometry(), {d.x_m, d.y_m}, side,
+                                                   static_cast<int>(whole_cubes(d.volume_m3, side)))
+                                     .rises)
           modules_->map.record_built(r.cell, r.rise_m);
     }
   }
@@ -130,7 +133,8 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
   if (frame.last_result == protocol::ActionResult::kRejected && sent_motion_)
     refused_[{sent_motion_->row, sent_motion_->col}] = frame.step + kRefusedMotionSteps;
   sent_motion_.reset();
-  for (auto it = refused_.begin(); it != refused_.end();) it = it->second <= frame.step ? refused_.erase(it) : std::next(it);
+  for (auto it = refused_.begin(); it != refused_.end();)
+    it = it->second <= frame.step ? refused_.erase(it) : std::next(it);
   const Position robot{frame.x_m, frame.y_m};
   modules_->map.integrate(frame.tiles, robot);
   const SensorSpec& sensor = context_.type.sensor;
@@ -143,9 +147,10 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
   const Position target = goal.value_or(robot);  // nothing left to build towards: stay
   BuildView view{modules_->synthesizer.synthesize(modules_->map, robot, target), robot, target};
   clear_pad_gap(view.local);
+  if (sensor.casts_rays()) count_gap_scans(view.local, frame.scanned);
   const RobotBody& body = context_.type.body;
-  others_ = executive::body_clearances(frame.neighbours, context_.agent_id, 0.5 * body.navigability.delta_m,
-                                       body.max_step_m);
+  others_ =
+      executive::body_clearances(frame.neighbours, context_.agent_id, 0.5 * body.navigability.delta_m, body.max_step_m);
   corridor_ = view.local.navigable;
   terrain_occupiable_ = view.local.occupiable;
   executive::keep_clear(view.local, robot, others_);
@@ -165,7 +170,7 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
 
 bool RampSteps::plan_path(const deliberative::LocalMap& local, BuildTrace& trace) {
   if (!trace.planned) {
-    trace.plan = modules_->planner.plan(local.gap, local.known, local.robot, local.goal);
+    trace.plan = modules_->planner.plan(local.gap, local.passable, local.robot, local.goal);
     trace.planned = true;
   }
   return trace.plan.found;
@@ -184,12 +189,39 @@ void RampSteps::clear_pad_gap(deliberative::LocalMap& local) const {
       if (std::hypot(local.center({r, c}).x - base.x, local.center({r, c}).y - base.y) <= radius) local.gap(r, c) = 0.0;
 }
 
+void RampSteps::count_gap_scans(const deliberative::LocalMap& local, bool scanned) {
+  const executive::MappingSystem& map = modules_->map;
+  const int cols = map.geometry().cols;
+  if (gap_streaks_.empty()) gap_streaks_.resize(static_cast<std::size_t>(map.geometry().rows) * cols);
+  if (!scanned) return;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      const CellIndex g = local.to_global({r, c});
+      if (!(local.gap(r, c) > gap_margin_m_) || !map.hit_within(g, kFreshScans)) continue;
+      GapStreak& streak = gap_streaks_[static_cast<std::size_t>(g.row) * cols + g.col];
+      streak.scans = streak.last_scan == map.scans() - 1 ? streak.scans + 1 : 1;
+      streak.last_scan = map.scans();
+    }
+}
+
+void RampSteps::clear_unconfirmed_gap(deliberative::LocalMap& local) const {
+  const executive::MappingSystem& map = modules_->map;
+  const int cols = map.geometry().cols;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      const CellIndex g = local.to_global({r, c});
+      const GapStreak& streak = gap_streaks_[static_cast<std::size_t>(g.row) * cols + g.col];
+      if (streak.last_scan != map.scans() || streak.scans < kConfirmScans) local.gap(r, c) = 0.0;
+    }
+}
+
 void RampSteps::set_lane(double offset_m, double corridor_width_m) {
   lane_offset_m_ = offset_m;
   corridor_width_m_ = corridor_width_m;
 }
 
-std::vector<CellIndex> RampSteps::in_lane(const deliberative::LocalMap& local, const std::vector<CellIndex>& path) const {
+std::vector<CellIndex> RampSteps::in_lane(const deliberative::LocalMap& local,
+                                          const std::vector<CellIndex>& path) const {
   if (!(lane_offset_m_ > 0.0) || corridor_.rows() != local.rows() || corridor_.cols() != local.cols()) return path;
   return executive::lane_path(local, corridor_, path, lane_offset_m_, corridor_width_m_);
 }
@@ -215,6 +247,7 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
     terrain_only.occupiable = terrain_occupiable_;
     terrain_only.navigable = corridor_;
   }
+  if (context_.type.sensor.casts_rays()) clear_unconfirmed_gap(terrain_only);
   trace.deposition = modules_->depositor->plan(modules_->depositions, terrain_only, ahead, at, frame.material_m3,
                                                neighbourhood(frame));
   auto& deposits = trace.deposition.deposits;

@@ -49,6 +49,13 @@ inline constexpr double kPadFraction = 0.5;
 /// A robot that maps with range scans leaves this many noise spreads (its sensor's sd at its reach plus a body
 /// length) of each cell's MARS gap unfilled (DepositionParams::gap_margin_m).
 inline constexpr double kScanGapMargin = 3.0;
+/// A scanning robot deposits only on cells one of its last kFreshScans scans hit: an older reading may be from before
+/// another robot built there, and filling that stale gap again overbuilds [scans].
+inline constexpr int kFreshScans = 3;
+/// ... and only on a gap (beyond its margin) that its last kConfirmScans scans all showed: a single scan misreads a
+/// surface by a step's height now and then (hits near a riser), and a gap filled on such a reading is a bump others
+/// build around [scans].
+inline constexpr int kConfirmScans = 3;
 /// A motion target the world refused is left out of the robot's local map for this many steps.
 inline constexpr std::uint64_t kRefusedMotionSteps = 40;
 
@@ -141,21 +148,34 @@ class RampSteps {
                BuildTrace& trace, protocol::ActionRequest& request) const;
   std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
   void clear_pad_gap(deliberative::LocalMap& local) const;  // no work on the base station's pad
+  /// A scanned map: counts, per cell of the window, the scans in a row that showed its gap (beyond the margin) on a
+  /// surface a recent scan hit (kFreshScans, kConfirmScans).
+  void count_gap_scans(const deliberative::LocalMap& local, bool scanned);
+  /// A scanned map: no work where the gap is not confirmed: on a cell no recent scan hit (others may have built there
+  /// since) or whose gap fewer than kConfirmScans scans in a row showed (one scan's misread surface is no gap). The
+  /// path is still planned on the whole gap.
+  void clear_unconfirmed_gap(deliberative::LocalMap& local) const;
   static std::optional<CellIndex> farthest_navigable_from_goal(const deliberative::LocalMap& local);
 
   AgentContext context_;
   std::optional<PlannerParams> planner_;
   std::unique_ptr<deliberative::GoalSynthesizer> goal_;
   std::unique_ptr<Modules> modules_;  // made on admission, when the grid is known
-  CellIndex registration_{0, 0};       // set_registration()
+  CellIndex registration_{0, 0};      // set_registration()
   bool deposited_since_blocked_ = false;
   int idle_retreat_moves_ = 0;
   // The world gives deposits (cube, cone) their shape and may judge one the prediction passed: after a rejected
   // request with deposits, the next ones carry at most half as many (none after one), until one is accepted, so a
   // mismatch never repeats the same request forever. -1: no limit.
   int deposit_limit_ = -1;
-  mutable int deposits_sent_ = 0;  // deposits in the request being built (the last deposit() call's)
+  mutable int deposits_sent_ = 0;                 // deposits in the request being built (the last deposit() call's)
   mutable std::optional<CellIndex> sent_motion_;  // the world cell the request being built moves to
+  struct GapStreak {
+    int last_scan = 0;  // the map's scan that last showed the gap
+    int scans = 0;      // scans in a row, up to that one, that showed it
+  };
+  std::vector<GapStreak> gap_streaks_;                    // scanned maps, per cell (row-major): count_gap_scans()
+  double gap_margin_m_ = 0.0;                             // the gap a scanned map leaves unfilled [m]
   std::map<std::pair<int, int>, std::uint64_t> refused_;  // motion targets the world refused, avoided until a step
   // What the request being built deposits, for the map once the world accepts it (MappingSystem::record_built).
   mutable std::vector<Deposition> sent_layers_;

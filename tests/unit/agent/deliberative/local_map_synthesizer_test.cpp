@@ -2,13 +2,13 @@
 
 #include <gtest/gtest.h>
 
-#include "unit/agent/agent_test_support.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/iterators.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
 #include "marsala/core/ray_caster.hpp"
 #include "support/mars_brute_force.hpp"
 #include "support/navigability_brute_force.hpp"
+#include "unit/agent/agent_test_support.hpp"
 
 namespace marsala::agent::deliberative {
 namespace {
@@ -200,6 +200,42 @@ TEST(LocalMapSynthesizer, ScannedMapsNeverLetTheRobotOntoUnknownCells) {
       }
       for (const CellIndex p : plan.path) EXPECT_EQ(local.known(p.row, p.col), 1) << r << ", " << c;
     }
+}
+
+// A scanned map whose goal (where the line to the target leaves the window) cannot be judged yet: a hole in the
+// known corridor lies within its body ball. The robot heads for the nearest known cell that can be judged and
+// reaches it through such cells only (LocalMap::passable); before, it followed the blind cells along the edge of its
+// knowledge, where a structure's side hides what lies beyond and the robot stalled.
+TEST(LocalMapSynthesizer, AScannedMapsGoalAndPathAvoidCellsItCannotJudge) {
+  executive::MappingSystem map(kWorld, 16, sensor_defaults("laser"));
+  // Known flat ground (assumed, which marks cells known): the corridor rows 27..33, cols 25..79, but cell (31, 64).
+  for (int r = 27; r <= 33; ++r)
+    for (int c = 25; c < 80; ++c)
+      if (!(r == 31 && c == 64)) map.assume_ground(kWorld.cell_center({r, c}), 0.0, 0.0);
+  map.record_pose(kRobot);
+  const LocalMapSynthesizer synthesizer(kBody, 2.5);                         // ball radius 2 cells; window cols 15..65
+  const LocalMap local = synthesizer.synthesize(map, kRobot, {7.05, 2.95});  // the target (30, 70), off the window
+  const CellIndex exit = local.to_local({30, 65});
+  ASSERT_EQ(local.blind(exit.row, exit.col), 1);  // (31, 64) lies within its ball
+  // Judged cells reachable through judged cells end before the hole: (29, 64), (30, 63) and (31, 63) hold it in
+  // their balls, (28, 64) the unknown row 26. The nearest of them to the exit cell: (29, 63), d^2 = 5.
+  EXPECT_EQ(local.to_global(local.goal), (CellIndex{29, 63}));
+  EXPECT_FALSE(local.goal_is_target);
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c)
+      EXPECT_EQ(local.passable(r, c), local.known(r, c) != 0 && local.blind(r, c) == 0) << r << ", " << c;
+  const NavigablePathPlanner planner(default_planner_params(kBody.delta_m, kWorld.cell_size_m));
+  const PlannerResult plan = planner.plan(local.gap, local.passable, local.robot, local.goal);
+  ASSERT_TRUE(plan.found);
+  for (const CellIndex p : plan.path) EXPECT_EQ(local.blind(p.row, p.col), 0) << p.row << ", " << p.col;
+
+  // A ground-truth map is whole: the goal is the exit cell and every known cell is passable.
+  executive::MappingSystem exact(kWorld, 16);
+  for (int r = 27; r <= 33; ++r)
+    for (int c = 25; c < 80; ++c) exact.assume_ground(kWorld.cell_center({r, c}), 0.0, 0.0);
+  const LocalMap whole = synthesizer.synthesize(exact, kRobot, {7.05, 2.95});
+  EXPECT_EQ(whole.to_global(whole.goal), (CellIndex{30, 65}));
+  EXPECT_EQ(whole.passable, whole.known);
 }
 
 }  // namespace
