@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "marsala/core/deposit_shapes.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/world_server/completion.hpp"
@@ -47,7 +48,8 @@ WorldState make_world_state(const scenario::Scenario& scenario, Heightmap terrai
     const scenario::AgentSlot& slot = scenario.slots[id - 1];
     const RobotType& type = scenario.robot_for(id);
     // docs/runtime.md#depositors: a cube narrower than a cell has no footprint of its own on the heightmap.
-    if (type.depositor.name == "cube" && depositor_cube_size_m(type) < s.terrain.cell_size_m() - 1e-12)
+    if (depositor_kind(type.depositor.name) == DepositorKind::kCube &&
+        depositor_cube_size_m(type) < s.terrain.cell_size_m() - 1e-12)
       throw InvalidArgument("robot type '" + type.name + "': depositor.cube_size_m " +
                             fmt::format("{}", depositor_cube_size_m(type)) + " m is smaller than the cell size " +
                             fmt::format("{}", s.terrain.cell_size_m()) +

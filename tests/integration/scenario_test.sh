@@ -390,7 +390,12 @@ case "$case_name" in
     "$root/deploy/spawn.sh" --scenario "$root/deploy/scenarios/crowd_120.pbtxt" --agents 120 --dds "$dds" \
       --domain "$domain" --out "$out" --max-steps 100 --quiet --timeout 600 >&2 && rc=0 || rc=$?
     s="$out/summary.json"
-    [ "$rc" = 3 ] || fail "spawn.sh exit $rc, expected 3 (max_steps); logs: $out/logs"
+    if [ "$rc" != 3 ]; then
+      # The folder goes with the test: show the logs of the processes that ended badly (an abort was seen once).
+      grep -l -i -E "terminate|abort|assert|fatal|error|exit" "$out"/logs/*.log 2>/dev/null | head -n 5 |
+        while read -r log; do echo "--- $log (last lines)" >&2; tail -n 15 "$log" >&2; done
+      fail "spawn.sh exit $rc, expected 3 (max_steps)"
+    fi
     top() { jq -r ".$1" "$s"; }  # a top-level field (per_agent entries have some of the same names)
     for f in admitted connected; do
       [ "$(top "$f")" = 120 ] || { cat "$s"; fail "$f: $(top "$f") of 120"; }
