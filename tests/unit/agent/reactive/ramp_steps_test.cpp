@@ -11,6 +11,8 @@
 
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/ray_caster.hpp"
+#include "marsala/core/sensor_spec.hpp"
 #include "unit/agent/agent_test_support.hpp"
 
 namespace marsala::agent::reactive {
@@ -106,7 +108,9 @@ TEST(RampSteps, AMotionTheWorldRefusedIsLeftOutOfTheLocalMapForAWhile) {
   protocol::ActionRequest q = empty(steps, f0);
   ASSERT_EQ(steps.build_step(view.local, f0, trace, q), BuildPhase::kAdvance);
   const CellIndex refused = *steps.map().geometry().cell_at({q.target_x_m, q.target_y_m});
-  const auto local = [&](const BuildView& v) { return CellIndex{refused.row - v.local.offset.row, refused.col - v.local.offset.col}; };
+  const auto local = [&](const BuildView& v) {
+    return CellIndex{refused.row - v.local.offset.row, refused.col - v.local.offset.col};
+  };
   EXPECT_NE(view.local.occupiable(local(view).row, local(view).col), 0);
 
   // The world refused it: the robot (still where it was) leaves that cell out and goes elsewhere.
@@ -293,6 +297,56 @@ TEST(RampSteps, AfterARejectedRequestWithDepositsTheNextCarriesAtMostHalfAsManyU
   EXPECT_EQ(n, 0u);  // no deposits now: the robot does something else, and the world judges something new
   deposits_with(protocol::ActionResult::kAccepted);  // the request without deposits was accepted
   EXPECT_EQ(deposits_with(protocol::ActionResult::kAccepted), full);
+}
+
+// A laser robot before a 0.3 m step: the MARS gap in front of it is real, but it fills it only once its last 3 scans
+// in a row all showed it on cells they hit (kConfirmScans): one scan's misread step is no gap. Each frame here
+// carries a scan of the same terrain from the same pose; the first two frames request no deposition, the third does,
+// and a robot with exact sensing at the same pose at its first.
+TEST(RampSteps, AScanningRobotFillsAGapOnlyOnceItsLastScansAgree) {
+  AgentContext c = test::agent_context(3, test::husky());
+  c.type.sensor = sensor_defaults("laser");
+  RampSteps steps(c);
+  Heightmap h = test::platform_world();  // with a 0.3 m step instead of the 1.5 m platform: its top lies below the
+  for (int r = 0; r < h.rows(); ++r)     // laser (0.5 m up), which sees no higher than 10 degrees up
+    for (int c = 70; c < h.cols(); ++c) h(r, c) = 0.3;
+  steps.admit(test::admission_on(c, h.geometry(), kTarget, kBase));
+  const Position robot{6.05, 3.05};
+  const Point3 origin = sensor_origin(h, robot.x, robot.y, c.type.sensor);
+  bool deposited_before_third = false;
+  for (std::uint64_t step = 0; step < 3; ++step) {
+    protocol::SensorFrame f;
+    f.agent_id = 3;
+    f.step = step;
+    f.x_m = robot.x;
+    f.y_m = robot.y;
+    f.material_m3 = 1.0;
+    f.scanned = true;
+    f.points = cast_scan(h, origin, 0.0, c.type.sensor, step + 1);
+    BuildTrace trace;
+    const BuildView view = steps.look(f, trace);
+    protocol::ActionRequest q = empty(steps, f);
+    (void)steps.build_step(view.local, f, trace, q);
+    const bool deposits = !q.depositions.empty();
+    EXPECT_GT(view.local.gap.heights().maxCoeff(), 0.2) << "step " << step;  // the step's gap, seen at every scan
+    if (step < 2) {
+      deposited_before_third = deposited_before_third || deposits;
+    } else {
+      EXPECT_TRUE(deposits) << "the third scan confirms the gap";
+    }
+  }
+  EXPECT_FALSE(deposited_before_third);
+
+  // The same robot with exact sensing fills it at its first frame.
+  AgentContext exact = test::agent_context(3, test::husky());
+  RampSteps now(exact);
+  now.admit(test::admission_on(exact, h.geometry(), kTarget, kBase));
+  const protocol::SensorFrame f = test::full_frame(exact, 0, robot, 1.0, h);
+  BuildTrace trace;
+  const BuildView view = now.look(f, trace);
+  protocol::ActionRequest q = empty(now, f);
+  (void)now.build_step(view.local, f, trace, q);
+  EXPECT_FALSE(q.depositions.empty());
 }
 
 }  // namespace
