@@ -173,6 +173,33 @@ CellIndex cell_under(const Heightmap& map, Position p, const std::string& what) 
   return *cell;
 }
 
+/// Labels the 8-connected components of the mask's 1-cells 1, 2, ... in row-major order of their first cell; 0 off
+/// the mask. Two occupiable cells are navigable from one another exactly when they share a label.
+Eigen::MatrixXi component_labels(const CellMask& mask) {
+  Eigen::MatrixXi label = Eigen::MatrixXi::Zero(mask.rows(), mask.cols());
+  int next = 0;
+  std::vector<CellIndex> stack;
+  for (int r = 0; r < mask.rows(); ++r)
+    for (int c = 0; c < mask.cols(); ++c) {
+      if (mask(r, c) == 0 || label(r, c) != 0) continue;
+      label(r, c) = ++next;
+      stack.push_back({r, c});
+      while (!stack.empty()) {
+        const CellIndex p = stack.back();
+        stack.pop_back();
+        for (int dr = -1; dr <= 1; ++dr)
+          for (int dc = -1; dc <= 1; ++dc) {
+            const int rr = p.row + dr, cc = p.col + dc;
+            if (rr < 0 || cc < 0 || rr >= mask.rows() || cc >= mask.cols()) continue;
+            if (mask(rr, cc) == 0 || label(rr, cc) != 0) continue;
+            label(rr, cc) = next;
+            stack.push_back({rr, cc});
+          }
+      }
+    }
+  return label;
+}
+
 std::string fixed(double v, int digits) { return fmt::format("{:.{}f}", v, digits); }
 
 }  // namespace
@@ -443,7 +470,7 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       site_params.min_depth_m = min_depth;
       site_params.min_natural_m = min_natural >= 0.0 ? min_natural : payload.delta_m;
       const Heightmap gap = route_gap(map, site_kappa, local_radius);
-      const CellMask occupiable = NavigabilityProcessor(payload).occupiable(map);
+      const Eigen::MatrixXi region = component_labels(NavigabilityProcessor(payload).occupiable(map));
       const auto& g = map.geometry();
       if (route_json)
         out << "{\"terrain\":{\"rows\":" << g.rows << ",\"cols\":" << g.cols << ",\"cell_size_m\":" << g.cell_size_m
@@ -455,16 +482,17 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
         const auto [from, to] = cells[i];
         const RouteSites r = plan_route_sites(gap, from, to, site_params);
         const Position a = map.cell_center(from), b = map.cell_center(to);
-        const bool from_ok = occupiable(from.row, from.col) != 0, to_ok = occupiable(to.row, to.col) != 0;
-        const bool connected =
-            from_ok && to_ok && NavigabilityProcessor::navigable_from(occupiable, from)(to.row, to.col) != 0;
+        const int from_region = region(from.row, from.col), to_region = region(to.row, to.col);
+        const bool from_ok = from_region != 0, to_ok = to_region != 0;
+        const bool connected = from_ok && from_region == to_region;
         if (route_json) {
           out << (i > 0 ? "," : "") << "{\"from\":[" << a.x << "," << a.y << "],\"to\":[" << b.x << "," << b.y
               << "],\"length_m\":" << fixed(r.length_m, 3) << ",\"volume_m3\":" << fixed(r.band_volume_m3, 3)
               << ",\"band_cells\":" << r.band_cells << ",\"from_occupiable\":" << (from_ok ? "true" : "false")
-              << ",\"to_occupiable\":" << (to_ok ? "true" : "false")
-              << ",\"navigable_now\":" << (connected ? "true" : "false") << ",\"from_gap_m\":" << fixed(r.from_gap_m, 4)
-              << ",\"to_gap_m\":" << fixed(r.to_gap_m, 4) << ",\"sites\":[";
+              << ",\"to_occupiable\":" << (to_ok ? "true" : "false") << ",\"from_region\":" << from_region
+              << ",\"to_region\":" << to_region << ",\"navigable_now\":" << (connected ? "true" : "false")
+              << ",\"from_gap_m\":" << fixed(r.from_gap_m, 4) << ",\"to_gap_m\":" << fixed(r.to_gap_m, 4)
+              << ",\"sites\":[";
           for (std::size_t k = 0; k < r.sites.size(); ++k)
             out << (k > 0 ? "," : "") << "{\"from_m\":" << fixed(r.sites[k].from_m, 3)
                 << ",\"to_m\":" << fixed(r.sites[k].to_m, 3) << ",\"volume_m3\":" << fixed(r.sites[k].volume_m3, 3)
