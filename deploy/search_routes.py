@@ -12,8 +12,8 @@ import tempfile
 
 USAGE = """\
 For every window (a square of --size metres at each X0 Y0 of --windows, cropped and resampled as a scenario's
-terrain is), takes the points of a grid (--spacing) that are occupiable for the payload and stand on their own
-ground (MARS gap, as the builders see it, below --min-depth), plans the builders' route between every two of them
+terrain is), takes the points of a grid (--spacing) that are occupiable for the payload as bases and those that
+also stand on their own ground (MARS gap below --min-depth) as targets, plans the builders' route between every two of them
 --min-dist .. --max-dist apart that the payload cannot drive yet (marsala-terrain route --pairs), keeps the routes
 with at least --min-sites construction sites separated by natural ground, and ranks them by volume. Prints what it
 searched and the best routes; --json FILE writes every kept route.
@@ -61,11 +61,14 @@ def main():
     parser.add_argument("--delta", type=float, default=2.0, help="payload body [m]")
     parser.add_argument("--eps", type=float, default=0.05, help="payload discontinuity [m]")
     parser.add_argument("--width", type=float, default=3.0, help="construction band width [m]")
-    parser.add_argument("--local-radius", type=float, default=5.0,
-                        help="the builders' sensing range: their MARS bound's half-window [m] (0: whole window)")
+    parser.add_argument("--local-radius", type=float, default=0.0,
+                        help="take the MARS bound within this half-window only [m] (0, the default: the whole window, "
+                             "which the builders' ramps reach in the end)")
     parser.add_argument("--min-depth", type=float, default=0.016,
                         help="gap a cell needs to be built on: one cube layer [m] (0.1 m cubes on 0.25 m cells)")
     parser.add_argument("--min-sites", type=int, default=3, help="keep routes with at least this many sites")
+    parser.add_argument("--rank", choices=("volume", "site"), default="volume",
+                        help="rank by the route's volume, or by the volume of its --min-sites-th largest site")
     parser.add_argument("--top", type=int, default=15, help="routes to print")
     parser.add_argument("--json", help="write every kept route to this file")
     args = parser.parse_args()
@@ -94,26 +97,35 @@ def main():
                 for j in range(n) for i in range(n)]
         # A route from a point to itself says whether the point is occupiable and on its own ground.
         here = run_route(binary, common, [(x, y, x, y) for x, y in grid])
-        points = [(p, r["from_region"]) for p, r in zip(grid, here)
-                  if r["from_occupiable"] and r["from_gap_m"] < args.min_depth]
-        # Only points of different payload regions: within one the payload drives already (the run would be over).
-        pairs = [(a[0], a[1], b[0], b[1]) for i, (a, ra) in enumerate(points) for b, rb in points[i + 1:]
+        points = [(p, r["from_region"], r["from_gap_m"] < args.min_depth) for p, r in zip(grid, here)
+                  if r["from_occupiable"]]
+        targets = [p for p in points if p[2]]
+        # Bases anywhere occupiable, targets on their own ground (no gap for the builders to fill there), in different
+        # payload regions: within one the payload drives already (the run would be over at its start).
+        pairs = [(a[0], a[1], b[0], b[1]) for a, ra, _ in points for b, rb, _ in targets
                  if ra != rb and args.min_dist <= math.hypot(a[0] - b[0], a[1] - b[1]) <= args.max_dist]
         routes = run_route(binary, common, pairs) if pairs else []
         blocked = [r for r in routes if not r["navigable_now"]]
+        largest = max(blocked, key=lambda r: r["volume_m3"], default=None)
         good = [r for r in blocked if len(r["sites"]) >= args.min_sites]
         for r in good:
             r["window"] = [x0, y0]
         kept += good
         best = max((r["volume_m3"] for r in good), default=0.0)
-        searched.append((x0, y0, len(grid), len(points), len(pairs), len(blocked), len(good), best))
-        print("window [%g, %g] + %g m: %d grid points, %d occupiable on their own ground, %d pairs in different "
-              "regions, %d not navigable yet, %d with >= %d sites (best %.1f m^3)" % (x0, y0, args.size, len(grid), len(points), len(pairs),
-                                                           len(blocked), len(good), args.min_sites, best), flush=True)
+        top = largest["volume_m3"] if largest else 0.0
+        searched.append((x0, y0, len(grid), len(points), len(targets), len(pairs), len(good), best, top))
+        print("window [%g, %g] + %g m: %d grid points, %d occupiable (%d on their own ground), %d pairs in different "
+              "regions, %d with >= %d sites (best %.1f m^3); largest route volume %.1f m^3 (%d sites)"
+              % (x0, y0, args.size, len(grid), len(points), len(targets), len(pairs), len(good), args.min_sites, best,
+                 top, len(largest["sites"]) if largest else 0), flush=True)
 
-    kept.sort(key=lambda r: -r["volume_m3"])
-    print("\n%d windows, %d pairs planned, %d routes with >= %d sites; best by volume (MARS gap within %g m, %g m band):"
-          % (len(searched), sum(s[4] for s in searched), len(kept), args.min_sites, args.local_radius, args.width))
+    def third_site(r):
+        return sorted((s["volume_m3"] for s in r["sites"]), reverse=True)[args.min_sites - 1]
+
+    kept.sort(key=lambda r: -(third_site(r) if args.rank == "site" else r["volume_m3"]))
+    print("\n%d windows, %d pairs planned, %d routes with >= %d sites; best by %s (MARS gap within %s, %g m band):"
+          % (len(searched), sum(s[5] for s in searched), len(kept), args.min_sites, args.rank,
+             "%g m" % args.local_radius if args.local_radius > 0 else "the window", args.width))
     for r in kept[:args.top]:
         sites = ", ".join("%.1f-%.1f m %.1f m^3" % (s["from_m"], s["to_m"], s["volume_m3"]) for s in r["sites"])
         print("  [%g, %g]  (%.3f, %.3f) -> (%.3f, %.3f)  %.1f m  %.1f m^3  %d sites: %s" % (
@@ -121,8 +133,8 @@ def main():
             r["volume_m3"], len(r["sites"]), sites))
     if args.json:
         with open(args.json, "w") as f:
-            json.dump({"searched": [dict(zip(("x0", "y0", "grid", "points", "pairs", "not_navigable", "kept",
-                                              "best_m3"), s)) for s in searched], "routes": kept}, f, indent=1)
+            json.dump({"searched": [dict(zip(("x0", "y0", "grid", "occupiable", "targets", "pairs", "kept",
+                                              "best_m3", "largest_m3"), s)) for s in searched], "routes": kept}, f, indent=1)
     return 0
 
 
