@@ -12,8 +12,8 @@ import tempfile
 
 USAGE = """\
 For every window (a square of --size metres at each X0 Y0 of --windows, cropped and resampled as a scenario's
-terrain is), takes the points of a grid (--spacing) that are occupiable for the payload as bases and those that
-also stand on their own ground (MARS gap below --min-depth) as targets, plans the builders' route between every two of them
+terrain is), takes the points of a grid (--spacing) that are occupiable for the payload and stand on their own
+ground (MARS gap below --min-depth; --base-gap relaxes it for bases), plans the builders' route between every two of them
 --min-dist .. --max-dist apart that the payload cannot drive yet (marsala-terrain route --pairs), keeps the routes
 with at least --min-sites construction sites separated by natural ground, and ranks them by volume. Prints what it
 searched and the best routes; --json FILE writes every kept route.
@@ -66,6 +66,9 @@ def main():
                              "which the builders' ramps reach in the end)")
     parser.add_argument("--min-depth", type=float, default=0.016,
                         help="gap a cell needs to be built on: one cube layer [m] (0.1 m cubes on 0.25 m cells)")
+    parser.add_argument("--base-gap", type=float, default=0.0,
+                        help="largest MARS gap at the base [m] (default: below --min-depth, on its own ground like the "
+                             "target; bases in pits several metres deep stall the builders)")
     parser.add_argument("--min-sites", type=int, default=3, help="keep routes with at least this many sites")
     parser.add_argument("--rank", choices=("volume", "site"), default="volume",
                         help="rank by the route's volume, or by the volume of its --min-sites-th largest site")
@@ -97,12 +100,12 @@ def main():
                 for j in range(n) for i in range(n)]
         # A route from a point to itself says whether the point is occupiable and on its own ground.
         here = run_route(binary, common, [(x, y, x, y) for x, y in grid])
-        points = [(p, r["from_region"], r["from_gap_m"] < args.min_depth) for p, r in zip(grid, here)
-                  if r["from_occupiable"]]
-        targets = [p for p in points if p[2]]
-        # Bases anywhere occupiable, targets on their own ground (no gap for the builders to fill there), in different
-        # payload regions: within one the payload drives already (the run would be over at its start).
-        pairs = [(a[0], a[1], b[0], b[1]) for a, ra, _ in points for b, rb, _ in targets
+        points = [(p, r["from_region"], r["from_gap_m"]) for p, r in zip(grid, here) if r["from_occupiable"]]
+        bases = [p for p in points if p[2] < max(args.base_gap, args.min_depth)]
+        targets = [p for p in points if p[2] < args.min_depth]
+        # Targets on their own ground (no gap for the builders to fill there), bases with at most --base-gap, in
+        # different payload regions: within one the payload drives already (the run would be over at its start).
+        pairs = [(a[0], a[1], b[0], b[1]) for a, ra, _ in bases for b, rb, _ in targets
                  if ra != rb and args.min_dist <= math.hypot(a[0] - b[0], a[1] - b[1]) <= args.max_dist]
         routes = run_route(binary, common, pairs) if pairs else []
         blocked = [r for r in routes if not r["navigable_now"]]
