@@ -200,6 +200,9 @@ Eigen::MatrixXi component_labels(const CellMask& mask) {
   return label;
 }
 
+/// The shortest text that reads back as v (cell centres such as 206.125 m stay exact in --json).
+std::string shortest(double v) { return fmt::format("{}", v); }
+
 std::string fixed(double v, int digits) { return fmt::format("{:.{}f}", v, digits); }
 
 }  // namespace
@@ -473,8 +476,9 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       const Eigen::MatrixXi region = component_labels(NavigabilityProcessor(payload).occupiable(map));
       const auto& g = map.geometry();
       if (route_json)
-        out << "{\"terrain\":{\"rows\":" << g.rows << ",\"cols\":" << g.cols << ",\"cell_size_m\":" << g.cell_size_m
-            << ",\"xll_m\":" << g.xll_m << ",\"yll_m\":" << g.yll_m << "},\"construction_kappa\":" << site_kappa
+        out << "{\"terrain\":{\"rows\":" << g.rows << ",\"cols\":" << g.cols
+            << ",\"cell_size_m\":" << shortest(g.cell_size_m) << ",\"xll_m\":" << shortest(g.xll_m)
+            << ",\"yll_m\":" << shortest(g.yll_m) << "},\"construction_kappa\":" << site_kappa
             << ",\"local_radius_m\":" << local_radius << ",\"width_m\":" << site_params.width_m
             << ",\"min_depth_m\":" << site_params.min_depth_m << ",\"min_natural_m\":" << site_params.min_natural_m
             << ",\"routes\":[";
@@ -486,9 +490,10 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
         const bool from_ok = from_region != 0, to_ok = to_region != 0;
         const bool connected = from_ok && from_region == to_region;
         if (route_json) {
-          out << (i > 0 ? "," : "") << "{\"from\":[" << a.x << "," << a.y << "],\"to\":[" << b.x << "," << b.y
-              << "],\"length_m\":" << fixed(r.length_m, 3) << ",\"volume_m3\":" << fixed(r.band_volume_m3, 3)
-              << ",\"band_cells\":" << r.band_cells << ",\"from_occupiable\":" << (from_ok ? "true" : "false")
+          out << (i > 0 ? "," : "") << "{\"from\":[" << shortest(a.x) << "," << shortest(a.y) << "],\"to\":["
+              << shortest(b.x) << "," << shortest(b.y) << "],\"length_m\":" << fixed(r.length_m, 3)
+              << ",\"volume_m3\":" << fixed(r.band_volume_m3, 3) << ",\"band_cells\":" << r.band_cells
+              << ",\"from_occupiable\":" << (from_ok ? "true" : "false")
               << ",\"to_occupiable\":" << (to_ok ? "true" : "false") << ",\"from_region\":" << from_region
               << ",\"to_region\":" << to_region << ",\"navigable_now\":" << (connected ? "true" : "false")
               << ",\"from_gap_m\":" << fixed(r.from_gap_m, 4) << ",\"to_gap_m\":" << fixed(r.to_gap_m, 4)
@@ -499,9 +504,9 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
                 << ",\"max_gap_m\":" << fixed(r.sites[k].max_gap_m, 3) << "}";
           out << "]}";
         } else {
-          out << "route (" << a.x << ", " << a.y << ") -> (" << b.x << ", " << b.y << ") m: length "
-              << fixed(r.length_m, 2) << " m, MARS gap " << fixed(r.band_volume_m3, 2) << " m^3 over a "
-              << site_params.width_m << " m band (kappa " << site_kappa
+          out << "route (" << shortest(a.x) << ", " << shortest(a.y) << ") -> (" << shortest(b.x) << ", "
+              << shortest(b.y) << ") m: length " << fixed(r.length_m, 2) << " m, MARS gap "
+              << fixed(r.band_volume_m3, 2) << " m^3 over a " << site_params.width_m << " m band (kappa " << site_kappa
               << (local_radius > 0.0 ? fmt::format(", bound within {} m", local_radius) : std::string()) << "), "
               << r.sites.size() << " construction site" << (r.sites.size() == 1 ? "" : "s") << "\n";
           for (std::size_t k = 0; k < r.sites.size(); ++k)

@@ -163,9 +163,9 @@ TEST_F(TerrainCli, RouteFindsTheThreeRampsOfThreeCliffs) {
   const CliRun json = run(args + " --json");
   ASSERT_EQ(json.exit_code, 0) << json.err;
   EXPECT_NE(json.out.find("\"length_m\":51.000,\"volume_m3\":10.125"), std::string::npos) << json.out;
+  EXPECT_NE(json.out.find("{\"from\":[105.125,205.125],\"to\":[156.125,205.125],"), std::string::npos) << json.out;
   // Each terrace is its own payload region (labelled in row-major order of its first cell: west to east).
-  EXPECT_NE(json.out.find("\"from_region\":1,\"to_region\":4,\"navigable_now\":false"), std::string::npos)
-      << json.out;
+  EXPECT_NE(json.out.find("\"from_region\":1,\"to_region\":4,\"navigable_now\":false"), std::string::npos) << json.out;
   for (const char* site : {"{\"from_m\":10.000,\"to_m\":13.500,\"volume_m3\":3.375,\"max_gap_m\":0.750}",
                            "{\"from_m\":25.000,\"to_m\":28.500,\"volume_m3\":3.375,\"max_gap_m\":0.750}",
                            "{\"from_m\":40.000,\"to_m\":43.500,\"volume_m3\":3.375,\"max_gap_m\":0.750}"})
