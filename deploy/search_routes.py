@@ -21,7 +21,7 @@ searched and the best routes; --json FILE writes every kept route.
 Coordinates are the DEM's (a crop keeps them), as in deploy/scenarios/*.pbtxt. MARSALA_BUILD_DIR (default build/)
 names the build with bin/marsala-terrain.
 
-Example (what deploy/scenarios/path_gale.pbtxt was chosen with):
+Example (what deploy/scenarios/path_gale_sites.pbtxt was chosen with; about 6 min):
   deploy/search_routes.py --dem ../shared/data/terrains/gale_crater_1m.asc
 """
 
