@@ -1,7 +1,9 @@
 #include "marsala/cli/terrain_cli.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <fstream>
 #include <iomanip>
 #include <map>
 #include <ostream>
@@ -17,6 +19,7 @@
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/mars_processor.hpp"
 #include "marsala/core/navigability_processor.hpp"
+#include "marsala/core/route_sites.hpp"
 #include "marsala/render/perspective.hpp"
 #include "marsala/render/png_writer.hpp"
 #include "marsala/render/terrain_renderer.hpp"
@@ -118,6 +121,89 @@ void check_origin(const Heightmap& map, CellIndex origin) {
   if (!map.contains(origin))
     throw InvalidArgument(fmt::format("origin cell {} is off the {} x {} grid", origin, map.rows(), map.cols()));
 }
+
+/// One route to plan: from and to in the terrain's frame [m].
+struct RouteQuery {
+  Position from, to;
+};
+
+/// The routes of --pairs FILE: one "FROM_X FROM_Y TO_X TO_Y" per line [m]; blank lines and '#' comments skipped.
+std::vector<RouteQuery> read_route_pairs(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw UsageError("--pairs " + path + ": cannot be read");
+  std::vector<RouteQuery> queries;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.erase(hash);
+    std::istringstream s(line);
+    std::vector<double> v;
+    std::string word;
+    while (s >> word) {
+      std::size_t used = 0;
+      double value = 0.0;
+      try {
+        value = std::stod(word, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != word.size() || !std::isfinite(value))
+        throw UsageError(fmt::format("{}:{}: '{}' is not a finite number", path, number, word));
+      v.push_back(value);
+    }
+    if (v.empty()) continue;
+    if (v.size() != 4)
+      throw UsageError(fmt::format("{}:{}: expected FROM_X FROM_Y TO_X TO_Y, got {} numbers", path, number, v.size()));
+    queries.push_back({{v[0], v[1]}, {v[2], v[3]}});
+  }
+  if (queries.empty()) throw UsageError("--pairs " + path + " holds no route");
+  return queries;
+}
+
+/// The cell under a point given on the command line; off the terrain or not finite is a usage error.
+CellIndex cell_under(const Heightmap& map, Position p, const std::string& what) {
+  if (!std::isfinite(p.x) || !std::isfinite(p.y))
+    throw UsageError(fmt::format("{} ({}, {}) m is not a finite point", what, p.x, p.y));
+  const auto cell = map.cell_at(p);
+  if (!cell) {
+    const auto& g = map.geometry();
+    throw UsageError(fmt::format("{} ({}, {}) m is off the terrain (x {} .. {} m, y {} .. {} m)", what, p.x, p.y,
+                                 g.xll_m, g.xll_m + g.cols * g.cell_size_m, g.yll_m, g.yll_m + g.rows * g.cell_size_m));
+  }
+  return *cell;
+}
+
+/// Labels the 8-connected components of the mask's 1-cells 1, 2, ... in row-major order of their first cell; 0 off
+/// the mask. Two occupiable cells are navigable from one another exactly when they share a label.
+Eigen::MatrixXi component_labels(const CellMask& mask) {
+  Eigen::MatrixXi label = Eigen::MatrixXi::Zero(mask.rows(), mask.cols());
+  int next = 0;
+  std::vector<CellIndex> stack;
+  for (int r = 0; r < mask.rows(); ++r)
+    for (int c = 0; c < mask.cols(); ++c) {
+      if (mask(r, c) == 0 || label(r, c) != 0) continue;
+      label(r, c) = ++next;
+      stack.push_back({r, c});
+      while (!stack.empty()) {
+        const CellIndex p = stack.back();
+        stack.pop_back();
+        for (int dr = -1; dr <= 1; ++dr)
+          for (int dc = -1; dc <= 1; ++dc) {
+            const int rr = p.row + dr, cc = p.col + dc;
+            if (rr < 0 || cc < 0 || rr >= mask.rows() || cc >= mask.cols()) continue;
+            if (mask(rr, cc) == 0 || label(rr, cc) != 0) continue;
+            label(rr, cc) = next;
+            stack.push_back({rr, cc});
+          }
+      }
+    }
+  return label;
+}
+
+/// The shortest text that reads back as v (cell centres such as 206.125 m stay exact in --json).
+std::string shortest(double v) { return fmt::format("{}", v); }
+
+std::string fixed(double v, int digits) { return fmt::format("{:.{}f}", v, digits); }
 
 }  // namespace
 
@@ -232,6 +318,50 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
   render3d->add_option("--title", view.title, "title drawn in the top-left corner");
   render3d->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
 
+  // route
+  std::pair<double, double> route_from{0.0, 0.0}, route_to{0.0, 0.0};
+  std::string pairs_path;
+  NavigabilityParams payload;
+  double build_kappa = 0.0, band_width = 0.0, local_radius = 0.0, min_depth = 0.0, min_natural = -1.0;
+  bool route_json = false;
+  auto* route = app.add_subcommand(
+      "route",
+      "plan the route builders would build for a payload (planner priced by the MARS gap, paper eq. 4-5) and list "
+      "the construction sites along it");
+  route->add_option("input", in_path, "input .asc or .tif")->required()->check(CLI::ExistingFile);
+  route->add_option("--crop", crop, "crop X0 Y0 W H [m] in the input's frame (as a scenario's terrain.crop)")
+      ->expected(4);
+  route->add_option("--cell-size", target_cell_size, "resample bilinearly to this cell size [m]")
+      ->check(CLI::PositiveNumber);
+  route->add_flag("--zero-base", zero_base, "shift heights so that the lowest cell is at 0 m");
+  route->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
+  add_navigability_options(*route, payload, true);
+  auto* from_option =
+      route->add_option("--from", route_from, "where the route starts, X Y [m] in the terrain's frame (the base)");
+  auto* to_option = route->add_option("--to", route_to, "where it ends, X Y [m] (the target)");
+  route->add_option("--pairs", pairs_path, "plan every route of FILE instead: one 'FROM_X FROM_Y TO_X TO_Y' a line")
+      ->check(CLI::ExistingFile);
+  route->add_option("--construction-kappa", build_kappa, "slope the builders build to [m/m] (default: --kappa)")
+      ->check(CLI::PositiveNumber);
+  route->add_option("--width", band_width, "construction band width [m] (default: --delta)")
+      ->check(CLI::PositiveNumber);
+  route
+      ->add_option("--min-depth", min_depth,
+                   "a route cell needs construction when its MARS gap is at least this [m], e.g. one cube layer")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  route
+      ->add_option("--min-natural", min_natural,
+                   "natural ground shorter than this does not separate two sites [m] (default: --delta)")
+      ->check(CLI::NonNegativeNumber);
+  route
+      ->add_option("--local-radius", local_radius,
+                   "take each cell's MARS bound over the square of this half-side around it only, as a builder's local "
+                   "map of its sensing range does [m]; 0: the whole terrain")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  route->add_flag("--json", route_json, "print JSON instead of text");
+
   if (const auto code = parse_command_line(app, argc, argv, "marsala-terrain", out, err)) return *code;
 
   try {
@@ -316,6 +446,79 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       if (render_gap) options.gap = MarsProcessor(render_params.kappa).gap(map);
       render::write_png(render::render_terrain(map, options), out_path);
       out << "rendered " << map.rows() << " x " << map.cols() << " -> " << out_path << "\n";
+    } else if (*route) {
+      std::vector<RouteQuery> queries;
+      if (!pairs_path.empty()) {
+        if (from_option->count() > 0 || to_option->count() > 0)
+          throw UsageError("route: give either --pairs or --from and --to, not both");
+        queries = read_route_pairs(pairs_path);
+      } else {
+        if (from_option->count() == 0 || to_option->count() == 0)
+          throw UsageError("route: --from X Y and --to X Y (or --pairs FILE) are required");
+        queries.push_back({{route_from.first, route_from.second}, {route_to.first, route_to.second}});
+      }
+      Heightmap map = load_terrain(in_path, fill_nodata);
+      if (!crop.empty()) map = terrain::crop(map, crop[0], crop[1], crop[2], crop[3]);
+      if (target_cell_size > 0.0) map = terrain::resample_bilinear(map, target_cell_size);
+      if (zero_base) map.heights().array() -= map.min_height();
+      std::vector<std::pair<CellIndex, CellIndex>> cells;
+      for (std::size_t i = 0; i < queries.size(); ++i) {
+        const std::string which = queries.size() > 1 ? fmt::format(" (route {})", i + 1) : std::string();
+        cells.push_back(
+            {cell_under(map, queries[i].from, "--from" + which), cell_under(map, queries[i].to, "--to" + which)});
+      }
+      RouteSiteParams site_params;
+      const double site_kappa = build_kappa > 0.0 ? build_kappa : payload.kappa;
+      site_params.width_m = band_width > 0.0 ? band_width : payload.delta_m;
+      site_params.min_depth_m = min_depth;
+      site_params.min_natural_m = min_natural >= 0.0 ? min_natural : payload.delta_m;
+      const Heightmap gap = route_gap(map, site_kappa, local_radius);
+      const Eigen::MatrixXi region = component_labels(NavigabilityProcessor(payload).occupiable(map));
+      const auto& g = map.geometry();
+      if (route_json)
+        out << "{\"terrain\":{\"rows\":" << g.rows << ",\"cols\":" << g.cols
+            << ",\"cell_size_m\":" << shortest(g.cell_size_m) << ",\"xll_m\":" << shortest(g.xll_m)
+            << ",\"yll_m\":" << shortest(g.yll_m) << "},\"construction_kappa\":" << site_kappa
+            << ",\"local_radius_m\":" << local_radius << ",\"width_m\":" << site_params.width_m
+            << ",\"min_depth_m\":" << site_params.min_depth_m << ",\"min_natural_m\":" << site_params.min_natural_m
+            << ",\"routes\":[";
+      for (std::size_t i = 0; i < queries.size(); ++i) {
+        const auto [from, to] = cells[i];
+        const RouteSites r = plan_route_sites(gap, from, to, site_params);
+        const Position a = map.cell_center(from), b = map.cell_center(to);
+        const int from_region = region(from.row, from.col), to_region = region(to.row, to.col);
+        const bool from_ok = from_region != 0, to_ok = to_region != 0;
+        const bool connected = from_ok && from_region == to_region;
+        if (route_json) {
+          out << (i > 0 ? "," : "") << "{\"from\":[" << shortest(a.x) << "," << shortest(a.y) << "],\"to\":["
+              << shortest(b.x) << "," << shortest(b.y) << "],\"length_m\":" << fixed(r.length_m, 3)
+              << ",\"volume_m3\":" << fixed(r.band_volume_m3, 3) << ",\"band_cells\":" << r.band_cells
+              << ",\"from_occupiable\":" << (from_ok ? "true" : "false")
+              << ",\"to_occupiable\":" << (to_ok ? "true" : "false") << ",\"from_region\":" << from_region
+              << ",\"to_region\":" << to_region << ",\"navigable_now\":" << (connected ? "true" : "false")
+              << ",\"from_gap_m\":" << fixed(r.from_gap_m, 4) << ",\"to_gap_m\":" << fixed(r.to_gap_m, 4)
+              << ",\"sites\":[";
+          for (std::size_t k = 0; k < r.sites.size(); ++k)
+            out << (k > 0 ? "," : "") << "{\"from_m\":" << fixed(r.sites[k].from_m, 3)
+                << ",\"to_m\":" << fixed(r.sites[k].to_m, 3) << ",\"volume_m3\":" << fixed(r.sites[k].volume_m3, 3)
+                << ",\"max_gap_m\":" << fixed(r.sites[k].max_gap_m, 3) << "}";
+          out << "]}";
+        } else {
+          out << "route (" << shortest(a.x) << ", " << shortest(a.y) << ") -> (" << shortest(b.x) << ", "
+              << shortest(b.y) << ") m: length " << fixed(r.length_m, 2) << " m, MARS gap "
+              << fixed(r.band_volume_m3, 2) << " m^3 over a " << site_params.width_m << " m band (kappa " << site_kappa
+              << (local_radius > 0.0 ? fmt::format(", bound within {} m", local_radius) : std::string()) << "), "
+              << r.sites.size() << " construction site" << (r.sites.size() == 1 ? "" : "s") << "\n";
+          for (std::size_t k = 0; k < r.sites.size(); ++k)
+            out << "  site " << k + 1 << ": " << fixed(r.sites[k].from_m, 2) << " .. " << fixed(r.sites[k].to_m, 2)
+                << " m along, " << fixed(r.sites[k].volume_m3, 2) << " m^3, deepest gap "
+                << fixed(r.sites[k].max_gap_m, 2) << " m\n";
+          out << "  payload: from " << (from_ok ? "occupiable" : "NOT occupiable") << " (gap " << fixed(r.from_gap_m, 3)
+              << " m), to " << (to_ok ? "occupiable" : "NOT occupiable") << " (gap " << fixed(r.to_gap_m, 3) << " m), "
+              << (connected ? "already navigable" : "not navigable") << " from one to the other\n";
+        }
+      }
+      if (route_json) out << "]}\n";
     } else if (*render3d) {
       const Heightmap map = load_terrain(in_path, fill_nodata);
       double built_m3 = 0.0;

@@ -56,7 +56,7 @@ class TerrainCli : public ::testing::Test {
 TEST_F(TerrainCli, HelpOnEverySubcommand) {
   const CliRun top = run("--help");
   EXPECT_EQ(top.exit_code, 0);
-  for (const char* sub : {"generate", "import", "info", "mars", "navigable", "render"}) {
+  for (const char* sub : {"generate", "import", "info", "mars", "navigable", "render", "route"}) {
     EXPECT_NE(top.out.find(sub), std::string::npos) << sub;
     const CliRun r = run(std::string(sub) + " --help");
     EXPECT_EQ(r.exit_code, 0) << sub;
@@ -133,6 +133,77 @@ TEST_F(TerrainCli, MarsGapOfASpikeIsACone) {
     }
   ASSERT_EQ(run("mars --kappa 0.4 " + path("spike.asc") + " -o " + path("p.asc")).exit_code, 0);
   EXPECT_NEAR(terrain::read_asc(path("p.asc"))(4, 6), 0.6, 1e-12);
+}
+
+// Terraces falling to the east (as tests/integration/scenarios/path_three_gaps.pbtxt): 40 x 240 cells of 0.25 m, in a
+// frame whose lower-left corner is (100, 200) m, with 0.8 m cliffs at x = 115, 130 and 145 m. A kappa-0.2 ramp down
+// each covers the 15 cells past the cliff (gaps 0.75 .. 0.05 m), so a route along y = 205.125 m from x = 105.125 m
+// meets sites at 10 .. 13.5, 25 .. 28.5 and 40 .. 43.5 m, each 9 band rows (2 m) x 6 m x 0.0625 m^2 = 3.375 m^3.
+std::string three_cliffs_asc() {
+  std::ostringstream asc;
+  asc << "ncols 240\nnrows 40\nxllcorner 100\nyllcorner 200\ncellsize 0.25\n";
+  for (int r = 0; r < 40; ++r)
+    for (int c = 0; c < 240; ++c) {
+      const double x = (c + 0.5) * 0.25;
+      asc << 0.8 * ((x < 15.0) + (x < 30.0) + (x < 45.0)) << (c < 239 ? " " : "\n");
+    }
+  return asc.str();
+}
+
+TEST_F(TerrainCli, RouteFindsTheThreeRampsOfThreeCliffs) {
+  write("cliffs.asc", three_cliffs_asc());
+  const std::string args =
+      "route " + path("cliffs.asc") + " --kappa 0.2 --delta 2 --eps 0.05 --from 105.125 205.125 --to 156.125 205.125";
+  const CliRun text = run(args);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("m^3 over a 2 m band (kappa 0.2), 3 construction sites"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("site 2: 25.00 .. 28.50 m along, 3.3"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("length 51.00 m"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("not navigable"), std::string::npos) << text.out;
+  const CliRun json = run(args + " --json");
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  EXPECT_NE(json.out.find("\"length_m\":51.000,\"volume_m3\":10.125"), std::string::npos) << json.out;
+  EXPECT_NE(json.out.find("{\"from\":[105.125,205.125],\"to\":[156.125,205.125],"), std::string::npos) << json.out;
+  // Each terrace is its own payload region (labelled in row-major order of its first cell: west to east).
+  EXPECT_NE(json.out.find("\"from_region\":1,\"to_region\":4,\"navigable_now\":false"), std::string::npos) << json.out;
+  for (const char* site : {"{\"from_m\":10.000,\"to_m\":13.500,\"volume_m3\":3.375,\"max_gap_m\":0.750}",
+                           "{\"from_m\":25.000,\"to_m\":28.500,\"volume_m3\":3.375,\"max_gap_m\":0.750}",
+                           "{\"from_m\":40.000,\"to_m\":43.500,\"volume_m3\":3.375,\"max_gap_m\":0.750}"})
+    EXPECT_NE(json.out.find(site), std::string::npos) << site << "\n" << json.out;
+  // Natural ground of 11.5 m between the ramps: asking for 12 m makes them one site; --pairs plans several routes.
+  EXPECT_NE(run(args + " --min-natural 12").out.find("1 construction site\n  site 1: 10.00 .. 43.50 m along"),
+            std::string::npos);
+  write("pairs.txt", "# from, to\n105.125 205.125 156.125 205.125\n\n105.125 205.125 120.125 205.125  # one cliff\n");
+  const CliRun pairs =
+      run("route " + path("cliffs.asc") + " --kappa 0.2 --delta 2 --eps 0.05 --json --pairs " + path("pairs.txt"));
+  ASSERT_EQ(pairs.exit_code, 0) << pairs.err;
+  EXPECT_NE(pairs.out.find("\"length_m\":15.000,\"volume_m3\":3.375"), std::string::npos) << pairs.out;
+  // Cropped to the first two terraces (x 100 .. 130 m): one cliff left on the way to x = 125.125 m.
+  const CliRun cropped = run("route " + path("cliffs.asc") +
+                             " --crop 100 200 30 10 --kappa 0.2 --delta 2 --eps 0.05 --from 105.125 205.125 --to "
+                             "125.125 205.125");
+  EXPECT_NE(cropped.out.find("1 construction site"), std::string::npos) << cropped.out << cropped.err;
+}
+
+TEST_F(TerrainCli, RouteBadInputExitsTwoWithOneLine) {
+  write("cliffs.asc", three_cliffs_asc());
+  write("bad_pairs.txt", "105 205 156 abc\n");
+  write("short_pairs.txt", "105 205 156\n");
+  const std::string base = "route " + path("cliffs.asc") + " --kappa 0.2 --delta 2 --eps 0.05 ";
+  for (const std::string& args :
+       {base + "--from 105 205 --to 156 205 --frobnicate", base + "--from 105 205 --to 99 205",
+        base + "--from 105 205 --to 156 300", base + "--from nan 205 --to 156 205", base + "--from 105 205",
+        base + "--from 105 205 --to 156 205 --pairs " + path("bad_pairs.txt"),
+        base + "--pairs " + path("bad_pairs.txt"), base + "--pairs " + path("short_pairs.txt"),
+        base + "--from 105 205 --to 156 205 --width 0",
+        "route " + path("cliffs.asc") + " --kappa 0.2 --from 105 205 --to 156 205"}) {
+    const CliRun r = run(args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("marsala-terrain: ", 0), 0u) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+  }
+  EXPECT_NE(run(base + "--from 105 205 --to 99 205").err.find("off the terrain (x 100 .. 160 m"), std::string::npos);
+  EXPECT_NE(run(base + "--pairs " + path("bad_pairs.txt")).err.find("bad_pairs.txt:1: 'abc'"), std::string::npos);
 }
 
 TEST_F(TerrainCli, NavigableAcrossAStep) {
