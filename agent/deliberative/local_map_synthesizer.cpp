@@ -102,21 +102,26 @@ LocalMap LocalMapSynthesizer::synthesize(const executive::MappingSystem& map, Po
     // is not 8-connected to the robot through them, head for the reachable one nearest to it (ties: the first in
     // row-major order): the robot moves, its next scans fill the holes ahead. Known cells that can be judged (not
     // blind) first, and the path through them only: a path or goal on blind cells draws the robot along the edge of
-    // what it knows (a structure's side, whose shadow it never sees) instead of where its map is whole.
+    // what it knows (a structure's side, whose shadow it never sees) instead of where its map is whole. When the
+    // judged cells hold nothing nearer than the robot's own cell, the known ones: the robot would otherwise stand
+    // still, its goal reached, and a camera that sees only ahead would never learn more.
     const CellMask judged = (local.known.array() != 0 && local.blind.array() == 0).cast<std::uint8_t>();
     for (const CellMask* mask : std::initializer_list<const CellMask*>{&judged, &local.known}) {
       if ((*mask)(local.robot.row, local.robot.col) == 0) continue;
       const CellMask reachable = NavigabilityProcessor::navigable_from(*mask, local.robot);
+      CellIndex nearest = goal;
       if (reachable(goal.row, goal.col) == 0) {
         long long best = std::numeric_limits<long long>::max();
         for (int r = 0; r < local.rows(); ++r)
           for (int c = 0; c < local.cols(); ++c) {
             if (reachable(r, c) == 0) continue;
             const long long dr = r - goal.row, dc = c - goal.col, d = dr * dr + dc * dc;
-            if (d < best) best = d, local.goal = {r, c};
+            if (d < best) best = d, nearest = {r, c};
           }
+        if (nearest == local.robot && mask == &judged) continue;
         local.goal_is_target = false;
       }
+      local.goal = nearest;
       local.passable = *mask;
       break;
     }

@@ -229,6 +229,17 @@ TEST(LocalMapSynthesizer, AScannedMapsGoalAndPathAvoidCellsItCannotJudge) {
   ASSERT_TRUE(plan.found);
   for (const CellIndex p : plan.path) EXPECT_EQ(local.blind(p.row, p.col), 0) << p.row << ", " << p.col;
 
+  // Known ground only as far as the robot's own body ball (radius 2 cells): every other cell is blind, and the robot's
+  // own cell is the only judged one. The goal is then the known cell nearest the exit, reached through known cells
+  // (before, the robot's own cell: it stood still, "at its goal").
+  executive::MappingSystem small(kWorld, 16, sensor_defaults("laser"));
+  for (const CellIndex o : disc_offsets(2.0))
+    small.assume_ground(kWorld.cell_center({30 + o.row, 40 + o.col}), 0.0, 0.0);
+  const LocalMap boxed = synthesizer.synthesize(small, kRobot, {7.05, 2.95});
+  ASSERT_EQ(boxed.blind(boxed.robot.row, boxed.robot.col), 0);
+  EXPECT_EQ(boxed.to_global(boxed.goal), (CellIndex{30, 42}));
+  EXPECT_EQ(boxed.passable, boxed.known);
+
   // A ground-truth map is whole: the goal is the exit cell and every known cell is passable.
   executive::MappingSystem exact(kWorld, 16);
   for (int r = 27; r <= 33; ++r)
