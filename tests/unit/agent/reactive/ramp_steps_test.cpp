@@ -309,7 +309,7 @@ TEST(RampSteps, AScanningRobotFillsAGapOnlyOnceItsLastScansAgree) {
   RampSteps steps(c);
   Heightmap h = test::platform_world();  // with a 0.3 m step instead of the 1.5 m platform: its top lies below the
   for (int r = 0; r < h.rows(); ++r)     // laser (0.5 m up), which sees no higher than 10 degrees up
-    for (int c = 70; c < h.cols(); ++c) h(r, c) = 0.3;
+    for (int col = 70; col < h.cols(); ++col) h(r, col) = 0.3;
   steps.admit(test::admission_on(c, h.geometry(), kTarget, kBase));
   const Position robot{6.05, 3.05};
   const Point3 origin = sensor_origin(h, robot.x, robot.y, c.type.sensor);
