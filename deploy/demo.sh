@@ -50,9 +50,10 @@ if [ "$mode" = scenario ]; then
     ramp*) default_agents=3; what="robots build ramps to climb a 1.5 m platform (paper Fig. 2)" ;;
     path_*) default_agents=5; what="builders build a navigable path for a payload robot (paper §V-A)" ;;
     site_*) default_agents=11; what="robots level a site for kappa 0.1 (paper §V-B)" ;;
+    hetero) default_agents=5; what="robots of four kinds (layer, cube and cone builders, a laser and an RGB-D scout) build one structure and climb it" ;;
     *)  # every agent slot, as the world counts them (marsala-world --check prints the scenario as JSON)
       facts="$("${MARSALA_BUILD_DIR:-$root/build}/bin/marsala-world" --check --json "$file")" || exit $?
-      default_agents="$(jq '.slots | length' <<<"$facts")"; what="scenario $file" ;;
+      default_agents="$(jq '.slots | length' <<<"$facts")"; what="agents, every slot of $file" ;;
   esac
   agents="${agents:-$default_agents}"
   echo "== $name: $agents $what"
