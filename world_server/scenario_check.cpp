@@ -76,6 +76,10 @@ proto::ScenarioCheck to_message(const WorldStart& start) {
     r->set_sensor(type.sensor.name);
     r->set_depositor(type.depositor.name);
     r->set_localisation_noise_sd_m(type.localisation.noise_sd_m);
+    if (type.sensor.casts_rays()) {
+      r->set_sensor_rays(type.sensor.ray_count());
+      r->set_sensor_max_range_m(type.sensor.max_range_m);
+    }
   }
   for (const scenario::AgentSlot& slot : s.slots) {
     proto::SlotCheck* p = m.add_slots();
@@ -171,8 +175,11 @@ std::string scenario_check_text(const WorldStart& start) {
     out << "  " << t.name << ": behaviour " << t.behaviour << ", kappa " << number(t.body.navigability.kappa)
         << ", delta_m " << number(t.body.navigability.delta_m) << ", eps_m " << number(t.body.navigability.eps_m)
         << ", max_step_m " << number(t.body.max_step_m) << ", cube_size_m " << number(t.body.cube_size_m)
-        << ", goal_synthesizer " << t.goal_synthesizer << ", sensor " << t.sensor.name << ", depositor "
-        << t.depositor.name
+        << ", goal_synthesizer " << t.goal_synthesizer << ", sensor " << t.sensor.name
+        << (t.sensor.casts_rays() ? " (" + std::to_string(t.sensor.ray_count()) + " rays, " +
+                                        number(t.sensor.min_range_m) + "-" + number(t.sensor.max_range_m) + " m)"
+                                  : "")
+        << ", depositor " << t.depositor.name
         << (t.localisation.noise_sd_m > 0.0 ? ", localisation noise " + number(t.localisation.noise_sd_m) + " m" : "")
         << "\n";
   out << "slots (" << s.slots.size() << "; the world waits for agents 1.." << state.agents.size() << "):\n";
@@ -197,8 +204,9 @@ std::string scenario_check_text(const WorldStart& start) {
       const scenario::PayloadPath& p = state.payload_path;
       out << ", payload kappa " << number(p.navigability.kappa) << ", delta_m " << number(p.navigability.delta_m)
           << ", eps_m " << number(p.navigability.eps_m) << ", from " << point(p.from_x_m, p.from_y_m) << " to "
-          << point(p.to_x_m, p.to_y_m) << " (its cell " << number(state.check.target_initial_m) << " m high, to end at most "
-          << number(state.check.max_target_rise_m) << " m higher), checked every " << p.check_every_steps
+          << point(p.to_x_m, p.to_y_m) << " (its cell " << number(state.check.target_initial_m)
+          << " m high, to end at most " << number(state.check.max_target_rise_m) << " m higher), checked every "
+          << p.check_every_steps
           << " steps; at start: " << (state.check.met ? "navigable (the run ends at once)" : "not navigable") << "\n";
       break;
     }

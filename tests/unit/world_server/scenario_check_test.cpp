@@ -140,7 +140,9 @@ TEST_F(ScenarioCheckTest, SensorDepositorAndLocalisationAreReportedWithSetOverri
                  "robot_type.localisation.noise_sd_m=0.1"}),
             0)
       << err_.str();
-  EXPECT_NE(out_.str().find("goal_synthesizer fixed_target, sensor laser, depositor layer, localisation noise 0.1 m\n"),
+  // The laser's defaults: 360 / 2 azimuths x (10 - -60) / 1 + 1 elevations = 180 x 71 rays, 0.1-8 m.
+  EXPECT_NE(out_.str().find("goal_synthesizer fixed_target, sensor laser (12780 rays, 0.1-8 m), depositor layer, "
+                            "localisation noise 0.1 m\n"),
             std::string::npos)
       << out_.str();
   ASSERT_EQ(run({"--check", "--json", ramp, "--set", "robot_type.depositor.name=cone"}), 0) << err_.str();
@@ -148,6 +150,18 @@ TEST_F(ScenarioCheckTest, SensorDepositorAndLocalisationAreReportedWithSetOverri
   const Struct& husky = at(check, "robot_types").list_value().values(0).struct_value();
   EXPECT_EQ(at(husky, "depositor").string_value(), "cone");
   EXPECT_EQ(at(husky, "sensor").string_value(), "ground_truth");
+  // A camera with a finer grid than its default (64 x 48): 87 / 0.5 + 1 = 175 azimuths (both edges of the field of
+  // view) x 58 / 0.5 + 1 = 117 elevations.
+  ASSERT_EQ(run({"--check", "--json", ramp, "--set", "robot_type.sensor.name=rgbd", "--set",
+                 "robot_type.sensor.horizontal_resolution_deg=0.5", "--set",
+                 "robot_type.sensor.vertical_resolution_deg=0.5"}),
+            0)
+      << err_.str();
+  const Struct camera = parse_json(out_.str());
+  const Struct& rgbd = at(camera, "robot_types").list_value().values(0).struct_value();
+  EXPECT_EQ(at(rgbd, "sensor").string_value(), "rgbd");
+  EXPECT_EQ(at(rgbd, "sensor_rays").string_value(), std::to_string(175 * 117));  // int64: a JSON string
+  EXPECT_EQ(at(rgbd, "sensor_max_range_m").number_value(), 6.0);
   // A misspelt override is the scenario's error: exit 2, one line naming it.
   EXPECT_EQ(run({"--check", ramp, "--set", "robot_type.sensor.nam=laser"}), kExitInvalidScenario);
   EXPECT_NE(err_.str().find("--set 'robot_type.sensor.nam=laser': Sensor has no field 'nam'; valid: name,"),
