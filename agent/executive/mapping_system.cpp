@@ -203,7 +203,8 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
     const std::optional<CellIndex> cell = g.cell_at({x, y});
     if (!cell || std::abs(z) >= z_limit) continue;
     const double range = std::sqrt(double{p.x_m} * p.x_m + double{p.y_m} * p.y_m + double{p.z_m} * p.z_m);
-    const double band = std::max(kEdgeBand * cs, kEdgeBandNoise * sensor_.noise_sd_at(range));
+    const double spread = kEdgeBandNoise * sensor_.noise_sd_at(range);  // where noise may carry the hit [m]
+    const double band = std::max(kEdgeBand * cs, spread);
     if (band > kMaxEdgeBand * cs + 1e-12) continue;
     const double u = (x - g.xll_m) / cs, v = (y - g.yll_m) / cs;
     const double fu = (u - std::floor(u)) * cs, fv = (v - std::floor(v)) * cs;
@@ -214,9 +215,9 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
     // before this scan; a cell that really rose to its neighbour's height reads so from a steeper ray.
     if (const auto entry = column_entry(g, origin, {x, y, z}, *cell);
         entry && known_(entry->from.row, entry->from.col) != 0) {
-      const double tol = kEdgeBandNoise * sensor_.noise_sd_at(range), edge = heights_(entry->from);
-      const bool lower = known_(cell->row, cell->col) == 0 || heights_(*cell) < edge - tol;
-      if (lower && entry->z_m <= edge + tol) continue;
+      const double edge = heights_(entry->from);
+      const bool lower = known_(cell->row, cell->col) == 0 || heights_(*cell) < edge - spread;
+      if (lower && entry->z_m <= edge + spread) continue;
     }
     const octomap::point3d end = to_tree(x, y, z);
     octomap::OcTreeKey key;

@@ -87,8 +87,7 @@ void RampSteps::admit(const protocol::Admission& admission) {
   // A scanned map reads each surface within a few noise spreads at the manipulator's reach: leave that much unfilled.
   if (context_.type.sensor.casts_rays())
     deposits.gap_margin_m = kScanGapMargin * context_.type.sensor.noise_sd_at(body.reach_m + body.navigability.delta_m);
-  gap_margin_m_ = deposits.gap_margin_m;
-  gap_streaks_.clear();
+  gap_streaks_.assign(context_.type.sensor.casts_rays() ? static_cast<std::size_t>(world.rows) * world.cols : 0, {});
   PlannerParams router = planner;
   router.alpha = 0.0;
   router.beta = 1.0;
@@ -109,11 +108,10 @@ void RampSteps::set_registration(CellIndex offset) {
 
 BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace) {
   modules_->map.set_registration(registration_);
-  if (frame.last_result == protocol::ActionResult::kRejected && deposits_sent_ > 0)
-    deposit_limit_ = deposits_sent_ / 2;
+  if (frame.last_result == protocol::ActionResult::kRejected && !sent_deposits_.empty())
+    deposit_limit_ = static_cast<int>(sent_deposits_.size()) / 2;
   else if (frame.last_result == protocol::ActionResult::kAccepted)
     deposit_limit_ = -1;
-  deposits_sent_ = 0;
   // The robot's own construction, once accepted, is in its map even where its sensor cannot see it (a scanned map).
   if (frame.last_result == protocol::ActionResult::kAccepted && context_.type.sensor.casts_rays()) {
     for (const Deposition& d : sent_layers_) modules_->map.record_built({d.row, d.col}, d.height_m);
@@ -192,12 +190,12 @@ void RampSteps::clear_pad_gap(deliberative::LocalMap& local) const {
 void RampSteps::count_gap_scans(const deliberative::LocalMap& local, bool scanned) {
   const executive::MappingSystem& map = modules_->map;
   const int cols = map.geometry().cols;
-  if (gap_streaks_.empty()) gap_streaks_.resize(static_cast<std::size_t>(map.geometry().rows) * cols);
+  const double margin = modules_->depositions.params().gap_margin_m;
   if (!scanned) return;
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c) {
       const CellIndex g = local.to_global({r, c});
-      if (!(local.gap(r, c) > gap_margin_m_) || !map.hit_within(g, kFreshScans)) continue;
+      if (!(local.gap(r, c) > margin) || !map.hit_within(g, kFreshScans)) continue;
       GapStreak& streak = gap_streaks_[static_cast<std::size_t>(g.row) * cols + g.col];
       streak.scans = streak.last_scan == map.scans() - 1 ? streak.scans + 1 : 1;
       streak.last_scan = map.scans();
@@ -256,7 +254,6 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
     trace.deposition.volume_m3 = 0.0;
     for (const Deposit& d : deposits) trace.deposition.volume_m3 += d.volume_m3;
   }
-  deposits_sent_ = static_cast<int>(deposits.size());
   request.depositions = trace.deposition.depositions;
   request.deposits = deposits;
   sent_layers_ = request.depositions;

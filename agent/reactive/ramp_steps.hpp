@@ -168,16 +168,15 @@ class RampSteps {
   // request with deposits, the next ones carry at most half as many (none after one), until one is accepted, so a
   // mismatch never repeats the same request forever. -1: no limit.
   int deposit_limit_ = -1;
-  mutable int deposits_sent_ = 0;                 // deposits in the request being built (the last deposit() call's)
   mutable std::optional<CellIndex> sent_motion_;  // the world cell the request being built moves to
   struct GapStreak {
     int last_scan = 0;  // the map's scan that last showed the gap
     int scans = 0;      // scans in a row, up to that one, that showed it
   };
   std::vector<GapStreak> gap_streaks_;                    // scanned maps, per cell (row-major): count_gap_scans()
-  double gap_margin_m_ = 0.0;                             // the gap a scanned map leaves unfilled [m]
   std::map<std::pair<int, int>, std::uint64_t> refused_;  // motion targets the world refused, avoided until a step
-  // What the request being built deposits, for the map once the world accepts it (MappingSystem::record_built).
+  // What the request being built deposits (the last deposit() call's): for the map once the world accepts it
+  // (MappingSystem::record_built), and for deposit_limit_ when it refuses it.
   mutable std::vector<Deposition> sent_layers_;
   mutable std::vector<Deposit> sent_deposits_;
   std::vector<executive::BodyClearance> others_;  // the last frame's neighbours

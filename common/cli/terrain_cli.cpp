@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -66,6 +67,19 @@ std::string percent(long long part, long long whole) {
   return s.str();
 }
 
+/// The whole of `text` as a number (std::stod, nothing left over), or nullopt.
+std::optional<double> parse_number(const std::string& text) {
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (used == 0 || used != text.size()) return std::nullopt;
+  return value;
+}
+
 /// Parses "key=value" pairs of --param into a map; a malformed pair is a usage error.
 std::map<std::string, double> parse_params(const std::vector<std::string>& pairs) {
   std::map<std::string, double> params;
@@ -74,15 +88,9 @@ std::map<std::string, double> parse_params(const std::vector<std::string>& pairs
     if (eq == std::string::npos || eq == 0) throw UsageError("--param expects KEY=VALUE, got '" + pair + "'");
     const std::string key = pair.substr(0, eq);
     const std::string text = pair.substr(eq + 1);
-    std::size_t used = 0;
-    double value = 0.0;
-    try {
-      value = std::stod(text, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != text.size()) throw UsageError("--param " + key + ": '" + text + "' is not a number");
-    if (!params.emplace(key, value).second) throw UsageError("--param " + key + " is given twice");
+    const std::optional<double> value = parse_number(text);
+    if (!value) throw UsageError("--param " + key + ": '" + text + "' is not a number");
+    if (!params.emplace(key, *value).second) throw UsageError("--param " + key + " is given twice");
   }
   return params;
 }
@@ -140,16 +148,10 @@ std::vector<RouteQuery> read_route_pairs(const std::string& path) {
     std::vector<double> v;
     std::string word;
     while (s >> word) {
-      std::size_t used = 0;
-      double value = 0.0;
-      try {
-        value = std::stod(word, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != word.size() || !std::isfinite(value))
+      const std::optional<double> value = parse_number(word);
+      if (!value || !std::isfinite(*value))
         throw UsageError(fmt::format("{}:{}: '{}' is not a finite number", path, number, word));
-      v.push_back(value);
+      v.push_back(*value);
     }
     if (v.empty()) continue;
     if (v.size() != 4)
@@ -171,6 +173,15 @@ CellIndex cell_under(const Heightmap& map, Position p, const std::string& what) 
                                  g.xll_m, g.xll_m + g.cols * g.cell_size_m, g.yll_m, g.yll_m + g.rows * g.cell_size_m));
   }
   return *cell;
+}
+
+/// `map` as import makes it: cropped (X0 Y0 W H [m], when given), resampled (when the cell size is > 0), its lowest
+/// cell shifted to 0 m (zero_base).
+Heightmap import_terrain(Heightmap map, const std::vector<double>& crop, double cell_size_m, bool zero_base) {
+  if (!crop.empty()) map = terrain::crop(map, crop[0], crop[1], crop[2], crop[3]);
+  if (cell_size_m > 0.0) map = terrain::resample_bilinear(map, cell_size_m);
+  if (zero_base) map.heights().array() -= map.min_height();
+  return map;
 }
 
 /// Labels the 8-connected components of the mask's 1-cells 1, 2, ... in row-major order of their first cell; 0 off
@@ -377,10 +388,7 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       out << "generated " << method << " " << map.rows() << " x " << map.cols() << " at " << map.cell_size_m()
           << " m, heights " << map.min_height() << " .. " << map.max_height() << " m -> " << out_path << "\n";
     } else if (*import) {
-      Heightmap map = load_terrain(in_path, fill_nodata);
-      if (!crop.empty()) map = terrain::crop(map, crop[0], crop[1], crop[2], crop[3]);
-      if (target_cell_size > 0.0) map = terrain::resample_bilinear(map, target_cell_size);
-      if (zero_base) map.heights().array() -= map.min_height();
+      Heightmap map = import_terrain(load_terrain(in_path, fill_nodata), crop, target_cell_size, zero_base);
       // The written grid starts its own local frame at (0, 0).
       GridGeometry local = map.geometry();
       local.xll_m = 0.0;
@@ -457,10 +465,7 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
           throw UsageError("route: --from X Y and --to X Y (or --pairs FILE) are required");
         queries.push_back({{route_from.first, route_from.second}, {route_to.first, route_to.second}});
       }
-      Heightmap map = load_terrain(in_path, fill_nodata);
-      if (!crop.empty()) map = terrain::crop(map, crop[0], crop[1], crop[2], crop[3]);
-      if (target_cell_size > 0.0) map = terrain::resample_bilinear(map, target_cell_size);
-      if (zero_base) map.heights().array() -= map.min_height();
+      Heightmap map = import_terrain(load_terrain(in_path, fill_nodata), crop, target_cell_size, zero_base);
       std::vector<std::pair<CellIndex, CellIndex>> cells;
       for (std::size_t i = 0; i < queries.size(); ++i) {
         const std::string which = queries.size() > 1 ? fmt::format(" (route {})", i + 1) : std::string();

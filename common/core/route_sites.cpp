@@ -46,8 +46,7 @@ Heightmap route_gap(const Heightmap& terrain, double kappa, double radius_m) {
       }
     return gap;
   }
-  const Heightmap bound = MarsProcessor(kappa).project(terrain);
-  return Heightmap(terrain.geometry(), (bound.heights() - terrain.heights()).cwiseMax(0.0).eval());
+  return MarsProcessor(kappa).gap(terrain);
 }
 
 RouteSites plan_route_sites(const Heightmap& gap, CellIndex from, CellIndex to, const RouteSiteParams& params) {
