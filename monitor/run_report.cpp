@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "idl/run_summary.pb.h"
 #include "marsala/core/error.hpp"
 #include "marsala/monitor/format.hpp"
+#include "marsala/protocol/end_reason.hpp"
 
 namespace marsala::monitor {
 namespace {
@@ -26,9 +28,14 @@ std::string number(const char* format, double value) {
 
 /// Why a run that did not complete ended, in words (docs/runtime.md#end-reasons).
 std::string why_not(const std::string& end_reason) {
-  if (end_reason == "max_steps") return "it reached its step limit (max_steps)";
-  if (end_reason == "no_live_agents") return "every agent was dropped (no_live_agents)";
-  if (end_reason == "signal") return "it was stopped by a signal (signal)";
+  if (const std::optional<protocol::EndReason> reason = protocol::find_end_reason(end_reason)) {
+    switch (*reason) {
+      case protocol::EndReason::kMaxSteps: return "it reached its step limit (max_steps)";
+      case protocol::EndReason::kNoLiveAgents: return "every agent was dropped (no_live_agents)";
+      case protocol::EndReason::kSignal: return "it was stopped by a signal (signal)";
+      case protocol::EndReason::kCompleted: break;
+    }
+  }
   return "it ended with '" + printable(end_reason) + "'";
 }
 

@@ -23,6 +23,7 @@
 #include "marsala/monitor/replay.hpp"
 #include "marsala/monitor/web_assets.hpp"
 #include "marsala/monitor/world_gate.hpp"
+#include "marsala/protocol/end_reason.hpp"
 #include "marsala/render/terrain_renderer.hpp"
 #include "marsala/runlog/run_log.hpp"
 #include "marsala/scenario/scenario.hpp"
@@ -323,7 +324,7 @@ struct LiveServer::Impl {
     s.progress = total_steps > 0 ? std::min(1.0, static_cast<double>(r.steps()) / static_cast<double>(total_steps))
                                  : 0.0;
     s.running = !over;
-    s.completed = over && r.run_end() && r.run_end()->end_reason() == "completed";
+    s.completed = over && r.run_end() && protocol::find_end_reason(r.run_end()->end_reason()) == protocol::EndReason::kCompleted;
     for (const auto& [id, a] : r.agents()) {
       if (id == 0 || !a.admitted) continue;
       protocol::AgentStatus as;

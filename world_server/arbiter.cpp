@@ -11,57 +11,21 @@
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/core/iterators.hpp"
-#include "marsala/core/navigability_processor.hpp"
+#include "marsala/core/cell_occupancy.hpp"
+#include "marsala/core/robot_body.hpp"
 #include "marsala/core/segment_cells.hpp"
 
 namespace marsala::world_server {
 namespace {
 
-namespace tol = arbiter_tolerance;
+namespace tol = tolerance;
 
-// Balls above this many cells are checked by the processor on a window: the pair check is quadratic.
-constexpr std::size_t kMaxPairBallCells = 2000;
 // A bound on one cube column's count, far above any column within the 1 m per-cell limit: it keeps the count an int.
 constexpr long long kMaxCubesPerColumn = 1000000;
 
 double distance(double ax, double ay, double bx, double by) {
   const double dx = ax - bx, dy = ay - by;
   return std::sqrt(dx * dx + dy * dy);
-}
-
-bool occupiable_by_pairs(const Heightmap& h, CellIndex cell, const NavigabilityParams& p,
-                         const std::vector<CellIndex>& offsets) {
-  struct BallCell {
-    int dr, dc;
-    double height;
-  };
-  std::vector<BallCell> ball;
-  ball.reserve(offsets.size());
-  for (const CellIndex& o : offsets) {
-    const CellIndex c{cell.row + o.row, cell.col + o.col};
-    if (h.contains(c)) ball.push_back({o.row, o.col, h(c)});
-  }
-  const double cs = h.cell_size_m();
-  for (std::size_t a = 0; a < ball.size(); ++a)
-    for (std::size_t b = a + 1; b < ball.size(); ++b) {
-      const long long dr = ball[a].dr - ball[b].dr, dc = ball[a].dc - ball[b].dc;
-      // The expression NavigabilityProcessor's kernel uses, so that ties are decided identically.
-      const double threshold =
-          p.eps_m + p.kappa * (cs * std::sqrt(static_cast<double>(dr * dr + dc * dc))) + tolerance::kHeightM;
-      if (std::abs(ball[a].height - ball[b].height) > threshold) return false;
-    }
-  return true;
-}
-
-bool occupiable_by_window(const Heightmap& h, CellIndex cell, const NavigabilityParams& p,
-                          const std::vector<CellIndex>& offsets) {
-  int reach = 0;
-  for (const CellIndex& o : offsets) reach = std::max({reach, std::abs(o.row), std::abs(o.col)});
-  const int r0 = std::max(0, cell.row - reach), c0 = std::max(0, cell.col - reach);
-  const int r1 = std::min(h.rows() - 1, cell.row + reach), c1 = std::min(h.cols() - 1, cell.col + reach);
-  // The ball of `cell` lies inside the window, so the window's edges clip nothing the definition keeps.
-  const Heightmap window = h.window({r0, c0}, r1 - r0 + 1, c1 - c0 + 1);
-  return NavigabilityProcessor(p).occupiable(window)(cell.row - r0, cell.col - c0) != 0;
 }
 
 /// Rule 4: a refill only at the base; nullopt when it passes.
@@ -134,7 +98,7 @@ Verdict validate_deposits(const WorldState& state, const AgentRecord& me, double
       }
       double& total = raised[{c.cell.row, c.cell.col}];
       total += c.rise_m;
-      if (!(total <= tol::kMaxDepositionM + tol::kLengthM))
+      if (!(total <= kMaxDepositionM + tol::kLengthM))
         return reject("deposit at " + where(d) + " raises cell " + fmt::format("{}", c.cell) + " by " +
                       fmt::format("{}", total) + " m in this request, more than 1 m");
       if (layered) (*after)(c.cell) += c.rise_m;
@@ -153,22 +117,6 @@ double body_clearance_m(const AgentRecord& a, const AgentRecord& b) {
 
 bool bodies_overlap(const AgentRecord& a, double ax, double ay, const AgentRecord& b, double bx, double by) {
   return distance(ax, ay, bx, by) < body_clearance_m(a, b) - tol::kLengthM;
-}
-
-double cube_layer_m(double cube_size_m, double cell_size_m) {
-  return cube_size_m * cube_size_m * cube_size_m / (cell_size_m * cell_size_m);
-}
-
-bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
-                     OccupancyMethod method) {
-  if (!terrain.contains(cell))
-    throw InvalidArgument("cell_occupiable: cell " + fmt::format("{}", cell) + " is off the " +
-                          std::to_string(terrain.rows()) + " x " + std::to_string(terrain.cols()) + " grid");
-  const std::vector<CellIndex> offsets = disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m()));
-  if (method == OccupancyMethod::kAutomatic)
-    method = offsets.size() <= kMaxPairBallCells ? OccupancyMethod::kPairs : OccupancyMethod::kWindow;
-  return method == OccupancyMethod::kPairs ? occupiable_by_pairs(terrain, cell, params, offsets)
-                                           : occupiable_by_window(terrain, cell, params, offsets);
 }
 
 const std::vector<Deposition>& raised_cells(const protocol::ActionRequest& request, const Verdict& verdict) {
@@ -205,9 +153,9 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
     if (!sane(d.x_m) || !sane(d.y_m) || !sane(d.volume_m3))
       return reject("deposit at (" + fmt::format("{}", d.x_m) + ", " + fmt::format("{}", d.y_m) + ") of " +
                     fmt::format("{}", d.volume_m3) + " m^3 is not finite or too large");
-  if (r.deposits.size() > tol::kMaxDeposits)
+  if (r.deposits.size() > kMaxDeposits)
     return reject(std::to_string(r.deposits.size()) + " deposits exceed the limit of " +
-                  std::to_string(tol::kMaxDeposits) + " per request");
+                  std::to_string(kMaxDeposits) + " per request");
 
   // 2. Motion.
   rule = 2;
@@ -273,7 +221,7 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
     const CellIndex c{d.row, d.col};
     if (!terrain.contains(c)) return reject("deposition cell " + fmt::format("{}", c) + " is off the grid");
     cells.emplace_back(d.row, d.col);
-    if (!(d.height_m > 0.0 && d.height_m <= tol::kMaxDepositionM + tol::kLengthM))
+    if (!(d.height_m > 0.0 && d.height_m <= kMaxDepositionM + tol::kLengthM))
       return reject("deposition height " + fmt::format("{}", d.height_m) + " m at " + fmt::format("{}", c) +
                     " is not in (0, 1] m");
     const double layers = d.height_m / layer;

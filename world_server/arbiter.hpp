@@ -14,27 +14,9 @@
 
 namespace marsala::world_server {
 
-/// Tolerances of docs/runtime.md#tolerances.
-namespace arbiter_tolerance {
-inline constexpr double kLengthM = 1e-9;        ///< added to length limits [m]
-inline constexpr double kVolumeM3 = 1e-12;      ///< added to volume limits [m^3]
-inline constexpr double kCubeMultiple = 1e-6;   ///< |h/q - round(h/q)| limit for a whole number of cube layers
-inline constexpr double kMaxDepositionM = 1.0;  ///< tallest single deposition [m]
+/// Limits of docs/runtime.md#validation (the tolerances are the core's, marsala::tolerance).
+inline constexpr double kMaxDepositionM = 1.0;    ///< tallest single deposition [m]
 inline constexpr std::size_t kMaxDeposits = 256;  ///< most deposits in one request
-}  // namespace arbiter_tolerance
-
-/// How cell_occupiable decides; every method gives the same answer (ARCHITECTURE.md definition).
-enum class OccupancyMethod {
-  kAutomatic,  ///< pairs for balls up to a few thousand cells, the processor window beyond
-  kPairs,      ///< every pair of the ball, with the processor's threshold expression
-  kWindow,     ///< NavigabilityProcessor on the window that holds the ball
-};
-
-/// True when on-grid `cell` is occupiable for `params` on `terrain`: every pair of cells within delta/2 of its centre
-/// (cells off the grid ignored) has |h(r) - h(q)| <= eps + kappa |r - q| + 1e-9 m. Throws InvalidArgument when the
-/// cell is off the grid.
-bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
-                     OccupancyMethod method = OccupancyMethod::kAutomatic);
 
 /// The arbiter's answer to one request.
 struct Verdict {
@@ -62,9 +44,6 @@ void apply_request(WorldState& state, const protocol::ActionRequest& request, co
 double body_clearance_m(const AgentRecord& a, const AgentRecord& b);
 /// True when the bodies of `a` at (ax, ay) and `b` at (bx, by) overlap: closer than body_clearance_m - 1e-9 m.
 bool bodies_overlap(const AgentRecord& a, double ax, double ay, const AgentRecord& b, double bx, double by);
-
-/// Thickness of one layer of cubes on a cell: cube_size^3 / cell_size^2 [m].
-double cube_layer_m(double cube_size_m, double cell_size_m);
 
 /// The cells an accepted request raised and by how much: its depositions, or its verdict's rises.
 const std::vector<Deposition>& raised_cells(const protocol::ActionRequest& request, const Verdict& verdict);

@@ -46,7 +46,7 @@ void check_on_mask(const CellMask& mask, CellIndex c, const char* what) {
 }  // namespace
 
 bool at_goal(const WorldState& state, const AgentRecord& agent) {
-  constexpr double tol = arbiter_tolerance::kLengthM;
+  constexpr double tol = tolerance::kLengthM;
   const scenario::Goal& g = state.goal;
   const bool inside =
       agent.x_m >= g.x0_m - tol && agent.x_m <= g.x1_m + tol && agent.y_m >= g.y0_m - tol && agent.y_m <= g.y1_m + tol;
@@ -125,7 +125,7 @@ void evaluate_completion(WorldState& state) {
   const CellMask& mask = check.occupancy.occupiable();
   if (state.completion == scenario::CompletionKind::kPayloadPath) {
     check.path_found = connected(mask, check.from, check.to);
-    check.met = check.path_found && target_rise_m(state) <= check.max_target_rise_m + arbiter_tolerance::kLengthM;
+    check.met = check.path_found && target_rise_m(state) <= check.max_target_rise_m + tolerance::kLengthM;
     check.route_gap_m3 = route_gap_m3(state.terrain, check.route);
   } else {
     check.level_fraction =
@@ -143,7 +143,7 @@ std::string payload_completion_detail(const WorldState& state, bool found) {
   if (state.completion != scenario::CompletionKind::kPayloadPath) return {};
   if (!found) return "no payload path from base to target";
   const double rise = target_rise_m(state), allowed = state.check.max_target_rise_m;
-  if (rise > allowed + arbiter_tolerance::kLengthM)
+  if (rise > allowed + tolerance::kLengthM)
     return fmt::format("payload path found, but the target's cell stands {:.4g} m above its initial height (at most "
                        "{:.4g} m allowed)",
                        rise, allowed);
@@ -158,7 +158,7 @@ double largest_cube_layer_m(const WorldState& state) {
 }
 
 CellRect site_cells(const GridGeometry& grid, const scenario::Site& site) {
-  constexpr double tol = arbiter_tolerance::kLengthM;
+  constexpr double tol = tolerance::kLengthM;
   // Scanning every row and column decides each centre exactly as the definition says, with no rounding shortcut.
   int r0 = grid.rows, r1 = -1, c0 = grid.cols, c1 = -1;
   for (int r = 0; r < grid.rows; ++r) {

@@ -28,19 +28,6 @@
 
 namespace marsala::world_server {
 
-/// A rectangle of grid cells: rows [first.row, first.row + rows) x cols [first.col, first.col + cols).
-struct CellRect {
-  CellIndex first;  ///< top-left (north-west) cell
-  int rows = 0;     ///< [cells]
-  int cols = 0;     ///< [cells]
-
-  bool empty() const { return rows <= 0 || cols <= 0; }
-  long long size() const { return empty() ? 0 : static_cast<long long>(rows) * cols; }
-  bool contains(CellIndex c) const {
-    return c.row >= first.row && c.row < first.row + rows && c.col >= first.col && c.col < first.col + cols;
-  }
-};
-
 /// Occupiability (paper eq. 1, ARCHITECTURE.md) of the cells of one area of a terrain, balls cut at the area's edge,
 /// recomputed only where heights changed.
 class OccupancyCache {

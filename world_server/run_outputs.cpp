@@ -282,7 +282,7 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
             {"payload path " + format_number("%.2f m", route->length_m), kPathYellow, render::LegendSwatch::kLine});
         outcome += ", path " + format_number("%.2f m", route->length_m);
         const double rise = target_rise_m(state);
-        if (rise > state.check.max_target_rise_m + arbiter_tolerance::kLengthM)
+        if (rise > state.check.max_target_rise_m + tolerance::kLengthM)
           outcome += ", target raised " + format_number("%.2f m", rise);
       } else {
         outcome += ", no payload path";

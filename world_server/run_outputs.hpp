@@ -30,7 +30,7 @@
 #include "marsala/render/terrain_renderer.hpp"
 #include "marsala/world_server/completion.hpp"
 #include "marsala/world_server/construction_sites.hpp"
-#include "marsala/world_server/end_reason.hpp"
+#include "marsala/protocol/end_reason.hpp"
 #include "marsala/world_server/occupancy_cache.hpp"
 #include "marsala/world_server/persistence.hpp"
 #include "marsala/world_server/world_state.hpp"
@@ -46,7 +46,7 @@ struct RunInfo {
   std::string dds;  ///< cyclone, fastdds or inprocess
   std::uint64_t seed = 0;
   bool completed = false;
-  EndReason end_reason = EndReason::kSignal;  ///< why the run ended
+  protocol::EndReason end_reason = protocol::EndReason::kSignal;  ///< why the run ended
   double wall_seconds = 0.0;                  ///< [s]
   double step_wall_median_ms = 0.0;           ///< median wall time of one lockstep step [ms]
   double step_wall_p90_ms = 0.0;              ///< its 90th percentile [ms]

@@ -62,7 +62,7 @@ protocol::SensorFrame SensingService::frame_for(const WorldState& state, std::ui
   for (const AgentRecord& other : state.agents) {
     if (!other.alive || other.id == id) continue;
     const double dx = other.x_m - me.x_m, dy = other.y_m - me.y_m;
-    if (std::sqrt(dx * dx + dy * dy) <= me.type.body.proximity_range_m + arbiter_tolerance::kLengthM)
+    if (std::sqrt(dx * dx + dy * dy) <= me.type.body.proximity_range_m + tolerance::kLengthM)
       f.neighbours.push_back({other.id, other.x_m, other.y_m, other.z_m, 0.5 * other.type.body.navigability.delta_m});
   }
   return f;

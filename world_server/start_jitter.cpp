@@ -5,7 +5,7 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/random.hpp"
-#include "marsala/world_server/arbiter.hpp"
+#include "marsala/core/cell_occupancy.hpp"
 
 namespace marsala::world_server {
 

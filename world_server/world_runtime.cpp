@@ -590,20 +590,20 @@ struct WorldRuntime::Impl {
   }
 
   /// Runs steps until an end condition; returns the end reason.
-  EndReason lockstep(const std::atomic<bool>& stop, Clock::time_point start) {
+  protocol::EndReason lockstep(const std::atomic<bool>& stop, Clock::time_point start) {
     for (;;) {
       if (frames) frames->maybe_write(state.step, false, [this] { return frame_picture(false); });
-      if (stop) return EndReason::kSignal;
-      if (is_completed(state)) return EndReason::kCompleted;
-      if (state.step >= options.max_steps) return EndReason::kMaxSteps;
+      if (stop) return protocol::EndReason::kSignal;
+      if (is_completed(state)) return protocol::EndReason::kCompleted;
+      if (state.step >= options.max_steps) return protocol::EndReason::kMaxSteps;
       const std::vector<std::uint32_t> live = state.live_ids();
-      if (live.empty()) return EndReason::kNoLiveAgents;
+      if (live.empty()) return protocol::EndReason::kNoLiveAgents;
       const Clock::time_point step_start = Clock::now();
       step_waited = Clock::duration::zero();
       for (std::uint32_t id : live) send_frame(id, false);
       std::uint32_t surplus = 0;
       std::vector<Submission> submissions = collect(stop, surplus);
-      if (stop) return EndReason::kSignal;  // the interrupted step is not applied
+      if (stop) return protocol::EndReason::kSignal;  // the interrupted step is not applied
       const StepOutcome outcome = apply_step(state, submissions);
       state.surplus_requests += surplus;
       // Recorded before anything of the step is published: a crash never loses a step an agent has seen applied.
@@ -794,12 +794,12 @@ struct WorldRuntime::Impl {
     const Clock::time_point start = Clock::now();
     const double cpu_before = process_cpu_seconds();
     publish_status(true, false, 0.0);
-    const EndReason end_reason = lockstep(stop, start);
+    const protocol::EndReason end_reason = lockstep(stop, start);
     const double cpu_steps = process_cpu_seconds() - cpu_before;
 
     RunResult result;
     result.end_reason = end_reason;
-    result.completed = end_reason == EndReason::kCompleted;
+    result.completed = end_reason == protocol::EndReason::kCompleted;
     result.steps = state.step;
     result.wall_seconds = elapsed_s(start);
     const std::vector<std::uint32_t> live = state.live_ids();

@@ -18,7 +18,7 @@
 #include "marsala/bus/bus.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/scenario/scenario.hpp"
-#include "marsala/world_server/end_reason.hpp"
+#include "marsala/protocol/end_reason.hpp"
 #include "marsala/world_server/world_state.hpp"
 
 namespace marsala::world_server {
@@ -54,7 +54,7 @@ struct ResumeInfo {
 /// How a run ended.
 struct RunResult {
   bool completed = false;
-  EndReason end_reason = EndReason::kSignal;  ///< why the run ended
+  protocol::EndReason end_reason = protocol::EndReason::kSignal;  ///< why the run ended
   std::uint64_t steps = 0;                    ///< steps applied
   double wall_seconds = 0.0;                  ///< from the first frame to the end [s]
   std::uint32_t admitted = 0;

@@ -12,12 +12,41 @@ struct CellIndex {
   int col = 0;
   friend bool operator==(CellIndex a, CellIndex b) { return a.row == b.row && a.col == b.col; }
   friend bool operator!=(CellIndex a, CellIndex b) { return !(a == b); }
+  /// Row-major order (north to south, then west to east): the order of the grid's storage.
+  friend bool operator<(CellIndex a, CellIndex b) { return a.row < b.row || (a.row == b.row && a.col < b.col); }
+};
+
+/// A rectangle of grid cells: rows [first.row, first.row + rows) x cols [first.col, first.col + cols).
+struct CellRect {
+  CellIndex first;  ///< top-left (north-west) cell
+  int rows = 0;     ///< [cells]
+  int cols = 0;     ///< [cells]
+
+  bool empty() const { return rows <= 0 || cols <= 0; }
+  long long size() const { return empty() ? 0 : static_cast<long long>(rows) * cols; }
+  bool contains(CellIndex c) const {
+    return c.row >= first.row && c.row < first.row + rows && c.col >= first.col && c.col < first.col + cols;
+  }
 };
 
 /// A point in the world frame [m]: x grows east, y grows north.
 struct Position {
   double x = 0.0;
   double y = 0.0;
+  friend bool operator==(Position a, Position b) { return a.x == b.x && a.y == b.y; }
+  friend bool operator!=(Position a, Position b) { return !(a == b); }
+};
+
+/// An axis-aligned rectangle of the world frame [m]: [x0, x1] x [y0, y1] (x0 <= x1 and y0 <= y1 once validated).
+struct Rect {
+  double x0 = 0.0;
+  double y0 = 0.0;
+  double x1 = 0.0;
+  double y1 = 0.0;
+  friend bool operator==(const Rect& a, const Rect& b) {
+    return a.x0 == b.x0 && a.y0 == b.y0 && a.x1 == b.x1 && a.y1 == b.y1;
+  }
+  friend bool operator!=(const Rect& a, const Rect& b) { return !(a == b); }
 };
 
 /// Motion parameters of a robot (paper eq. 1).
@@ -65,12 +94,18 @@ struct Deposit {
   double volume_m3 = 0.0;
 };
 
-/// Fixed tolerances every implementation shares (ARCHITECTURE.md, grid conventions).
+/// Fixed tolerances every implementation shares (ARCHITECTURE.md, grid conventions; docs/runtime.md#tolerances).
 namespace tolerance {
 /// Added to (delta / (2 cs))^2 when deciding whether an offset lies in the ball [cells^2].
 inline constexpr double kBallCells2 = 1e-9;
 /// Added to eps + kappa * distance when deciding whether a pair of heights passes [m].
 inline constexpr double kHeightM = 1e-9;
+/// Added to length limits (step, reach, base radius, proximity, clearance) [m].
+inline constexpr double kLengthM = 1e-9;
+/// Added to volume limits [m^3].
+inline constexpr double kVolumeM3 = 1e-12;
+/// Largest |h/q - round(h/q)| of a height h that counts as a whole number of cube layers q.
+inline constexpr double kCubeMultiple = 1e-6;
 }  // namespace tolerance
 
 }  // namespace marsala

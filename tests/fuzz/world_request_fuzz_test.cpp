@@ -35,7 +35,7 @@
 namespace marsala::world_server {
 namespace {
 
-namespace tol = arbiter_tolerance;
+namespace tol = tolerance;
 using testing::admitted_state;
 using testing::flat_terrain;
 using testing::kLayer;
@@ -384,7 +384,7 @@ void check_accepted_request(const WorldState& before, const AgentRecord& me, con
   ASSERT_TRUE(kind == DepositorKind::kLayer ? r.deposits.empty() : r.depositions.empty())
       << "a request of the other depositor kind accepted\n"
       << report();
-  ASSERT_LE(r.deposits.size(), tol::kMaxDeposits) << report();
+  ASSERT_LE(r.deposits.size(), kMaxDeposits) << report();
   for (const Deposit& d : r.deposits) {
     ASSERT_TRUE(std::isfinite(d.x_m) && std::isfinite(d.y_m) && std::isfinite(d.volume_m3) && d.volume_m3 > 0.0)
         << report();

@@ -53,7 +53,7 @@ RunInfo info_for(const std::string& name, bool completed) {
   RunInfo info;
   info.scenario = name;
   info.completed = completed;
-  info.end_reason = completed ? EndReason::kCompleted : EndReason::kMaxSteps;
+  info.end_reason = completed ? protocol::EndReason::kCompleted : protocol::EndReason::kMaxSteps;
   return info;
 }
 

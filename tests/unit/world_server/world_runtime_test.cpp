@@ -145,7 +145,7 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   a2.join();
 
   EXPECT_TRUE(result.completed);
-  EXPECT_EQ(result.end_reason, EndReason::kCompleted);
+  EXPECT_EQ(result.end_reason, protocol::EndReason::kCompleted);
   EXPECT_EQ(result.steps, kStepsToGoal);
   EXPECT_EQ(result.admitted, 2u);
   const WorldState& s = runtime.state();
@@ -308,7 +308,7 @@ TEST_F(RuntimeTest, StopEndsTheRunCleanlyWithRunOverFramesAndOutputs) {
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
   a1.join();
   a2.join();
-  EXPECT_EQ(result.end_reason, EndReason::kSignal);
+  EXPECT_EQ(result.end_reason, protocol::EndReason::kSignal);
   EXPECT_FALSE(result.completed);
   EXPECT_EQ(result.steps, 0u);
   for (const FakeAgent* a : {&a1, &a2}) {
@@ -328,7 +328,7 @@ TEST_F(RuntimeTest, MaxStepsEndsAnUnfinishedRun) {
   // The small goal [2.9, 3.2] x [1.9, 2.2]: agent 1 needs 11 steps.
   WorldRuntime runtime(testing::small_scenario(), testing::flat_terrain(), o, *participant);
   const RunResult result = run_with_one_walker(runtime, kDomain);
-  EXPECT_EQ(result.end_reason, EndReason::kMaxSteps);
+  EXPECT_EQ(result.end_reason, protocol::EndReason::kMaxSteps);
   EXPECT_FALSE(result.completed);
   EXPECT_EQ(result.steps, 5u);
   EXPECT_NE(read_text(out_ / "summary.json").find("\"completed\": false"), std::string::npos);
@@ -344,7 +344,7 @@ TEST_F(RuntimeTest, APayloadScenarioNavigableFromTheStartCompletesAtOnceWithTheS
   WorldRuntime runtime(payload, testing::flat_terrain(), o, *participant);
   const RunResult result = run_with_one_walker(runtime, kDomain);
   EXPECT_TRUE(result.completed);
-  EXPECT_EQ(result.end_reason, EndReason::kCompleted);
+  EXPECT_EQ(result.end_reason, protocol::EndReason::kCompleted);
   EXPECT_EQ(result.steps, 0u);
   auto late = participant->create_reader<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
   const auto latest = late->take();
@@ -368,7 +368,7 @@ TEST_F(RuntimeTest, ALevelSiteRunPublishesItsLevelFractionAsProgress) {
   o.max_steps = 4;
   WorldRuntime runtime(site, terrain, o, *participant);
   const RunResult result = run_with_one_walker(runtime, kDomain);
-  EXPECT_EQ(result.end_reason, EndReason::kMaxSteps);
+  EXPECT_EQ(result.end_reason, protocol::EndReason::kMaxSteps);
   auto late = participant->create_reader<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
   const auto latest = late->take();
   ASSERT_EQ(latest.size(), 1u);

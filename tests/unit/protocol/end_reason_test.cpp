@@ -1,10 +1,10 @@
-#include "marsala/world_server/end_reason.hpp"
+#include "marsala/protocol/end_reason.hpp"
 
 #include <gtest/gtest.h>
 
 #include "marsala/core/error.hpp"
 
-namespace marsala::world_server {
+namespace marsala::protocol {
 namespace {
 
 TEST(EndReason, NamesAreTheDocumentedStringsAndReadBack) {
@@ -36,4 +36,4 @@ TEST(EndReason, AnUnknownNameListsTheValidOnes) {
 }
 
 }  // namespace
-}  // namespace marsala::world_server
+}  // namespace marsala::protocol

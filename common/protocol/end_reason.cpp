@@ -1,8 +1,8 @@
-#include "marsala/world_server/end_reason.hpp"
+#include "marsala/protocol/end_reason.hpp"
 
 #include "marsala/core/enum_names.hpp"
 
-namespace marsala::world_server {
+namespace marsala::protocol {
 namespace {
 
 constexpr EnumName<EndReason> kEndReasonNames[] = {{EndReason::kSignal, "signal"},
@@ -28,4 +28,10 @@ EndReason end_reason_from_string(const std::string& name) {
   return enum_from_string(kEndReasonNames, name, "end reason");
 }
 
-}  // namespace marsala::world_server
+std::optional<EndReason> find_end_reason(const std::string& name) {
+  for (const EnumName<EndReason>& n : kEndReasonNames)
+    if (name == n.name) return n.value;
+  return std::nullopt;
+}
+
+}  // namespace marsala::protocol

@@ -1,9 +1,11 @@
 #pragma once
-// Why a run ended (docs/runtime.md#end-reasons).
+// Why a run ended (docs/runtime.md#end-reasons): the world decides it, run.log and summary.json name it, the monitor
+// reads it back.
 
+#include <optional>
 #include <string>
 
-namespace marsala::world_server {
+namespace marsala::protocol {
 
 /// Why the lockstep stopped; the first that holds at the top of a step wins, in this order.
 enum class EndReason {
@@ -22,5 +24,7 @@ int exit_code(EndReason reason);
 std::string to_string(EndReason reason);
 /// The reason named `name`; throws InvalidArgument listing the valid names.
 EndReason end_reason_from_string(const std::string& name);
+/// The reason named `name`, or none for a name that is not one (a reader of run files that may be damaged).
+std::optional<EndReason> find_end_reason(const std::string& name);
 
-}  // namespace marsala::world_server
+}  // namespace marsala::protocol

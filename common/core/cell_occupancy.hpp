@@ -1,0 +1,23 @@
+#pragma once
+// Whether one cell is occupiable (ARCHITECTURE.md, grid conventions): the single-cell question the world asks of every
+// motion and start, and the agent of its own body, answered exactly as NavigabilityProcessor answers it for a grid.
+
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/types.hpp"
+
+namespace marsala {
+
+/// How cell_occupiable decides; every method gives the same answer (ARCHITECTURE.md definition).
+enum class OccupancyMethod {
+  kAutomatic,  ///< pairs for balls up to a few thousand cells, the processor window beyond
+  kPairs,      ///< every pair of the ball, with the processor's threshold expression
+  kWindow,     ///< NavigabilityProcessor on the window that holds the ball
+};
+
+/// True when on-grid `cell` is occupiable for `params` on `terrain`: every pair of cells within delta/2 of its centre
+/// (cells off the grid ignored) has |h(r) - h(q)| <= eps + kappa |r - q| + 1e-9 m. Throws InvalidArgument when the
+/// cell is off the grid.
+bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
+                     OccupancyMethod method = OccupancyMethod::kAutomatic);
+
+}  // namespace marsala

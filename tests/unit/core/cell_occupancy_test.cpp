@@ -1,0 +1,96 @@
+#include "marsala/core/cell_occupancy.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "marsala/core/error.hpp"
+#include "marsala/core/navigability_processor.hpp"
+
+namespace marsala {
+namespace {
+
+TEST(CellOccupiable, MatchesTheNavigabilityProcessorOnRoughTerrains) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 6; ++trial) {
+    GridGeometry g;
+    g.rows = 18 + trial;
+    g.cols = 23 - trial;
+    g.cell_size_m = 0.1;
+    Heightmap h(g, 0.0);
+    // Smooth noise below eps with sparse spikes: cells near a spike are not occupiable, the others are.
+    std::uniform_real_distribution<double> noise(0.0, 0.02), spike(0.0, 1.0);
+    for (long long i = 0; i < h.size(); ++i) h.data()[i] = noise(rng) + (spike(rng) < 0.03 ? 0.3 : 0.0);
+    const NavigabilityParams params{0.3, 0.4 + 0.15 * trial, 0.05};
+    const CellMask want = NavigabilityProcessor(params).occupiable(h);
+    int occupiable = 0;
+    for (int r = 0; r < h.rows(); ++r)
+      for (int c = 0; c < h.cols(); ++c) {
+        occupiable += want(r, c);
+        ASSERT_EQ(cell_occupiable(h, {r, c}, params, OccupancyMethod::kPairs), want(r, c) != 0)
+            << "trial " << trial << " cell " << r << ", " << c;
+        ASSERT_EQ(cell_occupiable(h, {r, c}, params, OccupancyMethod::kWindow), want(r, c) != 0);
+      }
+    // Both answers occur, so the comparison means something.
+    EXPECT_GT(occupiable, 0) << trial;
+    EXPECT_LT(occupiable, h.size()) << trial;
+  }
+}
+
+TEST(CellOccupiable, RampsExactlyAtKappaAreOccupiableOneLayerSteeperIsNot) {
+  GridGeometry g;
+  g.rows = 20;
+  g.cols = 30;
+  g.cell_size_m = 0.1;
+  Heightmap ramp(g, 0.0);
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c) ramp(r, c) = 0.3 * (c * 0.1);  // slope exactly kappa, steps of eps = 0
+  const NavigabilityParams params{0.3, 1.0, 0.0};
+  const CellMask want = NavigabilityProcessor(params).occupiable(ramp);
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c) {
+      EXPECT_TRUE(cell_occupiable(ramp, {r, c}, params));
+      EXPECT_EQ(want(r, c), 1);
+    }
+  Heightmap steeper = ramp;
+  steeper(10, 15) += 0.0125;
+  const CellMask want_steeper = NavigabilityProcessor(params).occupiable(steeper);
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c)
+      ASSERT_EQ(cell_occupiable(steeper, {r, c}, params), want_steeper(r, c) != 0) << r << ", " << c;
+  EXPECT_FALSE(cell_occupiable(steeper, {10, 15}, params));
+  EXPECT_TRUE(cell_occupiable(steeper, {10, 2}, params));
+}
+
+TEST(CellOccupiable, BigBallsUseTheWindowAndAgree) {
+  GridGeometry g;
+  g.rows = 70;
+  g.cols = 70;
+  g.cell_size_m = 0.1;
+  Heightmap h(g, 0.0);
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c) h(r, c) = (r + c) % 7 == 0 ? 0.04 : 0.0;
+  h(5, 5) = 3.0;                                    // a pillar near a corner
+  const NavigabilityParams params{0.3, 6.0, 0.05};  // ball radius 30 cells: about 2800 cells
+  const CellMask want = NavigabilityProcessor(params).occupiable(h);
+  int occupiable = 0;
+  for (const CellIndex c :
+       {CellIndex{35, 35}, CellIndex{5, 40}, CellIndex{60, 60}, CellIndex{20, 20}, CellIndex{5, 30}}) {
+    occupiable += want(c.row, c.col);
+    EXPECT_EQ(cell_occupiable(h, c, params), want(c.row, c.col) != 0);
+    EXPECT_EQ(cell_occupiable(h, c, params, OccupancyMethod::kPairs), want(c.row, c.col) != 0);
+  }
+  EXPECT_EQ(occupiable, 3);  // the two within 30 cells of the pillar are not
+}
+
+TEST(CellOccupiable, OffGridThrows) {
+  GridGeometry g;
+  g.rows = 4;
+  g.cols = 4;
+  EXPECT_THROW(cell_occupiable(Heightmap(g, 0.0), {4, 0}, {}), InvalidArgument);
+  EXPECT_THROW(cell_occupiable(Heightmap(g, 0.0), {0, -1}, {}), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace marsala
