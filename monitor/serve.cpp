@@ -19,11 +19,11 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/monitor/live_model.hpp"
-#include "marsala/monitor/png_bytes.hpp"
 #include "marsala/monitor/replay.hpp"
 #include "marsala/monitor/web_assets.hpp"
 #include "marsala/monitor/world_gate.hpp"
 #include "marsala/protocol/end_reason.hpp"
+#include "marsala/render/png_writer.hpp"
 #include "marsala/render/terrain_renderer.hpp"
 #include "marsala/runlog/run_log.hpp"
 #include "marsala/scenario/scenario.hpp"
@@ -353,7 +353,8 @@ struct LiveServer::Impl {
     o.max_size_px = options.max_picture_px;
     if (r.depositor().size() > 0 && r.depositor().maxCoeff() > 0) o.labels = r.depositor();
     const render::Image image = render::render_terrain(r.terrain(), o);
-    auto png = std::make_shared<const std::string>(encode_png(image));
+    const std::vector<std::uint8_t> bytes = render::encode_png(image, render::PngSpeed::kFast);
+    auto png = std::make_shared<const std::string>(bytes.begin(), bytes.end());
     LiveMap map;
     map.geometry = r.terrain().geometry();
     map.min_height_m = r.terrain().min_height();

@@ -5,6 +5,8 @@
 
 #include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -36,6 +38,33 @@ Image read_png(const std::string& path) {
     return {};
   }
   return image;
+}
+
+// Decodes PNG bytes with libpng (independent of the encoder) as 8-bit RGB.
+Image decode_png(const std::vector<std::uint8_t>& bytes) {
+  png_image png;
+  std::memset(&png, 0, sizeof png);
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_memory(&png, bytes.data(), bytes.size())) {
+    ADD_FAILURE() << "cannot read the bytes: " << png.message;
+    return {};
+  }
+  png.format = PNG_FORMAT_RGB;
+  Image image;
+  image.width = static_cast<int>(png.width);
+  image.height = static_cast<int>(png.height);
+  image.rgb.resize(PNG_IMAGE_SIZE(png));
+  if (!png_image_finish_read(&png, nullptr, image.rgb.data(), 0, nullptr)) {
+    ADD_FAILURE() << "cannot decode the bytes: " << png.message;
+    png_image_free(&png);
+    return {};
+  }
+  return image;
+}
+
+std::vector<std::uint8_t> file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 Image pattern(int width, int height) {
@@ -118,6 +147,47 @@ TEST(PngWriter, MalformedImagesAreRejected) {
   EXPECT_THROW(write_png(short_buffer, temp_path("short.png")), InvalidArgument);
   Image negative{-2, 3, {}};
   EXPECT_THROW(write_png(negative, temp_path("negative.png")), InvalidArgument);
+}
+
+TEST(PngWriter, EncodedBytesDecodeToEveryPixelAtBothSpeeds) {
+  Heightmap map(GridGeometry{9, 13, 0.0, 0.0, 0.5});
+  for (int r = 0; r < 9; ++r)
+    for (int c = 0; c < 13; ++c) map(r, c) = 0.1 * r * c - 0.3 * c;
+  for (const Image& image : {pattern(3, 2), render_terrain(map)})
+    for (const PngSpeed speed : {PngSpeed::kSmall, PngSpeed::kFast}) {
+      const std::vector<std::uint8_t> bytes = encode_png(image, speed);
+      const Image back = decode_png(bytes);
+      EXPECT_EQ(back.width, image.width);
+      EXPECT_EQ(back.height, image.height);
+      EXPECT_EQ(back.rgb, image.rgb);
+    }
+}
+
+TEST(PngWriter, FileHoldsTheEncodedBytesAsLibpngsFileWriterWritesThem) {
+  Heightmap map(GridGeometry{20, 30, 0.0, 0.0, 0.5});
+  for (int r = 0; r < 20; ++r)
+    for (int c = 0; c < 30; ++c) map(r, c) = 0.02 * r * r - 0.1 * c;
+  const Image image = render_terrain(map);
+  const std::string path = temp_path("same_bytes.png");
+  write_png(image, path);
+  // The reference: libpng's own file writer with default settings, as the pictures of a run were always written.
+  png_image png;
+  std::memset(&png, 0, sizeof png);
+  png.version = PNG_IMAGE_VERSION;
+  png.width = static_cast<png_uint_32>(image.width);
+  png.height = static_cast<png_uint_32>(image.height);
+  png.format = PNG_FORMAT_RGB;
+  const std::string reference = temp_path("reference.png");
+  ASSERT_TRUE(png_image_write_to_file(&png, reference.c_str(), 0, image.rgb.data(), 3 * image.width, nullptr));
+  EXPECT_EQ(file_bytes(path), file_bytes(reference));
+  EXPECT_EQ(file_bytes(path), encode_png(image));
+}
+
+TEST(PngWriter, EncodingMalformedImagesThrows) {
+  EXPECT_THROW(encode_png(Image{}), InvalidArgument);
+  Image short_buffer = pattern(3, 3);
+  short_buffer.rgb.pop_back();
+  EXPECT_THROW(encode_png(short_buffer, PngSpeed::kFast), InvalidArgument);
 }
 
 }  // namespace
