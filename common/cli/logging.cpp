@@ -1,12 +1,14 @@
 #include "marsala/cli/logging.hpp"
 
+#include <fmt/format.h>
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include <atomic>
-#include <cstdio>
 #include <ctime>
 #include <mutex>
 #include <streambuf>
@@ -41,7 +43,7 @@ spdlog::level::level_enum level_from(const std::string& name) {
   if (name == "warn") return spdlog::level::warn;
   if (name == "error") return spdlog::level::err;
   if (name == "off") return spdlog::level::off;
-  throw InvalidArgument("log level '" + name + "' is none of trace, debug, info, warn, error, off");
+  throw InvalidArgument(fmt::format("log level '{}' is none of trace, debug, info, warn, error, off", name));
 }
 
 std::string utc_time(std::chrono::system_clock::time_point time) {
@@ -51,10 +53,8 @@ std::string utc_time(std::chrono::system_clock::time_point time) {
   const std::time_t t = static_cast<std::time_t>(seconds.count());
   std::tm tm{};
   gmtime_r(&t, &tm);
-  char text[80];
-  std::snprintf(text, sizeof text, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday,
-                tm.tm_hour, tm.tm_min, tm.tm_sec, static_cast<int>(millis));
-  return text;
+  return fmt::format("{:04d}-{:02d}-{:02d}T{:02d}:{:02d}:{:02d}.{:03d}Z", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday,
+                     tm.tm_hour, tm.tm_min, tm.tm_sec, millis);
 }
 
 /// spdlog's formatter for both formats: the process and the agent id it carries are this program's.
@@ -96,7 +96,7 @@ void setup_logging(const std::string& process, std::uint32_t agent_id, const Log
   else if (options.format == "json")
     format = LogFormat::kJson;
   else
-    throw InvalidArgument("log format '" + options.format + "' is neither text nor json");
+    throw InvalidArgument(fmt::format("log format '{}' is neither text nor json", options.format));
   const spdlog::level::level_enum level = level_from(options.level);
   spdlog::sink_ptr sink;
   if (out)
@@ -129,66 +129,23 @@ void set_log_agent_id(std::uint32_t id) { g_agent_id = id; }
 LogFormat log_format() { return g_format.load(); }
 
 std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  const auto* s = reinterpret_cast<const unsigned char*>(text.data());
-  const std::size_t n = text.size();
-  for (std::size_t i = 0; i < n;) {
-    const unsigned char c = s[i];
-    if (c < 0x80) {
-      switch (c) {
-        case '"': out += "\\\""; break;
-        case '\\': out += "\\\\"; break;
-        case '\n': out += "\\n"; break;
-        case '\r': out += "\\r"; break;
-        case '\t': out += "\\t"; break;
-        default:
-          if (c < 0x20 || c == 0x7f) {
-            char esc[8];
-            std::snprintf(esc, sizeof esc, "\\u%04x", c);
-            out += esc;
-          } else {
-            out += static_cast<char>(c);
-          }
-      }
-      ++i;
-      continue;
-    }
-    // A multi-byte sequence: copied when it is valid UTF-8 (no overlong form, no surrogate, <= U+10FFFF).
-    std::size_t len = 0;
-    std::uint32_t cp = 0;
-    if (c >= 0xc2 && c <= 0xdf) len = 2, cp = c & 0x1f;
-    else if (c >= 0xe0 && c <= 0xef) len = 3, cp = c & 0x0f;
-    else if (c >= 0xf0 && c <= 0xf4) len = 4, cp = c & 0x07;
-    bool valid = len > 0 && i + len <= n;
-    for (std::size_t k = 1; valid && k < len; ++k) {
-      if ((s[i + k] & 0xc0) != 0x80) valid = false;
-      cp = (cp << 6) | (s[i + k] & 0x3f);
-    }
-    if (valid && ((len == 3 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) || (len == 4 && (cp < 0x10000 || cp > 0x10ffff))))
-      valid = false;
-    if (valid) {
-      out.append(text, i, len);
-      i += len;
-    } else {
-      out += "\xef\xbf\xbd";  // U+FFFD for the one byte that does not start a valid sequence
-      ++i;
-    }
-  }
-  return out + "\"";
+  return nlohmann::json(text).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::string format_log_line(LogFormat format, const std::string& process, std::uint32_t agent_id, long pid,
                             std::chrono::system_clock::time_point time, const std::string& level,
                             const std::string& message) {
-  if (format == LogFormat::kJson)
-    return "{\"time\":\"" + utc_time(time) + "\",\"level\":" + json_string(level) + ",\"process\":" +
-           json_string(process) + ",\"agent_id\":" + (agent_id == 0 ? std::string("null") : std::to_string(agent_id)) +
-           ",\"pid\":" + std::to_string(pid) + ",\"msg\":" + json_string(message) + "}";
-  std::string who = process;
-  if (agent_id != 0) who += "-" + std::to_string(agent_id);
-  std::string padded = level;
-  if (padded.size() < 5) padded.resize(5, ' ');
-  return utc_time(time) + " " + padded + " " + who + "[" + std::to_string(pid) + "]: " + message;
+  if (format == LogFormat::kJson) {
+    const nlohmann::ordered_json record = {{"time", utc_time(time)},
+                                           {"level", level},
+                                           {"process", process},
+                                           {"agent_id", agent_id == 0 ? nlohmann::ordered_json() : nlohmann::ordered_json(agent_id)},
+                                           {"pid", pid},
+                                           {"msg", message}};
+    return record.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+  }
+  const std::string who = agent_id == 0 ? process : fmt::format("{}-{}", process, agent_id);
+  return fmt::format("{} {:<5} {}[{}]: {}", utc_time(time), level, who, pid, message);
 }
 
 void write_exit_error(std::ostream& err, const std::string& text) {

@@ -70,8 +70,8 @@ std::string format_log_line(LogFormat format, const std::string& process, std::u
                             std::chrono::system_clock::time_point time, const std::string& level,
                             const std::string& message);
 
-/// `text` with every byte that is not part of valid UTF-8 replaced by U+FFFD, escaped as a JSON string (quotes
-/// included).
+/// `text` as a JSON string (quotes included), written by nlohmann::json as every machine output of the project is,
+/// with each invalid UTF-8 sequence replaced by U+FFFD.
 std::string json_string(const std::string& text);
 
 /// Writes the program's last line on an error: `text` and a newline in text format; in json a record at level error

@@ -38,6 +38,13 @@ TEST(JsonString, EscapesControlsAndReplacesInvalidUtf8) {
   EXPECT_EQ(json_string("caf\xc3\xa9"), "\"caf\xc3\xa9\"");          // valid UTF-8 kept
   EXPECT_EQ(json_string("bad\xff!"), "\"bad\xef\xbf\xbd!\"");          // a stray byte becomes U+FFFD
   EXPECT_EQ(json_string("\xc0\xaf"), "\"\xef\xbf\xbd\xef\xbf\xbd\"");  // an overlong form too
+  EXPECT_EQ(json_string("\xe2\x82x"), "\"\xef\xbf\xbdx\"");             // a cut sequence is one U+FFFD
+}
+
+TEST(LogLine, JsonReplacesInvalidUtf8InTheMessage) {
+  EXPECT_EQ(format_log_line(LogFormat::kJson, "monitor", 0, 7, kTime, "warn", "run \xff\t"),
+            "{\"time\":\"2026-11-24T06:26:08.123Z\",\"level\":\"warn\",\"process\":\"monitor\",\"agent_id\":null,"
+            "\"pid\":7,\"msg\":\"run \xef\xbf\xbd\\t\"}");
 }
 
 TEST(Logging, JsonRecordsGoToTheStreamAndTheScopeRestoresTheLogger) {
