@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
-#include <iomanip>
 #include <map>
 #include <optional>
 #include <ostream>
@@ -12,6 +12,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "marsala/cli/command_line.hpp"
 #include "marsala/core/deposition.hpp"
@@ -61,11 +63,8 @@ Heightmap mask_as_heights(const CellMask& mask, const GridGeometry& geometry) {
 
 long long count(const CellMask& mask) { return mask.cast<long long>().sum(); }
 
-std::string percent(long long part, long long whole) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(1) << (whole > 0 ? 100.0 * part / whole : 0.0) << "%";
-  return s.str();
-}
+/// `part` of `whole` in percent, one decimal.
+double percent(long long part, long long whole) { return whole > 0 ? 100.0 * part / whole : 0.0; }
 
 /// The whole of `text` as a number (std::stod, nothing left over), or nullopt.
 std::optional<double> parse_number(const std::string& text) {
@@ -85,24 +84,23 @@ std::map<std::string, double> parse_params(const std::vector<std::string>& pairs
   std::map<std::string, double> params;
   for (const std::string& pair : pairs) {
     const auto eq = pair.find('=');
-    if (eq == std::string::npos || eq == 0) throw UsageError("--param expects KEY=VALUE, got '" + pair + "'");
+    if (eq == std::string::npos || eq == 0) throw UsageError(fmt::format("--param expects KEY=VALUE, got '{}'", pair));
     const std::string key = pair.substr(0, eq);
     const std::string text = pair.substr(eq + 1);
     const std::optional<double> value = parse_number(text);
-    if (!value) throw UsageError("--param " + key + ": '" + text + "' is not a number");
-    if (!params.emplace(key, *value).second) throw UsageError("--param " + key + " is given twice");
+    if (!value) throw UsageError(fmt::format("--param {}: '{}' is not a number", key, text));
+    if (!params.emplace(key, *value).second) throw UsageError(fmt::format("--param {} is given twice", key));
   }
   return params;
 }
 
 std::string methods_help() {
-  std::ostringstream s;
-  s << "Methods and their --param keys:\n";
+  std::string help = "Methods and their --param keys:\n";
   for (const std::string& name : terrain::generator_names()) {
-    s << "  " << name << "\n";
-    for (const std::string& line : terrain::generator_parameter_help(name)) s << "    " << line << "\n";
+    help += fmt::format("  {}\n", name);
+    for (const std::string& line : terrain::generator_parameter_help(name)) help += fmt::format("    {}\n", line);
   }
-  return s.str();
+  return help;
 }
 
 /// Adds --kappa/--eps/--delta with range checks to a subcommand.
@@ -138,7 +136,7 @@ struct RouteQuery {
 /// The routes of --pairs FILE: one "FROM_X FROM_Y TO_X TO_Y" per line [m]; blank lines and '#' comments skipped.
 std::vector<RouteQuery> read_route_pairs(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw UsageError("--pairs " + path + ": cannot be read");
+  if (!in) throw UsageError(fmt::format("--pairs {}: cannot be read", path));
   std::vector<RouteQuery> queries;
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
@@ -158,18 +156,18 @@ std::vector<RouteQuery> read_route_pairs(const std::string& path) {
       throw UsageError(fmt::format("{}:{}: expected FROM_X FROM_Y TO_X TO_Y, got {} numbers", path, number, v.size()));
     queries.push_back({{v[0], v[1]}, {v[2], v[3]}});
   }
-  if (queries.empty()) throw UsageError("--pairs " + path + " holds no route");
+  if (queries.empty()) throw UsageError(fmt::format("--pairs {} holds no route", path));
   return queries;
 }
 
 /// The cell under a point given on the command line; off the terrain or not finite is a usage error.
 CellIndex cell_under(const Heightmap& map, Position p, const std::string& what) {
   if (!std::isfinite(p.x) || !std::isfinite(p.y))
-    throw UsageError(fmt::format("{} ({}, {}) m is not a finite point", what, p.x, p.y));
+    throw UsageError(fmt::format("{} {} is not a finite point", what, p));
   const auto cell = map.cell_at(p);
   if (!cell) {
     const auto& g = map.geometry();
-    throw UsageError(fmt::format("{} ({}, {}) m is off the terrain (x {} .. {} m, y {} .. {} m)", what, p.x, p.y,
+    throw UsageError(fmt::format("{} {} is off the terrain (x {} .. {} m, y {} .. {} m)", what, p,
                                  g.xll_m, g.xll_m + g.cols * g.cell_size_m, g.yll_m, g.yll_m + g.rows * g.cell_size_m));
   }
   return *cell;
@@ -211,10 +209,504 @@ Eigen::MatrixXi component_labels(const CellMask& mask) {
   return label;
 }
 
-/// The shortest text that reads back as v (cell centres such as 206.125 m stay exact in --json).
-std::string shortest(double v) { return fmt::format("{}", v); }
+/// The value `v` printed with `digits` decimals has (machine outputs keep the precision their text always had).
+double rounded(double v, int digits) { return std::strtod(fmt::format("{:.{}f}", v, digits).c_str(), nullptr); }
 
-std::string fixed(double v, int digits) { return fmt::format("{:.{}f}", v, digits); }
+/// Adds the input terrain argument every subcommand that reads one has.
+void add_input(CLI::App& cmd, std::string& path, const std::string& help = "input .asc or .tif") {
+  cmd.add_option("input", path, help)->required()->check(CLI::ExistingFile);
+}
+
+/// Adds --fill-nodata.
+void add_fill_nodata(CLI::App& cmd, bool& fill, const char* help = "fill NODATA cells instead of failing") {
+  cmd.add_flag("--fill-nodata", fill, help);
+}
+
+/// How import and route prepare a terrain: import_terrain()'s crop (X0 Y0 W H [m], or empty), cell size [m] (0: as
+/// read) and zero base.
+struct TerrainPreparation {
+  std::vector<double> crop;
+  double cell_size_m = 0.0;
+  bool zero_base = false;
+};
+
+// generate
+
+struct GenerateCommand {
+  CLI::App* cmd = nullptr;
+  terrain::GeneratorSpec spec;
+  std::string method;
+  std::string out_path;
+  std::vector<std::string> param_pairs;
+};
+
+void define_generate(CLI::App& app, GenerateCommand& c) {
+  c.cmd = app.add_subcommand("generate", "generate a seeded, deterministic terrain");
+  c.cmd->add_option("--method", c.method, "generator name (see below)")->required();
+  c.cmd->add_option("--seed", c.spec.seed, "random seed")->capture_default_str();
+  c.cmd->add_option("--rows", c.spec.rows, "rows")->required()->check(CLI::Range(1, 1 << 16));
+  c.cmd->add_option("--cols", c.spec.cols, "columns")->required()->check(CLI::Range(1, 1 << 16));
+  c.cmd->add_option("--cell-size", c.spec.cell_size_m, "cell size [m]")->required()->check(CLI::PositiveNumber);
+  c.cmd->add_option("--param", c.param_pairs, "method parameter KEY=VALUE (repeatable)");
+  c.cmd->add_option("-o,--output", c.out_path, "output .asc")->required();
+  c.cmd->footer(methods_help());
+}
+
+void run_generate(GenerateCommand& c, std::ostream& out) {
+  c.spec.params = parse_params(c.param_pairs);
+  Heightmap map;
+  try {
+    map = terrain::generate_terrain(c.method, c.spec);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());  // unknown method or parameter: the command line is wrong
+  }
+  terrain::write_asc(map, c.out_path);
+  out << fmt::format("generated {} {} x {} at {:.6g} m, heights {:.6g} .. {:.6g} m -> {}\n", c.method, map.rows(),
+                     map.cols(), map.cell_size_m(), map.min_height(), map.max_height(), c.out_path);
+}
+
+// import
+
+struct ImportCommand {
+  CLI::App* cmd = nullptr;
+  std::string in_path;
+  std::string out_path;
+  TerrainPreparation preparation;
+  bool fill_nodata = false;
+};
+
+void define_import(CLI::App& app, ImportCommand& c) {
+  c.cmd = app.add_subcommand("import", "import a GeoTIFF (or .asc) with optional crop and resampling");
+  add_input(*c.cmd, c.in_path, "input .tif/.tiff or .asc");
+  c.cmd->add_option("-o,--output", c.out_path, "output .asc")->required();
+  c.cmd->add_option("--crop", c.preparation.crop, "crop X0 Y0 W H [m], in the imported local frame (lower-left = 0, 0)")
+      ->expected(4);
+  c.cmd->add_option("--cell-size", c.preparation.cell_size_m, "resample bilinearly to this cell size [m]")
+      ->check(CLI::PositiveNumber);
+  add_fill_nodata(*c.cmd, c.fill_nodata, "fill NODATA cells from their valid neighbours instead of failing");
+  c.cmd->add_flag("--zero-base", c.preparation.zero_base, "shift heights so that the lowest cell is at 0 m");
+}
+
+void run_import(const ImportCommand& c, std::ostream& out) {
+  const TerrainPreparation& p = c.preparation;
+  const Heightmap map = import_terrain(load_terrain(c.in_path, c.fill_nodata), p.crop, p.cell_size_m, p.zero_base);
+  // The written grid starts its own local frame at (0, 0).
+  GridGeometry local = map.geometry();
+  local.xll_m = 0.0;
+  local.yll_m = 0.0;
+  terrain::write_asc(Heightmap(local, map.heights()), c.out_path);
+  out << fmt::format("imported {}: {} x {} at {:.6g} m -> {}\n", c.in_path, map.rows(), map.cols(), map.cell_size_m(),
+                     c.out_path);
+}
+
+// info
+
+struct InfoCommand {
+  CLI::App* cmd = nullptr;
+  std::string in_path;
+  bool fill_nodata = false;
+};
+
+void define_info(CLI::App& app, InfoCommand& c) {
+  c.cmd = app.add_subcommand("info", "print size, cell size, extent, height range and mean slope");
+  add_input(*c.cmd, c.in_path);
+  add_fill_nodata(*c.cmd, c.fill_nodata);
+}
+
+void run_info(const InfoCommand& c, std::ostream& out) {
+  const Heightmap map = load_terrain(c.in_path, c.fill_nodata);
+  const terrain::TerrainStats s = terrain::compute_terrain_stats(map);
+  const auto& g = map.geometry();
+  // Six significant digits: a summary for people.
+  out << fmt::format(
+      "file        {}\n"
+      "size        {} rows x {} cols ({} cells)\n"
+      "cell size   {:.6g} m\n"
+      "extent      x {:.6g} .. {:.6g} m, y {:.6g} .. {:.6g} m ({:.6g} x {:.6g} m)\n"
+      "height      {:.6g} .. {:.6g} m (mean {:.6g} m, relief {:.6g} m)\n"
+      "mean slope  {:.6g} (rise over run; max {:.6g})\n",
+      c.in_path, s.rows, s.cols, map.size(), s.cell_size_m, g.xll_m, g.xll_m + s.width_m, g.yll_m,
+      g.yll_m + s.height_m, s.width_m, s.height_m, s.min_height_m, s.max_height_m, s.mean_height_m,
+      s.max_height_m - s.min_height_m, s.mean_slope, s.max_slope);
+}
+
+// mars
+
+struct MarsCommand {
+  CLI::App* cmd = nullptr;
+  std::string in_path;
+  std::string out_path;
+  double kappa = 0.0;
+  bool write_gap = false;
+  bool fill_nodata = false;
+};
+
+void define_mars(CLI::App& app, MarsCommand& c) {
+  c.cmd = app.add_subcommand("mars", "write the MARS bound P_kappa[h] (or, with --gap, the MARS gap)");
+  add_input(*c.cmd, c.in_path);
+  c.cmd->add_option("--kappa", c.kappa, "maximum climbable slope, rise over run [m/m]")
+      ->required()
+      ->check(CLI::PositiveNumber);
+  c.cmd->add_option("-o,--output", c.out_path, "output .asc")->required();
+  c.cmd->add_flag("--gap", c.write_gap, "write the gap P_kappa[h] - h instead of P_kappa[h]");
+  add_fill_nodata(*c.cmd, c.fill_nodata);
+}
+
+void run_mars(const MarsCommand& c, std::ostream& out) {
+  const Heightmap map = load_terrain(c.in_path, c.fill_nodata);
+  const MarsProcessor processor(c.kappa);
+  const Heightmap bound = processor.project(map);
+  const Heightmap gap(map.geometry(), (bound.heights() - map.heights()).eval());
+  terrain::write_asc(c.write_gap ? gap : bound, c.out_path);
+  out << fmt::format("MARS at kappa {:.6g}: gap volume {:.6g} m^3, largest gap {:.6g} m -> {}\n", c.kappa,
+                     deposition_target_volume(gap), gap.max_height(), c.out_path);
+}
+
+// navigable
+
+struct NavigableCommand {
+  CLI::App* cmd = nullptr;
+  std::string in_path;
+  std::string out_path;
+  NavigabilityParams params;
+  std::pair<int, int> origin{0, 0};
+  CLI::Option* origin_option = nullptr;
+  bool write_occupiable = false;
+  bool fill_nodata = false;
+};
+
+void define_navigable(CLI::App& app, NavigableCommand& c) {
+  c.cmd = app.add_subcommand("navigable", "write 1 for navigable cells, 0 otherwise");
+  add_input(*c.cmd, c.in_path);
+  add_navigability_options(*c.cmd, c.params, true);
+  c.origin_option = c.cmd->add_option("--origin-cell", c.origin, "origin cell ROW COL");
+  c.cmd->add_option("-o,--output", c.out_path, "output .asc")->required();
+  c.cmd->add_flag("--occupiable", c.write_occupiable, "write occupiability instead (no origin needed)");
+  add_fill_nodata(*c.cmd, c.fill_nodata);
+}
+
+void run_navigable(const NavigableCommand& c, std::ostream& out) {
+  const Heightmap map = load_terrain(c.in_path, c.fill_nodata);
+  const NavigabilityProcessor processor(c.params);
+  const CellMask occupiable = processor.occupiable(map);
+  const long long cells = map.size();
+  if (c.write_occupiable) {
+    terrain::write_asc(mask_as_heights(occupiable, map.geometry()), c.out_path);
+    out << fmt::format("occupiable {} of {} cells ({:.1f}%) -> {}\n", count(occupiable), cells,
+                       percent(count(occupiable), cells), c.out_path);
+    return;
+  }
+  if (c.origin_option->count() == 0) throw UsageError("navigable: --origin-cell ROW COL is required");
+  const CellIndex origin = to_cell(c.origin);
+  check_origin(map, origin);
+  const CellMask reach = NavigabilityProcessor::navigable_from(occupiable, origin);
+  terrain::write_asc(mask_as_heights(reach, map.geometry()), c.out_path);
+  out << fmt::format("navigable from {}: {} of {} cells ({:.1f}%); occupiable {} -> {}\n", origin, count(reach), cells,
+                     percent(count(reach), cells), count(occupiable), c.out_path);
+  if (count(reach) == 0) out << "note: the origin cell is not occupiable, so nothing is navigable\n";
+}
+
+// render
+
+struct RenderCommand {
+  CLI::App* cmd = nullptr;
+  std::string in_path;
+  std::string out_path;
+  std::vector<std::pair<int, int>> origins;
+  bool gap = false;
+  std::string title;
+  int max_size_px = 1024;
+  NavigabilityParams params;
+  bool fill_nodata = false;
+};
+
+void define_render(CLI::App& app, RenderCommand& c) {
+  c.cmd = app.add_subcommand("render", "write a hillshaded, colour-mapped PNG with optional overlays");
+  add_input(*c.cmd, c.in_path);
+  c.cmd->add_option("-o,--output", c.out_path, "output .png")->required();
+  c.cmd->add_option("--navigable-from", c.origins,
+                    "overlay the region navigable from ROW COL (repeatable; give the input file first)");
+  c.cmd->add_flag("--gap", c.gap, "overlay the MARS gap at --kappa");
+  add_navigability_options(*c.cmd, c.params, false);
+  c.cmd->add_option("--title", c.title, "title drawn above the picture");
+  c.cmd->add_option("--max-size", c.max_size_px, "longest side of the terrain picture [px]")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  add_fill_nodata(*c.cmd, c.fill_nodata);
+}
+
+void run_render(const RenderCommand& c, std::ostream& out) {
+  const Heightmap map = load_terrain(c.in_path, c.fill_nodata);
+  render::RenderOptions options;
+  options.title = c.title;
+  options.max_size_px = c.max_size_px;
+  if (!c.origins.empty()) {
+    const NavigabilityProcessor processor(c.params);
+    const CellMask occupiable = processor.occupiable(map);
+    CellMask reach = CellMask::Zero(map.rows(), map.cols());
+    for (const auto& rc : c.origins) {
+      const CellIndex origin = to_cell(rc);
+      check_origin(map, origin);
+      reach = reach.cwiseMax(NavigabilityProcessor::navigable_from(occupiable, origin));
+      options.markers.push_back(origin);
+    }
+    options.navigable = reach;
+  }
+  if (c.gap) options.gap = MarsProcessor(c.params.kappa).gap(map);
+  render::write_png(render::render_terrain(map, options), c.out_path);
+  out << fmt::format("rendered {} x {} -> {}\n", map.rows(), map.cols(), c.out_path);
+}
+
+// render3d
+
+struct Render3dCommand {
+  CLI::App* cmd = nullptr;
+  std::string in_path;
+  std::string out_path;
+  render::PerspectiveOptions view;
+  std::string deposits_from;
+  std::pair<int, int> size{1200, 800};
+  bool fill_nodata = false;
+};
+
+void define_render3d(CLI::App& app, Render3dCommand& c) {
+  c.cmd = app.add_subcommand(
+      "render3d", "write a perspective view of a terrain (built material tinted with --deposits-from) as a PNG");
+  add_input(*c.cmd, c.in_path, "input .asc or .tif (e.g. a run's terrain_final.asc)");
+  c.cmd->add_option("-o,--output", c.out_path, "output .png")->required();
+  c.cmd
+      ->add_option("--deposits-from", c.deposits_from,
+                   "the terrain before construction (e.g. terrain_initial.asc): cells raised since are tinted")
+      ->check(CLI::ExistingFile);
+  c.cmd
+      ->add_option("--azimuth", c.view.azimuth_deg,
+                   "where the camera stands, from the centre: 0 north, 90 east [deg]")
+      ->capture_default_str();
+  c.cmd->add_option("--elevation", c.view.elevation_deg, "camera height above the horizon, (0, 90] [deg]")
+      ->capture_default_str();
+  c.cmd->add_option("--exaggeration", c.view.vertical_exaggeration, "vertical exaggeration")->capture_default_str();
+  c.cmd->add_option("--size", c.size, "picture size WIDTH HEIGHT [px]")->capture_default_str();
+  c.cmd->add_option("--title", c.view.title, "title drawn in the top-left corner");
+  add_fill_nodata(*c.cmd, c.fill_nodata);
+}
+
+void run_render3d(Render3dCommand& c, std::ostream& out) {
+  const Heightmap map = load_terrain(c.in_path, c.fill_nodata);
+  double built_m3 = 0.0;
+  if (!c.deposits_from.empty()) {
+    const Heightmap before = load_terrain(c.deposits_from, c.fill_nodata);
+    if (before.rows() != map.rows() || before.cols() != map.cols())
+      throw UsageError(fmt::format("--deposits-from {} is {} x {} cells, {} {} x {}", c.deposits_from, before.rows(),
+                                   before.cols(), c.in_path, map.rows(), map.cols()));
+    Heightmap deposit(map.geometry());
+    for (int r = 0; r < map.rows(); ++r)
+      for (int col = 0; col < map.cols(); ++col) {
+        deposit(r, col) = std::max(0.0, map(r, col) - before(r, col));
+        built_m3 += deposit(r, col) * map.cell_size_m() * map.cell_size_m();
+      }
+    c.view.deposit = std::move(deposit);
+  }
+  c.view.width_px = c.size.first;
+  c.view.height_px = c.size.second;
+  render::write_png(render::render_perspective(map, c.view), c.out_path);
+  const std::string built = c.view.deposit ? fmt::format(" ({:.6g} m^3 built, tinted)", built_m3) : std::string();
+  out << fmt::format("rendered a perspective view of {} x {} cells{} -> {}\n", map.rows(), map.cols(), built,
+                     c.out_path);
+}
+
+// route
+
+struct RouteCommand {
+  CLI::App* cmd = nullptr;
+  std::string in_path;
+  TerrainPreparation preparation;
+  bool fill_nodata = false;
+  NavigabilityParams payload;
+  std::pair<double, double> from{0.0, 0.0};
+  std::pair<double, double> to{0.0, 0.0};
+  CLI::Option* from_option = nullptr;
+  CLI::Option* to_option = nullptr;
+  std::string pairs_path;
+  double build_kappa = 0.0;
+  double band_width_m = 0.0;
+  double local_radius_m = 0.0;
+  double min_depth_m = 0.0;
+  double min_natural_m = -1.0;
+  bool json = false;
+};
+
+void define_route(CLI::App& app, RouteCommand& c) {
+  c.cmd = app.add_subcommand(
+      "route",
+      "plan the route builders would build for a payload (planner priced by the MARS gap, paper eq. 4-5) and list "
+      "the construction sites along it");
+  add_input(*c.cmd, c.in_path);
+  c.cmd->add_option("--crop", c.preparation.crop, "crop X0 Y0 W H [m] in the input's frame (as a scenario's terrain.crop)")
+      ->expected(4);
+  c.cmd->add_option("--cell-size", c.preparation.cell_size_m, "resample bilinearly to this cell size [m]")
+      ->check(CLI::PositiveNumber);
+  c.cmd->add_flag("--zero-base", c.preparation.zero_base, "shift heights so that the lowest cell is at 0 m");
+  add_fill_nodata(*c.cmd, c.fill_nodata);
+  add_navigability_options(*c.cmd, c.payload, true);
+  c.from_option =
+      c.cmd->add_option("--from", c.from, "where the route starts, X Y [m] in the terrain's frame (the base)");
+  c.to_option = c.cmd->add_option("--to", c.to, "where it ends, X Y [m] (the target)");
+  c.cmd->add_option("--pairs", c.pairs_path, "plan every route of FILE instead: one 'FROM_X FROM_Y TO_X TO_Y' a line")
+      ->check(CLI::ExistingFile);
+  c.cmd->add_option("--construction-kappa", c.build_kappa, "slope the builders build to [m/m] (default: --kappa)")
+      ->check(CLI::PositiveNumber);
+  c.cmd->add_option("--width", c.band_width_m, "construction band width [m] (default: --delta)")
+      ->check(CLI::PositiveNumber);
+  c.cmd
+      ->add_option("--min-depth", c.min_depth_m,
+                   "a route cell needs construction when its MARS gap is at least this [m], e.g. one cube layer")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  c.cmd
+      ->add_option("--min-natural", c.min_natural_m,
+                   "natural ground shorter than this does not separate two sites [m] (default: --delta)")
+      ->check(CLI::NonNegativeNumber);
+  c.cmd
+      ->add_option("--local-radius", c.local_radius_m,
+                   "take each cell's MARS bound over the square of this half-side around it only, as a builder's local "
+                   "map of its sensing range does [m]; 0: the whole terrain")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  c.cmd->add_flag("--json", c.json, "print JSON instead of text");
+}
+
+/// The routes the command line asks for: --pairs FILE, or --from and --to.
+std::vector<RouteQuery> route_queries(const RouteCommand& c) {
+  if (!c.pairs_path.empty()) {
+    if (c.from_option->count() > 0 || c.to_option->count() > 0)
+      throw UsageError("route: give either --pairs or --from and --to, not both");
+    return read_route_pairs(c.pairs_path);
+  }
+  if (c.from_option->count() == 0 || c.to_option->count() == 0)
+    throw UsageError("route: --from X Y and --to X Y (or --pairs FILE) are required");
+  return {{{c.from.first, c.from.second}, {c.to.first, c.to.second}}};
+}
+
+/// One planned route with what the payload can do at its ends.
+struct PlannedRoute {
+  Position from, to;  ///< centres of the end cells [m]
+  RouteSites sites;
+  int from_region = 0, to_region = 0;  ///< payload regions of the ends (component_labels); 0: not occupiable
+  bool from_occupiable() const { return from_region != 0; }
+  bool to_occupiable() const { return to_region != 0; }
+  bool navigable_now() const { return from_region != 0 && from_region == to_region; }
+};
+
+/// The route as text for people: head line, one line per site, the payload's ends.
+std::string route_text(const PlannedRoute& p, const RouteSiteParams& site_params, double site_kappa,
+                       double local_radius_m) {
+  const RouteSites& r = p.sites;
+  const std::string bound = local_radius_m > 0.0 ? fmt::format(", bound within {} m", local_radius_m) : std::string();
+  std::string text =
+      fmt::format("route {} -> {}: length {:.2f} m, MARS gap {:.2f} m^3 over a {:.6g} m band (kappa {:.6g}{}), {} "
+                  "construction site{}\n",
+                  p.from, p.to, r.length_m, r.band_volume_m3, site_params.width_m, site_kappa, bound, r.sites.size(),
+                  r.sites.size() == 1 ? "" : "s");
+  for (std::size_t k = 0; k < r.sites.size(); ++k)
+    text += fmt::format("  site {}: {:.2f} .. {:.2f} m along, {:.2f} m^3, deepest gap {:.2f} m\n", k + 1,
+                        r.sites[k].from_m, r.sites[k].to_m, r.sites[k].volume_m3, r.sites[k].max_gap_m);
+  text += fmt::format("  payload: from {} (gap {:.3f} m), to {} (gap {:.3f} m), {} from one to the other\n",
+                      p.from_occupiable() ? "occupiable" : "NOT occupiable", r.from_gap_m,
+                      p.to_occupiable() ? "occupiable" : "NOT occupiable", r.to_gap_m,
+                      p.navigable_now() ? "already navigable" : "not navigable");
+  return text;
+}
+
+/// The route as a JSON object (route --json; deploy/search_routes.py reads it). Lengths, volumes and gaps keep the
+/// decimals the text gives them.
+nlohmann::ordered_json route_json(const PlannedRoute& p) {
+  const RouteSites& r = p.sites;
+  nlohmann::ordered_json sites = nlohmann::ordered_json::array();
+  for (const RouteSite& s : r.sites)
+    sites.push_back({{"from_m", rounded(s.from_m, 3)},
+                     {"to_m", rounded(s.to_m, 3)},
+                     {"volume_m3", rounded(s.volume_m3, 3)},
+                     {"max_gap_m", rounded(s.max_gap_m, 3)}});
+  return {{"from", {p.from.x, p.from.y}},
+          {"to", {p.to.x, p.to.y}},
+          {"length_m", rounded(r.length_m, 3)},
+          {"volume_m3", rounded(r.band_volume_m3, 3)},
+          {"band_cells", r.band_cells},
+          {"from_occupiable", p.from_occupiable()},
+          {"to_occupiable", p.to_occupiable()},
+          {"from_region", p.from_region},
+          {"to_region", p.to_region},
+          {"navigable_now", p.navigable_now()},
+          {"from_gap_m", rounded(r.from_gap_m, 4)},
+          {"to_gap_m", rounded(r.to_gap_m, 4)},
+          {"sites", std::move(sites)}};
+}
+
+void run_route(const RouteCommand& c, std::ostream& out) {
+  const std::vector<RouteQuery> queries = route_queries(c);
+  const TerrainPreparation& prep = c.preparation;
+  const Heightmap map =
+      import_terrain(load_terrain(c.in_path, c.fill_nodata), prep.crop, prep.cell_size_m, prep.zero_base);
+  std::vector<std::pair<CellIndex, CellIndex>> cells;
+  for (std::size_t i = 0; i < queries.size(); ++i) {
+    const std::string which = queries.size() > 1 ? fmt::format(" (route {})", i + 1) : std::string();
+    cells.push_back({cell_under(map, queries[i].from, fmt::format("--from{}", which)),
+                     cell_under(map, queries[i].to, fmt::format("--to{}", which))});
+  }
+  RouteSiteParams site_params;
+  const double site_kappa = c.build_kappa > 0.0 ? c.build_kappa : c.payload.kappa;
+  site_params.width_m = c.band_width_m > 0.0 ? c.band_width_m : c.payload.delta_m;
+  site_params.min_depth_m = c.min_depth_m;
+  site_params.min_natural_m = c.min_natural_m >= 0.0 ? c.min_natural_m : c.payload.delta_m;
+  const Heightmap gap = route_gap(map, site_kappa, c.local_radius_m);
+  const Eigen::MatrixXi region = component_labels(NavigabilityProcessor(c.payload).occupiable(map));
+  nlohmann::ordered_json routes = nlohmann::ordered_json::array();
+  for (const auto& [from, to] : cells) {
+    const PlannedRoute planned{map.cell_center(from), map.cell_center(to),
+                               plan_route_sites(gap, from, to, site_params), region(from.row, from.col),
+                               region(to.row, to.col)};
+    if (c.json)
+      routes.push_back(route_json(planned));
+    else
+      out << route_text(planned, site_params, site_kappa, c.local_radius_m);
+  }
+  if (!c.json) return;
+  const GridGeometry& g = map.geometry();
+  const nlohmann::ordered_json doc = {
+      {"terrain",
+       {{"rows", g.rows}, {"cols", g.cols}, {"cell_size_m", g.cell_size_m}, {"xll_m", g.xll_m}, {"yll_m", g.yll_m}}},
+      {"construction_kappa", site_kappa},
+      {"local_radius_m", c.local_radius_m},
+      {"width_m", site_params.width_m},
+      {"min_depth_m", site_params.min_depth_m},
+      {"min_natural_m", site_params.min_natural_m},
+      {"routes", std::move(routes)}};
+  out << doc.dump() << "\n";
+}
+
+/// Every subcommand, defined on one CLI::App (which keeps pointers into this struct: it must not move).
+struct TerrainCommands {
+  GenerateCommand generate;
+  ImportCommand import;
+  InfoCommand info;
+  MarsCommand mars;
+  NavigableCommand navigable;
+  RenderCommand render;
+  Render3dCommand render3d;
+  RouteCommand route;
+};
+
+/// Runs the subcommand the command line chose.
+void run_chosen(TerrainCommands& c, std::ostream& out) {
+  if (*c.generate.cmd) run_generate(c.generate, out);
+  else if (*c.import.cmd) run_import(c.import, out);
+  else if (*c.info.cmd) run_info(c.info, out);
+  else if (*c.mars.cmd) run_mars(c.mars, out);
+  else if (*c.navigable.cmd) run_navigable(c.navigable, out);
+  else if (*c.render.cmd) run_render(c.render, out);
+  else if (*c.route.cmd) run_route(c.route, out);
+  else if (*c.render3d.cmd) run_render3d(c.render3d, out);
+}
 
 }  // namespace
 
@@ -225,334 +717,24 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
       "marsala-terrain"};
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "help for every subcommand");
-
-  // generate
-  terrain::GeneratorSpec spec;
-  std::string method;
-  std::string out_path;
-  std::vector<std::string> param_pairs;
-  auto* generate = app.add_subcommand("generate", "generate a seeded, deterministic terrain");
-  generate->add_option("--method", method, "generator name (see below)")->required();
-  generate->add_option("--seed", spec.seed, "random seed")->capture_default_str();
-  generate->add_option("--rows", spec.rows, "rows")->required()->check(CLI::Range(1, 1 << 16));
-  generate->add_option("--cols", spec.cols, "columns")->required()->check(CLI::Range(1, 1 << 16));
-  generate->add_option("--cell-size", spec.cell_size_m, "cell size [m]")->required()->check(CLI::PositiveNumber);
-  generate->add_option("--param", param_pairs, "method parameter KEY=VALUE (repeatable)");
-  generate->add_option("-o,--output", out_path, "output .asc")->required();
-  generate->footer(methods_help());
-
-  // import
-  std::string in_path;
-  std::vector<double> crop;
-  double target_cell_size = 0.0;
-  bool fill_nodata = false;
-  bool zero_base = false;
-  auto* import = app.add_subcommand("import", "import a GeoTIFF (or .asc) with optional crop and resampling");
-  import->add_option("input", in_path, "input .tif/.tiff or .asc")->required()->check(CLI::ExistingFile);
-  import->add_option("-o,--output", out_path, "output .asc")->required();
-  import->add_option("--crop", crop, "crop X0 Y0 W H [m], in the imported local frame (lower-left = 0, 0)")
-      ->expected(4);
-  import->add_option("--cell-size", target_cell_size, "resample bilinearly to this cell size [m]")
-      ->check(CLI::PositiveNumber);
-  import->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells from their valid neighbours instead of failing");
-  import->add_flag("--zero-base", zero_base, "shift heights so that the lowest cell is at 0 m");
-
-  // info
-  auto* info = app.add_subcommand("info", "print size, cell size, extent, height range and mean slope");
-  info->add_option("input", in_path, "input .asc or .tif")->required()->check(CLI::ExistingFile);
-  info->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
-
-  // mars
-  double kappa = 0.0;
-  bool write_gap = false;
-  auto* mars = app.add_subcommand("mars", "write the MARS bound P_kappa[h] (or, with --gap, the MARS gap)");
-  mars->add_option("input", in_path, "input .asc or .tif")->required()->check(CLI::ExistingFile);
-  mars->add_option("--kappa", kappa, "maximum climbable slope, rise over run [m/m]")
-      ->required()
-      ->check(CLI::PositiveNumber);
-  mars->add_option("-o,--output", out_path, "output .asc")->required();
-  mars->add_flag("--gap", write_gap, "write the gap P_kappa[h] - h instead of P_kappa[h]");
-  mars->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
-
-  // navigable
-  NavigabilityParams nav_params;
-  std::pair<int, int> origin{0, 0};
-  bool write_occupiable = false;
-  auto* navigable = app.add_subcommand("navigable", "write 1 for navigable cells, 0 otherwise");
-  navigable->add_option("input", in_path, "input .asc or .tif")->required()->check(CLI::ExistingFile);
-  add_navigability_options(*navigable, nav_params, true);
-  auto* origin_option = navigable->add_option("--origin-cell", origin, "origin cell ROW COL");
-  navigable->add_option("-o,--output", out_path, "output .asc")->required();
-  navigable->add_flag("--occupiable", write_occupiable, "write occupiability instead (no origin needed)");
-  navigable->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
-
-  // render
-  std::vector<std::pair<int, int>> render_origins;
-  bool render_gap = false;
-  std::string title;
-  int max_size_px = 1024;
-  NavigabilityParams render_params;
-  auto* render = app.add_subcommand("render", "write a hillshaded, colour-mapped PNG with optional overlays");
-  render->add_option("input", in_path, "input .asc or .tif")->required()->check(CLI::ExistingFile);
-  render->add_option("-o,--output", out_path, "output .png")->required();
-  render->add_option("--navigable-from", render_origins,
-                     "overlay the region navigable from ROW COL (repeatable; give the input file first)");
-  render->add_flag("--gap", render_gap, "overlay the MARS gap at --kappa");
-  add_navigability_options(*render, render_params, false);
-  render->add_option("--title", title, "title drawn above the picture");
-  render->add_option("--max-size", max_size_px, "longest side of the terrain picture [px]")
-      ->check(CLI::Range(16, 8192))
-      ->capture_default_str();
-  render->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
-
-  // render3d
-  render::PerspectiveOptions view;
-  std::string deposits_from;
-  std::pair<int, int> view_size{1200, 800};
-  auto* render3d = app.add_subcommand(
-      "render3d", "write a perspective view of a terrain (built material tinted with --deposits-from) as a PNG");
-  render3d->add_option("input", in_path, "input .asc or .tif (e.g. a run's terrain_final.asc)")
-      ->required()
-      ->check(CLI::ExistingFile);
-  render3d->add_option("-o,--output", out_path, "output .png")->required();
-  render3d
-      ->add_option("--deposits-from", deposits_from,
-                   "the terrain before construction (e.g. terrain_initial.asc): cells raised since are tinted")
-      ->check(CLI::ExistingFile);
-  render3d
-      ->add_option("--azimuth", view.azimuth_deg, "where the camera stands, from the centre: 0 north, 90 east [deg]")
-      ->capture_default_str();
-  render3d->add_option("--elevation", view.elevation_deg, "camera height above the horizon, (0, 90] [deg]")
-      ->capture_default_str();
-  render3d->add_option("--exaggeration", view.vertical_exaggeration, "vertical exaggeration")->capture_default_str();
-  render3d->add_option("--size", view_size, "picture size WIDTH HEIGHT [px]")->capture_default_str();
-  render3d->add_option("--title", view.title, "title drawn in the top-left corner");
-  render3d->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
-
-  // route
-  std::pair<double, double> route_from{0.0, 0.0}, route_to{0.0, 0.0};
-  std::string pairs_path;
-  NavigabilityParams payload;
-  double build_kappa = 0.0, band_width = 0.0, local_radius = 0.0, min_depth = 0.0, min_natural = -1.0;
-  bool route_json = false;
-  auto* route = app.add_subcommand(
-      "route",
-      "plan the route builders would build for a payload (planner priced by the MARS gap, paper eq. 4-5) and list "
-      "the construction sites along it");
-  route->add_option("input", in_path, "input .asc or .tif")->required()->check(CLI::ExistingFile);
-  route->add_option("--crop", crop, "crop X0 Y0 W H [m] in the input's frame (as a scenario's terrain.crop)")
-      ->expected(4);
-  route->add_option("--cell-size", target_cell_size, "resample bilinearly to this cell size [m]")
-      ->check(CLI::PositiveNumber);
-  route->add_flag("--zero-base", zero_base, "shift heights so that the lowest cell is at 0 m");
-  route->add_flag("--fill-nodata", fill_nodata, "fill NODATA cells instead of failing");
-  add_navigability_options(*route, payload, true);
-  auto* from_option =
-      route->add_option("--from", route_from, "where the route starts, X Y [m] in the terrain's frame (the base)");
-  auto* to_option = route->add_option("--to", route_to, "where it ends, X Y [m] (the target)");
-  route->add_option("--pairs", pairs_path, "plan every route of FILE instead: one 'FROM_X FROM_Y TO_X TO_Y' a line")
-      ->check(CLI::ExistingFile);
-  route->add_option("--construction-kappa", build_kappa, "slope the builders build to [m/m] (default: --kappa)")
-      ->check(CLI::PositiveNumber);
-  route->add_option("--width", band_width, "construction band width [m] (default: --delta)")
-      ->check(CLI::PositiveNumber);
-  route
-      ->add_option("--min-depth", min_depth,
-                   "a route cell needs construction when its MARS gap is at least this [m], e.g. one cube layer")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  route
-      ->add_option("--min-natural", min_natural,
-                   "natural ground shorter than this does not separate two sites [m] (default: --delta)")
-      ->check(CLI::NonNegativeNumber);
-  route
-      ->add_option("--local-radius", local_radius,
-                   "take each cell's MARS bound over the square of this half-side around it only, as a builder's local "
-                   "map of its sensing range does [m]; 0: the whole terrain")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  route->add_flag("--json", route_json, "print JSON instead of text");
-
+  TerrainCommands commands;
+  define_generate(app, commands.generate);
+  define_import(app, commands.import);
+  define_info(app, commands.info);
+  define_mars(app, commands.mars);
+  define_navigable(app, commands.navigable);
+  define_render(app, commands.render);
+  define_render3d(app, commands.render3d);
+  define_route(app, commands.route);
   if (const auto code = parse_command_line(app, argc, argv, "marsala-terrain", out, err)) return *code;
 
   try {
-    if (*generate) {
-      spec.params = parse_params(param_pairs);
-      Heightmap map;
-      try {
-        map = terrain::generate_terrain(method, spec);
-      } catch (const InvalidArgument& e) {
-        throw UsageError(e.what());  // unknown method or parameter: the command line is wrong
-      }
-      terrain::write_asc(map, out_path);
-      out << "generated " << method << " " << map.rows() << " x " << map.cols() << " at " << map.cell_size_m()
-          << " m, heights " << map.min_height() << " .. " << map.max_height() << " m -> " << out_path << "\n";
-    } else if (*import) {
-      Heightmap map = import_terrain(load_terrain(in_path, fill_nodata), crop, target_cell_size, zero_base);
-      // The written grid starts its own local frame at (0, 0).
-      GridGeometry local = map.geometry();
-      local.xll_m = 0.0;
-      local.yll_m = 0.0;
-      terrain::write_asc(Heightmap(local, map.heights()), out_path);
-      out << "imported " << in_path << ": " << map.rows() << " x " << map.cols() << " at " << map.cell_size_m()
-          << " m -> " << out_path << "\n";
-    } else if (*info) {
-      const Heightmap map = load_terrain(in_path, fill_nodata);
-      const terrain::TerrainStats s = terrain::compute_terrain_stats(map);
-      const auto& g = map.geometry();
-      out << std::setprecision(6) << "file        " << in_path << "\n"
-          << "size        " << s.rows << " rows x " << s.cols << " cols (" << map.size() << " cells)\n"
-          << "cell size   " << s.cell_size_m << " m\n"
-          << "extent      x " << g.xll_m << " .. " << g.xll_m + s.width_m << " m, y " << g.yll_m << " .. "
-          << g.yll_m + s.height_m << " m (" << s.width_m << " x " << s.height_m << " m)\n"
-          << "height      " << s.min_height_m << " .. " << s.max_height_m << " m (mean " << s.mean_height_m
-          << " m, relief " << s.max_height_m - s.min_height_m << " m)\n"
-          << "mean slope  " << s.mean_slope << " (rise over run; max " << s.max_slope << ")\n";
-    } else if (*mars) {
-      const Heightmap map = load_terrain(in_path, fill_nodata);
-      const MarsProcessor processor(kappa);
-      const Heightmap bound = processor.project(map);
-      Heightmap gap(map.geometry(), (bound.heights() - map.heights()).eval());
-      terrain::write_asc(write_gap ? gap : bound, out_path);
-      out << "MARS at kappa " << kappa << ": gap volume " << deposition_target_volume(gap) << " m^3, largest gap "
-          << gap.max_height() << " m -> " << out_path << "\n";
-    } else if (*navigable) {
-      const Heightmap map = load_terrain(in_path, fill_nodata);
-      const NavigabilityProcessor processor(nav_params);
-      const CellMask occupiable = processor.occupiable(map);
-      if (write_occupiable) {
-        terrain::write_asc(mask_as_heights(occupiable, map.geometry()), out_path);
-        out << "occupiable " << count(occupiable) << " of " << map.size() << " cells ("
-            << percent(count(occupiable), map.size()) << ") -> " << out_path << "\n";
-      } else {
-        if (origin_option->count() == 0) throw UsageError("navigable: --origin-cell ROW COL is required");
-        check_origin(map, to_cell(origin));
-        const CellMask reach = NavigabilityProcessor::navigable_from(occupiable, to_cell(origin));
-        terrain::write_asc(mask_as_heights(reach, map.geometry()), out_path);
-        out << "navigable from (" << origin.first << ", " << origin.second << "): " << count(reach) << " of "
-            << map.size() << " cells (" << percent(count(reach), map.size()) << "); occupiable " << count(occupiable)
-            << " -> " << out_path << "\n";
-        if (count(reach) == 0) out << "note: the origin cell is not occupiable, so nothing is navigable\n";
-      }
-    } else if (*render) {
-      const Heightmap map = load_terrain(in_path, fill_nodata);
-      render::RenderOptions options;
-      options.title = title;
-      options.max_size_px = max_size_px;
-      if (!render_origins.empty()) {
-        const NavigabilityProcessor processor(render_params);
-        const CellMask occupiable = processor.occupiable(map);
-        CellMask reach = CellMask::Zero(map.rows(), map.cols());
-        for (const auto& rc : render_origins) {
-          const CellIndex origin_cell = to_cell(rc);
-          check_origin(map, origin_cell);
-          reach = reach.cwiseMax(NavigabilityProcessor::navigable_from(occupiable, origin_cell));
-          options.markers.push_back(origin_cell);
-        }
-        options.navigable = reach;
-      }
-      if (render_gap) options.gap = MarsProcessor(render_params.kappa).gap(map);
-      render::write_png(render::render_terrain(map, options), out_path);
-      out << "rendered " << map.rows() << " x " << map.cols() << " -> " << out_path << "\n";
-    } else if (*route) {
-      std::vector<RouteQuery> queries;
-      if (!pairs_path.empty()) {
-        if (from_option->count() > 0 || to_option->count() > 0)
-          throw UsageError("route: give either --pairs or --from and --to, not both");
-        queries = read_route_pairs(pairs_path);
-      } else {
-        if (from_option->count() == 0 || to_option->count() == 0)
-          throw UsageError("route: --from X Y and --to X Y (or --pairs FILE) are required");
-        queries.push_back({{route_from.first, route_from.second}, {route_to.first, route_to.second}});
-      }
-      Heightmap map = import_terrain(load_terrain(in_path, fill_nodata), crop, target_cell_size, zero_base);
-      std::vector<std::pair<CellIndex, CellIndex>> cells;
-      for (std::size_t i = 0; i < queries.size(); ++i) {
-        const std::string which = queries.size() > 1 ? fmt::format(" (route {})", i + 1) : std::string();
-        cells.push_back(
-            {cell_under(map, queries[i].from, "--from" + which), cell_under(map, queries[i].to, "--to" + which)});
-      }
-      RouteSiteParams site_params;
-      const double site_kappa = build_kappa > 0.0 ? build_kappa : payload.kappa;
-      site_params.width_m = band_width > 0.0 ? band_width : payload.delta_m;
-      site_params.min_depth_m = min_depth;
-      site_params.min_natural_m = min_natural >= 0.0 ? min_natural : payload.delta_m;
-      const Heightmap gap = route_gap(map, site_kappa, local_radius);
-      const Eigen::MatrixXi region = component_labels(NavigabilityProcessor(payload).occupiable(map));
-      const auto& g = map.geometry();
-      if (route_json)
-        out << "{\"terrain\":{\"rows\":" << g.rows << ",\"cols\":" << g.cols
-            << ",\"cell_size_m\":" << shortest(g.cell_size_m) << ",\"xll_m\":" << shortest(g.xll_m)
-            << ",\"yll_m\":" << shortest(g.yll_m) << "},\"construction_kappa\":" << site_kappa
-            << ",\"local_radius_m\":" << local_radius << ",\"width_m\":" << site_params.width_m
-            << ",\"min_depth_m\":" << site_params.min_depth_m << ",\"min_natural_m\":" << site_params.min_natural_m
-            << ",\"routes\":[";
-      for (std::size_t i = 0; i < queries.size(); ++i) {
-        const auto [from, to] = cells[i];
-        const RouteSites r = plan_route_sites(gap, from, to, site_params);
-        const Position a = map.cell_center(from), b = map.cell_center(to);
-        const int from_region = region(from.row, from.col), to_region = region(to.row, to.col);
-        const bool from_ok = from_region != 0, to_ok = to_region != 0;
-        const bool connected = from_ok && from_region == to_region;
-        if (route_json) {
-          out << (i > 0 ? "," : "") << "{\"from\":[" << shortest(a.x) << "," << shortest(a.y) << "],\"to\":["
-              << shortest(b.x) << "," << shortest(b.y) << "],\"length_m\":" << fixed(r.length_m, 3)
-              << ",\"volume_m3\":" << fixed(r.band_volume_m3, 3) << ",\"band_cells\":" << r.band_cells
-              << ",\"from_occupiable\":" << (from_ok ? "true" : "false")
-              << ",\"to_occupiable\":" << (to_ok ? "true" : "false") << ",\"from_region\":" << from_region
-              << ",\"to_region\":" << to_region << ",\"navigable_now\":" << (connected ? "true" : "false")
-              << ",\"from_gap_m\":" << fixed(r.from_gap_m, 4) << ",\"to_gap_m\":" << fixed(r.to_gap_m, 4)
-              << ",\"sites\":[";
-          for (std::size_t k = 0; k < r.sites.size(); ++k)
-            out << (k > 0 ? "," : "") << "{\"from_m\":" << fixed(r.sites[k].from_m, 3)
-                << ",\"to_m\":" << fixed(r.sites[k].to_m, 3) << ",\"volume_m3\":" << fixed(r.sites[k].volume_m3, 3)
-                << ",\"max_gap_m\":" << fixed(r.sites[k].max_gap_m, 3) << "}";
-          out << "]}";
-        } else {
-          out << "route (" << shortest(a.x) << ", " << shortest(a.y) << ") -> (" << shortest(b.x) << ", "
-              << shortest(b.y) << ") m: length " << fixed(r.length_m, 2) << " m, MARS gap "
-              << fixed(r.band_volume_m3, 2) << " m^3 over a " << site_params.width_m << " m band (kappa " << site_kappa
-              << (local_radius > 0.0 ? fmt::format(", bound within {} m", local_radius) : std::string()) << "), "
-              << r.sites.size() << " construction site" << (r.sites.size() == 1 ? "" : "s") << "\n";
-          for (std::size_t k = 0; k < r.sites.size(); ++k)
-            out << "  site " << k + 1 << ": " << fixed(r.sites[k].from_m, 2) << " .. " << fixed(r.sites[k].to_m, 2)
-                << " m along, " << fixed(r.sites[k].volume_m3, 2) << " m^3, deepest gap "
-                << fixed(r.sites[k].max_gap_m, 2) << " m\n";
-          out << "  payload: from " << (from_ok ? "occupiable" : "NOT occupiable") << " (gap " << fixed(r.from_gap_m, 3)
-              << " m), to " << (to_ok ? "occupiable" : "NOT occupiable") << " (gap " << fixed(r.to_gap_m, 3) << " m), "
-              << (connected ? "already navigable" : "not navigable") << " from one to the other\n";
-        }
-      }
-      if (route_json) out << "]}\n";
-    } else if (*render3d) {
-      const Heightmap map = load_terrain(in_path, fill_nodata);
-      double built_m3 = 0.0;
-      if (!deposits_from.empty()) {
-        const Heightmap before = load_terrain(deposits_from, fill_nodata);
-        if (before.rows() != map.rows() || before.cols() != map.cols())
-          throw UsageError("--deposits-from " + deposits_from + " is " + std::to_string(before.rows()) + " x " +
-                           std::to_string(before.cols()) + " cells, " + in_path + " " + std::to_string(map.rows()) +
-                           " x " + std::to_string(map.cols()));
-        Heightmap deposit(map.geometry());
-        for (int r = 0; r < map.rows(); ++r)
-          for (int c = 0; c < map.cols(); ++c) {
-            deposit(r, c) = std::max(0.0, map(r, c) - before(r, c));
-            built_m3 += deposit(r, c) * map.cell_size_m() * map.cell_size_m();
-          }
-        view.deposit = std::move(deposit);
-      }
-      view.width_px = view_size.first;
-      view.height_px = view_size.second;
-      render::write_png(render::render_perspective(map, view), out_path);
-      out << "rendered a perspective view of " << map.rows() << " x " << map.cols() << " cells";
-      if (view.deposit) out << " (" << built_m3 << " m^3 built, tinted)";
-      out << " -> " << out_path << "\n";
-    }
+    run_chosen(commands, out);
   } catch (const UsageError& e) {
-    err << "marsala-terrain: " << e.what() << " (run with --help for usage)\n";
+    err << fmt::format("marsala-terrain: {} (run with --help for usage)\n", e.what());
     return kExitUsage;
   } catch (const Error& e) {
-    err << "marsala-terrain: " << e.what() << "\n";
+    err << fmt::format("marsala-terrain: {}\n", e.what());
     return kExitData;
   } catch (const std::bad_alloc&) {
     err << "marsala-terrain: out of memory\n";

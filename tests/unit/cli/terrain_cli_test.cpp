@@ -1,5 +1,6 @@
 // Runs the real marsala-terrain binary: exit codes, messages, and the files it writes.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <sys/wait.h>
 
 #include <cmath>
@@ -162,13 +163,14 @@ TEST_F(TerrainCli, RouteFindsTheThreeRampsOfThreeCliffs) {
   EXPECT_NE(text.out.find("not navigable"), std::string::npos) << text.out;
   const CliRun json = run(args + " --json");
   ASSERT_EQ(json.exit_code, 0) << json.err;
-  EXPECT_NE(json.out.find("\"length_m\":51.000,\"volume_m3\":10.125"), std::string::npos) << json.out;
+  // Lengths, volumes and gaps keep the decimals of the text (3; gaps at the ends 4), as nlohmann::json writes them.
+  EXPECT_NE(json.out.find("\"length_m\":51.0,\"volume_m3\":10.125"), std::string::npos) << json.out;
   EXPECT_NE(json.out.find("{\"from\":[105.125,205.125],\"to\":[156.125,205.125],"), std::string::npos) << json.out;
   // Each terrace is its own payload region (labelled in row-major order of its first cell: west to east).
   EXPECT_NE(json.out.find("\"from_region\":1,\"to_region\":4,\"navigable_now\":false"), std::string::npos) << json.out;
-  for (const char* site : {"{\"from_m\":10.000,\"to_m\":13.500,\"volume_m3\":3.375,\"max_gap_m\":0.750}",
-                           "{\"from_m\":25.000,\"to_m\":28.500,\"volume_m3\":3.375,\"max_gap_m\":0.750}",
-                           "{\"from_m\":40.000,\"to_m\":43.500,\"volume_m3\":3.375,\"max_gap_m\":0.750}"})
+  for (const char* site : {"{\"from_m\":10.0,\"to_m\":13.5,\"volume_m3\":3.375,\"max_gap_m\":0.75}",
+                           "{\"from_m\":25.0,\"to_m\":28.5,\"volume_m3\":3.375,\"max_gap_m\":0.75}",
+                           "{\"from_m\":40.0,\"to_m\":43.5,\"volume_m3\":3.375,\"max_gap_m\":0.75}"})
     EXPECT_NE(json.out.find(site), std::string::npos) << site << "\n" << json.out;
   // Natural ground of 11.5 m between the ramps: asking for 12 m makes them one site; --pairs plans several routes.
   EXPECT_NE(run(args + " --min-natural 12").out.find("1 construction site\n  site 1: 10.00 .. 43.50 m along"),
@@ -177,7 +179,14 @@ TEST_F(TerrainCli, RouteFindsTheThreeRampsOfThreeCliffs) {
   const CliRun pairs =
       run("route " + path("cliffs.asc") + " --kappa 0.2 --delta 2 --eps 0.05 --json --pairs " + path("pairs.txt"));
   ASSERT_EQ(pairs.exit_code, 0) << pairs.err;
-  EXPECT_NE(pairs.out.find("\"length_m\":15.000,\"volume_m3\":3.375"), std::string::npos) << pairs.out;
+  EXPECT_NE(pairs.out.find("\"length_m\":15.0,\"volume_m3\":3.375"), std::string::npos) << pairs.out;
+  // One JSON document, as deploy/search_routes.py reads it: the routes in the order of the file.
+  const nlohmann::json doc = nlohmann::json::parse(pairs.out);
+  ASSERT_EQ(doc["routes"].size(), 2u);
+  EXPECT_EQ(doc["routes"][0]["length_m"].get<double>(), 51.0);
+  EXPECT_EQ(doc["routes"][1]["to"], nlohmann::json::parse("[120.125, 205.125]"));
+  EXPECT_EQ(doc["routes"][1]["sites"].size(), 1u);
+  EXPECT_EQ(doc["terrain"]["xll_m"].get<double>(), 100.0);
   // Cropped to the first two terraces (x 100 .. 130 m): one cliff left on the way to x = 125.125 m.
   const CliRun cropped = run("route " + path("cliffs.asc") +
                              " --crop 100 200 30 10 --kappa 0.2 --delta 2 --eps 0.05 --from 105.125 205.125 --to "
