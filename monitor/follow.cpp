@@ -1,8 +1,9 @@
 #include "marsala/monitor/follow.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cstdint>
-#include <cstdio>
 #include <ostream>
 #include <set>
 #include <utility>
@@ -22,14 +23,8 @@ constexpr std::int32_t kEventDepth = 256;
 
 Clock::duration to_clock(std::chrono::duration<double> d) { return std::chrono::duration_cast<Clock::duration>(d); }
 
-std::string seconds_text(std::chrono::duration<double> d) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g s", d.count());
-  return text;
-}
-
 std::string where(const bus::Participant& participant) {
-  return "domain " + std::to_string(participant.domain_id()) + " (" + bus::to_string(participant.vendor()) + ")";
+  return fmt::format("domain {} ({})", participant.domain_id(), bus::to_string(participant.vendor()));
 }
 
 /// What one tail has printed so far, and the merge of statuses and events into one stream of lines.
@@ -91,7 +86,7 @@ class TailPrinter {
 
   void print_stopped() {
     if (last_)
-      out_ << "tail stopped after step " << last_->step << " of run " << printable(last_->run_id) << '\n';
+      out_ << fmt::format("tail stopped after step {} of run {}\n", last_->step, printable(last_->run_id));
     else
       out_ << "tail stopped before any world status\n";
     out_.flush();
@@ -99,7 +94,7 @@ class TailPrinter {
 
   std::string last_seen() const {
     if (!last_) return "";
-    return " (last: step " + std::to_string(last_->step) + " of run " + printable(last_->run_id) + ")";
+    return fmt::format(" (last: step {} of run {})", last_->step, printable(last_->run_id));
   }
 
  private:
@@ -107,8 +102,8 @@ class TailPrinter {
     if (run_id_.empty()) run_id_ = status.run_id;
     if (status.run_id == run_id_) return true;
     if (ignored_runs_.insert(status.run_id).second)
-      err_ << "marsala-monitor: ignoring run '" << printable(status.run_id) << "' (following '" << printable(run_id_)
-           << "')\n";
+      err_ << fmt::format("marsala-monitor: ignoring run '{}' (following '{}')\n", printable(status.run_id),
+                          printable(run_id_));
     return false;
   }
 
@@ -151,8 +146,8 @@ int run_tail(bus::Participant& participant, const TailOptions& options, const St
   std::unique_ptr<bus::Reader<protocol::WorldEvent>> events;
   if (options.events)
     events = participant.create_reader<protocol::WorldEvent>({"", signal, bus::Durability::kVolatile, kEventDepth});
-  err << "marsala-monitor: tailing " << where(participant)
-      << (options.run_id.empty() ? "" : ", run " + printable(options.run_id)) << "; Ctrl-C stops" << std::endl;
+  const std::string run = options.run_id.empty() ? std::string() : fmt::format(", run {}", printable(options.run_id));
+  err << fmt::format("marsala-monitor: tailing {}{}; Ctrl-C stops", where(participant), run) << std::endl;
 
   TailPrinter printer(options, out, err);
   WorldGate gate(err);  // only the run's own world speaks for it
@@ -178,8 +173,9 @@ int run_tail(bus::Participant& participant, const TailOptions& options, const St
     } else if (Clock::now() < *deadline) {
       signal->wait_until(*deadline);
     } else {
-      err << "marsala-monitor: no world status on " << where(participant) << " for " << seconds_text(*options.timeout)
-          << printer.last_seen() << std::endl;
+      err << fmt::format("marsala-monitor: no world status on {} for {:g} s{}", where(participant),
+                         options.timeout->count(), printer.last_seen())
+          << std::endl;
       return 1;
     }
   }
@@ -217,8 +213,9 @@ int run_status(bus::Participant& participant, const StatusOptions& options, cons
       return 1;
     }
     if (Clock::now() >= deadline) {
-      err << "marsala-monitor: no world server on " << where(participant) << ": no world status within "
-          << seconds_text(options.timeout) << std::endl;
+      err << fmt::format("marsala-monitor: no world server on {}: no world status within {:g} s", where(participant),
+                         options.timeout.count())
+          << std::endl;
       return 1;
     }
     stop.signal()->wait_until(deadline);

@@ -1,35 +1,18 @@
 #include "marsala/monitor/format.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
-#include <cstdarg>
 #include <cstdint>
-#include <cstdio>
 #include <map>
 #include <utility>
 
 namespace marsala::monitor {
 namespace {
 
-[[gnu::format(printf, 1, 2)]] std::string printf_string(const char* format, ...) {
-  va_list args;
-  va_start(args, format);
-  va_list copy;
-  va_copy(copy, args);
-  const int size = std::vsnprintf(nullptr, 0, format, copy);
-  va_end(copy);
-  std::string text(size > 0 ? static_cast<std::size_t>(size) : 0, '\0');
-  if (size > 0) std::vsnprintf(text.data(), text.size() + 1, format, args);
-  va_end(args);
-  return text;
-}
-
 std::string trim_right(std::string line) {
   line.erase(line.find_last_not_of(' ') + 1);
   return line;
-}
-
-std::string pad_right(const std::string& text, int width) {
-  return text.size() >= static_cast<std::size_t>(width) ? text : text + std::string(width - text.size(), ' ');
 }
 
 std::string cut(const std::string& text, int width) {
@@ -72,7 +55,7 @@ std::string states_summary(const protocol::WorldStatus& status) {
   std::vector<std::pair<std::string, int>> sorted(counts.begin(), counts.end());
   std::stable_sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
   std::string text;
-  for (const auto& [state, count] : sorted) text += (text.empty() ? "" : ", ") + state + " " + std::to_string(count);
+  for (const auto& [state, count] : sorted) text += fmt::format("{}{} {}", text.empty() ? "" : ", ", state, count);
   return text;
 }
 
@@ -110,7 +93,7 @@ int agent_column_text_width(std::size_t agent_count, const FormatOptions& option
 }
 
 std::string format_step_header(const protocol::WorldStatus& status, const FormatOptions& options) {
-  std::string line = printf_string("%6s %5s %7s %8s %4s |", "step", "live", "mat[m3]", "dep[m3]", "prog");
+  std::string line = fmt::format("{:>6} {:>5} {:>7} {:>8} {:>4} |", "step", "live", "mat[m3]", "dep[m3]", "prog");
   const int text_width = agent_column_text_width(status.agents.size(), options);
   if (status.agents.empty()) {
     line += " no agents";
@@ -118,7 +101,7 @@ std::string format_step_header(const protocol::WorldStatus& status, const Format
     line += " live agents by state";
   } else {
     for (const protocol::AgentStatus* a : by_id(status))
-      line += " " + pad_right(std::to_string(a->agent_id), text_width);
+      line += fmt::format(" {:<{}}", a->agent_id, text_width);
   }
   return fit_width(trim_right(line), options.width);
 }
@@ -127,17 +110,17 @@ std::string format_step_line(const protocol::WorldStatus& status, const FormatOp
   double material_m3 = 0.0;
   for (const protocol::AgentStatus& a : status.agents)
     if (a.alive) material_m3 += a.material_m3;
-  const std::string live = std::to_string(count_alive(status)) + "/" + std::to_string(status.agents.size());
-  std::string line = printf_string("%6llu %5s %7.2f %8.3f %3.0f%% |", static_cast<unsigned long long>(status.step),
-                                   live.c_str(), material_m3, status.deposited_volume_m3, 100.0 * status.progress);
+  const std::string live = fmt::format("{}/{}", count_alive(status), status.agents.size());
+  std::string line = fmt::format("{:>6} {:>5} {:7.2f} {:8.3f} {:3.0f}% |", status.step, live, material_m3,
+                                 status.deposited_volume_m3, 100.0 * status.progress);
   const int text_width = agent_column_text_width(status.agents.size(), options);
   if (status.agents.empty()) {
     line += " no agents";
   } else if (text_width == 0) {
-    line += " " + states_summary(status);
+    line += fmt::format(" {}", states_summary(status));
   } else {
     for (const protocol::AgentStatus* a : by_id(status))
-      line += " " + pad_right(agent_column(*a, text_width), text_width);
+      line += fmt::format(" {:<{}}", agent_column(*a, text_width), text_width);
   }
   return fit_width(trim_right(line), options.width);
 }
@@ -149,58 +132,56 @@ std::string format_run_summary(const protocol::WorldStatus& status) {
     rejected += a.rejected;
     missed += a.missed;
   }
-  std::string line = printf_string(
-      "run %s %s at step %llu (%.1f s) | live %zu/%zu, at goal %zu | dep %.3f m3 | acc %llu rej %llu "
-      "miss %llu",
-      printable(status.run_id).c_str(), run_outcome(status).c_str(), static_cast<unsigned long long>(status.step),
-      status.wall_seconds, count_alive(status), status.agents.size(), count_at_goal(status), status.deposited_volume_m3,
-      accepted, rejected, missed);
-  if (!status.progress_detail.empty())
-    line += printf_string(" | progress %.1f%%: %s", 100.0 * status.progress, printable(status.progress_detail).c_str());
-  return line;
+  const std::string progress =
+      status.progress_detail.empty()
+          ? std::string()
+          : fmt::format(" | progress {:.1f}%: {}", 100.0 * status.progress, printable(status.progress_detail));
+  return fmt::format("run {} {} at step {} ({:.1f} s) | live {}/{}, at goal {} | dep {:.3f} m3 | acc {} rej {} miss {}{}",
+                     printable(status.run_id), run_outcome(status), status.step, status.wall_seconds,
+                     count_alive(status), status.agents.size(), count_at_goal(status), status.deposited_volume_m3,
+                     accepted, rejected, missed, progress);
 }
 
 std::string format_event(const protocol::WorldEvent& event, const FormatOptions& options) {
-  const std::string who = event.agent_id == 0 ? "world" : "agent " + std::to_string(event.agent_id);
+  const std::string who = event.agent_id == 0 ? std::string("world") : fmt::format("agent {}", event.agent_id);
   const auto kind_value = static_cast<unsigned>(event.kind);
   const std::string kind = kind_value <= static_cast<unsigned>(protocol::EventKind::kRunOver)
                                ? protocol::to_string(event.kind)
-                               : "kind " + std::to_string(kind_value);
-  std::string line =
-      printf_string("%6llu > %-8s %-9s", static_cast<unsigned long long>(event.step), who.c_str(), kind.c_str());
-  if (event.kind == protocol::EventKind::kDeposited) line += printf_string(" %.6g m3", event.volume_m3);
-  if (!event.detail.empty()) line += " " + printable(event.detail);
+                               : fmt::format("kind {}", kind_value);
+  const std::string volume =
+      event.kind == protocol::EventKind::kDeposited ? fmt::format(" {:.6g} m3", event.volume_m3) : std::string();
+  const std::string detail = event.detail.empty() ? std::string() : fmt::format(" {}", printable(event.detail));
+  const std::string line = fmt::format("{:>6} > {:<8} {:<9}{}{}", event.step, who, kind, volume, detail);
   return fit_width(trim_right(line), options.width);
 }
 
 std::vector<std::string> format_status_table(const protocol::WorldStatus& status) {
   std::vector<std::string> lines;
-  lines.push_back(printf_string("run %s  scenario %s  step %llu  wall %.1f s  %s  progress %.1f%%  deposited %.4f m3",
-                                printable(status.run_id).c_str(), printable(status.scenario).c_str(),
-                                static_cast<unsigned long long>(status.step), status.wall_seconds,
-                                run_outcome(status).c_str(), 100.0 * status.progress, status.deposited_volume_m3));
-  if (!status.progress_detail.empty()) lines.back() += "  (" + printable(status.progress_detail) + ")";
-  lines.push_back(
-      trim_right(printf_string("%3s %-12s %-11s %8s %8s %7s %7s %7s %5s %4s %4s %-5s %-4s", "id", "name", "state",
-                               "x[m]", "y[m]", "z[m]", "mat[m3]", "dep[m3]", "acc", "rej", "miss", "alive", "goal")));
+  const std::string detail =
+      status.progress_detail.empty() ? std::string() : fmt::format("  ({})", printable(status.progress_detail));
+  lines.push_back(fmt::format("run {}  scenario {}  step {}  wall {:.1f} s  {}  progress {:.1f}%  deposited {:.4f} m3{}",
+                              printable(status.run_id), printable(status.scenario), status.step, status.wall_seconds,
+                              run_outcome(status), 100.0 * status.progress, status.deposited_volume_m3, detail));
+  lines.push_back(trim_right(fmt::format("{:>3} {:<12} {:<11} {:>8} {:>8} {:>7} {:>7} {:>7} {:>5} {:>4} {:>4} {:<5} {:<4}",
+                                         "id", "name", "state", "x[m]", "y[m]", "z[m]", "mat[m3]", "dep[m3]", "acc",
+                                         "rej", "miss", "alive", "goal")));
   double material_m3 = 0.0, deposited_m3 = 0.0;
   unsigned long long accepted = 0, rejected = 0, missed = 0;
   for (const protocol::AgentStatus* a : by_id(status)) {
-    lines.push_back(trim_right(printf_string(
-        "%3u %-12s %-11s %8.2f %8.2f %7.3f %7.4f %7.4f %5u %4u %4u %-5s %-4s", static_cast<unsigned>(a->agent_id),
-        cut(printable(a->name), 12).c_str(), cut(state_of(*a), 11).c_str(), a->x_m, a->y_m, a->z_m, a->material_m3,
-        a->deposited_m3, static_cast<unsigned>(a->accepted), static_cast<unsigned>(a->rejected),
-        static_cast<unsigned>(a->missed), yes_no(a->alive), yes_no(a->at_goal))));
+    lines.push_back(trim_right(fmt::format(
+        "{:>3} {:<12} {:<11} {:8.2f} {:8.2f} {:7.3f} {:7.4f} {:7.4f} {:>5} {:>4} {:>4} {:<5} {:<4}", a->agent_id,
+        cut(printable(a->name), 12), cut(state_of(*a), 11), a->x_m, a->y_m, a->z_m, a->material_m3, a->deposited_m3,
+        a->accepted, a->rejected, a->missed, yes_no(a->alive), yes_no(a->at_goal))));
     material_m3 += a->material_m3;
     deposited_m3 += a->deposited_m3;
     accepted += a->accepted;
     rejected += a->rejected;
     missed += a->missed;
   }
-  const std::string agents = std::to_string(status.agents.size()) + (status.agents.size() == 1 ? " agent" : " agents");
-  lines.push_back(trim_right(printf_string("%3s %-12s %-11s %8s %8s %7s %7.4f %7.4f %5llu %4llu %4llu %-5zu %-4zu", "",
-                                           "total", agents.c_str(), "", "", "", material_m3, deposited_m3, accepted,
-                                           rejected, missed, count_alive(status), count_at_goal(status))));
+  const std::string agents = fmt::format("{} agent{}", status.agents.size(), status.agents.size() == 1 ? "" : "s");
+  lines.push_back(trim_right(fmt::format(
+      "{:>3} {:<12} {:<11} {:>8} {:>8} {:>7} {:7.4f} {:7.4f} {:>5} {:>4} {:>4} {:<5} {:<4}", "", "total", agents, "", "",
+      "", material_m3, deposited_m3, accepted, rejected, missed, count_alive(status), count_at_goal(status))));
   return lines;
 }
 

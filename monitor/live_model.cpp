@@ -1,7 +1,8 @@
 #include "marsala/monitor/live_model.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
-#include <cstdio>
 
 #include <nlohmann/json.hpp>
 
@@ -16,18 +17,14 @@ using nlohmann::json;
 /// The window of world wall time over which steps/s is measured [s].
 constexpr double kRateWindowS = 2.0;
 
-std::string hex_colour(render::Rgb c) {
-  char text[8];
-  std::snprintf(text, sizeof text, "#%02x%02x%02x", c.r, c.g, c.b);
-  return text;
-}
+std::string hex_colour(render::Rgb c) { return fmt::format("#{:02x}{:02x}{:02x}", c.r, c.g, c.b); }
 
-json rectangle(const SceneRectangle& r) { return {{"x0", r.x0_m}, {"y0", r.y0_m}, {"x1", r.x1_m}, {"y1", r.y1_m}}; }
+json rectangle(const Rect& r) { return {{"x0", r.x0}, {"y0", r.y0}, {"x1", r.x1}, {"y1", r.y1}}; }
 json point(const Position& p) { return json::array({p.x, p.y}); }
 
 json scene_json(const LiveScene& s) {
   json j = {{"completion", s.completion},
-            {"base", {{"x", s.base_x_m}, {"y", s.base_y_m}, {"r", s.base_radius_m}}},
+            {"base", {{"x", s.base.x}, {"y", s.base.y}, {"r", s.base_radius_m}}},
             {"targets", json::array()}};
   if (s.goal) j["goal"] = rectangle(*s.goal);
   if (s.site) j["site"] = rectangle(*s.site);
@@ -176,7 +173,7 @@ std::string LiveModel::state_json(Clock::time_point now) const {
                       {"agent", it->agent_id},
                       {"kind", kind <= static_cast<unsigned>(protocol::EventKind::kRunOver)
                                    ? protocol::to_string(it->kind)
-                                   : "kind " + std::to_string(kind)},
+                                   : fmt::format("kind {}", kind)},
                       {"volume_m3", it->volume_m3},
                       {"detail", printable(it->detail)}});
   }

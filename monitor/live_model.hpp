@@ -40,17 +40,13 @@ std::string to_string(RobotRole role);
 /// dropped whatever its state; anything else (empty included) -> waiting.
 RobotRole role_of(const std::string& state, bool alive);
 
-/// An axis-aligned rectangle [x0, x1] x [y0, y1] [m].
-struct SceneRectangle {
-  double x0_m = 0.0, y0_m = 0.0, x1_m = 0.0, y1_m = 0.0;
-};
-
 /// Where the scenario puts things, for the overlays (from the scenario text in the run log's header).
 struct LiveScene {
   std::string completion;  ///< "agents_at_goal", "payload_path" or "level_site"
-  double base_x_m = 0.0, base_y_m = 0.0, base_radius_m = 0.0;
-  std::optional<SceneRectangle> goal;  ///< agents_at_goal
-  std::optional<SceneRectangle> site;  ///< level_site
+  Position base;              ///< the base's centre [m]
+  double base_radius_m = 0.0;  ///< [m]
+  std::optional<Rect> goal;    ///< agents_at_goal [m]
+  std::optional<Rect> site;    ///< level_site [m]
   /// payload_path: the payload's start and destination [m].
   std::optional<std::pair<Position, Position>> payload;
   /// Each slot's target [m], by agent id.

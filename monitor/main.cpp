@@ -1,5 +1,7 @@
 // marsala-monitor: tail a running system (tail, status), replay a run's log (replay). Reads only; Ctrl-C ends it
 // cleanly.
+#include <fmt/format.h>
+
 #include <exception>
 #include <iostream>
 
@@ -13,7 +15,7 @@ int main(int argc, char** argv) {
     marsala::monitor::SignalWatcher watcher(stop);
     return marsala::monitor::run_monitor_cli(argc, argv, std::cout, std::cerr, stop);
   } catch (const std::exception& e) {
-    std::cerr << "marsala-monitor: " << e.what() << "\n";
+    std::cerr << fmt::format("marsala-monitor: {}\n", e.what());
     return 1;
   }
 }

@@ -1,8 +1,9 @@
 #include "marsala/monitor/progress.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <ostream>
 #include <vector>
 
@@ -20,12 +21,6 @@ constexpr std::int32_t kStatusDepth = 64;
 constexpr double kSampleSpacingS = 0.1;
 
 Clock::duration to_clock(std::chrono::duration<double> d) { return std::chrono::duration_cast<Clock::duration>(d); }
-
-std::string printf_text(const char* format, double a) {
-  char text[64];
-  std::snprintf(text, sizeof text, format, a);
-  return text;
-}
 
 }  // namespace
 
@@ -78,33 +73,25 @@ std::optional<double> ProgressMeter::eta_s() const {
 std::string format_duration(std::optional<double> seconds) {
   if (!seconds || !std::isfinite(*seconds) || *seconds < 0.0) return "-";
   const auto s = static_cast<long long>(std::llround(*seconds));
-  char text[48];
-  if (*seconds < 1.0)
-    return "< 1 s";  // "0 s" would say it is over
-  if (s < 60)
-    std::snprintf(text, sizeof text, "%lld s", s);
-  else if (s < 3600)
-    std::snprintf(text, sizeof text, "%lld min %02lld s", s / 60, s % 60);
-  else
-    std::snprintf(text, sizeof text, "%lld h %02lld min", s / 3600, (s % 3600) / 60);
-  return text;
+  if (*seconds < 1.0) return "< 1 s";  // "0 s" would say it is over
+  if (s < 60) return fmt::format("{} s", s);
+  if (s < 3600) return fmt::format("{} min {:02} s", s / 60, s % 60);
+  return fmt::format("{} h {:02} min", s / 3600, (s % 3600) / 60);
 }
 
 std::string format_progress_line(const protocol::WorldStatus& status, const ProgressMeter& meter, int width) {
-  std::string line;
-  const std::string percent = printf_text("%.1f %%", 100.0 * status.progress);
-  const std::string detail = status.progress_detail.empty() ? "" : " | " + printable(status.progress_detail);
-  if (status.admitting) {
-    line = "admitting agents: " + std::to_string(status.agents.size()) + " admitted";
-  } else if (status.running) {
-    // The detail last: on a narrow terminal it is what gets cut.
-    line = "step " + std::to_string(status.step) + " | " + percent + " | " +
-           printf_text("%.0f steps/s", meter.steps_per_s()) + " | ETA " + format_duration(meter.eta_s()) + detail;
-  } else {
-    line = std::string(status.completed ? "completed" : "stopped") + " at step " + std::to_string(status.step) +
-           " in " + printf_text("%.1f s", status.wall_seconds) + " | " + percent + detail;
-  }
-  return fit_width(line, width);
+  if (status.admitting) return fit_width(fmt::format("admitting agents: {} admitted", status.agents.size()), width);
+  const double percent = 100.0 * status.progress;
+  const std::string detail =
+      status.progress_detail.empty() ? std::string() : fmt::format(" | {}", printable(status.progress_detail));
+  // The detail last: on a narrow terminal it is what gets cut.
+  if (status.running)
+    return fit_width(fmt::format("step {} | {:.1f} % | {:.0f} steps/s | ETA {}{}", status.step, percent,
+                                 meter.steps_per_s(), format_duration(meter.eta_s()), detail),
+                     width);
+  return fit_width(fmt::format("{} at step {} in {:.1f} s | {:.1f} %{}", status.completed ? "completed" : "stopped",
+                               status.step, status.wall_seconds, percent, detail),
+                   width);
 }
 
 int run_progress(bus::Participant& participant, const ProgressOptions& options, const StopSource& stop,
@@ -163,8 +150,9 @@ int run_progress(bus::Participant& participant, const ProgressOptions& options, 
     }
     if (deadline && now >= *deadline) {
       if (line_open) out << '\n';
-      err << "marsala-monitor: no world status on domain " << participant.domain_id() << " for "
-          << options.timeout->count() << " s" << std::endl;
+      err << fmt::format("marsala-monitor: no world status on domain {} for {:g} s", participant.domain_id(),
+                         options.timeout->count())
+          << std::endl;
       return 1;
     }
     Clock::time_point wake = deadline ? *deadline : now + std::chrono::hours(1);

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <utility>
 #include <vector>
@@ -57,8 +56,8 @@ void check_initial_terrain(const proto::LogHeader& header, const Heightmap& terr
   const std::string sha = runlog::terrain_sha256(terrain);
   if (sha != header.initial_terrain_sha256())
     throw ParseError(terrain_name, 0,
-                     "SHA-256 " + sha + ", but the run log's header says " + header.initial_terrain_sha256() +
-                         ": not this run's initial terrain");
+                     fmt::format("SHA-256 {}, but the run log's header says {}: not this run's initial terrain", sha,
+                                 header.initial_terrain_sha256()));
 }
 
 TerrainReplayer::TerrainReplayer(const proto::LogHeader& header, Heightmap initial_terrain, std::string log_name)
@@ -79,7 +78,7 @@ void TerrainReplayer::apply(const proto::LogRecord& record, std::uint64_t offset
     throw ParseError(log_name_, 0,
                      fmt::format("{}: a record after the run's end (RunEnd after {} steps)", where, run_end_->steps()));
   switch (record.record_case()) {
-    case proto::LogRecord::kHeader: throw ParseError(log_name_, 0, where + ": a second header");
+    case proto::LogRecord::kHeader: throw ParseError(log_name_, 0, fmt::format("{}: a second header", where));
     case proto::LogRecord::kAdmitted: {
       ReplayedAgent& a = agent(record.admitted().agent_id());
       a.name = record.admitted().name();
@@ -105,7 +104,7 @@ void TerrainReplayer::apply(const proto::LogRecord& record, std::uint64_t offset
     }
     case proto::LogRecord::RECORD_NOT_SET: break;
   }
-  throw ParseError(log_name_, 0, where + ": an empty record");
+  throw ParseError(log_name_, 0, fmt::format("{}: an empty record", where));
 }
 
 void TerrainReplayer::apply_step(const proto::StepRecord& step, const std::string& where) {
@@ -168,7 +167,7 @@ render::RenderOptions replay_picture_options(const TerrainReplayer& replayer) {
   std::vector<std::string> ids_of_colour(palette.size());
   auto list_id = [&](std::uint32_t id) {
     std::string& ids = ids_of_colour[(id - 1) % ids_of_colour.size()];
-    ids += (ids.empty() ? "" : ", ") + std::to_string(id);
+    ids += fmt::format("{}{}", ids.empty() ? "" : ", ", id);
   };
   for (std::uint32_t id = 1; id <= replayer.header().agents(); ++id) list_id(id);
   for (const auto& [id, a] : replayer.agents()) {
@@ -180,9 +179,9 @@ render::RenderOptions replay_picture_options(const TerrainReplayer& replayer) {
   for (std::size_t k = 0; k < ids_of_colour.size(); ++k)
     if (!ids_of_colour[k].empty())
       o.legend_entries.push_back(
-          {(ids_of_colour[k].find(',') == std::string::npos ? "agent " : "agents ") + ids_of_colour[k], palette[k],
-           render::LegendSwatch::kDisc});
-  o.title = replayer.header().scenario() + ": step " + std::to_string(replayer.steps());
+          {fmt::format("{} {}", ids_of_colour[k].find(',') == std::string::npos ? "agent" : "agents", ids_of_colour[k]),
+           palette[k], render::LegendSwatch::kDisc});
+  o.title = fmt::format("{}: step {}", replayer.header().scenario(), replayer.steps());
   return o;
 }
 
@@ -259,19 +258,18 @@ std::string format_replay_report(const ReplayReport& r) {
                       r.admitted, r.slots, r.dropped, r.requests, r.accepted,
                       r.resumptions > 0 ? fmt::format(", resumed {} times", r.resumptions) : std::string());
   text += fmt::format("deposited {:.6f} m3\n", r.deposited_volume_m3);
-  text += fmt::format("run end: {}\n", r.end_reason ? *r.end_reason + ", final terrain sha256 matches the log"
-                                                    : std::string("not reached"));
+  text += r.end_reason ? fmt::format("run end: {}, final terrain sha256 matches the log\n", *r.end_reason)
+                       : std::string("run end: not reached\n");
   const double speed = r.replay_seconds > 0.0 ? static_cast<double>(r.steps) / r.replay_seconds : 0.0;
   text += fmt::format("wall {:.3f} s, replay speed {:.0f} steps/s (frames excluded)\n",
                       r.replay_seconds + r.frame_seconds + r.timelapse_seconds, speed);
   if (!r.frames_dir.empty()) {
     text += fmt::format("frames: {} in {} ({:.3f} s, {:.1f} ms per frame)\n", r.frames, r.frames_dir, r.frame_seconds,
                         r.frames > 0 ? 1e3 * r.frame_seconds / static_cast<double>(r.frames) : 0.0);
-    text += r.timelapse.empty()
-                ? r.timelapse_note + "\n"
-                : fmt::format("timelapse: {} ({:.3f} s with ffmpeg)\n", r.timelapse, r.timelapse_seconds);
+    text += r.timelapse.empty() ? fmt::format("{}\n", r.timelapse_note)
+                                : fmt::format("timelapse: {} ({:.3f} s with ffmpeg)\n", r.timelapse, r.timelapse_seconds);
   }
-  text += "terrain_sha256 " + r.terrain_sha256 + "\n";
+  text += fmt::format("terrain_sha256 {}\n", r.terrain_sha256);
   return text;
 }
 

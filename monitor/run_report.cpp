@@ -1,9 +1,10 @@
 #include "marsala/monitor/run_report.hpp"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <google/protobuf/util/json_util.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 #include <optional>
 #include <fstream>
@@ -20,12 +21,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string number(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
 /// Why a run that did not complete ended, in words (docs/runtime.md#end-reasons).
 std::string why_not(const std::string& end_reason) {
   if (const std::optional<protocol::EndReason> reason = protocol::find_end_reason(end_reason)) {
@@ -36,13 +31,7 @@ std::string why_not(const std::string& end_reason) {
       case protocol::EndReason::kCompleted: break;
     }
   }
-  return "it ended with '" + printable(end_reason) + "'";
-}
-
-std::string join(const std::vector<std::string>& names) {
-  std::string text;
-  for (const std::string& n : names) text += (text.empty() ? "" : ", ") + n;
-  return text;
+  return fmt::format("it ended with '{}'", printable(end_reason));
 }
 
 }  // namespace
@@ -50,34 +39,31 @@ std::string join(const std::vector<std::string>& names) {
 std::string run_report(const std::string& dir) {
   const fs::path path = fs::path(dir) / "summary.json";
   std::ifstream in(path);
-  if (!in) throw IoError(path.string() + ": cannot be read (no run ended in " + dir + "?)");
+  if (!in) throw IoError(fmt::format("{}: cannot be read (no run ended in {}?)", path.string(), dir));
   std::stringstream text;
   text << in.rdbuf();
   proto::RunSummary s;
   google::protobuf::util::JsonParseOptions options;
   options.ignore_unknown_fields = true;
   const auto status = google::protobuf::util::JsonStringToMessage(text.str(), &s, options);
-  if (!status.ok()) throw ParseError(path.string(), 0, "not a run summary: " + status.ToString());
+  if (!status.ok()) throw ParseError(path.string(), 0, fmt::format("not a run summary: {}", status.ToString()));
 
-  std::string out = printable(s.scenario());
-  const std::string steps = std::to_string(s.steps()) + (s.steps() == 1 ? " step" : " steps");
-  const std::string timing = number("%.1f s", s.wall_seconds()) + " (admission " + number("%.1f s", s.admit_seconds()) + ")";
-  if (s.completed())
-    out += " completed after " + steps + " in " + timing + "\n";
-  else
-    out += " did not complete: " + why_not(s.end_reason()) + ", after " + steps + " in " + timing + "\n";
-  out += "  agents " + std::to_string(s.agents()) + " (" + std::to_string(s.admitted()) + " admitted, " +
-         std::to_string(s.dropped()) + " dropped), " + number("%.3f", s.deposited_volume_m3()) + " m3 deposited";
+  const std::string outcome =
+      s.completed() ? std::string(" completed after") : fmt::format(" did not complete: {}, after", why_not(s.end_reason()));
+  std::string out = fmt::format("{}{} {} step{} in {:.1f} s (admission {:.1f} s)\n", printable(s.scenario()), outcome,
+                                s.steps(), s.steps() == 1 ? "" : "s", s.wall_seconds(), s.admit_seconds());
+  std::string goal;
   if (s.completion() == "payload_path")
-    out += s.path_found() ? ", payload path " + number("%.1f m", s.path_length_m()) : ", no payload path yet";
-  if (s.completion() == "level_site") out += ", site " + number("%.1f %%", 100.0 * s.site_level_fraction()) + " level";
-  out += "\n";
+    goal = s.path_found() ? fmt::format(", payload path {:.1f} m", s.path_length_m()) : ", no payload path yet";
+  if (s.completion() == "level_site") goal = fmt::format(", site {:.1f} % level", 100.0 * s.site_level_fraction());
+  out += fmt::format("  agents {} ({} admitted, {} dropped), {:.3f} m3 deposited{}\n", s.agents(), s.admitted(),
+                     s.dropped(), s.deposited_volume_m3(), goal);
   if (s.missed_deadlines() > 0 || s.rejected_requests() > 0)
-    out += "  " + std::to_string(s.missed_deadlines()) + " missed deadlines, " + std::to_string(s.rejected_requests()) +
-           " rejected requests (events.log says which)\n";
-  out += "  progress " + number("%.1f %%", 100.0 * s.progress());
-  if (!s.progress_detail().empty()) out += ": " + printable(s.progress_detail());
-  out += "\n";
+    out += fmt::format("  {} missed deadlines, {} rejected requests (events.log says which)\n", s.missed_deadlines(),
+                       s.rejected_requests());
+  const std::string detail =
+      s.progress_detail().empty() ? std::string() : fmt::format(": {}", printable(s.progress_detail()));
+  out += fmt::format("  progress {:.1f} %{}\n", 100.0 * s.progress(), detail);
 
   std::vector<std::string> pictures, others;
   std::error_code ec;
@@ -85,14 +71,14 @@ std::string run_report(const std::string& dir) {
     const std::string name = e.path().filename().string();
     if (e.path().extension() == ".png") pictures.push_back(name);
     else if (name == "summary.json" || name == "events.log" || name == "run.log" || name == "logs")
-      others.push_back(e.is_directory() ? name + "/" : name);
+      others.push_back(e.is_directory() ? fmt::format("{}/", name) : name);
   }
   // final.png first, then the rest by name: the picture people look at first leads.
   std::sort(pictures.begin(), pictures.end(), [](const std::string& a, const std::string& b) {
     return (a == "final.png") != (b == "final.png") ? a == "final.png" : a < b;
   });
   std::sort(others.begin(), others.end());
-  if (!pictures.empty()) out += "  pictures in " + dir + ": " + join(pictures) + "\n";
+  if (!pictures.empty()) out += fmt::format("  pictures in {}: {}\n", dir, fmt::join(pictures, ", "));
   // The time-lapse of --frames-every, when the run drew one.
   const fs::path frames_dir = fs::path(dir) / "frames";
   std::size_t frames = 0;
@@ -103,9 +89,9 @@ std::string run_report(const std::string& dir) {
     video = video || name == "timelapse.mp4";
   }
   if (frames > 0)
-    out += "  time-lapse in " + frames_dir.string() + ": " + std::to_string(frames) + " frame" +
-           (frames == 1 ? "" : "s") + (video ? ", timelapse.mp4" : "") + "\n";
-  out += "  everything else in " + dir + ": " + join(others) + "\n";
+    out += fmt::format("  time-lapse in {}: {} frame{}{}\n", frames_dir.string(), frames, frames == 1 ? "" : "s",
+                       video ? ", timelapse.mp4" : "");
+  out += fmt::format("  everything else in {}: {}\n", dir, fmt::join(others, ", "));
   return out;
 }
 

@@ -1,6 +1,7 @@
 #include "marsala/monitor/serve.hpp"
 
 #include <arpa/inet.h>
+#include <fmt/format.h>
 #include <httplib.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -91,15 +92,14 @@ std::optional<LiveScene> scene_of(const proto::LogHeader& header) {
     const scenario::Scenario s = scenario::parse_scenario(header.scenario_text(), header.scenario_file());
     LiveScene scene;
     scene.completion = scenario::to_string(s.completion);
-    scene.base_x_m = s.base.x_m;
-    scene.base_y_m = s.base.y_m;
+    scene.base = Position{s.base.x_m, s.base.y_m};
     scene.base_radius_m = s.base.radius_m;
     switch (s.completion) {
       case scenario::CompletionKind::kAgentsAtGoal:
-        scene.goal = SceneRectangle{s.goal.x0_m, s.goal.y0_m, s.goal.x1_m, s.goal.y1_m};
+        scene.goal = Rect{s.goal.x0_m, s.goal.y0_m, s.goal.x1_m, s.goal.y1_m};
         break;
       case scenario::CompletionKind::kLevelSite:
-        scene.site = SceneRectangle{s.site.x0_m, s.site.y0_m, s.site.x1_m, s.site.y1_m};
+        scene.site = Rect{s.site.x0_m, s.site.y0_m, s.site.x1_m, s.site.y1_m};
         break;
       case scenario::CompletionKind::kPayloadPath:
         scene.payload = std::make_pair(Position{s.payload_path.from_x_m, s.payload_path.from_y_m},
@@ -130,7 +130,7 @@ struct LiveServer::Impl {
   explicit Impl(ServeOptions o) : options(std::move(o)), model(source_name(options), !options.replay_dir.empty()) {}
 
   static std::string source_name(const ServeOptions& o) {
-    return o.replay_dir.empty() ? std::string("DDS") : "replay of " + o.replay_dir;
+    return o.replay_dir.empty() ? std::string("DDS") : fmt::format("replay of {}", o.replay_dir);
   }
 
   ServeOptions options;
@@ -237,7 +237,7 @@ struct LiveServer::Impl {
     while (!stop_requested()) {
       if (!replayer) {
         try {
-          if (!fs::exists(log_path)) throw IoError("waiting for " + log_path);
+          if (!fs::exists(log_path)) throw IoError(fmt::format("waiting for {}", log_path));
           runlog::RunLogReader reader(log_path);
           Heightmap initial = terrain::read_asc(terrain_path);
           check_initial_terrain(reader.header(), initial, terrain_path);
@@ -261,7 +261,7 @@ struct LiveServer::Impl {
       try {
         reader.emplace(log_path);
         if (reader->header().run_id() != run_id || reader->file_bytes() < offset)
-          throw IoError(log_path + " now holds another run");
+          throw IoError(fmt::format("{} now holds another run", log_path));
         reader->seek(offset);
       } catch (const Error& e) {
         replayer.reset();  // the folder was cleared or another run took it over: start again
@@ -288,7 +288,7 @@ struct LiveServer::Impl {
         }
       } catch (const Error& e) {
         // The log disagrees with the replay of itself: show why and stop following.
-        set_note(std::string("stopped following the run log: ") + e.what());
+        set_note(fmt::format("stopped following the run log: {}", e.what()));
         wait_stop_for(std::chrono::hours(24 * 365));
         return;
       }
@@ -377,12 +377,12 @@ struct LiveServer::Impl {
 LiveServer::LiveServer(ServeOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {
   const ServeOptions& o = impl_->options;
   if (o.port < 1 || o.port > 65535)
-    throw InvalidArgument("--port " + std::to_string(o.port) + ": must be a TCP port, 1..65535");
+    throw InvalidArgument(fmt::format("--port {}: must be a TCP port, 1..65535", o.port));
   if (!(o.replay_steps_per_s > 0.0)) throw InvalidArgument("--speed must be > 0 steps/s");
   if (!o.replay_dir.empty() && !fs::is_directory(o.replay_dir))
-    throw InvalidArgument("--replay " + o.replay_dir + ": not a folder");
+    throw InvalidArgument(fmt::format("--replay {}: not a folder", o.replay_dir));
   if (!o.replay_dir.empty() && !fs::exists(fs::path(o.replay_dir) / runlog::kRunLogFile))
-    throw InvalidArgument("--replay " + o.replay_dir + ": holds no " + runlog::kRunLogFile);
+    throw InvalidArgument(fmt::format("--replay {}: holds no {}", o.replay_dir, runlog::kRunLogFile));
   Impl& impl = *impl_;
   impl.routes();
   impl.http.new_task_queue = [] { return new httplib::ThreadPool(kHttpThreads); };
@@ -393,8 +393,8 @@ LiveServer::LiveServer(ServeOptions options) : impl_(std::make_unique<Impl>(std:
   impl.http.set_write_timeout(kSocketTimeoutS, 0);
   impl.http.set_payload_max_length(1 << 16);
   if (!impl.http.bind_to_port(o.bind_address, o.port))
-    throw ListenError("cannot listen on " + o.bind_address + " port " + std::to_string(o.port) + ": " +
-                      bind_problem(o.bind_address, o.port));
+    throw ListenError(
+        fmt::format("cannot listen on {} port {}: {}", o.bind_address, o.port, bind_problem(o.bind_address, o.port)));
 }
 
 LiveServer::~LiveServer() = default;
@@ -411,8 +411,8 @@ int LiveServer::run(bus::Participant* participant, const StopSource& stop, std::
     statuses = participant->create_reader<protocol::WorldStatus>({"", signal, bus::Durability::kTransientLocal, 64});
     events = participant->create_reader<protocol::WorldEvent>({"", signal, bus::Durability::kVolatile, 256});
     std::lock_guard<std::mutex> lock(impl.model_mutex);
-    impl.model = LiveModel("DDS domain " + std::to_string(participant->domain_id()) + " (" +
-                           bus::to_string(participant->vendor()) + ")");
+    impl.model =
+        LiveModel(fmt::format("DDS domain {} ({})", participant->domain_id(), bus::to_string(participant->vendor())));
     if (o.run_dir.empty()) impl.model.set_map_note("no terrain: start serve with --run-dir (the run's --out folder)");
   }
   impl.publish_state();
@@ -425,15 +425,17 @@ int LiveServer::run(bus::Participant* participant, const StopSource& stop, std::
       try {
         impl.follow(dir, replay);
       } catch (const std::exception& e) {  // nothing escapes the thread: the page says why the terrain stopped
-        impl.set_note(std::string("stopped following the run folder: ") + e.what());
+        impl.set_note(fmt::format("stopped following the run folder: {}", e.what()));
       }
     });
 
-  const std::string host = o.bind_address.find(':') == std::string::npos ? o.bind_address : "[" + o.bind_address + "]";
-  out << "marsala-monitor: live view on http://" << host << ":" << o.port << "/ ("
-      << (participant ? "following " + std::string("DDS domain ") + std::to_string(participant->domain_id())
-                      : "replaying " + o.replay_dir)
-      << (o.run_dir.empty() ? "" : ", terrain from " + o.run_dir) << "); Ctrl-C stops" << std::endl;
+  const std::string host =
+      o.bind_address.find(':') == std::string::npos ? o.bind_address : fmt::format("[{}]", o.bind_address);
+  const std::string source = participant ? fmt::format("following DDS domain {}", participant->domain_id())
+                                         : fmt::format("replaying {}", o.replay_dir);
+  const std::string terrain = o.run_dir.empty() ? std::string() : fmt::format(", terrain from {}", o.run_dir);
+  out << fmt::format("marsala-monitor: live view on http://{}:{}/ ({}{}); Ctrl-C stops", host, o.port, source, terrain)
+      << std::endl;
 
   const auto publish_interval =
       std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.publish_interval_s));

@@ -1,5 +1,7 @@
 #include "marsala/monitor/world_gate.hpp"
 
+#include <fmt/format.h>
+
 #include "marsala/monitor/format.hpp"
 
 namespace marsala::monitor {
@@ -15,16 +17,16 @@ std::vector<protocol::WorldStatus> WorldGate::statuses(std::vector<bus::Received
       world.last_step = std::max(world.last_step, r.sample.step);
       world.last_heard = now;
     } else if (now - world.last_heard >= kWorldSilence && r.sample.step >= world.last_step) {
-      err_ << "marsala-monitor: run '" << printable(r.sample.run_id) << "' continues from participant "
-           << r.from.to_string() << " at step " << r.sample.step << " (its world was " << world.writer.to_string()
-           << ")\n";
+      err_ << fmt::format("marsala-monitor: run '{}' continues from participant {} at step {} (its world was {})\n",
+                          printable(r.sample.run_id), r.from.to_string(), r.sample.step, world.writer.to_string());
       world = World{r.from, r.sample.step, now};
     } else {
+      const std::string why = r.sample.step < world.last_step
+                                  ? std::string(", and its step went back")
+                                  : fmt::format(", which is alive (last heard at step {})", world.last_step);
       report("statuses", r.from,
-             "run '" + printable(r.sample.run_id) + "' is published by participant " + world.writer.to_string() +
-                 (r.sample.step < world.last_step ? ", and its step went back"
-                                                  : ", which is alive (last heard at step " +
-                                                        std::to_string(world.last_step) + ")"));
+             fmt::format("run '{}' is published by participant {}{}", printable(r.sample.run_id),
+                         world.writer.to_string(), why));
       continue;
     }
     believed.push_back(std::move(r.sample));
@@ -56,7 +58,7 @@ std::vector<protocol::WorldEvent> WorldGate::events(std::vector<bus::Received<pr
 void WorldGate::report(const std::string& what, const bus::WriterId& from, const std::string& why) {
   ++ignored_;
   if (reported_.insert(what + from.to_string()).second)
-    err_ << "marsala-monitor: ignoring " << what << " from participant " << from.to_string() << ": " << why << "\n";
+    err_ << fmt::format("marsala-monitor: ignoring {} from participant {}: {}\n", what, from.to_string(), why);
 }
 
 }  // namespace marsala::monitor

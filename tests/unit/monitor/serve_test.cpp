@@ -110,7 +110,8 @@ TEST(LiveModel, StateDocumentForThePage) {
   map.version = 3;
   LiveScene scene;
   scene.completion = "agents_at_goal";
-  scene.goal = SceneRectangle{1, 2, 3, 4};
+  scene.goal = Rect{1, 2, 3, 4};
+  scene.base = Position{5.5, 6.25};
   scene.targets.emplace_back(1, Position{2.5, 3.5});
   map.scene = scene;
   model.set_map(map);
@@ -118,7 +119,10 @@ TEST(LiveModel, StateDocumentForThePage) {
   EXPECT_EQ(k["map"]["version"], 3);
   EXPECT_DOUBLE_EQ(k["map"]["width_m"].get<double>(), 3.0);
   EXPECT_DOUBLE_EQ(k["map"]["height_m"].get<double>(), 2.0);
-  EXPECT_EQ(k["map"]["scene"]["goal"]["x1"], 3);
+  EXPECT_EQ(k["map"]["scene"]["goal"], json::parse(R"({"x0": 1.0, "y0": 2.0, "x1": 3.0, "y1": 4.0})"));
+  EXPECT_EQ(k["map"]["scene"]["base"]["x"], 5.5);
+  EXPECT_EQ(k["map"]["scene"]["base"]["y"], 6.25);
+  EXPECT_FALSE(k["map"]["scene"].contains("site"));
   EXPECT_EQ(k["map"]["scene"]["targets"][0]["id"], 1);
 }
 
