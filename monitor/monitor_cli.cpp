@@ -7,6 +7,8 @@
 #include <sys/ioctl.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
+
 #include <cstdint>
 #include <cstdlib>
 #include <iostream>
@@ -60,6 +62,257 @@ int terminal_columns() {
   return 80;
 }
 
+/// Joins the DDS domain of the command line, read only.
+std::unique_ptr<bus::Participant> join_domain(const cli::DdsOptions& dds) {
+  return bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,
+                                bus::Security::of(dds.security, dds.identity, "monitor")});
+}
+
+// tail
+
+struct TailCommand {
+  CLI::App* cmd = nullptr;
+  TailOptions options;
+  double timeout_s = 0.0;
+  CLI::Option* timeout = nullptr;
+  double interval_s = 0.0;
+};
+
+void define_tail(CLI::App& app, TailCommand& c, cli::DdsOptions& dds) {
+  c.cmd = app.add_subcommand("tail", "print one line per step (and per event) until the run ends or Ctrl-C");
+  cli::add_dds_options(*c.cmd, dds);
+  c.cmd->add_option("--run-id", c.options.run_id, "follow this run only (default: the first run seen)");
+  c.cmd->add_flag("--events", c.options.events, "also print one line per world event");
+  c.timeout = c.cmd->add_option("--timeout", c.timeout_s,
+                                "exit 1 after this long without a world status [s] (default: wait forever)")
+                  ->check(CLI::Range(1e-3, 1e6));
+  c.cmd->add_option("--width", c.options.format.width, "longest line [columns]; 0 = no limit")
+      ->check(CLI::Range(0, 10000))
+      ->capture_default_str();
+  c.cmd->add_option("--every", c.options.every_steps,
+                    "print a step line only when the step passes a multiple of N (and the last one)")
+      ->check(cli::at_least_one())
+      ->type_name("N");
+  c.cmd->add_option("--interval", c.interval_s, "print at most one step line every S seconds (and the last one)")
+      ->check(CLI::Range(1e-3, 86400.0))
+      ->type_name("S");
+  c.cmd->footer(kTailLegend);
+}
+
+int run_tail_command(TailCommand& c, bus::Participant& participant, const StopSource& stop, std::ostream& out,
+                     std::ostream& err) {
+  if (c.timeout->count() > 0) c.options.timeout = std::chrono::duration<double>(c.timeout_s);
+  c.options.interval = std::chrono::duration<double>(c.interval_s);
+  return run_tail(participant, c.options, stop, out, err);
+}
+
+// progress
+
+struct ProgressCommand {
+  CLI::App* cmd = nullptr;
+  ProgressOptions options;
+  double interval_s = options.interval.count();
+  double timeout_s = 0.0;
+  CLI::Option* timeout = nullptr;
+  bool in_place = false;
+  bool lines = false;
+};
+
+void define_progress(CLI::App& app, ProgressCommand& c, cli::DdsOptions& dds) {
+  c.cmd = app.add_subcommand(
+      "progress", "one line with the step, progress, steps/s and ETA, kept up to date, until the run ends");
+  cli::add_dds_options(*c.cmd, dds);
+  c.cmd->add_option("--run-id", c.options.run_id, "follow this run only (default: the first run seen)");
+  c.cmd->add_option("--interval", c.interval_s, "shortest time between two updates [s]")
+      ->check(CLI::Range(1e-3, 86400.0))
+      ->capture_default_str();
+  c.timeout = c.cmd->add_option("--timeout", c.timeout_s, "exit 1 after this long without a world status [s]")
+                  ->check(CLI::Range(1e-3, 1e6));
+  auto* in_place_flag = c.cmd->add_flag("--in-place", c.in_place,
+                                        "rewrite one line in place (the default when stdout is a terminal)");
+  c.cmd->add_flag("--lines", c.lines, "print a new line at each update (the default otherwise)")->excludes(in_place_flag);
+  c.cmd->add_option("--width", c.options.width, "longest line [columns]; 0 = the terminal's width or none")
+      ->check(CLI::Range(0, 10000));
+}
+
+int run_progress_command(ProgressCommand& c, bus::Participant& participant, const StopSource& stop, std::ostream& out,
+                         std::ostream& err) {
+  // In place only on a terminal (or when asked): anything else, a file or a pipe, gets whole lines.
+  const bool terminal = &out == &std::cout && isatty(STDOUT_FILENO) == 1;
+  c.options.in_place = c.in_place || (terminal && !c.lines);
+  if (c.options.width == 0 && terminal) c.options.width = terminal_columns() - 1;
+  c.options.interval = std::chrono::duration<double>(c.interval_s);
+  if (c.timeout->count() > 0) c.options.timeout = std::chrono::duration<double>(c.timeout_s);
+  return run_progress(participant, c.options, stop, out, err);
+}
+
+// summary
+
+struct SummaryCommand {
+  CLI::App* cmd = nullptr;
+  std::string dir;
+};
+
+void define_summary(CLI::App& app, SummaryCommand& c) {
+  c.cmd = app.add_subcommand("summary", "a short account of a finished run, from DIR/summary.json");
+  c.cmd->add_option("DIR", c.dir, "the run's output folder")->required();
+}
+
+// status
+
+struct StatusCommand {
+  CLI::App* cmd = nullptr;
+  StatusOptions options;
+  double timeout_s = options.timeout.count();
+};
+
+void define_status(CLI::App& app, StatusCommand& c, cli::DdsOptions& dds) {
+  c.cmd = app.add_subcommand("status", "print the latest world status as a table, once");
+  cli::add_dds_options(*c.cmd, dds);
+  c.cmd->add_option("--timeout", c.timeout_s, "exit 1 when no world status arrives within this long [s]")
+      ->check(CLI::Range(1e-3, 1e6))
+      ->capture_default_str();
+}
+
+int run_status_command(StatusCommand& c, bus::Participant& participant, const StopSource& stop, std::ostream& out,
+                       std::ostream& err) {
+  c.options.timeout = std::chrono::duration<double>(c.timeout_s);
+  return run_status(participant, c.options, stop, out, err);
+}
+
+// replay
+
+struct ReplayCommand {
+  CLI::App* cmd = nullptr;
+  std::string dir;
+  std::uint64_t to_step = 0;
+  CLI::Option* to_step_option = nullptr;
+  ReplayOptions options;
+};
+
+void define_replay(CLI::App& app, ReplayCommand& c) {
+  c.cmd = app.add_subcommand("replay", "rebuild a run's terrain from its run.log, without any agent");
+  c.cmd->add_option("DIR", c.dir, "the run's output folder (run.log, terrain_initial.asc)")->required();
+  c.to_step_option = c.cmd
+                         ->add_option("--to-step", c.to_step,
+                                      "stop after N steps (0..N-1): the terrain the world had when it awaited step N")
+                         ->check(CLI::NonNegativeNumber)
+                         ->type_name("N");
+  auto* frames =
+      c.cmd->add_option("--frames-every", c.options.frames_every, "write a PNG frame every K steps and the last")
+          ->check(cli::at_least_one())
+          ->type_name("K");
+  c.cmd
+      ->add_option("--out", c.options.frames_dir,
+                   "the frames' folder (default DIR/replay); one that holds frames is refused")
+      ->type_name("FRAMES_DIR")
+      ->needs(frames);
+  c.cmd->footer(kReplayFooter);
+}
+
+int run_replay_command(ReplayCommand& c, std::ostream& out, std::ostream& err) {
+  if (c.to_step_option->count() > 0) c.options.to_step = c.to_step;
+  if (const char* path = std::getenv("PATH")) c.options.search_path = path;
+  const ReplayReport report = replay_run(c.dir, c.options);
+  if (!report.tail_problem.empty())
+    err << fmt::format("marsala-monitor: replayed the {} good steps; {}\n", report.steps, report.tail_problem);
+  out << format_replay_report(report);
+  return 0;
+}
+
+// serve
+
+struct ServeCommand {
+  CLI::App* cmd = nullptr;
+  ServeOptions options;
+};
+
+void define_serve(CLI::App& app, ServeCommand& c, cli::DdsOptions& dds) {
+  c.cmd = app.add_subcommand("serve", "serve a live view of the run to browsers (HTTP, loopback by default)");
+  cli::add_dds_options(*c.cmd, dds);
+  c.cmd->add_option("--port", c.options.port, "TCP port to listen on")
+      ->check(CLI::Range(1, 65535))
+      ->capture_default_str();
+  c.cmd->add_option("--bind", c.options.bind_address, "numeric address to listen on (0.0.0.0: every interface)")
+      ->capture_default_str();
+  auto* run_dir =
+      c.cmd
+          ->add_option("--run-dir", c.options.run_dir,
+                       "the run's --out folder: its run.log, followed as it grows, gives the terrain and deposits")
+          ->type_name("DIR");
+  auto* replay =
+      c.cmd->add_option("--replay", c.options.replay_dir, "play this run folder back instead of following DDS")
+          ->type_name("DIR")
+          ->excludes(run_dir);
+  c.cmd->add_option("--speed", c.options.replay_steps_per_s, "replay pace [steps/s]")
+      ->check(CLI::Range(1e-3, 1e9))
+      ->needs(replay)
+      ->capture_default_str();
+  c.cmd
+      ->add_option("--terrain-every", c.options.terrain_interval_s,
+                   "shortest time between two terrain pictures [s]")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
+  c.cmd->footer(kServeFooter);
+}
+
+/// serve has its own exit codes: a port or address it cannot listen on is a usage error (2).
+int run_serve_command(const ServeCommand& c, const cli::DdsOptions& dds, const StopSource& stop, std::ostream& out,
+                      std::ostream& err) {
+  try {
+    // Bound first: a bad port or address is a usage error, found before anything joins DDS.
+    LiveServer server(c.options);
+    std::unique_ptr<bus::Participant> participant;
+    if (c.options.replay_dir.empty()) participant = join_domain(dds);
+    return server.run(participant.get(), stop, out);
+  } catch (const ListenError& e) {
+    err << fmt::format("marsala-monitor: serve: {}\n", e.what());
+    return kExitUsage;
+  } catch (const InvalidArgument& e) {
+    err << fmt::format("marsala-monitor: serve: {}\n", e.what());
+    return kExitUsage;
+  } catch (const Error& e) {
+    err << fmt::format("marsala-monitor: serve: {}\n", e.what());
+    return kExitError;
+  } catch (const std::exception& e) {
+    err << fmt::format("marsala-monitor: serve: unexpected error: {}\n", e.what());
+    return kExitError;
+  }
+}
+
+/// Every subcommand, defined on one CLI::App (which keeps pointers into this struct: it must not move).
+struct MonitorCommands {
+  cli::DdsOptions dds;  ///< shared by the subcommands that join DDS (only one runs)
+  TailCommand tail;
+  ProgressCommand progress;
+  SummaryCommand summary;
+  StatusCommand status;
+  ReplayCommand replay;
+  ServeCommand serve;
+};
+
+/// Runs the chosen subcommand other than serve; errors become one line on `err` and exit code 1.
+int run_chosen(MonitorCommands& c, const StopSource& stop, std::ostream& out, std::ostream& err) {
+  try {
+    if (*c.summary.cmd) {
+      out << run_report(c.summary.dir);
+      return 0;
+    }
+    if (*c.replay.cmd) return run_replay_command(c.replay, out, err);
+    const std::unique_ptr<bus::Participant> participant = join_domain(c.dds);
+    if (*c.tail.cmd) return run_tail_command(c.tail, *participant, stop, out, err);
+    if (*c.progress.cmd) return run_progress_command(c.progress, *participant, stop, out, err);
+    return run_status_command(c.status, *participant, stop, out, err);
+  } catch (const Error& e) {
+    err << fmt::format("marsala-monitor: {}\n", e.what());
+  } catch (const std::bad_alloc&) {
+    err << "marsala-monitor: out of memory\n";
+  } catch (const std::exception& e) {
+    err << fmt::format("marsala-monitor: unexpected error: {}\n", e.what());
+  }
+  return kExitError;
+}
+
 }  // namespace
 
 int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& usage_err,
@@ -72,116 +325,15 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
   cli::LogOptions log_options;
   cli::add_log_options(app, log_options);
   app.fallthrough();  // before the subcommands, which inherit it: --log-format and --log-level also after one
-
-  cli::DdsOptions dds;
-  auto add_bus_options = [&](CLI::App& cmd) { cli::add_dds_options(cmd, dds); };
-
-  TailOptions tail_options;
-  double tail_timeout_s = 0.0;
-  auto* tail = app.add_subcommand("tail", "print one line per step (and per event) until the run ends or Ctrl-C");
-  add_bus_options(*tail);
-  tail->add_option("--run-id", tail_options.run_id, "follow this run only (default: the first run seen)");
-  tail->add_flag("--events", tail_options.events, "also print one line per world event");
-  auto* tail_timeout = tail->add_option("--timeout", tail_timeout_s,
-                                        "exit 1 after this long without a world status [s] (default: wait forever)")
-                           ->check(CLI::Range(1e-3, 1e6));
-  tail->add_option("--width", tail_options.format.width, "longest line [columns]; 0 = no limit")
-      ->check(CLI::Range(0, 10000))
-      ->capture_default_str();
-  tail->add_option("--every", tail_options.every_steps,
-                   "print a step line only when the step passes a multiple of N (and the last one)")
-      ->check(cli::at_least_one())
-      ->type_name("N");
-  double tail_interval_s = 0.0;
-  tail->add_option("--interval", tail_interval_s, "print at most one step line every S seconds (and the last one)")
-      ->check(CLI::Range(1e-3, 86400.0))
-      ->type_name("S");
-  tail->footer(kTailLegend);
-
-  ProgressOptions progress_options;
-  double progress_interval_s = progress_options.interval.count();
-  double progress_timeout_s = 0.0;
-  bool progress_in_place = false, progress_lines = false;
-  auto* progress = app.add_subcommand(
-      "progress", "one line with the step, progress, steps/s and ETA, kept up to date, until the run ends");
-  add_bus_options(*progress);
-  progress->add_option("--run-id", progress_options.run_id, "follow this run only (default: the first run seen)");
-  progress->add_option("--interval", progress_interval_s, "shortest time between two updates [s]")
-      ->check(CLI::Range(1e-3, 86400.0))
-      ->capture_default_str();
-  auto* progress_timeout =
-      progress->add_option("--timeout", progress_timeout_s, "exit 1 after this long without a world status [s]")
-          ->check(CLI::Range(1e-3, 1e6));
-  auto* in_place_flag = progress->add_flag(
-      "--in-place", progress_in_place, "rewrite one line in place (the default when stdout is a terminal)");
-  progress->add_flag("--lines", progress_lines, "print a new line at each update (the default otherwise)")
-      ->excludes(in_place_flag);
-  progress->add_option("--width", progress_options.width, "longest line [columns]; 0 = the terminal's width or none")
-      ->check(CLI::Range(0, 10000));
-
-  std::string summary_dir;
-  auto* summary = app.add_subcommand("summary", "a short account of a finished run, from DIR/summary.json");
-  summary->add_option("DIR", summary_dir, "the run's output folder")->required();
-
-  StatusOptions status_options;
-  double status_timeout_s = status_options.timeout.count();
-  auto* status = app.add_subcommand("status", "print the latest world status as a table, once");
-  add_bus_options(*status);
-  status->add_option("--timeout", status_timeout_s, "exit 1 when no world status arrives within this long [s]")
-      ->check(CLI::Range(1e-3, 1e6))
-      ->capture_default_str();
-
-  std::string replay_dir;
-  std::uint64_t to_step = 0;
-  ReplayOptions replay_options;
-  auto* replay = app.add_subcommand("replay", "rebuild a run's terrain from its run.log, without any agent");
-  replay->add_option("DIR", replay_dir, "the run's output folder (run.log, terrain_initial.asc)")->required();
-  auto* replay_to_step =
-      replay
-          ->add_option("--to-step", to_step,
-                       "stop after N steps (0..N-1): the terrain the world had when it awaited step N")
-          ->check(CLI::NonNegativeNumber)
-          ->type_name("N");
-  auto* replay_frames =
-      replay->add_option("--frames-every", replay_options.frames_every, "write a PNG frame every K steps and the last")
-          ->check(cli::at_least_one())
-          ->type_name("K");
-  replay
-      ->add_option("--out", replay_options.frames_dir,
-                   "the frames' folder (default DIR/replay); one that holds frames is refused")
-      ->type_name("FRAMES_DIR")
-      ->needs(replay_frames);
-  replay->footer(kReplayFooter);
-
-  ServeOptions serve_options;
-  auto* serve = app.add_subcommand("serve", "serve a live view of the run to browsers (HTTP, loopback by default)");
-  add_bus_options(*serve);
-  serve->add_option("--port", serve_options.port, "TCP port to listen on")
-      ->check(CLI::Range(1, 65535))
-      ->capture_default_str();
-  serve->add_option("--bind", serve_options.bind_address, "numeric address to listen on (0.0.0.0: every interface)")
-      ->capture_default_str();
-  auto* serve_run_dir =
-      serve
-          ->add_option("--run-dir", serve_options.run_dir,
-                       "the run's --out folder: its run.log, followed as it grows, gives the terrain and deposits")
-          ->type_name("DIR");
-  auto* serve_replay =
-      serve->add_option("--replay", serve_options.replay_dir, "play this run folder back instead of following DDS")
-          ->type_name("DIR")
-          ->excludes(serve_run_dir);
-  serve->add_option("--speed", serve_options.replay_steps_per_s, "replay pace [steps/s]")
-      ->check(CLI::Range(1e-3, 1e9))
-      ->needs(serve_replay)
-      ->capture_default_str();
-  serve
-      ->add_option("--terrain-every", serve_options.terrain_interval_s,
-                   "shortest time between two terrain pictures [s]")
-      ->check(CLI::Range(0.0, 3600.0))
-      ->capture_default_str();
-  serve->footer(kServeFooter);
-
+  MonitorCommands commands;
+  define_tail(app, commands.tail, commands.dds);
+  define_progress(app, commands.progress, commands.dds);
+  define_summary(app, commands.summary);
+  define_status(app, commands.status, commands.dds);
+  define_replay(app, commands.replay);
+  define_serve(app, commands.serve, commands.dds);
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-monitor", out, usage_err)) return *code;
+
   // The monitor's diagnostics are lines on a stream; in json each becomes one log record (common/cli/logging.hpp).
   const cli::LoggingScope logging("monitor", 0, log_options, &usage_err);
   std::optional<cli::LogLineStream> json_err;
@@ -191,73 +343,8 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
       return line.rfind("replayed the ", 0) == 0 ? "warn" : "error";
     });
   std::ostream& err = json_err ? static_cast<std::ostream&>(*json_err) : usage_err;
-
-  if (*serve) {
-    try {
-      // Bound first: a bad port or address is a usage error, found before anything joins DDS.
-      LiveServer server(serve_options);
-      std::unique_ptr<bus::Participant> participant;
-      if (serve_options.replay_dir.empty())
-        participant =
-            bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,
-                                   bus::Security::of(dds.security, dds.identity, "monitor")});
-      return server.run(participant.get(), stop, out);
-    } catch (const ListenError& e) {
-      err << "marsala-monitor: serve: " << e.what() << "\n";
-      return kExitUsage;
-    } catch (const InvalidArgument& e) {
-      err << "marsala-monitor: serve: " << e.what() << "\n";
-      return kExitUsage;
-    } catch (const Error& e) {
-      err << "marsala-monitor: serve: " << e.what() << "\n";
-      return kExitError;
-    } catch (const std::exception& e) {
-      err << "marsala-monitor: serve: unexpected error: " << e.what() << "\n";
-      return kExitError;
-    }
-  }
-
-  try {
-    if (*summary) {
-      out << run_report(summary_dir);
-      return 0;
-    }
-    if (*replay) {
-      if (replay_to_step->count() > 0) replay_options.to_step = to_step;
-      if (const char* path = std::getenv("PATH")) replay_options.search_path = path;
-      const ReplayReport report = replay_run(replay_dir, replay_options);
-      if (!report.tail_problem.empty())
-        err << "marsala-monitor: replayed the " << report.steps << " good steps; " << report.tail_problem << "\n";
-      out << format_replay_report(report);
-      return 0;
-    }
-    auto participant =
-        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,
-                               bus::Security::of(dds.security, dds.identity, "monitor")});
-    if (*tail) {
-      if (tail_timeout->count() > 0) tail_options.timeout = std::chrono::duration<double>(tail_timeout_s);
-      tail_options.interval = std::chrono::duration<double>(tail_interval_s);
-      return run_tail(*participant, tail_options, stop, out, err);
-    }
-    if (*progress) {
-      // In place only on a terminal (or when asked): anything else, a file or a pipe, gets whole lines.
-      const bool terminal = &out == &std::cout && isatty(STDOUT_FILENO) == 1;
-      progress_options.in_place = progress_in_place || (terminal && !progress_lines);
-      if (progress_options.width == 0 && terminal) progress_options.width = terminal_columns() - 1;
-      progress_options.interval = std::chrono::duration<double>(progress_interval_s);
-      if (progress_timeout->count() > 0) progress_options.timeout = std::chrono::duration<double>(progress_timeout_s);
-      return run_progress(*participant, progress_options, stop, out, err);
-    }
-    status_options.timeout = std::chrono::duration<double>(status_timeout_s);
-    return run_status(*participant, status_options, stop, out, err);
-  } catch (const Error& e) {
-    err << "marsala-monitor: " << e.what() << "\n";
-  } catch (const std::bad_alloc&) {
-    err << "marsala-monitor: out of memory\n";
-  } catch (const std::exception& e) {
-    err << "marsala-monitor: unexpected error: " << e.what() << "\n";
-  }
-  return kExitError;
+  if (*commands.serve.cmd) return run_serve_command(commands.serve, commands.dds, stop, out, err);
+  return run_chosen(commands, stop, out, err);
 }
 
 }  // namespace marsala::monitor
