@@ -4,6 +4,8 @@
 // one line "<program>: <reason> (run with --help for usage)" and exits 2.
 // Include it only from files that link marsala::cli.
 
+#include <fmt/format.h>
+
 #include <optional>
 #include <ostream>
 #include <string>
@@ -62,7 +64,7 @@ inline CLI::Validator at_least_one() {
         const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
         return digits && text.find_first_not_of('0') != std::string::npos
                    ? std::string()
-                   : "must be a whole number of at least 1, not " + text;
+                   : fmt::format("must be a whole number of at least 1, not {}", text);
       },
       ">= 1");
 }
@@ -87,7 +89,7 @@ inline std::optional<int> parse_command_line(CLI::App& app, int argc, const char
       for (const CLI::App* sub : subcommands) out << sub->help();
       return 0;
     }
-    err << program << ": " << e.what() << " (run with --help for usage)\n";
+    err << fmt::format("{}: {} (run with --help for usage)\n", program, e.what());
     return kExitUsage;
   }
 }

@@ -18,28 +18,6 @@ namespace {
 
 std::string temp_path(const std::string& name) { return ::testing::TempDir() + "/marsala_png_writer_" + name; }
 
-// Reads a PNG back with libpng (independent of the writer) as 8-bit RGB.
-Image read_png(const std::string& path) {
-  png_image png;
-  std::memset(&png, 0, sizeof png);
-  png.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&png, path.c_str())) {
-    ADD_FAILURE() << "cannot read " << path << ": " << png.message;
-    return {};
-  }
-  png.format = PNG_FORMAT_RGB;
-  Image image;
-  image.width = static_cast<int>(png.width);
-  image.height = static_cast<int>(png.height);
-  image.rgb.resize(PNG_IMAGE_SIZE(png));
-  if (!png_image_finish_read(&png, nullptr, image.rgb.data(), 0, nullptr)) {
-    ADD_FAILURE() << "cannot decode " << path << ": " << png.message;
-    png_image_free(&png);
-    return {};
-  }
-  return image;
-}
-
 // Decodes PNG bytes with libpng (independent of the encoder) as 8-bit RGB.
 Image decode_png(const std::vector<std::uint8_t>& bytes) {
   png_image png;
@@ -66,6 +44,9 @@ std::vector<std::uint8_t> file_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
+
+// Reads a PNG file back with libpng (independent of the writer) as 8-bit RGB.
+Image read_png(const std::string& path) { return decode_png(file_bytes(path)); }
 
 Image pattern(int width, int height) {
   Image image{width, height, std::vector<std::uint8_t>(3u * width * height)};
