@@ -68,8 +68,7 @@ std::unique_ptr<bus::Participant> join_domain(const cli::DdsOptions& dds) {
                                 bus::Security::of(dds.security, dds.identity, "monitor")});
 }
 
-// tail
-
+/// The tail subcommand: its options (define_tail binds them) and its CLI11 subcommand.
 struct TailCommand {
   CLI::App* cmd = nullptr;
   TailOptions options;
@@ -106,8 +105,7 @@ int run_tail_command(TailCommand& c, bus::Participant& participant, const StopSo
   return run_tail(participant, c.options, stop, out, err);
 }
 
-// progress
-
+/// The progress subcommand: its options (define_progress binds them) and its CLI11 subcommand.
 struct ProgressCommand {
   CLI::App* cmd = nullptr;
   ProgressOptions options;
@@ -146,8 +144,7 @@ int run_progress_command(ProgressCommand& c, bus::Participant& participant, cons
   return run_progress(participant, c.options, stop, out, err);
 }
 
-// summary
-
+/// The summary subcommand: its options (define_summary binds them) and its CLI11 subcommand.
 struct SummaryCommand {
   CLI::App* cmd = nullptr;
   std::string dir;
@@ -158,8 +155,7 @@ void define_summary(CLI::App& app, SummaryCommand& c) {
   c.cmd->add_option("DIR", c.dir, "the run's output folder")->required();
 }
 
-// status
-
+/// The status subcommand: its options (define_status binds them) and its CLI11 subcommand.
 struct StatusCommand {
   CLI::App* cmd = nullptr;
   StatusOptions options;
@@ -180,8 +176,7 @@ int run_status_command(StatusCommand& c, bus::Participant& participant, const St
   return run_status(participant, c.options, stop, out, err);
 }
 
-// replay
-
+/// The replay subcommand: its options (define_replay binds them) and its CLI11 subcommand.
 struct ReplayCommand {
   CLI::App* cmd = nullptr;
   std::string dir;
@@ -220,8 +215,7 @@ int run_replay_command(ReplayCommand& c, std::ostream& out, std::ostream& err) {
   return 0;
 }
 
-// serve
-
+/// The serve subcommand: its options (define_serve binds them) and its CLI11 subcommand.
 struct ServeCommand {
   CLI::App* cmd = nullptr;
   ServeOptions options;

@@ -230,8 +230,7 @@ struct TerrainPreparation {
   bool zero_base = false;
 };
 
-// generate
-
+/// The generate subcommand: its options (define_generate binds them) and its CLI11 subcommand.
 struct GenerateCommand {
   CLI::App* cmd = nullptr;
   terrain::GeneratorSpec spec;
@@ -265,8 +264,7 @@ void run_generate(GenerateCommand& c, std::ostream& out) {
                      map.cols(), map.cell_size_m(), map.min_height(), map.max_height(), c.out_path);
 }
 
-// import
-
+/// The import subcommand: its options (define_import binds them) and its CLI11 subcommand.
 struct ImportCommand {
   CLI::App* cmd = nullptr;
   std::string in_path;
@@ -299,8 +297,7 @@ void run_import(const ImportCommand& c, std::ostream& out) {
                      c.out_path);
 }
 
-// info
-
+/// The info subcommand: its options (define_info binds them) and its CLI11 subcommand.
 struct InfoCommand {
   CLI::App* cmd = nullptr;
   std::string in_path;
@@ -330,8 +327,7 @@ void run_info(const InfoCommand& c, std::ostream& out) {
       s.max_height_m - s.min_height_m, s.mean_slope, s.max_slope);
 }
 
-// mars
-
+/// The mars subcommand: its options (define_mars binds them) and its CLI11 subcommand.
 struct MarsCommand {
   CLI::App* cmd = nullptr;
   std::string in_path;
@@ -362,8 +358,7 @@ void run_mars(const MarsCommand& c, std::ostream& out) {
                      deposition_target_volume(gap), gap.max_height(), c.out_path);
 }
 
-// navigable
-
+/// The navigable subcommand: its options (define_navigable binds them) and its CLI11 subcommand.
 struct NavigableCommand {
   CLI::App* cmd = nullptr;
   std::string in_path;
@@ -406,8 +401,7 @@ void run_navigable(const NavigableCommand& c, std::ostream& out) {
   if (count(reach) == 0) out << "note: the origin cell is not occupiable, so nothing is navigable\n";
 }
 
-// render
-
+/// The render subcommand: its options (define_render binds them) and its CLI11 subcommand.
 struct RenderCommand {
   CLI::App* cmd = nullptr;
   std::string in_path;
@@ -457,8 +451,7 @@ void run_render(const RenderCommand& c, std::ostream& out) {
   out << fmt::format("rendered {} x {} -> {}\n", map.rows(), map.cols(), c.out_path);
 }
 
-// render3d
-
+/// The render3d subcommand: its options (define_render3d binds them) and its CLI11 subcommand.
 struct Render3dCommand {
   CLI::App* cmd = nullptr;
   std::string in_path;
@@ -514,8 +507,7 @@ void run_render3d(Render3dCommand& c, std::ostream& out) {
                      c.out_path);
 }
 
-// route
-
+/// The route subcommand: its options (define_route binds them) and its CLI11 subcommand.
 struct RouteCommand {
   CLI::App* cmd = nullptr;
   std::string in_path;
