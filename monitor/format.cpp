@@ -69,6 +69,12 @@ const char* yes_no(bool value) { return value ? "yes" : "no"; }
 
 }  // namespace
 
+std::string event_kind(protocol::EventKind kind) {
+  const auto value = static_cast<unsigned>(kind);
+  return value <= static_cast<unsigned>(protocol::EventKind::kRunOver) ? protocol::to_string(kind)
+                                                                       : fmt::format("kind {}", value);
+}
+
 std::string printable(const std::string& text) {
   std::string out = text;
   for (char& ch : out) {
@@ -144,14 +150,11 @@ std::string format_run_summary(const protocol::WorldStatus& status) {
 
 std::string format_event(const protocol::WorldEvent& event, const FormatOptions& options) {
   const std::string who = event.agent_id == 0 ? std::string("world") : fmt::format("agent {}", event.agent_id);
-  const auto kind_value = static_cast<unsigned>(event.kind);
-  const std::string kind = kind_value <= static_cast<unsigned>(protocol::EventKind::kRunOver)
-                               ? protocol::to_string(event.kind)
-                               : fmt::format("kind {}", kind_value);
   const std::string volume =
       event.kind == protocol::EventKind::kDeposited ? fmt::format(" {:.6g} m3", event.volume_m3) : std::string();
   const std::string detail = event.detail.empty() ? std::string() : fmt::format(" {}", printable(event.detail));
-  const std::string line = fmt::format("{:>6} > {:<8} {:<9}{}{}", event.step, who, kind, volume, detail);
+  const std::string line =
+      fmt::format("{:>6} > {:<8} {:<9}{}{}", event.step, who, event_kind(event.kind), volume, detail);
   return fit_width(trim_right(line), options.width);
 }
 

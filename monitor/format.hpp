@@ -50,6 +50,8 @@ std::string format_event(const protocol::WorldEvent& event, const FormatOptions&
 /// The status table: run line, column header, one row per agent in the order given, a totals row.
 std::vector<std::string> format_status_table(const protocol::WorldStatus& status);
 
+/// The name of an event's kind ("deposited", ...), or "kind N" for a kind this monitor does not know (a newer world).
+std::string event_kind(protocol::EventKind kind);
 /// `text` with every byte outside printable ASCII replaced by '?'.
 std::string printable(const std::string& text);
 /// `line` cut to `width` columns, ending in "..." when cut; unchanged when it fits or `width` is 0.

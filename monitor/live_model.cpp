@@ -168,12 +168,9 @@ std::string LiveModel::state_json(Clock::time_point now) const {
   }
   json events = json::array();
   for (auto it = events_.rbegin(); it != events_.rend(); ++it) {
-    const auto kind = static_cast<unsigned>(it->kind);
     events.push_back({{"step", it->step},
                       {"agent", it->agent_id},
-                      {"kind", kind <= static_cast<unsigned>(protocol::EventKind::kRunOver)
-                                   ? protocol::to_string(it->kind)
-                                   : fmt::format("kind {}", kind)},
+                      {"kind", event_kind(it->kind)},
                       {"volume_m3", it->volume_m3},
                       {"detail", printable(it->detail)}});
   }

@@ -129,6 +129,12 @@ TEST(Format, EventLines) {
   EXPECT_EQ(format_event(e), "     1 > agent 2  kind 42   x");
 }
 
+TEST(Format, EventKindsByNameOrNumber) {
+  EXPECT_EQ(event_kind(protocol::EventKind::kDeposited), "deposited");
+  EXPECT_EQ(event_kind(protocol::EventKind::kRunOver), "run_over");
+  EXPECT_EQ(event_kind(static_cast<protocol::EventKind>(200)), "kind 200");
+}
+
 TEST(Format, TextFromTheWireCannotDriveTheTerminal) {
   protocol::WorldEvent e;
   e.step = 5;
