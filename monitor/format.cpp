@@ -19,14 +19,6 @@ std::string cut(const std::string& text, int width) {
   return text.substr(0, static_cast<std::size_t>(std::max(width, 0)));
 }
 
-/// Agents in id order (the world sends them so; sorting keeps the columns stable whatever arrives).
-std::vector<const protocol::AgentStatus*> by_id(const protocol::WorldStatus& status) {
-  std::vector<const protocol::AgentStatus*> agents;
-  for (const protocol::AgentStatus& a : status.agents) agents.push_back(&a);
-  std::stable_sort(agents.begin(), agents.end(), [](auto* a, auto* b) { return a->agent_id < b->agent_id; });
-  return agents;
-}
-
 std::size_t count_alive(const protocol::WorldStatus& status) {
   return static_cast<std::size_t>(
       std::count_if(status.agents.begin(), status.agents.end(), [](const auto& a) { return a.alive; }));
@@ -69,6 +61,13 @@ const char* yes_no(bool value) { return value ? "yes" : "no"; }
 
 }  // namespace
 
+std::vector<const protocol::AgentStatus*> agents_by_id(const protocol::WorldStatus& status) {
+  std::vector<const protocol::AgentStatus*> agents;
+  for (const protocol::AgentStatus& a : status.agents) agents.push_back(&a);
+  std::stable_sort(agents.begin(), agents.end(), [](auto* a, auto* b) { return a->agent_id < b->agent_id; });
+  return agents;
+}
+
 std::string event_kind(protocol::EventKind kind) {
   const auto value = static_cast<unsigned>(kind);
   return value <= static_cast<unsigned>(protocol::EventKind::kRunOver) ? protocol::to_string(kind)
@@ -106,7 +105,7 @@ std::string format_step_header(const protocol::WorldStatus& status, const Format
   } else if (text_width == 0) {
     line += " live agents by state";
   } else {
-    for (const protocol::AgentStatus* a : by_id(status))
+    for (const protocol::AgentStatus* a : agents_by_id(status))
       line += fmt::format(" {:<{}}", a->agent_id, text_width);
   }
   return fit_width(trim_right(line), options.width);
@@ -125,7 +124,7 @@ std::string format_step_line(const protocol::WorldStatus& status, const FormatOp
   } else if (text_width == 0) {
     line += fmt::format(" {}", states_summary(status));
   } else {
-    for (const protocol::AgentStatus* a : by_id(status))
+    for (const protocol::AgentStatus* a : agents_by_id(status))
       line += fmt::format(" {:<{}}", agent_column(*a, text_width), text_width);
   }
   return fit_width(trim_right(line), options.width);
@@ -170,7 +169,7 @@ std::vector<std::string> format_status_table(const protocol::WorldStatus& status
                                          "rej", "miss", "alive", "goal")));
   double material_m3 = 0.0, deposited_m3 = 0.0;
   unsigned long long accepted = 0, rejected = 0, missed = 0;
-  for (const protocol::AgentStatus* a : by_id(status)) {
+  for (const protocol::AgentStatus* a : agents_by_id(status)) {
     lines.push_back(trim_right(fmt::format(
         "{:>3} {:<12} {:<11} {:8.2f} {:8.2f} {:7.3f} {:7.4f} {:7.4f} {:>5} {:>4} {:>4} {:<5} {:<4}", a->agent_id,
         cut(printable(a->name), 12), cut(state_of(*a), 11), a->x_m, a->y_m, a->z_m, a->material_m3, a->deposited_m3,

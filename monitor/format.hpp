@@ -50,6 +50,9 @@ std::string format_event(const protocol::WorldEvent& event, const FormatOptions&
 /// The status table: run line, column header, one row per agent in the order given, a totals row.
 std::vector<std::string> format_status_table(const protocol::WorldStatus& status);
 
+/// The agents of `status` in id order (the world sends them so; sorting keeps columns and tables stable whatever
+/// arrives).
+std::vector<const protocol::AgentStatus*> agents_by_id(const protocol::WorldStatus& status);
 /// The name of an event's kind ("deposited", ...), or "kind N" for a kind this monitor does not know (a newer world).
 std::string event_kind(protocol::EventKind kind);
 /// `text` with every byte outside printable ASCII replaced by '?'.

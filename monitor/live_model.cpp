@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 
 #include <nlohmann/json.hpp>
 
@@ -143,10 +142,7 @@ std::string LiveModel::state_json(Clock::time_point now) const {
                 {"mean_steps_per_s", mean_rate},
                 {"status_age_s", std::chrono::duration<double>(now - status_time_).count()}};
     json agents = json::array();
-    std::vector<const protocol::AgentStatus*> sorted;
-    for (const protocol::AgentStatus& a : s.agents) sorted.push_back(&a);
-    std::stable_sort(sorted.begin(), sorted.end(), [](auto* a, auto* b) { return a->agent_id < b->agent_id; });
-    for (const protocol::AgentStatus* a : sorted)
+    for (const protocol::AgentStatus* a : agents_by_id(s))
       agents.push_back({{"id", a->agent_id},
                         {"name", printable(a->name)},
                         {"state", printable(a->state)},
