@@ -92,22 +92,21 @@ std::optional<LiveScene> scene_of(const proto::LogHeader& header) {
     const scenario::Scenario s = scenario::parse_scenario(header.scenario_text(), header.scenario_file());
     LiveScene scene;
     scene.completion = scenario::to_string(s.completion);
-    scene.base = Position{s.base.x_m, s.base.y_m};
+    scene.base = s.base.centre;
     scene.base_radius_m = s.base.radius_m;
     switch (s.completion) {
       case scenario::CompletionKind::kAgentsAtGoal:
-        scene.goal = Rect{s.goal.x0_m, s.goal.y0_m, s.goal.x1_m, s.goal.y1_m};
+        scene.goal = s.goal.area;
         break;
       case scenario::CompletionKind::kLevelSite:
-        scene.site = Rect{s.site.x0_m, s.site.y0_m, s.site.x1_m, s.site.y1_m};
+        scene.site = s.site.area;
         break;
       case scenario::CompletionKind::kPayloadPath:
-        scene.payload = std::make_pair(Position{s.payload_path.from_x_m, s.payload_path.from_y_m},
-                                       Position{s.payload_path.to_x_m, s.payload_path.to_y_m});
+        scene.payload = std::make_pair(s.payload_path.from, s.payload_path.to);
         break;
     }
     for (const scenario::AgentSlot& slot : s.slots)
-      if (slot.id <= header.agents()) scene.targets.emplace_back(slot.id, Position{slot.target_x_m, slot.target_y_m});
+      if (slot.id <= header.agents()) scene.targets.emplace_back(slot.id, slot.target);
     return scene;
   } catch (const Error&) {
     return std::nullopt;
