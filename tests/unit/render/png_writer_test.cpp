@@ -48,6 +48,14 @@ std::vector<std::uint8_t> file_bytes(const std::string& path) {
 // Reads a PNG file back with libpng (independent of the writer) as 8-bit RGB.
 Image read_png(const std::string& path) { return decode_png(file_bytes(path)); }
 
+// A rendered terrain of rows x cols cells of 0.5 m, rising in steps of varied slope.
+Image terrain_picture(int rows, int cols) {
+  Heightmap map(GridGeometry{rows, cols, 0.0, 0.0, 0.5});
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) map(r, c) = 0.1 * r * c - 0.3 * c;
+  return render_terrain(map);
+}
+
 Image pattern(int width, int height) {
   Image image{width, height, std::vector<std::uint8_t>(3u * width * height)};
   for (int y = 0; y < height; ++y)
@@ -90,10 +98,7 @@ TEST(PngWriter, FileStartsWithThePngSignature) {
 }
 
 TEST(PngWriter, RenderedTerrainRoundTrips) {
-  Heightmap map(GridGeometry{9, 13, 0.0, 0.0, 0.5});
-  for (int r = 0; r < 9; ++r)
-    for (int c = 0; c < 13; ++c) map(r, c) = 0.1 * r * c - 0.3 * c;
-  const Image image = render_terrain(map);
+  const Image image = terrain_picture(9, 13);
   const std::string path = temp_path("terrain.png");
   write_png(image, path);
   const Image back = read_png(path);
@@ -131,10 +136,7 @@ TEST(PngWriter, MalformedImagesAreRejected) {
 }
 
 TEST(PngWriter, EncodedBytesDecodeToEveryPixelAtBothSpeeds) {
-  Heightmap map(GridGeometry{9, 13, 0.0, 0.0, 0.5});
-  for (int r = 0; r < 9; ++r)
-    for (int c = 0; c < 13; ++c) map(r, c) = 0.1 * r * c - 0.3 * c;
-  for (const Image& image : {pattern(3, 2), render_terrain(map)})
+  for (const Image& image : {pattern(3, 2), terrain_picture(9, 13)})
     for (const PngSpeed speed : {PngSpeed::kSmall, PngSpeed::kFast}) {
       const std::vector<std::uint8_t> bytes = encode_png(image, speed);
       const Image back = decode_png(bytes);
@@ -145,10 +147,7 @@ TEST(PngWriter, EncodedBytesDecodeToEveryPixelAtBothSpeeds) {
 }
 
 TEST(PngWriter, FileHoldsTheEncodedBytesAsLibpngsFileWriterWritesThem) {
-  Heightmap map(GridGeometry{20, 30, 0.0, 0.0, 0.5});
-  for (int r = 0; r < 20; ++r)
-    for (int c = 0; c < 30; ++c) map(r, c) = 0.02 * r * r - 0.1 * c;
-  const Image image = render_terrain(map);
+  const Image image = terrain_picture(20, 30);
   const std::string path = temp_path("same_bytes.png");
   write_png(image, path);
   // The reference: libpng's own file writer with default settings, as the pictures of a run were always written.
