@@ -179,9 +179,7 @@ class Experiment:
         s, problem = summary.run_summary(job.run_dir, exit_code)
         name = f"{PROG}: {self.args.vary}={value} seed {seed}"
         if s is None:
-            lines = summary.failure_lines(job.run_dir, problem)
-            say(f"{name}: {lines[0]}")
-            for line in lines[1:]:
+            for line in summary.failure_lines(name, job.run_dir, problem):
                 say(line)
             self.failed += 1
             return

@@ -86,10 +86,11 @@ def run_summary(run_dir, exit_code):
         return None, f"unreadable {path}: {e}"
 
 
-def failure_lines(run_dir, problem, tail=5):
-    """What a failed run's line says after its name, then the last `tail` lines of its spawn.log, indented."""
+def failure_lines(name, run_dir, problem, tail=5):
+    """The lines that tell of a failed run: "<name>: FAILED (problem; ...)", then the last `tail` lines of its
+    spawn.log, indented."""
     log = os.path.join(run_dir, "spawn.log")
-    lines = [f"FAILED ({problem}; see {log} and {run_dir}/logs)"]
+    lines = [f"{name}: FAILED ({problem}; see {log} and {run_dir}/logs)"]
     try:
         with open(log, encoding="utf-8", errors="replace") as f:
             lines += ["    " + line.rstrip("\n") for line in f.readlines()[-tail:]]

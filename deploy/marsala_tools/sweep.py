@@ -204,9 +204,7 @@ class Sweep:
         team, seed = job.key
         s, problem = summary.run_summary(job.run_dir, exit_code)
         if s is None:
-            lines = summary.failure_lines(job.run_dir, problem)
-            say(f"  team {team}, seed {seed}: {lines[0]}")
-            for line in lines[1:]:
+            for line in summary.failure_lines(f"  team {team}, seed {seed}", job.run_dir, problem):
                 say(line)
             self.failed += 1
             return

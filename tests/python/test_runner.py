@@ -3,24 +3,28 @@
 import os
 import signal
 import sys
-import threading
 import time
 
 import pytest
 
 from marsala_tools import runner
 
-# The fake spawn.sh: `fake SECONDS EXIT_CODE --domain D` notes its start and end in the log given by $FAKE_LOG,
-# sleeps, and exits with EXIT_CODE (KILL: dies by SIGKILL).
+# The fake spawn.sh: `fake WAIT EXIT_CODE --domain D` notes its start and end in the log given by $FAKE_LOG, waits
+# (WAIT seconds, or until the file WAIT exists, at most 30 s), and exits with EXIT_CODE (KILL: dies by SIGKILL).
 FAKE = """
 import os, signal, sys, time
-seconds, code, domain = float(sys.argv[1]), sys.argv[2], sys.argv[4]
+wait, code, domain = sys.argv[1], sys.argv[2], sys.argv[4]
 def note(what):
     with open(os.environ["FAKE_LOG"], "a") as f:
         f.write(f"{what} {domain} {time.monotonic()}\\n")
 note("start")
 print("fake spawn.sh output")
-time.sleep(seconds)
+if wait.startswith("/"):
+    deadline = time.monotonic() + 30
+    while not os.path.exists(wait) and time.monotonic() < deadline:
+        time.sleep(0.01)
+else:
+    time.sleep(float(wait))
 note("end")
 if code == "KILL":
     os.kill(os.getpid(), signal.SIGKILL)
@@ -69,9 +73,16 @@ def test_consecutive_runs_get_consecutive_fresh_domains(tmp_path, fake):
 
 def test_parallel_runs_finish_in_the_order_they_end_and_never_exceed_the_limit(tmp_path, fake):
     finished = []
-    r = runner.Runner(fake, 2, lambda job, code: finished.append(job.key))
-    r.run(jobs_of(tmp_path, [(1.0, 0), (0.1, 0), (0.1, 0), (0.1, 0)]))
-    assert finished == [1, 2, 3, 0]  # the long first run ends last
+    release = tmp_path / "release"
+
+    def on_finish(job, code):
+        finished.append(job.key)
+        if job.key == 3:
+            release.touch()
+
+    r = runner.Runner(fake, 2, on_finish)
+    r.run(jobs_of(tmp_path, [(str(release), 0), (0, 0), (0, 0), (0, 0)]))
+    assert finished == [1, 2, 3, 0]  # the first run waits for the last one: the others pass it on the second slot
     running = peak = 0
     for kind, _, _ in sorted(events(tmp_path), key=lambda e: float(e[2])):
         running += 1 if kind == "start" else -1
@@ -96,18 +107,20 @@ def test_an_old_run_folder_is_replaced(tmp_path, fake):
 
 def test_a_stop_signal_stops_the_runs_under_way(tmp_path, fake):
     finished = []
-    r = runner.Runner(fake, 2, lambda job, code: finished.append(job.key))
+
+    def on_finish(job, code):  # the first run's end brings a stop signal; the second run is under way then
+        finished.append(job.key)
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    r = runner.Runner(fake, 2, on_finish)
     before = signal.getsignal(signal.SIGTERM)
-    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGTERM))
-    timer.start()
     started = time.monotonic()
     with pytest.raises(runner.Interrupted):
-        r.run(jobs_of(tmp_path, [(0, 0), (30, 0), (30, 0), (30, 0)]))
-    timer.join()
+        r.run(jobs_of(tmp_path, [(0, 0), (30, 0), (30, 0)]))
     assert time.monotonic() - started < 10  # stopped, not waited for
-    assert finished == [0]  # the stopped runs have no result; the fourth never started
-    kinds = [e[0] for e in events(tmp_path)]
-    assert (kinds.count("start"), kinds.count("end")) == (3, 1)  # only the first run ended
+    assert finished == [0]  # the stopped run has no result
+    assert [e[0] for e in events(tmp_path)].count("end") == 1
+    assert (tmp_path / "run1").exists() and not (tmp_path / "run2").exists()  # the third never started
     assert r.running == []
     assert signal.getsignal(signal.SIGTERM) == before
 

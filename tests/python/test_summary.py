@@ -53,8 +53,8 @@ def test_run_summary_needs_an_ended_exit_code_and_the_file(tmp_path):
 
 def test_failure_lines_end_with_the_log_tail(tmp_path):
     (tmp_path / "spawn.log").write_text("".join(f"line {i}\n" for i in range(8)))
-    lines = summary.failure_lines(str(tmp_path), "spawn.sh exit 1, no summary", tail=2)
-    assert lines[0].startswith("FAILED (spawn.sh exit 1, no summary; see ")
+    lines = summary.failure_lines("run 1", str(tmp_path), "spawn.sh exit 1, no summary", tail=2)
+    assert lines[0].startswith("run 1: FAILED (spawn.sh exit 1, no summary; see ")
     assert lines[1:] == ["    line 6", "    line 7"]
 
 
