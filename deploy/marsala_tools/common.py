@@ -41,6 +41,7 @@ class ArgumentParser(argparse.ArgumentParser):
         super().__init__(allow_abbrev=False, **kwargs)
 
     def error(self, message):
+        """Raises UsageError(message) instead of printing usage and exiting."""
         raise UsageError(f"{message} (try --help)")
 
 

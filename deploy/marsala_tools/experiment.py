@@ -164,6 +164,7 @@ class Experiment:
         self.failed = 0
 
     def job(self, value, seed, agents):
+        """The spawn.sh job of one (value, seed) with `agents` robots."""
         a = self.args
         run_dir = os.path.join(a.out, f"v{value}-s{seed}")
         args = ["--scenario", a.scenario, "--seed", str(seed), "--out", run_dir, "--quiet", "--dds", a.dds,
@@ -175,6 +176,7 @@ class Experiment:
         return runner.Job((value, seed), run_dir, args)
 
     def finish_run(self, job, exit_code):
+        """Records a finished run (its Summary, for the outputs at the end) and prints its line."""
         value, seed = job.key
         s, problem = summary.run_summary(job.run_dir, exit_code)
         name = f"{PROG}: {self.args.vary}={value} seed {seed}"
@@ -203,6 +205,7 @@ class Experiment:
         return third
 
     def plot(self, third):
+        """OUT/experiment.png with gnuplot, when it is installed."""
         if shutil.which("gnuplot") is None:
             warn(PROG, "gnuplot not found: no plot (install gnuplot-nox)")
             return
@@ -214,6 +217,7 @@ class Experiment:
             say(f"{PROG}: plot {self.args.out}/experiment.png")
 
     def main(self):
+        """Checks the values, runs every (value, seed), writes the outputs; returns the exit code."""
         a = self.args
         check_values(a)
         agents = a.agents or common.agent_slots(a.scenario)

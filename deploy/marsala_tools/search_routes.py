@@ -133,6 +133,7 @@ def report(args, kept, searched):
     """Ranks the kept routes, prints the best, writes --json."""
 
     def nth_site(r):
+        """The volume of the route's --min-sites-th largest site [m^3]."""
         return sorted((s["volume_m3"] for s in r["sites"]), reverse=True)[args.min_sites - 1]
 
     kept.sort(key=lambda r: -(nth_site(r) if args.rank == "site" else r["volume_m3"]))
@@ -150,6 +151,7 @@ def report(args, kept, searched):
 
 
 def search(argv):
+    """Searches every window and reports; returns the exit code."""
     args = build_parser().parse_args(argv)
     if not os.path.isfile(args.dem):
         raise UsageError(f"terrain file '{args.dem}' not found")

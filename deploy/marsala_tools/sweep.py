@@ -219,6 +219,7 @@ class Sweep:
             % (team, seed, state, s.steps, s.wall_seconds, s.deposited_m3, 100 * s.idle_fraction))
 
     def run_all(self):
+        """Runs the (team, seed) pairs to do, `--jobs` at a time."""
         a = self.args
         todo = [(t, s) for t in a.teams for s in a.seeds if a.force or (t, s) not in self.rows]
         say(f"{PROG}: {os.path.basename(a.scenario)} ({self.slots} slots), teams {' '.join(map(str, a.teams))}, "
@@ -241,6 +242,7 @@ class Sweep:
             self.plot()
 
     def plot(self):
+        """OUT/sweep.png with gnuplot and deploy/plot_sweep.gp, when gnuplot is installed."""
         if shutil.which("gnuplot") is None:
             say(f"{PROG}: note: gnuplot is not installed (deploy/install-deps.sh or apt-get install gnuplot-nox): "
                 "no sweep.png")
@@ -261,6 +263,7 @@ class Sweep:
             self.failed += 1
 
     def main(self):
+        """Checks, opens OUT, runs, reports; returns the exit code."""
         self.prepare()
         self.open_output()
         try:
