@@ -32,12 +32,17 @@ class UsageError(ToolError):
         super().__init__(message, EXIT_USAGE)
 
 
+def _help_format(prog):
+    # The descriptions keep their own lines; the options' help is as wide as the project's text (118 columns).
+    return argparse.RawDescriptionHelpFormatter(prog, max_help_position=30, width=118)
+
+
 class ArgumentParser(argparse.ArgumentParser):
     """argparse whose errors raise UsageError (so the tool prints them in its own style) and that takes no
     abbreviated option names."""
 
     def __init__(self, **kwargs):
-        kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
+        kwargs.setdefault("formatter_class", _help_format)
         super().__init__(allow_abbrev=False, **kwargs)
 
     def error(self, message):

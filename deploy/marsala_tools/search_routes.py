@@ -42,7 +42,7 @@ def windows_type(text):
 def build_parser():
     """The route search's command line."""
     p = common.ArgumentParser(prog="deploy/search_routes.py", description=DESCRIPTION)
-    p.add_argument("--dem", required=True, help="terrain file (.asc or .tif)")
+    p.add_argument("--dem", required=True, metavar="FILE", help="terrain file (.asc or .tif)")
     p.add_argument("--windows", type=windows_type,
                    default="0,0 94,0 188,0 0,88 94,88 188,88 0,177 94,177 188,177 90,90",
                    help="lower-left corners X0,Y0 of the windows [m] (default: a 3 x 3 grid over 348 x 337 m "

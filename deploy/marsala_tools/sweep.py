@@ -38,7 +38,7 @@ MAX_SEEDS = 999999
 def build_parser():
     """The sweep's command line."""
     p = common.ArgumentParser(prog="deploy/sweep.sh", description=DESCRIPTION, epilog=EPILOG)
-    p.add_argument("--scenario", default=os.path.join(ROOT, "deploy/scenarios/path_gale.pbtxt"),
+    p.add_argument("--scenario", default=os.path.join(ROOT, "deploy/scenarios/path_gale.pbtxt"), metavar="FILE",
                    help="scenario file (default deploy/scenarios/path_gale.pbtxt); needs as many agent slots as the "
                         "largest team")
     p.add_argument("--teams", default="1 3 5 9 12", metavar='"T1 T2 ..."',
