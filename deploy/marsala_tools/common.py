@@ -5,6 +5,7 @@ import argparse
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 
@@ -54,9 +55,10 @@ def positive_int(limit):
     """An argparse type: a decimal integer in [1, limit]."""
 
     def parse(text):
-        if not (text.isdigit() and 1 <= int(text) <= limit):
-            raise argparse.ArgumentTypeError(f"'{text}' is not an integer in [1, {limit}]")
-        return int(text)
+        try:
+            return count_word(limit)(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not an integer in [1, {limit}]") from None
 
     return parse
 
@@ -82,11 +84,15 @@ def word_list(parse_one, noun, description):
     return parse
 
 
+def _is_decimal(word):
+    return re.fullmatch(r"[0-9]+", word) is not None
+
+
 def count_word(limit):
     """Reads a word as an integer in [1, limit] (ValueError otherwise)."""
 
     def parse(word):
-        if not (word.isdigit() and 1 <= int(word) <= limit):
+        if not (_is_decimal(word) and 1 <= int(word) <= limit):
             raise ValueError(word)
         return int(word)
 
@@ -94,8 +100,8 @@ def count_word(limit):
 
 
 def seed_word(word):
-    """Reads a word as a seed: a non-negative integer (ValueError otherwise)."""
-    if not (word.isdigit() and len(word) <= 18):
+    """Reads a word as a seed: a non-negative integer of at most 18 digits (ValueError otherwise)."""
+    if not (_is_decimal(word) and len(word) <= 18):
         raise ValueError(word)
     return int(word)
 

@@ -33,6 +33,7 @@ def scenario(tmp_path):
     (["--dds", "opensplice"], "invalid choice: 'opensplice'"),
     (["--max-steps", "1.5"], "argument --max-steps: '1.5' is not an integer"),
     (["--jobs", "65"], "argument --jobs: '65' is not an integer in [1, 64]"),
+    (["--jobs", "\u00b2"], "argument --jobs: '\u00b2' is not an integer"),  # a digit to str.isdigit, not to int()
     (["--tea", "1"], "unrecognized arguments: --tea 1"),  # no abbreviations
     (["--scenario", "/none/x.pbtxt"], "scenario file '/none/x.pbtxt' not found"),
 ])
