@@ -126,6 +126,14 @@ def binary(name):
     return path
 
 
+def spawn_command():
+    """The command that runs one scenario as real processes: deploy/spawn.sh; ToolError when it cannot run."""
+    path = os.path.join(ROOT, "deploy", "spawn.sh")
+    if not (os.path.isfile(path) and os.access(path, os.X_OK)):
+        raise ToolError(f"{path} missing or not executable")
+    return [path]
+
+
 def world_check(scenario, overrides=(), as_json=False):
     """Runs marsala-world --check on the scenario with `--set` overrides; returns its stdout (the check's JSON when
     as_json). A scenario or override the world rejects is a UsageError with the check's message."""

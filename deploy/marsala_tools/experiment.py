@@ -7,7 +7,7 @@ import shutil
 import subprocess
 
 from . import common, runner, stats, summary, tables
-from .common import ROOT, UsageError, say, warn
+from .common import UsageError, say, warn
 
 PROG = "experiment"
 DESCRIPTION = """\
@@ -219,14 +219,15 @@ class Experiment:
     def main(self):
         """Checks the values, runs every (value, seed), writes the outputs; returns the exit code."""
         a = self.args
+        common.binary("marsala-agent")
         check_values(a)
         agents = a.agents or common.agent_slots(a.scenario)
-        spawn = os.path.join(ROOT, "deploy", "spawn.sh")
+        spawn = common.spawn_command()
         os.makedirs(a.out, exist_ok=True)
         jobs = [self.job(v, s, agents) for v in a.values for s in range(1, a.seeds + 1)]
         self.total = len(jobs)
         try:
-            runner.Runner(["bash", spawn], a.jobs, self.finish_run).run(jobs)
+            runner.Runner(spawn, a.jobs, self.finish_run).run(jobs)
         except runner.Interrupted:
             if self.results:
                 self.write_outputs()

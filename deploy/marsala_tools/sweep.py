@@ -8,7 +8,7 @@ import shutil
 import subprocess
 
 from . import common, runner, stats, summary, tables
-from .common import ROOT, ToolError, UsageError, say, warn
+from .common import ROOT, UsageError, say, warn
 
 PROG = "sweep"
 DESCRIPTION = """\
@@ -148,9 +148,7 @@ class Sweep:
         if self.slots < max(self.args.teams):
             raise UsageError(f"scenario '{self.args.scenario}' has {self.slots} agent slots, fewer than the largest "
                              f"team ({max(self.args.teams)}); use smaller --teams")
-        self.spawn = os.path.join(ROOT, "deploy/spawn.sh")
-        if not os.access(self.spawn, os.X_OK):
-            raise ToolError(f"{self.spawn} missing or not executable")
+        self.spawn = common.spawn_command()
 
     def conf_text(self):
         """What makes rows comparable: a re-run into the same OUT with other settings would mix them."""
@@ -227,7 +225,7 @@ class Sweep:
             f"CSV {self.csv}")
         if a.jobs != 1:
             warn(PROG, f"{a.jobs} runs at a time share the cores: wall times are not comparable to --jobs 1")
-        runner.Runner([self.spawn], a.jobs, self.finish_run).run(self.job(t, s) for t, s in todo)
+        runner.Runner(self.spawn, a.jobs, self.finish_run).run(self.job(t, s) for t, s in todo)
 
     def report(self):
         """sweep_stats.csv, the table and the plot, over every row of the CSV."""
