@@ -83,7 +83,7 @@ class AgentRuntime {
  private:
   bool admit(const std::atomic<bool>& stop, RunResult& result, protocol::Admission& admission);
   void make_behaviour();
-  void lockstep(const std::atomic<bool>& stop, const protocol::Admission& admission, RunResult& result);
+  class Lockstep;  // the loop after admission, in agent_runtime.cpp
 
   bus::Participant& participant_;
   RuntimeConfig config_;
