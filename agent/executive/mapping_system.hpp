@@ -10,6 +10,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "marsala/agent/deliberative/known_map.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/ray_caster.hpp"
 #include "marsala/core/robot_body.hpp"
@@ -91,6 +92,10 @@ class MappingSystem {
   const std::vector<CellIndex>& trajectory() const { return trajectory_; }
   /// The world grid.
   const GridGeometry& geometry() const { return heights_.geometry(); }
+  /// This map as the deliberative layer reads it (the local map synthesizer); valid while this map lives, unchanged.
+  deliberative::KnownMap known_map() const {
+    return {heights_, known_, assumed_, trajectory_, sensor_.casts_rays()};
+  }
   int tile_size() const { return tile_size_; }
   const SensorSpec& sensor() const { return sensor_; }
   /// Leaf voxels of the octree, 0 before the first scan (for benchmarks and tests).

@@ -143,7 +143,7 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
                                 0.5 * context_.type.body.navigability.delta_m + context_.type.body.max_step_m);
   const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
   const Position target = goal.value_or(robot);  // nothing left to build towards: stay
-  BuildView view{modules_->synthesizer.synthesize(modules_->map, robot, target), robot, target};
+  BuildView view{modules_->synthesizer.synthesize(modules_->map.known_map(), robot, target), robot, target};
   clear_pad_gap(view.local);
   if (sensor.casts_rays()) count_gap_scans(view.local, frame.scanned);
   const RobotBody& body = context_.type.body;
