@@ -10,6 +10,12 @@ namespace {
 
 double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
+/// Navigable again after cells were taken out: occupiable and 8-connected to the robot's cell, as the synthesizer
+/// makes it.
+void renavigate(deliberative::LocalMap& local) {
+  local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
+}
+
 }  // namespace
 
 std::vector<BodyClearance> body_clearances(const std::vector<Neighbour>& neighbours, std::uint32_t self_id,
@@ -46,9 +52,19 @@ long long keep_clear(deliberative::LocalMap& local, Position robot, const std::v
       local.occupiable(r, c) = 0;
       ++removed;
     }
-  if (removed == 0) return 0;
-  // Navigable again: occupiable and 8-connected to the robot's cell, as the synthesizer makes it.
-  local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
+  if (removed > 0) renavigate(local);
+  return removed;
+}
+
+long long keep_off(deliberative::LocalMap& local, const std::vector<CellIndex>& cells) {
+  long long removed = 0;
+  for (const CellIndex global : cells) {
+    const CellIndex p = local.to_local(global);
+    if (!local.contains(p) || local.occupiable(p.row, p.col) == 0 || p == local.robot) continue;
+    local.occupiable(p.row, p.col) = 0;
+    ++removed;
+  }
+  if (removed > 0) renavigate(local);
   return removed;
 }
 
