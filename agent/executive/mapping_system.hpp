@@ -103,7 +103,12 @@ class MappingSystem {
 
  private:
   struct Octree;                      // OctoMap's tree and the hits per cell, in mapping_system.cpp
+  struct ScanBatch;                   // one scan's hits binned into the octree's voxels, in mapping_system.cpp
   void mark_known(int row, int col);  // observed by a sensor
+  // integrate_scan()'s steps: bin the hits a scan can place, judge a hit in an edge's shadow, re-derive the heights.
+  ScanBatch bin_hits(const std::vector<ScanPoint>& points, Point3 origin);
+  bool behind_edge(Point3 origin, Point3 hit, CellIndex cell, double spread_m) const;
+  void rederive_heights(const ScanBatch& batch);
 
   Heightmap heights_;
   CellMask known_;
