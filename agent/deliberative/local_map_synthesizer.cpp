@@ -23,7 +23,7 @@ int clamp_int(double v, int lo, int hi) {
 
 Window sensing_window(const GridGeometry& world, Position robot, double range_m) {
   if (!(range_m >= 0.0) || !std::isfinite(range_m))
-    throw InvalidArgument("sensing range must be finite and >= 0 m, got " + std::to_string(range_m));
+    throw InvalidArgument(fmt::format("sensing range must be finite and >= 0 m, got {}", range_m));
   if (!std::isfinite(robot.x) || !std::isfinite(robot.y) || !world.cell_at(robot))
     throw InvalidArgument(fmt::format("local map: the robot at {} is off the grid", robot));
   const double cs = world.cell_size_m;
@@ -38,8 +38,8 @@ LocalMapSynthesizer::LocalMapSynthesizer(NavigabilityParams params, double sensi
                                          std::optional<double> construction_kappa)
     : mars_(construction_kappa.value_or(params.kappa)), navigability_(params), sensing_range_m_(sensing_range_m) {
   if (!(sensing_range_m >= 0.0) || !std::isfinite(sensing_range_m))
-    throw InvalidArgument("local map synthesizer: sensing range must be finite and >= 0 m, got " +
-                          std::to_string(sensing_range_m));
+    throw InvalidArgument(
+        fmt::format("local map synthesizer: sensing range must be finite and >= 0 m, got {}", sensing_range_m));
 }
 
 LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Position target) const {

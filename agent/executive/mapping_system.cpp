@@ -15,8 +15,7 @@ namespace marsala::agent::executive {
 namespace {
 
 std::string describe(const TerrainTile& t) {
-  return "tile (" + std::to_string(t.tile_row) + ", " + std::to_string(t.tile_col) + ") of " + std::to_string(t.rows) +
-         " x " + std::to_string(t.cols) + " cells";
+  return fmt::format("tile ({}, {}) of {} x {} cells", t.tile_row, t.tile_col, t.rows, t.cols);
 }
 
 /// OctoMap keys are 16 bits around the origin: 32768 voxels each way.
@@ -162,9 +161,9 @@ struct MappingSystem::ScanBatch {
 
 MappingSystem::MappingSystem(const GridGeometry& world, int tile_size, SensorSpec sensor)
     : heights_(world, 0.0), tile_size_(tile_size), sensor_(std::move(sensor)) {
-  if (tile_size < 1) throw InvalidArgument("mapping system: tile size must be >= 1, got " + std::to_string(tile_size));
+  if (tile_size < 1) throw InvalidArgument(fmt::format("mapping system: tile size must be >= 1, got {}", tile_size));
   const std::string problem = sensor_problem(sensor_);
-  if (!problem.empty()) throw InvalidArgument("mapping system: sensor " + problem);
+  if (!problem.empty()) throw InvalidArgument(fmt::format("mapping system: sensor {}", problem));
   if (sensor_.casts_rays() && std::max(world.rows, world.cols) >= kOctreeHalfVoxels)
     throw InvalidArgument(fmt::format("mapping system: a {} x {} grid is too large for the octree ({} cells a side)",
                                       world.rows, world.cols, kOctreeHalfVoxels));
@@ -206,12 +205,12 @@ std::string tile_problem(const TerrainTile& tile, const GridGeometry& world, int
   const bool sized = placed && tile.rows == std::min<long long>(tile_size, world.rows - row0) &&
                      tile.cols == std::min<long long>(tile_size, world.cols - col0);
   if (!sized)
-    return describe(tile) + " does not fit the " + std::to_string(world.rows) + " x " + std::to_string(world.cols) +
-           " grid in " + std::to_string(tile_size) + "-cell tiles";
+    return fmt::format("{} does not fit the {} x {} grid in {}-cell tiles", describe(tile), world.rows, world.cols,
+                       tile_size);
   if (tile.heights.size() != static_cast<std::size_t>(tile.rows) * static_cast<std::size_t>(tile.cols))
-    return describe(tile) + " carries " + std::to_string(tile.heights.size()) + " heights";
+    return fmt::format("{} carries {} heights", describe(tile), tile.heights.size());
   for (double h : tile.heights)
-    if (!std::isfinite(h) || std::abs(h) >= kMaxMagnitude) return describe(tile) + " has a non-finite or huge height";
+    if (!std::isfinite(h) || std::abs(h) >= kMaxMagnitude) return fmt::format("{} has a non-finite or huge height", describe(tile));
   return {};
 }
 
@@ -240,7 +239,7 @@ void MappingSystem::mark_known(int row, int col) {
 
 void MappingSystem::integrate_tile(const TerrainTile& tile) {
   const std::string problem = tile_problem(tile, heights_.geometry(), tile_size_);
-  if (!problem.empty()) throw InvalidArgument("sensor frame: " + problem);
+  if (!problem.empty()) throw InvalidArgument(fmt::format("sensor frame: {}", problem));
   const long long row0 = static_cast<long long>(tile.tile_row) * tile_size_;
   const long long col0 = static_cast<long long>(tile.tile_col) * tile_size_;
   for (int r = 0; r < tile.rows; ++r)
@@ -368,7 +367,7 @@ void MappingSystem::assume_ground(Position pose, double ground_z_m, double radiu
         fmt::format("mapping system: ground {} m within {} m is not a finite height and radius", ground_z_m, radius_m));
   const std::optional<CellIndex> centre =
       std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;
-  if (!centre) throw InvalidArgument(fmt::format("mapping system: pose ({}, {}) m is off the grid", pose.x, pose.y));
+  if (!centre) throw InvalidArgument(fmt::format("mapping system: pose {} is off the grid", pose));
   const GridGeometry& g = heights_.geometry();
   // The body's ball around the cell it stands on, with the project's tie tolerance (ARCHITECTURE.md, grid conventions).
   const double radius_cells = radius_m / g.cell_size_m;
@@ -389,8 +388,7 @@ std::size_t MappingSystem::octree_leaves() const { return octree_ ? octree_->tre
 void MappingSystem::record_pose(Position pose) {
   const auto cell = std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;
   if (!cell)
-    throw InvalidArgument("mapping system: pose (" + std::to_string(pose.x) + ", " + std::to_string(pose.y) +
-                          ") m is off the grid");
+    throw InvalidArgument(fmt::format("mapping system: pose {} is off the grid", pose));
   if (trajectory_.empty() || trajectory_.back() != *cell) trajectory_.push_back(*cell);
 }
 
