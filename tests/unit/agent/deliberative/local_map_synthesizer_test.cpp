@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/iterators.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
@@ -72,6 +73,32 @@ TEST(LocalMapSynthesizer, WindowGapAndNavigabilityMatchReferences) {
   // The block is not occupiable, so the navigable region has a hole.
   EXPECT_EQ(local.occupiable(6, 15), 0);
   EXPECT_GT(local.navigable.cast<int>().sum(), 300);
+}
+
+TEST(LocalMapSynthesizer, OccupiableIsTheWorldsSingleCellAnswer) {
+  // A ramp at exactly slope kappa with a step of exactly eps halfway, beside the bumps and the block: the pairs across
+  // the step are ties (|dh| = eps + kappa |r - q|). The agent judges each cell of its window as the world judges one
+  // cell (core cell_occupiable) on the same heights, and a cell whose ball lies inside the window as the world judges
+  // it on the whole terrain.
+  Heightmap h = bumpy_terrain();
+  for (int r = 30; r < 40; ++r)
+    for (int c = 30; c < 40; ++c) h(r, c) = kBody.kappa * 0.1 * (c - 30) + (c >= 35 ? kBody.eps_m : 0.0);
+  executive::MappingSystem map = test::full_map(h);
+  map.record_pose(kRobot);
+  const LocalMap local = LocalMapSynthesizer(kBody, 1.0).synthesize(map.known_map(), kRobot, {4.55, 2.95});
+  const int ball = 2;  // delta / 2 = 0.2 m = 2 cells
+  int inside = 0, not_occupiable = 0;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      const bool agent = local.occupiable(r, c) != 0;
+      EXPECT_EQ(agent, cell_occupiable(local.heights, {r, c}, kBody, OccupancyMethod::kPairs)) << r << ", " << c;
+      not_occupiable += !agent;
+      if (r < ball || c < ball || r >= local.rows() - ball || c >= local.cols() - ball) continue;
+      ++inside;
+      EXPECT_EQ(agent, cell_occupiable(h, local.to_global({r, c}), kBody)) << r << ", " << c;
+    }
+  EXPECT_EQ(inside, 17 * 17);
+  EXPECT_GT(not_occupiable, 10);  // the block and the bumps' steps are judged, not only flat ground
 }
 
 TEST(LocalMapSynthesizer, LocalGoalIsTheTargetInsideOrWhereTheLineLeaves) {
