@@ -74,8 +74,9 @@ DepositionManager::DepositionManager(DepositionParams params) : params_(params),
       !std::isfinite(params.pad_centre.x) || !std::isfinite(params.pad_centre.y) || !(params.gap_margin_m >= 0.0) ||
       !std::isfinite(params.gap_margin_m))
     throw InvalidArgument(fmt::format(
-        "deposition manager: reach ({} m), max deposit ({} m^3), cube layer ({} m) and max height ({} m) must be finite "
-        "and > 0, neighbour keep-out, step and pad radius ({} m) finite and >= 0, gap margin ({} m) finite and >= 0",
+        "deposition manager: reach ({} m), max deposit ({} m^3), cube layer ({} m) and max height ({} m) must be "
+        "finite and > 0, neighbour keep-out, step and pad radius ({} m) finite and >= 0, gap margin ({} m) finite and "
+        ">= 0",
         params.reach_m, params.max_deposit_m3, params.cube_layer_m, params.max_height_m, params.pad_radius_m,
         params.gap_margin_m));
 }

@@ -210,7 +210,8 @@ std::string tile_problem(const TerrainTile& tile, const GridGeometry& world, int
   if (tile.heights.size() != static_cast<std::size_t>(tile.rows) * static_cast<std::size_t>(tile.cols))
     return fmt::format("{} carries {} heights", describe(tile), tile.heights.size());
   for (double h : tile.heights)
-    if (!std::isfinite(h) || std::abs(h) >= kMaxMagnitude) return fmt::format("{} has a non-finite or huge height", describe(tile));
+    if (!std::isfinite(h) || std::abs(h) >= kMaxMagnitude)
+      return fmt::format("{} has a non-finite or huge height", describe(tile));
   return {};
 }
 
@@ -387,8 +388,7 @@ std::size_t MappingSystem::octree_leaves() const { return octree_ ? octree_->tre
 
 void MappingSystem::record_pose(Position pose) {
   const auto cell = std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;
-  if (!cell)
-    throw InvalidArgument(fmt::format("mapping system: pose {} is off the grid", pose));
+  if (!cell) throw InvalidArgument(fmt::format("mapping system: pose {} is off the grid", pose));
   if (trajectory_.empty() || trajectory_.back() != *cell) trajectory_.push_back(*cell);
 }
 

@@ -93,9 +93,7 @@ class MappingSystem {
   /// The world grid.
   const GridGeometry& geometry() const { return heights_.geometry(); }
   /// This map as the deliberative layer reads it (the local map synthesizer); valid while this map lives, unchanged.
-  deliberative::KnownMap known_map() const {
-    return {heights_, known_, assumed_, trajectory_, sensor_.casts_rays()};
-  }
+  deliberative::KnownMap known_map() const { return {heights_, known_, assumed_, trajectory_, sensor_.casts_rays()}; }
   int tile_size() const { return tile_size_; }
   const SensorSpec& sensor() const { return sensor_; }
   /// Leaf voxels of the octree, 0 before the first scan (for benchmarks and tests).

@@ -54,8 +54,7 @@ Assignment assignment_from(const AgentContext& context, const protocol::Admissio
 
 void check_frame(const AgentContext& context, const protocol::SensorFrame& frame) {
   if (frame.agent_id != context.agent_id)
-    throw InvalidArgument(
-        fmt::format("sensor frame for agent {} reached agent {}", frame.agent_id, context.agent_id));
+    throw InvalidArgument(fmt::format("sensor frame for agent {} reached agent {}", frame.agent_id, context.agent_id));
 }
 
 }  // namespace marsala::agent::reactive

@@ -12,8 +12,7 @@ void IdleBehaviour::on_admission(const protocol::Admission& admission) {
 }
 
 protocol::ActionRequest IdleBehaviour::decide(const protocol::SensorFrame& frame) {
-  if (!admitted_)
-    throw InvalidArgument(fmt::format("idle behaviour: frame for step {} before admission", frame.step));
+  if (!admitted_) throw InvalidArgument(fmt::format("idle behaviour: frame for step {} before admission", frame.step));
   check_frame(context_, frame);
   if (frame.run_over) done_ = true;
   return empty_request(context_, frame, state_name());

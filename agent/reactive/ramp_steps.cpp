@@ -87,7 +87,9 @@ void RampSteps::admit(const protocol::Admission& admission) {
   // A scanned map reads each surface within a few noise spreads at the manipulator's reach: leave that much unfilled.
   if (context_.type.sensor.casts_rays())
     deposits.gap_margin_m = kScanGapMargin * context_.type.sensor.noise_sd_at(body.reach_m + body.navigability.delta_m);
-  memory_.gap_streaks.assign(context_.type.sensor.casts_rays() ? static_cast<std::size_t>(world.rows) * world.cols : 0, {});
+  const std::size_t streak_cells =
+      context_.type.sensor.casts_rays() ? static_cast<std::size_t>(world.rows) * world.cols : 0;
+  memory_.gap_streaks.assign(streak_cells, {});
   PlannerParams router = planner;
   router.alpha = 0.0;
   router.beta = 1.0;
@@ -236,7 +238,8 @@ void RampSteps::set_lane(double offset_m, double corridor_width_m) {
 
 std::vector<CellIndex> RampSteps::in_lane(const deliberative::LocalMap& local,
                                           const std::vector<CellIndex>& path) const {
-  if (!(lane_offset_m_ > 0.0) || memory_.corridor.rows() != local.rows() || memory_.corridor.cols() != local.cols()) return path;
+  if (!(lane_offset_m_ > 0.0) || memory_.corridor.rows() != local.rows() || memory_.corridor.cols() != local.cols())
+    return path;
   return executive::lane_path(local, memory_.corridor, path, lane_offset_m_, corridor_width_m_);
 }
 

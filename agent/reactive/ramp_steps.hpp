@@ -163,19 +163,19 @@ class RampSteps {
     /// request with deposits, the next ones carry at most half as many (none after one), until one is accepted, so a
     /// mismatch never repeats the same request forever. -1: no limit.
     int deposit_limit = -1;
-    std::map<CellIndex, std::uint64_t> refused;  ///< motion targets the world refused -> avoided until this step
-    std::vector<GapStreak> gap_streaks;          ///< scanned maps, per world cell (row-major): count_gap_scans()
-    bool deposited_since_blocked = false;        ///< the retreat deposited since the path was last blocked
-    int idle_retreat_moves = 0;                  ///< retreat moves without work since
+    std::map<CellIndex, std::uint64_t> refused;    ///< motion targets the world refused -> avoided until this step
+    std::vector<GapStreak> gap_streaks;            ///< scanned maps, per world cell (row-major): count_gap_scans()
+    bool deposited_since_blocked = false;          ///< the retreat deposited since the path was last blocked
+    int idle_retreat_moves = 0;                    ///< retreat moves without work since
     std::vector<executive::BodyClearance> others;  ///< the last frame's neighbours
     CellMask corridor;                             ///< the last local map's navigable cells, neighbours not taken out
     CellMask terrain_occupiable;                   ///< and its occupiable cells
   };
 
   // look()'s steps, in order.
-  void remember_result(const protocol::SensorFrame& frame);  // what the world made of the last request
-  void update_map(const protocol::SensorFrame& frame);       // tiles, scan and the ground under the body
-  BuildView synthesize_view(const protocol::SensorFrame& frame);  // target, local map, the gap to work on
+  void remember_result(const protocol::SensorFrame& frame);              // what the world made of the last request
+  void update_map(const protocol::SensorFrame& frame);                   // tiles, scan and the ground under the body
+  BuildView synthesize_view(const protocol::SensorFrame& frame);         // target, local map, the gap to work on
   void keep_clear(const protocol::SensorFrame& frame, BuildView& view);  // the neighbours and the refused cells
   void deposit(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position at, std::size_t from,
                BuildTrace& trace, protocol::ActionRequest& request);

@@ -45,7 +45,7 @@ class DecisionCosts {
   }
 
  private:
-  std::vector<double> decision_ms_;           // [ms]
+  std::vector<double> decision_ms_;            // [ms]
   std::optional<double> process_at_first_ms_;  // [ms]
 };
 
@@ -107,7 +107,9 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
   protocol::AgentHello& hello = hello_;
   hello.agent_id = config_.agent_id;
   hello.session = config_.session;
-  hello.name = config_.agent_id != 0 ? config_.name : config_.name.empty() ? fmt::format("{}-any", config_.type.name) : config_.name;
+  hello.name = config_.agent_id != 0  ? config_.name
+               : config_.name.empty() ? fmt::format("{}-any", config_.type.name)
+                                      : config_.name;
   hello.behaviour = config_.type.behaviour;
   hello.body = config_.type.body;
   spdlog::info("agent {} ({}, {}): saying hello, session {:016x}", config_.agent_id, config_.name,
@@ -212,8 +214,9 @@ class AgentRuntime::Lockstep {
       return false;
     }
     if (turn.paused_s)
-      spdlog::info("agent {}: this process did not run for {} s; asking the world whether it still counts this agent in",
-                   id(), *turn.paused_s);
+      spdlog::info(
+          "agent {}: this process did not run for {} s; asking the world whether it still counts this agent in", id(),
+          *turn.paused_s);
     if (turn.no_frame_s)
       spdlog::info("agent {}: no frame for {} s; asking the world whether it still counts this agent in", id(),
                    *turn.no_frame_s);
@@ -262,9 +265,7 @@ class AgentRuntime::Lockstep {
       spdlog::warn("agent {}: request before step {} rejected: {}", id(), frame.step, frame.last_reason);
     }
     switch (judgement.call) {
-      case FrameCall::kRunOver:
-        run_over(frame);
-        return true;
+      case FrameCall::kRunOver: run_over(frame); return true;
       case FrameCall::kRepeat:
         // The world did not get (or not yet) the answer: the same request again, never a second decision.
         spdlog::debug("agent {}: the frame of step {} again; repeating its request", id(), frame.step);
@@ -273,9 +274,7 @@ class AgentRuntime::Lockstep {
       case FrameCall::kStale:
         spdlog::warn("agent {}: ignoring a stale frame for step {}", id(), frame.step);
         return false;
-      default:
-        decide(frame);
-        return false;
+      default: decide(frame); return false;
     }
   }
 
@@ -298,10 +297,11 @@ class AgentRuntime::Lockstep {
     result_.message = fmt::format("run over at step {}", frame.step);
     result_.decision_cpu_median_ms = costs_.median_ms();
     result_.cpu_ms_per_step = costs_.process_ms_per(result_.requests);
-    spdlog::info("agent {}: {} ({} requests, {} rejected, {} frames ignored; decision CPU median {:.3f} ms, "
-                 "process CPU {:.3f} ms per step)",
-                 id(), result_.message, result_.requests, result_.rejected, result_.ignored_frames,
-                 result_.decision_cpu_median_ms, result_.cpu_ms_per_step);
+    spdlog::info(
+        "agent {}: {} ({} requests, {} rejected, {} frames ignored; decision CPU median {:.3f} ms, "
+        "process CPU {:.3f} ms per step)",
+        id(), result_.message, result_.requests, result_.rejected, result_.ignored_frames,
+        result_.decision_cpu_median_ms, result_.cpu_ms_per_step);
   }
 
   AgentRuntime& agent_;

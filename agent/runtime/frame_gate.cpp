@@ -40,10 +40,9 @@ FrameJudgement FrameGate::judge(const protocol::SensorFrame& frame, const bus::W
   // Only the world that admitted this agent speaks for the run; what it sends must make sense.
   if (from != world_)
     return {FrameCall::kIgnored,
-            fmt::format("written by participant {}, not by the world this agent was admitted to ({})",
-                        from.to_string(), world_.to_string())};
-  if (frame.agent_id != agent_id_)
-    return {FrameCall::kIgnored, fmt::format("addressed to agent {}", frame.agent_id)};
+            fmt::format("written by participant {}, not by the world this agent was admitted to ({})", from.to_string(),
+                        world_.to_string())};
+  if (frame.agent_id != agent_id_) return {FrameCall::kIgnored, fmt::format("addressed to agent {}", frame.agent_id)};
   if (answered_any_ && frame.step > last_answered_ && frame.step - last_answered_ > kMaxStepsAhead)
     return {FrameCall::kIgnored, fmt::format("step {} is more than {} steps ahead of the last one answered ({})",
                                              frame.step, kMaxStepsAhead, last_answered_)};

@@ -67,7 +67,7 @@ class FrameGate {
   SensorSpec sensor_;
   bus::WriterId world_;
   bool answered_any_ = false;
-  std::uint64_t last_answered_ = 0;      // the step of last_request_
+  std::uint64_t last_answered_ = 0;       // the step of last_request_
   protocol::ActionRequest last_request_;  // repeated when the world sends the frame of its step again
 };
 

@@ -31,9 +31,9 @@ enum class WorldState { kWatching, kWorldGone, kWorldTimeout };
 /// What one turn of the loop must do, and why.
 struct WatchTurn {
   WorldState state = WorldState::kWatching;
-  double silent_s = 0.0;           ///< kWorldGone: how long no sign of the world came [s]
-  bool hello = false;              ///< say hello now: ask the world whether it still counts this agent in
-  std::optional<double> paused_s;  ///< set when the process did not run for this long before this turn [s]
+  double silent_s = 0.0;             ///< kWorldGone: how long no sign of the world came [s]
+  bool hello = false;                ///< say hello now: ask the world whether it still counts this agent in
+  std::optional<double> paused_s;    ///< set when the process did not run for this long before this turn [s]
   std::optional<double> no_frame_s;  ///< set when this turn's hello is the first of a silence this long [s]
 };
 

@@ -241,7 +241,8 @@ TEST(LocalMapSynthesizer, AScannedMapsGoalAndPathAvoidCellsItCannotJudge) {
       if (!(r == 31 && c == 64)) map.assume_ground(kWorld.cell_center({r, c}), 0.0, 0.0);
   map.record_pose(kRobot);
   const LocalMapSynthesizer synthesizer(kBody, 2.5);                         // ball radius 2 cells; window cols 15..65
-  const LocalMap local = synthesizer.synthesize(map.known_map(), kRobot, {7.05, 2.95});  // the target (30, 70), off the window
+  const LocalMap local =
+      synthesizer.synthesize(map.known_map(), kRobot, {7.05, 2.95});  // the target (30, 70), off the window
   const CellIndex exit = local.to_local({30, 65});
   ASSERT_EQ(local.blind(exit.row, exit.col), 1);  // (31, 64) lies within its ball
   // Judged cells reachable through judged cells end before the hole: (29, 64), (30, 63) and (31, 63) hold it in

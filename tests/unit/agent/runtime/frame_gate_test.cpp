@@ -1,4 +1,5 @@
-// The frame gate without a bus: which frames an agent takes, repeats, calls stale or ignores (docs/runtime.md#lockstep).
+// The frame gate without a bus: which frames an agent takes, repeats, calls stale or ignores
+// (docs/runtime.md#lockstep).
 
 #include "marsala/agent/runtime/frame_gate.hpp"
 

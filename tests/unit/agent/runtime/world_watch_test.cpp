@@ -88,7 +88,7 @@ TEST(WorldWatch, ASilenceAsksEveryHelloPeriodUntilAFrame) {
   const WatchTurn second = watch.turn(kT0 + kRehelloAfter + 200ms, kAlive);
   EXPECT_TRUE(second.hello);
   EXPECT_FALSE(second.no_frame_s.has_value());  // the silence was said once
-  EXPECT_TRUE(watch.frame(kT0 + 2300ms));        // frames again after asking
+  EXPECT_TRUE(watch.frame(kT0 + 2300ms));       // frames again after asking
   EXPECT_FALSE(watch.asked());
   EXPECT_FALSE(watch.frame(kT0 + 2400ms));
   for (auto t = 2500ms; t < 4400ms; t += 100ms) EXPECT_FALSE(watch.turn(kT0 + t, kAlive).hello) << t.count() << " ms";
