@@ -31,7 +31,7 @@ double distance(double ax, double ay, double bx, double by) {
 /// Rule 4: a refill only at the base; nullopt when it passes.
 std::optional<Verdict> check_refill(const WorldState& state, const protocol::ActionRequest& r, double x, double y) {
   if (!r.refill) return std::nullopt;
-  const double to_base = distance(x, y, state.base.x_m, state.base.y_m);
+  const double to_base = distance(x, y, state.base.centre.x, state.base.centre.y);
   if (to_base <= state.base.radius_m + tol::kLengthM) return std::nullopt;
   return Verdict{false,
                  "refill requested " + fmt::format("{}", to_base) + " m from the base station (radius " +
@@ -39,7 +39,7 @@ std::optional<Verdict> check_refill(const WorldState& state, const protocol::Act
                  4, 0.0, {}};
 }
 
-std::string where(const Deposit& d) { return "(" + fmt::format("{}", d.x_m) + ", " + fmt::format("{}", d.y_m) + ")"; }
+std::string where(const Deposit& d) { return "(" + fmt::format("{}", d.centre.x) + ", " + fmt::format("{}", d.centre.y) + ")"; }
 
 /// Rule 3 for a cube or cone depositor (docs/runtime.md#rule-3-deposits), judged from (x, y), the position after the
 /// motion. The volumes are checked before any shape is computed, so no request costs more than its volume allows.
@@ -47,11 +47,11 @@ Verdict validate_deposits(const WorldState& state, const AgentRecord& me, double
                           const std::vector<Deposit>& deposits) {
   const auto reject = [](std::string reason) { return Verdict{false, std::move(reason), 3, 0.0, {}}; };
   const Heightmap& terrain = state.terrain;
-  const DepositorKind kind = depositor_kind(me.type.depositor.name);
+  const DepositorKind kind = me.type.depositor.kind;
   const double side = depositor_cube_size_m(me.type);
   double volume = 0.0;
   for (const Deposit& d : deposits) {
-    const double from_me = distance(d.x_m, d.y_m, x, y);
+    const double from_me = distance(d.centre.x, d.centre.y, x, y);
     if (!(from_me <= me.type.body.reach_m + tol::kLengthM))
       return reject("deposit at " + where(d) + " is " + fmt::format("{}", from_me) + " m away, beyond reach_m " +
                     fmt::format("{}", me.type.body.reach_m));
@@ -83,15 +83,15 @@ Verdict validate_deposits(const WorldState& state, const AgentRecord& me, double
                     std::to_string(kMaxCubesPerColumn));
     const DepositShape shape =
         kind == DepositorKind::kCube
-            ? cube_column_shape(terrain.geometry(), {d.x_m, d.y_m}, side, static_cast<int>(cubes))
-            : cone_pile_shape(layered ? *after : terrain, {d.x_m, d.y_m}, d.volume_m3, me.type.depositor.repose_deg);
+            ? cube_column_shape(terrain.geometry(), d.centre, side, static_cast<int>(cubes))
+            : cone_pile_shape(layered ? *after : terrain, d.centre, d.volume_m3, me.type.depositor.repose_deg);
     if (!shape.on_grid) return reject("deposit at " + where(d) + " would leave the grid");
     for (const CellRise& c : shape.rises) {
       const Position centre = terrain.cell_center(c.cell);
       for (const AgentRecord& other : state.agents) {
         if (!other.alive) continue;
         const bool self = other.id == me.id;
-        const double gap = distance(centre.x, centre.y, self ? x : other.x_m, self ? y : other.y_m);
+        const double gap = distance(centre.x, centre.y, self ? x : other.position.x, self ? y : other.position.y);
         if (gap <= 0.5 * other.type.body.navigability.delta_m + tol::kLengthM)
           return reject("deposit at " + where(d) + " raises cell " + fmt::format("{}", c.cell) + ", under agent " +
                         std::to_string(other.id));
@@ -150,8 +150,8 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
   if (static_cast<long long>(r.depositions.size()) > terrain.size())
     return reject(std::to_string(r.depositions.size()) + " depositions exceed the grid's cells");
   for (const Deposit& d : r.deposits)
-    if (!sane(d.x_m) || !sane(d.y_m) || !sane(d.volume_m3))
-      return reject("deposit at (" + fmt::format("{}", d.x_m) + ", " + fmt::format("{}", d.y_m) + ") of " +
+    if (!sane(d.centre.x) || !sane(d.centre.y) || !sane(d.volume_m3))
+      return reject("deposit at (" + fmt::format("{}", d.centre.x) + ", " + fmt::format("{}", d.centre.y) + ") of " +
                     fmt::format("{}", d.volume_m3) + " m^3 is not finite or too large");
   if (r.deposits.size() > kMaxDeposits)
     return reject(std::to_string(r.deposits.size()) + " deposits exceed the limit of " +
@@ -159,7 +159,7 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
 
   // 2. Motion.
   rule = 2;
-  double x = me.x_m, y = me.y_m;
+  double x = me.position.x, y = me.position.y;
   if (r.move) {
     const double d = distance(r.target_x_m, r.target_y_m, x, y);
     if (!(d <= me.type.body.max_step_m + tol::kLengthM))
@@ -186,9 +186,9 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
     // may move apart.
     for (const AgentRecord& other : state.agents) {
       if (!other.alive || other.id == me.id) continue;
-      if (!bodies_overlap(me, r.target_x_m, r.target_y_m, other, other.x_m, other.y_m)) continue;
-      const double after = distance(r.target_x_m, r.target_y_m, other.x_m, other.y_m);
-      if (bodies_overlap(me, x, y, other, other.x_m, other.y_m) && after >= distance(x, y, other.x_m, other.y_m))
+      if (!bodies_overlap(me, r.target_x_m, r.target_y_m, other, other.position.x, other.position.y)) continue;
+      const double after = distance(r.target_x_m, r.target_y_m, other.position.x, other.position.y);
+      if (bodies_overlap(me, x, y, other, other.position.x, other.position.y) && after >= distance(x, y, other.position.x, other.position.y))
         continue;
       return reject("motion ends " + fmt::format("{}", after) + " m from agent " + std::to_string(other.id) +
                     ", whose body it would overlap (bodies need " + fmt::format("{}", body_clearance_m(me, other)) +
@@ -200,7 +200,7 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
 
   // 3. Depositions, from the position after the motion, by the robot's own depositor.
   rule = 3;
-  const DepositorKind kind = depositor_kind(me.type.depositor.name);
+  const DepositorKind kind = me.type.depositor.kind;
   if (kind == DepositorKind::kLayer && !r.deposits.empty())
     return reject("robot type '" + me.type.name + "' has the layer depositor: it sends depositions, not deposits");
   if (kind != DepositorKind::kLayer && !r.depositions.empty())
@@ -237,7 +237,7 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
     for (const AgentRecord& other : state.agents) {
       if (!other.alive) continue;
       const bool self = other.id == me.id;
-      const double gap = distance(centre.x, centre.y, self ? x : other.x_m, self ? y : other.y_m);
+      const double gap = distance(centre.x, centre.y, self ? x : other.position.x, self ? y : other.position.y);
       if (gap <= 0.5 * other.type.body.navigability.delta_m + tol::kLengthM)
         return reject("deposition cell " + fmt::format("{}", c) + " is under agent " + std::to_string(other.id));
     }
@@ -263,10 +263,10 @@ void apply_request(WorldState& state, const protocol::ActionRequest& r, const Ve
   AgentRecord& me = state.agent(r.agent_id);
   if (r.move) {
     // docs/runtime.md#heading: the direction of the last motion of non-zero length.
-    const double dx = r.target_x_m - me.x_m, dy = r.target_y_m - me.y_m;
+    const double dx = r.target_x_m - me.position.x, dy = r.target_y_m - me.position.y;
     if (dx != 0.0 || dy != 0.0) me.heading_rad = std::atan2(dy, dx);
-    me.x_m = r.target_x_m;
-    me.y_m = r.target_y_m;
+    me.position.x = r.target_x_m;
+    me.position.y = r.target_y_m;
   }
   if ((!r.depositions.empty() || !verdict.rises.empty()) &&
       (state.depositor.rows() != state.terrain.rows() || state.depositor.cols() != state.terrain.cols()))
@@ -277,7 +277,7 @@ void apply_request(WorldState& state, const protocol::ActionRequest& r, const Ve
     state.depositor(d.row, d.col) = r.agent_id;
     changed_cells.push_back({d.row, d.col});
   }
-  me.z_m = height_under(state.terrain, me.x_m, me.y_m);
+  me.z_m = height_under(state.terrain, me.position.x, me.position.y);
   me.material_m3 = std::max(0.0, me.material_m3 - verdict.volume_m3);
   if (r.refill) me.material_m3 = me.type.body.material_capacity_m3;
   me.deposited_m3 += verdict.volume_m3;

@@ -13,7 +13,7 @@ Position jittered_start(const Heightmap& terrain, const scenario::AgentSlot& slo
                         double jitter_m, std::uint64_t seed) {
   if (!(jitter_m >= 0.0) || !std::isfinite(jitter_m))
     throw InvalidArgument("start jitter of agent " + std::to_string(slot.id) + " must be finite and >= 0 m");
-  const Position start{slot.start_x_m, slot.start_y_m};
+  const Position start{slot.start.x, slot.start.y};
   if (jitter_m == 0.0) return start;
   // Streams of different agents start at unrelated points of the generator's cycle.
   random::Rng rng(random::mix64(random::mix64(seed) + slot.id));

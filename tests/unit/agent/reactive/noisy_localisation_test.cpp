@@ -64,8 +64,8 @@ TEST(NoisyLocalisation, ActsOnTheBelievedPoseAndShiftsItsRequestsBack) {
     protocol::SensorFrame believed = frame;
     believed.x_m += shift.x;
     believed.y_m += shift.y;
-    believed.neighbours[0].x_m += shift.x;
-    believed.neighbours[0].y_m += shift.y;
+    believed.neighbours[0].position.x += shift.x;
+    believed.neighbours[0].position.y += shift.y;
     plain.set_registration(k);
     const protocol::ActionRequest expected = plain.decide(believed);
     const protocol::ActionRequest got = noisy.decide(frame);

@@ -100,10 +100,10 @@ TEST(FrameGate, IgnoresFramesThatDoNotDescribeTheWorld) {
   points.points.push_back({0.0f, 0.0f, 0.0f});
   EXPECT_EQ(g.judge(points, writer(1)).problem, "1 scan points in a frame without a scan");
   protocol::SensorFrame neighbour = frame(1);
-  neighbour.neighbours.push_back({3, std::nan(""), 1.0, 0.0, 0.5});
+  neighbour.neighbours.push_back({3, {std::nan(""), 1.0}, 0.0, 0.5});
   EXPECT_EQ(g.judge(neighbour, writer(1)).call, FrameCall::kIgnored);
   protocol::SensorFrame wide = frame(1);
-  wide.neighbours.push_back({3, 1.0, 1.0, 0.0, 2e3});
+  wide.neighbours.push_back({3, {1.0, 1.0}, 0.0, 2e3});
   EXPECT_EQ(g.judge(wide, writer(1)).problem, "neighbour 3 has a body radius of 2000 m, not in [0, 1000] m");
   protocol::SensorFrame tile = frame(1);
   tile.tiles.push_back({0, 0, 10, 16, std::vector<double>(160, 0.0)});
