@@ -21,7 +21,8 @@ std::string frame_problem(const protocol::SensorFrame& f, const Assignment& assi
     if (!problem.empty()) return problem;
   }
   if (!f.scanned && !f.points.empty()) return fmt::format("{} scan points in a frame without a scan", f.points.size());
-  if (f.scanned && !sensor.casts_rays()) return fmt::format("a scan for a robot whose sensor is '{}'", to_string(sensor.kind));
+  if (f.scanned && !sensor.casts_rays())
+    return fmt::format("a scan for a robot whose sensor is '{}'", to_string(sensor.kind));
   const std::string scan = executive::scan_problem(f.points, sensor);
   if (!scan.empty()) return scan;
   for (const Neighbour& n : f.neighbours) {
