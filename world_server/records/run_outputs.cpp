@@ -1,6 +1,7 @@
 #include "marsala/world_server/records/run_outputs.hpp"
 
 #include <google/protobuf/util/json_util.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +12,6 @@
 #include <limits>
 
 #include "idl/run_summary.pb.h"
-#include "marsala/cli/logging.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/render/perspective.hpp"
@@ -405,28 +405,20 @@ void write_final_outputs(const std::string& dir, const WorldState& state, const 
 }
 
 std::string event_json(const protocol::WorldEvent& e, const std::vector<Deposition>& cells) {
-  std::string line = "{\"step\":" + std::to_string(e.step) + ",\"agent\":" + std::to_string(e.agent_id) +
-                     ",\"kind\":" + cli::json_string(protocol::to_string(e.kind));
-  char buf[64];
-  if (e.kind == protocol::EventKind::kDeposited) {
-    std::snprintf(buf, sizeof buf, ",\"volume_m3\":%.9g", e.volume_m3);
-    line += buf;
+  nlohmann::ordered_json line = {{"step", e.step}, {"agent", e.agent_id}, {"kind", protocol::to_string(e.kind)}};
+  const bool deposited = e.kind == protocol::EventKind::kDeposited;
+  if (deposited) line["volume_m3"] = e.volume_m3;
+  if (!e.detail.empty()) line["detail"] = e.detail;
+  if (deposited) {
+    nlohmann::ordered_json& set = line["cells"] = nlohmann::ordered_json::array();
+    for (const Deposition& d : cells) set.push_back({d.row, d.col, d.height_m});
   }
-  if (!e.detail.empty()) line += ",\"detail\":" + cli::json_string(e.detail);
-  if (e.kind == protocol::EventKind::kDeposited) {
-    line += ",\"cells\":[";
-    for (std::size_t i = 0; i < cells.size(); ++i) {
-      std::snprintf(buf, sizeof buf, "%s[%d,%d,%.17g]", i == 0 ? "" : ",", cells[i].row, cells[i].col,
-                    cells[i].height_m);
-      line += buf;
-    }
-    line += "]";
-  }
-  return line + "}";
+  return line.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
 std::string note_json(std::uint64_t step, const std::string& text) {
-  return "{\"step\":" + std::to_string(step) + ",\"kind\":\"note\",\"detail\":" + cli::json_string(text) + "}";
+  const nlohmann::ordered_json line = {{"step", step}, {"kind", "note"}, {"detail", text}};
+  return line.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
 EventLog::EventLog(const std::string& path, bool append) : path_(path) {

@@ -259,7 +259,7 @@ TEST(EventLogLines, AreJsonObjectsWithTheDepositedCells) {
   e.detail = "2 cells";
   EXPECT_EQ(event_json(e, {{10, 11, 0.05}, {10, 12, 0.1}}),
             "{\"step\":42,\"agent\":3,\"kind\":\"deposited\",\"volume_m3\":0.000125,\"detail\":\"2 cells\","
-            "\"cells\":[[10,11,0.050000000000000003],[10,12,0.10000000000000001]]}");
+            "\"cells\":[[10,11,0.05],[10,12,0.1]]}");
   protocol::WorldEvent over;
   over.step = 7;
   over.kind = protocol::EventKind::kRunOver;
