@@ -85,9 +85,7 @@ std::string pack(const T* values, std::size_t count) {
 template <typename T>
 void unpack(const std::string& bytes, T* values, std::size_t count, const std::string& file, const char* what) {
   if (bytes.size() != count * sizeof(T))
-    throw ParseError(file, 0,
-                     std::string(what) + " holds " + std::to_string(bytes.size()) + " bytes, expected " +
-                         std::to_string(count * sizeof(T)));
+    throw ParseError(file, 0, fmt::format("{} holds {} bytes, expected {}", what, bytes.size(), count * sizeof(T)));
   if (count > 0) std::memcpy(values, bytes.data(), bytes.size());
 }
 
@@ -221,7 +219,7 @@ proto::Snapshot read_snapshot(const std::string& path) {
   proto::Snapshot s;
   if (!s.ParseFromString(bytes.str())) throw ParseError(path, 0, "not a snapshot (it does not parse)");
   if (s.format_version() != kSnapshotFormat)
-    throw ParseError(path, 0, "snapshot format " + std::to_string(s.format_version()) + " is not the known format 1");
+    throw ParseError(path, 0, fmt::format("snapshot format {} is not the known format 1", s.format_version()));
   if (snapshot_crc(s) != s.snapshot_crc32c()) throw ParseError(path, 0, "the snapshot fails its checksum");
   return s;
 }
@@ -237,11 +235,10 @@ void restore_snapshot(WorldState& state, const proto::Snapshot& s, const std::st
   const auto bad = [&](const std::string& what) { return ParseError(file, 0, what); };
   const auto cells = static_cast<std::size_t>(state.terrain.rows()) * state.terrain.cols();
   if (static_cast<std::size_t>(s.agents_size()) != state.agents.size())
-    throw bad("the snapshot holds " + std::to_string(s.agents_size()) + " agents, the run " +
-              std::to_string(state.agents.size()));
+    throw bad(fmt::format("the snapshot holds {} agents, the run {}", s.agents_size(), state.agents.size()));
   if (static_cast<std::size_t>(s.tile_versions_size()) != state.tile_versions.size())
-    throw bad("the snapshot holds " + std::to_string(s.tile_versions_size()) + " tile versions, the grid has " +
-              std::to_string(state.tile_versions.size()) + " tiles");
+    throw bad(fmt::format("the snapshot holds {} tile versions, the grid has {} tiles", s.tile_versions_size(),
+                          state.tile_versions.size()));
   unpack(s.heights(), state.terrain.data(), cells, file, "heights");
   if (runlog::terrain_sha256(state.terrain) != s.terrain_sha256())
     throw bad("the snapshot's heights do not match its terrain_sha256");
@@ -263,9 +260,9 @@ void restore_snapshot(WorldState& state, const proto::Snapshot& s, const std::st
   for (std::size_t i = 0; i < state.agents.size(); ++i) {
     const proto::AgentSnapshot& p = s.agents(static_cast<int>(i));
     AgentRecord& a = state.agents[i];
-    if (p.agent_id() != a.id) throw bad("agent " + std::to_string(p.agent_id()) + " out of order");
+    if (p.agent_id() != a.id) throw bad(fmt::format("agent {} out of order", p.agent_id()));
     if (p.last_result() > static_cast<std::uint32_t>(protocol::ActionResult::kMissed))
-      throw bad("agent " + std::to_string(a.id) + ": last_result " + std::to_string(p.last_result()) + " is undefined");
+      throw bad(fmt::format("agent {}: last_result {} is undefined", a.id, p.last_result()));
     a.admitted = p.admitted();
     a.alive = p.alive();
     a.dropped = p.dropped();
@@ -288,7 +285,7 @@ void restore_snapshot(WorldState& state, const proto::Snapshot& s, const std::st
     a.last_result = static_cast<protocol::ActionResult>(p.last_result());
     a.last_reason = p.last_reason();
     if (p.has_heading_rad() && !std::isfinite(p.heading_rad()))
-      throw bad("agent " + std::to_string(a.id) + ": heading " + std::to_string(p.heading_rad()) + " is not finite");
+      throw bad(fmt::format("agent {}: heading {} is not finite", a.id, p.heading_rad()));
     a.heading_rad = p.has_heading_rad() ? p.heading_rad() : initial_heading_rad(a);
   }
   if (state.completion != scenario::CompletionKind::kAgentsAtGoal) {
@@ -314,7 +311,7 @@ void apply_record(WorldState& state, const proto::LogRecord& record, const std::
     case proto::LogRecord::kAdmitted: {
       const proto::AgentAdmitted& r = record.admitted();
       if (!state.has_agent(r.agent_id()))
-        throw bad("admission of agent " + std::to_string(r.agent_id()) + ", which has no slot");
+        throw bad(fmt::format("admission of agent {}, which has no slot", r.agent_id()));
       protocol::AgentHello hello;
       hello.agent_id = r.agent_id();
       hello.session = r.session();
@@ -324,20 +321,20 @@ void apply_record(WorldState& state, const proto::LogRecord& record, const std::
                                  : r.takeover()  ? AdmissionKind::kTakeover
                                                  : AdmissionKind::kFirst;
       if (!admit(state, hello, kind) && kind == AdmissionKind::kFirst)
-        throw bad("agent " + std::to_string(r.agent_id()) + " admitted twice");
+        throw bad(fmt::format("agent {} admitted twice", r.agent_id()));
       return;
     }
     case proto::LogRecord::kDropped: {
       const proto::AgentDropped& r = record.dropped();
       if (!state.has_agent(r.agent_id()) || !state.agent(r.agent_id()).alive)
-        throw bad("drop of agent " + std::to_string(r.agent_id()) + ", which is not live");
+        throw bad(fmt::format("drop of agent {}, which is not live", r.agent_id()));
       drop_agent(state, r.agent_id(), r.reason());
       return;
     }
     case proto::LogRecord::kStep: {
       const proto::StepRecord& r = record.step();
       if (r.step() != state.step)
-        throw bad("step " + std::to_string(r.step()) + " where step " + std::to_string(state.step) + " was due");
+        throw bad(fmt::format("step {} where step {} was due", r.step(), state.step));
       std::vector<Submission> submissions;
       submissions.reserve(static_cast<std::size_t>(r.requests_size()));
       for (const proto::LoggedRequest& q : r.requests()) submissions.push_back(submission(q));
@@ -345,15 +342,14 @@ void apply_record(WorldState& state, const proto::LogRecord& record, const std::
       state.surplus_requests += r.surplus_requests();
       for (int i = 0; i < r.requests_size(); ++i)
         if (outcome.accepted_submissions[static_cast<std::size_t>(i)] != r.requests(i).accepted())
-          throw bad("step " + std::to_string(r.step()) + ": request " + std::to_string(i) + " of agent " +
-                    std::to_string(r.requests(i).agent_id()) + " was " +
-                    (r.requests(i).accepted() ? "accepted" : "rejected") + " by the run and is " +
-                    (outcome.accepted_submissions[static_cast<std::size_t>(i)] ? "accepted" : "rejected") +
-                    " on replay: the log and this world's rules disagree");
+          throw bad(fmt::format(
+              "step {}: request {} of agent {} was {} by the run and is {} on replay: the log and this world's rules "
+              "disagree",
+              r.step(), i, r.requests(i).agent_id(), r.requests(i).accepted() ? "accepted" : "rejected",
+              outcome.accepted_submissions[static_cast<std::size_t>(i)] ? "accepted" : "rejected"));
       if (!(state.deposited_volume_m3 == r.deposited_volume_m3()))
-        throw bad("step " + std::to_string(r.step()) + ": deposited volume " +
-                  fmt::format("{}", state.deposited_volume_m3) + " m3 on replay, " +
-                  fmt::format("{}", r.deposited_volume_m3()) + " m3 in the run");
+        throw bad(fmt::format("step {}: deposited volume {} m3 on replay, {} m3 in the run", r.step(),
+                              state.deposited_volume_m3, r.deposited_volume_m3()));
       return;
     }
     case proto::LogRecord::kResumed: ++state.resumes; return;
@@ -375,10 +371,10 @@ RebuiltState rebuild_state(const std::string& dir, WorldState initial, runlog::R
     try {
       const proto::Snapshot s = read_snapshot(snapshot_path);
       if (s.run_id() != out.header.run_id())
-        throw ParseError(snapshot_path, 0, "it belongs to run '" + s.run_id() + "', not '" + out.header.run_id() + "'");
-      if (s.log_offset() < reader.first_record_offset() || s.log_offset() > reader.file_bytes())
         throw ParseError(snapshot_path, 0,
-                         "its log offset " + std::to_string(s.log_offset()) + " lies outside run.log");
+                         fmt::format("it belongs to run '{}', not '{}'", s.run_id(), out.header.run_id()));
+      if (s.log_offset() < reader.first_record_offset() || s.log_offset() > reader.file_bytes())
+        throw ParseError(snapshot_path, 0, fmt::format("its log offset {} lies outside run.log", s.log_offset()));
       WorldState restored = out.state;
       restore_snapshot(restored, s, snapshot_path);
       out.state = std::move(restored);
@@ -391,7 +387,7 @@ RebuiltState rebuild_state(const std::string& dir, WorldState initial, runlog::R
   reader.seek(offset);
   proto::LogRecord record;
   for (std::uint64_t at = reader.offset(); reader.next(record); at = reader.offset()) {
-    const std::string where = log_path + " (record at byte " + std::to_string(at) + ")";
+    const std::string where = fmt::format("{} (record at byte {})", log_path, at);
     apply_record(out.state, record, where);
     ++out.records;
     if (record.has_end()) {

@@ -1,5 +1,7 @@
 #include "marsala/world_server/records/run_outputs.hpp"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <google/protobuf/util/json_util.h>
 #include <nlohmann/json.hpp>
 
@@ -31,7 +33,7 @@ using runlog::write_atomically;
 void make_dir(const std::string& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec) throw IoError("cannot create output folder '" + dir + "': " + ec.message());
+  if (ec) throw IoError(fmt::format("cannot create output folder '{}': {}", dir, ec.message()));
 }
 
 std::string path_in(const std::string& dir, const char* name) { return (fs::path(dir) / name).string(); }
@@ -62,12 +64,6 @@ FinalTerrainReport final_terrain_report(const WorldState& state, const RunInfo& 
   return report;
 }
 
-std::string format_number(const char* format, double v) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
-
 // The zoom window's framing (run_outputs.hpp, zoom_window()).
 constexpr double kZoomMinMarginM = 3.0;
 constexpr double kZoomMarginFraction = 0.15;
@@ -96,8 +92,6 @@ struct WorldBox {
 };
 
 /// "140.25" (no trailing zeros, no rounding noise of the cell arithmetic).
-std::string format_metres(double v) { return format_number("%.10g", v); }
-
 std::string summary_text(const WorldState& state, const RunInfo& info, const FinalTerrainReport& report) {
   proto::RunSummary s;
   s.set_scenario(info.scenario);
@@ -188,7 +182,7 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   options.preserve_proto_field_names = true;
   std::string json;
   const auto status = google::protobuf::util::MessageToJsonString(s, &json, options);
-  if (!status.ok()) throw IoError("cannot print the run summary as JSON: " + status.ToString());
+  if (!status.ok()) throw IoError(fmt::format("cannot print the run summary as JSON: {}", status.ToString()));
   return json;
 }
 
@@ -266,7 +260,7 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
         for (const AgentRecord& a : state.agents)
           if (a.admitted) o.circles.push_back({{a.target_x_m, a.target_y_m}, g.target_radius_m, kToGreen, 0.0});
         o.legend_entries.push_back(
-            {"targets (" + format_number("%g", g.target_radius_m) + " m)", kToGreen, render::LegendSwatch::kRing});
+            {fmt::format("targets ({:g} m)", g.target_radius_m), kToGreen, render::LegendSwatch::kRing});
       }
       break;
     }
@@ -279,11 +273,11 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
         if (line.points.size() == 1) line.points.push_back(line.points.front());
         o.polylines.push_back(std::move(line));
         o.legend_entries.push_back(
-            {"payload path " + format_number("%.2f m", route->length_m), kPathYellow, render::LegendSwatch::kLine});
-        outcome += ", path " + format_number("%.2f m", route->length_m);
+            {fmt::format("payload path {:.2f} m", route->length_m), kPathYellow, render::LegendSwatch::kLine});
+        outcome += fmt::format(", path {:.2f} m", route->length_m);
         const double rise = target_rise_m(state);
         if (rise > state.check.max_target_rise_m + tolerance::kLengthM)
-          outcome += ", target raised " + format_number("%.2f m", rise);
+          outcome += fmt::format(", target raised {:.2f} m", rise);
       } else {
         outcome += ", no payload path";
       }
@@ -297,7 +291,7 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
       const scenario::Site& site = state.site;
       o.rectangles.push_back({{site.x0_m, site.y0_m}, {site.x1_m, site.y1_m}, kWhite, 0.0});
       o.legend_entries.push_back({"site", kWhite, render::LegendSwatch::kOutline});
-      outcome += ", level " + format_number("%.1f%%", 100.0 * state.check.level_fraction);
+      outcome += fmt::format(", level {:.1f}%", 100.0 * state.check.level_fraction);
       break;
     }
   }
@@ -307,7 +301,7 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
     if (!a.admitted) continue;
     o.points.push_back({{a.x_m, a.y_m}, render::label_colour(a.id), render::PointShape::kDisc, 0.0});
     std::string& ids = ids_of_colour[(a.id - 1) % ids_of_colour.size()];
-    ids += (ids.empty() ? "" : ", ") + std::to_string(a.id);
+    ids += fmt::format("{}{}", ids.empty() ? "" : ", ", a.id);
   }
   for (std::size_t k = 0; k < ids_of_colour.size(); ++k)
     if (!ids_of_colour[k].empty())
@@ -318,11 +312,11 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
     const double cs = t.cell_size_m();
     const double x0 = t.geometry().xll_m + area.first.col * cs;
     const double y1 = t.geometry().yll_m + (t.rows() - area.first.row) * cs;
-    o.title = info.scenario + ": close-up x " + format_metres(x0) + ".." + format_metres(x0 + area.cols * cs) +
-              " m, y " + format_metres(y1 - area.rows * cs) + ".." + format_metres(y1) + " m";
+    o.title = fmt::format("{}: close-up x {:.10g}..{:.10g} m, y {:.10g}..{:.10g} m", info.scenario, x0,
+                          x0 + area.cols * cs, y1 - area.rows * cs, y1);
   } else {
-    o.title = info.scenario + ": step " + std::to_string(state.step) + ", " + scenario::to_string(state.completion) +
-              " " + outcome;
+    o.title = fmt::format("{}: step {}, {} {}", info.scenario, state.step, scenario::to_string(state.completion),
+                          outcome);
   }
   return o;
 }
@@ -337,8 +331,8 @@ render::RenderOptions goal_vector_map_picture_options(const WorldState& state, c
   for (const GoalArrow& a : map.arrows()) o.arrows.push_back({a.tail, a.head, kArrowRed, 0.0});
   o.legend_entries.push_back({"tail -> head", kArrowRed, render::LegendSwatch::kArrow});
   o.legend_entries.push_back({"site", kWhite, render::LegendSwatch::kOutline});
-  o.title = info.scenario + ": goal vector map, " + std::to_string(map.arrows().size()) + " arrows in " +
-            std::to_string(map.strips()) + " strips, heading " + to_string(spec.heading);
+  o.title = fmt::format("{}: goal vector map, {} arrows in {} strips, heading {}", info.scenario, map.arrows().size(),
+                        map.strips(), to_string(spec.heading));
   return o;
 }
 
@@ -354,7 +348,7 @@ render::PerspectiveOptions perspective_options(const WorldState& state, const Ru
     if (a.admitted)
       o.bodies.push_back({a.x_m, a.y_m, 0.8 * a.type.body.navigability.delta_m,
                           0.4 * a.type.body.navigability.delta_m, render::label_colour(a.id)});
-  o.title = info.scenario + ": step " + std::to_string(state.step) + ", built material in orange";
+  o.title = fmt::format("{}: step {}, built material in orange", info.scenario, state.step);
   return o;
 }
 
@@ -392,7 +386,7 @@ void write_final_outputs(const std::string& dir, const WorldState& state, const 
     std::ofstream out(p, std::ios::binary | std::ios::trunc);
     out << summary;
     out.close();
-    if (!out) throw IoError("cannot write '" + p + "'");
+    if (!out) throw IoError(fmt::format("cannot write '{}'", p));
   });
 
   if (info.goal_vector_map) {
@@ -424,7 +418,7 @@ std::string note_json(std::uint64_t step, const std::string& text) {
 EventLog::EventLog(const std::string& path, bool append) : path_(path) {
   make_dir(fs::path(path).parent_path().empty() ? "." : fs::path(path).parent_path().string());
   out_.open(path, append ? std::ios::app : std::ios::trunc);
-  if (!out_) throw IoError("cannot write '" + path + "'");
+  if (!out_) throw IoError(fmt::format("cannot write '{}'", path));
 }
 
 void EventLog::append(const protocol::WorldEvent& event, const std::vector<Deposition>& cells) {
@@ -437,8 +431,8 @@ void EventLog::write_line(const std::string& line) {
   errno = 0;
   out_ << line << std::endl;
   if (!out_)
-    throw IoError("cannot write '" + path_ + "': " + (errno != 0 ? std::strerror(errno) : "disk full or the file gone?") +
-                  "; the run's record is lost");
+    throw IoError(fmt::format("cannot write '{}': {}; the run's record is lost", path_,
+                              errno != 0 ? std::strerror(errno) : "disk full or the file gone?"));
 }
 
 std::vector<std::string> run_files_in(const std::string& dir) {
@@ -455,7 +449,8 @@ void clear_run_files(const std::string& dir) {
     for (const std::string& file : {std::string(name), std::string(name) + ".tmp"}) {
       std::error_code ec;
       fs::remove(fs::path(dir) / file, ec);
-      if (ec) throw IoError("cannot remove '" + (fs::path(dir) / file).string() + "' (--replace): " + ec.message());
+      if (ec)
+        throw IoError(fmt::format("cannot remove '{}' (--replace): {}", (fs::path(dir) / file).string(), ec.message()));
     }
   // The time-lapse of --frames-every: its frames and video only, then the folder when nothing else is in it.
   const fs::path frames = fs::path(dir) / "frames";
@@ -469,7 +464,7 @@ void clear_run_files(const std::string& dir) {
   }
   for (const fs::path& p : doomed) {
     fs::remove(p, ec);
-    if (ec) throw IoError("cannot remove '" + p.string() + "' (--replace): " + ec.message());
+    if (ec) throw IoError(fmt::format("cannot remove '{}' (--replace): {}", p.string(), ec.message()));
   }
   fs::remove(frames, ec);  // fails, and is meant to, when the folder holds anything else
 }
@@ -477,10 +472,9 @@ void clear_run_files(const std::string& dir) {
 void check_fresh_output_dir(const std::string& dir) {
   const std::vector<std::string> found = run_files_in(dir);
   if (found.empty()) return;
-  std::string list;
-  for (const std::string& f : found) list += (list.empty() ? "" : ", ") + f;
-  throw IoError("output folder '" + dir + "' holds another run (" + list +
-                "): give a fresh --out, or --replace to remove them first");
+  throw IoError(fmt::format(
+      "output folder '{}' holds another run ({}): give a fresh --out, or --replace to remove them first", dir,
+      fmt::join(found, ", ")));
 }
 
 }  // namespace marsala::world_server

@@ -28,7 +28,7 @@ std::string body_difference(const RobotBody& got, const RobotBody& want) {
                 {"cube_size_m", got.cube_size_m, want.cube_size_m}};
   for (const auto& f : fields)
     if (!(f.got == f.want))
-      return std::string(f.name) + " " + fmt::format("{}", f.got) + " != " + fmt::format("{}", f.want);
+      return fmt::format("{} {} != {}", f.name, f.got, f.want);
   return {};
 }
 
@@ -65,10 +65,9 @@ AdmissionDecision decide_admission(const WorldState& state, const protocol::Agen
   };
   const auto accept = [&](AdmissionKind kind) { return AdmissionDecision{true, {}, kind, hello.agent_id}; };
   if (hello.agent_id == kAnySlot) return decide_any_slot(state, hello, run_started);
-  const std::string who = "agent " + std::to_string(hello.agent_id);
+  const std::string who = fmt::format("agent {}", hello.agent_id);
   if (!state.has_agent(hello.agent_id))
-    return refuse("unknown agent id " + std::to_string(hello.agent_id) + ": this run has agents 1.." +
-                  std::to_string(state.agents.size()));
+    return refuse(fmt::format("unknown agent id {}: this run has agents 1..{}", hello.agent_id, state.agents.size()));
   const AgentRecord& slot = state.agent(hello.agent_id);
   const std::string problem = body_problem(hello.body);
   if (!problem.empty()) return refuse(who + ": invalid body: " + problem);
@@ -125,7 +124,7 @@ protocol::AgentHello slot_hello(const WorldState& state, const protocol::AgentHe
   protocol::AgentHello slot = hello;
   slot.agent_id = decision.agent_id;
   if (hello.agent_id == kAnySlot && state.has_agent(slot.agent_id))
-    slot.name = state.agent(slot.agent_id).type.name + "-" + std::to_string(slot.agent_id);
+    slot.name = fmt::format("{}-{}", state.agent(slot.agent_id).type.name, slot.agent_id);
   return slot;
 }
 

@@ -23,18 +23,16 @@ namespace {
 CellIndex cell_of(const Heightmap& terrain, double x_m, double y_m, const char* what) {
   const auto cell = terrain.cell_at({x_m, y_m});
   if (!cell)
-    throw InvalidArgument(std::string(what) + " (" + fmt::format("{}", x_m) + ", " + fmt::format("{}", y_m) +
-                          ") is off the " + std::to_string(terrain.rows()) + " x " + std::to_string(terrain.cols()) +
-                          " grid");
+    throw InvalidArgument(fmt::format("{} {} is off the {} x {} grid", what, Position{x_m, y_m}, terrain.rows(),
+                                      terrain.cols()));
   return *cell;
 }
 
 CellRect site_rect_or_throw(const Heightmap& terrain, const scenario::Site& site) {
   const CellRect rect = site_cells(terrain.geometry(), site);
   if (rect.empty())
-    throw InvalidArgument("site [" + fmt::format("{}", site.x0_m) + ", " + fmt::format("{}", site.x1_m) + "] x [" +
-                          fmt::format("{}", site.y0_m) + ", " + fmt::format("{}", site.y1_m) +
-                          "] holds no cell centre of the grid");
+    throw InvalidArgument(fmt::format("site [{}, {}] x [{}, {}] holds no cell centre of the grid", site.x0_m,
+                                      site.x1_m, site.y0_m, site.y1_m));
   return rect;
 }
 

@@ -5,23 +5,21 @@
 #include <vector>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 
 namespace marsala::world_server {
 
 std::vector<ConstructionSite> construction_sites(const Heightmap& initial, const Heightmap& final_terrain,
                                                  const PayloadRoute& route, double min_gap_m) {
   if (initial.rows() != final_terrain.rows() || initial.cols() != final_terrain.cols())
-    throw InvalidArgument("construction sites: initial terrain " + std::to_string(initial.rows()) + " x " +
-                          std::to_string(initial.cols()) + " and final terrain " +
-                          std::to_string(final_terrain.rows()) + " x " + std::to_string(final_terrain.cols()) +
-                          " differ");
+    throw InvalidArgument(fmt::format("construction sites: initial terrain {} x {} and final terrain {} x {} differ",
+                                      initial.rows(), initial.cols(), final_terrain.rows(), final_terrain.cols()));
   const int rows = final_terrain.rows(), cols = final_terrain.cols();
   const double cs = final_terrain.cell_size_m();
   const auto raised = [&](int r, int c) { return final_terrain(r, c) - initial(r, c) > kRaisedM; };
   for (const CellIndex& c : route.cells)
     if (!final_terrain.contains(c))
-      throw InvalidArgument("construction sites: route cell (" + std::to_string(c.row) + ", " +
-                            std::to_string(c.col) + ") is off the grid");
+      throw InvalidArgument(fmt::format("construction sites: route cell {} is off the grid", c));
 
   // Regions of raised cells, labelled on demand from the route (flood fill, 8-connected).
   std::vector<int> region(static_cast<std::size_t>(rows) * cols, -1);

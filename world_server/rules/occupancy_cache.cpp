@@ -66,8 +66,8 @@ void OccupancyCache::recompute(const Heightmap& terrain, const CellRect& t) {
 long long OccupancyCache::update(const Heightmap& terrain) {
   if (!has_changes_) return 0;
   if (!terrain.contains({area_.first.row + area_.rows - 1, area_.first.col + area_.cols - 1}))
-    throw InvalidArgument("OccupancyCache::update: the " + std::to_string(terrain.rows()) + " x " +
-                          std::to_string(terrain.cols()) + " grid does not hold the cached area");
+    throw InvalidArgument(fmt::format("OccupancyCache::update: the {} x {} grid does not hold the cached area",
+                                      terrain.rows(), terrain.cols()));
   // The cells within reach of each block's changes; overlapping boxes are merged (their hull), so no cell is
   // recomputed twice within one merged box.
   std::vector<Box> boxes;

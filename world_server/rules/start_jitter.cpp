@@ -4,6 +4,7 @@
 #include <string>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/core/random.hpp"
 #include "marsala/core/cell_occupancy.hpp"
 
@@ -12,7 +13,7 @@ namespace marsala::world_server {
 Position jittered_start(const Heightmap& terrain, const scenario::AgentSlot& slot, const RobotBody& body,
                         double jitter_m, std::uint64_t seed) {
   if (!(jitter_m >= 0.0) || !std::isfinite(jitter_m))
-    throw InvalidArgument("start jitter of agent " + std::to_string(slot.id) + " must be finite and >= 0 m");
+    throw InvalidArgument(fmt::format("start jitter of agent {} must be finite and >= 0 m", slot.id));
   const Position start{slot.start_x_m, slot.start_y_m};
   if (jitter_m == 0.0) return start;
   // Streams of different agents start at unrelated points of the generator's cycle.

@@ -28,7 +28,6 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
                  const std::vector<std::size_t>& mine, std::vector<CellIndex>& changed_cells, StepOutcome& out,
                  bool& deposited) {
   const std::uint64_t step = state.step;
-  const std::string who = "agent " + std::to_string(agent.id);
   bool answered = false;
   const protocol::ActionRequest* first = nullptr;  // the request that answered the step
   for (std::size_t index : mine) {
@@ -44,23 +43,23 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
         ++state.unattributed_rejections;
       ++out.rejected;
       out.events.push_back(event(step, known ? r->agent_id : 0, protocol::EventKind::kRejected,
-                                 "request claiming agent " + std::to_string(r->agent_id) + " session " +
-                                     std::to_string(r->session) + " on agent " + std::to_string(agent.id) +
-                                     "'s partition rejected: not its admitted identity"));
+                                 fmt::format("request claiming agent {} session {} on agent {}'s partition "
+                                             "rejected: not its admitted identity",
+                                             r->agent_id, r->session, agent.id)));
       continue;
     }
     if (r->step < step) {
-      out.notes.push_back(who + ": request for past step " + std::to_string(r->step) + " dropped");
+      out.notes.push_back(fmt::format("agent {}: request for past step {} dropped", agent.id, r->step));
       continue;
     }
     if (answered && r->step == step && protocol::same_request(*r, *first)) {
-      out.notes.push_back(who + ": request for step " + std::to_string(step) + " repeated; the first stands");
+      out.notes.push_back(fmt::format("agent {}: request for step {} repeated; the first stands", agent.id, step));
       continue;
     }
     if (r->step > step || answered) {
       const std::string reason =
-          r->step > step ? "request for future step " + std::to_string(r->step) + " rejected"
-                         : "duplicate request for step " + std::to_string(step) + " rejected; the first stands";
+          r->step > step ? fmt::format("request for future step {} rejected", r->step)
+                         : fmt::format("duplicate request for step {} rejected; the first stands", step);
       ++agent.rejected;
       ++out.rejected;
       out.events.push_back(event(step, agent.id, protocol::EventKind::kRejected, reason));
@@ -80,7 +79,7 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
       ++out.accepted;
       if (verdict.volume_m3 > 0.0)
         out.events.push_back(event(step, agent.id, protocol::EventKind::kDeposited,
-                                   std::to_string(out.raised_cells[index].size()) + " cells", verdict.volume_m3));
+                                   fmt::format("{} cells", out.raised_cells[index].size()), verdict.volume_m3));
     } else {
       agent.last_result = protocol::ActionResult::kRejected;
       agent.last_reason = verdict.reason;
@@ -99,12 +98,12 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
   ++agent.consecutive_missed;
   ++out.missed;
   agent.last_result = protocol::ActionResult::kMissed;
-  agent.last_reason = "no request for step " + std::to_string(step) + " before the deadline";
+  agent.last_reason = fmt::format("no request for step {} before the deadline", step);
   out.events.push_back(event(step, agent.id, protocol::EventKind::kMissed, agent.last_reason));
   const int recent = std::bitset<kMissWindowSteps>(agent.recent_misses).count();
   std::string why;
   if (agent.consecutive_missed >= kMaxConsecutiveMisses)
-    why = std::to_string(agent.consecutive_missed) + " consecutive missed deadlines";
+    why = fmt::format("{} consecutive missed deadlines", agent.consecutive_missed);
   else if (recent >= kMaxMissesInWindow)
     why = fmt::format("{} missed deadlines in its last {} steps", recent, kMissWindowSteps);
   if (!why.empty()) {
@@ -139,8 +138,8 @@ StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submiss
   for (std::size_t i = 0; i < submissions.size(); ++i) {
     const Submission& s = submissions[i];
     if (!state.has_agent(s.channel_id) || !state.agent(s.channel_id).alive) {
-      out.notes.push_back("request on the partition of agent " + std::to_string(s.channel_id) +
-                          ", which is not in the run, ignored");
+      out.notes.push_back(
+          fmt::format("request on the partition of agent {}, which is not in the run, ignored", s.channel_id));
       continue;
     }
     by_agent[s.channel_id - 1].push_back(i);

@@ -5,12 +5,13 @@
 #include <string>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 
 namespace marsala::world_server {
 
 TileLayout::TileLayout(const GridGeometry& grid, int tile_size) : grid_(grid), tile_size_(tile_size) {
   if (grid.rows <= 0 || grid.cols <= 0) throw InvalidArgument("tile layout: the grid is empty");
-  if (tile_size < 1) throw InvalidArgument("tile layout: tile_size must be >= 1, got " + std::to_string(tile_size));
+  if (tile_size < 1) throw InvalidArgument(fmt::format("tile layout: tile_size must be >= 1, got {}", tile_size));
   tile_rows_ = (grid.rows + tile_size - 1) / tile_size;
   tile_cols_ = (grid.cols + tile_size - 1) / tile_size;
 }

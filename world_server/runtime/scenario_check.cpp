@@ -1,5 +1,6 @@
 #include "marsala/world_server/runtime/scenario_check.hpp"
 
+#include <fmt/format.h>
 #include <google/protobuf/util/json_util.h>
 
 #include <charconv>
@@ -176,11 +177,13 @@ std::string scenario_check_text(const WorldStart& start) {
         << ", delta_m " << number(t.body.navigability.delta_m) << ", eps_m " << number(t.body.navigability.eps_m)
         << ", max_step_m " << number(t.body.max_step_m) << ", cube_size_m " << number(t.body.cube_size_m)
         << ", goal_synthesizer " << t.goal_synthesizer << ", sensor " << t.sensor.name
-        << (t.sensor.casts_rays() ? " (" + std::to_string(t.sensor.ray_count()) + " rays, " +
-                                        number(t.sensor.min_range_m) + "-" + number(t.sensor.max_range_m) + " m)"
+        << (t.sensor.casts_rays() ? fmt::format(" ({} rays, {}-{} m)", t.sensor.ray_count(),
+                                                number(t.sensor.min_range_m), number(t.sensor.max_range_m))
                                   : "")
         << ", depositor " << t.depositor.name
-        << (t.localisation.noise_sd_m > 0.0 ? ", localisation noise " + number(t.localisation.noise_sd_m) + " m" : "")
+        << (t.localisation.noise_sd_m > 0.0
+                ? fmt::format(", localisation noise {} m", number(t.localisation.noise_sd_m))
+                : "")
         << "\n";
   out << "slots (" << s.slots.size() << "; the world waits for agents 1.." << state.agents.size() << "):\n";
   for (const scenario::AgentSlot& slot : s.slots) {

@@ -1,5 +1,7 @@
 #include "marsala/world_server/runtime/world_cli.hpp"
 
+#include <fmt/format.h>
+
 #include <cstdlib>
 #include <ostream>
 
@@ -114,18 +116,19 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
                                bus::Security::of(dds.security, dds.identity, "world")});
     WorldRuntime runtime(std::move(start), *participant);
     const RunResult result = runtime.run(stop);
-    out << "run " << runtime.run_id() << ": " << to_string(result.end_reason) << " after " << result.steps << " steps"
-        << (result.resumed_at_step ? " (resumed at step " + std::to_string(*result.resumed_at_step) + ")" : "") << ", "
-        << result.admitted << " agents, terrain sha256 " << result.terrain_sha256 << "\n";
+    out << fmt::format("run {}: {} after {} steps{}, {} agents, terrain sha256 {}\n", runtime.run_id(),
+                       to_string(result.end_reason), result.steps,
+                       result.resumed_at_step ? fmt::format(" (resumed at step {})", *result.resumed_at_step) : "",
+                       result.admitted, result.terrain_sha256);
     return exit_code(result.end_reason);
   } catch (const Error& e) {
-    cli::write_exit_error(err, std::string("marsala-world: error: ") + e.what());
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
     return 1;
   } catch (const std::bad_alloc&) {
     cli::write_exit_error(err, "marsala-world: error: out of memory");
     return 1;
   } catch (const std::exception& e) {  // a library's own exception: still one line and exit 1, never an abort
-    cli::write_exit_error(err, std::string("marsala-world: error: ") + e.what());
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
     return 1;
   }
   return 0;

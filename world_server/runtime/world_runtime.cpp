@@ -373,8 +373,9 @@ struct WorldRuntime::Impl {
   /// What a step applied, told: notes and events to the log, events.log and the bus.
   void report_step(const std::vector<Submission>& submissions, const StepOutcome& outcome) {
     if (outcome.completion_checked)
-      spdlog::debug("step {}: {} check: {} (level fraction {:.4f})", outcome.step, scenario::to_string(state.completion),
-                    state.check.met ? "met" : "not met", state.check.level_fraction);
+      spdlog::debug("step {}: {} check: {} (level fraction {:.4f})", outcome.step,
+                    scenario::to_string(state.completion), state.check.met ? "met" : "not met",
+                    state.check.level_fraction);
     for (const std::string& text : outcome.notes) note(text);
     for (const protocol::WorldEvent& e : outcome.events) {
       if (e.kind == protocol::EventKind::kRejected)
