@@ -213,7 +213,7 @@ proto::Snapshot make_snapshot(const WorldState& state, const std::string& run_id
 
 proto::Snapshot read_snapshot(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open the snapshot");
+  if (!in) throw IoError(fmt::format("{}: cannot open the snapshot", path));
   std::ostringstream bytes;
   bytes << in.rdbuf();
   proto::Snapshot s;
@@ -227,7 +227,8 @@ proto::Snapshot read_snapshot(const std::string& path) {
 void write_snapshot(const std::string& path, const proto::Snapshot& snapshot) {
   runlog::write_atomically(path, [&](const std::string& tmp) {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out || !snapshot.SerializeToOstream(&out) || !out.flush()) throw IoError(tmp + ": cannot write the snapshot");
+    if (!out || !snapshot.SerializeToOstream(&out) || !out.flush())
+      throw IoError(fmt::format("{}: cannot write the snapshot", tmp));
   });
 }
 

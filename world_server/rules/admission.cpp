@@ -37,13 +37,13 @@ std::string body_difference(const RobotBody& got, const RobotBody& want) {
 namespace {
 
 AdmissionDecision decide_any_slot(const WorldState& state, const protocol::AgentHello& hello, bool run_started) {
-  const auto refuse = [](std::string reason) {
-    return AdmissionDecision{false, "any slot: " + std::move(reason), AdmissionKind::kRefused, kAnySlot};
+  const auto refuse = [](const std::string& reason) {
+    return AdmissionDecision{false, fmt::format("any slot: {}", reason), AdmissionKind::kRefused, kAnySlot};
   };
   for (const AgentRecord& a : state.agents)
     if (a.admitted && a.session == hello.session) return {true, {}, AdmissionKind::kRepeat, a.id};
   const std::string problem = body_problem(hello.body);
-  if (!problem.empty()) return refuse("invalid body: " + problem);
+  if (!problem.empty()) return refuse(fmt::format("invalid body: {}", problem));
   if (run_started) return refuse("the run has already started");
   std::size_t of_type = 0;
   for (const AgentRecord& a : state.agents) {
@@ -52,7 +52,8 @@ AdmissionDecision decide_any_slot(const WorldState& state, const protocol::Agent
     if (!a.admitted && !a.dropped) return {true, {}, AdmissionKind::kFirst, a.id};
   }
   if (of_type == 0)
-    return refuse("no slot of this run has a robot type with this body and behaviour '" + hello.behaviour + "'");
+    return refuse(
+        fmt::format("no slot of this run has a robot type with this body and behaviour '{}'", hello.behaviour));
   return refuse(fmt::format("all {} slots of this robot type are taken", of_type));
 }
 
@@ -65,29 +66,30 @@ AdmissionDecision decide_admission(const WorldState& state, const protocol::Agen
   };
   const auto accept = [&](AdmissionKind kind) { return AdmissionDecision{true, {}, kind, hello.agent_id}; };
   if (hello.agent_id == kAnySlot) return decide_any_slot(state, hello, run_started);
-  const std::string who = fmt::format("agent {}", hello.agent_id);
   if (!state.has_agent(hello.agent_id))
     return refuse(fmt::format("unknown agent id {}: this run has agents 1..{}", hello.agent_id, state.agents.size()));
   const AgentRecord& slot = state.agent(hello.agent_id);
   const std::string problem = body_problem(hello.body);
-  if (!problem.empty()) return refuse(who + ": invalid body: " + problem);
+  if (!problem.empty()) return refuse(fmt::format("agent {}: invalid body: {}", hello.agent_id, problem));
   const std::string difference = body_difference(hello.body, slot.type.body);
   if (!difference.empty())
-    return refuse(who + ": body differs from robot type '" + slot.type.name + "' of its slot: " + difference);
+    return refuse(fmt::format("agent {}: body differs from robot type '{}' of its slot: {}", hello.agent_id,
+                              slot.type.name, difference));
   if (slot.dropped) {
     if (slot.readmissions >= kMaxReadmissions)
       return refuse(
-          fmt::format("{} was dropped from the run: {}; it has taken its slot back {} times, the most a run "
+          fmt::format("agent {} was dropped from the run: {}; it has taken its slot back {} times, the most a run "
                       "allows",
-                      who, slot.drop_reason, slot.readmissions));
+                      hello.agent_id, slot.drop_reason, slot.readmissions));
     return accept(AdmissionKind::kReadmission);
   }
   if (slot.admitted) {
     if (slot.session == hello.session) return accept(AdmissionKind::kRepeat);
     if (!holder_connected) return accept(AdmissionKind::kTakeover);
-    return refuse(who + " is already admitted with another session that is still connected");
+    return refuse(
+        fmt::format("agent {} is already admitted with another session that is still connected", hello.agent_id));
   }
-  if (run_started) return refuse(who + ": the run has already started");
+  if (run_started) return refuse(fmt::format("agent {}: the run has already started", hello.agent_id));
   return accept(AdmissionKind::kFirst);
 }
 

@@ -24,14 +24,14 @@ std::string number(double v) {
   return std::string(buf, result.ptr);
 }
 
-std::string point(double x_m, double y_m) { return "(" + number(x_m) + ", " + number(y_m) + ")"; }
+std::string point(double x_m, double y_m) { return fmt::format("({}, {})", number(x_m), number(y_m)); }
 
 std::string box(double x0_m, double y0_m, double x1_m, double y1_m) {
-  return "x [" + number(x0_m) + ", " + number(x1_m) + "] y [" + number(y0_m) + ", " + number(y1_m) + "] m";
+  return fmt::format("x [{}, {}] y [{}, {}] m", number(x0_m), number(x1_m), number(y0_m), number(y1_m));
 }
 
 std::string terrain_source(const scenario::Scenario& s) {
-  return s.terrain.file.empty() ? "generator " + s.terrain.method : scenario::resolve_terrain_path(s);
+  return s.terrain.file.empty() ? fmt::format("generator {}", s.terrain.method) : scenario::resolve_terrain_path(s);
 }
 
 void set_point(proto::CheckPoint* p, double x_m, double y_m) {
@@ -157,7 +157,7 @@ WorldStart check_scenario(const std::string& scenario_path, const RuntimeOptions
     return prepare_world_start(scenario, std::move(terrain), options, domain_id);
   } catch (const InvalidArgument& e) {
     // The loader's and the terrain builder's messages name the file; these (completion set-up, options) do not.
-    throw InvalidArgument("scenario " + scenario.source_path + ": " + e.what());
+    throw InvalidArgument(fmt::format("scenario {}: {}", scenario.source_path, e.what()));
   }
 }
 
@@ -237,7 +237,7 @@ std::string scenario_check_json(const WorldStart& start) {
   options.preserve_proto_field_names = true;
   std::string json;
   const auto status = google::protobuf::util::MessageToJsonString(to_message(start), &json, options);
-  if (!status.ok()) throw Error("cannot print the scenario check as JSON: " + status.ToString());
+  if (!status.ok()) throw Error(fmt::format("cannot print the scenario check as JSON: {}", status.ToString()));
   if (json.empty() || json.back() != '\n') json += '\n';
   return json;
 }
