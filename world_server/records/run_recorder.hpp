@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "marsala/core/heightmap.hpp"
@@ -34,6 +35,7 @@ struct RecorderSetup {
 /// The files of one run.
 class RunRecorder {
  public:
+  /// A recorder for `setup`; nothing is written before open().
   explicit RunRecorder(RecorderSetup setup) : setup_(std::move(setup)) {}
 
   /// Opens the run's files for `state`, the initial or resumed one: a fresh run writes terrain_initial.asc, creates

@@ -15,11 +15,13 @@ namespace marsala::world_server {
 
 /// Who says hello: an agent id and the session of its process.
 struct SenderKey {
-  std::uint32_t agent_id = 0;
-  std::uint64_t session = 0;
+  std::uint32_t agent_id = 0;  ///< the hello's agent id (kAnySlot included)
+  std::uint64_t session = 0;   ///< the hello's session: one per agent process
+  /// Ordered by agent id, then session.
   bool operator<(const SenderKey& o) const {
     return agent_id != o.agent_id ? agent_id < o.agent_id : session < o.session;
   }
+  /// Same id and session.
   bool operator==(const SenderKey& o) const { return agent_id == o.agent_id && session == o.session; }
 };
 
@@ -51,7 +53,7 @@ enum class TakeoverWait {
 /// The gate's memory of senders; every method takes the time of the round it serves.
 class AdmissionGate {
  public:
-  using Clock = std::chrono::steady_clock;
+  using Clock = std::chrono::steady_clock;  ///< the runtime's clock; the gate only compares its time points
 
   /// True when `sender` said hello before, at least kHelloConfirmation before `now` (within the last two
   /// generations of kHelloMemory); remembers this hello. Bounded: a generation holds the hellos of kHelloMemory.

@@ -23,7 +23,7 @@ enum class LivelinessVerdict {
 /// The observations of one agent session's request writer.
 class LivelinessWatch {
  public:
-  using Clock = std::chrono::steady_clock;
+  using Clock = std::chrono::steady_clock;  ///< the observations' clock
 
   /// Takes one observation at `now`: `alive` = the request writer is alive.
   LivelinessVerdict observe(bool alive, Clock::time_point now);

@@ -8,6 +8,8 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "marsala/bus/bus.hpp"
@@ -45,8 +47,9 @@ struct Collected {
 /// Collects the requests of each step from the agents' links.
 class RequestCollector {
  public:
-  using Clock = std::chrono::steady_clock;
+  using Clock = std::chrono::steady_clock;  ///< the wall clock of the step deadline
 
+  /// Reads from `links`; waits on `signal`, which their request readers notify.
   RequestCollector(AgentLinks& links, std::shared_ptr<bus::Signal> signal)
       : links_(links), signal_(std::move(signal)) {}
 

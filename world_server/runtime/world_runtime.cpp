@@ -400,6 +400,31 @@ struct WorldRuntime::Impl {
     return std::nullopt;
   }
 
+  /// Frames: each live agent's frame of this step.
+  void send_frames() {
+    for (std::uint32_t id : state.live_ids()) send_frame(id, false);
+  }
+
+  /// Record: the step in run.log before anything of it is published (a crash never loses a step an agent has seen
+  /// applied), then the surplus note and the snapshot when due.
+  void record_step(const Collected& collected, const StepOutcome& outcome) {
+    recorder.record(step_record(collected.submissions, outcome, state, collected.surplus));
+    if (collected.surplus > 0)
+      note(fmt::format("{} requests beyond {} per partition ignored", collected.surplus, kMaxRequestsPerPartition));
+    recorder.after_step(state);
+  }
+
+  /// Status: the step's notes and events, run_over frames to agents the step dropped (one dropped for missing its
+  /// deadlines may only be slow or hung), WorldStatus and the progress line.
+  void publish_step(const Collected& collected, const StepOutcome& outcome, Clock::time_point start) {
+    report_step(collected.submissions, outcome);
+    for (std::uint32_t id : outcome.dropped) send_frame(id, true);
+    publish_status(true, outcome.completed, elapsed_s(start));
+    if (state.step % kProgressEvery == 0)
+      spdlog::info("step {}: {} live agents, {:.6f} m3 deposited, progress {:.3f}: {}", state.step,
+                   state.live_ids().size(), state.deposited_volume_m3, progress(state), progress_detail(state));
+  }
+
   /// Runs steps until an end condition; returns the end reason. A step: frames -> collect -> apply -> record ->
   /// status.
   protocol::EndReason lockstep(const std::atomic<bool>& stop, Clock::time_point start) {
@@ -409,26 +434,16 @@ struct WorldRuntime::Impl {
       recorder.frame(state, scenario.name, false);
       if (const auto end = end_before_step(stop)) return *end;
       const Clock::time_point step_start = Clock::now();
-      for (std::uint32_t id : state.live_ids()) send_frame(id, false);
-      Collected collected = collector->collect(state, options.step_deadline_s, stop, duties);
+      send_frames();
+      const Collected collected = collector->collect(state, options.step_deadline_s, stop, duties);
       if (stop) return protocol::EndReason::kSignal;  // the interrupted step is not applied
       const StepOutcome outcome = apply_step(state, collected.submissions);
       state.surplus_requests += collected.surplus;
-      // Recorded before anything of the step is published: a crash never loses a step an agent has seen applied.
-      recorder.record(step_record(collected.submissions, outcome, state, collected.surplus));
-      if (collected.surplus > 0)
-        note(fmt::format("{} requests beyond {} per partition ignored", collected.surplus, kMaxRequestsPerPartition));
-      recorder.after_step(state);
+      record_step(collected, outcome);
       const Clock::duration step_took = Clock::now() - step_start;
       step_ms.push_back(milliseconds(step_took));
       step_world_ms.push_back(milliseconds(step_took - collected.waited));
-      report_step(collected.submissions, outcome);
-      // An agent dropped for missing its deadlines may only be slow or hung: tell it the run is over for it.
-      for (std::uint32_t id : outcome.dropped) send_frame(id, true);
-      publish_status(true, outcome.completed, elapsed_s(start));
-      if (state.step % kProgressEvery == 0)
-        spdlog::info("step {}: {} live agents, {:.6f} m3 deposited, progress {:.3f}: {}", state.step,
-                     state.live_ids().size(), state.deposited_volume_m3, progress(state), progress_detail(state));
+      publish_step(collected, outcome, start);
     }
   }
 
