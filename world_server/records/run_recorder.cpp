@@ -82,10 +82,9 @@ void RunRecorder::finish(const WorldState& state, RunInfo info, const std::strin
   if (!frames_) return;
   frame(state, scenario_name, true);
   const render::TimelapseResult video = frames_->finish(search_path);
-  spdlog::info("time-lapse: {} frames in {} ({:.3f} s drawing){}", frames_->names().size(), frames_->dir(),
-               frames_->seconds(),
-               video.path.empty() ? fmt::format("; {}", video.note)
-                                  : fmt::format(", {} ({:.3f} s)", video.path, video.seconds));
+  spdlog::info(
+      "time-lapse: {} frames in {} ({:.3f} s drawing){}", frames_->names().size(), frames_->dir(), frames_->seconds(),
+      video.path.empty() ? fmt::format("; {}", video.note) : fmt::format(", {} ({:.3f} s)", video.path, video.seconds));
 }
 
 }  // namespace marsala::world_server

@@ -43,8 +43,7 @@ bool AdmissionGate::report_refusal(SenderKey sender) {
 }
 
 std::size_t AdmissionGate::remembered() const {
-  return seen_current_.size() + seen_previous_.size() + takeover_since_.size() + answered_at_.size() +
-         refused_.size();
+  return seen_current_.size() + seen_previous_.size() + takeover_since_.size() + answered_at_.size() + refused_.size();
 }
 
 }  // namespace marsala::world_server

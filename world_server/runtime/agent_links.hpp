@@ -33,8 +33,7 @@ void write_logged(bus::Writer<T>& writer, const T& sample, const char* what);
 class AgentLinks {
  public:
   /// `signal` wakes the world when a request arrives on any link.
-  AgentLinks(bus::Participant& participant, std::shared_ptr<bus::Signal> signal, std::string run_id,
-             std::size_t slots);
+  AgentLinks(bus::Participant& participant, std::shared_ptr<bus::Signal> signal, std::string run_id, std::size_t slots);
 
   /// Opens the partition endpoints of `agent`'s admitted session, replacing another session's (a new link: its
   /// liveliness starts unseen); nothing when they are open already.

@@ -32,15 +32,15 @@ inline constexpr std::chrono::milliseconds kPollInterval{100};
 
 /// What the runtime does while a step waits; the state it changes (admissions, drops) is the one being collected for.
 struct CollectDuties {
-  std::function<void()> on_wake;                     ///< at every wake-up: hellos (taken at their own pace)
-  std::function<void()> check_liveliness;            ///< every kLivelinessPoll
-  std::function<void(std::uint32_t)> send_frame;     ///< an agent without a frame of this step gets its first
+  std::function<void()> on_wake;                  ///< at every wake-up: hellos (taken at their own pace)
+  std::function<void()> check_liveliness;         ///< every kLivelinessPoll
+  std::function<void(std::uint32_t)> send_frame;  ///< an agent without a frame of this step gets its first
 };
 
 /// What one step collected.
 struct Collected {
-  std::vector<Submission> submissions;  ///< in the order read, partition by partition
-  std::uint32_t surplus = 0;            ///< requests beyond a partition's limit, never applied
+  std::vector<Submission> submissions;           ///< in the order read, partition by partition
+  std::uint32_t surplus = 0;                     ///< requests beyond a partition's limit, never applied
   std::chrono::steady_clock::duration waited{};  ///< time spent waiting for requests
 };
 

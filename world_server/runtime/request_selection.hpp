@@ -35,8 +35,8 @@ class RequestSelection {
   std::uint32_t surplus() const { return surplus_; }
 
  private:
-  std::vector<bool> answered_;       ///< [id - 1]
-  std::vector<std::size_t> taken_;   ///< [id - 1]: requests other than the answer taken
+  std::vector<bool> answered_;      ///< [id - 1]
+  std::vector<std::size_t> taken_;  ///< [id - 1]: requests other than the answer taken
   std::uint32_t surplus_ = 0;
 };
 

@@ -123,10 +123,10 @@ RecorderSetup recorder_setup(const RuntimeOptions& options, const std::optional<
 
 /// What a resume says about itself, in the log and in events.log.
 std::string resume_note(const ResumeInfo& resume) {
-  return fmt::format("resumed: {} records replayed{}{}", resume.records,
-                     resume.snapshot_step > 0 ? fmt::format(" after the snapshot of step {}", resume.snapshot_step)
-                                              : std::string(),
-                     resume.tail_problem.empty() ? std::string() : fmt::format("; cut {}", resume.tail_problem));
+  return fmt::format(
+      "resumed: {} records replayed{}{}", resume.records,
+      resume.snapshot_step > 0 ? fmt::format(" after the snapshot of step {}", resume.snapshot_step) : std::string(),
+      resume.tail_problem.empty() ? std::string() : fmt::format("; cut {}", resume.tail_problem));
 }
 
 }  // namespace

@@ -28,8 +28,8 @@ namespace marsala::world_server {
 struct RunResult {
   bool completed = false;
   protocol::EndReason end_reason = protocol::EndReason::kSignal;  ///< why the run ended
-  std::uint64_t steps = 0;                    ///< steps applied
-  double wall_seconds = 0.0;                  ///< from the first frame to the end [s]
+  std::uint64_t steps = 0;                                        ///< steps applied
+  double wall_seconds = 0.0;                                      ///< from the first frame to the end [s]
   std::uint32_t admitted = 0;
   std::string terrain_sha256;                    ///< of the final heights
   std::optional<std::uint64_t> resumed_at_step;  ///< set when this process continued a run from its log

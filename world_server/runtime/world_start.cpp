@@ -28,8 +28,7 @@ void check_run_id(const std::string& run_id) {
   const bool ok = !run_id.empty() && std::all_of(run_id.begin(), run_id.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
   });
-  if (!ok)
-    throw InvalidArgument(fmt::format("run id '{}' must be non-empty letters, digits, '_', '-', '.'", run_id));
+  if (!ok) throw InvalidArgument(fmt::format("run id '{}' must be non-empty letters, digits, '_', '-', '.'", run_id));
 }
 
 WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, RuntimeOptions options, int domain_id) {

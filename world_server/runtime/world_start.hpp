@@ -27,9 +27,9 @@ struct RuntimeOptions {
   std::uint64_t snapshot_every = 1000;  ///< write snapshot.pb after every this many steps; 0 = never
   std::uint64_t frames_every = 0;       ///< a PNG frame every this many steps and the last in out_dir/frames; 0 = none
   std::string search_path;              ///< where to look for ffmpeg (the timelapse.mp4 of the frames); empty = none
-  std::string scenario_text;  ///< the scenario file's text, recorded in run.log so that --resume needs no file
+  std::string scenario_text;           ///< the scenario file's text, recorded in run.log so that --resume needs no file
   std::vector<std::string> overrides;  ///< --set FIELD=VALUE applied to scenario_text (recorded in run.log too)
-  bool replace = false;       ///< out_dir may hold another run's files: the caller clears them (clear_run_files())
+  bool replace = false;  ///< out_dir may hold another run's files: the caller clears them (clear_run_files())
 };
 
 /// Where a resumed run picks up (prepare_resume()).

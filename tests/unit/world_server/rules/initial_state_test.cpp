@@ -16,8 +16,8 @@ using testing::flat_terrain;
 using testing::small_scenario;
 
 TEST(WorldStateAt, PlacesEachSlotAtTheStartGivenAndChecksNothingYet) {
-  const scenario::Scenario s = scenario::parse_scenario(
-      testing::small_scenario_text_completing(testing::payload_block()), "small.pbtxt");
+  const scenario::Scenario s =
+      scenario::parse_scenario(testing::small_scenario_text_completing(testing::payload_block()), "small.pbtxt");
   const WorldState w = world_state_at(s, flat_terrain(), {{1.25, 2.5}, {3.0, 0.75}});
   ASSERT_EQ(w.agents.size(), 2u);
   EXPECT_EQ(w.agent(1).start_x_m, 1.25);

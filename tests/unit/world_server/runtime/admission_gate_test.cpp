@@ -35,9 +35,9 @@ TEST(AdmissionGate, AHelloIsRememberedAcrossOneGenerationNotTwo) {
   EXPECT_TRUE(gate.persistent(agent, t0 + 1500ms));
   AdmissionGate other;
   EXPECT_FALSE(other.persistent(agent, t0));
-  EXPECT_FALSE(other.persistent({9, 9}, t0 + 1000ms));  // rotates: agent's hello is now in the previous generation
+  EXPECT_FALSE(other.persistent({9, 9}, t0 + 1000ms));   // rotates: agent's hello is now in the previous generation
   EXPECT_FALSE(other.persistent({9, 10}, t0 + 2000ms));  // rotates again: it is forgotten
-  EXPECT_FALSE(other.persistent(agent, t0 + 2000ms));   // so this is a first hello again
+  EXPECT_FALSE(other.persistent(agent, t0 + 2000ms));    // so this is a first hello again
 }
 
 TEST(AdmissionGate, AFloodOfOneShotRandomSessionsIsNeverConfirmedAndStaysBounded) {
