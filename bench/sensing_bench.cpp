@@ -36,7 +36,7 @@ const char* kSensorNames[] = {"laser", "rgbd"};
 
 void BM_Scan(benchmark::State& state) {
   const Heightmap terrain = terrain_named(static_cast<int>(state.range(1)));
-  const SensorSpec sensor = sensor_defaults(kSensorNames[state.range(0)]);
+  const SensorSpec sensor = sensor_defaults(sensor_kind(kSensorNames[state.range(0)]));
   const Point3 origin = sensor_origin(terrain, 15.05, 10.05, sensor);
   std::uint64_t step = 0;
   std::size_t points = 0;
@@ -53,7 +53,7 @@ void BM_Scan(benchmark::State& state) {
 // One scan into a map that already holds the scans of the 10 steps before (a robot on its way).
 void BM_InsertAndDerive(benchmark::State& state) {
   const Heightmap terrain = terrain_named(static_cast<int>(state.range(1)));
-  const SensorSpec sensor = sensor_defaults(kSensorNames[state.range(0)]);
+  const SensorSpec sensor = sensor_defaults(sensor_kind(kSensorNames[state.range(0)]));
   agent::executive::MappingSystem warm(terrain.geometry(), 16, sensor);
   for (int k = 0; k < 10; ++k) {
     const Point3 o = sensor_origin(terrain, 13.05 + 0.2 * k, 10.05, sensor);
@@ -75,7 +75,7 @@ void BM_InsertAndDerive(benchmark::State& state) {
 // A robot step: the world's scan, then the agent's insertion and derivation, moving 0.2 m per step.
 void BM_RobotStep(benchmark::State& state) {
   const Heightmap terrain = terrain_named(static_cast<int>(state.range(1)));
-  const SensorSpec sensor = sensor_defaults(kSensorNames[state.range(0)]);
+  const SensorSpec sensor = sensor_defaults(sensor_kind(kSensorNames[state.range(0)]));
   agent::executive::MappingSystem map(terrain.geometry(), 16, sensor);
   int k = 0;
   for (auto _ : state) {

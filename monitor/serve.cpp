@@ -91,23 +91,23 @@ std::optional<LiveScene> scene_of(const proto::LogHeader& header) {
     const scenario::Scenario s = scenario::parse_scenario(header.scenario_text(), header.scenario_file());
     LiveScene scene;
     scene.completion = scenario::to_string(s.completion);
-    scene.base_x_m = s.base.x_m;
-    scene.base_y_m = s.base.y_m;
+    scene.base_x_m = s.base.centre.x;
+    scene.base_y_m = s.base.centre.y;
     scene.base_radius_m = s.base.radius_m;
     switch (s.completion) {
       case scenario::CompletionKind::kAgentsAtGoal:
-        scene.goal = SceneRectangle{s.goal.x0_m, s.goal.y0_m, s.goal.x1_m, s.goal.y1_m};
+        scene.goal = SceneRectangle{s.goal.area.x0, s.goal.area.y0, s.goal.area.x1, s.goal.area.y1};
         break;
       case scenario::CompletionKind::kLevelSite:
-        scene.site = SceneRectangle{s.site.x0_m, s.site.y0_m, s.site.x1_m, s.site.y1_m};
+        scene.site = SceneRectangle{s.site.area.x0, s.site.area.y0, s.site.area.x1, s.site.area.y1};
         break;
       case scenario::CompletionKind::kPayloadPath:
-        scene.payload = std::make_pair(Position{s.payload_path.from_x_m, s.payload_path.from_y_m},
-                                       Position{s.payload_path.to_x_m, s.payload_path.to_y_m});
+        scene.payload = std::make_pair(Position{s.payload_path.from.x, s.payload_path.from.y},
+                                       Position{s.payload_path.to.x, s.payload_path.to.y});
         break;
     }
     for (const scenario::AgentSlot& slot : s.slots)
-      if (slot.id <= header.agents()) scene.targets.emplace_back(slot.id, Position{slot.target_x_m, slot.target_y_m});
+      if (slot.id <= header.agents()) scene.targets.emplace_back(slot.id, Position{slot.target.x, slot.target.y});
     return scene;
   } catch (const Error&) {
     return std::nullopt;

@@ -39,7 +39,7 @@ bool neighbour_takes(Position tail, const GoalQuery& query, std::uint32_t self_i
   const double mine = distance2(query.robot, tail);
   for (const Neighbour& n : query.neighbours) {
     if (n.agent_id == self_id) continue;
-    const double theirs = distance2({n.x_m, n.y_m}, tail);
+    const double theirs = distance2(n.position, tail);
     if (theirs < mine || (theirs == mine && n.agent_id < self_id)) return true;
   }
   return false;

@@ -17,10 +17,10 @@ std::vector<BodyClearance> body_clearances(const std::vector<Neighbour>& neighbo
   std::vector<BodyClearance> out;
   out.reserve(neighbours.size());
   for (const Neighbour& n : neighbours) {
-    if (!std::isfinite(n.x_m) || !std::isfinite(n.y_m) || !std::isfinite(n.radius_m) || n.agent_id == self_id)
+    if (!std::isfinite(n.position.x) || !std::isfinite(n.position.y) || !std::isfinite(n.radius_m) || n.agent_id == self_id)
       continue;
     const double moves_first = n.agent_id < self_id ? max_step_m : 0.0;
-    out.push_back({n.agent_id, {n.x_m, n.y_m}, radius_m + std::max(0.0, n.radius_m) + moves_first});
+    out.push_back({n.agent_id, n.position, radius_m + std::max(0.0, n.radius_m) + moves_first});
   }
   return out;
 }

@@ -39,7 +39,7 @@ bool DepositionManager::in_territory(const deliberative::LocalMap& map, CellInde
                                      const Neighbourhood& neighbours, std::optional<CellIndex> self_cell) const {
   const CellIndex global = map.to_global(cell);
   for (const Neighbour& n : neighbours.others) {
-    const Position p{n.x_m, n.y_m};
+    const Position p = n.position;
     if (distance(centre, p) <= params_.neighbour_keep_out_m) return false;
     // Whole-cell distances: every robot computes them exactly alike, so territories never overlap.
     const auto other = map.world.cell_at(p);
@@ -174,7 +174,7 @@ bool DepositionManager::keeps_way_back(const deliberative::LocalMap& map, Positi
   const double cs = map.geometry().cell_size_m;
   const auto step_disc = disc_offsets(params_.neighbour_step_m / cs);
   for (const Neighbour& n : neighbours.others)
-    if (const auto c = map.cell_at({n.x_m, n.y_m}))
+    if (const auto c = map.cell_at(n.position))
       for (const CellIndex o : step_disc) {
         const CellIndex p{c->row + o.row, c->col + o.col};
         if (map.contains(p)) robots.push_back(p);

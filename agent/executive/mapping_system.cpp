@@ -132,7 +132,7 @@ std::string tile_problem(const TerrainTile& tile, const GridGeometry& world, int
 
 std::string scan_problem(const std::vector<ScanPoint>& points, const SensorSpec& sensor) {
   if (static_cast<long long>(points.size()) > sensor.ray_count())
-    return fmt::format("a scan of {} points from a '{}' sensor of {} rays", points.size(), sensor.name,
+    return fmt::format("a scan of {} points from a '{}' sensor of {} rays", points.size(), to_string(sensor.kind),
                        sensor.ray_count());
   const double reach = sensor.max_range_m + std::max(1.0, 6.0 * sensor.noise_sd_at(sensor.max_range_m));
   for (std::size_t i = 0; i < points.size(); ++i) {

@@ -61,8 +61,8 @@ protocol::ActionRequest NoisyLocalisation::decide(const protocol::SensorFrame& f
   believed.y_m = pose.y;
   // What proximity sensing measures is relative: the robot places its neighbours from where it believes it is.
   for (Neighbour& n : believed.neighbours) {
-    n.x_m += pose.x - frame.x_m;
-    n.y_m += pose.y - frame.y_m;
+    n.position.x += pose.x - frame.x_m;
+    n.position.y += pose.y - frame.y_m;
   }
   offset_ = k;
   inner_->set_registration(k);
@@ -73,8 +73,8 @@ protocol::ActionRequest NoisyLocalisation::decide(const protocol::SensorFrame& f
     request.target_y_m += frame.y_m - pose.y;
   }
   for (Deposit& d : request.deposits) {  // a cube or cone depositor's positions
-    d.x_m += frame.x_m - pose.x;
-    d.y_m += frame.y_m - pose.y;
+    d.centre.x += frame.x_m - pose.x;
+    d.centre.y += frame.y_m - pose.y;
   }
   // Believed cell (r, c) is world cell (r - k.row, c - k.col).
   std::vector<Deposition> landed;

@@ -105,7 +105,7 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
   const PipelinePlace place = pipeline_.place(view.robot, view.target);
   trace_.role = place.role;
   if (place.role != PipelineRole::kActive)
-    if (const auto other = oncoming(view, frame)) return yield_step(view, {other->x_m, other->y_m}, request);
+    if (const auto other = oncoming(view, frame)) return yield_step(view, other->position, request);
   switch (place.role) {
     case PipelineRole::kActive:
       if (state_ == PathState::kRetreat) {
@@ -114,14 +114,14 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
         state_ = state_of(*phase);
       }
       return;
-    case PipelineRole::kFollow: follow_step(view, {place.front->x_m, place.front->y_m}, request); return;
+    case PipelineRole::kFollow: follow_step(view, place.front->position, request); return;
     case PipelineRole::kHold:
       state_ = PathState::kHold;
       // A front neighbour that stays put as long as this robot has waited may be waiting for it to make way (a
       // robot on its way back that has not got far enough to be seen returning): step aside, off its line to the base.
-      if (still_steps_ >= kPatienceSteps) yield_step(view, {place.front->x_m, place.front->y_m}, request);
+      if (still_steps_ >= kPatienceSteps) yield_step(view, place.front->position, request);
       return;
-    case PipelineRole::kBackOff: back_off_step(view, {place.front->x_m, place.front->y_m}, request); return;
+    case PipelineRole::kBackOff: back_off_step(view, place.front->position, request); return;
   }
 }
 
@@ -144,7 +144,7 @@ std::optional<Neighbour> PathBuilder::oncoming(const BuildView& view, const prot
   std::optional<Neighbour> nearest;
   double nearest_d = pipeline_.params().separation_m;
   for (const Neighbour& n : frame.neighbours) {
-    const Position p{n.x_m, n.y_m};
+    const Position p = n.position;
     if (!pipeline_.returning(n.agent_id) || !(distance(p, view.target) < mine)) continue;
     const double d = distance(p, view.robot);
     if (d <= nearest_d) nearest_d = d, nearest = n;

@@ -15,7 +15,7 @@ constexpr EnumName<PipelineRole> kPipelineRoleNames[] = {{PipelineRole::kActive,
                                                          {PipelineRole::kBackOff, "back_off"}};
 
 double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
-Position where(const Neighbour& n) { return {n.x_m, n.y_m}; }
+Position where(const Neighbour& n) { return n.position; }
 
 }  // namespace
 

@@ -115,10 +115,10 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
   // The robot's own construction, once accepted, is in its map even where its sensor cannot see it (a scanned map).
   if (frame.last_result == protocol::ActionResult::kAccepted && context_.type.sensor.casts_rays()) {
     for (const Deposition& d : sent_layers_) modules_->map.record_built({d.row, d.col}, d.height_m);
-    if (depositor_kind(context_.type.depositor.name) == DepositorKind::kCube) {
+    if (context_.type.depositor.kind == DepositorKind::kCube) {
       const double side = depositor_cube_size_m(context_.type);
       for (const Deposit& d : sent_deposits_)
-        for (const CellRise& r : cube_column_shape(modules_->map.geometry(), {d.x_m, d.y_m}, side,
+        for (const CellRise& r : cube_column_shape(modules_->map.geometry(), d.centre, side,
                                                    static_cast<int>(whole_cubes(d.volume_m3, side)))
                                      .rises)
           modules_->map.record_built(r.cell, r.rise_m);

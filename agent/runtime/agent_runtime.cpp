@@ -58,12 +58,12 @@ std::string frame_problem(const protocol::SensorFrame& f, const Assignment& assi
     if (!problem.empty()) return problem;
   }
   if (!f.scanned && !f.points.empty()) return fmt::format("{} scan points in a frame without a scan", f.points.size());
-  if (f.scanned && !sensor.casts_rays()) return "a scan for a robot whose sensor is '" + sensor.name + "'";
+  if (f.scanned && !sensor.casts_rays()) return fmt::format("a scan for a robot whose sensor is '{}'", to_string(sensor.kind));
   const std::string scan = executive::scan_problem(f.points, sensor);
   if (!scan.empty()) return scan;
   for (const Neighbour& n : f.neighbours) {
-    if (!sane(n.x_m) || !sane(n.y_m) || !sane(n.z_m))
-      return fmt::format("neighbour {} at ({}, {}, {}) m is not finite", n.agent_id, n.x_m, n.y_m, n.z_m);
+    if (!sane(n.position.x) || !sane(n.position.y) || !sane(n.z_m))
+      return fmt::format("neighbour {} at ({}, {}, {}) m is not finite", n.agent_id, n.position.x, n.position.y, n.z_m);
     if (!(n.radius_m >= 0.0 && n.radius_m <= 1e3))
       return fmt::format("neighbour {} has a body radius of {} m, not in [0, 1000] m", n.agent_id, n.radius_m);
   }

@@ -14,19 +14,10 @@
 #include <vector>
 
 #include "marsala/core/heightmap.hpp"
+#include "marsala/core/robot_type.hpp"
 #include "marsala/core/types.hpp"
 
 namespace marsala {
-
-/// The depositor kinds (robot_type.hpp's DepositorSpec::name).
-enum class DepositorKind { kLayer, kCube, kCone };
-
-/// "layer", "cube", "cone".
-std::string to_string(DepositorKind kind);
-/// The kind named `name`; throws InvalidArgument "unknown depositor 'x'; valid: cone, cube, layer".
-DepositorKind depositor_kind(const std::string& name);
-/// The valid depositor names, sorted.
-std::vector<std::string> depositor_names();
 
 /// One cell a deposit raises.
 struct CellRise {

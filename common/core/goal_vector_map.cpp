@@ -38,10 +38,10 @@ std::string to_string(Heading heading) { return enum_to_string(kHeadingNames, he
 Heading heading_from_string(const std::string& name) { return enum_from_string(kHeadingNames, name, "heading"); }
 
 GoalVectorMap::GoalVectorMap(const GoalVectorMapSpec& spec, const GridGeometry& grid) : spec_(spec) {
-  check_finite("x0_m", spec.x0_m);
-  check_finite("y0_m", spec.y0_m);
-  check_finite("x1_m", spec.x1_m);
-  check_finite("y1_m", spec.y1_m);
+  check_finite("x0_m", spec.area.x0);
+  check_finite("y0_m", spec.area.y0);
+  check_finite("x1_m", spec.area.x1);
+  check_finite("y1_m", spec.area.y1);
   check_finite("strip_width_m", spec.strip_width_m);
   check_finite("arrow_length_m", spec.arrow_length_m);
   const double cs = grid.cell_size_m;
@@ -49,14 +49,14 @@ GoalVectorMap::GoalVectorMap(const GoalVectorMapSpec& spec, const GridGeometry& 
       !std::isfinite(grid.yll_m))
     fail("the grid " + std::to_string(grid.rows) + " x " + std::to_string(grid.cols) + " with cell size " +
          fmt::format("{}", cs) + " m is not a valid grid");
-  const std::string rect = "[" + fmt::format("{}", spec.x0_m) + ", " + fmt::format("{}", spec.x1_m) + "] x [" +
-                           fmt::format("{}", spec.y0_m) + ", " + fmt::format("{}", spec.y1_m) + "] m";
-  if (!(spec.x0_m < spec.x1_m) || !(spec.y0_m < spec.y1_m))
+  const std::string rect = "[" + fmt::format("{}", spec.area.x0) + ", " + fmt::format("{}", spec.area.x1) + "] x [" +
+                           fmt::format("{}", spec.area.y0) + ", " + fmt::format("{}", spec.area.y1) + "] m";
+  if (!(spec.area.x0 < spec.area.x1) || !(spec.area.y0 < spec.area.y1))
     fail("the rectangle " + rect + " is empty (needs x0_m < x1_m and y0_m < y1_m)");
   const double gx1 = grid.xll_m + grid.cols * cs;
   const double gy1 = grid.yll_m + grid.rows * cs;
-  if (spec.x0_m < grid.xll_m - kTolM || spec.x1_m > gx1 + kTolM || spec.y0_m < grid.yll_m - kTolM ||
-      spec.y1_m > gy1 + kTolM)
+  if (spec.area.x0 < grid.xll_m - kTolM || spec.area.x1 > gx1 + kTolM || spec.area.y0 < grid.yll_m - kTolM ||
+      spec.area.y1 > gy1 + kTolM)
     fail("the rectangle " + rect + " is not inside the grid [" + fmt::format("{}", grid.xll_m) + ", " +
          fmt::format("{}", gx1) + "] x [" + fmt::format("{}", grid.yll_m) + ", " + fmt::format("{}", gy1) + "] m");
   if (!(spec.strip_width_m > 0.0)) fail("strip_width_m is " + fmt::format("{}", spec.strip_width_m) + ", must be > 0");
@@ -72,18 +72,18 @@ GoalVectorMap::GoalVectorMap(const GoalVectorMapSpec& spec, const GridGeometry& 
   const Heading heading = spec.heading;
   const bool ax = along_x(heading);
   const bool fwd = forward(heading);
-  const double across_lo = ax ? spec.y0_m : spec.x0_m;
-  const double across_hi = ax ? spec.y1_m : spec.x1_m;
-  const double along_lo = ax ? spec.x0_m : spec.y0_m;
-  const double along_hi = ax ? spec.x1_m : spec.y1_m;
+  const double across_lo = ax ? spec.area.y0 : spec.area.x0;
+  const double across_hi = ax ? spec.area.y1 : spec.area.x1;
+  const double along_lo = ax ? spec.area.x0 : spec.area.y0;
+  const double along_hi = ax ? spec.area.x1 : spec.area.y1;
   const double w = spec.strip_width_m;
   const double len = spec.arrow_length_m;
 
   // Snaps a point to the centre of its cell; points on the far (high-coordinate) edges would fall into the cell
   // beyond, so they move half a cell inwards first. Clamping only absorbs the tolerance of the inside check.
   const auto snap = [&](double x, double y) {
-    if (x >= spec.x1_m) x = spec.x1_m - 0.5 * cs;
-    if (y >= spec.y1_m) y = spec.y1_m - 0.5 * cs;
+    if (x >= spec.area.x1) x = spec.area.x1 - 0.5 * cs;
+    if (y >= spec.area.y1) y = spec.area.y1 - 0.5 * cs;
     const int col = std::clamp(static_cast<int>(std::floor((x - grid.xll_m) / cs)), 0, grid.cols - 1);
     const int row_from_south = std::clamp(static_cast<int>(std::floor((y - grid.yll_m) / cs)), 0, grid.rows - 1);
     return grid.cell_center({grid.rows - 1 - row_from_south, col});

@@ -38,7 +38,7 @@ Heading heading_from_string(const std::string& name);
 
 /// What the map is compiled from (scenario block goal_vector_map).
 struct GoalVectorMapSpec {
-  double x0_m = 0.0, y0_m = 0.0, x1_m = 0.0, y1_m = 0.0;  ///< the site [m]
+  Rect area;                                              ///< the site [m]
   double strip_width_m = 1.0;                             ///< [m]
   double arrow_length_m = 5.0;                            ///< [m]
   Heading heading = Heading::kEast;

@@ -87,7 +87,7 @@ std::vector<ScanPoint> cast_scan(const Heightmap& terrain, Point3 origin, double
                                    1e-9)) +
                                1;
   // The laser's azimuths start east; the camera's are centred on its heading.
-  const double azimuth0 = sensor.name == "rgbd" ? heading_rad - 0.5 * sensor.horizontal_fov_deg * deg : 0.0;
+  const double azimuth0 = sensor.kind == SensorKind::kRgbd ? heading_rad - 0.5 * sensor.horizontal_fov_deg * deg : 0.0;
   random::Rng rng(seed);
   std::vector<ScanPoint> points;
   points.reserve(static_cast<std::size_t>(azimuths * elevations / 2));

@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "marsala/core/robot_body.hpp"
 #include "marsala/core/sensor_spec.hpp"
@@ -27,11 +28,20 @@ struct Localisation {
   double correlation_steps = 50.0;   ///< steps over which the error decorrelates to 1/e [steps]
 };
 
+/// The depositor kinds, named in scenarios "layer", "cube", "cone".
+enum class DepositorKind { kLayer, kCube, kCone };
+/// "layer", "cube", "cone".
+std::string to_string(DepositorKind kind);
+/// The kind named `name`; throws InvalidArgument "unknown depositor 'x'; valid: cone, cube, layer".
+DepositorKind depositor_kind(const std::string& name);
+/// The valid depositor names, sorted.
+std::vector<std::string> depositor_names();
+
 /// What a robot's depositor does with material (docs/runtime.md#depositors): "layer" (the default) raises whole
 /// cells by whole cube layers (Deposition), "cube" places columns of cubes and "cone" dumps granular material that
 /// settles at its angle of repose, both at a position (Deposit; common/core/deposit_shapes.hpp).
 struct DepositorSpec {
-  std::string name = "layer";  ///< "layer", "cube" or "cone" (depositor_names())
+  DepositorKind kind = DepositorKind::kLayer;
   /// cube: side of one cube [m]; unset: the body's cube_size_m. Must be >= the grid's cell size (the world refuses
   /// to start otherwise): a narrower cube has no footprint of its own on the heightmap.
   std::optional<double> cube_size_m;

@@ -3,20 +3,20 @@
 #include <cmath>
 
 #include "marsala/core/format.hpp"
-#include "marsala/core/registry.hpp"
+#include "marsala/core/enum_names.hpp"
 
 namespace marsala {
 namespace {
 
 SensorSpec laser() {
   SensorSpec s;
-  s.name = "laser";
+  s.kind = SensorKind::kLaser;
   return s;  // the struct's defaults are the laser's
 }
 
 SensorSpec rgbd() {
   SensorSpec s;
-  s.name = "rgbd";
+  s.kind = SensorKind::kRgbd;
   s.horizontal_fov_deg = 87.0;
   s.horizontal_resolution_deg = 87.0 / 63.0;  // 64 columns, edges included
   s.vertical_min_deg = -44.0;                 // 58 deg, tilted 15 deg down to see the ground before the robot
@@ -29,16 +29,8 @@ SensorSpec rgbd() {
   return s;
 }
 
-const NamedRegistry<SensorSpec (*)()>& registry() {
-  static const NamedRegistry<SensorSpec (*)()> r = [] {
-    NamedRegistry<SensorSpec (*)()> out("sensor");
-    out.add("ground_truth", [] { return SensorSpec{}; });
-    out.add("laser", &laser);
-    out.add("rgbd", &rgbd);
-    return out;
-  }();
-  return r;
-}
+constexpr EnumName<SensorKind> kSensorNames[] = {
+    {SensorKind::kGroundTruth, "ground_truth"}, {SensorKind::kLaser, "laser"}, {SensorKind::kRgbd, "rgbd"}};
 
 /// Rays along one axis: span / resolution + 1, the span's both ends included (a 360 deg span holds 0 deg once).
 long long rays_along(double span_deg, double resolution_deg, bool wraps) {
@@ -54,16 +46,21 @@ long long SensorSpec::ray_count() const {
          rays_along(vertical_max_deg - vertical_min_deg, vertical_resolution_deg, false);
 }
 
-SensorSpec sensor_defaults(const std::string& name) { return registry().find(name)(); }
+std::string to_string(SensorKind kind) { return enum_to_string(kSensorNames, kind); }
 
-std::vector<std::string> sensor_names() { return registry().names(); }
+SensorKind sensor_kind(const std::string& name) { return enum_from_string(kSensorNames, name, "sensor"); }
+
+SensorSpec sensor_defaults(SensorKind kind) {
+  switch (kind) {
+    case SensorKind::kLaser: return laser();
+    case SensorKind::kRgbd: return rgbd();
+    case SensorKind::kGroundTruth: break;
+  }
+  return SensorSpec{};
+}
 
 std::string sensor_problem(const SensorSpec& s) {
-  if (!registry().contains(s.name)) {
-    std::string valid;
-    for (const auto& n : sensor_names()) valid += (valid.empty() ? "" : ", ") + n;
-    return "name: unknown sensor '" + s.name + "'; valid: " + valid;
-  }
+  if (to_string(s.kind) == "unknown") return fmt::format("name: unknown sensor kind {}", static_cast<int>(s.kind));
   const auto in = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
   const auto bad = [](const char* field, double v, const char* range) {
     return fmt::format("{}: {} must be {}", field, v, range);

@@ -20,11 +20,18 @@ struct ScanPoint {
   }
 };
 
+/// The terrain sensor kinds, named in scenarios "ground_truth", "laser", "rgbd".
+enum class SensorKind { kGroundTruth, kLaser, kRgbd };
+/// "ground_truth", "laser", "rgbd".
+std::string to_string(SensorKind kind);
+/// The kind named `name`; throws InvalidArgument "unknown sensor 'x'; valid: ground_truth, laser, rgbd".
+SensorKind sensor_kind(const std::string& name);
+
 /// A terrain sensor. "ground_truth": exact heights in tiles of the square window (no ray casting; the other fields
 /// are unused). "laser": a 3D laser scanner, world-aligned (azimuth 0 = east, counter-clockwise). "rgbd": a depth
 /// camera looking along the robot's heading. Angles [deg]: azimuth in the horizontal plane, elevation above it.
 struct SensorSpec {
-  std::string name = "ground_truth";
+  SensorKind kind = SensorKind::kGroundTruth;
   double mount_height_m = 0.5;             ///< sensor origin above the terrain under the robot's centre [m]
   double horizontal_fov_deg = 360.0;       ///< azimuth span, centred on the heading (rgbd) or starting east (laser)
   double horizontal_resolution_deg = 2.0;  ///< azimuth between neighbouring rays [deg]
@@ -38,19 +45,16 @@ struct SensorSpec {
   int scan_every_steps = 1;                ///< a scan every this many steps (steps divisible by it) [steps]
 
   /// True for the sensors whose frames carry points instead of tiles.
-  bool casts_rays() const { return name != "ground_truth"; }
+  bool casts_rays() const { return kind != SensorKind::kGroundTruth; }
   /// Range noise standard deviation at range r [m].
   double noise_sd_at(double range_m) const { return noise_sd_m + noise_sd_per_m2 * range_m * range_m; }
   /// Number of rays per scan (azimuths x elevations).
   long long ray_count() const;
 };
 
-/// The defaults of a named sensor: "ground_truth", "laser" (360 deg, -60..+10 deg at 2 x 1 deg, 0.1-8 m, sd 1 cm),
-/// "rgbd" (87 x 58 deg tilted 15 deg down, 64 x 48 rays, 0.3-6 m, sd 2 mm + 2 mm/m^2 r^2). Throws InvalidArgument
-/// "unknown sensor 'x'; valid: ..." for another name.
-SensorSpec sensor_defaults(const std::string& name);
-/// The sensor names, sorted.
-std::vector<std::string> sensor_names();
+/// The defaults of a sensor kind: ground truth, laser (360 deg, -60..+10 deg at 2 x 1 deg, 0.1-8 m, sd 1 cm),
+/// rgbd (87 x 58 deg tilted 15 deg down, 64 x 48 rays, 0.3-6 m, sd 2 mm + 2 mm/m^2 r^2).
+SensorSpec sensor_defaults(SensorKind kind);
 /// Empty when `s` is usable; otherwise the first problem, naming the field (e.g. "max_range_m: nan must be ...").
 std::string sensor_problem(const SensorSpec& s);
 

@@ -73,9 +73,8 @@ struct TerrainTile {
 /// Another robot within proximity range, as proximity sensing reports it.
 struct Neighbour {
   std::uint32_t agent_id = 0;
-  double x_m = 0.0;
-  double y_m = 0.0;
-  double z_m = 0.0;
+  Position position;  ///< its centre [m]
+  double z_m = 0.0;   ///< terrain height under its centre [m]
   double radius_m = 0.0;  ///< half its body length delta: proximity sensing sees the body's extent [m]
 };
 
@@ -89,8 +88,7 @@ struct Deposition {
 /// Deposit `volume_m3` of material with its centre at (x_m, y_m) in the world frame: the robot's depositor gives it
 /// its physical shape (common/core/deposit_shapes.hpp: a column of cubes, a cone of granular material).
 struct Deposit {
-  double x_m = 0.0;
-  double y_m = 0.0;
+  Position centre;  ///< [m]
   double volume_m3 = 0.0;
 };
 

@@ -33,7 +33,8 @@ bool same_request(const ActionRequest& a, const ActionRequest& b) {
     return false;
   for (std::size_t i = 0; i < a.deposits.size(); ++i) {
     const Deposit &p = a.deposits[i], &q = b.deposits[i];
-    if (!same(p.x_m, q.x_m) || !same(p.y_m, q.y_m) || !same(p.volume_m3, q.volume_m3)) return false;
+    if (!same(p.centre.x, q.centre.x) || !same(p.centre.y, q.centre.y) || !same(p.volume_m3, q.volume_m3))
+      return false;
   }
   for (std::size_t i = 0; i < a.depositions.size(); ++i) {
     const Deposition &p = a.depositions[i], &q = b.depositions[i];

@@ -34,14 +34,14 @@ struct TerrainSource {
 struct AgentSlot {
   std::uint32_t id = 0;
   std::string robot_type;  ///< a RobotType name
-  double start_x_m = 0.0, start_y_m = 0.0;
-  double target_x_m = 0.0, target_y_m = 0.0;
+  Position start;   ///< [m]
+  Position target;  ///< [m]
 };
 
-/// Completion: every live agent inside [x0, x1] x [y0, y1] [m] standing at >= min_height_m and, when
-/// target_radius_m > 0, within target_radius_m of its own slot's target.
+/// Completion: every live agent inside `area` standing at >= min_height_m and, when target_radius_m > 0, within
+/// target_radius_m of its own slot's target.
 struct Goal {
-  double x0_m = 0.0, y0_m = 0.0, x1_m = 0.0, y1_m = 0.0;
+  Rect area;  ///< [m]
   double min_height_m = -1e9;
   double target_radius_m = 0.0;  ///< 0 = no target condition (the box alone) [m]
 };
@@ -55,17 +55,17 @@ enum class CompletionKind : std::uint8_t {
 /// "agents_at_goal", "payload_path", "level_site".
 std::string to_string(CompletionKind kind);
 
-/// A payload robot's navigable path from (from_x, from_y) to (to_x, to_y) [m] for kappa, delta, eps.
+/// A payload robot's navigable path from `from` to `to` [m] for kappa, delta, eps.
 struct PayloadPath {
   NavigabilityParams navigability{0.2, 2.0, 0.05};  ///< the payload's kappa [m/m], delta_m [m], eps_m [m]
-  double from_x_m = 0.0, from_y_m = 0.0, to_x_m = 0.0, to_y_m = 0.0;
+  Position from;  ///< [m]
+  Position to;    ///< [m]
   std::uint32_t check_every_steps = 10;
 };
 
-/// A level site: [x0, x1] x [y0, y1] [m], at least min_fraction of its cells occupiable (kappa, delta, eps) and
-/// connected.
+/// A level site: `area`, at least min_fraction of its cells occupiable (kappa, delta, eps) and connected.
 struct Site {
-  double x0_m = 0.0, y0_m = 0.0, x1_m = 0.0, y1_m = 0.0;
+  Rect area;  ///< [m]
   NavigabilityParams navigability{0.1, 1.0, 0.05};  ///< what "level" means: kappa [m/m], delta_m [m], eps_m [m]
   double min_fraction = 1.0;
   std::uint32_t check_every_steps = 10;
@@ -73,7 +73,8 @@ struct Site {
 
 /// The base station: material is refilled only within radius of its centre.
 struct BaseStation {
-  double x_m = 0.0, y_m = 0.0, radius_m = 1.0;
+  Position centre;  ///< [m]
+  double radius_m = 1.0;
 };
 
 /// A whole scenario.

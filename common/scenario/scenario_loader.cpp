@@ -1,4 +1,5 @@
 // Scenario files: protobuf text format (idl/scenario.proto) -> validated plain structs (scenario.hpp).
+#include <fmt/ranges.h>
 #include <google/protobuf/io/tokenizer.h>
 #include <google/protobuf/text_format.h>
 
@@ -28,7 +29,7 @@ class TextFormatError : public ParseError {
  public:
   TextFormatError(const std::string& file, int line, int column, const std::string& message)
       : ParseError(file, line, message),
-        text_(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + message) {}
+        text_(fmt::format("{}:{}:{}: {}", file, line, column, message)) {}
   const char* what() const noexcept override { return text_.c_str(); }
 
  private:
@@ -63,15 +64,15 @@ class Validator {
   explicit Validator(std::string source) : source_(std::move(source)) {}
 
   [[noreturn]] void fail(const std::string& field, const std::string& problem) const {
-    throw InvalidArgument("scenario " + source_ + ": " + field + ": " + problem);
+    throw InvalidArgument(fmt::format("scenario {}: {}: {}", source_, field, problem));
   }
   double finite(const std::string& field, double v) const {
     if (!std::isfinite(v) || std::abs(v) >= kMaxMagnitude)
-      fail(field, fmt::format("{}", v) + " must be finite and < 1e6 in magnitude");
+      fail(field, fmt::format("{} must be finite and < 1e6 in magnitude", v));
     return v;
   }
   double positive(const std::string& field, double v) const {
-    if (!(finite(field, v) > 0.0)) fail(field, fmt::format("{}", v) + " must be > 0");
+    if (!(finite(field, v) > 0.0)) fail(field, fmt::format("{} must be > 0", v));
     return v;
   }
 
@@ -137,14 +138,15 @@ RobotBody to_body(const proto::Body& p) {
 
 /// The named sensor's defaults with the file's values on top; every failure names the robot type's field.
 SensorSpec to_sensor(const proto::Sensor& p, const std::string& field, const Validator& check) {
-  const std::string name = p.has_name() ? p.name() : "ground_truth";
-  const std::vector<std::string> names = sensor_names();
-  if (std::find(names.begin(), names.end(), name) == names.end()) {
-    std::string valid;
-    for (const auto& n : names) valid += (valid.empty() ? "" : ", ") + n;
-    check.fail(field + ".name", "unknown sensor '" + name + "'; valid: " + valid);
+  SensorKind kind = SensorKind::kGroundTruth;
+  if (p.has_name()) {
+    try {
+      kind = sensor_kind(p.name());
+    } catch (const InvalidArgument& e) {
+      check.fail(field + ".name", e.what());
+    }
   }
-  SensorSpec s = sensor_defaults(name);
+  SensorSpec s = sensor_defaults(kind);
   if (p.has_mount_height_m()) s.mount_height_m = p.mount_height_m();
   if (p.has_horizontal_fov_deg()) s.horizontal_fov_deg = p.horizontal_fov_deg();
   if (p.has_horizontal_resolution_deg()) s.horizontal_resolution_deg = p.horizontal_resolution_deg();
@@ -176,22 +178,23 @@ SensorSpec to_sensor(const proto::Sensor& p, const std::string& field, const Val
 DepositorSpec to_depositor(const proto::Depositor& p, const RobotBody& body, const std::string& field,
                            const Validator& check) {
   DepositorSpec d;
-  if (p.has_name()) d.name = p.name();
-  try {
-    depositor_kind(d.name);
-  } catch (const InvalidArgument& e) {
-    check.fail(field + ".name", e.what());
+  if (p.has_name()) {
+    try {
+      d.kind = depositor_kind(p.name());
+    } catch (const InvalidArgument& e) {
+      check.fail(field + ".name", e.what());
+    }
   }
   if (p.has_cube_size_m()) {
-    if (d.name != "cube") check.fail(field + ".cube_size_m", "applies to the 'cube' depositor only");
+    if (d.kind != DepositorKind::kCube) check.fail(field + ".cube_size_m", "applies to the 'cube' depositor only");
     d.cube_size_m = check.positive(field + ".cube_size_m", p.cube_size_m());
   }
-  if (d.name == "cube" && !(body.cube_size_m > 0.0)) check.fail(field + ".cube_size_m", "the body's must be > 0");
+  if (d.kind == DepositorKind::kCube && !(body.cube_size_m > 0.0)) check.fail(field + ".cube_size_m", "the body's must be > 0");
   if (p.has_repose_deg()) {
-    if (d.name != "cone") check.fail(field + ".repose_deg", "applies to the 'cone' depositor only");
+    if (d.kind != DepositorKind::kCone) check.fail(field + ".repose_deg", "applies to the 'cone' depositor only");
     d.repose_deg = check.finite(field + ".repose_deg", p.repose_deg());
     if (!(d.repose_deg > 0.0 && d.repose_deg < 90.0))
-      check.fail(field + ".repose_deg", fmt::format("{}", d.repose_deg) + " must be in (0, 90) degrees");
+      check.fail(field + ".repose_deg", fmt::format("{} must be in (0, 90) degrees", d.repose_deg));
   }
   return d;
 }
@@ -203,194 +206,237 @@ bool valid_name(const std::string& name) {
   return true;
 }
 
-Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
-  const Validator check(source);
-  Scenario s;
-  s.source_path = source;
-  if (!valid_name(p.name())) check.fail("name", "'" + p.name() + "' must be non-empty letters, digits, '_', '-', '.'");
-  s.name = p.name();
-  if (!p.has_terrain()) check.fail("terrain", "missing");
-  s.terrain = to_terrain(p.terrain(), check);
+/// The construction a robot type builds: its body's unless the file says otherwise, checked against what the body can
+/// climb and reach.
+NavigabilityParams to_construction(const proto::Construction& cp, const RobotBody& body, const std::string& field,
+                                   const Validator& check) {
+  // Unset fields build for the robot's own body (kappa, eps, and its length as the band's width).
+  NavigabilityParams build = body.navigability;
+  if (cp.has_kappa()) build.kappa = check.positive(field + ".construction.kappa", cp.kappa());
+  if (cp.has_eps_m()) build.eps_m = check.finite(field + ".construction.eps_m", cp.eps_m());
+  if (build.eps_m < 0.0) check.fail(field + ".construction.eps_m", "must be >= 0");
+  if (cp.has_width_m()) build.delta_m = check.positive(field + ".construction.width_m", cp.width_m());
+  if (build.kappa > body.navigability.kappa)
+    check.fail(field + ".construction.kappa",
+               fmt::format("{} exceeds the body's kappa {}: the builder could not climb what it builds", build.kappa,
+                           body.navigability.kappa));
+  const double reach_band_m = 2.0 * body.reach_m + body.navigability.delta_m;
+  if (build.delta_m > reach_band_m)
+    check.fail(field + ".construction.width_m",
+               fmt::format("{} is wider than the robot can reach from its path (delta + 2 reach = {} m)",
+                           build.delta_m, reach_band_m));
+  return build;
+}
 
-  if (p.robot_type_size() == 0) check.fail("robot_type", "at least one robot type is required");
-  for (int i = 0; i < p.robot_type_size(); ++i) {
-    const proto::RobotType& rp = p.robot_type(i);
-    const std::string field = "robot_type[" + std::to_string(i) + "]";
-    RobotType t;
-    if (rp.name().empty()) check.fail(field + ".name", "missing");
-    for (const RobotType& earlier : s.robot_types)
-      if (earlier.name == rp.name()) check.fail(field + ".name", "robot type '" + rp.name() + "' is defined twice");
-    t.name = rp.name();
-    if (rp.has_behaviour()) t.behaviour = rp.behaviour();
-    if (t.behaviour.empty()) check.fail(field + ".behaviour", "must not be empty");
-    t.body = to_body(rp.body());
-    const std::string problem = body_problem(t.body);
-    if (!problem.empty()) check.fail(field + ".body", problem);
-    const proto::Construction& cp = rp.construction();
-    // Unset fields build for the robot's own body (kappa, eps, and its length as the band's width).
-    NavigabilityParams build = t.body.navigability;
-    if (cp.has_kappa()) build.kappa = check.positive(field + ".construction.kappa", cp.kappa());
-    if (cp.has_eps_m()) build.eps_m = check.finite(field + ".construction.eps_m", cp.eps_m());
-    if (build.eps_m < 0.0) check.fail(field + ".construction.eps_m", "must be >= 0");
-    if (cp.has_width_m()) build.delta_m = check.positive(field + ".construction.width_m", cp.width_m());
-    if (build.kappa > t.body.navigability.kappa)
-      check.fail(field + ".construction.kappa",
-                 fmt::format("{} exceeds the body's kappa {}: the builder could not climb what it builds", build.kappa,
-                             t.body.navigability.kappa));
-    const double reach_band_m = 2.0 * t.body.reach_m + t.body.navigability.delta_m;
-    if (build.delta_m > reach_band_m)
-      check.fail(field + ".construction.width_m",
-                 fmt::format("{} is wider than the robot can reach from its path (delta + 2 reach = {} m)",
-                             build.delta_m, reach_band_m));
-    t.construction = build;
-    const proto::Pipeline& pp = rp.pipeline();
-    if (pp.has_separation_m())
-      t.pipeline.separation_m = check.positive(field + ".pipeline.separation_m", pp.separation_m());
-    if (pp.has_lane_offset_m())
-      t.pipeline.lane_offset_m = check.finite(field + ".pipeline.lane_offset_m", pp.lane_offset_m());
-    if (t.pipeline.lane_offset_m < 0.0) check.fail(field + ".pipeline.lane_offset_m", "must be >= 0");
-    const proto::Localisation& lp = rp.localisation();
-    if (lp.has_noise_sd_m()) t.localisation.noise_sd_m = check.finite(field + ".localisation.noise_sd_m", lp.noise_sd_m());
-    if (t.localisation.noise_sd_m < 0.0 || t.localisation.noise_sd_m > 10.0)
-      check.fail(field + ".localisation.noise_sd_m", fmt::format("{} must be in [0, 10] m", t.localisation.noise_sd_m));
-    if (lp.has_correlation_steps())
-      t.localisation.correlation_steps =
-          check.finite(field + ".localisation.correlation_steps", lp.correlation_steps());
-    if (t.localisation.correlation_steps < 1.0 || t.localisation.correlation_steps > 1e5)
-      check.fail(field + ".localisation.correlation_steps",
-                 fmt::format("{} must be in [1, 1e5] steps", t.localisation.correlation_steps));
-    if (rp.has_goal_synthesizer()) t.goal_synthesizer = rp.goal_synthesizer();
-    if (t.goal_synthesizer.empty()) check.fail(field + ".goal_synthesizer", "must not be empty");
-    if (t.goal_synthesizer == "goal_vector_map" && !p.has_goal_vector_map())
-      check.fail(field + ".goal_synthesizer", "'goal_vector_map' needs the scenario's goal_vector_map block");
-    t.sensor = to_sensor(rp.sensor(), field + ".sensor", check);
-    t.depositor = to_depositor(rp.depositor(), t.body, field + " (" + t.name + ").depositor", check);
-    s.robot_types.push_back(std::move(t));
+Pipeline to_pipeline(const proto::Pipeline& pp, const std::string& field, const Validator& check) {
+  Pipeline pipeline;
+  if (pp.has_separation_m())
+    pipeline.separation_m = check.positive(field + ".pipeline.separation_m", pp.separation_m());
+  if (pp.has_lane_offset_m())
+    pipeline.lane_offset_m = check.finite(field + ".pipeline.lane_offset_m", pp.lane_offset_m());
+  if (pipeline.lane_offset_m < 0.0) check.fail(field + ".pipeline.lane_offset_m", "must be >= 0");
+  return pipeline;
+}
+
+Localisation to_localisation(const proto::Localisation& lp, const std::string& field, const Validator& check) {
+  Localisation l;
+  if (lp.has_noise_sd_m()) l.noise_sd_m = check.finite(field + ".localisation.noise_sd_m", lp.noise_sd_m());
+  if (l.noise_sd_m < 0.0 || l.noise_sd_m > 10.0)
+    check.fail(field + ".localisation.noise_sd_m", fmt::format("{} must be in [0, 10] m", l.noise_sd_m));
+  if (lp.has_correlation_steps())
+    l.correlation_steps = check.finite(field + ".localisation.correlation_steps", lp.correlation_steps());
+  if (l.correlation_steps < 1.0 || l.correlation_steps > 1e5)
+    check.fail(field + ".localisation.correlation_steps",
+               fmt::format("{} must be in [1, 1e5] steps", l.correlation_steps));
+  return l;
+}
+
+/// Robot type `i` of the file; `earlier` are the types before it (names are unique).
+RobotType to_robot_type(const proto::Scenario& p, int i, const std::vector<RobotType>& earlier,
+                        const Validator& check) {
+  const proto::RobotType& rp = p.robot_type(i);
+  const std::string field = fmt::format("robot_type[{}]", i);
+  RobotType t;
+  if (rp.name().empty()) check.fail(field + ".name", "missing");
+  for (const RobotType& e : earlier)
+    if (e.name == rp.name()) check.fail(field + ".name", fmt::format("robot type '{}' is defined twice", rp.name()));
+  t.name = rp.name();
+  if (rp.has_behaviour()) t.behaviour = rp.behaviour();
+  if (t.behaviour.empty()) check.fail(field + ".behaviour", "must not be empty");
+  t.body = to_body(rp.body());
+  const std::string problem = body_problem(t.body);
+  if (!problem.empty()) check.fail(field + ".body", problem);
+  t.construction = to_construction(rp.construction(), t.body, field, check);
+  t.pipeline = to_pipeline(rp.pipeline(), field, check);
+  t.localisation = to_localisation(rp.localisation(), field, check);
+  if (rp.has_goal_synthesizer()) t.goal_synthesizer = rp.goal_synthesizer();
+  if (t.goal_synthesizer.empty()) check.fail(field + ".goal_synthesizer", "must not be empty");
+  if (t.goal_synthesizer == "goal_vector_map" && !p.has_goal_vector_map())
+    check.fail(field + ".goal_synthesizer", "'goal_vector_map' needs the scenario's goal_vector_map block");
+  t.sensor = to_sensor(rp.sensor(), field + ".sensor", check);
+  t.depositor = to_depositor(rp.depositor(), t.body, fmt::format("{} ({}).depositor", field, t.name), check);
+  return t;
+}
+
+/// The field name of agent slot `id` in messages: "agent[i] (agent id)".
+std::string slot_field(std::uint32_t id) { return fmt::format("agent[{}] (agent {})", id - 1, id); }
+
+/// A point of the file, each coordinate finite ("<field>.x_m", "<field>.y_m").
+Position to_position(const proto::Point& pp, const std::string& field, const Validator& check) {
+  return {check.finite(field + ".x_m", pp.x_m()), check.finite(field + ".y_m", pp.y_m())};
+}
+
+/// A rectangle of the file (fields x0_m, y0_m, x1_m, y1_m of `block`), finite and not empty.
+template <typename Block>
+Rect to_rect(const Block& b, const std::string& block, const Validator& check) {
+  const Rect r{check.finite(block + ".x0_m", b.x0_m()), check.finite(block + ".y0_m", b.y0_m()),
+               check.finite(block + ".x1_m", b.x1_m()), check.finite(block + ".y1_m", b.y1_m())};
+  if (!(r.x0 < r.x1) || !(r.y0 < r.y1)) check.fail(block, "the rectangle needs x0_m < x1_m and y0_m < y1_m");
+  return r;
+}
+
+AgentSlot to_slot(const proto::AgentSlot& ap, std::uint32_t id, const std::vector<RobotType>& types,
+                  const Validator& check) {
+  const std::string field = slot_field(id);
+  if (ap.has_id() && ap.id() != id)
+    check.fail(field + ".id", fmt::format("{} differs from its position in the file ({})", ap.id(), id));
+  AgentSlot slot;
+  slot.id = id;
+  slot.robot_type = ap.robot_type();
+  const bool known = std::any_of(types.begin(), types.end(),
+                                 [&](const RobotType& t) { return t.name == slot.robot_type; });
+  if (!known) {
+    std::vector<std::string> valid;
+    for (const RobotType& t : types) valid.push_back(t.name);
+    check.fail(field + ".robot_type",
+               fmt::format("unknown robot type '{}'; valid: {}", slot.robot_type, fmt::join(valid, ", ")));
   }
+  if (!ap.has_start()) check.fail(field + ".start", "missing");
+  if (!ap.has_target()) check.fail(field + ".target", "missing");
+  slot.start = to_position(ap.start(), field + ".start", check);
+  slot.target = to_position(ap.target(), field + ".target", check);
+  return slot;
+}
 
-  if (p.agent_size() == 0) check.fail("agent", "at least one agent slot is required");
-  for (int i = 0; i < p.agent_size(); ++i) {
-    const proto::AgentSlot& ap = p.agent(i);
-    const std::uint32_t id = static_cast<std::uint32_t>(i) + 1;
-    const std::string field = "agent[" + std::to_string(i) + "] (agent " + std::to_string(id) + ")";
-    if (ap.has_id() && ap.id() != id)
-      check.fail(field + ".id",
-                 std::to_string(ap.id()) + " differs from its position in the file (" + std::to_string(id) + ")");
-    AgentSlot slot;
-    slot.id = id;
-    slot.robot_type = ap.robot_type();
-    bool known = false;
-    std::string valid;
-    for (const RobotType& t : s.robot_types) {
-      known = known || t.name == slot.robot_type;
-      valid += (valid.empty() ? "" : ", ") + t.name;
+Goal to_goal(const proto::Goal& gp, const std::vector<AgentSlot>& slots, const Validator& check) {
+  Goal goal;
+  goal.area = to_rect(gp, "goal", check);
+  if (gp.has_min_height_m()) goal.min_height_m = check.finite("goal.min_height_m", gp.min_height_m());
+  if (gp.has_target_radius_m()) goal.target_radius_m = check.positive("goal.target_radius_m", gp.target_radius_m());
+  // With a target condition every agent must be able to meet both: its target lies in the box.
+  if (goal.target_radius_m > 0.0)
+    for (const AgentSlot& slot : slots)
+      if (slot.target.x < goal.area.x0 || slot.target.x > goal.area.x1 || slot.target.y < goal.area.y0 ||
+          slot.target.y > goal.area.y1)
+        check.fail(slot_field(slot.id) + ".target",
+                   fmt::format("({}, {}) lies outside the goal box, so the agent could never complete with "
+                               "goal.target_radius_m",
+                               slot.target.x, slot.target.y));
+  return goal;
+}
+
+PayloadPath to_payload_path(const proto::PayloadPath& pp, const Validator& check) {
+  PayloadPath path;
+  const RobotBody body = to_body(pp.body());
+  path.navigability.kappa = check.positive("payload_path.body.kappa", body.navigability.kappa);
+  path.navigability.delta_m = check.positive("payload_path.body.delta_m", body.navigability.delta_m);
+  path.navigability.eps_m = check.finite("payload_path.body.eps_m", body.navigability.eps_m);
+  if (path.navigability.eps_m < 0.0) check.fail("payload_path.body.eps_m", "must be >= 0");
+  if (!pp.has_from()) check.fail("payload_path.from", "missing");
+  if (!pp.has_to()) check.fail("payload_path.to", "missing");
+  path.from = to_position(pp.from(), "payload_path.from", check);
+  path.to = to_position(pp.to(), "payload_path.to", check);
+  if (pp.has_check_every_steps()) path.check_every_steps = pp.check_every_steps();
+  if (path.check_every_steps == 0) check.fail("payload_path.check_every_steps", "must be >= 1");
+  return path;
+}
+
+Site to_site(const proto::Site& sp, const Validator& check) {
+  Site site;
+  site.area = to_rect(sp, "site", check);
+  if (sp.has_kappa()) site.navigability.kappa = check.positive("site.kappa", sp.kappa());
+  if (sp.has_delta_m()) site.navigability.delta_m = check.positive("site.delta_m", sp.delta_m());
+  if (sp.has_eps_m()) site.navigability.eps_m = check.finite("site.eps_m", sp.eps_m());
+  if (site.navigability.eps_m < 0.0) check.fail("site.eps_m", "must be >= 0");
+  if (sp.has_min_fraction()) site.min_fraction = check.finite("site.min_fraction", sp.min_fraction());
+  if (!(site.min_fraction > 0.0 && site.min_fraction <= 1.0))
+    check.fail("site.min_fraction", fmt::format("{} must be in (0, 1]", site.min_fraction));
+  if (sp.has_check_every_steps()) site.check_every_steps = sp.check_every_steps();
+  if (site.check_every_steps == 0) check.fail("site.check_every_steps", "must be >= 1");
+  return site;
+}
+
+GoalVectorMapSpec to_goal_vector_map(const proto::GoalVectorMap& gp, const Validator& check) {
+  GoalVectorMapSpec map;
+  map.area = to_rect(gp, "goal_vector_map", check);
+  map.strip_width_m = check.positive("goal_vector_map.strip_width_m", gp.strip_width_m());
+  map.arrow_length_m = check.positive("goal_vector_map.arrow_length_m", gp.arrow_length_m());
+  if (gp.has_heading()) {
+    try {
+      map.heading = heading_from_string(gp.heading());
+    } catch (const InvalidArgument& e) {
+      check.fail("goal_vector_map.heading", e.what());
     }
-    if (!known) check.fail(field + ".robot_type", "unknown robot type '" + slot.robot_type + "'; valid: " + valid);
-    if (!ap.has_start()) check.fail(field + ".start", "missing");
-    if (!ap.has_target()) check.fail(field + ".target", "missing");
-    slot.start_x_m = check.finite(field + ".start.x_m", ap.start().x_m());
-    slot.start_y_m = check.finite(field + ".start.y_m", ap.start().y_m());
-    slot.target_x_m = check.finite(field + ".target.x_m", ap.target().x_m());
-    slot.target_y_m = check.finite(field + ".target.y_m", ap.target().y_m());
-    s.slots.push_back(slot);
   }
+  return map;
+}
 
+/// How the run completes: exactly one of goal, payload_path and site.
+void read_completion(const proto::Scenario& p, Scenario& s, const Validator& check) {
   const int completions = (p.has_goal() ? 1 : 0) + (p.has_payload_path() ? 1 : 0) + (p.has_site() ? 1 : 0);
   if (completions != 1)
     check.fail("goal", "give exactly one of 'goal', 'payload_path' and 'site' (how the run completes)");
   if (p.has_goal()) {
     s.completion = CompletionKind::kAgentsAtGoal;
-    s.goal.x0_m = check.finite("goal.x0_m", p.goal().x0_m());
-    s.goal.y0_m = check.finite("goal.y0_m", p.goal().y0_m());
-    s.goal.x1_m = check.finite("goal.x1_m", p.goal().x1_m());
-    s.goal.y1_m = check.finite("goal.y1_m", p.goal().y1_m());
-    if (!(s.goal.x0_m < s.goal.x1_m) || !(s.goal.y0_m < s.goal.y1_m))
-      check.fail("goal", "the rectangle needs x0_m < x1_m and y0_m < y1_m");
-    if (p.goal().has_min_height_m()) s.goal.min_height_m = check.finite("goal.min_height_m", p.goal().min_height_m());
-    if (p.goal().has_target_radius_m())
-      s.goal.target_radius_m = check.positive("goal.target_radius_m", p.goal().target_radius_m());
-    // With a target condition every agent must be able to meet both: its target lies in the box.
-    if (s.goal.target_radius_m > 0.0)
-      for (const AgentSlot& slot : s.slots)
-        if (slot.target_x_m < s.goal.x0_m || slot.target_x_m > s.goal.x1_m || slot.target_y_m < s.goal.y0_m ||
-            slot.target_y_m > s.goal.y1_m)
-          check.fail("agent[" + std::to_string(slot.id - 1) + "] (agent " + std::to_string(slot.id) + ").target",
-                     "(" + fmt::format("{}", slot.target_x_m) + ", " + fmt::format("{}", slot.target_y_m) +
-                         ") lies outside the goal box, so the agent could never complete with goal.target_radius_m");
+    s.goal = to_goal(p.goal(), s.slots, check);
   }
   if (p.has_payload_path()) {
     s.completion = CompletionKind::kPayloadPath;
-    const proto::PayloadPath& pp = p.payload_path();
-    PayloadPath& path = s.payload_path;
-    const RobotBody body = to_body(pp.body());
-    path.navigability.kappa = check.positive("payload_path.body.kappa", body.navigability.kappa);
-    path.navigability.delta_m = check.positive("payload_path.body.delta_m", body.navigability.delta_m);
-    path.navigability.eps_m = check.finite("payload_path.body.eps_m", body.navigability.eps_m);
-    if (path.navigability.eps_m < 0.0) check.fail("payload_path.body.eps_m", "must be >= 0");
-    if (!pp.has_from()) check.fail("payload_path.from", "missing");
-    if (!pp.has_to()) check.fail("payload_path.to", "missing");
-    path.from_x_m = check.finite("payload_path.from.x_m", pp.from().x_m());
-    path.from_y_m = check.finite("payload_path.from.y_m", pp.from().y_m());
-    path.to_x_m = check.finite("payload_path.to.x_m", pp.to().x_m());
-    path.to_y_m = check.finite("payload_path.to.y_m", pp.to().y_m());
-    if (pp.has_check_every_steps()) path.check_every_steps = pp.check_every_steps();
-    if (path.check_every_steps == 0) check.fail("payload_path.check_every_steps", "must be >= 1");
+    s.payload_path = to_payload_path(p.payload_path(), check);
   }
   if (p.has_site()) {
     s.completion = CompletionKind::kLevelSite;
-    const proto::Site& sp = p.site();
-    Site& site = s.site;
-    site.x0_m = check.finite("site.x0_m", sp.x0_m());
-    site.y0_m = check.finite("site.y0_m", sp.y0_m());
-    site.x1_m = check.finite("site.x1_m", sp.x1_m());
-    site.y1_m = check.finite("site.y1_m", sp.y1_m());
-    if (!(site.x0_m < site.x1_m) || !(site.y0_m < site.y1_m))
-      check.fail("site", "the rectangle needs x0_m < x1_m and y0_m < y1_m");
-    if (sp.has_kappa()) site.navigability.kappa = check.positive("site.kappa", sp.kappa());
-    if (sp.has_delta_m()) site.navigability.delta_m = check.positive("site.delta_m", sp.delta_m());
-    if (sp.has_eps_m()) site.navigability.eps_m = check.finite("site.eps_m", sp.eps_m());
-    if (site.navigability.eps_m < 0.0) check.fail("site.eps_m", "must be >= 0");
-    if (sp.has_min_fraction()) site.min_fraction = check.finite("site.min_fraction", sp.min_fraction());
-    if (!(site.min_fraction > 0.0 && site.min_fraction <= 1.0))
-      check.fail("site.min_fraction", fmt::format("{}", site.min_fraction) + " must be in (0, 1]");
-    if (sp.has_check_every_steps()) site.check_every_steps = sp.check_every_steps();
-    if (site.check_every_steps == 0) check.fail("site.check_every_steps", "must be >= 1");
+    s.site = to_site(p.site(), check);
   }
-  if (p.has_goal_vector_map()) {
-    const proto::GoalVectorMap& gp = p.goal_vector_map();
-    GoalVectorMapSpec& map = s.goal_vector_map;
-    s.has_goal_vector_map = true;
-    map.x0_m = check.finite("goal_vector_map.x0_m", gp.x0_m());
-    map.y0_m = check.finite("goal_vector_map.y0_m", gp.y0_m());
-    map.x1_m = check.finite("goal_vector_map.x1_m", gp.x1_m());
-    map.y1_m = check.finite("goal_vector_map.y1_m", gp.y1_m());
-    if (!(map.x0_m < map.x1_m) || !(map.y0_m < map.y1_m))
-      check.fail("goal_vector_map", "the rectangle needs x0_m < x1_m and y0_m < y1_m");
-    map.strip_width_m = check.positive("goal_vector_map.strip_width_m", gp.strip_width_m());
-    map.arrow_length_m = check.positive("goal_vector_map.arrow_length_m", gp.arrow_length_m());
-    if (gp.has_heading()) {
-      try {
-        map.heading = heading_from_string(gp.heading());
-      } catch (const InvalidArgument& e) {
-        check.fail("goal_vector_map.heading", e.what());
-      }
-    }
-  }
+}
+
+/// The run's settings: start jitter, base, step limits, tiles, seed.
+void read_run_settings(const proto::Scenario& p, Scenario& s, const Validator& check) {
   if (p.has_start_jitter_m()) s.start_jitter_m = check.finite("start_jitter_m", p.start_jitter_m());
   if (s.start_jitter_m < 0.0) check.fail("start_jitter_m", "must be >= 0");
-
   if (p.has_base()) {
-    s.base.x_m = check.finite("base.x_m", p.base().x_m());
-    s.base.y_m = check.finite("base.y_m", p.base().y_m());
+    s.base.centre = {check.finite("base.x_m", p.base().x_m()), check.finite("base.y_m", p.base().y_m())};
     if (p.base().has_radius_m()) s.base.radius_m = check.positive("base.radius_m", p.base().radius_m());
   }
   if (p.has_max_steps()) s.max_steps = p.max_steps();
   if (s.max_steps == 0) check.fail("max_steps", "must be >= 1");
   if (p.has_step_deadline_s()) s.step_deadline_s = check.positive("step_deadline_s", p.step_deadline_s());
   if (p.has_tile_size()) s.tile_size = p.tile_size();
-  if (s.tile_size < 1 || s.tile_size > 4096)
-    check.fail("tile_size", std::to_string(s.tile_size) + " must be in 1..4096");
+  if (s.tile_size < 1 || s.tile_size > 4096) check.fail("tile_size", fmt::format("{} must be in 1..4096", s.tile_size));
   if (p.has_seed()) s.seed = p.seed();
+}
+
+Scenario to_scenario(const proto::Scenario& p, const std::string& source) {
+  const Validator check(source);
+  Scenario s;
+  s.source_path = source;
+  if (!valid_name(p.name()))
+    check.fail("name", fmt::format("'{}' must be non-empty letters, digits, '_', '-', '.'", p.name()));
+  s.name = p.name();
+  if (!p.has_terrain()) check.fail("terrain", "missing");
+  s.terrain = to_terrain(p.terrain(), check);
+
+  if (p.robot_type_size() == 0) check.fail("robot_type", "at least one robot type is required");
+  for (int i = 0; i < p.robot_type_size(); ++i) s.robot_types.push_back(to_robot_type(p, i, s.robot_types, check));
+  if (p.agent_size() == 0) check.fail("agent", "at least one agent slot is required");
+  for (int i = 0; i < p.agent_size(); ++i)
+    s.slots.push_back(to_slot(p.agent(i), static_cast<std::uint32_t>(i) + 1, s.robot_types, check));
+  read_completion(p, s, check);
+  if (p.has_goal_vector_map()) {
+    s.has_goal_vector_map = true;
+    s.goal_vector_map = to_goal_vector_map(p.goal_vector_map(), check);
+  }
+  read_run_settings(p, s, check);
 
   // Generated terrains have a known extent: check placements now. File terrains are checked by build_terrain().
   if (!s.terrain.method.empty()) {

@@ -95,26 +95,26 @@ void check_placement(const Scenario& s, const GridGeometry& g) {
   for (std::size_t i = 0; i < s.slots.size(); ++i) {
     const AgentSlot& slot = s.slots[i];
     const std::string field = "agent[" + std::to_string(i) + "] (agent " + std::to_string(slot.id) + ")";
-    on_grid(field + ".start", slot.start_x_m, slot.start_y_m);
-    on_grid(field + ".target", slot.target_x_m, slot.target_y_m);
+    on_grid(field + ".start", slot.start.x, slot.start.y);
+    on_grid(field + ".target", slot.target.x, slot.target.y);
   }
-  on_grid("base", s.base.x_m, s.base.y_m);
+  on_grid("base", s.base.centre.x, s.base.centre.y);
   const auto inside = [&](const std::string& field, double x0, double y0, double xa, double ya) {
     if (x0 < g.xll_m || xa > x1 || y0 < g.yll_m || ya > y1)
       fail(field, "[" + fmt::format("{}", x0) + ", " + fmt::format("{}", xa) + "] x [" + fmt::format("{}", y0) + ", " +
                       fmt::format("{}", ya) + "] m is not inside the terrain");
   };
   switch (s.completion) {
-    case CompletionKind::kAgentsAtGoal: inside("goal", s.goal.x0_m, s.goal.y0_m, s.goal.x1_m, s.goal.y1_m); break;
+    case CompletionKind::kAgentsAtGoal: inside("goal", s.goal.area.x0, s.goal.area.y0, s.goal.area.x1, s.goal.area.y1); break;
     case CompletionKind::kPayloadPath:
-      on_grid("payload_path.from", s.payload_path.from_x_m, s.payload_path.from_y_m);
-      on_grid("payload_path.to", s.payload_path.to_x_m, s.payload_path.to_y_m);
+      on_grid("payload_path.from", s.payload_path.from.x, s.payload_path.from.y);
+      on_grid("payload_path.to", s.payload_path.to.x, s.payload_path.to.y);
       break;
-    case CompletionKind::kLevelSite: inside("site", s.site.x0_m, s.site.y0_m, s.site.x1_m, s.site.y1_m); break;
+    case CompletionKind::kLevelSite: inside("site", s.site.area.x0, s.site.area.y0, s.site.area.x1, s.site.area.y1); break;
   }
   if (s.has_goal_vector_map) {
     const GoalVectorMapSpec& m = s.goal_vector_map;
-    inside("goal_vector_map", m.x0_m, m.y0_m, m.x1_m, m.y1_m);
+    inside("goal_vector_map", m.area.x0, m.area.y0, m.area.x1, m.area.y1);
   }
 }
 

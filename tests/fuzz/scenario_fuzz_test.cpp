@@ -80,22 +80,22 @@ void check_loaded(const Scenario& s, const Report& report) {
     ASSERT_EQ(slot.id, i + 1) << report();
     ASSERT_TRUE(names.count(slot.robot_type)) << report();
     ASSERT_EQ(s.robot_for(slot.id).name, slot.robot_type) << report();
-    ASSERT_TRUE(sane(slot.start_x_m) && sane(slot.start_y_m) && sane(slot.target_x_m) && sane(slot.target_y_m))
+    ASSERT_TRUE(sane(slot.start.x) && sane(slot.start.y) && sane(slot.target.x) && sane(slot.target.y))
         << report();
   }
   switch (s.completion) {
     case CompletionKind::kAgentsAtGoal:
-      check_rectangle(s.goal.x0_m, s.goal.y0_m, s.goal.x1_m, s.goal.y1_m, "goal", report);
+      check_rectangle(s.goal.area.x0, s.goal.area.y0, s.goal.area.x1, s.goal.area.y1, "goal", report);
       break;
     case CompletionKind::kPayloadPath:
       check_navigability(s.payload_path.navigability, "payload_path", report);
-      ASSERT_TRUE(sane(s.payload_path.from_x_m) && sane(s.payload_path.from_y_m) && sane(s.payload_path.to_x_m) &&
-                  sane(s.payload_path.to_y_m))
+      ASSERT_TRUE(sane(s.payload_path.from.x) && sane(s.payload_path.from.y) && sane(s.payload_path.to.x) &&
+                  sane(s.payload_path.to.y))
           << report();
       ASSERT_GE(s.payload_path.check_every_steps, 1u) << report();
       break;
     case CompletionKind::kLevelSite:
-      check_rectangle(s.site.x0_m, s.site.y0_m, s.site.x1_m, s.site.y1_m, "site", report);
+      check_rectangle(s.site.area.x0, s.site.area.y0, s.site.area.x1, s.site.area.y1, "site", report);
       check_navigability(s.site.navigability, "site", report);
       ASSERT_TRUE(s.site.min_fraction > 0.0 && s.site.min_fraction <= 1.0) << report();
       ASSERT_GE(s.site.check_every_steps, 1u) << report();
@@ -103,12 +103,12 @@ void check_loaded(const Scenario& s, const Report& report) {
   }
   if (s.has_goal_vector_map) {
     const GoalVectorMapSpec& m = s.goal_vector_map;
-    check_rectangle(m.x0_m, m.y0_m, m.x1_m, m.y1_m, "goal_vector_map", report);
+    check_rectangle(m.area.x0, m.area.y0, m.area.x1, m.area.y1, "goal_vector_map", report);
     ASSERT_TRUE(sane(m.strip_width_m) && m.strip_width_m > 0.0) << report();
     ASSERT_TRUE(sane(m.arrow_length_m) && m.arrow_length_m > 0.0) << report();
   }
   ASSERT_TRUE(sane(s.start_jitter_m) && s.start_jitter_m >= 0.0) << report();
-  ASSERT_TRUE(sane(s.base.x_m) && sane(s.base.y_m) && sane(s.base.radius_m) && s.base.radius_m > 0.0) << report();
+  ASSERT_TRUE(sane(s.base.centre.x) && sane(s.base.centre.y) && sane(s.base.radius_m) && s.base.radius_m > 0.0) << report();
   ASSERT_GE(s.max_steps, 1u) << report();
   ASSERT_TRUE(sane(s.step_deadline_s) && s.step_deadline_s > 0.0) << report();
   ASSERT_TRUE(s.tile_size >= 1 && s.tile_size <= 4096) << report();

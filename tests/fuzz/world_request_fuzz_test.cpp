@@ -69,11 +69,11 @@ class WorldFuzzer {
     WorldState state = admitted_state(s, std::move(terrain), agents);
     for (AgentRecord& a : state.agents) {
       if (mutator_.chance(0.5)) {
-        a.x_m = uniform(0.0, 4.0);
-        a.y_m = uniform(0.0, 4.0);
-        if (mutator_.chance(0.2)) a.x_m = mutator_.chance(0.5) ? 1e-9 : 4.0 - 1e-9;  // at an edge
+        a.position.x = uniform(0.0, 4.0);
+        a.position.y = uniform(0.0, 4.0);
+        if (mutator_.chance(0.2)) a.position.x = mutator_.chance(0.5) ? 1e-9 : 4.0 - 1e-9;  // at an edge
       }
-      a.z_m = height_under(state.terrain, a.x_m, a.y_m);
+      a.z_m = height_under(state.terrain, a.position.x, a.position.y);
       a.material_m3 = mutator_.chance(0.3) ? 0.0 : uniform(0.0, a.type.body.material_capacity_m3);
     }
     if (mutator_.chance(0.1)) drop_agent(state, 1 + static_cast<std::uint32_t>(mutator_.below(agents)), "fuzz");
@@ -169,7 +169,7 @@ robot_type {
     if (!state.has_agent(id)) return r;
     const AgentRecord& me = state.agent(id);
     r.session = me.session;
-    double x = me.x_m, y = me.y_m;
+    double x = me.position.x, y = me.position.y;
     if (mutator_.chance(0.6)) {
       const double angle = uniform(0.0, 6.283185307179586);
       const double d = uniform(0.0, 1.1 * me.type.body.max_step_m);
@@ -181,7 +181,7 @@ robot_type {
     }
     const auto centre = state.terrain.cell_at({x, y});
     const int reach = static_cast<int>(me.type.body.reach_m / state.terrain.cell_size_m()) + 1;
-    const DepositorKind kind = depositor_kind(me.type.depositor.name);
+    const DepositorKind kind = me.type.depositor.kind;
     for (std::size_t n = kind == DepositorKind::kLayer ? 0 : mutator_.below(4); n > 0; --n) {
       const double angle = uniform(0.0, 6.283185307179586), d = uniform(0.0, 1.1 * me.type.body.reach_m);
       const double side = depositor_cube_size_m(me.type);
@@ -244,7 +244,7 @@ robot_type {
           if (r.deposits.empty()) r.deposits.push_back({r.target_x_m, r.target_y_m, 0.001});
           Deposit& d = r.deposits[mutator_.below(r.deposits.size())];
           const double nasty = mutator_.chance(0.5) ? mutator_.pick(fuzz::nasty_doubles()) : nasty_height();
-          (mutator_.chance(0.33) ? d.x_m : mutator_.chance(0.5) ? d.y_m : d.volume_m3) = nasty;
+          (mutator_.chance(0.33) ? d.centre.x : mutator_.chance(0.5) ? d.centre.y : d.volume_m3) = nasty;
           break;
         }
         case 13:  // the other kind: a deposit from a layer robot, a deposition from a cube or cone robot
@@ -258,7 +258,7 @@ robot_type {
             r.deposits.assign(mutator_.chance(0.5) ? 256 : 257 + mutator_.below(3000), Deposit{2.0, 2.0, 1e-6});
           } else if (!r.deposits.empty()) {
             Deposit d = r.deposits[mutator_.below(r.deposits.size())];
-            if (mutator_.chance(0.5)) d.x_m = mutator_.chance(0.5) ? 0.01 : 3.99;
+            if (mutator_.chance(0.5)) d.centre.x = mutator_.chance(0.5) ? 0.01 : 3.99;
             r.deposits.push_back(d);
           }
           break;
@@ -287,7 +287,7 @@ std::string describe(const protocol::ActionRequest& r) {
       << r.target_x_m << ", " << r.target_y_m << ") refill " << r.refill << " depositions " << r.depositions.size()
       << " deposits " << r.deposits.size();
   for (std::size_t i = 0; i < r.deposits.size() && i < 12; ++i)
-    out << " {" << r.deposits[i].x_m << "," << r.deposits[i].y_m << " " << r.deposits[i].volume_m3 << "}";
+    out << " {" << r.deposits[i].centre.x << "," << r.deposits[i].centre.y << " " << r.deposits[i].volume_m3 << "}";
   for (std::size_t i = 0; i < r.depositions.size() && i < 12; ++i)
     out << " [" << r.depositions[i].row << "," << r.depositions[i].col << " " << r.depositions[i].height_m << "]";
   out << "}";
@@ -299,7 +299,7 @@ std::string describe(const WorldState& state, const std::vector<Submission>& sub
   out.precision(17);
   out << "step " << state.step << "; agents:";
   for (const AgentRecord& a : state.agents)
-    out << " #" << a.id << (a.alive ? "" : " (not alive)") << " at (" << a.x_m << ", " << a.y_m << ") material "
+    out << " #" << a.id << (a.alive ? "" : " (not alive)") << " at (" << a.position.x << ", " << a.position.y << ") material "
         << a.material_m3 << " session " << a.session << ";";
   out << "\nsubmissions:";
   for (const Submission& s : submissions) out << "\n  on " << s.channel_id << ": " << describe(s.request);
@@ -359,7 +359,7 @@ void check_accepted_request(const WorldState& before, const AgentRecord& me, con
   ASSERT_TRUE(std::isfinite(r.target_x_m) && std::isfinite(r.target_y_m) && std::abs(r.target_x_m) < 1e6 &&
               std::abs(r.target_y_m) < 1e6)
       << report();
-  double x = me.x_m, y = me.y_m;
+  double x = me.position.x, y = me.position.y;
   if (r.move) {
     ASSERT_LE(distance(r.target_x_m, r.target_y_m, x, y), body.max_step_m + tol::kLengthM) << report();
     ASSERT_TRUE(before.terrain.cell_at({r.target_x_m, r.target_y_m})) << report();
@@ -380,15 +380,15 @@ void check_accepted_request(const WorldState& before, const AgentRecord& me, con
     ASSERT_LE(distance(c.x, c.y, x, y), body.reach_m + tol::kLengthM) << report();
     volume += d.height_m * cs * cs;
   }
-  const DepositorKind kind = depositor_kind(me.type.depositor.name);
+  const DepositorKind kind = me.type.depositor.kind;
   ASSERT_TRUE(kind == DepositorKind::kLayer ? r.deposits.empty() : r.depositions.empty())
       << "a request of the other depositor kind accepted\n"
       << report();
   ASSERT_LE(r.deposits.size(), kMaxDeposits) << report();
   for (const Deposit& d : r.deposits) {
-    ASSERT_TRUE(std::isfinite(d.x_m) && std::isfinite(d.y_m) && std::isfinite(d.volume_m3) && d.volume_m3 > 0.0)
+    ASSERT_TRUE(std::isfinite(d.centre.x) && std::isfinite(d.centre.y) && std::isfinite(d.volume_m3) && d.volume_m3 > 0.0)
         << report();
-    ASSERT_LE(distance(d.x_m, d.y_m, x, y), body.reach_m + tol::kLengthM) << report();
+    ASSERT_LE(distance(d.centre.x, d.centre.y, x, y), body.reach_m + tol::kLengthM) << report();
     if (kind == DepositorKind::kCube) {
       const double side = depositor_cube_size_m(me.type), cubes = d.volume_m3 / (side * side * side);
       ASSERT_NEAR(cubes, std::round(cubes), 1e-6) << report();
@@ -399,7 +399,7 @@ void check_accepted_request(const WorldState& before, const AgentRecord& me, con
   ASSERT_LE(volume, body.max_deposit_m3 + tol::kVolumeM3) << report();
   ASSERT_LE(volume, me.material_m3 + tol::kVolumeM3) << report();
   if (r.refill) {
-    ASSERT_LE(distance(x, y, before.base.x_m, before.base.y_m), before.base.radius_m + tol::kLengthM) << report();
+    ASSERT_LE(distance(x, y, before.base.centre.x, before.base.centre.y), before.base.radius_m + tol::kLengthM) << report();
   }
 }
 
@@ -440,7 +440,7 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
       ASSERT_EQ(now.accepted, was.accepted) << report();
       ASSERT_EQ(now.rejected - was.rejected, extra_rejections(before, was, before.step, submissions)) << report();
       rejected += now.rejected - was.rejected;
-      ASSERT_TRUE(now.x_m == was.x_m && now.y_m == was.y_m && now.material_m3 == was.material_m3) << report();
+      ASSERT_TRUE(now.position.x == was.position.x && now.position.y == was.position.y && now.material_m3 == was.material_m3) << report();
       continue;
     }
     const protocol::ActionRequest* answer = answer_of(was, before.step, submissions);
@@ -456,7 +456,7 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
     rejected += now.rejected - was.rejected;
     missed += answer ? 0 : 1;
     if (took == 0) {  // rejected or missed: nothing but counts
-      ASSERT_TRUE(now.x_m == was.x_m && now.y_m == was.y_m) << "agent " << was.id << " moved\n" << report();
+      ASSERT_TRUE(now.position.x == was.position.x && now.position.y == was.position.y) << "agent " << was.id << " moved\n" << report();
       ASSERT_EQ(now.material_m3, was.material_m3) << report();
       ASSERT_EQ(now.deposited_m3, was.deposited_m3) << report();
       continue;
@@ -466,7 +466,7 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
     // the terrain of other agents matter to it, and the terrain only through occupancy, which is not re-checked.
     check_accepted_request(before, was, r, report);
     if (::testing::Test::HasFatalFailure()) return;
-    ASSERT_TRUE(r.move ? now.x_m == r.target_x_m && now.y_m == r.target_y_m : now.x_m == was.x_m && now.y_m == was.y_m)
+    ASSERT_TRUE(r.move ? now.position.x == r.target_x_m && now.position.y == r.target_y_m : now.position.x == was.position.x && now.position.y == was.position.y)
         << report();
     double volume = 0.0;
     for (const Deposition& d : r.depositions) {
@@ -479,17 +479,17 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
     std::map<std::pair<int, int>, double> raised;
     deposit_requests += r.deposits.empty() ? 0 : 1;
     for (const Deposit& d : r.deposits) {
-      const bool cube = depositor_kind(was.type.depositor.name) == DepositorKind::kCube;
+      const bool cube = was.type.depositor.kind == DepositorKind::kCube;
       const double side = depositor_cube_size_m(was.type);
       const DepositShape shape =
-          cube ? cube_column_shape(expected.geometry(), {d.x_m, d.y_m}, side,
+          cube ? cube_column_shape(expected.geometry(), d.centre, side,
                                    static_cast<int>(std::round(d.volume_m3 / (side * side * side))))
-               : cone_pile_shape(expected, {d.x_m, d.y_m}, d.volume_m3, was.type.depositor.repose_deg);
+               : cone_pile_shape(expected, d.centre, d.volume_m3, was.type.depositor.repose_deg);
       ASSERT_TRUE(shape.on_grid) << report();
       ASSERT_NEAR(shape.volume_m3, d.volume_m3, 1e-9 * d.volume_m3 + 1e-15) << report();
       for (const CellRise& c : shape.rises) {
         const Position p = expected.cell_center(c.cell);
-        ASSERT_GT(distance(p.x, p.y, now.x_m, now.y_m), 0.5 * body.navigability.delta_m) << report();
+        ASSERT_GT(distance(p.x, p.y, now.position.x, now.position.y), 0.5 * body.navigability.delta_m) << report();
         const double total = raised[std::make_pair(c.cell.row, c.cell.col)] += c.rise_m;
         ASSERT_LE(total, 1.0 + tol::kLengthM) << report();
         expected(c.cell) += c.rise_m;
@@ -524,7 +524,7 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
       << report();
   for (const AgentRecord& a : state.agents) {
     if (!a.alive) continue;
-    ASSERT_TRUE(state.terrain.cell_at({a.x_m, a.y_m})) << "agent " << a.id << " off the grid\n" << report();
+    ASSERT_TRUE(state.terrain.cell_at(a.position)) << "agent " << a.id << " off the grid\n" << report();
   }
 }
 

@@ -37,8 +37,8 @@ proto::LoggedRequest logged(const Submission& s, bool accepted, const std::vecto
   }
   for (const Deposit& d : r.deposits) {
     proto::LoggedDeposit* ld = q.add_deposits();
-    ld->set_x_m(d.x_m);
-    ld->set_y_m(d.y_m);
+    ld->set_x_m(d.centre.x);
+    ld->set_y_m(d.centre.y);
     ld->set_volume_m3(d.volume_m3);
   }
   if (accepted && raised != nullptr && !r.deposits.empty())
@@ -67,7 +67,7 @@ Submission submission(const proto::LoggedRequest& q) {
   r.depositions.reserve(static_cast<std::size_t>(q.depositions_size()));
   for (const proto::LoggedDeposition& d : q.depositions()) r.depositions.push_back({d.row(), d.col(), d.height_m()});
   r.deposits.reserve(static_cast<std::size_t>(q.deposits_size()));
-  for (const proto::LoggedDeposit& d : q.deposits()) r.deposits.push_back({d.x_m(), d.y_m(), d.volume_m3()});
+  for (const proto::LoggedDeposit& d : q.deposits()) r.deposits.push_back({{d.x_m(), d.y_m()}, d.volume_m3()});
   r.refill = q.refill();
   r.state = q.state();
   return s;
@@ -187,8 +187,8 @@ proto::Snapshot make_snapshot(const WorldState& state, const std::string& run_id
     p->set_readmissions(a.readmissions);
     p->set_session(a.session);
     p->set_name(a.name);
-    p->set_x_m(a.x_m);
-    p->set_y_m(a.y_m);
+    p->set_x_m(a.position.x);
+    p->set_y_m(a.position.y);
     p->set_z_m(a.z_m);
     p->set_material_m3(a.material_m3);
     p->set_accepted(a.accepted);
@@ -271,8 +271,8 @@ void restore_snapshot(WorldState& state, const proto::Snapshot& s, const std::st
     a.readmissions = p.readmissions();
     a.session = p.session();
     a.name = p.name();
-    a.x_m = p.x_m();
-    a.y_m = p.y_m();
+    a.position.x = p.x_m();
+    a.position.y = p.y_m();
     a.z_m = p.z_m();
     a.material_m3 = p.material_m3();
     a.accepted = p.accepted();

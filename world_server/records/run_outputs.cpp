@@ -131,8 +131,8 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
     p->set_at_goal(a.at_goal);
     p->set_dropped(a.dropped);
     p->set_drop_reason(a.drop_reason);
-    p->set_x_m(a.x_m);
-    p->set_y_m(a.y_m);
+    p->set_x_m(a.position.x);
+    p->set_y_m(a.position.y);
     p->set_z_m(a.z_m);
     p->set_material_m3(a.material_m3);
     p->set_state(a.state);
@@ -204,13 +204,13 @@ std::optional<CellRect> zoom_window(const WorldState& state, const std::optional
     for (const CellIndex& c : route->cells) box.add(g, c);
   if (state.completion == scenario::CompletionKind::kPayloadPath) {
     const scenario::PayloadPath& p = state.payload_path;
-    box.add(p.from_x_m, p.from_y_m, p.to_x_m, p.to_y_m);
+    box.add(p.from.x, p.from.y, p.to.x, p.to.y);
   }
   if (state.completion == scenario::CompletionKind::kLevelSite)
-    box.add(state.site.x0_m, state.site.y0_m, state.site.x1_m, state.site.y1_m);
+    box.add(state.site.area.x0, state.site.area.y0, state.site.area.x1, state.site.area.y1);
   if (box.empty()) return std::nullopt;
   const scenario::BaseStation& b = state.base;
-  box.add(b.x_m - b.radius_m, b.y_m - b.radius_m, b.x_m + b.radius_m, b.y_m + b.radius_m);
+  box.add(b.centre.x - b.radius_m, b.centre.y - b.radius_m, b.centre.x + b.radius_m, b.centre.y + b.radius_m);
 
   const double margin = std::max(kZoomMinMarginM, kZoomMarginFraction * std::max(box.x1 - box.x0, box.y1 - box.y0));
   const double side = std::max(std::max(box.x1 - box.x0, box.y1 - box.y0) + 2.0 * margin, kZoomMinSideM);
@@ -246,19 +246,19 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
     const render::CellLabels labels = state.depositor.block(area.first.row, area.first.col, area.rows, area.cols);
     if (labels.maxCoeff() > 0) o.labels = labels;
   }
-  o.circles.push_back({{state.base.x_m, state.base.y_m}, state.base.radius_m, kWhite, 0.0});
+  o.circles.push_back({{state.base.centre.x, state.base.centre.y}, state.base.radius_m, kWhite, 0.0});
   o.legend_entries.push_back({"base station", kWhite, render::LegendSwatch::kRing});
   std::string outcome = info.completed ? "completed" : "not completed";
   switch (state.completion) {
     case scenario::CompletionKind::kAgentsAtGoal: {
       const scenario::Goal& g = state.goal;
-      o.rectangles.push_back({{g.x0_m, g.y0_m}, {g.x1_m, g.y1_m}, kWhite, 0.0});
-      const auto cell = t.cell_at({0.5 * (g.x0_m + g.x1_m), 0.5 * (g.y0_m + g.y1_m)});
+      o.rectangles.push_back({{g.area.x0, g.area.y0}, {g.area.x1, g.area.y1}, kWhite, 0.0});
+      const auto cell = t.cell_at({0.5 * (g.area.x0 + g.area.x1), 0.5 * (g.area.y0 + g.area.y1)});
       if (cell && area.contains(*cell)) o.markers.push_back({cell->row - area.first.row, cell->col - area.first.col});
       o.legend_entries.push_back({"goal", kWhite, render::LegendSwatch::kOutline});
       if (g.target_radius_m > 0.0) {  // each agent's own target: the ring it must end in
         for (const AgentRecord& a : state.agents)
-          if (a.admitted) o.circles.push_back({{a.target_x_m, a.target_y_m}, g.target_radius_m, kToGreen, 0.0});
+          if (a.admitted) o.circles.push_back({{a.target.x, a.target.y}, g.target_radius_m, kToGreen, 0.0});
         o.legend_entries.push_back(
             {fmt::format("targets ({:g} m)", g.target_radius_m), kToGreen, render::LegendSwatch::kRing});
       }
@@ -281,15 +281,15 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
       } else {
         outcome += ", no payload path";
       }
-      o.points.push_back({{p.from_x_m, p.from_y_m}, kFromRed, render::PointShape::kSquare, 0.0});
-      o.points.push_back({{p.to_x_m, p.to_y_m}, kToGreen, render::PointShape::kDiamond, 0.0});
+      o.points.push_back({{p.from.x, p.from.y}, kFromRed, render::PointShape::kSquare, 0.0});
+      o.points.push_back({{p.to.x, p.to.y}, kToGreen, render::PointShape::kDiamond, 0.0});
       o.legend_entries.push_back({"payload from", kFromRed, render::LegendSwatch::kSquare});
       o.legend_entries.push_back({"payload to", kToGreen, render::LegendSwatch::kDiamond});
       break;
     }
     case scenario::CompletionKind::kLevelSite: {
       const scenario::Site& site = state.site;
-      o.rectangles.push_back({{site.x0_m, site.y0_m}, {site.x1_m, site.y1_m}, kWhite, 0.0});
+      o.rectangles.push_back({{site.area.x0, site.area.y0}, {site.area.x1, site.area.y1}, kWhite, 0.0});
       o.legend_entries.push_back({"site", kWhite, render::LegendSwatch::kOutline});
       outcome += fmt::format(", level {:.1f}%", 100.0 * state.check.level_fraction);
       break;
@@ -299,7 +299,7 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
   std::vector<std::string> ids_of_colour(render::default_palette().size());
   for (const AgentRecord& a : state.agents) {
     if (!a.admitted) continue;
-    o.points.push_back({{a.x_m, a.y_m}, render::label_colour(a.id), render::PointShape::kDisc, 0.0});
+    o.points.push_back({a.position, render::label_colour(a.id), render::PointShape::kDisc, 0.0});
     std::string& ids = ids_of_colour[(a.id - 1) % ids_of_colour.size()];
     ids += fmt::format("{}{}", ids.empty() ? "" : ", ", a.id);
   }
@@ -325,9 +325,9 @@ render::RenderOptions goal_vector_map_picture_options(const WorldState& state, c
                                                       const GoalVectorMap& map) {
   render::RenderOptions o;
   const GoalVectorMapSpec& spec = map.spec();
-  o.rectangles.push_back({{spec.x0_m, spec.y0_m}, {spec.x1_m, spec.y1_m}, kWhite, 0.0});
+  o.rectangles.push_back({{spec.area.x0, spec.area.y0}, {spec.area.x1, spec.area.y1}, kWhite, 0.0});
   if (state.completion == scenario::CompletionKind::kLevelSite)
-    o.rectangles.push_back({{state.site.x0_m, state.site.y0_m}, {state.site.x1_m, state.site.y1_m}, kWhite, 0.0});
+    o.rectangles.push_back({{state.site.area.x0, state.site.area.y0}, {state.site.area.x1, state.site.area.y1}, kWhite, 0.0});
   for (const GoalArrow& a : map.arrows()) o.arrows.push_back({a.tail, a.head, kArrowRed, 0.0});
   o.legend_entries.push_back({"tail -> head", kArrowRed, render::LegendSwatch::kArrow});
   o.legend_entries.push_back({"site", kWhite, render::LegendSwatch::kOutline});
@@ -346,7 +346,7 @@ render::PerspectiveOptions perspective_options(const WorldState& state, const Ru
   // The robots where they ended, in their colours (as in final.png): a box 0.8 of the body long, 0.4 of it high.
   for (const AgentRecord& a : state.agents)
     if (a.admitted)
-      o.bodies.push_back({a.x_m, a.y_m, 0.8 * a.type.body.navigability.delta_m,
+      o.bodies.push_back({a.position.x, a.position.y, 0.8 * a.type.body.navigability.delta_m,
                           0.4 * a.type.body.navigability.delta_m, render::label_colour(a.id)});
   o.title = fmt::format("{}: step {}, built material in orange", info.scenario, state.step);
   return o;

@@ -112,10 +112,10 @@ bool admit(WorldState& state, const protocol::AgentHello& hello, AdmissionKind k
   a.alive = true;
   a.session = hello.session;
   a.name = hello.name.substr(0, kMaxNameChars);
-  a.x_m = a.start_x_m;
-  a.y_m = a.start_y_m;
+  a.position.x = a.start.x;
+  a.position.y = a.start.y;
   a.heading_rad = initial_heading_rad(a);
-  a.z_m = height_under(state.terrain, a.x_m, a.y_m);
+  a.z_m = height_under(state.terrain, a.position.x, a.position.y);
   a.material_m3 = a.type.body.material_capacity_m3;
   a.at_goal = at_goal(state, a);
   return true;
@@ -141,12 +141,12 @@ protocol::Admission admission_message(const WorldState& state, const protocol::A
   const GridGeometry& g = state.terrain.geometry();
   m.assignment.world = g;
   m.assignment.tile_size = state.tile_size;
-  m.assignment.base = {state.base.x_m, state.base.y_m};
+  m.assignment.base = {state.base.centre.x, state.base.centre.y};
   m.assignment.base_radius_m = state.base.radius_m;
   if (state.has_agent(m.agent_id)) {
     const AgentRecord& a = state.agent(m.agent_id);
-    m.assignment.start = {a.start_x_m, a.start_y_m};
-    m.assignment.target = {a.target_x_m, a.target_y_m};
+    m.assignment.start = {a.start.x, a.start.y};
+    m.assignment.target = {a.target.x, a.target.y};
   }
   return m;
 }

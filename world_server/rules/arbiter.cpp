@@ -31,7 +31,7 @@ double distance(double ax, double ay, double bx, double by) {
 /// Rule 4: a refill only at the base; nullopt when it passes.
 std::optional<Verdict> check_refill(const WorldState& state, const protocol::ActionRequest& r, double x, double y) {
   if (!r.refill) return std::nullopt;
-  const double to_base = distance(x, y, state.base.x_m, state.base.y_m);
+  const double to_base = distance(x, y, state.base.centre.x, state.base.centre.y);
   if (to_base <= state.base.radius_m + tol::kLengthM) return std::nullopt;
   return Verdict{false,
                  fmt::format("refill requested {} m from the base station (radius {} m)", to_base,
@@ -39,7 +39,7 @@ std::optional<Verdict> check_refill(const WorldState& state, const protocol::Act
                  4, 0.0, {}};
 }
 
-Position at(const Deposit& d) { return {d.x_m, d.y_m}; }
+Position at(const Deposit& d) { return d.centre; }
 
 /// Rule 3's bounds on the volume of one request, from its body and the material on board; nullopt when it passes.
 std::optional<std::string> volume_problem(const AgentRecord& me, double volume) {
@@ -55,7 +55,7 @@ const AgentRecord* agent_over(const WorldState& state, const AgentRecord& me, do
   for (const AgentRecord& other : state.agents) {
     if (!other.alive) continue;
     const bool self = other.id == me.id;
-    const double gap = distance(centre.x, centre.y, self ? x : other.x_m, self ? y : other.y_m);
+    const double gap = distance(centre.x, centre.y, self ? x : other.position.x, self ? y : other.position.y);
     if (gap <= 0.5 * other.type.body.navigability.delta_m + tol::kLengthM) return &other;
   }
   return nullptr;
@@ -67,11 +67,11 @@ Verdict validate_deposits(const WorldState& state, const AgentRecord& me, double
                           const std::vector<Deposit>& deposits) {
   const auto reject = [](std::string reason) { return Verdict{false, std::move(reason), 3, 0.0, {}}; };
   const Heightmap& terrain = state.terrain;
-  const DepositorKind kind = depositor_kind(me.type.depositor.name);
+  const DepositorKind kind = me.type.depositor.kind;
   const double side = depositor_cube_size_m(me.type);
   double volume = 0.0;
   for (const Deposit& d : deposits) {
-    const double from_me = distance(d.x_m, d.y_m, x, y);
+    const double from_me = distance(d.centre.x, d.centre.y, x, y);
     if (!(from_me <= me.type.body.reach_m + tol::kLengthM))
       return reject(fmt::format("deposit at {} is {} m away, beyond reach_m {}", at(d), from_me, me.type.body.reach_m));
     if (!(d.volume_m3 > 0.0)) return reject(fmt::format("deposit volume {} m^3 at {} is not > 0", d.volume_m3, at(d)));
@@ -96,8 +96,8 @@ Verdict validate_deposits(const WorldState& state, const AgentRecord& me, double
           fmt::format("deposit at {} is a column of {} cubes, more than {}", at(d), cubes, kMaxCubesPerColumn));
     const DepositShape shape =
         kind == DepositorKind::kCube
-            ? cube_column_shape(terrain.geometry(), {d.x_m, d.y_m}, side, static_cast<int>(cubes))
-            : cone_pile_shape(layered ? *after : terrain, {d.x_m, d.y_m}, d.volume_m3, me.type.depositor.repose_deg);
+            ? cube_column_shape(terrain.geometry(), d.centre, side, static_cast<int>(cubes))
+            : cone_pile_shape(layered ? *after : terrain, d.centre, d.volume_m3, me.type.depositor.repose_deg);
     if (!shape.on_grid) return reject(fmt::format("deposit at {} would leave the grid", at(d)));
     for (const CellRise& c : shape.rises) {
       if (const AgentRecord* other = agent_over(state, me, x, y, terrain.cell_center(c.cell)))
@@ -172,7 +172,7 @@ std::optional<std::string> envelope_problem(const WorldState& state, std::uint32
   if (static_cast<long long>(r.depositions.size()) > state.terrain.size())
     return fmt::format("{} depositions exceed the grid's cells", r.depositions.size());
   for (const Deposit& d : r.deposits)
-    if (!sane(d.x_m) || !sane(d.y_m) || !sane(d.volume_m3))
+    if (!sane(d.centre.x) || !sane(d.centre.y) || !sane(d.volume_m3))
       return fmt::format("deposit at {} of {} m^3 is not finite or too large", at(d), d.volume_m3);
   if (r.deposits.size() > kMaxDeposits)
     return fmt::format("{} deposits exceed the limit of {} per request", r.deposits.size(), kMaxDeposits);
@@ -183,7 +183,7 @@ std::optional<std::string> envelope_problem(const WorldState& state, std::uint32
 std::optional<std::string> motion_problem(const WorldState& state, const AgentRecord& me,
                                           const protocol::ActionRequest& r) {
   const Heightmap& terrain = state.terrain;
-  const double x = me.x_m, y = me.y_m;
+  const double x = me.position.x, y = me.position.y;
   const double d = distance(r.target_x_m, r.target_y_m, x, y);
   if (!(d <= me.type.body.max_step_m + tol::kLengthM))
     return fmt::format("motion of {} m exceeds max_step_m {}", d, me.type.body.max_step_m);
@@ -205,9 +205,9 @@ std::optional<std::string> motion_problem(const WorldState& state, const AgentRe
   // may move apart.
   for (const AgentRecord& other : state.agents) {
     if (!other.alive || other.id == me.id) continue;
-    if (!bodies_overlap(me, r.target_x_m, r.target_y_m, other, other.x_m, other.y_m)) continue;
-    const double after = distance(r.target_x_m, r.target_y_m, other.x_m, other.y_m);
-    if (bodies_overlap(me, x, y, other, other.x_m, other.y_m) && after >= distance(x, y, other.x_m, other.y_m))
+    if (!bodies_overlap(me, r.target_x_m, r.target_y_m, other, other.position.x, other.position.y)) continue;
+    const double after = distance(r.target_x_m, r.target_y_m, other.position.x, other.position.y);
+    if (bodies_overlap(me, x, y, other, other.position.x, other.position.y) && after >= distance(x, y, other.position.x, other.position.y))
       continue;
     return fmt::format("motion ends {} m from agent {}, whose body it would overlap (bodies need {} m)", after,
                        other.id, body_clearance_m(me, other));
@@ -233,14 +233,14 @@ Verdict validate_request(const WorldState& state, std::uint32_t channel_id, cons
   const auto reject = [](int rule, std::string reason) { return Verdict{false, std::move(reason), rule, 0.0, {}}; };
   if (auto problem = envelope_problem(state, channel_id, r)) return reject(1, std::move(*problem));
   const AgentRecord& me = state.agent(channel_id);
-  double x = me.x_m, y = me.y_m;
+  double x = me.position.x, y = me.position.y;
   if (r.move) {
     if (auto problem = motion_problem(state, me, r)) return reject(2, std::move(*problem));
     x = r.target_x_m;
     y = r.target_y_m;
   }
   // 3. Depositions, from the position after the motion, by the robot's own depositor.
-  const DepositorKind kind = depositor_kind(me.type.depositor.name);
+  const DepositorKind kind = me.type.depositor.kind;
   if (kind == DepositorKind::kLayer && !r.deposits.empty())
     return reject(3, fmt::format("robot type '{}' has the layer depositor: it sends depositions, not deposits",
                                  me.type.name));
@@ -259,10 +259,10 @@ void apply_request(WorldState& state, const protocol::ActionRequest& r, const Ve
   AgentRecord& me = state.agent(r.agent_id);
   if (r.move) {
     // docs/runtime.md#heading: the direction of the last motion of non-zero length.
-    const double dx = r.target_x_m - me.x_m, dy = r.target_y_m - me.y_m;
+    const double dx = r.target_x_m - me.position.x, dy = r.target_y_m - me.position.y;
     if (dx != 0.0 || dy != 0.0) me.heading_rad = std::atan2(dy, dx);
-    me.x_m = r.target_x_m;
-    me.y_m = r.target_y_m;
+    me.position.x = r.target_x_m;
+    me.position.y = r.target_y_m;
   }
   if ((!r.depositions.empty() || !verdict.rises.empty()) &&
       (state.depositor.rows() != state.terrain.rows() || state.depositor.cols() != state.terrain.cols()))
@@ -273,7 +273,7 @@ void apply_request(WorldState& state, const protocol::ActionRequest& r, const Ve
     state.depositor(d.row, d.col) = r.agent_id;
     changed_cells.push_back({d.row, d.col});
   }
-  me.z_m = height_under(state.terrain, me.x_m, me.y_m);
+  me.z_m = height_under(state.terrain, me.position.x, me.position.y);
   me.material_m3 = std::max(0.0, me.material_m3 - verdict.volume_m3);
   if (r.refill) me.material_m3 = me.type.body.material_capacity_m3;
   me.deposited_m3 += verdict.volume_m3;

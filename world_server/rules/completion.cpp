@@ -31,8 +31,8 @@ CellIndex cell_of(const Heightmap& terrain, double x_m, double y_m, const char* 
 CellRect site_rect_or_throw(const Heightmap& terrain, const scenario::Site& site) {
   const CellRect rect = site_cells(terrain.geometry(), site);
   if (rect.empty())
-    throw InvalidArgument(fmt::format("site [{}, {}] x [{}, {}] holds no cell centre of the grid", site.x0_m,
-                                      site.x1_m, site.y0_m, site.y1_m));
+    throw InvalidArgument(fmt::format("site [{}, {}] x [{}, {}] holds no cell centre of the grid", site.area.x0,
+                                      site.area.x1, site.area.y0, site.area.y1));
   return rect;
 }
 
@@ -47,12 +47,12 @@ bool at_goal(const WorldState& state, const AgentRecord& agent) {
   constexpr double tol = tolerance::kLengthM;
   const scenario::Goal& g = state.goal;
   const bool inside =
-      agent.x_m >= g.x0_m - tol && agent.x_m <= g.x1_m + tol && agent.y_m >= g.y0_m - tol && agent.y_m <= g.y1_m + tol;
+      agent.position.x >= g.area.x0 - tol && agent.position.x <= g.area.x1 + tol && agent.position.y >= g.area.y0 - tol && agent.position.y <= g.area.y1 + tol;
   if (!inside) return false;
-  const double h = height_under(state.terrain, agent.x_m, agent.y_m);
+  const double h = height_under(state.terrain, agent.position.x, agent.position.y);
   if (!(h >= g.min_height_m - tol)) return false;  // also for NaN (off the grid)
   return g.target_radius_m <= 0.0 ||
-         std::hypot(agent.x_m - agent.target_x_m, agent.y_m - agent.target_y_m) <= g.target_radius_m + tol;
+         std::hypot(agent.position.x - agent.target.x, agent.position.y - agent.target.y) <= g.target_radius_m + tol;
 }
 
 bool is_completed(const WorldState& state) {
@@ -99,8 +99,8 @@ void start_completion_check(WorldState& state) {
     case scenario::CompletionKind::kAgentsAtGoal: return;
     case scenario::CompletionKind::kPayloadPath: {
       const scenario::PayloadPath& p = state.payload_path;
-      check.from = cell_of(state.terrain, p.from_x_m, p.from_y_m, "payload_path.from");
-      check.to = cell_of(state.terrain, p.to_x_m, p.to_y_m, "payload_path.to");
+      check.from = cell_of(state.terrain, p.from.x, p.from.y, "payload_path.from");
+      check.to = cell_of(state.terrain, p.to.x, p.to.y, "payload_path.to");
       check.occupancy =
           OccupancyCache(state.terrain, {{0, 0}, state.terrain.rows(), state.terrain.cols()}, p.navigability);
       check.target_initial_m = state.terrain(check.to.row, check.to.col);
@@ -161,11 +161,11 @@ CellRect site_cells(const GridGeometry& grid, const scenario::Site& site) {
   int r0 = grid.rows, r1 = -1, c0 = grid.cols, c1 = -1;
   for (int r = 0; r < grid.rows; ++r) {
     const double y = grid.cell_center({r, 0}).y;
-    if (y >= site.y0_m - tol && y <= site.y1_m + tol) r0 = std::min(r0, r), r1 = std::max(r1, r);
+    if (y >= site.area.y0 - tol && y <= site.area.y1 + tol) r0 = std::min(r0, r), r1 = std::max(r1, r);
   }
   for (int c = 0; c < grid.cols; ++c) {
     const double x = grid.cell_center({0, c}).x;
-    if (x >= site.x0_m - tol && x <= site.x1_m + tol) c0 = std::min(c0, c), c1 = std::max(c1, c);
+    if (x >= site.area.x0 - tol && x <= site.area.x1 + tol) c0 = std::min(c0, c), c1 = std::max(c1, c);
   }
   if (r1 < 0 || c1 < 0) return {};
   return {{r0, c0}, r1 - r0 + 1, c1 - c0 + 1};
@@ -207,8 +207,8 @@ bool connected(const CellMask& passable, CellIndex from, CellIndex to) {
 }
 
 bool payload_path_navigable(const Heightmap& terrain, const scenario::PayloadPath& path) {
-  const CellIndex from = cell_of(terrain, path.from_x_m, path.from_y_m, "payload_path.from");
-  const CellIndex to = cell_of(terrain, path.to_x_m, path.to_y_m, "payload_path.to");
+  const CellIndex from = cell_of(terrain, path.from.x, path.from.y, "payload_path.from");
+  const CellIndex to = cell_of(terrain, path.to.x, path.to.y, "payload_path.to");
   return connected(NavigabilityProcessor(path.navigability).occupiable(terrain), from, to);
 }
 
@@ -220,8 +220,8 @@ double site_level_fraction(const Heightmap& terrain, const scenario::Site& site)
 }
 
 RouteGap plan_route_gap(const Heightmap& terrain, const scenario::PayloadPath& path) {
-  const CellIndex from = cell_of(terrain, path.from_x_m, path.from_y_m, "payload_path.from");
-  const CellIndex to = cell_of(terrain, path.to_x_m, path.to_y_m, "payload_path.to");
+  const CellIndex from = cell_of(terrain, path.from.x, path.from.y, "payload_path.from");
+  const CellIndex to = cell_of(terrain, path.to.x, path.to.y, "payload_path.to");
   const NavigabilityParams& body = path.navigability;
   const double cs = terrain.cell_size_m();
   const Heightmap ceiling = MarsProcessor(body.kappa).project(terrain);
@@ -293,8 +293,8 @@ std::optional<PayloadRoute> shortest_path(const CellMask& passable, CellIndex fr
 }
 
 std::optional<PayloadRoute> payload_path(const Heightmap& terrain, const scenario::PayloadPath& path) {
-  const CellIndex from = cell_of(terrain, path.from_x_m, path.from_y_m, "payload_path.from");
-  const CellIndex to = cell_of(terrain, path.to_x_m, path.to_y_m, "payload_path.to");
+  const CellIndex from = cell_of(terrain, path.from.x, path.from.y, "payload_path.from");
+  const CellIndex to = cell_of(terrain, path.to.x, path.to.y, "payload_path.to");
   return shortest_path(NavigabilityProcessor(path.navigability).occupiable(terrain), from, to, terrain.cell_size_m());
 }
 

@@ -19,7 +19,7 @@ void SensingService::forget(std::uint32_t id) {
 void SensingService::add_tiles(const WorldState& state, const AgentRecord& me, protocol::SensorFrame& f) {
   std::vector<std::uint64_t>& seen = seen_[me.id - 1];
   const Heightmap& terrain = state.terrain;
-  for (int index : layout_.tiles_in_square({me.x_m, me.y_m}, me.type.body.sensing_range_m)) {
+  for (int index : layout_.tiles_in_square(me.position, me.type.body.sensing_range_m)) {
     const std::uint64_t version = state.tile_versions[static_cast<std::size_t>(index)];
     if (seen[static_cast<std::size_t>(index)] == version) continue;
     seen[static_cast<std::size_t>(index)] = version;
@@ -41,8 +41,8 @@ protocol::SensorFrame SensingService::frame_for(const WorldState& state, std::ui
   protocol::SensorFrame f;
   f.agent_id = id;
   f.step = state.step;
-  f.x_m = me.x_m;
-  f.y_m = me.y_m;
+  f.x_m = me.position.x;
+  f.y_m = me.position.y;
   f.z_m = me.z_m;
   f.material_m3 = me.material_m3;
   f.last_result = me.last_result;
@@ -55,15 +55,15 @@ protocol::SensorFrame SensingService::frame_for(const WorldState& state, std::ui
   } else if (!run_over && state.step % static_cast<std::uint64_t>(sensor.scan_every_steps) == 0) {
     // docs/runtime.md#sensing: a scan instead of tiles, every scan_every_steps steps, from the robot's pose.
     f.scanned = true;
-    f.points = cast_scan(state.terrain, sensor_origin(state.terrain, me.x_m, me.y_m, sensor), me.heading_rad, sensor,
+    f.points = cast_scan(state.terrain, sensor_origin(state.terrain, me.position.x, me.position.y, sensor), me.heading_rad, sensor,
                          scan_seed(state.seed, id, state.step));
   }
 
   for (const AgentRecord& other : state.agents) {
     if (!other.alive || other.id == id) continue;
-    const double dx = other.x_m - me.x_m, dy = other.y_m - me.y_m;
+    const double dx = other.position.x - me.position.x, dy = other.position.y - me.position.y;
     if (std::sqrt(dx * dx + dy * dy) <= me.type.body.proximity_range_m + tolerance::kLengthM)
-      f.neighbours.push_back({other.id, other.x_m, other.y_m, other.z_m, 0.5 * other.type.body.navigability.delta_m});
+      f.neighbours.push_back({other.id, other.position.x, other.position.y, other.z_m, 0.5 * other.type.body.navigability.delta_m});
   }
   return f;
 }

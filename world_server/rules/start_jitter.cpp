@@ -14,7 +14,7 @@ Position jittered_start(const Heightmap& terrain, const scenario::AgentSlot& slo
                         double jitter_m, std::uint64_t seed) {
   if (!(jitter_m >= 0.0) || !std::isfinite(jitter_m))
     throw InvalidArgument(fmt::format("start jitter of agent {} must be finite and >= 0 m", slot.id));
-  const Position start{slot.start_x_m, slot.start_y_m};
+  const Position start = slot.start;
   if (jitter_m == 0.0) return start;
   // Streams of different agents start at unrelated points of the generator's cycle.
   random::Rng rng(random::mix64(random::mix64(seed) + slot.id));

@@ -120,7 +120,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_pairs(const Wor
     if (!a.alive) continue;
     for (std::size_t j = i + 1; j < state.agents.size(); ++j) {
       const AgentRecord& b = state.agents[j];
-      if (b.alive && bodies_overlap(a, a.x_m, a.y_m, b, b.x_m, b.y_m)) pairs.emplace_back(a.id, b.id);
+      if (b.alive && bodies_overlap(a, a.position.x, a.position.y, b, b.position.x, b.position.y)) pairs.emplace_back(a.id, b.id);
     }
   }
   return pairs;
@@ -164,7 +164,7 @@ StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submiss
 
   for (AgentRecord& agent : state.agents) {
     if (!agent.admitted) continue;
-    agent.z_m = height_under(state.terrain, agent.x_m, agent.y_m);
+    agent.z_m = height_under(state.terrain, agent.position.x, agent.position.y);
     if (!agent.alive) continue;
     const bool reached = at_goal(state, agent);
     if (reached && !agent.at_goal) out.events.push_back(event(state.step, agent.id, protocol::EventKind::kAtGoal, ""));

@@ -50,7 +50,7 @@ WorldState world_state_at(const scenario::Scenario& scenario, Heightmap terrain,
     const scenario::AgentSlot& slot = scenario.slots[id - 1];
     const RobotType& type = scenario.robot_for(id);
     // docs/runtime.md#depositors: a cube narrower than a cell has no footprint of its own on the heightmap.
-    if (depositor_kind(type.depositor.name) == DepositorKind::kCube &&
+    if (type.depositor.kind == DepositorKind::kCube &&
         depositor_cube_size_m(type) < s.terrain.cell_size_m() - 1e-12)
       throw InvalidArgument(fmt::format(
           "robot type '{}': depositor.cube_size_m {} m is smaller than the cell size {} m; a cube narrower than a "
@@ -60,13 +60,10 @@ WorldState world_state_at(const scenario::Scenario& scenario, Heightmap terrain,
     a.id = id;
     a.type = type;
     const Position& start = starts[id - 1];
-    a.start_x_m = start.x;
-    a.start_y_m = start.y;
-    a.target_x_m = slot.target_x_m;
-    a.target_y_m = slot.target_y_m;
-    a.x_m = start.x;
-    a.y_m = start.y;
-    a.z_m = height_under(s.terrain, a.x_m, a.y_m);
+    a.start = start;
+    a.target = slot.target;
+    a.position = start;
+    a.z_m = height_under(s.terrain, a.position.x, a.position.y);
     a.heading_rad = initial_heading_rad(a);
     s.agents.push_back(std::move(a));
   }
@@ -74,7 +71,7 @@ WorldState world_state_at(const scenario::Scenario& scenario, Heightmap terrain,
 }
 
 double initial_heading_rad(const AgentRecord& a) {
-  const double dx = a.target_x_m - a.start_x_m, dy = a.target_y_m - a.start_y_m;
+  const double dx = a.target.x - a.start.x, dy = a.target.y - a.start.y;
   return dx == 0.0 && dy == 0.0 ? 0.0 : std::atan2(dy, dx);
 }
 

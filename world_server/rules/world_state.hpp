@@ -20,8 +20,8 @@ namespace marsala::world_server {
 struct AgentRecord {
   std::uint32_t id = 0;  ///< >= 1
   RobotType type;        ///< its slot's robot type: body (what the hello must declare), behaviour, name
-  double start_x_m = 0.0, start_y_m = 0.0;    ///< [m]
-  double target_x_m = 0.0, target_y_m = 0.0;  ///< [m]
+  Position start;   ///< [m]
+  Position target;  ///< [m]
 
   bool admitted = false;
   bool alive = false;  ///< admitted and not dropped: takes part in the lockstep
@@ -31,7 +31,7 @@ struct AgentRecord {
   std::uint64_t session = 0;       ///< from the admitted hello
   std::string name;                ///< from the admitted hello
 
-  double x_m = 0.0, y_m = 0.0;  ///< position [m]
+  Position position;            ///< [m]
   double z_m = 0.0;             ///< terrain height of the cell under the centre [m]
   double material_m3 = 0.0;     ///< material on board [m^3]
   /// Direction the robot faces [rad from east, counter-clockwise]: of its last accepted motion of non-zero length,

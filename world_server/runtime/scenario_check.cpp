@@ -74,8 +74,8 @@ proto::ScenarioCheck to_message(const WorldStart& start) {
     r->set_max_step_m(type.body.max_step_m);
     r->set_cube_size_m(type.body.cube_size_m);
     r->set_goal_synthesizer(type.goal_synthesizer);
-    r->set_sensor(type.sensor.name);
-    r->set_depositor(type.depositor.name);
+    r->set_sensor(to_string(type.sensor.kind));
+    r->set_depositor(to_string(type.depositor.kind));
     r->set_localisation_noise_sd_m(type.localisation.noise_sd_m);
     if (type.sensor.casts_rays()) {
       r->set_sensor_rays(type.sensor.ray_count());
@@ -86,20 +86,20 @@ proto::ScenarioCheck to_message(const WorldStart& start) {
     proto::SlotCheck* p = m.add_slots();
     p->set_id(slot.id);
     p->set_robot_type(slot.robot_type);
-    set_point(p->mutable_start(), slot.start_x_m, slot.start_y_m);
-    set_point(p->mutable_target(), slot.target_x_m, slot.target_y_m);
+    set_point(p->mutable_start(), slot.start.x, slot.start.y);
+    set_point(p->mutable_target(), slot.target.x, slot.target.y);
     if (const AgentRecord* a = record_of(state, slot.id))
-      set_point(p->mutable_world_start(), a->start_x_m, a->start_y_m);
+      set_point(p->mutable_world_start(), a->start.x, a->start.y);
   }
   m.set_agents(static_cast<std::uint32_t>(state.agents.size()));
   m.set_completion(scenario::to_string(state.completion));
   switch (state.completion) {
     case scenario::CompletionKind::kAgentsAtGoal: {
       proto::GoalCheck* goal = m.mutable_goal();
-      goal->set_x0_m(state.goal.x0_m);
-      goal->set_y0_m(state.goal.y0_m);
-      goal->set_x1_m(state.goal.x1_m);
-      goal->set_y1_m(state.goal.y1_m);
+      goal->set_x0_m(state.goal.area.x0);
+      goal->set_y0_m(state.goal.area.y0);
+      goal->set_x1_m(state.goal.area.x1);
+      goal->set_y1_m(state.goal.area.y1);
       goal->set_min_height_m(state.goal.min_height_m);
       goal->set_target_radius_m(state.goal.target_radius_m);
       break;
@@ -110,8 +110,8 @@ proto::ScenarioCheck to_message(const WorldStart& start) {
       path->set_kappa(p.navigability.kappa);
       path->set_delta_m(p.navigability.delta_m);
       path->set_eps_m(p.navigability.eps_m);
-      set_point(path->mutable_from(), p.from_x_m, p.from_y_m);
-      set_point(path->mutable_to(), p.to_x_m, p.to_y_m);
+      set_point(path->mutable_from(), p.from.x, p.from.y);
+      set_point(path->mutable_to(), p.to.x, p.to.y);
       path->set_check_every_steps(p.check_every_steps);
       path->set_met_at_start(state.check.met);
       path->set_target_height_m(state.check.target_initial_m);
@@ -121,10 +121,10 @@ proto::ScenarioCheck to_message(const WorldStart& start) {
     case scenario::CompletionKind::kLevelSite: {
       const scenario::Site& p = state.site;
       proto::SiteCheck* site = m.mutable_site();
-      site->set_x0_m(p.x0_m);
-      site->set_y0_m(p.y0_m);
-      site->set_x1_m(p.x1_m);
-      site->set_y1_m(p.y1_m);
+      site->set_x0_m(p.area.x0);
+      site->set_y0_m(p.area.y0);
+      site->set_x1_m(p.area.x1);
+      site->set_y1_m(p.area.y1);
       site->set_kappa(p.navigability.kappa);
       site->set_delta_m(p.navigability.delta_m);
       site->set_eps_m(p.navigability.eps_m);
@@ -136,7 +136,7 @@ proto::ScenarioCheck to_message(const WorldStart& start) {
       break;
     }
   }
-  set_point(m.mutable_base(), state.base.x_m, state.base.y_m);
+  set_point(m.mutable_base(), state.base.centre.x, state.base.centre.y);
   m.set_base_radius_m(state.base.radius_m);
   m.set_max_steps(start.options.max_steps);
   m.set_seed(s.seed);
@@ -176,28 +176,28 @@ std::string scenario_check_text(const WorldStart& start) {
     out << "  " << t.name << ": behaviour " << t.behaviour << ", kappa " << number(t.body.navigability.kappa)
         << ", delta_m " << number(t.body.navigability.delta_m) << ", eps_m " << number(t.body.navigability.eps_m)
         << ", max_step_m " << number(t.body.max_step_m) << ", cube_size_m " << number(t.body.cube_size_m)
-        << ", goal_synthesizer " << t.goal_synthesizer << ", sensor " << t.sensor.name
+        << ", goal_synthesizer " << t.goal_synthesizer << ", sensor " << to_string(t.sensor.kind)
         << (t.sensor.casts_rays() ? fmt::format(" ({} rays, {}-{} m)", t.sensor.ray_count(),
                                                 number(t.sensor.min_range_m), number(t.sensor.max_range_m))
                                   : "")
-        << ", depositor " << t.depositor.name
+        << ", depositor " << to_string(t.depositor.kind)
         << (t.localisation.noise_sd_m > 0.0
                 ? fmt::format(", localisation noise {} m", number(t.localisation.noise_sd_m))
                 : "")
         << "\n";
   out << "slots (" << s.slots.size() << "; the world waits for agents 1.." << state.agents.size() << "):\n";
   for (const scenario::AgentSlot& slot : s.slots) {
-    out << "  " << slot.id << " " << slot.robot_type << ": start " << point(slot.start_x_m, slot.start_y_m)
-        << " target " << point(slot.target_x_m, slot.target_y_m);
+    out << "  " << slot.id << " " << slot.robot_type << ": start " << point(slot.start.x, slot.start.y)
+        << " target " << point(slot.target.x, slot.target.y);
     const AgentRecord* a = record_of(state, slot.id);
-    if (a && (a->start_x_m != slot.start_x_m || a->start_y_m != slot.start_y_m))
-      out << ", jittered start " << point(a->start_x_m, a->start_y_m);
+    if (a && (a->start.x != slot.start.x || a->start.y != slot.start.y))
+      out << ", jittered start " << point(a->start.x, a->start.y);
     out << "\n";
   }
   out << "completion: " << scenario::to_string(state.completion);
   switch (state.completion) {
     case scenario::CompletionKind::kAgentsAtGoal:
-      out << ", goal " << box(state.goal.x0_m, state.goal.y0_m, state.goal.x1_m, state.goal.y1_m) << ", min_height_m "
+      out << ", goal " << box(state.goal.area.x0, state.goal.area.y0, state.goal.area.x1, state.goal.area.y1) << ", min_height_m "
           << number(state.goal.min_height_m);
       if (state.goal.target_radius_m > 0.0)
         out << ", each agent within " << number(state.goal.target_radius_m) << " m of its target";
@@ -206,8 +206,8 @@ std::string scenario_check_text(const WorldStart& start) {
     case scenario::CompletionKind::kPayloadPath: {
       const scenario::PayloadPath& p = state.payload_path;
       out << ", payload kappa " << number(p.navigability.kappa) << ", delta_m " << number(p.navigability.delta_m)
-          << ", eps_m " << number(p.navigability.eps_m) << ", from " << point(p.from_x_m, p.from_y_m) << " to "
-          << point(p.to_x_m, p.to_y_m) << " (its cell " << number(state.check.target_initial_m)
+          << ", eps_m " << number(p.navigability.eps_m) << ", from " << point(p.from.x, p.from.y) << " to "
+          << point(p.to.x, p.to.y) << " (its cell " << number(state.check.target_initial_m)
           << " m high, to end at most " << number(state.check.max_target_rise_m) << " m higher), checked every "
           << p.check_every_steps
           << " steps; at start: " << (state.check.met ? "navigable (the run ends at once)" : "not navigable") << "\n";
@@ -215,7 +215,7 @@ std::string scenario_check_text(const WorldStart& start) {
     }
     case scenario::CompletionKind::kLevelSite: {
       const scenario::Site& p = state.site;
-      out << ", site " << box(p.x0_m, p.y0_m, p.x1_m, p.y1_m) << " (" << site_cell_count(state) << " cells), kappa "
+      out << ", site " << box(p.area.x0, p.area.y0, p.area.x1, p.area.y1) << " (" << site_cell_count(state) << " cells), kappa "
           << number(p.navigability.kappa) << ", delta_m " << number(p.navigability.delta_m) << ", eps_m "
           << number(p.navigability.eps_m) << ", min_fraction " << number(p.min_fraction) << ", checked every "
           << p.check_every_steps << " steps; at start: level fraction " << number(state.check.level_fraction)
@@ -223,7 +223,7 @@ std::string scenario_check_text(const WorldStart& start) {
       break;
     }
   }
-  out << "base: " << point(state.base.x_m, state.base.y_m) << " m, radius " << number(state.base.radius_m) << " m\n";
+  out << "base: " << point(state.base.centre.x, state.base.centre.y) << " m, radius " << number(state.base.radius_m) << " m\n";
   out << "max_steps " << start.options.max_steps << ", seed " << s.seed << ", start_jitter_m "
       << number(s.start_jitter_m) << ", step_deadline_s " << number(start.options.step_deadline_s) << ", tile_size "
       << state.tile_size << ", run id " << start.options.run_id << "\n";

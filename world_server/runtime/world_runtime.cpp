@@ -12,6 +12,7 @@
 
 #include "marsala/core/cpu_time.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/core/log_pacing.hpp"
 #include "marsala/core/statistics.hpp"
 #include "marsala/runlog/sha256.hpp"
@@ -66,8 +67,8 @@ protocol::WorldStatus world_status(const WorldState& state, bool running, bool c
     as.agent_id = a.id;
     as.name = a.name;
     as.state = a.state;
-    as.x_m = a.x_m;
-    as.y_m = a.y_m;
+    as.x_m = a.position.x;
+    as.y_m = a.position.y;
     as.z_m = a.z_m;
     as.material_m3 = a.material_m3;
     as.deposited_m3 = a.deposited_m3;
@@ -86,9 +87,8 @@ void log_completion(const scenario::Scenario& scenario, const WorldState& state)
   switch (state.completion) {
     case scenario::CompletionKind::kAgentsAtGoal: spdlog::info("completion: agents_at_goal"); break;
     case scenario::CompletionKind::kPayloadPath:
-      spdlog::info("completion: payload_path from ({}, {}) to ({}, {}), checked every {} steps: {}",
-                   state.payload_path.from_x_m, state.payload_path.from_y_m, state.payload_path.to_x_m,
-                   state.payload_path.to_y_m, state.payload_path.check_every_steps,
+      spdlog::info("completion: payload_path from {} to {}, checked every {} steps: {}", state.payload_path.from,
+                   state.payload_path.to, state.payload_path.check_every_steps,
                    state.check.met ? "already navigable" : "not navigable yet");
       spdlog::info("completion: the target's cell ({} m) may end at most {} m (one cube layer) higher",
                    state.check.target_initial_m, state.check.max_target_rise_m);

@@ -157,8 +157,8 @@ marsala_wire_SensorFrame to_msg(const SensorFrame& in, Storage& storage) {
   for (const Neighbour& n : in.neighbours) {
     marsala_wire_Neighbour neighbour{};
     neighbour.agent_id = n.agent_id;
-    neighbour.x_m = n.x_m;
-    neighbour.y_m = n.y_m;
+    neighbour.x_m = n.position.x;
+    neighbour.y_m = n.position.y;
     neighbour.z_m = n.z_m;
     neighbour.radius_m = n.radius_m;
     storage.neighbours.push_back(neighbour);
@@ -199,8 +199,7 @@ SensorFrame from_msg(const marsala_wire_SensorFrame& in) {
     const marsala_wire_Neighbour& n = in.neighbours._buffer[i];
     Neighbour neighbour;
     neighbour.agent_id = n.agent_id;
-    neighbour.x_m = n.x_m;
-    neighbour.y_m = n.y_m;
+    neighbour.position = {n.x_m, n.y_m};
     neighbour.z_m = n.z_m;
     neighbour.radius_m = n.radius_m;
     out.neighbours.push_back(neighbour);
@@ -235,8 +234,8 @@ marsala_wire_ActionRequest to_msg(const ActionRequest& in, Storage& storage) {
   storage.deposits.clear();
   for (const Deposit& d : in.deposits) {
     marsala_wire_Deposit deposit{};
-    deposit.x_m = d.x_m;
-    deposit.y_m = d.y_m;
+    deposit.x_m = d.centre.x;
+    deposit.y_m = d.centre.y;
     deposit.volume_m3 = d.volume_m3;
     storage.deposits.push_back(deposit);
   }
@@ -267,8 +266,7 @@ ActionRequest from_msg(const marsala_wire_ActionRequest& in) {
   for (std::uint32_t i = 0; i < in.deposits._length; ++i) {
     const marsala_wire_Deposit& d = in.deposits._buffer[i];
     Deposit deposit;
-    deposit.x_m = d.x_m;
-    deposit.y_m = d.y_m;
+    deposit.centre = {d.x_m, d.y_m};
     deposit.volume_m3 = d.volume_m3;
     out.deposits.push_back(deposit);
   }

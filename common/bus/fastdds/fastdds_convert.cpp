@@ -134,8 +134,8 @@ wire::SensorFrame to_msg(const SensorFrame& in) {
   for (const Neighbour& n : in.neighbours) {
     wire::Neighbour neighbour;
     neighbour.agent_id(n.agent_id);
-    neighbour.x_m(n.x_m);
-    neighbour.y_m(n.y_m);
+    neighbour.x_m(n.position.x);
+    neighbour.y_m(n.position.y);
     neighbour.z_m(n.z_m);
     neighbour.radius_m(n.radius_m);
     out.neighbours().push_back(neighbour);
@@ -177,8 +177,7 @@ SensorFrame from_msg(const wire::SensorFrame& in) {
   for (const wire::Neighbour& n : in.neighbours()) {
     Neighbour neighbour;
     neighbour.agent_id = n.agent_id();
-    neighbour.x_m = n.x_m();
-    neighbour.y_m = n.y_m();
+    neighbour.position = {n.x_m(), n.y_m()};
     neighbour.z_m = n.z_m();
     neighbour.radius_m = n.radius_m();
     out.neighbours.push_back(neighbour);
@@ -209,8 +208,8 @@ wire::ActionRequest to_msg(const ActionRequest& in) {
   out.deposits().reserve(in.deposits.size());
   for (const Deposit& d : in.deposits) {
     wire::Deposit deposit;
-    deposit.x_m(d.x_m);
-    deposit.y_m(d.y_m);
+    deposit.x_m(d.centre.x);
+    deposit.y_m(d.centre.y);
     deposit.volume_m3(d.volume_m3);
     out.deposits().push_back(deposit);
   }
@@ -238,8 +237,7 @@ ActionRequest from_msg(const wire::ActionRequest& in) {
   out.deposits.reserve(in.deposits().size());
   for (const wire::Deposit& d : in.deposits()) {
     Deposit deposit;
-    deposit.x_m = d.x_m();
-    deposit.y_m = d.y_m();
+    deposit.centre = {d.x_m(), d.y_m()};
     deposit.volume_m3 = d.volume_m3();
     out.deposits.push_back(deposit);
   }

@@ -122,8 +122,8 @@ void expect_same(const SensorFrame& a, const SensorFrame& b) {
   ASSERT_EQ(a.neighbours.size(), b.neighbours.size());
   for (std::size_t i = 0; i < a.neighbours.size(); ++i) {
     EXPECT_EQ(a.neighbours[i].agent_id, b.neighbours[i].agent_id);
-    EXPECT_SAME_DOUBLE(a.neighbours[i].x_m, b.neighbours[i].x_m);
-    EXPECT_SAME_DOUBLE(a.neighbours[i].y_m, b.neighbours[i].y_m);
+    EXPECT_SAME_DOUBLE(a.neighbours[i].position.x, b.neighbours[i].position.x);
+    EXPECT_SAME_DOUBLE(a.neighbours[i].position.y, b.neighbours[i].position.y);
     EXPECT_SAME_DOUBLE(a.neighbours[i].z_m, b.neighbours[i].z_m);
   }
   EXPECT_EQ(a.run_over, b.run_over);
@@ -149,8 +149,8 @@ void expect_same(const ActionRequest& a, const ActionRequest& b) {
   }
   ASSERT_EQ(a.deposits.size(), b.deposits.size());
   for (std::size_t i = 0; i < a.deposits.size(); ++i) {
-    EXPECT_SAME_DOUBLE(a.deposits[i].x_m, b.deposits[i].x_m);
-    EXPECT_SAME_DOUBLE(a.deposits[i].y_m, b.deposits[i].y_m);
+    EXPECT_SAME_DOUBLE(a.deposits[i].centre.x, b.deposits[i].centre.x);
+    EXPECT_SAME_DOUBLE(a.deposits[i].centre.y, b.deposits[i].centre.y);
     EXPECT_SAME_DOUBLE(a.deposits[i].volume_m3, b.deposits[i].volume_m3);
   }
   EXPECT_EQ(a.refill, b.refill);

@@ -17,10 +17,10 @@ GridGeometry grid_1m() { return {12, 12, 100.0, -20.0, 1.0}; }
 
 GoalVectorMapSpec spec(double x0, double y0, double x1, double y1, double w, double len, Heading h) {
   GoalVectorMapSpec s;
-  s.x0_m = x0;
-  s.y0_m = y0;
-  s.x1_m = x1;
-  s.y1_m = y1;
+  s.area.x0 = x0;
+  s.area.y0 = y0;
+  s.area.x1 = x1;
+  s.area.y1 = y1;
   s.strip_width_m = w;
   s.arrow_length_m = len;
   s.heading = h;
@@ -163,17 +163,17 @@ struct RandomSpecs {
     s.heading = static_cast<Heading>(integer(0, 3));
     if (aligned) {
       const int c0 = integer(0, grid.cols - 4), r0 = integer(0, grid.rows - 4);
-      s.x0_m = grid.xll_m + c0 * cs;
-      s.x1_m = grid.xll_m + integer(c0 + 3, grid.cols) * cs;
-      s.y0_m = grid.yll_m + r0 * cs;
-      s.y1_m = grid.yll_m + integer(r0 + 3, grid.rows) * cs;
+      s.area.x0 = grid.xll_m + c0 * cs;
+      s.area.x1 = grid.xll_m + integer(c0 + 3, grid.cols) * cs;
+      s.area.y0 = grid.yll_m + r0 * cs;
+      s.area.y1 = grid.yll_m + integer(r0 + 3, grid.rows) * cs;
       s.strip_width_m = integer(1, 8) * cs;
       s.arrow_length_m = integer(1, 12) * cs;
     } else {
-      s.x0_m = uniform(grid.xll_m, grid.xll_m + grid.cols * cs - 2.0);
-      s.x1_m = uniform(s.x0_m + 1.0, grid.xll_m + grid.cols * cs);
-      s.y0_m = uniform(grid.yll_m, grid.yll_m + grid.rows * cs - 2.0);
-      s.y1_m = uniform(s.y0_m + 1.0, grid.yll_m + grid.rows * cs);
+      s.area.x0 = uniform(grid.xll_m, grid.xll_m + grid.cols * cs - 2.0);
+      s.area.x1 = uniform(s.area.x0 + 1.0, grid.xll_m + grid.cols * cs);
+      s.area.y0 = uniform(grid.yll_m, grid.yll_m + grid.rows * cs - 2.0);
+      s.area.y1 = uniform(s.area.y0 + 1.0, grid.yll_m + grid.rows * cs);
       s.strip_width_m = uniform(cs, 2.5);
       s.arrow_length_m = uniform(cs, 4.0);
     }
@@ -271,7 +271,7 @@ TEST(GoalVectorMap, StripsCoverTheRectangleBruteForce) {
     for (int r = 0; r < g.rows; ++r)
       for (int c = 0; c < g.cols; ++c) {
         const Position p = g.cell_center({r, c});
-        if (p.x < s.x0_m || p.x > s.x1_m || p.y < s.y0_m || p.y > s.y1_m) continue;
+        if (p.x < s.area.x0 || p.x > s.area.x1 || p.y < s.area.y0 || p.y > s.area.y1) continue;
         bool covered = false;
         for (std::size_t k = 0; k < line.size() && !covered; ++k)
           covered = std::abs(across(s, p) - line[k]) <= 0.5 * s.strip_width_m + slack &&
@@ -367,25 +367,25 @@ TEST(GoalVectorMap, RejectsBadSpecsWithClearMessages) {
     return what.find(part) != std::string::npos;
   };
   // Not finite: every field.
-  EXPECT_TRUE(contains(with([&](GoalVectorMapSpec& s) { s.x0_m = nan; }), "x0_m is nan"));
-  EXPECT_TRUE(contains(with([&](GoalVectorMapSpec& s) { s.y0_m = nan; }), "y0_m"));
-  EXPECT_TRUE(contains(with([&](GoalVectorMapSpec& s) { s.x1_m = inf; }), "x1_m is inf"));
-  EXPECT_TRUE(contains(with([&](GoalVectorMapSpec& s) { s.y1_m = nan; }), "y1_m"));
+  EXPECT_TRUE(contains(with([&](GoalVectorMapSpec& s) { s.area.x0 = nan; }), "x0_m is nan"));
+  EXPECT_TRUE(contains(with([&](GoalVectorMapSpec& s) { s.area.y0 = nan; }), "y0_m"));
+  EXPECT_TRUE(contains(with([&](GoalVectorMapSpec& s) { s.area.x1 = inf; }), "x1_m is inf"));
+  EXPECT_TRUE(contains(with([&](GoalVectorMapSpec& s) { s.area.y1 = nan; }), "y1_m"));
   EXPECT_TRUE(contains(with([&](GoalVectorMapSpec& s) { s.strip_width_m = nan; }), "strip_width_m"));
   EXPECT_TRUE(contains(with([&](GoalVectorMapSpec& s) { s.arrow_length_m = -inf; }), "arrow_length_m"));
   // Empty rectangles.
-  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.x1_m = s.x0_m; }), "is empty"));
-  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.x1_m = 99; }), "is empty"));
-  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.y1_m = -20; }), "is empty"));
+  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.area.x1 = s.area.x0; }), "is empty"));
+  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.area.x1 = 99; }), "is empty"));
+  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.area.y1 = -20; }), "is empty"));
   // Outside the grid [100, 112] x [-20, -8], on each side.
   EXPECT_TRUE(
-      contains(with([](GoalVectorMapSpec& s) { s.x0_m = 99.9; }), "not inside the grid [100, 112] x [-20, -8]"));
-  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.x1_m = 112.1; }), "not inside the grid"));
-  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.y0_m = -20.01; }), "not inside the grid"));
-  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.y1_m = -7.5; }), "not inside the grid"));
+      contains(with([](GoalVectorMapSpec& s) { s.area.x0 = 99.9; }), "not inside the grid [100, 112] x [-20, -8]"));
+  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.area.x1 = 112.1; }), "not inside the grid"));
+  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.area.y0 = -20.01; }), "not inside the grid"));
+  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.area.y1 = -7.5; }), "not inside the grid"));
   EXPECT_EQ(with([](GoalVectorMapSpec& s) {
-              s.x1_m = 112;
-              s.y1_m = -8;
+              s.area.x1 = 112;
+              s.area.y1 = -8;
             }),
             "");  // touching the edges is inside
   // Non-positive strip width or arrow length.
@@ -396,23 +396,23 @@ TEST(GoalVectorMap, RejectsBadSpecsWithClearMessages) {
   // Strips narrower than a cell: all of them, or the last one (5.5 m across in strips of 2.5 m leaves 0.5 m).
   EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.strip_width_m = 0.75; }), "narrower than one cell (1 m)"));
   EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) {
-                         s.y1_m = -14.5;
+                         s.area.y1 = -14.5;
                          s.strip_width_m = 2.5;
                        }),
                        "strip 2 of 3 is only 0.5 m wide, narrower than one cell"));
   EXPECT_EQ(with([](GoalVectorMapSpec& s) {
-              s.y1_m = -14;
+              s.area.y1 = -14;
               s.strip_width_m = 2.5;
             }),
             "");  // last strip 1 m
   // Arrows shorter than a cell, and a site whose upwind and downwind cells coincide.
   EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.arrow_length_m = 0.5; }), "shorter than one cell"));
-  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.x1_m = 101; }), "only 1 m long along heading east"));
-  EXPECT_EQ(with([](GoalVectorMapSpec& s) { s.x1_m = 102; }), "");  // two cells: one arrow of one cell
+  EXPECT_TRUE(contains(with([](GoalVectorMapSpec& s) { s.area.x1 = 101; }), "only 1 m long along heading east"));
+  EXPECT_EQ(with([](GoalVectorMapSpec& s) { s.area.x1 = 102; }), "");  // two cells: one arrow of one cell
   for (Heading h : {Heading::kWest, Heading::kNorth, Heading::kSouth}) {
     GoalVectorMapSpec s = good;
     s.heading = h;
-    s.x0_m = 99;
+    s.area.x0 = 99;
     EXPECT_TRUE(contains(error_of(s), "not inside the grid")) << to_string(h);
     s = good;
     s.heading = h;

@@ -23,8 +23,8 @@ double norm(const ScanPoint& p) {
   return std::sqrt(double{p.x_m} * p.x_m + double{p.y_m} * p.y_m + double{p.z_m} * p.z_m);
 }
 
-SensorSpec noiseless(const std::string& name) {
-  SensorSpec s = sensor_defaults(name);
+SensorSpec noiseless(SensorKind kind) {
+  SensorSpec s = sensor_defaults(kind);
   s.noise_sd_m = 0.0;
   s.noise_sd_per_m2 = 0.0;
   return s;
@@ -59,7 +59,7 @@ TEST(RayCaster, FlatPlaneHitsAtHeightOverSineOfTheAngle) {
 
   // The scan: every point on the plane, at the analytic range, no point beyond max range or before min range; a
   // ray is missing exactly when its analytic range lies outside [min, max].
-  const SensorSpec laser = noiseless("laser");
+  const SensorSpec laser = noiseless(SensorKind::kLaser);
   const std::vector<ScanPoint> points = cast_scan(flat, origin, 0.0, laser, 1);
   long long expected = 0;
   const long long azimuths = static_cast<long long>(360.0 / laser.horizontal_resolution_deg + 1e-9);
@@ -91,7 +91,7 @@ TEST(RayCaster, AWallOccludesWhatLiesBehindIt) {
   const double t = first_hit(terrain, origin, direction(0.0, low), 20.0).value();
   EXPECT_NEAR(t * std::cos(low * kDeg), 3.0, 1e-9);
 
-  SensorSpec laser = noiseless("laser");
+  SensorSpec laser = noiseless(SensorKind::kLaser);
   laser.max_range_m = 20.0;
   for (const ScanPoint& p : cast_scan(terrain, origin, 0.0, laser, 7))
     EXPECT_LE(origin.x + p.x_m, 5.1 + 1e-4) << "a point behind the wall: " << p.x_m << " " << p.y_m << " " << p.z_m;
@@ -124,7 +124,7 @@ TEST(RayCaster, NoiseIsSeededAndHasTheConfiguredSpread) {
   const double H = 1.0;
   const Heightmap flat(GridGeometry{300, 300, -15.0, -15.0, 0.1}, 0.0);
   const Point3 origin{0.0, 0.0, H};
-  SensorSpec laser = sensor_defaults("laser");
+  SensorSpec laser = sensor_defaults(SensorKind::kLaser);
   laser.horizontal_resolution_deg = 0.5;
   laser.vertical_min_deg = -80.0;
   laser.vertical_max_deg = -10.0;
@@ -157,7 +157,7 @@ TEST(RayCaster, NoiseIsSeededAndHasTheConfiguredSpread) {
 // The camera looks along the heading, over its horizontal field of view only.
 TEST(RayCaster, TheCameraFollowsTheHeading) {
   const Heightmap flat(GridGeometry{200, 200, -10.0, -10.0, 0.1}, 0.0);
-  const SensorSpec rgbd = noiseless("rgbd");
+  const SensorSpec rgbd = noiseless(SensorKind::kRgbd);
   for (double heading_deg : {0.0, 90.0, 200.0, -45.0}) {
     const std::vector<ScanPoint> points = cast_scan(flat, {0.0, 0.0, 0.5}, heading_deg * kDeg, rgbd, 3);
     ASSERT_FALSE(points.empty());
@@ -171,12 +171,14 @@ TEST(RayCaster, TheCameraFollowsTheHeading) {
 
 TEST(RayCaster, RefusesABadSensorAndAPositionOffTheGrid) {
   const Heightmap flat(GridGeometry{10, 10, 0.0, 0.0, 0.1}, 0.0);
-  SensorSpec bad = sensor_defaults("laser");
+  SensorSpec bad = sensor_defaults(SensorKind::kLaser);
   bad.max_range_m = std::nan("");
   EXPECT_THROW(cast_scan(flat, {0.5, 0.5, 1.0}, 0.0, bad, 1), InvalidArgument);
-  EXPECT_THROW(sensor_origin(flat, 5.0, 0.5, sensor_defaults("laser")), InvalidArgument);
+  EXPECT_THROW(sensor_origin(flat, 5.0, 0.5, sensor_defaults(SensorKind::kLaser)), InvalidArgument);
   EXPECT_TRUE(cast_scan(flat, {0.5, 0.5, 1.0}, 0.0, SensorSpec{}, 1).empty());  // ground truth casts nothing
-  EXPECT_THROW(sensor_defaults("sonar"), InvalidArgument);
+  EXPECT_THROW(sensor_kind("sonar"), InvalidArgument);
+  EXPECT_EQ(sensor_kind("rgbd"), SensorKind::kRgbd);
+  EXPECT_EQ(to_string(SensorKind::kGroundTruth), "ground_truth");
 }
 
 }  // namespace

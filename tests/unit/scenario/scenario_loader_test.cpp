@@ -45,13 +45,13 @@ std::string invalid(const std::string& text) {
 
 TEST(ScenarioLoader, DepositorDefaultsToLayerAndReadsItsParameters) {
   const Scenario plain = parse_scenario(kMinimal, "t.pbtxt");
-  EXPECT_EQ(plain.robot_types[0].depositor.name, "layer");
+  EXPECT_EQ(plain.robot_types[0].depositor.kind, DepositorKind::kLayer);
   EXPECT_FALSE(plain.robot_types[0].depositor.cube_size_m);
   const Scenario cube =
       parse_scenario(edit("robot_type { name: \"bot\" }",
                           "robot_type { name: \"bot\" body { cube_size_m: 0.5 } depositor { name: \"cube\" } }"),
                      "t.pbtxt");
-  EXPECT_EQ(cube.robot_types[0].depositor.name, "cube");
+  EXPECT_EQ(cube.robot_types[0].depositor.kind, DepositorKind::kCube);
   EXPECT_EQ(depositor_cube_size_m(cube.robot_types[0]), 0.5);  // the body's
   const Scenario own = parse_scenario(
       edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" depositor { name: \"cube\" cube_size_m: 0.6 } }"),
@@ -60,7 +60,7 @@ TEST(ScenarioLoader, DepositorDefaultsToLayerAndReadsItsParameters) {
   const Scenario cone = parse_scenario(
       edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" depositor { name: \"cone\" repose_deg: 40 } }"),
       "t.pbtxt");
-  EXPECT_EQ(cone.robot_types[0].depositor.name, "cone");
+  EXPECT_EQ(cone.robot_types[0].depositor.kind, DepositorKind::kCone);
   EXPECT_EQ(cone.robot_types[0].depositor.repose_deg, 40.0);
   EXPECT_EQ(parse_scenario(edit("robot_type { name: \"bot\" }",
                                 "robot_type { name: \"bot\" depositor { name: \"cone\" } }"),
@@ -120,19 +120,19 @@ TEST(ScenarioLoader, TheRampScenarioLoadsWithEveryValue) {
     const AgentSlot& slot = s.slots[id - 1];
     EXPECT_EQ(slot.id, id);
     EXPECT_EQ(slot.robot_type, "husky");
-    EXPECT_EQ(slot.start_x_m, 5.05);
-    EXPECT_EQ(slot.target_x_m, 22.05);
-    EXPECT_EQ(slot.start_y_m, slot.target_y_m);  // straight ahead
+    EXPECT_EQ(slot.start.x, 5.05);
+    EXPECT_EQ(slot.target.x, 22.05);
+    EXPECT_EQ(slot.start.y, slot.target.y);  // straight ahead
     EXPECT_EQ(&s.robot_for(id), &s.robot_types[0]);
   }
-  EXPECT_NEAR(s.slots[1].start_y_m - s.slots[0].start_y_m, 3.0, 1e-12);  // spaced 3 m along the platform
-  EXPECT_EQ(s.goal.x0_m, 18.0);
-  EXPECT_EQ(s.goal.x1_m, 28.0);
-  EXPECT_EQ(s.goal.y0_m, 3.0);
-  EXPECT_EQ(s.goal.y1_m, 17.0);
+  EXPECT_NEAR(s.slots[1].start.y - s.slots[0].start.y, 3.0, 1e-12);  // spaced 3 m along the platform
+  EXPECT_EQ(s.goal.area.x0, 18.0);
+  EXPECT_EQ(s.goal.area.x1, 28.0);
+  EXPECT_EQ(s.goal.area.y0, 3.0);
+  EXPECT_EQ(s.goal.area.y1, 17.0);
   EXPECT_EQ(s.goal.min_height_m, 1.4);
   EXPECT_EQ(s.goal.target_radius_m, 0.25);
-  EXPECT_EQ(s.base.x_m, 3.05);
+  EXPECT_EQ(s.base.centre.x, 3.05);
   EXPECT_EQ(s.base.radius_m, 1.5);
   EXPECT_EQ(s.max_steps, 4000u);
   EXPECT_EQ(s.step_deadline_s, 10.0);
@@ -360,7 +360,7 @@ TEST(ScenarioOverrides, BadOverridesNameTheOverrideAndWhatIsWrong) {
 
 TEST(ScenarioLoader, SensorsTakeTheirNamedDefaultsAndTheFileOnTop) {
   const Scenario plain = parse_scenario(kMinimal, "t.pbtxt");
-  EXPECT_EQ(plain.robot_types[0].sensor.name, "ground_truth");
+  EXPECT_EQ(plain.robot_types[0].sensor.kind, SensorKind::kGroundTruth);
   EXPECT_FALSE(plain.robot_types[0].sensor.casts_rays());
 
   const Scenario laser =
@@ -371,8 +371,8 @@ TEST(ScenarioLoader, SensorsTakeTheirNamedDefaultsAndTheFileOnTop) {
   EXPECT_EQ(l.name, "laser");
   EXPECT_EQ(l.max_range_m, 5.0);
   EXPECT_EQ(l.scan_every_steps, 3);
-  EXPECT_EQ(l.horizontal_fov_deg, sensor_defaults("laser").horizontal_fov_deg);
-  EXPECT_EQ(l.vertical_min_deg, sensor_defaults("laser").vertical_min_deg);
+  EXPECT_EQ(l.horizontal_fov_deg, sensor_defaults(SensorKind::kLaser).horizontal_fov_deg);
+  EXPECT_EQ(l.vertical_min_deg, sensor_defaults(SensorKind::kLaser).vertical_min_deg);
 
   const Scenario rgbd = parse_scenario(
       edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" sensor { name: \"rgbd\" } }"), "t.pbtxt");

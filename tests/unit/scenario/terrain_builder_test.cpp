@@ -77,8 +77,8 @@ TEST_F(TerrainBuilderTest, TheRampPlatformStandsWhereTheScenarioSays) {
   EXPECT_EQ(at(22.05, 17.05), 0.0);
   EXPECT_EQ(h.heights().sum(), 1.5 * 100 * 140);
   for (const AgentSlot& slot : s.slots) {
-    EXPECT_EQ(at(slot.start_x_m, slot.start_y_m), 0.0);    // starts on the ground
-    EXPECT_EQ(at(slot.target_x_m, slot.target_y_m), 1.5);  // targets on the platform top
+    EXPECT_EQ(at(slot.start.x, slot.start.y), 0.0);    // starts on the ground
+    EXPECT_EQ(at(slot.target.x, slot.target.y), 1.5);  // targets on the platform top
   }
 }
 
@@ -204,7 +204,7 @@ TEST(DeployScenarios, EachBuildsItsTerrainAndNeedsConstruction) {
       const PayloadPath& p = s.payload_path;
       const NavigabilityProcessor nav(p.navigability);
       const CellMask occupiable = nav.occupiable(h);
-      const CellIndex from = cell(p.from_x_m, p.from_y_m), to = cell(p.to_x_m, p.to_y_m);
+      const CellIndex from = cell(p.from.x, p.from.y), to = cell(p.to.x, p.to.y);
       EXPECT_EQ(occupiable(from.row, from.col), 1) << "the payload cannot stand at its start";
       EXPECT_EQ(NavigabilityProcessor::navigable_from(occupiable, from)(to.row, to.col), 0)
           << "the target is reachable without construction";
@@ -214,8 +214,8 @@ TEST(DeployScenarios, EachBuildsItsTerrainAndNeedsConstruction) {
       ASSERT_TRUE(s.has_goal_vector_map);
       const GoalVectorMap map(s.goal_vector_map, h.geometry());
       EXPECT_GE(static_cast<std::size_t>(map.strips()), 1u);
-      const CellIndex lo = cell(s.site.x0_m + 1e-6, s.site.y1_m - 1e-6),
-                      hi = cell(s.site.x1_m - 1e-6, s.site.y0_m + 1e-6);
+      const CellIndex lo = cell(s.site.area.x0 + 1e-6, s.site.area.y1 - 1e-6),
+                      hi = cell(s.site.area.x1 - 1e-6, s.site.area.y0 + 1e-6);
       const Heightmap site = h.window(lo, hi.row - lo.row + 1, hi.col - lo.col + 1);
       const CellMask occupiable = NavigabilityProcessor(s.site.navigability).occupiable(site);
       EXPECT_LT(occupiable.cast<long long>().sum(), static_cast<long long>(site.rows()) * site.cols())

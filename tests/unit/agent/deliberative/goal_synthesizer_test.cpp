@@ -55,10 +55,10 @@ AgentContext site_context(std::uint32_t id) {
   c.assignment.world = {12, 12, 0.0, 0.0, 1.0};
   c.type.goal_synthesizer = "goal_vector_map";
   GoalVectorMapSpec spec;
-  spec.x0_m = 2.0;
-  spec.y0_m = 2.0;
-  spec.x1_m = 10.0;
-  spec.y1_m = 6.0;
+  spec.area.x0 = 2.0;
+  spec.area.y0 = 2.0;
+  spec.area.x1 = 10.0;
+  spec.area.y1 = 6.0;
   spec.strip_width_m = 2.0;
   spec.arrow_length_m = 4.0;
   spec.heading = Heading::kEast;

@@ -161,7 +161,7 @@ TEST(LocalMapSynthesizer, UnknownCellsAreNeverOccupiableNorTargets) {
 // never ends on one, even when unknown cells are the shorter way.
 TEST(LocalMapSynthesizer, ScannedMapsNeverLetTheRobotOntoUnknownCells) {
   const Heightmap h = bumpy_terrain();
-  executive::MappingSystem map(kWorld, 16, sensor_defaults("laser"));
+  executive::MappingSystem map(kWorld, 16, sensor_defaults(SensorKind::kLaser));
   const Point3 origin = sensor_origin(h, kRobot.x, kRobot.y, map.sensor());
   map.integrate_scan(cast_scan(h, origin, 0.0, map.sensor(), 3), origin);
   map.assume_ground(kRobot, h(30, 40), 0.5 * kBody.delta_m);  // as the behaviours do: it stands there
@@ -207,7 +207,7 @@ TEST(LocalMapSynthesizer, ScannedMapsNeverLetTheRobotOntoUnknownCells) {
 // reaches it through such cells only (LocalMap::passable); before, it followed the blind cells along the edge of its
 // knowledge, where a structure's side hides what lies beyond and the robot stalled.
 TEST(LocalMapSynthesizer, AScannedMapsGoalAndPathAvoidCellsItCannotJudge) {
-  executive::MappingSystem map(kWorld, 16, sensor_defaults("laser"));
+  executive::MappingSystem map(kWorld, 16, sensor_defaults(SensorKind::kLaser));
   // Known flat ground (assumed, which marks cells known): the corridor rows 27..33, cols 25..79, but cell (31, 64).
   for (int r = 27; r <= 33; ++r)
     for (int c = 25; c < 80; ++c)
@@ -232,7 +232,7 @@ TEST(LocalMapSynthesizer, AScannedMapsGoalAndPathAvoidCellsItCannotJudge) {
   // Known ground only as far as the robot's own body ball (radius 2 cells): every other cell is blind, and the robot's
   // own cell is the only judged one. The goal is then the known cell nearest the exit, reached through known cells
   // (before, the robot's own cell: it stood still, "at its goal").
-  executive::MappingSystem small(kWorld, 16, sensor_defaults("laser"));
+  executive::MappingSystem small(kWorld, 16, sensor_defaults(SensorKind::kLaser));
   for (const CellIndex o : disc_offsets(2.0))
     small.assume_ground(kWorld.cell_center({30 + o.row, 40 + o.col}), 0.0, 0.0);
   const LocalMap boxed = synthesizer.synthesize(small, kRobot, {7.05, 2.95});

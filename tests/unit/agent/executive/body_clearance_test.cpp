@@ -95,8 +95,8 @@ TEST(BodyClearance, TheActionManagerNeverChoosesATargetTheWorldWouldRefuse) {
     ++moved;
     EXPECT_TRUE(clear_of(discs, robot, m->target));
     for (const Neighbour& n : seen) {
-      const double d = distance(m->target, {n.x_m, n.y_m});
-      const double before = distance(robot, {n.x_m, n.y_m});
+      const double d = distance(m->target, n.position);
+      const double before = distance(robot, n.position);
       if (d < 1.0) {  // never deeper into a body
         EXPECT_GE(d, before) << "trial " << trial;
       }

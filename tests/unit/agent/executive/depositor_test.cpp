@@ -48,7 +48,7 @@ LocalMap ramp_map(double per_cell_m = 0.03) {
 
 RobotType type_with(const std::string& depositor) {
   RobotType t;
-  t.depositor.name = depositor;
+  t.depositor.kind = depositor_kind(depositor);
   t.depositor.cube_size_m = 0.1;
   t.depositor.repose_deg = 34.0;
   return t;
@@ -59,10 +59,10 @@ Heightmap after(const LocalMap& map, const DepositionPlan& plan, const RobotType
   Heightmap h = map.heights;
   for (const Deposit& d : plan.deposits) {
     const DepositShape s =
-        type.depositor.name == "cube"
-            ? cube_column_shape(h.geometry(), {d.x_m, d.y_m}, *type.depositor.cube_size_m,
+        type.depositor.kind == DepositorKind::kCube
+            ? cube_column_shape(h.geometry(), d.centre, *type.depositor.cube_size_m,
                                 static_cast<int>(std::lround(d.volume_m3 / 0.001)))
-            : cone_pile_shape(h, {d.x_m, d.y_m}, d.volume_m3, type.depositor.repose_deg);
+            : cone_pile_shape(h, d.centre, d.volume_m3, type.depositor.repose_deg);
     EXPECT_TRUE(s.on_grid);
     for (const CellRise& r : s.rises) h(r.cell) += r.rise_m;
   }
@@ -105,7 +105,7 @@ TEST(Depositor, CubeColumnsStayUnderMarsWithinReachBudgetAndKeepOut) {
   EXPECT_TRUE(plan.depositions.empty());
   double volume = 0.0;
   for (const Deposit& d : plan.deposits) {
-    EXPECT_LE(dist({d.x_m, d.y_m}, robot), 1.5);
+    EXPECT_LE(dist(d.centre, robot), 1.5);
     const double cubes = d.volume_m3 / 0.001;
     EXPECT_NEAR(cubes, std::round(cubes), 1e-9);
     EXPECT_GE(std::round(cubes), 1.0);
@@ -150,15 +150,15 @@ TEST(Depositor, ConePilesStayUnderMarsWithinTheOvershootAndKeepOut) {
   // A neighbour at (4, 20): nothing within 0.7 m of it may rise.
   Neighbour n;
   n.agent_id = 2;
-  n.x_m = kGrid.cell_center({4, 20}).x;
-  n.y_m = kGrid.cell_center({4, 20}).y;
+  n.position.x = kGrid.cell_center({4, 20}).x;
+  n.position.y = kGrid.cell_center({4, 20}).y;
   n.radius_m = 0.2;
   const DepositionPlan plan = make_depositor(type)->plan(dm, map, row_path(10, 10, 40), robot, 10.0, {1, robot, {n}});
   ASSERT_FALSE(plan.deposits.empty());
   ASSERT_LE(plan.deposits.size(), static_cast<std::size_t>(kMaxConesPerStep));
   double volume = 0.0;
   for (const Deposit& d : plan.deposits) {
-    EXPECT_LE(dist({d.x_m, d.y_m}, robot), 1.5);
+    EXPECT_LE(dist(d.centre, robot), 1.5);
     volume += d.volume_m3;
   }
   EXPECT_LE(volume, 0.02 + 1e-12);
@@ -170,7 +170,7 @@ TEST(Depositor, ConePilesStayUnderMarsWithinTheOvershootAndKeepOut) {
       if (!(rise > 0.0)) continue;
       EXPECT_LE(rise, map.gap(r, c) + kConeOvershootFraction * kEps + 1e-12) << r << "," << c;
       EXPECT_GT(dist(kGrid.cell_center({r, c}), robot), 0.2);
-      EXPECT_GT(dist(kGrid.cell_center({r, c}), {n.x_m, n.y_m}), 0.7);
+      EXPECT_GT(dist(kGrid.cell_center({r, c}), n.position), 0.7);
       under += std::min(rise, map.gap(r, c)) * kCs * kCs;
       added += rise * kCs * kCs;
     }

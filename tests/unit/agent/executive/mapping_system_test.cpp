@@ -151,7 +151,7 @@ TEST(MappingSystem, ALaserMapConvergesToTheTerrainAsScansAccumulate) {
   spec.cell_size_m = 0.1;
   spec.seed = 7;
   const Heightmap truth = terrain::generate_terrain("mix", spec);
-  MappingSystem map(truth.geometry(), 16, sensor_defaults("laser"));
+  MappingSystem map(truth.geometry(), 16, sensor_defaults(SensorKind::kLaser));
 
   scan_into(map, truth, 2.05, 6.05, 0.0, 1);
   const CellMask first_known = map.known();
@@ -203,7 +203,7 @@ TEST(MappingSystem, OccludedCellsStayUnknown) {
     for (int c = 30; c < 32; ++c) truth(r, c) = 0.3;
   // A camera whose noise does not grow with range (2 mm): it places hits in cells past the shadow too (the default's
   // grows by 2 mm/m^2 and leaves hits beyond 2 m out: AHitTooNoisyToPlaceInACellIsLeftOut).
-  SensorSpec camera = sensor_defaults("rgbd");
+  SensorSpec camera = sensor_defaults(SensorKind::kRgbd);
   camera.noise_sd_per_m2 = 0.0;
   MappingSystem map(truth.geometry(), 16, camera);
   scan_into(map, truth, 2.05, 3.05, 0.0, 5);  // looking east
@@ -234,7 +234,7 @@ TEST(MappingSystem, OccludedCellsStayUnknown) {
 // A cell rises (a deposit within the same voxel): the map follows within a few scans.
 TEST(MappingSystem, TheMapFollowsADeposit) {
   Heightmap truth(GridGeometry{60, 60, 0.0, 0.0, 0.1}, 0.0);
-  SensorSpec laser = sensor_defaults("laser");
+  SensorSpec laser = sensor_defaults(SensorKind::kLaser);
   laser.noise_sd_m = 0.0;
   MappingSystem map(truth.geometry(), 16, laser);
   scan_into(map, truth, 3.05, 3.05, 0.0, 1);
@@ -253,7 +253,7 @@ TEST(MappingSystem, TheMapFollowsADeposit) {
 
 TEST(MappingSystem, RefusesAbsurdScans) {
   const GridGeometry world{60, 60, 0.0, 0.0, 0.1};
-  MappingSystem map(world, 16, sensor_defaults("laser"));
+  MappingSystem map(world, 16, sensor_defaults(SensorKind::kLaser));
   const Point3 origin{3.05, 3.05, 0.5};  // a cell centre: hits near cell edges are left out
   EXPECT_THROW(map.integrate_scan({{std::numeric_limits<float>::quiet_NaN(), 0.0F, 0.0F}}, origin), InvalidArgument);
   EXPECT_THROW(map.integrate_scan({{0.0F, 0.0F, -1e9F}}, origin), InvalidArgument);
@@ -265,12 +265,12 @@ TEST(MappingSystem, RefusesAbsurdScans) {
   // Points off the grid are left out, not an error.
   map.integrate_scan({{-5.0F, 0.0F, -0.5F}, {0.0F, 0.0F, -0.5F}}, origin);
   EXPECT_EQ(map.known_cells(), 1);
-  EXPECT_THROW(MappingSystem(GridGeometry{40000, 10, 0.0, 0.0, 0.1}, 16, sensor_defaults("laser")), InvalidArgument);
+  EXPECT_THROW(MappingSystem(GridGeometry{40000, 10, 0.0, 0.0, 0.1}, 16, sensor_defaults(SensorKind::kLaser)), InvalidArgument);
 }
 
 TEST(MappingSystem, AssumedGroundFillsOnlyUnknownCellsUnderTheBody) {
   const GridGeometry world{60, 60, 0.0, 0.0, 0.1};
-  MappingSystem map(world, 16, sensor_defaults("rgbd"));
+  MappingSystem map(world, 16, sensor_defaults(SensorKind::kRgbd));
   map.assume_ground({3.05, 3.05}, 0.7, 0.5);
   // The disc of radius 0.5 m around cell (29, 30): 81 cell centres (a radius of 5 cells).
   EXPECT_EQ(map.known_cells(), 81);
@@ -288,7 +288,7 @@ TEST(MappingSystem, AHitPushedPastAnEdgeIntoItsShadowIsLeftOut) {
   Heightmap truth(GridGeometry{60, 100, 0.0, 0.0, 0.1}, 0.0);
   for (int r = 0; r < 60; ++r)
     for (int c = 30; c < 32; ++c) truth(r, c) = 0.3;
-  SensorSpec laser = sensor_defaults("laser");
+  SensorSpec laser = sensor_defaults(SensorKind::kLaser);
   MappingSystem map(truth.geometry(), 16, laser);
   const auto hit = [](Point3 origin, double x, double y, double z) {
     return ScanPoint{static_cast<float>(x - origin.x), static_cast<float>(y - origin.y),
@@ -312,7 +312,7 @@ TEST(MappingSystem, AHitPushedPastAnEdgeIntoItsShadowIsLeftOut) {
 // spreads at the hit's range, and a hit whose band would exceed 0.3 cell cannot be placed in a cell: at 3 m
 // (sd 20 mm, band 60 mm on 0.1 m cells) it is left out; at 1 m (sd 4 mm, band 12 mm) a cell centre's hit is kept.
 TEST(MappingSystem, AHitTooNoisyToPlaceInACellIsLeftOut) {
-  MappingSystem map(GridGeometry{60, 100, 0.0, 0.0, 0.1}, 16, sensor_defaults("rgbd"));
+  MappingSystem map(GridGeometry{60, 100, 0.0, 0.0, 0.1}, 16, sensor_defaults(SensorKind::kRgbd));
   const Point3 origin{2.05, 3.05, 0.5};
   const float drop = -0.5F;
   map.integrate_scan({{0.9F, 0.0F, drop}, {3.0F, 0.0F, drop}}, origin);  // ranges 1.03 m and 3.04 m, cell centres
@@ -326,7 +326,7 @@ TEST(MappingSystem, AHitTooNoisyToPlaceInACellIsLeftOut) {
 
 // hit_within(cell, n): one of the last n scans hit the cell's surface.
 TEST(MappingSystem, HitWithinSaysWhetherARecentScanHitTheCell) {
-  MappingSystem map(GridGeometry{60, 60, 0.0, 0.0, 0.1}, 16, sensor_defaults("laser"));
+  MappingSystem map(GridGeometry{60, 60, 0.0, 0.0, 0.1}, 16, sensor_defaults(SensorKind::kLaser));
   const Point3 origin{3.05, 3.05, 0.5};
   EXPECT_FALSE(map.hit_within({29, 35}, 3));
   map.integrate_scan({{0.5F, 0.0F, -0.5F}}, origin);  // cell (29, 35)

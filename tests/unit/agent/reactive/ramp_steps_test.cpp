@@ -269,7 +269,7 @@ namespace {
 
 TEST(RampSteps, AfterARejectedRequestWithDepositsTheNextCarriesAtMostHalfAsManyUntilOneIsAccepted) {
   AgentContext c = test::agent_context(3, test::husky());
-  c.type.depositor.name = "cone";
+  c.type.depositor.kind = DepositorKind::kCone;
   RampSteps steps(c);
   steps.admit(test::admission_on(c, test::platform_world().geometry(), kTarget, kBase));
   const Position robot{6.45, 3.05};  // blocked at the foot of the platform: builds in place
@@ -305,7 +305,7 @@ TEST(RampSteps, AfterARejectedRequestWithDepositsTheNextCarriesAtMostHalfAsManyU
 // and a robot with exact sensing at the same pose at its first.
 TEST(RampSteps, AScanningRobotFillsAGapOnlyOnceItsLastScansAgree) {
   AgentContext c = test::agent_context(3, test::husky());
-  c.type.sensor = sensor_defaults("laser");
+  c.type.sensor = sensor_defaults(SensorKind::kLaser);
   RampSteps steps(c);
   Heightmap h = test::platform_world();  // with a 0.3 m step instead of the 1.5 m platform: its top lies below the
   for (int r = 0; r < h.rows(); ++r)     // laser (0.5 m up), which sees no higher than 10 degrees up

@@ -200,7 +200,7 @@ TEST(AgentRuntime, IgnoresScansThatMakeNoSense) {
   // ignored whole (a log line each, no crash); the run goes on to the world's end.
   auto participant = bus::make_participant({bus::Vendor::kInProcess, 113});
   RuntimeConfig c = config(4, "ramp_builder");
-  c.type.sensor = sensor_defaults("laser");
+  c.type.sensor = sensor_defaults(SensorKind::kLaser);
   AgentRuntime agent(*participant, c);
   std::atomic<bool> stop{false};
   auto running = std::async(std::launch::async, [&] { return agent.run(stop); });

@@ -67,16 +67,16 @@ class PersistenceTest : public ::testing::Test {
         const AgentRecord& a = state.agent(id);
         // Half near the robot, half in the site (often out of reach: rejected), so that the site's check sees changes.
         const bool in_site = random() % 2 == 0;
-        const double x = in_site ? 2.5 + offset(random) * 0.8 : a.x_m + offset(random);
-        const double y = in_site ? 2.1 + offset(random) * 0.15 : a.y_m + offset(random);
-        if (a.type.depositor.name != "layer")  // a cube (0.1 m) or cone robot: whole cubes at (x, y)
+        const double x = in_site ? 2.5 + offset(random) * 0.8 : a.position.x + offset(random);
+        const double y = in_site ? 2.1 + offset(random) * 0.15 : a.position.y + offset(random);
+        if (a.type.depositor.kind != DepositorKind::kLayer)  // a cube (0.1 m) or cone robot: whole cubes at (x, y)
           r.deposits.push_back({x, y, (random() % 5 == 0 ? 12 : 1) * 0.001});
         else if (const std::optional<CellIndex> c = state.terrain.geometry().cell_at({x, y}))
           r.depositions.push_back({c->row, c->col, (random() % 5 == 0 ? 40 : 1) * kLayer});
         if (random() % 3 == 0) {
           r.move = true;
-          r.target_x_m = a.x_m + 0.1;
-          r.target_y_m = a.y_m;
+          r.target_x_m = a.position.x + 0.1;
+          r.target_y_m = a.position.y;
         }
         r.refill = random() % 7 == 0;
         submissions.push_back({id, r});
@@ -150,8 +150,8 @@ robot_type { name: "piler" behaviour: "scripted"
   text.replace(text.find("robot_type: \"tester\" start { x_m: 2.55"), 20, "robot_type: \"cuber\"");
   text.replace(text.find("robot_type: \"tester\" start { x_m: 1.05 y_m: 3.05"), 20, "robot_type: \"piler\"");
   scenario_ = scenario::parse_scenario(text, "mixed.pbtxt");
-  ASSERT_EQ(initial().agent(2).type.depositor.name, "cube");
-  ASSERT_EQ(initial().agent(3).type.depositor.name, "cone");
+  ASSERT_EQ(initial().agent(2).type.depositor.kind, DepositorKind::kCube);
+  ASSERT_EQ(initial().agent(3).type.depositor.kind, DepositorKind::kCone);
   const WorldState live = record(40);
   // The log holds the deposits, and for accepted ones the cells the world raised.
   runlog::RunLogReader scan(log_path());

@@ -133,7 +133,7 @@ TEST(FinalPicture, PayloadRunsShowThePathEndsAgentsAndDepositors) {
   EXPECT_NE(o.points[0].colour, o.points[1].colour);
   EXPECT_EQ(o.points[2].colour, render::label_colour(1));
   EXPECT_EQ(o.points[3].colour, render::label_colour(2));
-  EXPECT_EQ(o.points[3].at.x, s.agent(2).x_m);
+  EXPECT_EQ(o.points[3].at.x, s.agent(2).position.x);
   ASSERT_EQ(o.circles.size(), 1u);
   EXPECT_EQ(o.circles[0].radius_m, 0.5);
   EXPECT_TRUE(has_legend(o, "agent 1", render::label_colour(1)));
@@ -277,10 +277,10 @@ TEST_F(OutputFiles, GoalVectorMapPictureOnlyWhenTheScenarioHasOne) {
   EXPECT_FALSE(fs::exists(dir_ / "goal_vector_map.png"));
 
   GoalVectorMapSpec spec;
-  spec.x0_m = 2.0;
-  spec.y0_m = 2.0;
-  spec.x1_m = 3.0;
-  spec.y1_m = 3.0;
+  spec.area.x0 = 2.0;
+  spec.area.y0 = 2.0;
+  spec.area.x1 = 3.0;
+  spec.area.y1 = 3.0;
   spec.strip_width_m = 0.5;
   spec.arrow_length_m = 0.5;
   info.goal_vector_map = spec;
@@ -314,10 +314,10 @@ WorldState flat_state(int rows, int cols, double cs, double xll, double yll, dou
 /// Makes `s` a level_site run on the site [x0, x1] x [y0, y1] [m].
 void level_site_on(WorldState& s, double x0, double y0, double x1, double y1) {
   s.completion = scenario::CompletionKind::kLevelSite;
-  s.site.x0_m = x0;
-  s.site.y0_m = y0;
-  s.site.x1_m = x1;
-  s.site.y1_m = y1;
+  s.site.area.x0 = x0;
+  s.site.area.y0 = y0;
+  s.site.area.x1 = x1;
+  s.site.area.y1 = y1;
 }
 
 /// Marks rows r0..r1 x cols c0..c1 (inclusive) as raised by agent `id`.
@@ -423,8 +423,8 @@ TEST(FinalPicture, AGoalWithATargetRadiusDrawsEachAdmittedAgentsTarget) {
     AgentRecord a;
     a.id = id;
     a.admitted = id != 2;  // slot 2 never joined: no ring for it
-    a.target_x_m = 15.0;
-    a.target_y_m = 10.0 + 2.0 * id;
+    a.target.x = 15.0;
+    a.target.y = 10.0 + 2.0 * id;
     s.agents.push_back(a);
   }
   const render::RenderOptions o = final_picture_options(s, info_for("targets", false), std::nullopt);

@@ -34,8 +34,8 @@ TEST_F(AdmissionTest, AdmitsAMatchingHelloAndPlacesTheAgentAtItsStart) {
   EXPECT_TRUE(a.alive);
   EXPECT_EQ(a.session, 77u);
   EXPECT_EQ(a.name, "tester-2");
-  EXPECT_EQ(a.x_m, 2.55);
-  EXPECT_EQ(a.y_m, 1.05);
+  EXPECT_EQ(a.position.x, 2.55);
+  EXPECT_EQ(a.position.y, 1.05);
   EXPECT_EQ(a.material_m3, 0.05);
   EXPECT_EQ(state_.live_ids(), std::vector<std::uint32_t>{2});
   // A repeated hello of the same session is answered yes again and changes nothing.
@@ -107,12 +107,12 @@ TEST_F(AdmissionTest, Refusals) {
 TEST_F(AdmissionTest, ReadmissionKeepsTheWorldsRecordOfTheRobot) {
   ASSERT_TRUE(admit(state_, hello_for(state_, 1, 5)));
   AgentRecord& a = state_.agent(1);
-  a.x_m += 1.0;
+  a.position.x += 1.0;
   a.material_m3 = 0.25;
   a.accepted = 12;
   a.consecutive_missed = 2;
   a.recent_misses = 0x5;
-  const double x = a.x_m;
+  const double x = a.position.x;
   drop_agent(state_, 1, "request writer lost liveliness");
   const protocol::AgentHello back = hello_for(state_, 1, 6);
   const AdmissionDecision d = decide_admission(state_, back, true);
@@ -122,7 +122,7 @@ TEST_F(AdmissionTest, ReadmissionKeepsTheWorldsRecordOfTheRobot) {
   EXPECT_FALSE(a.dropped);
   EXPECT_EQ(a.drop_reason, "");
   EXPECT_EQ(a.session, 6u);
-  EXPECT_EQ(a.x_m, x);
+  EXPECT_EQ(a.position.x, x);
   EXPECT_EQ(a.material_m3, 0.25);
   EXPECT_EQ(a.accepted, 12u);
   EXPECT_EQ(a.consecutive_missed, 0u);

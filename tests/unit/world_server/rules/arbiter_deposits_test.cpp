@@ -128,7 +128,7 @@ TEST_F(DepositsTest, CubeRulesRejectWithTheirReasons) {
 TEST_F(DepositsTest, ADepositUnderAnotherRobotIsRejected) {
   // Agent 2 stands at (2.45, 1.05) now; a cube 0.3 m west of it (1.1 m from agent 1: within reach).
   EXPECT_TRUE(validate_request(state_, 1, deposit(1, {{2.15, 1.05, 0.001}})).accepted);
-  state_.agent(2).x_m = 2.45;
+  state_.agent(2).position.x = 2.45;
   expect_rejected(deposit(1, {{2.15, 1.05, 0.001}}), "raises cell (29, 21), under agent 2");
 }
 

@@ -56,8 +56,8 @@ TEST_F(ArbiterTest, AcceptsAMoveWithDepositionsAndBooksThemExactly) {
   std::vector<CellIndex> changed;
   apply_request(state_, r, v, changed);
   const AgentRecord& me = state_.agent(1);
-  EXPECT_EQ(me.x_m, 1.25);
-  EXPECT_EQ(me.y_m, 1.05);
+  EXPECT_EQ(me.position.x, 1.25);
+  EXPECT_EQ(me.position.y, 1.05);
   EXPECT_EQ(me.z_m, 0.0);
   EXPECT_EQ(state_.terrain(a), kLayer);
   EXPECT_EQ(state_.terrain(b), 2 * kLayer);
@@ -124,10 +124,10 @@ TEST_F(ArbiterTest, MotionLongerThanTheStepIsRejectedTheStepItselfPasses) {
 }
 
 TEST_F(ArbiterTest, MotionOffTheGridIsRejected) {
-  state_.agent(1).x_m = 0.05;
-  state_.agent(1).y_m = 2.05;
+  state_.agent(1).position.x = 0.05;
+  state_.agent(1).position.y = 2.05;
   expect_rejected(move_to(state_, 1, -0.1, 2.05), "off the grid");
-  state_.agent(1).x_m = 3.95;
+  state_.agent(1).position.x = 3.95;
   expect_rejected(move_to(state_, 1, 4.05, 2.05), "off the grid");
   EXPECT_TRUE(check(move_to(state_, 1, 3.99, 2.05)).accepted);
 }
@@ -136,8 +136,8 @@ TEST_F(ArbiterTest, MotionOntoANonOccupiableCellIsRejected) {
   // A 1 m cliff: every cell with x >= 3.0 m is at 1 m.
   for (int r = 0; r < 40; ++r)
     for (int c = 30; c < 40; ++c) state_.terrain(r, c) = 1.0;
-  state_.agent(1).x_m = 2.35;
-  state_.agent(1).y_m = 2.05;
+  state_.agent(1).position.x = 2.35;
+  state_.agent(1).position.y = 2.05;
   // (2.55, 2.05): its ball (radius 0.5 m) reaches x = 3.05, a cell on the cliff 0.5 m from ground cells.
   expect_rejected(move_to(state_, 1, 2.55, 2.05), "not occupiable");
   // (2.45, 2.05): the ball stops at x = 2.95, all ground.
@@ -155,10 +155,10 @@ TEST_F(ArbiterTest, MotionAcrossANonOccupiableCellIsRejected) {
   ASSERT_TRUE(cell_occupiable(state_.terrain, {20, 19}, body));
   ASSERT_FALSE(cell_occupiable(state_.terrain, {20, 20}, body));
   ASSERT_TRUE(cell_occupiable(state_.terrain, {20, 21}, body));
-  state_.agent(1).x_m = 1.95;  // column 19
-  state_.agent(1).y_m = 1.95;  // row 20
-  state_.agent(2).x_m = 3.55;  // out of the way
-  state_.agent(2).y_m = 0.35;
+  state_.agent(1).position.x = 1.95;  // column 19
+  state_.agent(1).position.y = 1.95;  // row 20
+  state_.agent(2).position.x = 3.55;  // out of the way
+  state_.agent(2).position.y = 0.35;
   // 0.2 m east, from column 19 to column 21, across column 20: its end cell is occupiable, its way is not.
   expect_rejected(move_to(state_, 1, 2.15, 1.95), "motion passes through cell (20, 20), not occupiable");
   // Onto the wall, named as the target.
@@ -166,7 +166,7 @@ TEST_F(ArbiterTest, MotionAcrossANonOccupiableCellIsRejected) {
   // Along it (north, in column 19), fine.
   EXPECT_TRUE(check(move_to(state_, 1, 1.95, 2.15)).accepted);
   // A robot standing on the wall may leave it: its own cell is not part of the way.
-  state_.agent(1).x_m = 2.05;
+  state_.agent(1).position.x = 2.05;
   EXPECT_TRUE(check(move_to(state_, 1, 2.15, 1.95)).accepted);
   EXPECT_TRUE(check(move_to(state_, 1, 1.95, 1.95)).accepted);
 }
@@ -178,8 +178,8 @@ TEST_F(ArbiterTest, ALongStepCannotJumpAWall) {
   // A body the scenario validator would refuse (max_step_m 3 > delta/2), put into the state by hand: the world
   // still judges its way cell by cell.
   state_.agent(1).type.body.max_step_m = 3.0;
-  state_.agent(1).x_m = 0.55;
-  state_.agent(1).y_m = 1.95;
+  state_.agent(1).position.x = 0.55;
+  state_.agent(1).position.y = 1.95;
   ASSERT_TRUE(cell_occupiable(state_.terrain, *state_.terrain.cell_at({3.55, 1.95}), {0.3, 1.0, 0.05}));
   expect_rejected(move_to(state_, 1, 3.55, 1.95), "motion passes through cell (20, 15), not occupiable");
   EXPECT_FALSE(body_problem(state_.agent(1).type.body).empty());
@@ -187,7 +187,7 @@ TEST_F(ArbiterTest, ALongStepCannotJumpAWall) {
 
 TEST_F(ArbiterTest, AMotionMayNotEndInsideAnotherRobotsBody) {
   // Agent 1 at (1.05, 1.05), agent 2 at (2.55, 1.05): bodies of 1 m need 1 m between centres.
-  state_.agent(2).x_m = 2.15;  // 1.1 m east of agent 1
+  state_.agent(2).position.x = 2.15;  // 1.1 m east of agent 1
   // 0.15 m east ends 0.95 m from agent 2: overlap.
   expect_rejected(move_to(state_, 1, 1.20, 1.05), "whose body it would overlap");
   const Verdict v = check(move_to(state_, 1, 1.20, 1.05));
@@ -201,7 +201,7 @@ TEST_F(ArbiterTest, AMotionMayNotEndInsideAnotherRobotsBody) {
 }
 
 TEST_F(ArbiterTest, OverlappingBodiesMayMoveApartButNotCloser) {
-  state_.agent(2).x_m = 1.65;  // 0.6 m east of agent 1: already overlapping (e.g. jittered starts)
+  state_.agent(2).position.x = 1.65;  // 0.6 m east of agent 1: already overlapping (e.g. jittered starts)
   EXPECT_TRUE(check(move_to(state_, 1, 0.90, 1.05)).accepted);   // away: 0.75 m
   EXPECT_TRUE(check(move_to(state_, 1, 1.05, 1.10)).accepted);   // sideways, a little farther: 0.602 m
   expect_rejected(move_to(state_, 1, 1.15, 1.05), "agent 2");     // closer: 0.5 m
@@ -259,7 +259,7 @@ TEST_F(ArbiterTest, DepositionRules) {
   protocol::ActionRequest moved = move_to(state_, 1, 1.05, 1.25);
   moved.depositions = {dep(beyond.row, beyond.col, kLayer)};
   EXPECT_TRUE(check(moved).accepted);
-  EXPECT_EQ(me.y_m, 1.05);
+  EXPECT_EQ(me.position.y, 1.05);
 }
 
 TEST_F(ArbiterTest, DepositionUnderARobotIsRejected) {
@@ -315,8 +315,8 @@ TEST_F(ArbiterTest, RefillOnlyAtTheBase) {
   r = move_to(state_, 1, 0.95, 0.95);  // 0.566 m: still outside the 0.5 m radius
   r.refill = true;
   expect_rejected(r, "from the base station");
-  state_.agent(1).x_m = 0.75;
-  state_.agent(1).y_m = 0.75;
+  state_.agent(1).position.x = 0.75;
+  state_.agent(1).position.y = 0.75;
   state_.agent(1).material_m3 = 0.01;
   r = move_to(state_, 1, 0.85, 0.85);  // 0.424 m from the centre
   r.refill = true;
@@ -336,7 +336,7 @@ TEST_F(ArbiterTest, AllOrNothing) {
   r.depositions = {dep(good.row, good.col, kLayer), dep(bad.row, bad.col, kLayer)};
   EXPECT_FALSE(check(r).accepted);
   EXPECT_EQ(state_.terrain.heights().cwiseAbs().sum(), 0.0);
-  EXPECT_EQ(state_.agent(1).x_m, 1.05);
+  EXPECT_EQ(state_.agent(1).position.x, 1.05);
 }
 
 }  // namespace

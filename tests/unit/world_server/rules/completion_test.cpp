@@ -89,20 +89,20 @@ long long largest_component_brute_force(const CellMask& m) {
 scenario::PayloadPath payload(double kappa, double delta, double eps, Position from, Position to) {
   scenario::PayloadPath p;
   p.navigability = {kappa, delta, eps};
-  p.from_x_m = from.x;
-  p.from_y_m = from.y;
-  p.to_x_m = to.x;
-  p.to_y_m = to.y;
+  p.from.x = from.x;
+  p.from.y = from.y;
+  p.to.x = to.x;
+  p.to.y = to.y;
   return p;
 }
 
 scenario::Site site(double x0, double y0, double x1, double y1, double kappa = 0.1, double delta = 0.3,
                     double eps = 0.05) {
   scenario::Site s;
-  s.x0_m = x0;
-  s.y0_m = y0;
-  s.x1_m = x1;
-  s.y1_m = y1;
+  s.area.x0 = x0;
+  s.area.y0 = y0;
+  s.area.x1 = x1;
+  s.area.y1 = y1;
   s.navigability = {kappa, delta, eps};
   return s;
 }
@@ -120,8 +120,8 @@ WorldState platform_state(double target_radius_m) {
     AgentRecord a;
     a.id = id;
     a.admitted = a.alive = true;
-    a.target_x_m = 3.05;
-    a.target_y_m = id == 1 ? 1.05 : 3.05;
+    a.target.x = 3.05;
+    a.target.y = id == 1 ? 1.05 : 3.05;
     state.agents.push_back(a);
   }
   return state;
@@ -132,8 +132,8 @@ TEST(AgentsAtGoal, WithATargetRadiusEachAgentMustStandAtItsOwnTarget) {
   AgentRecord& a = state.agents[0];
   AgentRecord& b = state.agents[1];
   // Both on the platform's edge, half the body over the ramp: inside the box and high enough, but 1 m short.
-  a.x_m = b.x_m = 2.05;
-  a.y_m = 1.05, b.y_m = 3.05;
+  a.position.x = b.position.x = 2.05;
+  a.position.y = 1.05, b.position.y = 3.05;
   EXPECT_FALSE(at_goal(state, a));
   EXPECT_FALSE(is_completed(state));
   EXPECT_DOUBLE_EQ(progress(state), 0.0);
@@ -142,16 +142,16 @@ TEST(AgentsAtGoal, WithATargetRadiusEachAgentMustStandAtItsOwnTarget) {
   EXPECT_TRUE(is_completed(state));
   state.goal.target_radius_m = 0.25;
   // Agent 1 at 0.25 m from its target (a tie, inclusive); agent 2 on the other's target, 2 m from its own.
-  a.x_m = 2.80;
-  b.x_m = 3.05, b.y_m = 1.05;
+  a.position.x = 2.80;
+  b.position.x = 3.05, b.position.y = 1.05;
   EXPECT_TRUE(at_goal(state, a));
   EXPECT_FALSE(at_goal(state, b));
   EXPECT_DOUBLE_EQ(progress(state), 0.5);
   EXPECT_FALSE(is_completed(state));
-  b.y_m = 2.85;  // 0.2 m from its own
+  b.position.y = 2.85;  // 0.2 m from its own
   EXPECT_TRUE(is_completed(state));
   // On its target but below min_height_m (the cell under it sunk to 0.5 m): not at the goal.
-  a.x_m = 3.05;
+  a.position.x = 3.05;
   EXPECT_TRUE(at_goal(state, a));
   state.terrain(29, 30) = 0.5;  // (3.05, 1.05) m: row 39 - 10, col 30
   EXPECT_FALSE(at_goal(state, a));

@@ -20,10 +20,10 @@ TEST(WorldStateAt, PlacesEachSlotAtTheStartGivenAndChecksNothingYet) {
       scenario::parse_scenario(testing::small_scenario_text_completing(testing::payload_block()), "small.pbtxt");
   const WorldState w = world_state_at(s, flat_terrain(), {{1.25, 2.5}, {3.0, 0.75}});
   ASSERT_EQ(w.agents.size(), 2u);
-  EXPECT_EQ(w.agent(1).start_x_m, 1.25);
-  EXPECT_EQ(w.agent(1).y_m, 2.5);
-  EXPECT_EQ(w.agent(2).x_m, 3.0);
-  EXPECT_EQ(w.agent(2).start_y_m, 0.75);
+  EXPECT_EQ(w.agent(1).start.x, 1.25);
+  EXPECT_EQ(w.agent(1).position.y, 2.5);
+  EXPECT_EQ(w.agent(2).position.x, 3.0);
+  EXPECT_EQ(w.agent(2).start.y, 0.75);
   EXPECT_FALSE(w.agent(1).admitted);
   EXPECT_EQ(w.check.evaluations, 0u);  // the check is set up above this layer
   EXPECT_THROW(world_state_at(s, flat_terrain(), {}), InvalidArgument);
@@ -39,8 +39,8 @@ TEST(MakeWorldState, JittersTheStartsAndEvaluatesTheCheckOnce) {
   EXPECT_TRUE(w.check.met);  // a flat terrain is navigable from the start
   for (std::uint32_t id = 1; id <= 2; ++id) {
     const Position p = jittered_start(w.terrain, s.slots[id - 1], s.robot_for(id).body, 0.3, 5);
-    EXPECT_EQ(w.agent(id).start_x_m, p.x);
-    EXPECT_EQ(w.agent(id).start_y_m, p.y);
+    EXPECT_EQ(w.agent(id).start.x, p.x);
+    EXPECT_EQ(w.agent(id).start.y, p.y);
   }
   EXPECT_THROW(make_world_state(s, flat_terrain(), 0), InvalidArgument);
   EXPECT_THROW(make_world_state(s, flat_terrain(), 4), InvalidArgument);

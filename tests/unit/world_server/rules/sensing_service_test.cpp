@@ -32,12 +32,12 @@ WorldState sensing_state() {
   for (long long i = 0; i < h.size(); ++i) h.data()[i] = std::uniform_real_distribution<double>(0.0, 0.01)(rng);
   WorldState w = make_world_state(small_scenario(), h, 3);
   for (std::uint32_t id = 1; id <= 3; ++id) admit(w, testing::hello_for(w, id, 50 + id));
-  w.agent(1).x_m = 6.65;  // sensing 1 m: the square [5.65, 7.65] x [-0.65, 1.35]
-  w.agent(1).y_m = 0.35;
-  w.agent(2).x_m = 6.65;  // 1.5 m north of agent 1: exactly its proximity range
-  w.agent(2).y_m = 1.85;
-  w.agent(3).x_m = 5.0;  // 1.65 m west of agent 1
-  w.agent(3).y_m = 0.35;
+  w.agent(1).position.x = 6.65;  // sensing 1 m: the square [5.65, 7.65] x [-0.65, 1.35]
+  w.agent(1).position.y = 0.35;
+  w.agent(2).position.x = 6.65;  // 1.5 m north of agent 1: exactly its proximity range
+  w.agent(2).position.y = 1.85;
+  w.agent(3).position.x = 5.0;  // 1.65 m west of agent 1
+  w.agent(3).position.y = 0.35;
   return w;
 }
 
@@ -100,7 +100,7 @@ TEST(SensingService, LaterFramesCarryOnlyChangedOrNewTiles) {
   EXPECT_EQ(tile_ids(first_of_3), (std::set<std::pair<int, int>>{{2, 2}, {2, 3}, {3, 2}, {3, 3}}));
 
   // Moving north: only the tiles it has not seen.
-  w.agent(1).y_m = 1.05;  // square y [0.05, 2.05]: tile rows 1 [1.8, 3.4], 2 and 3
+  w.agent(1).position.y = 1.05;  // square y [0.05, 2.05]: tile rows 1 [1.8, 3.4], 2 and 3
   EXPECT_EQ(tile_ids(sensing.frame_for(w, 1)), (std::set<std::pair<int, int>>{{1, 3}, {1, 4}}));
   sensing.forget(1);
   EXPECT_EQ(sensing.frame_for(w, 1).tiles.size(), 6u);
@@ -112,12 +112,12 @@ TEST(SensingService, NeighboursWithinProximityRangeOnly) {
   protocol::SensorFrame f = sensing.frame_for(w, 1);
   ASSERT_EQ(f.neighbours.size(), 1u);  // agent 2 at exactly 1.5 m; agent 3 at 1.65 m is out
   EXPECT_EQ(f.neighbours[0].agent_id, 2u);
-  EXPECT_EQ(f.neighbours[0].x_m, 6.65);
-  EXPECT_EQ(f.neighbours[0].y_m, 1.85);
+  EXPECT_EQ(f.neighbours[0].position.x, 6.65);
+  EXPECT_EQ(f.neighbours[0].position.y, 1.85);
   EXPECT_EQ(f.neighbours[0].z_m, w.agent(2).z_m);
   f = sensing.frame_for(w, 3);
   EXPECT_TRUE(f.neighbours.empty());
-  w.agent(3).x_m = 5.2;  // now 1.45 m from agent 1
+  w.agent(3).position.x = 5.2;  // now 1.45 m from agent 1
   f = sensing.frame_for(w, 1);
   ASSERT_EQ(f.neighbours.size(), 2u);
   EXPECT_EQ(f.neighbours[0].agent_id, 2u);
@@ -142,7 +142,7 @@ WorldState scanning_state(const SensorSpec& sensor) {
 // A laser robot gets its scan instead of tiles, every scan_every_steps steps, the same points for the same seed,
 // agent and step; the others keep their tiles.
 TEST(SensingService, ALaserRobotGetsPointsInsteadOfTiles) {
-  SensorSpec laser = sensor_defaults("laser");
+  SensorSpec laser = sensor_defaults(SensorKind::kLaser);
   laser.scan_every_steps = 2;
   WorldState w = scanning_state(laser);
   SensingService sensing(w);
@@ -173,7 +173,7 @@ TEST(SensingService, ALaserRobotGetsPointsInsteadOfTiles) {
 
 // The camera looks along the heading: towards the target at first, then along the last motion of non-zero length.
 TEST(SensingService, TheCameraLooksAlongTheRobotsHeading) {
-  WorldState w = scanning_state(sensor_defaults("rgbd"));
+  WorldState w = scanning_state(sensor_defaults(SensorKind::kRgbd));
   const AgentRecord& me = w.agent(1);
   EXPECT_NEAR(me.heading_rad, std::atan2(2.05 - 1.05, 3.05 - 1.05), 1e-12);  // start (1.05, 1.05), target (3.05, 2.05)
   SensingService sensing(w);

@@ -18,8 +18,8 @@ namespace {
 scenario::AgentSlot slot(std::uint32_t id, double x, double y) {
   scenario::AgentSlot s;
   s.id = id;
-  s.start_x_m = x;
-  s.start_y_m = y;
+  s.start.x = x;
+  s.start.y = y;
   return s;
 }
 
@@ -113,22 +113,22 @@ TEST(StartJitter, TheWorldStateAndTheAdmissionUseTheJitteredStart) {
     const scenario::AgentSlot& sl = plain.slots[id - 1];
     const AgentRecord& a = s.agent(id);
     const Position expected = jittered_start(s.terrain, sl, a.type.body, 0.4, 17);
-    EXPECT_EQ(a.start_x_m, expected.x);
-    EXPECT_EQ(a.start_y_m, expected.y);
-    EXPECT_EQ(a.x_m, expected.x);
-    EXPECT_TRUE(a.start_x_m != sl.start_x_m || a.start_y_m != sl.start_y_m) << id;
-    EXPECT_LE(std::hypot(a.start_x_m - sl.start_x_m, a.start_y_m - sl.start_y_m), 0.4 + 1e-12);
+    EXPECT_EQ(a.start.x, expected.x);
+    EXPECT_EQ(a.start.y, expected.y);
+    EXPECT_EQ(a.position.x, expected.x);
+    EXPECT_TRUE(a.start.x != sl.start.x || a.start.y != sl.start.y) << id;
+    EXPECT_LE(std::hypot(a.start.x - sl.start.x, a.start.y - sl.start.y), 0.4 + 1e-12);
   }
   // Another seed, other starts; the admission reports the state's start.
   jittered.seed = 18;
   WorldState t = make_world_state(jittered, testing::flat_terrain(), 3);
-  EXPECT_NE(t.agent(1).start_x_m, s.agent(1).start_x_m);
+  EXPECT_NE(t.agent(1).start.x, s.agent(1).start.x);
   const protocol::AgentHello hello = testing::hello_for(t, 2, 77);
   admit(t, hello);
   const protocol::Admission m = admission_message(t, hello, decide_admission(t, hello, false), "run");
-  EXPECT_EQ(m.assignment.start.x, t.agent(2).start_x_m);
-  EXPECT_EQ(m.assignment.start.y, t.agent(2).start_y_m);
-  EXPECT_EQ(t.agent(2).x_m, t.agent(2).start_x_m);
+  EXPECT_EQ(m.assignment.start.x, t.agent(2).start.x);
+  EXPECT_EQ(m.assignment.start.y, t.agent(2).start.y);
+  EXPECT_EQ(t.agent(2).position.x, t.agent(2).start.x);
 }
 
 }  // namespace

@@ -61,8 +61,8 @@ TEST(PayloadCompletion, TheCheckRunsOnItsScheduleOnlyAfterChanges) {
   EXPECT_FALSE(is_completed(s));
   EXPECT_EQ(progress(s), 0.0);
   EXPECT_EQ(s.check.evaluations, 1u);
-  s.agent(1).x_m = 2.15;  // 0.8 m west of the hole: within reach, not over it
-  s.agent(1).y_m = 3.05;
+  s.agent(1).position.x = 2.15;  // 0.8 m west of the hole: within reach, not over it
+  s.agent(1).position.y = 3.05;
 
   // Step 0 fills the hole; no check at steps 0 and 1, the check at step 2 finds the path.
   StepOutcome o =
@@ -96,8 +96,8 @@ TEST(PayloadCompletion, APathOverARaisedTargetIsNoCompletion) {
   EXPECT_EQ(to, (CellIndex{9, 30}));
   EXPECT_EQ(s.check.target_initial_m, 0.0);
   EXPECT_EQ(s.check.max_target_rise_m, kLayer);  // one cube layer of the scenario's robot type
-  s.agent(1).x_m = 2.25;  // 0.8 m west of `to`
-  s.agent(1).y_m = 3.05;
+  s.agent(1).position.x = 2.25;  // 0.8 m west of `to`
+  s.agent(1).position.y = 3.05;
   // Two layers on the target's cell (0.025 m, less than eps: the payload still drives over it): a path, no completion.
   StepOutcome o = apply_step(s, std::vector<protocol::ActionRequest>{deposit(s, 1, to, 2 * kLayer), request_for(s, 2)});
   ASSERT_EQ(s.agent(1).last_result, protocol::ActionResult::kAccepted) << s.agent(1).last_reason;
@@ -114,8 +114,8 @@ TEST(PayloadCompletion, APathOverARaisedTargetIsNoCompletion) {
   EXPECT_EQ(payload_completion_detail(s, false), "no payload path from base to target");
   // One layer is within the allowance: the same with a single layer completes.
   WorldState t = admitted_state(scenario_with(payload_block(3)), flat_terrain(), 2);
-  t.agent(1).x_m = 2.25;
-  t.agent(1).y_m = 3.05;
+  t.agent(1).position.x = 2.25;
+  t.agent(1).position.y = 3.05;
   o = apply_step(t, std::vector<protocol::ActionRequest>{deposit(t, 1, to, kLayer), request_for(t, 2)});
   idle_steps(t, 2);
   EXPECT_EQ(t.check.evaluations, 2u);
@@ -144,16 +144,16 @@ TEST(SiteCompletion, LevelFractionIsProgressAndCompletesWhenLevel) {
   EXPECT_FALSE(is_completed(s));
 
   // A deposition outside the site (cell (30, 18), 0.81 m from the agent) is no change for its check.
-  s.agent(1).x_m = 1.05;
-  s.agent(1).y_m = 1.05;
+  s.agent(1).position.x = 1.05;
+  s.agent(1).position.y = 1.05;
   apply_step(s, std::vector<protocol::ActionRequest>{deposit(s, 1, {30, 18}, kLayer)});
   StepOutcome o = apply_step(s, std::vector<protocol::ActionRequest>{request_for(s, 1)});
   EXPECT_FALSE(o.completion_checked);
   EXPECT_EQ(s.check.evaluations, 1u);
 
   // Filling the hole at step 2 (not a check step), the check at step 3 sees a level site.
-  s.agent(1).x_m = 2.55;
-  s.agent(1).y_m = 1.65;  // 0.9 m south of the hole
+  s.agent(1).position.x = 2.55;
+  s.agent(1).position.y = 1.65;  // 0.9 m south of the hole
   o = apply_step(s, std::vector<protocol::ActionRequest>{deposit(s, 1, hole, 8 * kLayer)});
   ASSERT_EQ(s.agent(1).last_result, protocol::ActionResult::kAccepted) << s.agent(1).last_reason;
   EXPECT_FALSE(o.completion_checked);

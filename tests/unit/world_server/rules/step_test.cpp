@@ -48,7 +48,7 @@ TEST(ApplyStep, IdOrderDecidesConflictsWhateverTheArrivalOrder) {
   const StepOutcome oa = apply_step(a, std::vector<protocol::ActionRequest>{one, two});
   const StepOutcome ob = apply_step(b, std::vector<protocol::ActionRequest>{two, one});
   for (const WorldState* w : {&a, &b}) {
-    EXPECT_EQ(w->agent(1).x_m, 1.25);
+    EXPECT_EQ(w->agent(1).position.x, 1.25);
     EXPECT_EQ(w->agent(2).last_result, protocol::ActionResult::kRejected);
     EXPECT_NE(w->agent(2).last_reason.find("under agent 1"), std::string::npos) << w->agent(2).last_reason;
     EXPECT_EQ(w->terrain.heights().cwiseAbs().maxCoeff(), 0.0);
@@ -68,8 +68,8 @@ TEST(ApplyStep, IdOrderDecidesConflictsWhateverTheArrivalOrder) {
 TEST(ApplyStep, ADepositionOfALowerIdCanBlockAMotionOfAHigherId) {
   const scenario::Scenario s = small_scenario();
   WorldState base = admitted_state(s, flat_terrain(), 2);
-  base.agent(2).x_m = 2.45;
-  base.agent(2).y_m = 1.15;
+  base.agent(2).position.x = 2.45;
+  base.agent(2).position.y = 1.15;
   // A 1 m column at (2.05, 1.55): 1.118 m from agent 1, 0.566 m from agent 2, 0.424 m from agent 2's target.
   const protocol::ActionRequest column = with_deposition(request_for(base, 1), 2.05, 1.55, 80 * kLayer);
   const protocol::ActionRequest step_in = move_to(base, 2, 2.35, 1.25);
@@ -81,7 +81,7 @@ TEST(ApplyStep, ADepositionOfALowerIdCanBlockAMotionOfAHigherId) {
     EXPECT_EQ(w.terrain(cell_of(2.05, 1.55)), 80 * kLayer);
     EXPECT_EQ(w.agent(2).last_result, protocol::ActionResult::kRejected);
     EXPECT_NE(w.agent(2).last_reason.find("not occupiable"), std::string::npos) << w.agent(2).last_reason;
-    EXPECT_EQ(w.agent(2).x_m, 2.45);
+    EXPECT_EQ(w.agent(2).position.x, 2.45);
   }
 }
 
@@ -95,7 +95,7 @@ TEST(ApplyStep, ArrivalOrderAcrossAgentsNeverChangesTheResult) {
     for (std::uint32_t id = 1; id <= 3; ++id) {
       const AgentRecord& a = in_order.agent(id);
       const double angle = std::uniform_real_distribution<double>(0.0, 6.283185307179586)(rng);
-      protocol::ActionRequest r = move_to(in_order, id, a.x_m + 0.19 * std::cos(angle), a.y_m + 0.19 * std::sin(angle));
+      protocol::ActionRequest r = move_to(in_order, id, a.position.x + 0.19 * std::cos(angle), a.position.y + 0.19 * std::sin(angle));
       // Two depositions 0.7-1.1 m away, some of which collide with other robots or cells of other agents.
       for (int k = 0; k < 2; ++k) {
         const double d = std::uniform_real_distribution<double>(0.7, 1.1)(rng);
@@ -115,7 +115,7 @@ TEST(ApplyStep, ArrivalOrderAcrossAgentsNeverChangesTheResult) {
   EXPECT_GT(in_order.deposited_volume_m3, 0.0);
   EXPECT_EQ(in_order.deposited_volume_m3, shuffled.deposited_volume_m3);
   for (std::uint32_t id = 1; id <= 3; ++id) {
-    EXPECT_EQ(in_order.agent(id).x_m, shuffled.agent(id).x_m);
+    EXPECT_EQ(in_order.agent(id).position.x, shuffled.agent(id).position.x);
     EXPECT_EQ(in_order.agent(id).rejected, shuffled.agent(id).rejected);
   }
 }
@@ -123,20 +123,20 @@ TEST(ApplyStep, ArrivalOrderAcrossAgentsNeverChangesTheResult) {
 TEST(ApplyStep, TheLowerIdTakesASpotTheHigherIdOnlyOneThatWasLeft) {
   const scenario::Scenario s = small_scenario();
   WorldState base = admitted_state(s, flat_terrain(), 2);
-  base.agent(2).x_m = 2.05;  // 1.0 m east of agent 1: touching
+  base.agent(2).position.x = 2.05;  // 1.0 m east of agent 1: touching
   // Agent 2 moves east and agent 1 follows into the space: agent 1 is judged first, agent 2 has not moved yet.
   const protocol::ActionRequest one = move_to(base, 1, 1.2, 1.05), two = move_to(base, 2, 2.2, 1.05);
   WorldState w = base;
   apply_step(w, std::vector<protocol::ActionRequest>{two, one});
   EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kRejected);
-  EXPECT_EQ(w.agent(1).x_m, 1.05);
-  EXPECT_EQ(w.agent(2).x_m, 2.2);
+  EXPECT_EQ(w.agent(1).position.x, 1.05);
+  EXPECT_EQ(w.agent(2).position.x, 2.2);
   EXPECT_EQ(w.rejected_motions, 1u);
   // The other way round: agent 1 moves west and agent 2 follows in the same step.
   w = base;
   apply_step(w, std::vector<protocol::ActionRequest>{move_to(base, 2, 1.9, 1.05), move_to(base, 1, 0.9, 1.05)});
-  EXPECT_EQ(w.agent(1).x_m, 0.9);
-  EXPECT_EQ(w.agent(2).x_m, 1.9);
+  EXPECT_EQ(w.agent(1).position.x, 0.9);
+  EXPECT_EQ(w.agent(2).position.x, 1.9);
   EXPECT_EQ(w.rejected_motions, 0u);
 }
 
@@ -145,7 +145,7 @@ TEST(ApplyStep, RandomMotionsNeverMakeBodiesOverlap) {
   // after a step, and a pair that overlapped at the start (jittered starts) only moves apart.
   const scenario::Scenario s = small_scenario();
   WorldState w = admitted_state(s, flat_terrain(), 3);
-  w.agent(2).x_m = 1.6;  // 0.55 m from agent 1: the only overlap at the start
+  w.agent(2).position.x = 1.6;  // 0.55 m from agent 1: the only overlap at the start
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> angle(0.0, 6.283185307179586);
   std::uint64_t rejected = 0;
@@ -154,15 +154,15 @@ TEST(ApplyStep, RandomMotionsNeverMakeBodiesOverlap) {
     std::vector<protocol::ActionRequest> requests;
     for (std::uint32_t id = 1; id <= 3; ++id) {
       const double t = angle(rng);
-      const double x = std::clamp(w.agent(id).x_m + 0.19 * std::cos(t), 0.01, 3.99);
-      const double y = std::clamp(w.agent(id).y_m + 0.19 * std::sin(t), 0.01, 3.99);
+      const double x = std::clamp(w.agent(id).position.x + 0.19 * std::cos(t), 0.01, 3.99);
+      const double y = std::clamp(w.agent(id).position.y + 0.19 * std::sin(t), 0.01, 3.99);
       requests.push_back(move_to(w, id, x, y));
     }
     apply_step(w, requests);
     for (std::uint32_t a = 1; a <= 3; ++a)
       for (std::uint32_t b = a + 1; b <= 3; ++b) {
         const auto gap = [&](const WorldState& st) {
-          return std::hypot(st.agent(a).x_m - st.agent(b).x_m, st.agent(a).y_m - st.agent(b).y_m);
+          return std::hypot(st.agent(a).position.x - st.agent(b).position.x, st.agent(a).position.y - st.agent(b).position.y);
         };
         if (gap(w) < 1.0 - 1e-9) {
           ASSERT_LT(gap(before), 1.0 - 1e-9) << "agents " << a << ", " << b << " came to overlap at step " << step;
@@ -186,7 +186,7 @@ TEST(ApplyStep, CountsOverlappingPairSteps) {
   };
   stand_still();
   EXPECT_EQ(w.overlap_pair_steps, 0u);
-  w.agent(2).x_m = 1.55;  // overlaps agent 1 from now on
+  w.agent(2).position.x = 1.55;  // overlaps agent 1 from now on
   for (int i = 0; i < 3; ++i) stand_still();
   EXPECT_EQ(w.overlap_pair_steps, 3u);
   EXPECT_EQ(w.close_passes, 0u);  // the overlap was there before each step: no new pass
@@ -213,7 +213,7 @@ TEST(ApplyStep, DuplicatesPastAndFutureRequests) {
   const StepOutcome o =
       apply_step(w, std::vector<Submission>{{1, past}, {1, first}, {2, future_of_2}, {1, second}, {1, future}});
 
-  EXPECT_EQ(w.agent(1).x_m, 1.25);  // the first stands
+  EXPECT_EQ(w.agent(1).position.x, 1.25);  // the first stands
   EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kAccepted);
   EXPECT_EQ(w.agent(1).accepted, 2u);
   EXPECT_EQ(w.agent(1).rejected, 2u);  // the duplicate and the future one
@@ -241,7 +241,7 @@ TEST(ApplyStep, AForgedRequestOnAnAgentsPartitionDoesNotTakeItsSlot) {
   const protocol::ActionRequest real = move_to(w, 1, 1.25, 1.05);
   const StepOutcome o =
       apply_step(w, std::vector<Submission>{{1, forged}, {1, claims_2}, {1, real}, {2, request_for(w, 2)}});
-  EXPECT_EQ(w.agent(1).x_m, 1.25);
+  EXPECT_EQ(w.agent(1).position.x, 1.25);
   EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kAccepted);
   EXPECT_EQ(w.agent(1).missed, 0u);
   // Rejections are charged to the sender, never to the victim: the request with agent 2's admitted identity to
@@ -268,7 +268,7 @@ TEST(ApplyStep, ARepeatedIdenticalRequestIsIgnored) {
   const StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{r, r, other});
   EXPECT_EQ(w.agent(1).accepted, 1u);
   EXPECT_EQ(w.agent(1).rejected, 1u);  // only the different one
-  EXPECT_EQ(w.agent(1).x_m, 1.25);
+  EXPECT_EQ(w.agent(1).position.x, 1.25);
   EXPECT_EQ(o.rejected, 1u);
   ASSERT_EQ(o.notes.size(), 1u);
   EXPECT_NE(o.notes[0].find("repeated; the first stands"), std::string::npos) << o.notes[0];
@@ -282,7 +282,7 @@ TEST(ApplyStep, ARejectedRequestChangesNothingAndIsReportedInTheNextFrame) {
   r = with_deposition(r, 1.25, 2.55, kLayer);  // 1.5 m away: out of reach, so nothing of it happens
   const StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{r});
   EXPECT_EQ(runlog::terrain_sha256(w.terrain), before);
-  EXPECT_EQ(w.agent(1).x_m, 1.05);
+  EXPECT_EQ(w.agent(1).position.x, 1.05);
   EXPECT_EQ(w.agent(1).material_m3, 0.05);
   EXPECT_EQ(w.agent(1).last_result, protocol::ActionResult::kRejected);
   EXPECT_NE(w.agent(1).last_reason.find("beyond reach_m"), std::string::npos);
@@ -369,10 +369,10 @@ TEST(ApplyStep, ReachingTheGoalCompletesTheRun) {
   const scenario::Scenario s = scenario::parse_scenario(
       testing::small_scenario_text_completing("goal { x0_m: 2.0 y0_m: 1.9 x1_m: 3.9 y1_m: 3.9 }"), "small.pbtxt");
   WorldState w = admitted_state(s, flat_terrain(), 2);
-  w.agent(1).x_m = 1.85;
-  w.agent(1).y_m = 2.05;
-  w.agent(2).x_m = 3.05;
-  w.agent(2).y_m = 1.75;
+  w.agent(1).position.x = 1.85;
+  w.agent(1).position.y = 2.05;
+  w.agent(2).position.x = 3.05;
+  w.agent(2).position.y = 1.75;
   EXPECT_FALSE(is_completed(w));
   StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{move_to(w, 1, 2.05, 2.05), request_for(w, 2)});
   EXPECT_EQ(count(o, protocol::EventKind::kAtGoal), 1);

@@ -189,9 +189,9 @@ TEST_F(ScenarioCheckTest, CommandLineOverridesAreAppliedAsTheRunWouldApplyThem) 
   const WorldState expected = make_world_state(seeded, scenario::build_terrain(seeded), 2);
   for (int i = 0; i < 2; ++i) {
     const Struct& world_start = at(slots[i].struct_value(), "world_start").struct_value();
-    EXPECT_EQ(at(world_start, "x_m").number_value(), expected.agents[i].start_x_m);
-    EXPECT_EQ(at(world_start, "y_m").number_value(), expected.agents[i].start_y_m);
-    EXPECT_NE(expected.agents[i].start_x_m, seeded.slots[i].start_x_m);  // the jitter moved it
+    EXPECT_EQ(at(world_start, "x_m").number_value(), expected.agents[i].start.x);
+    EXPECT_EQ(at(world_start, "y_m").number_value(), expected.agents[i].start.y);
+    EXPECT_NE(expected.agents[i].start.x, seeded.slots[i].start.x);  // the jitter moved it
   }
 
   EXPECT_EQ(run({"--check", file, "--agents", "4"}), kExitInvalidScenario);

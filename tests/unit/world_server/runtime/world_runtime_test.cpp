@@ -151,8 +151,8 @@ TEST_F(RuntimeTest, AdmitsRefusesRunsToCompletionAndWritesOutputs) {
   const WorldState& s = runtime.state();
   EXPECT_EQ(s.agent(1).accepted, kStepsToGoal);
   EXPECT_EQ(s.agent(1).rejected + s.agent(1).missed + s.agent(2).rejected + s.agent(2).missed, 0u);
-  EXPECT_NEAR(s.agent(2).x_m, 2.55 + 4 * 0.2 * 0.5 / std::sqrt(1.25), 1e-12);  // four moves towards (3.05, 2.05)
-  EXPECT_NEAR(s.agent(2).y_m, 1.05 + 4 * 0.2 * 1.0 / std::sqrt(1.25), 1e-12);
+  EXPECT_NEAR(s.agent(2).position.x, 2.55 + 4 * 0.2 * 0.5 / std::sqrt(1.25), 1e-12);  // four moves towards (3.05, 2.05)
+  EXPECT_NEAR(s.agent(2).position.y, 1.05 + 4 * 0.2 * 1.0 / std::sqrt(1.25), 1e-12);
   const double volume = 2 * testing::kLayer * 0.1 * 0.1;
   EXPECT_EQ(s.deposited_volume_m3, volume);
   EXPECT_EQ(s.terrain(20, 5), 2 * testing::kLayer);
