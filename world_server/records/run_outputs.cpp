@@ -327,7 +327,8 @@ render::RenderOptions goal_vector_map_picture_options(const WorldState& state, c
   const GoalVectorMapSpec& spec = map.spec();
   o.rectangles.push_back({{spec.area.x0, spec.area.y0}, {spec.area.x1, spec.area.y1}, kWhite, 0.0});
   if (state.completion == scenario::CompletionKind::kLevelSite)
-    o.rectangles.push_back({{state.site.area.x0, state.site.area.y0}, {state.site.area.x1, state.site.area.y1}, kWhite, 0.0});
+    o.rectangles.push_back(
+        {{state.site.area.x0, state.site.area.y0}, {state.site.area.x1, state.site.area.y1}, kWhite, 0.0});
   for (const GoalArrow& a : map.arrows()) o.arrows.push_back({a.tail, a.head, kArrowRed, 0.0});
   o.legend_entries.push_back({"tail -> head", kArrowRed, render::LegendSwatch::kArrow});
   o.legend_entries.push_back({"site", kWhite, render::LegendSwatch::kOutline});

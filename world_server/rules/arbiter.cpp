@@ -207,7 +207,8 @@ std::optional<std::string> motion_problem(const WorldState& state, const AgentRe
     if (!other.alive || other.id == me.id) continue;
     if (!bodies_overlap(me, r.target_x_m, r.target_y_m, other, other.position.x, other.position.y)) continue;
     const double after = distance(r.target_x_m, r.target_y_m, other.position.x, other.position.y);
-    if (bodies_overlap(me, x, y, other, other.position.x, other.position.y) && after >= distance(x, y, other.position.x, other.position.y))
+    if (bodies_overlap(me, x, y, other, other.position.x, other.position.y) &&
+        after >= distance(x, y, other.position.x, other.position.y))
       continue;
     return fmt::format("motion ends {} m from agent {}, whose body it would overlap (bodies need {} m)", after,
                        other.id, body_clearance_m(me, other));

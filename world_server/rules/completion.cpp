@@ -46,8 +46,8 @@ void check_on_mask(const CellMask& mask, CellIndex c, const char* what) {
 bool at_goal(const WorldState& state, const AgentRecord& agent) {
   constexpr double tol = tolerance::kLengthM;
   const scenario::Goal& g = state.goal;
-  const bool inside =
-      agent.position.x >= g.area.x0 - tol && agent.position.x <= g.area.x1 + tol && agent.position.y >= g.area.y0 - tol && agent.position.y <= g.area.y1 + tol;
+  const bool inside = agent.position.x >= g.area.x0 - tol && agent.position.x <= g.area.x1 + tol &&
+                      agent.position.y >= g.area.y0 - tol && agent.position.y <= g.area.y1 + tol;
   if (!inside) return false;
   const double h = height_under(state.terrain, agent.position.x, agent.position.y);
   if (!(h >= g.min_height_m - tol)) return false;  // also for NaN (off the grid)

@@ -55,15 +55,16 @@ protocol::SensorFrame SensingService::frame_for(const WorldState& state, std::ui
   } else if (!run_over && state.step % static_cast<std::uint64_t>(sensor.scan_every_steps) == 0) {
     // docs/runtime.md#sensing: a scan instead of tiles, every scan_every_steps steps, from the robot's pose.
     f.scanned = true;
-    f.points = cast_scan(state.terrain, sensor_origin(state.terrain, me.position.x, me.position.y, sensor), me.heading_rad, sensor,
-                         scan_seed(state.seed, id, state.step));
+    f.points = cast_scan(state.terrain, sensor_origin(state.terrain, me.position.x, me.position.y, sensor),
+                         me.heading_rad, sensor, scan_seed(state.seed, id, state.step));
   }
 
   for (const AgentRecord& other : state.agents) {
     if (!other.alive || other.id == id) continue;
     const double dx = other.position.x - me.position.x, dy = other.position.y - me.position.y;
     if (std::sqrt(dx * dx + dy * dy) <= me.type.body.proximity_range_m + tolerance::kLengthM)
-      f.neighbours.push_back({other.id, other.position.x, other.position.y, other.z_m, 0.5 * other.type.body.navigability.delta_m});
+      f.neighbours.push_back(
+          {other.id, other.position.x, other.position.y, other.z_m, 0.5 * other.type.body.navigability.delta_m});
   }
   return f;
 }

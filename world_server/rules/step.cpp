@@ -120,7 +120,8 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_pairs(const Wor
     if (!a.alive) continue;
     for (std::size_t j = i + 1; j < state.agents.size(); ++j) {
       const AgentRecord& b = state.agents[j];
-      if (b.alive && bodies_overlap(a, a.position.x, a.position.y, b, b.position.x, b.position.y)) pairs.emplace_back(a.id, b.id);
+      if (b.alive && bodies_overlap(a, a.position.x, a.position.y, b, b.position.x, b.position.y))
+        pairs.emplace_back(a.id, b.id);
     }
   }
   return pairs;

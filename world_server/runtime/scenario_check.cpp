@@ -197,8 +197,8 @@ std::string scenario_check_text(const WorldStart& start) {
   out << "completion: " << scenario::to_string(state.completion);
   switch (state.completion) {
     case scenario::CompletionKind::kAgentsAtGoal:
-      out << ", goal " << box(state.goal.area.x0, state.goal.area.y0, state.goal.area.x1, state.goal.area.y1) << ", min_height_m "
-          << number(state.goal.min_height_m);
+      out << ", goal " << box(state.goal.area.x0, state.goal.area.y0, state.goal.area.x1, state.goal.area.y1)
+          << ", min_height_m " << number(state.goal.min_height_m);
       if (state.goal.target_radius_m > 0.0)
         out << ", each agent within " << number(state.goal.target_radius_m) << " m of its target";
       out << "\n";
@@ -215,15 +215,16 @@ std::string scenario_check_text(const WorldStart& start) {
     }
     case scenario::CompletionKind::kLevelSite: {
       const scenario::Site& p = state.site;
-      out << ", site " << box(p.area.x0, p.area.y0, p.area.x1, p.area.y1) << " (" << site_cell_count(state) << " cells), kappa "
-          << number(p.navigability.kappa) << ", delta_m " << number(p.navigability.delta_m) << ", eps_m "
-          << number(p.navigability.eps_m) << ", min_fraction " << number(p.min_fraction) << ", checked every "
-          << p.check_every_steps << " steps; at start: level fraction " << number(state.check.level_fraction)
-          << (state.check.met ? " (the run ends at once)" : "") << "\n";
+      out << ", site " << box(p.area.x0, p.area.y0, p.area.x1, p.area.y1) << " (" << site_cell_count(state)
+          << " cells), kappa " << number(p.navigability.kappa) << ", delta_m " << number(p.navigability.delta_m)
+          << ", eps_m " << number(p.navigability.eps_m) << ", min_fraction " << number(p.min_fraction)
+          << ", checked every " << p.check_every_steps << " steps; at start: level fraction "
+          << number(state.check.level_fraction) << (state.check.met ? " (the run ends at once)" : "") << "\n";
       break;
     }
   }
-  out << "base: " << point(state.base.centre.x, state.base.centre.y) << " m, radius " << number(state.base.radius_m) << " m\n";
+  out << "base: " << point(state.base.centre.x, state.base.centre.y) << " m, radius " << number(state.base.radius_m)
+      << " m\n";
   out << "max_steps " << start.options.max_steps << ", seed " << s.seed << ", start_jitter_m "
       << number(s.start_jitter_m) << ", step_deadline_s " << number(start.options.step_deadline_s) << ", tile_size "
       << state.tile_size << ", run id " << start.options.run_id << "\n";
