@@ -128,10 +128,6 @@ void set_log_agent_id(std::uint32_t id) { g_agent_id = id; }
 
 LogFormat log_format() { return g_format.load(); }
 
-std::string json_string(const std::string& text) {
-  return nlohmann::json(text).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
 std::string format_log_line(LogFormat format, const std::string& process, std::uint32_t agent_id, long pid,
                             std::chrono::system_clock::time_point time, const std::string& level,
                             const std::string& message) {

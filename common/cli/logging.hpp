@@ -70,10 +70,6 @@ std::string format_log_line(LogFormat format, const std::string& process, std::u
                             std::chrono::system_clock::time_point time, const std::string& level,
                             const std::string& message);
 
-/// `text` as a JSON string (quotes included), written by nlohmann::json as every machine output of the project is,
-/// with each invalid UTF-8 sequence replaced by U+FFFD.
-std::string json_string(const std::string& text);
-
 /// Writes the program's last line on an error: `text` and a newline in text format; in json a record at level error
 /// whose message is `text`.
 void write_exit_error(std::ostream& err, const std::string& text);

@@ -33,12 +33,17 @@ TEST(LogLine, JsonIsOneObjectWithTheSameFields) {
             "\"pid\":1,\"msg\":\"x\"}");
 }
 
-TEST(JsonString, EscapesControlsAndReplacesInvalidUtf8) {
-  EXPECT_EQ(json_string("a\tb\\c\x01"), "\"a\\tb\\\\c\\u0001\"");
-  EXPECT_EQ(json_string("caf\xc3\xa9"), "\"caf\xc3\xa9\"");          // valid UTF-8 kept
-  EXPECT_EQ(json_string("bad\xff!"), "\"bad\xef\xbf\xbd!\"");          // a stray byte becomes U+FFFD
-  EXPECT_EQ(json_string("\xc0\xaf"), "\"\xef\xbf\xbd\xef\xbf\xbd\"");  // an overlong form too
-  EXPECT_EQ(json_string("\xe2\x82x"), "\"\xef\xbf\xbdx\"");             // a cut sequence is one U+FFFD
+TEST(LogLine, JsonEscapesControlsAndReplacesInvalidUtf8) {
+  const auto msg = [](const std::string& message) {
+    const std::string line = format_log_line(LogFormat::kJson, "world", 0, 1, kTime, "info", message);
+    const std::string head = ",\"msg\":";
+    return line.substr(line.find(head) + head.size(), line.size() - line.find(head) - head.size() - 1);
+  };
+  EXPECT_EQ(msg("a\tb\\c\x01"), "\"a\\tb\\\\c\\u0001\"");
+  EXPECT_EQ(msg("caf\xc3\xa9"), "\"caf\xc3\xa9\"");          // valid UTF-8 kept
+  EXPECT_EQ(msg("bad\xff!"), "\"bad\xef\xbf\xbd!\"");          // a stray byte becomes U+FFFD
+  EXPECT_EQ(msg("\xc0\xaf"), "\"\xef\xbf\xbd\xef\xbf\xbd\"");  // an overlong form too
+  EXPECT_EQ(msg("\xe2\x82x"), "\"\xef\xbf\xbdx\"");             // a cut sequence is one U+FFFD
 }
 
 TEST(LogLine, JsonReplacesInvalidUtf8InTheMessage) {
