@@ -368,7 +368,7 @@ TEST(ScenarioLoader, SensorsTakeTheirNamedDefaultsAndTheFileOnTop) {
                           "robot_type { name: \"bot\" sensor { name: \"laser\" max_range_m: 5 scan_every_steps: 3 } }"),
                      "t.pbtxt");
   const SensorSpec& l = laser.robot_types[0].sensor;
-  EXPECT_EQ(l.name, "laser");
+  EXPECT_EQ(l.kind, SensorKind::kLaser);
   EXPECT_EQ(l.max_range_m, 5.0);
   EXPECT_EQ(l.scan_every_steps, 3);
   EXPECT_EQ(l.horizontal_fov_deg, sensor_defaults(SensorKind::kLaser).horizontal_fov_deg);
@@ -377,7 +377,7 @@ TEST(ScenarioLoader, SensorsTakeTheirNamedDefaultsAndTheFileOnTop) {
   const Scenario rgbd = parse_scenario(
       edit("robot_type { name: \"bot\" }", "robot_type { name: \"bot\" sensor { name: \"rgbd\" } }"), "t.pbtxt");
   const SensorSpec& c = rgbd.robot_types[0].sensor;
-  EXPECT_EQ(c.name, "rgbd");
+  EXPECT_EQ(c.kind, SensorKind::kRgbd);
   EXPECT_EQ(c.horizontal_fov_deg, 87.0);
   EXPECT_EQ(c.ray_count(), 64 * 48);
   EXPECT_GT(c.noise_sd_at(6.0), c.noise_sd_at(1.0));  // a depth camera's noise grows with range
