@@ -107,7 +107,7 @@ std::optional<LiveScene> scene_of(const proto::LogHeader& header) {
         break;
     }
     for (const scenario::AgentSlot& slot : s.slots)
-      if (slot.id <= header.agents()) scene.targets.emplace_back(slot.id, Position{slot.target.x, slot.target.y});
+      if (slot.id <= header.agents()) scene.targets.emplace_back(slot.id, slot.target);
     return scene;
   } catch (const Error&) {
     return std::nullopt;

@@ -287,7 +287,7 @@ std::string describe(const protocol::ActionRequest& r) {
       << r.target_x_m << ", " << r.target_y_m << ") refill " << r.refill << " depositions " << r.depositions.size()
       << " deposits " << r.deposits.size();
   for (std::size_t i = 0; i < r.deposits.size() && i < 12; ++i)
-    out << " {" << r.deposits[i].x_m << "," << r.deposits[i].y_m << " " << r.deposits[i].volume_m3 << "}";
+    out << " {" << r.deposits[i].centre.x << "," << r.deposits[i].centre.y << " " << r.deposits[i].volume_m3 << "}";
   for (std::size_t i = 0; i < r.depositions.size() && i < 12; ++i)
     out << " [" << r.depositions[i].row << "," << r.depositions[i].col << " " << r.depositions[i].height_m << "]";
   out << "}";
@@ -440,7 +440,7 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
       ASSERT_EQ(now.accepted, was.accepted) << report();
       ASSERT_EQ(now.rejected - was.rejected, extra_rejections(before, was, before.step, submissions)) << report();
       rejected += now.rejected - was.rejected;
-      ASSERT_TRUE(now.x_m == was.position.x && now.y_m == was.position.y && now.material_m3 == was.material_m3) << report();
+      ASSERT_TRUE(now.position.x == was.position.x && now.position.y == was.position.y && now.material_m3 == was.material_m3) << report();
       continue;
     }
     const protocol::ActionRequest* answer = answer_of(was, before.step, submissions);
@@ -456,7 +456,7 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
     rejected += now.rejected - was.rejected;
     missed += answer ? 0 : 1;
     if (took == 0) {  // rejected or missed: nothing but counts
-      ASSERT_TRUE(now.x_m == was.position.x && now.y_m == was.position.y) << "agent " << was.id << " moved\n" << report();
+      ASSERT_TRUE(now.position.x == was.position.x && now.position.y == was.position.y) << "agent " << was.id << " moved\n" << report();
       ASSERT_EQ(now.material_m3, was.material_m3) << report();
       ASSERT_EQ(now.deposited_m3, was.deposited_m3) << report();
       continue;
@@ -466,7 +466,7 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
     // the terrain of other agents matter to it, and the terrain only through occupancy, which is not re-checked.
     check_accepted_request(before, was, r, report);
     if (::testing::Test::HasFatalFailure()) return;
-    ASSERT_TRUE(r.move ? now.x_m == r.target_x_m && now.y_m == r.target_y_m : now.x_m == was.position.x && now.y_m == was.position.y)
+    ASSERT_TRUE(r.move ? now.position.x == r.target_x_m && now.position.y == r.target_y_m : now.position.x == was.position.x && now.position.y == was.position.y)
         << report();
     double volume = 0.0;
     for (const Deposition& d : r.depositions) {
@@ -489,7 +489,7 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
       ASSERT_NEAR(shape.volume_m3, d.volume_m3, 1e-9 * d.volume_m3 + 1e-15) << report();
       for (const CellRise& c : shape.rises) {
         const Position p = expected.cell_center(c.cell);
-        ASSERT_GT(distance(p.x, p.y, now.x_m, now.y_m), 0.5 * body.navigability.delta_m) << report();
+        ASSERT_GT(distance(p.x, p.y, now.position.x, now.position.y), 0.5 * body.navigability.delta_m) << report();
         const double total = raised[std::make_pair(c.cell.row, c.cell.col)] += c.rise_m;
         ASSERT_LE(total, 1.0 + tol::kLengthM) << report();
         expected(c.cell) += c.rise_m;

@@ -62,7 +62,7 @@ inline bool same(const protocol::SensorFrame& a, const protocol::SensorFrame& b)
   for (std::size_t i = 0; i < a.neighbours.size(); ++i) {
     const protocol::Neighbour& x = a.neighbours[i];
     const protocol::Neighbour& y = b.neighbours[i];
-    if (x.agent_id != y.agent_id || !same_bits(x.x_m, y.x_m) || !same_bits(x.y_m, y.y_m) || !same_bits(x.z_m, y.z_m) ||
+    if (x.agent_id != y.agent_id || !same_bits(x.position.x, y.position.x) || !same_bits(x.position.y, y.position.y) || !same_bits(x.z_m, y.z_m) ||
         !same_bits(x.radius_m, y.radius_m))
       return false;
   }

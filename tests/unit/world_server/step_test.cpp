@@ -264,7 +264,7 @@ TEST(ApplyStep, ARepeatedIdenticalRequestIsIgnored) {
   WorldState w = admitted_state(s, flat_terrain(), 1);
   const protocol::ActionRequest r = move_to(w, 1, 1.25, 1.05);
   protocol::ActionRequest other = r;
-  other.target.x = 1.15;
+  other.target_x_m = 1.15;
   const StepOutcome o = apply_step(w, std::vector<protocol::ActionRequest>{r, r, other});
   EXPECT_EQ(w.agent(1).accepted, 1u);
   EXPECT_EQ(w.agent(1).rejected, 1u);  // only the different one

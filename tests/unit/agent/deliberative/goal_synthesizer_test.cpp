@@ -220,7 +220,7 @@ TEST(GoalVectorMapSynthesizer, RejectsAContextWithoutAUsableMap) {
   }
   EXPECT_THROW(GoalVectorMapSynthesizer{no_spec}, InvalidArgument);
   AgentContext outside = site_context(1);
-  outside.goal_vector_map->x1_m = 12.5;  // the world ends at x = 12
+  outside.goal_vector_map->area.x1 = 12.5;  // the world ends at x = 12
   EXPECT_THROW(GoalVectorMapSynthesizer{outside}, InvalidArgument);
   AgentContext no_grid = site_context(1);
   no_grid.assignment.world.cell_size_m = 0.0;

@@ -123,8 +123,8 @@ TEST(Depositor, CubeColumnsStayUnderMarsWithinReachBudgetAndKeepOut) {
     }
   // In path order: the first column stands on the first wanted cell (a cube's rise 0.1 m is wanted from column 15
   // on: 0.03 * 4 = 0.12 m), on the path's row.
-  EXPECT_DOUBLE_EQ(plan.deposits[0].x_m, kGrid.cell_center({10, 15}).x);
-  EXPECT_DOUBLE_EQ(plan.deposits[0].y_m, kGrid.cell_center({10, 15}).y);
+  EXPECT_DOUBLE_EQ(plan.deposits[0].centre.x, kGrid.cell_center({10, 15}).x);
+  EXPECT_DOUBLE_EQ(plan.deposits[0].centre.y, kGrid.cell_center({10, 15}).y);
 }
 
 TEST(Depositor, CubeRespectsMaterialAndStopsWhenNoCubeFits) {

@@ -75,9 +75,9 @@ TEST(NoisyLocalisation, ActsOnTheBelievedPoseAndShiftsItsRequestsBack) {
     if (got.move) {
       ++moves;
       // The robot drives the displacement it meant, from where it truly is.
-      EXPECT_NEAR(got.target.x - truth.x, expected.target.x - believed.x_m, 1e-12);
-      EXPECT_NEAR(got.target.y - truth.y, expected.target.y - believed.y_m, 1e-12);
-      truth = {got.target.x, got.target.y};
+      EXPECT_NEAR(got.target_x_m - truth.x, expected.target_x_m - believed.x_m, 1e-12);
+      EXPECT_NEAR(got.target_y_m - truth.y, expected.target_y_m - believed.y_m, 1e-12);
+      truth = {got.target_x_m, got.target_y_m};
     }
     // Every deposition lands k cells back: on the world cell the robot saw in its believed cell.
     ASSERT_EQ(got.depositions.size(), expected.depositions.size()) << step;

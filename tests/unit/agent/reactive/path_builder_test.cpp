@@ -146,7 +146,7 @@ TEST(PathBuilder, FollowsAFrontNeighbourBeyondTheSeparationWithoutDepositing) {
   EXPECT_EQ(q.state, "follow");
   ASSERT_TRUE(q.move);
   EXPECT_GT(q.target_x_m, kAtFoot.x);  // along the path to the target
-  EXPECT_GE(distance({q.target_x_m, q.target_y_m}, {front.x_m, front.y_m}), 2.0);
+  EXPECT_GE(distance({q.target_x_m, q.target_y_m}, front.position), 2.0);
   EXPECT_TRUE(q.depositions.empty());  // the gap within reach is the front robot's work
   EXPECT_FALSE(q.refill);
 }
