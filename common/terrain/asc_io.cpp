@@ -67,6 +67,8 @@ std::string quote(std::string_view token) {
   return out + "'";
 }
 
+// A header number as the data rows write theirs: to_chars' shortest form, which is not fmt's "{}" (1e+06, not
+// 1000000), so written files keep their bytes.
 std::string format_double(double value) {
   char buf[64];
   const auto result = std::to_chars(buf, buf + sizeof buf, value);
@@ -372,8 +374,8 @@ void check_writable(const Heightmap& map) {
 }
 
 void emit(const Heightmap& map, std::ostream& out) {
-  // The header's doubles through to_chars like the heights below (the file's bytes are pinned by digests).
-  std::string buffer = fmt::format("ncols {}\nnrows {}\nxllcorner {}\nyllcorner {}\ncellsize {}\nNODATA_value -9999\n",
+  std::string buffer
+ = fmt::format("ncols {}\nnrows {}\nxllcorner {}\nyllcorner {}\ncellsize {}\nNODATA_value -9999\n",
                                    map.cols(), map.rows(), format_double(map.geometry().xll_m),
                                    format_double(map.geometry().yll_m), format_double(map.cell_size_m()));
   constexpr std::size_t kFlushBytes = 1 << 20;
