@@ -226,7 +226,7 @@ class CycloneReader final : public Reader<T> {
     set_partition(sub_qos.get(), options.partition);
     subscriber_ = dds_create_subscriber(context_->participant(), sub_qos.get(), nullptr);
     if (subscriber_ < 0)
-      throw BusError(failure(std::string("creating a subscriber for ") + TopicName<T>::value, subscriber_));
+      throw BusError(failure(fmt::format("creating a subscriber for {}", TopicName<T>::value), subscriber_));
     Qos qos;
     set_common_qos(qos.get(), options);
     dds_listener_t* listener = dds_create_listener(this);
@@ -237,7 +237,8 @@ class CycloneReader final : public Reader<T> {
     dds_delete_listener(listener);
     if (reader_ < 0) {
       dds_delete(subscriber_);
-      throw BusError(failure(std::string("creating a reader for ") + TopicName<T>::value, reader_));
+      throw BusError(failure(fmt::format("creating a reader for {}", TopicName<T>::value), reader_));
+
     }
   }
   // Cyclone waits for a running listener callback to return before the reader is gone.
