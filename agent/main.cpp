@@ -2,6 +2,7 @@
 // to marsala-world over DDS, then answers every sensor frame with one action request until the run is over.
 // Exit codes: 0 run over (or stopped by a signal), 1 error (one line on stderr), 2 usage.
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -35,12 +36,12 @@ const marsala::RobotType& any_slot_type(const marsala::scenario::Scenario& s, co
     if (std::find(names.begin(), names.end(), t.name) == names.end()) names.push_back(t.name);
     if (t.name == name || (name.empty() && !found)) found = &t;
   }
-  std::string list;
-  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
   if (found && (!name.empty() || names.size() == 1)) return *found;
   throw marsala::InvalidArgument(
-      name.empty() ? "--id auto: the scenario's slots have several robot types (" + list + "): give --robot-type"
-                   : "--robot-type '" + name + "' is no slot's type; the slots have: " + list);
+      name.empty()
+          ? fmt::format("--id auto: the scenario's slots have several robot types ({}): give --robot-type",
+                        fmt::join(names, ", "))
+          : fmt::format("--robot-type '{}' is no slot's type; the slots have: {}", name, fmt::join(names, ", ")));
 }
 
 int main(int argc, char** argv) {
@@ -88,7 +89,7 @@ int main(int argc, char** argv) {
     agent::runtime::RuntimeConfig config;
     config.agent_id = id;
     config.on_assigned = [](std::uint32_t assigned) { marsala::cli::set_log_agent_id(assigned); };
-    if (id != 0) config.name = type.name + "-" + std::to_string(id);
+    if (id != 0) config.name = fmt::format("{}-{}", type.name, id);
     config.type = type;
     config.neighbour_keep_out_m = agent::neighbour_keep_out_m(max_delta, max_step);
     config.seed = seed.value_or(s.seed);
@@ -102,7 +103,7 @@ int main(int argc, char** argv) {
           "assigned");
     const auto participant =
         bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kClient,
-                               bus::Security::of(dds.security, dds.identity, "agent-" + std::to_string(id))});
+                               bus::Security::of(dds.security, dds.identity, fmt::format("agent-{}", id))});
     agent::runtime::AgentRuntime agent(*participant, config);
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
@@ -112,10 +113,10 @@ int main(int argc, char** argv) {
       spdlog::info("agent {}: {}", id, result.message);
       return 0;
     }
-    marsala::cli::write_exit_error(std::cerr, "marsala-agent: agent " + std::to_string(id) + ": " + result.message);
+    marsala::cli::write_exit_error(std::cerr, fmt::format("marsala-agent: agent {}: {}", id, result.message));
     return 1;
   } catch (const std::exception& e) {
-    marsala::cli::write_exit_error(std::cerr, std::string("marsala-agent: ") + e.what());
+    marsala::cli::write_exit_error(std::cerr, fmt::format("marsala-agent: {}", e.what()));
     return 1;
   }
 }

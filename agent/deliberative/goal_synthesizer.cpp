@@ -4,6 +4,7 @@
 #include <string>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 
 namespace marsala::agent::deliberative {
 
@@ -60,9 +61,9 @@ std::optional<std::size_t> pick_tail(const GoalVectorMap& map, const std::vector
 
 std::optional<Position> GoalVectorMapSynthesizer::target(const GoalQuery& query) {
   if (!std::isfinite(query.robot.x) || !std::isfinite(query.robot.y))
-    throw InvalidArgument("goal synthesizer 'goal_vector_map' of agent " + std::to_string(self_id_) +
-                          ": the robot's position (" + std::to_string(query.robot.x) + ", " +
-                          std::to_string(query.robot.y) + ") m is not finite");
+    throw InvalidArgument(
+        fmt::format("goal synthesizer 'goal_vector_map' of agent {}: the robot's position {} is not finite", self_id_,
+                    query.robot));
   const std::vector<GoalArrow>& arrows = map_.arrows();
   // Every pass returns, reaches a tail (once per pick) or finishes an arrow, so the loop ends.
   for (;;) {

@@ -23,7 +23,7 @@ int clamp_int(double v, int lo, int hi) {
 
 Window sensing_window(const GridGeometry& world, Position robot, double range_m) {
   if (!(range_m >= 0.0) || !std::isfinite(range_m))
-    throw InvalidArgument("sensing range must be finite and >= 0 m, got " + std::to_string(range_m));
+    throw InvalidArgument(fmt::format("sensing range must be finite and >= 0 m, got {}", range_m));
   if (!std::isfinite(robot.x) || !std::isfinite(robot.y) || !world.cell_at(robot))
     throw InvalidArgument(fmt::format("local map: the robot at {} is off the grid", robot));
   const double cs = world.cell_size_m;
@@ -38,17 +38,17 @@ LocalMapSynthesizer::LocalMapSynthesizer(NavigabilityParams params, double sensi
                                          std::optional<double> construction_kappa)
     : mars_(construction_kappa.value_or(params.kappa)), navigability_(params), sensing_range_m_(sensing_range_m) {
   if (!(sensing_range_m >= 0.0) || !std::isfinite(sensing_range_m))
-    throw InvalidArgument("local map synthesizer: sensing range must be finite and >= 0 m, got " +
-                          std::to_string(sensing_range_m));
+    throw InvalidArgument(
+        fmt::format("local map synthesizer: sensing range must be finite and >= 0 m, got {}", sensing_range_m));
 }
 
-LocalMap LocalMapSynthesizer::synthesize(const executive::MappingSystem& map, Position robot, Position target) const {
+LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Position target) const {
   const Window w = sensing_window(map.geometry(), robot, sensing_range_m_);
   LocalMap local;
   local.world = map.geometry();
   local.offset = w.top_left;
-  local.heights = map.heights().window(w.top_left, w.rows, w.cols);
-  local.known = map.known().block(w.top_left.row, w.top_left.col, w.rows, w.cols);
+  local.heights = map.heights.window(w.top_left, w.rows, w.cols);
+  local.known = map.known.block(w.top_left.row, w.top_left.col, w.rows, w.cols);
 
   // Unknown cells take the lowest known height: they then never raise the MARS bound of a known cell.
   const bool all_known = local.known.minCoeff() != 0;
@@ -82,21 +82,21 @@ LocalMap LocalMapSynthesizer::synthesize(const executive::MappingSystem& map, Po
       }
   }
 
-  // Ground the map only assumes (under and around the robot's body: executive/mapping_system.hpp) is no deposition
+  // Ground the map only assumes (under and around the robot's body: KnownMap::assumed) is no deposition
   // target: building on it would never show in the map.
-  const auto assumed = map.assumed().block(w.top_left.row, w.top_left.col, w.rows, w.cols);
+  const auto assumed = map.assumed.block(w.top_left.row, w.top_left.col, w.rows, w.cols);
   for (int r = 0; r < w.rows; ++r)
     for (int c = 0; c < w.cols; ++c)
       if (assumed(r, c) != 0) local.gap(r, c) = 0.0;
 
   local.robot = local.to_local(*map.geometry().cell_at(robot));
   local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
-  local.origin = local_origin(local, map.trajectory(), robot, sensing_range_m_);
+  local.origin = local_origin(local, map.trajectory, robot, sensing_range_m_);
   const auto [goal, is_target] = local_goal(local, robot, target);
   local.goal = goal;
   local.goal_is_target = is_target;
   local.passable = local.known;
-  if (!all_known && map.sensor().casts_rays()) {
+  if (!all_known && map.scanned) {
     // A scanning sensor's map has holes (between a laser's rings) and shadows (tiles always cover the window, so a
     // ground-truth robot keeps waiting for its map to grow). A path runs through known cells only, so when the goal
     // is not 8-connected to the robot through them, head for the reachable one nearest to it (ties: the first in

@@ -15,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-#include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/agent/deliberative/known_map.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/mars_processor.hpp"
 #include "marsala/core/navigability_processor.hpp"
@@ -83,9 +83,9 @@ class LocalMapSynthesizer {
   LocalMapSynthesizer(NavigabilityParams params, double sensing_range_m,
                       std::optional<double> construction_kappa = std::nullopt);
 
-  /// The augmented local map around `robot` [m] heading for `target` [m]; throws InvalidArgument when the robot is
-  /// off the grid.
-  LocalMap synthesize(const executive::MappingSystem& map, Position robot, Position target) const;
+  /// The augmented local map of the agent's map `map` around `robot` [m] heading for `target` [m]; throws
+  /// InvalidArgument when the robot is off the grid.
+  LocalMap synthesize(const KnownMap& map, Position robot, Position target) const;
 
   /// The local origin: among trajectory cells (world indices) inside the window, the one nearest the boundary of
   /// the sensing square [x - r, x + r] x [y - r, y + r] around `robot` (r = range_m) that is navigable from the

@@ -1,5 +1,7 @@
 #include "marsala/agent/executive/action_manager.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <string>
 
@@ -31,7 +33,7 @@ bool sweep_clear(const deliberative::LocalMap& map, const CellMask& mask, Positi
 
 ActionManager::ActionManager(double max_step_m) : max_step_m_(max_step_m) {
   if (!(max_step_m > 0.0) || !std::isfinite(max_step_m))
-    throw InvalidArgument("action manager: max step must be finite and > 0 m, got " + std::to_string(max_step_m));
+    throw InvalidArgument(fmt::format("action manager: max step must be finite and > 0 m, got {}", max_step_m));
 }
 
 const CellMask& ActionManager::moves_mask(const deliberative::LocalMap& map) const {

@@ -10,6 +10,12 @@ namespace {
 
 double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
+/// Navigable again after cells were taken out: occupiable and 8-connected to the robot's cell, as the synthesizer
+/// makes it.
+void renavigate(deliberative::LocalMap& local) {
+  local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
+}
+
 }  // namespace
 
 std::vector<BodyClearance> body_clearances(const std::vector<Neighbour>& neighbours, std::uint32_t self_id,
@@ -17,7 +23,8 @@ std::vector<BodyClearance> body_clearances(const std::vector<Neighbour>& neighbo
   std::vector<BodyClearance> out;
   out.reserve(neighbours.size());
   for (const Neighbour& n : neighbours) {
-    if (!std::isfinite(n.position.x) || !std::isfinite(n.position.y) || !std::isfinite(n.radius_m) || n.agent_id == self_id)
+    if (!std::isfinite(n.position.x) || !std::isfinite(n.position.y) || !std::isfinite(n.radius_m) ||
+        n.agent_id == self_id)
       continue;
     const double moves_first = n.agent_id < self_id ? max_step_m : 0.0;
     out.push_back({n.agent_id, n.position, radius_m + std::max(0.0, n.radius_m) + moves_first});
@@ -46,9 +53,19 @@ long long keep_clear(deliberative::LocalMap& local, Position robot, const std::v
       local.occupiable(r, c) = 0;
       ++removed;
     }
-  if (removed == 0) return 0;
-  // Navigable again: occupiable and 8-connected to the robot's cell, as the synthesizer makes it.
-  local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
+  if (removed > 0) renavigate(local);
+  return removed;
+}
+
+long long keep_off(deliberative::LocalMap& local, const std::vector<CellIndex>& cells) {
+  long long removed = 0;
+  for (const CellIndex global : cells) {
+    const CellIndex p = local.to_local(global);
+    if (!local.contains(p) || local.occupiable(p.row, p.col) == 0 || p == local.robot) continue;
+    local.occupiable(p.row, p.col) = 0;
+    ++removed;
+  }
+  if (removed > 0) renavigate(local);
   return removed;
 }
 

@@ -39,4 +39,9 @@ bool clear_of(const std::vector<BodyClearance>& others, Position from, Position 
 /// out.
 long long keep_clear(deliberative::LocalMap& local, Position robot, const std::vector<BodyClearance>& others);
 
+/// Takes the world cells `cells` that lie in the window out of the local map's occupiable and navigable masks, the
+/// robot's own cell excepted, and recomputes navigable as keep_clear does: cells this robot must not step onto though
+/// its map holds them occupiable (a motion target the world refused). Returns the number of cells taken out.
+long long keep_off(deliberative::LocalMap& local, const std::vector<CellIndex>& cells);
+
 }  // namespace marsala::agent::executive

@@ -1,5 +1,7 @@
 #include "marsala/agent/executive/deposition_manager.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -71,13 +73,12 @@ DepositionManager::DepositionManager(DepositionParams params) : params_(params),
       !std::isfinite(params.neighbour_step_m) || !(params.pad_radius_m >= 0.0) || !std::isfinite(params.pad_radius_m) ||
       !std::isfinite(params.pad_centre.x) || !std::isfinite(params.pad_centre.y) || !(params.gap_margin_m >= 0.0) ||
       !std::isfinite(params.gap_margin_m))
-    throw InvalidArgument("deposition manager: reach (" + std::to_string(params.reach_m) + " m), max deposit (" +
-                          std::to_string(params.max_deposit_m3) + " m^3), cube layer (" +
-                          std::to_string(params.cube_layer_m) + " m) and max height (" +
-                          std::to_string(params.max_height_m) +
-                          " m) must be finite and > 0, neighbour keep-out, step and pad radius (" +
-                          std::to_string(params.pad_radius_m) + " m) finite and >= 0, gap margin (" +
-                          std::to_string(params.gap_margin_m) + " m) finite and >= 0");
+    throw InvalidArgument(fmt::format(
+        "deposition manager: reach ({} m), max deposit ({} m^3), cube layer ({} m) and max height ({} m) must be "
+        "finite and > 0, neighbour keep-out, step and pad radius ({} m) finite and >= 0, gap margin ({} m) finite and "
+        ">= 0",
+        params.reach_m, params.max_deposit_m3, params.cube_layer_m, params.max_height_m, params.pad_radius_m,
+        params.gap_margin_m));
 }
 
 std::vector<DepositionCandidate> DepositionManager::candidates(const deliberative::LocalMap& map,

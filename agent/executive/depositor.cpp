@@ -220,6 +220,8 @@ const DepositorRegistry& registry() {
 
 }  // namespace
 
-std::unique_ptr<Depositor> make_depositor(const RobotType& type) { return registry().make(to_string(type.depositor.kind), type); }
+std::unique_ptr<Depositor> make_depositor(const RobotType& type) {
+  return registry().make(to_string(type.depositor.kind), type);
+}
 
 }  // namespace marsala::agent::executive

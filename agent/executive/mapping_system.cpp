@@ -15,8 +15,7 @@ namespace marsala::agent::executive {
 namespace {
 
 std::string describe(const TerrainTile& t) {
-  return "tile (" + std::to_string(t.tile_row) + ", " + std::to_string(t.tile_col) + ") of " + std::to_string(t.rows) +
-         " x " + std::to_string(t.cols) + " cells";
+  return fmt::format("tile ({}, {}) of {} x {} cells", t.tile_row, t.tile_col, t.rows, t.cols);
 }
 
 /// OctoMap keys are 16 bits around the origin: 32768 voxels each way.
@@ -50,6 +49,20 @@ std::optional<ColumnEntry> column_entry(const GridGeometry& g, Point3 o, Point3 
   return ColumnEntry{*from, o.z + t_enter * (p.z - o.z)};
 }
 
+/// A point of the world frame [m] in the octree's frame: the grid's lower-left corner at x = y = 0, so voxel (i, j) is
+/// the cell of column i, row rows - 1 - j (a voxel boundary on every cell boundary).
+octomap::point3d tree_point(const GridGeometry& g, double x, double y, double z) {
+  return octomap::point3d(static_cast<float>(x - g.xll_m), static_cast<float>(y - g.yll_m), static_cast<float>(z));
+}
+
+/// True when `hit` [m] lies within band_m [m] of an edge of its cell.
+bool near_cell_edge(const GridGeometry& g, Point3 hit, double band_m) {
+  const double cs = g.cell_size_m;
+  const double u = (hit.x - g.xll_m) / cs, v = (hit.y - g.yll_m) / cs;
+  const double fu = (u - std::floor(u)) * cs, fv = (v - std::floor(v)) * cs;
+  return fu < band_m || fu > cs - band_m || fv < band_m || fv > cs - band_m;
+}
+
 }  // namespace
 
 /// The octree, in a frame shifted by the grid's lower-left corner so that voxel columns are exactly the grid's cells,
@@ -71,15 +84,86 @@ struct MappingSystem::Octree {
     tree.setClampingThresMin(0.4);
   }
 
+  /// The hits of voxel key_z of cell `index` (row-major), made when new; a cell that has kVoxelsPerCell forgets its
+  /// lowest one: the surface is the highest.
+  VoxelHits& voxel(std::size_t index, octomap::key_type key_z) {
+    std::vector<VoxelHits>& voxels = hits[index];
+    auto it = std::find_if(voxels.begin(), voxels.end(), [&](const VoxelHits& v) { return v.key_z == key_z; });
+    if (it != voxels.end()) return *it;
+    if (voxels.size() == kVoxelsPerCell)
+      voxels.erase(std::min_element(voxels.begin(), voxels.end(),
+                                    [](const VoxelHits& a, const VoxelHits& b) { return a.key_z < b.key_z; }));
+    voxels.push_back({key_z});
+    return voxels.back();
+  }
+
+  /// This scan's hits replace each touched voxel's estimate: the surface changes as robots build, and a blend of old
+  /// and new readings lags a deposit (a cell read half as raised as it is gets filled again, overshoots its MARS height
+  /// and lifts its neighbours' bound: robots with scans built without end that way).
+  void settle(std::vector<std::size_t> touched) {
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    for (std::size_t index : touched) {
+      for (VoxelHits& v : hits[index]) {
+        if (v.scan_count == 0) continue;
+        v.estimate_m = v.scan_sum_m / v.scan_count;
+        v.has_estimate = true;
+        v.hits_in_scan = v.scan_count;
+        v.scan_sum_m = 0.0;
+        v.scan_count = 0;
+      }
+    }
+  }
+
+  /// The voxel that holds the surface of cell `index` (its column's key in `key`, whose z is used up); `hit` tells
+  /// whether this scan hit the cell. A cell this scan hit: the highest voxel it hit (a ray grazing just above a
+  /// surface inside its voxel carves that voxel free in the octree, so occupancy alone would lose freshly built tops);
+  /// otherwise the highest occupied voxel of the column. Null when there is none.
+  const VoxelHits* surface(std::size_t index, octomap::OcTreeKey& key, bool& hit) const {
+    const std::vector<VoxelHits>& voxels = hits[index];
+    // The cell's hits in this scan (hits_in_scan is set for the touched cells only, until the scan is integrated).
+    int count = 0;
+    for (const VoxelHits& v : voxels) count += v.hits_in_scan;
+    hit = count > 0;
+    // A voxel a wall's scattered hits reached holds few of the cell's hits: the surface's voxel holds at least a
+    // fifth of them (and two), else the highest hit voxel is all there is.
+    const int enough = std::max(2, (count + 4) / 5);
+    const VoxelHits* top = nullptr;
+    const VoxelHits* top_any = nullptr;
+    for (const VoxelHits& v : voxels) {
+      if (hit) {
+        if (v.hits_in_scan > 0 && (!top_any || v.key_z > top_any->key_z)) top_any = &v;
+        if (v.hits_in_scan >= enough && (!top || v.key_z > top->key_z)) top = &v;
+        continue;
+      }
+      if (!v.has_estimate || (top && v.key_z <= top->key_z)) continue;
+      key[2] = v.key_z;
+      const octomap::OcTreeNode* node = tree.search(key);
+      if (node && tree.isNodeOccupied(node)) top = &v;
+    }
+    return top ? top : top_any;
+  }
+
   octomap::OcTree tree;
   std::vector<std::vector<VoxelHits>> hits;  ///< per cell (row-major)
 };
 
+/// One scan's hits binned into the octree's voxels: the points to insert, the cells with hits and their bounding rows
+/// and columns (max_row < 0: none).
+struct MappingSystem::ScanBatch {
+  octomap::Pointcloud cloud;
+  std::vector<std::size_t> touched;  ///< cells (row-major) with a voxel first hit in this scan
+  int min_row;
+  int max_row;
+  int min_col;
+  int max_col;
+};
+
 MappingSystem::MappingSystem(const GridGeometry& world, int tile_size, SensorSpec sensor)
     : heights_(world, 0.0), tile_size_(tile_size), sensor_(std::move(sensor)) {
-  if (tile_size < 1) throw InvalidArgument("mapping system: tile size must be >= 1, got " + std::to_string(tile_size));
+  if (tile_size < 1) throw InvalidArgument(fmt::format("mapping system: tile size must be >= 1, got {}", tile_size));
   const std::string problem = sensor_problem(sensor_);
-  if (!problem.empty()) throw InvalidArgument("mapping system: sensor " + problem);
+  if (!problem.empty()) throw InvalidArgument(fmt::format("mapping system: sensor {}", problem));
   if (sensor_.casts_rays() && std::max(world.rows, world.cols) >= kOctreeHalfVoxels)
     throw InvalidArgument(fmt::format("mapping system: a {} x {} grid is too large for the octree ({} cells a side)",
                                       world.rows, world.cols, kOctreeHalfVoxels));
@@ -121,12 +205,13 @@ std::string tile_problem(const TerrainTile& tile, const GridGeometry& world, int
   const bool sized = placed && tile.rows == std::min<long long>(tile_size, world.rows - row0) &&
                      tile.cols == std::min<long long>(tile_size, world.cols - col0);
   if (!sized)
-    return describe(tile) + " does not fit the " + std::to_string(world.rows) + " x " + std::to_string(world.cols) +
-           " grid in " + std::to_string(tile_size) + "-cell tiles";
+    return fmt::format("{} does not fit the {} x {} grid in {}-cell tiles", describe(tile), world.rows, world.cols,
+                       tile_size);
   if (tile.heights.size() != static_cast<std::size_t>(tile.rows) * static_cast<std::size_t>(tile.cols))
-    return describe(tile) + " carries " + std::to_string(tile.heights.size()) + " heights";
+    return fmt::format("{} carries {} heights", describe(tile), tile.heights.size());
   for (double h : tile.heights)
-    if (!std::isfinite(h) || std::abs(h) >= kMaxMagnitude) return describe(tile) + " has a non-finite or huge height";
+    if (!std::isfinite(h) || std::abs(h) >= kMaxMagnitude)
+      return fmt::format("{} has a non-finite or huge height", describe(tile));
   return {};
 }
 
@@ -155,7 +240,7 @@ void MappingSystem::mark_known(int row, int col) {
 
 void MappingSystem::integrate_tile(const TerrainTile& tile) {
   const std::string problem = tile_problem(tile, heights_.geometry(), tile_size_);
-  if (!problem.empty()) throw InvalidArgument("sensor frame: " + problem);
+  if (!problem.empty()) throw InvalidArgument(fmt::format("sensor frame: {}", problem));
   const long long row0 = static_cast<long long>(tile.tile_row) * tile_size_;
   const long long col0 = static_cast<long long>(tile.tile_col) * tile_size_;
   for (int r = 0; r < tile.rows; ++r)
@@ -170,140 +255,96 @@ void MappingSystem::integrate_tile(const TerrainTile& tile) {
 
 void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 origin) {
   const std::string problem = scan_problem(points, sensor_);
-  if (!problem.empty()) throw InvalidArgument("sensor frame: " + problem);
+  if (!problem.empty()) throw InvalidArgument(fmt::format("sensor frame: {}", problem));
   if (!std::isfinite(origin.x) || !std::isfinite(origin.y) || !std::isfinite(origin.z) ||
       std::abs(origin.z) >= kMaxMagnitude)
     throw InvalidArgument(
         fmt::format("mapping system: sensor origin ({}, {}, {}) m is not finite", origin.x, origin.y, origin.z));
   const GridGeometry& g = heights_.geometry();
-  const double cs = g.cell_size_m;
   ++scans_;
   if (hit_scan_.empty()) hit_scan_.assign(static_cast<std::size_t>(g.rows) * g.cols, 0);
   if (!octree_) {
-    octree_ = std::make_unique<Octree>(cs);
+    octree_ = std::make_unique<Octree>(g.cell_size_m);
     octree_->hits.resize(static_cast<std::size_t>(g.size()));
   }
-  octomap::OcTree& tree = octree_->tree;
+  const ScanBatch batch = bin_hits(points, origin);
+  // Rays carve free space up to each end voxel, which becomes more likely occupied (OctoMap's log-odds update).
+  // Lazy: inner nodes are brought up to date once, after the whole scan (OctoMap's own advice for batches).
+  octree_->tree.insertPointCloud(batch.cloud, tree_point(g, origin.x, origin.y, origin.z), -1.0, true, true);
+  octree_->tree.updateInnerOccupancy();
+  octree_->settle(batch.touched);
+  if (batch.max_row < 0) return;
+  rederive_heights(batch);
+  for (std::size_t index : batch.touched)
+    for (Octree::VoxelHits& v : octree_->hits[index]) v.hits_in_scan = 0;
+}
+
+MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& points, Point3 origin) {
+  const GridGeometry& g = heights_.geometry();
+  const double cs = g.cell_size_m;
   const double z_limit = 0.99 * kOctreeHalfVoxels * cs;
-  // The octree's frame: the grid's lower-left corner at x = y = 0, so voxel (i, j) is the cell of column i, row
-  // rows - 1 - j (a voxel boundary on every cell boundary).
-  const auto to_tree = [&](double x, double y, double z) {
-    return octomap::point3d(static_cast<float>(x - g.xll_m), static_cast<float>(y - g.yll_m), static_cast<float>(z));
-  };
-  const octomap::point3d tree_origin = to_tree(origin.x, origin.y, origin.z);
-  octomap::Pointcloud cloud;
-  cloud.reserve(points.size());
-  std::vector<std::size_t> touched;  // cells with hits in this scan
-  int min_row = g.rows, max_row = -1, min_col = g.cols, max_col = -1;
+  ScanBatch batch{{}, {}, g.rows, -1, g.cols, -1};
+  batch.cloud.reserve(points.size());
   // A hit on a wall between two cells lies on their common edge, and range noise puts it on either side: in the
   // lower cell's column it would read as a surface high above that cell. Hits within kEdgeBand of a cell edge are
   // therefore left out; the cell's interior hits say where its surface is (docs/runtime.md#mapping).
   for (const ScanPoint& p : points) {
-    const double x = origin.x + p.x_m, y = origin.y + p.y_m, z = origin.z + p.z_m;
-    const std::optional<CellIndex> cell = g.cell_at({x, y});
-    if (!cell || std::abs(z) >= z_limit) continue;
+    const Point3 hit{origin.x + p.x_m, origin.y + p.y_m, origin.z + p.z_m};
+    const std::optional<CellIndex> cell = g.cell_at({hit.x, hit.y});
+    if (!cell || std::abs(hit.z) >= z_limit) continue;
     const double range = std::sqrt(double{p.x_m} * p.x_m + double{p.y_m} * p.y_m + double{p.z_m} * p.z_m);
     const double spread = kEdgeBandNoise * sensor_.noise_sd_at(range);  // where noise may carry the hit [m]
     const double band = std::max(kEdgeBand * cs, spread);
-    if (band > kMaxEdgeBand * cs + 1e-12) continue;
-    const double u = (x - g.xll_m) / cs, v = (y - g.yll_m) / cs;
-    const double fu = (u - std::floor(u)) * cs, fv = (v - std::floor(v)) * cs;
-    if (fu < band || fu > cs - band || fv < band || fv > cs - band) continue;
-    // A hit just past a higher cell's edge, from a ray that crossed into this column at or below that cell's surface,
-    // is that edge's hit pushed over by range noise, not this cell's surface: in the shadow behind an edge nothing
-    // else lands, and a few such hits over many scans would raise the cell to the edge's height. Judged on the map
-    // before this scan; a cell that really rose to its neighbour's height reads so from a steeper ray.
-    if (const auto entry = column_entry(g, origin, {x, y, z}, *cell);
-        entry && known_(entry->from.row, entry->from.col) != 0) {
-      const double edge = heights_(entry->from);
-      const bool lower = known_(cell->row, cell->col) == 0 || heights_(*cell) < edge - spread;
-      if (lower && entry->z_m <= edge + spread) continue;
-    }
-    const octomap::point3d end = to_tree(x, y, z);
+    if (band > kMaxEdgeBand * cs + 1e-12 || near_cell_edge(g, hit, band) || behind_edge(origin, hit, *cell, spread))
+      continue;
+    const octomap::point3d end = tree_point(g, hit.x, hit.y, hit.z);
     octomap::OcTreeKey key;
-    if (!tree.coordToKeyChecked(end, key)) continue;
-    cloud.push_back(end);
+    if (!octree_->tree.coordToKeyChecked(end, key)) continue;
+    batch.cloud.push_back(end);
     const std::size_t index = static_cast<std::size_t>(cell->row) * g.cols + cell->col;
-    std::vector<Octree::VoxelHits>& voxels = octree_->hits[index];
-    auto it = std::find_if(voxels.begin(), voxels.end(), [&](const auto& voxel) { return voxel.key_z == key[2]; });
-    if (it == voxels.end()) {
-      if (voxels.size() == kVoxelsPerCell) {  // forget the lowest voxel: the surface is the highest
-        voxels.erase(std::min_element(voxels.begin(), voxels.end(),
-                                      [](const auto& a, const auto& b) { return a.key_z < b.key_z; }));
-      }
-      voxels.push_back({key[2]});
-      it = voxels.end() - 1;
-    }
-    if (it->scan_count == 0) touched.push_back(index);
-    min_row = std::min(min_row, cell->row);
-    max_row = std::max(max_row, cell->row);
-    min_col = std::min(min_col, cell->col);
-    max_col = std::max(max_col, cell->col);
-    it->scan_sum_m += z;
-    ++it->scan_count;
+    Octree::VoxelHits& voxel = octree_->voxel(index, key[2]);
+    if (voxel.scan_count == 0) batch.touched.push_back(index);
+    batch.min_row = std::min(batch.min_row, cell->row);
+    batch.max_row = std::max(batch.max_row, cell->row);
+    batch.min_col = std::min(batch.min_col, cell->col);
+    batch.max_col = std::max(batch.max_col, cell->col);
+    voxel.scan_sum_m += hit.z;
+    ++voxel.scan_count;
   }
-  // Rays carve free space up to each end voxel, which becomes more likely occupied (OctoMap's log-odds update).
-  // Lazy: inner nodes are brought up to date once, after the whole scan (OctoMap's own advice for batches).
-  tree.insertPointCloud(cloud, tree_origin, -1.0, true, true);
-  tree.updateInnerOccupancy();
+  return batch;
+}
 
-  // This scan's hits replace each voxel's estimate: the surface changes as robots build, and a blend of old and new
-  // readings lags a deposit (a cell read half as raised as it is gets filled again, overshoots its MARS height and
-  // lifts its neighbours' bound: robots with scans built without end that way).
-  std::sort(touched.begin(), touched.end());
-  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-  for (std::size_t index : touched) {
-    for (Octree::VoxelHits& v : octree_->hits[index]) {
-      if (v.scan_count == 0) continue;
-      v.estimate_m = v.scan_sum_m / v.scan_count;
-      v.has_estimate = true;
-      v.hits_in_scan = v.scan_count;
-      v.scan_sum_m = 0.0;
-      v.scan_count = 0;
-    }
-  }
+bool MappingSystem::behind_edge(Point3 origin, Point3 hit, CellIndex cell, double spread) const {
+  // A hit just past a higher cell's edge, from a ray that crossed into this column at or below that cell's surface, is
+  // that edge's hit pushed over by range noise, not this cell's surface: in the shadow behind an edge nothing else
+  // lands, and a few such hits over many scans would raise the cell to the edge's height. Judged on the map before
+  // this scan; a cell that really rose to its neighbour's height reads so from a steeper ray.
+  const auto entry = column_entry(heights_.geometry(), origin, hit, cell);
+  if (!entry || known_(entry->from.row, entry->from.col) == 0) return false;
+  const double edge = heights_(entry->from);
+  const bool lower = known_(cell.row, cell.col) == 0 || heights_(cell) < edge - spread;
+  return lower && entry->z_m <= edge + spread;
+}
 
-  // Heights of every cell the scan reached (carving may have freed a voxel of a cell it did not hit). A cell this scan
-  // hit: the highest voxel it hit (a ray grazing just above a surface inside its voxel carves that voxel free in the
-  // octree, so occupancy alone would lose freshly built tops); otherwise the highest occupied voxel of the column.
-  // Never below what the robot itself built there (record_built).
-  if (max_row < 0) return;
-  for (int row = min_row; row <= max_row; ++row)
-    for (int col = min_col; col <= max_col; ++col) {
-      const std::vector<Octree::VoxelHits>& voxels = octree_->hits[static_cast<std::size_t>(row) * g.cols + col];
-      if (voxels.empty()) continue;
+void MappingSystem::rederive_heights(const ScanBatch& batch) {
+  // Heights of every cell the scan reached (carving may have freed a voxel of a cell it did not hit). Never below what
+  // the robot itself built there (record_built).
+  const GridGeometry& g = heights_.geometry();
+  for (int row = batch.min_row; row <= batch.max_row; ++row)
+    for (int col = batch.min_col; col <= batch.max_col; ++col) {
+      const std::size_t index = static_cast<std::size_t>(row) * g.cols + col;
+      if (octree_->hits[index].empty()) continue;
       const Position centre = g.cell_center({row, col});
       octomap::OcTreeKey key;
-      if (!tree.coordToKeyChecked(to_tree(centre.x, centre.y, 0.0), key)) continue;
-      const Octree::VoxelHits* top = nullptr;
-      // The cell's hits in this scan (hits_in_scan is set for the touched cells only, until the end of this call).
-      int hits = 0;
-      for (const Octree::VoxelHits& v : voxels) hits += v.hits_in_scan;
-      const bool hit = hits > 0;
-      if (hit) hit_scan_[static_cast<std::size_t>(row) * g.cols + col] = scans_;
-      // A voxel a wall's scattered hits reached holds few of the cell's hits: the surface's voxel holds at least a
-      // fifth of them (and two), else the highest hit voxel is all there is.
-      const int enough = std::max(2, (hits + 4) / 5);
-      const Octree::VoxelHits* top_any = nullptr;
-      for (const Octree::VoxelHits& v : voxels) {
-        if (hit) {
-          if (v.hits_in_scan > 0 && (!top_any || v.key_z > top_any->key_z)) top_any = &v;
-          if (v.hits_in_scan >= enough && (!top || v.key_z > top->key_z)) top = &v;
-          continue;
-        }
-        if (!v.has_estimate || (top && v.key_z <= top->key_z)) continue;
-        key[2] = v.key_z;
-        const octomap::OcTreeNode* node = tree.search(key);
-        if (node && tree.isNodeOccupied(node)) top = &v;
-      }
-      if (!top) top = top_any;
+      if (!octree_->tree.coordToKeyChecked(tree_point(g, centre.x, centre.y, 0.0), key)) continue;
+      bool hit = false;
+      const Octree::VoxelHits* top = octree_->surface(index, key, hit);
+      if (hit) hit_scan_[index] = scans_;
       if (!top) continue;  // every voxel it had was carved free since: keep what the map said
       const auto built = built_.find(static_cast<long long>(row) * g.cols + col);
       heights_(row, col) = built == built_.end() ? top->estimate_m : std::max(top->estimate_m, built->second);
       mark_known(row, col);
     }
-  for (std::size_t index : touched)
-    for (Octree::VoxelHits& v : octree_->hits[index]) v.hits_in_scan = 0;
 }
 
 bool MappingSystem::hit_within(CellIndex cell, int scans) const {
@@ -327,7 +368,7 @@ void MappingSystem::assume_ground(Position pose, double ground_z_m, double radiu
         fmt::format("mapping system: ground {} m within {} m is not a finite height and radius", ground_z_m, radius_m));
   const std::optional<CellIndex> centre =
       std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;
-  if (!centre) throw InvalidArgument(fmt::format("mapping system: pose ({}, {}) m is off the grid", pose.x, pose.y));
+  if (!centre) throw InvalidArgument(fmt::format("mapping system: pose {} is off the grid", pose));
   const GridGeometry& g = heights_.geometry();
   // The body's ball around the cell it stands on, with the project's tie tolerance (ARCHITECTURE.md, grid conventions).
   const double radius_cells = radius_m / g.cell_size_m;
@@ -347,9 +388,7 @@ std::size_t MappingSystem::octree_leaves() const { return octree_ ? octree_->tre
 
 void MappingSystem::record_pose(Position pose) {
   const auto cell = std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;
-  if (!cell)
-    throw InvalidArgument("mapping system: pose (" + std::to_string(pose.x) + ", " + std::to_string(pose.y) +
-                          ") m is off the grid");
+  if (!cell) throw InvalidArgument(fmt::format("mapping system: pose {} is off the grid", pose));
   if (trajectory_.empty() || trajectory_.back() != *cell) trajectory_.push_back(*cell);
 }
 

@@ -10,6 +10,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "marsala/agent/deliberative/known_map.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/ray_caster.hpp"
 #include "marsala/core/robot_body.hpp"
@@ -91,6 +92,8 @@ class MappingSystem {
   const std::vector<CellIndex>& trajectory() const { return trajectory_; }
   /// The world grid.
   const GridGeometry& geometry() const { return heights_.geometry(); }
+  /// This map as the deliberative layer reads it (the local map synthesizer); valid while this map lives, unchanged.
+  deliberative::KnownMap known_map() const { return {heights_, known_, assumed_, trajectory_, sensor_.casts_rays()}; }
   int tile_size() const { return tile_size_; }
   const SensorSpec& sensor() const { return sensor_; }
   /// Leaf voxels of the octree, 0 before the first scan (for benchmarks and tests).
@@ -98,7 +101,12 @@ class MappingSystem {
 
  private:
   struct Octree;                      // OctoMap's tree and the hits per cell, in mapping_system.cpp
+  struct ScanBatch;                   // one scan's hits binned into the octree's voxels, in mapping_system.cpp
   void mark_known(int row, int col);  // observed by a sensor
+  // integrate_scan()'s steps: bin the hits a scan can place, judge a hit in an edge's shadow, re-derive the heights.
+  ScanBatch bin_hits(const std::vector<ScanPoint>& points, Point3 origin);
+  bool behind_edge(Point3 origin, Point3 hit, CellIndex cell, double spread_m) const;
+  void rederive_heights(const ScanBatch& batch);
 
   Heightmap heights_;
   CellMask known_;

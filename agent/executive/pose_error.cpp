@@ -34,8 +34,7 @@ Position PoseError::at(std::uint64_t step) {
     step_ = step;
     return error_;
   }
-  if (step < step_)
-    throw InvalidArgument("localisation: step " + std::to_string(step) + " comes after step " + std::to_string(step_));
+  if (step < step_) throw InvalidArgument(fmt::format("localisation: step {} comes after step {}", step, step_));
   // A gap beyond kMaxDrawnGap steps is one fresh draw (the error has long forgotten its past by then).
   const std::uint64_t gap = step - step_;
   if (gap > kMaxDrawnGap) {

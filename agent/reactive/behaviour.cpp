@@ -44,19 +44,17 @@ protocol::ActionRequest empty_request(const AgentContext& context, const protoco
 
 Assignment assignment_from(const AgentContext& context, const protocol::Admission& admission) {
   if (admission.agent_id != context.agent_id || admission.session != context.session || !admission.accepted)
-    throw InvalidArgument("admission for agent " + std::to_string(admission.agent_id) + " (session " +
-                          std::to_string(admission.session) + (admission.accepted ? "" : ", refused") +
-                          ") does not admit agent " + std::to_string(context.agent_id) + " (session " +
-                          std::to_string(context.session) + ")");
+    throw InvalidArgument(fmt::format("admission for agent {} (session {}{}) does not admit agent {} (session {})",
+                                      admission.agent_id, admission.session, admission.accepted ? "" : ", refused",
+                                      context.agent_id, context.session));
   if (const std::string problem = assignment_problem(admission.assignment); !problem.empty())
-    throw InvalidArgument("admission: " + problem);
+    throw InvalidArgument(fmt::format("admission: {}", problem));
   return admission.assignment;
 }
 
 void check_frame(const AgentContext& context, const protocol::SensorFrame& frame) {
   if (frame.agent_id != context.agent_id)
-    throw InvalidArgument("sensor frame for agent " + std::to_string(frame.agent_id) + " reached agent " +
-                          std::to_string(context.agent_id));
+    throw InvalidArgument(fmt::format("sensor frame for agent {} reached agent {}", frame.agent_id, context.agent_id));
 }
 
 }  // namespace marsala::agent::reactive

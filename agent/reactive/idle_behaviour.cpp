@@ -1,5 +1,7 @@
 #include "marsala/agent/reactive/idle_behaviour.hpp"
 
+#include <fmt/format.h>
+
 #include "marsala/core/error.hpp"
 
 namespace marsala::agent::reactive {
@@ -10,8 +12,7 @@ void IdleBehaviour::on_admission(const protocol::Admission& admission) {
 }
 
 protocol::ActionRequest IdleBehaviour::decide(const protocol::SensorFrame& frame) {
-  if (!admitted_)
-    throw InvalidArgument("idle behaviour: frame for step " + std::to_string(frame.step) + " before admission");
+  if (!admitted_) throw InvalidArgument(fmt::format("idle behaviour: frame for step {} before admission", frame.step));
   check_frame(context_, frame);
   if (frame.run_over) done_ = true;
   return empty_request(context_, frame, state_name());

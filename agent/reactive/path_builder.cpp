@@ -1,5 +1,7 @@
 #include "marsala/agent/reactive/path_builder.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -70,7 +72,7 @@ void PathBuilder::on_admission(const protocol::Admission& admission) {
 
 protocol::ActionRequest PathBuilder::decide(const protocol::SensorFrame& frame) {
   if (!steps_.admitted())
-    throw InvalidArgument("path builder: frame for step " + std::to_string(frame.step) + " before admission");
+    throw InvalidArgument(fmt::format("path builder: frame for step {} before admission", frame.step));
   check_frame(steps_.context(), frame);
   trace_ = PathBuilderTrace{};
   trace_.before = state_;

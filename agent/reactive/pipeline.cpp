@@ -1,5 +1,7 @@
 #include "marsala/agent/reactive/pipeline.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <limits>
 
@@ -26,10 +28,10 @@ PipelineTracker::PipelineTracker(PipelineParams params) : params_(params) {
   if (!finite(params.separation_m) || !(params.separation_m > 0.0) || !finite(params.back_off_margin_m) ||
       !(params.back_off_margin_m >= 0.0) || !(params.back_off_margin_m < params.separation_m) ||
       !finite(params.return_detect_m) || !(params.return_detect_m > 0.0))
-    throw InvalidArgument("pipeline: separation (" + std::to_string(params.separation_m) +
-                          " m) and return detection (" + std::to_string(params.return_detect_m) +
-                          " m) must be finite and > 0, the back-off margin (" +
-                          std::to_string(params.back_off_margin_m) + " m) in [0, separation)");
+    throw InvalidArgument(fmt::format(
+        "pipeline: separation ({} m) and return detection ({} m) must be finite and > 0, the back-off margin ({} m) in "
+        "[0, separation)",
+        params.separation_m, params.return_detect_m, params.back_off_margin_m));
 }
 
 void PipelineTracker::observe(const std::vector<Neighbour>& neighbours, Position target) {

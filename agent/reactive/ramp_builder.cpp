@@ -1,5 +1,7 @@
 #include "marsala/agent/reactive/ramp_builder.hpp"
 
+#include <fmt/format.h>
+
 #include <utility>
 
 #include "marsala/core/enum_names.hpp"
@@ -52,7 +54,7 @@ void RampBuilder::on_admission(const protocol::Admission& admission) {
 
 protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) {
   if (!steps_.admitted())
-    throw InvalidArgument("ramp builder: frame for step " + std::to_string(frame.step) + " before admission");
+    throw InvalidArgument(fmt::format("ramp builder: frame for step {} before admission", frame.step));
   check_frame(steps_.context(), frame);
   trace_ = RampBuilderTrace{};
   trace_.before = state_;

@@ -87,7 +87,9 @@ void RampSteps::admit(const protocol::Admission& admission) {
   // A scanned map reads each surface within a few noise spreads at the manipulator's reach: leave that much unfilled.
   if (context_.type.sensor.casts_rays())
     deposits.gap_margin_m = kScanGapMargin * context_.type.sensor.noise_sd_at(body.reach_m + body.navigability.delta_m);
-  gap_streaks_.assign(context_.type.sensor.casts_rays() ? static_cast<std::size_t>(world.rows) * world.cols : 0, {});
+  const std::size_t streak_cells =
+      context_.type.sensor.casts_rays() ? static_cast<std::size_t>(world.rows) * world.cols : 0;
+  memory_.gap_streaks.assign(streak_cells, {});
   PlannerParams router = planner;
   router.alpha = 0.0;
   router.beta = 1.0;
@@ -108,62 +110,78 @@ void RampSteps::set_registration(CellIndex offset) {
 
 BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace) {
   modules_->map.set_registration(registration_);
-  if (frame.last_result == protocol::ActionResult::kRejected && !sent_deposits_.empty())
-    deposit_limit_ = static_cast<int>(sent_deposits_.size()) / 2;
-  else if (frame.last_result == protocol::ActionResult::kAccepted)
-    deposit_limit_ = -1;
+  remember_result(frame);
+  update_map(frame);
+  BuildView view = synthesize_view(frame);
+  keep_clear(frame, view);
+  trace.window_offset = view.local.offset;
+  trace.local_goal = view.local.goal;
+  trace.local_origin = view.local.origin;
+  trace.navigable_cells = view.local.navigable.cast<long long>().sum();
+  return view;
+}
+
+void RampSteps::remember_result(const protocol::SensorFrame& frame) {
+  Sent& sent = memory_.sent;
+  const bool accepted = frame.last_result == protocol::ActionResult::kAccepted;
+  const bool rejected = frame.last_result == protocol::ActionResult::kRejected;
+  if (rejected && !sent.deposits.empty())
+    memory_.deposit_limit = static_cast<int>(sent.deposits.size()) / 2;
+  else if (accepted)
+    memory_.deposit_limit = -1;
   // The robot's own construction, once accepted, is in its map even where its sensor cannot see it (a scanned map).
-  if (frame.last_result == protocol::ActionResult::kAccepted && context_.type.sensor.casts_rays()) {
-    for (const Deposition& d : sent_layers_) modules_->map.record_built({d.row, d.col}, d.height_m);
+  if (accepted && context_.type.sensor.casts_rays()) {
+    for (const Deposition& d : sent.layers) modules_->map.record_built({d.row, d.col}, d.height_m);
     if (context_.type.depositor.kind == DepositorKind::kCube) {
       const double side = depositor_cube_size_m(context_.type);
-      for (const Deposit& d : sent_deposits_)
+      for (const Deposit& d : sent.deposits)
         for (const CellRise& r : cube_column_shape(modules_->map.geometry(), d.centre, side,
                                                    static_cast<int>(whole_cubes(d.volume_m3, side)))
                                      .rises)
           modules_->map.record_built(r.cell, r.rise_m);
     }
   }
-  sent_layers_.clear();
-  sent_deposits_.clear();
   // A motion the world refused (its target not occupiable for this body, though the robot's map said it was: a
   // scanned map's error) is not asked again for a while; the same frame would otherwise ask it again every step.
-  if (frame.last_result == protocol::ActionResult::kRejected && sent_motion_)
-    refused_[{sent_motion_->row, sent_motion_->col}] = frame.step + kRefusedMotionSteps;
-  sent_motion_.reset();
-  for (auto it = refused_.begin(); it != refused_.end();)
-    it = it->second <= frame.step ? refused_.erase(it) : std::next(it);
+  if (rejected && sent.motion) memory_.refused[*sent.motion] = frame.step + kRefusedMotionSteps;
+  sent = Sent{};
+  for (auto it = memory_.refused.begin(); it != memory_.refused.end();)
+    it = it->second <= frame.step ? memory_.refused.erase(it) : std::next(it);
+}
+
+void RampSteps::update_map(const protocol::SensorFrame& frame) {
   const Position robot{frame.x_m, frame.y_m};
-  modules_->map.integrate(frame.tiles, robot);
   const SensorSpec& sensor = context_.type.sensor;
+  modules_->map.integrate(frame.tiles, robot);
   if (frame.scanned)
     modules_->map.integrate_scan(frame.points, executive::believed_sensor_origin(robot, frame.z_m, sensor));
   if (sensor.casts_rays())  // docs/runtime.md#mapping: the ground its body stands on and may step onto next
     modules_->map.assume_ground(robot, frame.z_m,
                                 0.5 * context_.type.body.navigability.delta_m + context_.type.body.max_step_m);
+}
+
+BuildView RampSteps::synthesize_view(const protocol::SensorFrame& frame) {
+  const Position robot{frame.x_m, frame.y_m};
   const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
   const Position target = goal.value_or(robot);  // nothing left to build towards: stay
-  BuildView view{modules_->synthesizer.synthesize(modules_->map, robot, target), robot, target};
+  BuildView view{modules_->synthesizer.synthesize(modules_->map.known_map(), robot, target), robot, target};
   clear_pad_gap(view.local);
-  if (sensor.casts_rays()) count_gap_scans(view.local, frame.scanned);
-  const RobotBody& body = context_.type.body;
-  others_ =
-      executive::body_clearances(frame.neighbours, context_.agent_id, 0.5 * body.navigability.delta_m, body.max_step_m);
-  corridor_ = view.local.navigable;
-  terrain_occupiable_ = view.local.occupiable;
-  executive::keep_clear(view.local, robot, others_);
-  if (!refused_.empty()) {
-    std::vector<executive::BodyClearance> refused;
-    const double cs = modules_->map.geometry().cell_size_m;
-    for (const auto& [cell, until] : refused_)
-      refused.push_back({0, modules_->map.geometry().cell_center({cell.first, cell.second}), 0.5 * cs});
-    executive::keep_clear(view.local, robot, refused);
-  }
-  trace.window_offset = view.local.offset;
-  trace.local_goal = view.local.goal;
-  trace.local_origin = view.local.origin;
-  trace.navigable_cells = view.local.navigable.cast<long long>().sum();
+  if (context_.type.sensor.casts_rays()) count_gap_scans(view.local, frame.scanned);
   return view;
+}
+
+void RampSteps::keep_clear(const protocol::SensorFrame& frame, BuildView& view) {
+  const RobotBody& body = context_.type.body;
+  memory_.others =
+      executive::body_clearances(frame.neighbours, context_.agent_id, 0.5 * body.navigability.delta_m, body.max_step_m);
+  memory_.corridor = view.local.navigable;
+  memory_.terrain_occupiable = view.local.occupiable;
+  executive::keep_clear(view.local, view.robot, memory_.others);
+  if (memory_.refused.empty()) return;
+  std::vector<CellIndex> refused;
+  refused.reserve(memory_.refused.size());
+  for (const auto& [cell, until] : memory_.refused) refused.push_back(cell);
+  executive::keep_off(view.local, refused);
 }
 
 bool RampSteps::plan_path(const deliberative::LocalMap& local, BuildTrace& trace) {
@@ -176,7 +194,7 @@ bool RampSteps::plan_path(const deliberative::LocalMap& local, BuildTrace& trace
 
 std::optional<executive::Motion> RampSteps::advance(const deliberative::LocalMap& local,
                                                     const std::vector<CellIndex>& path, Position robot) const {
-  return modules_->actions.advance(local, path, robot, others_);
+  return modules_->actions.advance(local, path, robot, memory_.others);
 }
 
 void RampSteps::clear_pad_gap(deliberative::LocalMap& local) const {
@@ -196,7 +214,7 @@ void RampSteps::count_gap_scans(const deliberative::LocalMap& local, bool scanne
     for (int c = 0; c < local.cols(); ++c) {
       const CellIndex g = local.to_global({r, c});
       if (!(local.gap(r, c) > margin) || !map.hit_within(g, kFreshScans)) continue;
-      GapStreak& streak = gap_streaks_[static_cast<std::size_t>(g.row) * cols + g.col];
+      GapStreak& streak = memory_.gap_streaks[static_cast<std::size_t>(g.row) * cols + g.col];
       streak.scans = streak.last_scan == map.scans() - 1 ? streak.scans + 1 : 1;
       streak.last_scan = map.scans();
     }
@@ -208,7 +226,7 @@ void RampSteps::clear_unconfirmed_gap(deliberative::LocalMap& local) const {
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c) {
       const CellIndex g = local.to_global({r, c});
-      const GapStreak& streak = gap_streaks_[static_cast<std::size_t>(g.row) * cols + g.col];
+      const GapStreak& streak = memory_.gap_streaks[static_cast<std::size_t>(g.row) * cols + g.col];
       if (streak.last_scan != map.scans() || streak.scans < kConfirmScans) local.gap(r, c) = 0.0;
     }
 }
@@ -220,20 +238,21 @@ void RampSteps::set_lane(double offset_m, double corridor_width_m) {
 
 std::vector<CellIndex> RampSteps::in_lane(const deliberative::LocalMap& local,
                                           const std::vector<CellIndex>& path) const {
-  if (!(lane_offset_m_ > 0.0) || corridor_.rows() != local.rows() || corridor_.cols() != local.cols()) return path;
-  return executive::lane_path(local, corridor_, path, lane_offset_m_, corridor_width_m_);
+  if (!(lane_offset_m_ > 0.0) || memory_.corridor.rows() != local.rows() || memory_.corridor.cols() != local.cols())
+    return path;
+  return executive::lane_path(local, memory_.corridor, path, lane_offset_m_, corridor_width_m_);
 }
 
-void RampSteps::move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) const {
+void RampSteps::move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) {
   trace.motion = motion;
-  sent_motion_ = modules_->map.geometry().cell_at(motion.target);
+  memory_.sent.motion = modules_->map.geometry().cell_at(motion.target);
   request.move = true;
   request.target_x_m = motion.target.x;
   request.target_y_m = motion.target.y;
 }
 
 void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position at,
-                        std::size_t from, BuildTrace& trace, protocol::ActionRequest& request) const {
+                        std::size_t from, BuildTrace& trace, protocol::ActionRequest& request) {
   // The path from where the robot will stand: the cells it leaves behind are its way back, not work.
   const auto& path = trace.plan.path;
   const std::vector<CellIndex> ahead(path.begin() + static_cast<std::ptrdiff_t>(std::min(from, path.size())),
@@ -241,23 +260,23 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
   // Depositions are judged on the terrain alone (what stays occupiable and connected), not on where the other
   // robots stand this step: the masks before the neighbours were taken out.
   deliberative::LocalMap terrain_only = local;
-  if (terrain_occupiable_.rows() == local.rows() && terrain_occupiable_.cols() == local.cols()) {
-    terrain_only.occupiable = terrain_occupiable_;
-    terrain_only.navigable = corridor_;
+  if (memory_.terrain_occupiable.rows() == local.rows() && memory_.terrain_occupiable.cols() == local.cols()) {
+    terrain_only.occupiable = memory_.terrain_occupiable;
+    terrain_only.navigable = memory_.corridor;
   }
   if (context_.type.sensor.casts_rays()) clear_unconfirmed_gap(terrain_only);
   trace.deposition = modules_->depositor->plan(modules_->depositions, terrain_only, ahead, at, frame.material_m3,
                                                neighbourhood(frame));
   auto& deposits = trace.deposition.deposits;
-  if (deposit_limit_ >= 0 && deposits.size() > static_cast<std::size_t>(deposit_limit_)) {
-    deposits.resize(static_cast<std::size_t>(deposit_limit_));
+  if (memory_.deposit_limit >= 0 && deposits.size() > static_cast<std::size_t>(memory_.deposit_limit)) {
+    deposits.resize(static_cast<std::size_t>(memory_.deposit_limit));
     trace.deposition.volume_m3 = 0.0;
     for (const Deposit& d : deposits) trace.deposition.volume_m3 += d.volume_m3;
   }
   request.depositions = trace.deposition.depositions;
   request.deposits = deposits;
-  sent_layers_ = request.depositions;
-  sent_deposits_ = request.deposits;
+  memory_.sent.layers = request.depositions;
+  memory_.sent.deposits = request.deposits;
 }
 
 std::optional<BuildPhase> RampSteps::build_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,
@@ -271,8 +290,8 @@ std::optional<BuildPhase> RampSteps::build_step(const deliberative::LocalMap& lo
   }
   deposit(local, frame, robot, 0, trace, request);
   if (trace.deposition.any()) return BuildPhase::kBuild;
-  deposited_since_blocked_ = false;
-  idle_retreat_moves_ = 0;
+  memory_.deposited_since_blocked = false;
+  memory_.idle_retreat_moves = 0;
   return retreat_step(local, frame, trace, request);
 }
 
@@ -280,35 +299,35 @@ BuildPhase RampSteps::retreat_step(const deliberative::LocalMap& local, const pr
                                    BuildTrace& trace, protocol::ActionRequest& request) {
   const Position robot{frame.x_m, frame.y_m};
   if (!plan_path(local, trace)) {
-    ++idle_retreat_moves_;
+    ++memory_.idle_retreat_moves;
     return BuildPhase::kRetreat;
   }
   const auto& path = trace.plan.path;
   deposit(local, frame, robot, 0, trace, request);
   if (trace.deposition.any()) {
-    deposited_since_blocked_ = true;
-    idle_retreat_moves_ = 0;
+    memory_.deposited_since_blocked = true;
+    memory_.idle_retreat_moves = 0;
     return BuildPhase::kRetreat;
   }
   // Advance again only once something changed (or after a long idle retreat): advancing onto the cell just left
   // without building would only block again.
-  if (deposited_since_blocked_ || idle_retreat_moves_ >= modules_->max_idle_retreat_moves) {
+  if (memory_.deposited_since_blocked || memory_.idle_retreat_moves >= modules_->max_idle_retreat_moves) {
     if (const auto motion = advance(local, path, robot)) {
       move(*motion, trace, request);
       deposit(local, frame, motion->target, motion->path_index, trace, request);
       return BuildPhase::kAdvance;
     }
-    deposited_since_blocked_ = false;
+    memory_.deposited_since_blocked = false;
   }
   // Step back the way the robot came and fill what comes into reach: the gap where it stood.
-  ++idle_retreat_moves_;
+  ++memory_.idle_retreat_moves;
   const auto motion = step_back(local, robot);
   if (!motion) return BuildPhase::kRetreat;
   move(*motion, trace, request);
   deposit(local, frame, motion->target, 0, trace, request);
   if (trace.deposition.any()) {
-    deposited_since_blocked_ = true;
-    idle_retreat_moves_ = 0;
+    memory_.deposited_since_blocked = true;
+    memory_.idle_retreat_moves = 0;
   }
   return BuildPhase::kRetreat;
 }

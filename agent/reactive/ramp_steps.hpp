@@ -123,7 +123,7 @@ class RampSteps {
   /// `path` moved into this robot's lane on the last look()'s map (unchanged without lanes).
   std::vector<CellIndex> in_lane(const deliberative::LocalMap& local, const std::vector<CellIndex>& path) const;
   /// Requests `motion` and records it.
-  void move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) const;
+  void move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request);
   /// A step back the way the robot came: towards the local origin, or the oldest navigable cell of the trajectory in
   /// the window when the robot stands on the origin, or (it has not moved yet) to the navigable cell farthest from
   /// the local goal; when another robot cuts the way there, towards the navigable cell farthest from the local goal;
@@ -144,8 +144,41 @@ class RampSteps {
 
  private:
   struct Modules;
+  /// How many scans in a row showed a cell's gap (count_gap_scans).
+  struct GapStreak {
+    int last_scan = 0;  ///< the map's scan that last showed the gap
+    int scans = 0;      ///< scans in a row, up to that one, that showed it
+  };
+  /// What the request being built sends (the last move()'s and deposit()'s): for the map once the world accepts it
+  /// (MappingSystem::record_built), for the deposit limit and the refused cells when it refuses it.
+  struct Sent {
+    std::optional<CellIndex> motion;  ///< the world cell the request moves to
+    std::vector<Deposition> layers;
+    std::vector<Deposit> deposits;
+  };
+  /// What the steps remember from one frame to the next.
+  struct Memory {
+    Sent sent;
+    /// The world gives deposits (cube, cone) their shape and may judge one the prediction passed: after a rejected
+    /// request with deposits, the next ones carry at most half as many (none after one), until one is accepted, so a
+    /// mismatch never repeats the same request forever. -1: no limit.
+    int deposit_limit = -1;
+    std::map<CellIndex, std::uint64_t> refused;    ///< motion targets the world refused -> avoided until this step
+    std::vector<GapStreak> gap_streaks;            ///< scanned maps, per world cell (row-major): count_gap_scans()
+    bool deposited_since_blocked = false;          ///< the retreat deposited since the path was last blocked
+    int idle_retreat_moves = 0;                    ///< retreat moves without work since
+    std::vector<executive::BodyClearance> others;  ///< the last frame's neighbours
+    CellMask corridor;                             ///< the last local map's navigable cells, neighbours not taken out
+    CellMask terrain_occupiable;                   ///< and its occupiable cells
+  };
+
+  // look()'s steps, in order.
+  void remember_result(const protocol::SensorFrame& frame);              // what the world made of the last request
+  void update_map(const protocol::SensorFrame& frame);                   // tiles, scan and the ground under the body
+  BuildView synthesize_view(const protocol::SensorFrame& frame);         // target, local map, the gap to work on
+  void keep_clear(const protocol::SensorFrame& frame, BuildView& view);  // the neighbours and the refused cells
   void deposit(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position at, std::size_t from,
-               BuildTrace& trace, protocol::ActionRequest& request) const;
+               BuildTrace& trace, protocol::ActionRequest& request);
   std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
   void clear_pad_gap(deliberative::LocalMap& local) const;  // no work on the base station's pad
   /// A scanned map: counts, per cell of the window, the scans in a row that showed its gap (beyond the margin) on a
@@ -162,28 +195,9 @@ class RampSteps {
   std::unique_ptr<deliberative::GoalSynthesizer> goal_;
   std::unique_ptr<Modules> modules_;  // made on admission, when the grid is known
   CellIndex registration_{0, 0};      // set_registration()
-  bool deposited_since_blocked_ = false;
-  int idle_retreat_moves_ = 0;
-  // The world gives deposits (cube, cone) their shape and may judge one the prediction passed: after a rejected
-  // request with deposits, the next ones carry at most half as many (none after one), until one is accepted, so a
-  // mismatch never repeats the same request forever. -1: no limit.
-  int deposit_limit_ = -1;
-  mutable std::optional<CellIndex> sent_motion_;  // the world cell the request being built moves to
-  struct GapStreak {
-    int last_scan = 0;  // the map's scan that last showed the gap
-    int scans = 0;      // scans in a row, up to that one, that showed it
-  };
-  std::vector<GapStreak> gap_streaks_;                    // scanned maps, per cell (row-major): count_gap_scans()
-  std::map<std::pair<int, int>, std::uint64_t> refused_;  // motion targets the world refused, avoided until a step
-  // What the request being built deposits (the last deposit() call's): for the map once the world accepts it
-  // (MappingSystem::record_built), and for deposit_limit_ when it refuses it.
-  mutable std::vector<Deposition> sent_layers_;
-  mutable std::vector<Deposit> sent_deposits_;
-  std::vector<executive::BodyClearance> others_;  // the last frame's neighbours
-  CellMask corridor_;                             // the last local map's navigable cells, neighbours not taken out
-  CellMask terrain_occupiable_;                   // and its occupiable cells
-  double lane_offset_m_ = 0.0;
+  double lane_offset_m_ = 0.0;        // set_lane()
   double corridor_width_m_ = 0.0;
+  Memory memory_;
 };
 
 }  // namespace marsala::agent::reactive

@@ -3,85 +3,51 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <cmath>
-#include <ctime>
+#include <optional>
 #include <random>
 #include <vector>
 
-#include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/agent/runtime/frame_gate.hpp"
+#include "marsala/agent/runtime/world_watch.hpp"
+#include "marsala/core/cpu_time.hpp"
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/log_pacing.hpp"
+#include "marsala/core/statistics.hpp"
 
 namespace marsala::agent::runtime {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// CPU time of the calling thread so far [ms]: what a decision costs, apart from the other processes' share of the
-/// cores while it ran.
-double thread_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
-}
-
-/// CPU time of this process so far, every thread's (DDS's too) [ms].
-double process_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
-}
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  return *mid;
-}
-/// A frame further ahead of the last step answered is not the world's: no run goes on for a million steps while an
-/// agent waits for its next frame.
-constexpr std::uint64_t kMaxStepsAhead = 1000000;
-
-/// Empty when a frame addressed to this agent can be trusted to describe the world of `assignment`: a finite pose on
-/// the grid, finite height and material, tiles that fit the grid, a scan only for a scanning sensor with points within
-/// its reach, finite neighbours; otherwise the problem. A frame
-/// with a problem is ignored whole, before any of it reaches the behaviour (which would throw half-way through).
-std::string frame_problem(const protocol::SensorFrame& f, const Assignment& assignment, const SensorSpec& sensor) {
-  const auto sane = [](double v) { return std::isfinite(v) && std::abs(v) < kMaxMagnitude; };
-  if (!sane(f.x_m) || !sane(f.y_m) || !assignment.world.cell_at({f.x_m, f.y_m}))
-    return fmt::format("pose ({}, {}) m is not on the grid", f.x_m, f.y_m);
-  if (!sane(f.z_m) || !sane(f.material_m3) || f.material_m3 < 0.0)
-    return fmt::format("height {} m or material {} m^3 is not a finite amount", f.z_m, f.material_m3);
-  for (const TerrainTile& tile : f.tiles) {
-    const std::string problem = executive::tile_problem(tile, assignment.world, assignment.tile_size);
-    if (!problem.empty()) return problem;
-  }
-  if (!f.scanned && !f.points.empty()) return fmt::format("{} scan points in a frame without a scan", f.points.size());
-  if (f.scanned && !sensor.casts_rays()) return fmt::format("a scan for a robot whose sensor is '{}'", to_string(sensor.kind));
-  const std::string scan = executive::scan_problem(f.points, sensor);
-  if (!scan.empty()) return scan;
-  for (const Neighbour& n : f.neighbours) {
-    if (!sane(n.position.x) || !sane(n.position.y) || !sane(n.z_m))
-      return fmt::format("neighbour {} at ({}, {}, {}) m is not finite", n.agent_id, n.position.x, n.position.y, n.z_m);
-    if (!(n.radius_m >= 0.0 && n.radius_m <= 1e3))
-      return fmt::format("neighbour {} has a body radius of {} m, not in [0, 1000] m", n.agent_id, n.radius_m);
-  }
-  return {};
-}
-
 /// The longest a wait lasts before the stop flag is looked at again.
 constexpr std::chrono::milliseconds kStopPoll{100};
-// How long the world's frame writer may stay not alive before the agent concludes that the world is gone: longer
-// than the pauses a world must survive (5 s, docs/runtime.md#dropping-agents), so an agent learns of a dead world
-// within about 7 s (the 1 s DDS lease, then this) instead of world_timeout.
-constexpr std::chrono::seconds kWorldGrace{6};
-// A gap between two turns of the agent's loop this long means the process itself did not run.
-constexpr std::chrono::seconds kProcessPause{1};
-// How long without a frame before the agent says hello again: the world answers whether it still counts the agent
-// in (a pause longer than the world's grace dropped it; docs/runtime.md#re-admission), so a dropped agent learns it
-// within about this long after it runs again, and is re-admitted where the rules allow.
-constexpr std::chrono::seconds kRehelloAfter{2};
+
+/// What the behaviour's decisions cost: each decision's CPU time on this thread (apart from the other processes' share
+/// of the cores while it ran), and the process's CPU time, every thread's (DDS's too), from the first decision on.
+class DecisionCosts {
+ public:
+  /// Runs `decide` and records its cost.
+  template <typename Decide>
+  auto measure(Decide decide) {
+    if (!process_at_first_ms_) process_at_first_ms_ = process_cpu_ms();
+    const double began = thread_cpu_ms();
+    auto decision = decide();
+    decision_ms_.push_back(thread_cpu_ms() - began);
+    return decision;
+  }
+  /// The median decision [ms]; 0 before the first.
+  double median_ms() const { return median(decision_ms_); }
+  /// The process's CPU time since the first decision, per request sent [ms]; 0 when none was sent.
+  double process_ms_per(std::uint64_t requests) const {
+    if (requests == 0 || !process_at_first_ms_) return 0.0;
+    return (process_cpu_ms() - *process_at_first_ms_) / static_cast<double>(requests);
+  }
+
+ private:
+  std::vector<double> decision_ms_;            // [ms]
+  std::optional<double> process_at_first_ms_;  // [ms]
+};
 
 }  // namespace
 
@@ -105,7 +71,7 @@ std::uint64_t random_session() {
 AgentRuntime::AgentRuntime(bus::Participant& participant, RuntimeConfig config)
     : participant_(participant), config_(std::move(config)) {
   if (config_.hello_period.count() <= 0 || config_.admit_timeout.count() <= 0 || config_.world_timeout.count() <= 0)
-    throw InvalidArgument("agent " + std::to_string(config_.agent_id) + ": hello period and timeouts must be positive");
+    throw InvalidArgument(fmt::format("agent {}: hello period and timeouts must be positive", config_.agent_id));
   if (config_.session == 0) config_.session = random_session();
   // Made at once, so that an unknown behaviour fails before any traffic; an agent that asks for any slot (agent_id
   // 0) makes it again once its admission names the slot.
@@ -114,7 +80,7 @@ AgentRuntime::AgentRuntime(bus::Participant& participant, RuntimeConfig config)
 
 void AgentRuntime::make_behaviour() {
   if (config_.name.empty() && config_.agent_id != 0)
-    config_.name = (config_.type.name.empty() ? "agent" : config_.type.name) + "-" + std::to_string(config_.agent_id);
+    config_.name = fmt::format("{}-{}", config_.type.name.empty() ? "agent" : config_.type.name, config_.agent_id);
   AgentContext context;
   context.agent_id = config_.agent_id;
   context.session = config_.session;
@@ -130,14 +96,6 @@ void AgentRuntime::make_behaviour() {
 
 AgentRuntime::~AgentRuntime() = default;
 
-RunResult AgentRuntime::run(const std::atomic<bool>& stop) {
-  RunResult result;
-  protocol::Admission admission;
-  if (admit(stop, result, admission)) lockstep(stop, admission, result);
-  result.final_state = behaviour_->state_name();
-  return result;
-}
-
 bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, protocol::Admission& admission) {
   admission_signal_ = std::make_shared<bus::Signal>();
   hellos_ = participant_.create_writer<protocol::AgentHello>({"", nullptr, bus::Durability::kVolatile, 64});
@@ -149,7 +107,9 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
   protocol::AgentHello& hello = hello_;
   hello.agent_id = config_.agent_id;
   hello.session = config_.session;
-  hello.name = config_.agent_id != 0 ? config_.name : config_.name.empty() ? config_.type.name + "-any" : config_.name;
+  hello.name = config_.agent_id != 0  ? config_.name
+               : config_.name.empty() ? fmt::format("{}-any", config_.type.name)
+                                      : config_.name;
   hello.behaviour = config_.type.behaviour;
   hello.body = config_.type.body;
   spdlog::info("agent {} ({}, {}): saying hello, session {:016x}", config_.agent_id, config_.name,
@@ -176,7 +136,7 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
       if (a.session != config_.session || (!any_slot && a.agent_id != config_.agent_id)) continue;  // not ours
       if (!a.accepted) {
         result.outcome = RunOutcome::kRefused;
-        result.message = "refused by the world: " + a.reason;
+        result.message = fmt::format("refused by the world: {}", a.reason);
         return false;
       }
       if (any_slot) {
@@ -204,157 +164,164 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
   return false;
 }
 
-void AgentRuntime::lockstep(const std::atomic<bool>& stop, const protocol::Admission& admission, RunResult& result) {
-  const std::string partition = protocol::partition_for(admission.run_id, config_.agent_id, config_.session);
-  auto signal = std::make_shared<bus::Signal>();
-  auto frames = participant_.create_reader<protocol::SensorFrame>({partition, signal, bus::Durability::kVolatile, 64});
-  auto requests =
-      participant_.create_writer<protocol::ActionRequest>({partition, nullptr, bus::Durability::kVolatile, 64});
-  bool answered_any = false;
-  std::uint64_t last_answered = 0;
-  protocol::ActionRequest last_request;  // repeated when the world sends the frame of its step again
-  Clock::time_point last_frame_at = Clock::now();
-  Clock::time_point next_hello = last_frame_at + kRehelloAfter;
-  bool asked = false;  // a hello went out since the last frame
-  Clock::time_point deadline = Clock::now() + config_.world_timeout;
-  // Signs that the world lives: a frame, an answer to a hello (the world answers while it waits for a slow agent,
-  // whose step can last the whole deadline) or its frame writer's DDS liveliness. A frame or an answer spares the
-  // DDS status query on the per-step path.
-  bool world_seen = false;
-  bool sign_since_check = false;
-  std::vector<double> decision_cpu_ms;  // CPU time of each decision [ms]
-  double cpu_at_first_frame = 0.0;      // process CPU time when the first decision began [ms]
-  Clock::time_point last_sign = Clock::now();
-  Clock::time_point last_turn = last_sign;
-  while (!stop.load()) {
-    const Clock::time_point now = Clock::now();
-    // A turn of this loop takes at most kStopPoll: a much longer gap means this process was not running (stopped,
-    // starved), and what it could not see is no sign that the world is gone; its DDS readers may still hold the
-    // world's writer as not alive until the next lease renewal, so the world gets a fresh grace period.
-    // It also asks the world at once whether it still counts this agent in: frames queued before the pause may still
-    // arrive and look fresh, while the world may have dropped it meanwhile (docs/runtime.md#re-admission).
-    const bool was_paused = now - last_turn >= kProcessPause;
-    if (was_paused) last_sign = now;
-    if (sign_since_check || frames->alive_writers() >= 1) {
-      sign_since_check = false;
-      world_seen = true;
-      last_sign = now;
-    } else if (world_seen && now - last_sign >= kWorldGrace) {
-      result.outcome = RunOutcome::kWorldGone;
-      result.message =
+/// One admitted run's lockstep (docs/runtime.md#lockstep): the agent's partition, whether the world is still there
+/// (the world watch), which frame is taken (the frame gate), and one decision per new step.
+class AgentRuntime::Lockstep {
+ public:
+  Lockstep(AgentRuntime& agent, const protocol::Admission& admission, RunResult& result)
+      : agent_(agent),
+        admission_(admission),
+        result_(result),
+        partition_(protocol::partition_for(admission.run_id, agent.config_.agent_id, agent.config_.session)),
+        signal_(std::make_shared<bus::Signal>()),
+        frames_(agent.participant_.create_reader<protocol::SensorFrame>(
+            {partition_, signal_, bus::Durability::kVolatile, 64})),
+        requests_(agent.participant_.create_writer<protocol::ActionRequest>(
+            {partition_, nullptr, bus::Durability::kVolatile, 64})),
+        gate_(agent.config_.agent_id, agent.assignment_, agent.config_.type.sensor, agent.world_),
+        watch_(Clock::now(), agent.config_.world_timeout, agent.config_.hello_period) {}
+
+  /// Until the run is over, the world is gone, silent or no longer counts this agent in, or `stop`.
+  void run(const std::atomic<bool>& stop) {
+    while (!stop.load()) {
+      const Clock::time_point now = Clock::now();
+      if (!world_still_there(now) || !still_counted_in()) return;
+      signal_->wait_until(std::min(watch_.wake_by(), now + kStopPoll));
+      for (const bus::Received<protocol::SensorFrame>& received : frames_->take_received())
+        if (take(received)) return;
+    }
+    result_.outcome = RunOutcome::kStopped;
+    result_.message = fmt::format("stopped at step {}", result_.last_step);
+  }
+
+ private:
+  std::uint32_t id() const { return agent_.config_.agent_id; }
+
+  /// The world watch's turn: false (and the outcome) when the world is gone or silent; says hello when it asks.
+  bool world_still_there(Clock::time_point now) {
+    const WatchTurn turn = watch_.turn(now, [this] { return frames_->alive_writers() >= 1; });
+    if (turn.state == WorldState::kWorldGone) {
+      result_.outcome = RunOutcome::kWorldGone;
+      result_.message =
           fmt::format("the world is gone: no frame, no answer and its frame writer not alive for {} s (last step {})",
-                      std::chrono::duration<double>(now - last_sign).count(), result.last_step);
-      return;
+                      turn.silent_s, result_.last_step);
+      return false;
     }
-    if (now >= deadline) {
-      result.outcome = RunOutcome::kWorldTimeout;
-      result.message = fmt::format("no sensor frame for {} s (last step {})", config_.world_timeout.count() / 1000.0,
-                                   result.last_step);
-      return;
+    if (turn.state == WorldState::kWorldTimeout) {
+      result_.outcome = RunOutcome::kWorldTimeout;
+      result_.message = fmt::format("no sensor frame for {} s (last step {})",
+                                    agent_.config_.world_timeout.count() / 1000.0, result_.last_step);
+      return false;
     }
-    if (was_paused) {
-      spdlog::info("agent {}: this process did not run for {} s; asking the world whether it still counts this agent in",
-                   config_.agent_id, std::chrono::duration<double>(now - last_turn).count());
-      hellos_->write(hello_);
-      asked = true;
-      next_hello = now + config_.hello_period;
-    }
-    last_turn = now;
-    if (now - last_frame_at >= kRehelloAfter && now >= next_hello) {
-      if (!asked)
-        spdlog::info("agent {}: no frame for {} s; asking the world whether it still counts this agent in",
-                     config_.agent_id, std::chrono::duration<double>(now - last_frame_at).count());
-      hellos_->write(hello_);
-      asked = true;
-      next_hello = now + config_.hello_period;
-    }
-    for (const bus::Received<protocol::Admission>& received : admissions_->take_received()) {
+    if (turn.paused_s)
+      spdlog::info(
+          "agent {}: this process did not run for {} s; asking the world whether it still counts this agent in", id(),
+          *turn.paused_s);
+    if (turn.no_frame_s)
+      spdlog::info("agent {}: no frame for {} s; asking the world whether it still counts this agent in", id(),
+                   *turn.no_frame_s);
+    if (turn.hello) agent_.hellos_->write(agent_.hello_);
+    return true;
+  }
+
+  /// The world's answers to this agent's hellos: false (and the outcome) when it no longer counts the agent in.
+  bool still_counted_in() {
+    const RuntimeConfig& config = agent_.config_;
+    for (const bus::Received<protocol::Admission>& received : agent_.admissions_->take_received()) {
       const protocol::Admission& a = received.sample;
-      if (a.agent_id != config_.agent_id || a.session != config_.session || !asked) continue;
+      if (a.agent_id != config.agent_id || a.session != config.session || !watch_.asked()) continue;
       // Another participant answering: the world was restarted from its log (docs/runtime.md#resume), and frames now
       // come from it; or a stranger, which only a stop of the world's frames lets in (asked), and only for this run.
-      if (received.from != world_) {
-        if (!a.accepted || a.run_id != admission.run_id) continue;
-        spdlog::info("agent {}: the world of run '{}' answers from participant {} now (was {})", config_.agent_id,
-                     a.run_id, received.from.to_string(), world_.to_string());
-        world_ = received.from;
+      if (received.from != gate_.world()) {
+        if (!a.accepted || a.run_id != admission_.run_id) continue;
+        spdlog::info("agent {}: the world of run '{}' answers from participant {} now (was {})", id(), a.run_id,
+                     received.from.to_string(), gate_.world().to_string());
+        gate_.set_world(received.from);
       }
-      sign_since_check = true;
+      watch_.answered();
       if (!a.accepted) {
-        result.outcome = RunOutcome::kRefused;
-        result.message = "the world no longer counts this agent in: " + a.reason;
-        return;
+        result_.outcome = RunOutcome::kRefused;
+        result_.message = fmt::format("the world no longer counts this agent in: {}", a.reason);
+        return false;
       }
     }
-    signal->wait_until(std::min({deadline, now + kStopPoll, asked ? next_hello : now + kStopPoll}));
-    for (const bus::Received<protocol::SensorFrame>& received : frames->take_received()) {
-      const protocol::SensorFrame& frame = received.sample;
-      // Only the world that admitted this agent speaks for the run; what it sends must make sense.
-      std::string why;
-      if (received.from != world_)
-        why = "written by participant " + received.from.to_string() + ", not by the world this agent was admitted "
-              "to (" + world_.to_string() + ")";
-      else if (frame.agent_id != config_.agent_id)
-        why = "addressed to agent " + std::to_string(frame.agent_id);
-      else if (answered_any && frame.step > last_answered && frame.step - last_answered > kMaxStepsAhead)
-        why = fmt::format("step {} is more than {} steps ahead of the last one answered ({})", frame.step,
-                          kMaxStepsAhead, last_answered);
-      else
-        why = frame_problem(frame, assignment_, config_.type.sensor);
-      if (!why.empty()) {
-        if (power_of_ten(++result.ignored_frames))
-          spdlog::warn("agent {}: ignoring a frame ({} so far): {}", config_.agent_id, result.ignored_frames, why);
-        continue;
-      }
-      ++result.frames;
-      sign_since_check = true;
-      last_frame_at = Clock::now();
-      if (asked) spdlog::info("agent {}: frames again at step {}", config_.agent_id, frame.step);
-      asked = false;
-      result.last_step = frame.step;
-      deadline = Clock::now() + config_.world_timeout;
-      if (frame.last_result == protocol::ActionResult::kRejected) {
-        ++result.rejected;
-        spdlog::warn("agent {}: request before step {} rejected: {}", config_.agent_id, frame.step, frame.last_reason);
-      }
-      if (frame.run_over) {
-        behaviour_->decide(frame);
-        result.outcome = RunOutcome::kRunOver;
-        result.message = "run over at step " + std::to_string(frame.step);
-        result.decision_cpu_median_ms = median(decision_cpu_ms);
-        if (result.requests > 0)
-          result.cpu_ms_per_step = (process_cpu_ms() - cpu_at_first_frame) / static_cast<double>(result.requests);
-        spdlog::info("agent {}: {} ({} requests, {} rejected, {} frames ignored; decision CPU median {:.3f} ms, "
-                     "process CPU {:.3f} ms per step)",
-                     config_.agent_id, result.message, result.requests, result.rejected, result.ignored_frames,
-                     result.decision_cpu_median_ms, result.cpu_ms_per_step);
-        return;
-      }
-      if (answered_any && frame.step == last_answered) {
+    return true;
+  }
+
+  /// One received frame through the gate; true when the run is over.
+  bool take(const bus::Received<protocol::SensorFrame>& received) {
+    const protocol::SensorFrame& frame = received.sample;
+    const FrameJudgement judgement = gate_.judge(frame, received.from);
+    if (judgement.call == FrameCall::kIgnored) {
+      if (power_of_ten(++result_.ignored_frames))
+        spdlog::warn("agent {}: ignoring a frame ({} so far): {}", id(), result_.ignored_frames, judgement.problem);
+      return false;
+    }
+    ++result_.frames;
+    if (watch_.frame(Clock::now())) spdlog::info("agent {}: frames again at step {}", id(), frame.step);
+    result_.last_step = frame.step;
+    if (frame.last_result == protocol::ActionResult::kRejected) {
+      ++result_.rejected;
+      spdlog::warn("agent {}: request before step {} rejected: {}", id(), frame.step, frame.last_reason);
+    }
+    switch (judgement.call) {
+      case FrameCall::kRunOver: run_over(frame); return true;
+      case FrameCall::kRepeat:
         // The world did not get (or not yet) the answer: the same request again, never a second decision.
-        spdlog::debug("agent {}: the frame of step {} again; repeating its request", config_.agent_id, frame.step);
-        requests->write(last_request);
-        continue;
-      }
-      if (answered_any && frame.step < last_answered) {
-        spdlog::warn("agent {}: ignoring a stale frame for step {}", config_.agent_id, frame.step);
-        continue;
-      }
-      const std::string before = behaviour_->state_name();
-      if (!answered_any) cpu_at_first_frame = process_cpu_ms();
-      const double decision_began = thread_cpu_ms();
-      last_request = behaviour_->decide(frame);
-      decision_cpu_ms.push_back(thread_cpu_ms() - decision_began);
-      requests->write(last_request);
-      ++result.requests;
-      answered_any = true;
-      last_answered = frame.step;
-      if (behaviour_->state_name() != before)
-        spdlog::debug("agent {}: step {}: {} -> {}", config_.agent_id, frame.step, before, behaviour_->state_name());
+        spdlog::debug("agent {}: the frame of step {} again; repeating its request", id(), frame.step);
+        requests_->write(gate_.last_request());
+        return false;
+      case FrameCall::kStale:
+        spdlog::warn("agent {}: ignoring a stale frame for step {}", id(), frame.step);
+        return false;
+      default: decide(frame); return false;
     }
   }
-  result.outcome = RunOutcome::kStopped;
-  result.message = "stopped at step " + std::to_string(result.last_step);
+
+  /// A new step: the behaviour's decision, sent.
+  void decide(const protocol::SensorFrame& frame) {
+    reactive::Behaviour& behaviour = *agent_.behaviour_;
+    const std::string before = behaviour.state_name();
+    protocol::ActionRequest request = costs_.measure([&] { return behaviour.decide(frame); });
+    requests_->write(request);
+    ++result_.requests;
+    gate_.answered(frame.step, std::move(request));
+    if (behaviour.state_name() != before)
+      spdlog::debug("agent {}: step {}: {} -> {}", id(), frame.step, before, behaviour.state_name());
+  }
+
+  /// The run-over frame: the behaviour sees it, the run's costs are reported.
+  void run_over(const protocol::SensorFrame& frame) {
+    agent_.behaviour_->decide(frame);
+    result_.outcome = RunOutcome::kRunOver;
+    result_.message = fmt::format("run over at step {}", frame.step);
+    result_.decision_cpu_median_ms = costs_.median_ms();
+    result_.cpu_ms_per_step = costs_.process_ms_per(result_.requests);
+    spdlog::info(
+        "agent {}: {} ({} requests, {} rejected, {} frames ignored; decision CPU median {:.3f} ms, "
+        "process CPU {:.3f} ms per step)",
+        id(), result_.message, result_.requests, result_.rejected, result_.ignored_frames,
+        result_.decision_cpu_median_ms, result_.cpu_ms_per_step);
+  }
+
+  AgentRuntime& agent_;
+  const protocol::Admission& admission_;
+  RunResult& result_;
+  std::string partition_;
+  std::shared_ptr<bus::Signal> signal_;
+  std::unique_ptr<bus::Reader<protocol::SensorFrame>> frames_;
+  std::unique_ptr<bus::Writer<protocol::ActionRequest>> requests_;
+  FrameGate gate_;
+  WorldWatch watch_;
+  DecisionCosts costs_;
+};
+
+RunResult AgentRuntime::run(const std::atomic<bool>& stop) {
+  RunResult result;
+  protocol::Admission admission;
+  if (admit(stop, result, admission)) Lockstep(*this, admission, result).run(stop);
+  result.final_state = behaviour_->state_name();
+  return result;
 }
 
 }  // namespace marsala::agent::runtime

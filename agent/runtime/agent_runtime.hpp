@@ -83,7 +83,7 @@ class AgentRuntime {
  private:
   bool admit(const std::atomic<bool>& stop, RunResult& result, protocol::Admission& admission);
   void make_behaviour();
-  void lockstep(const std::atomic<bool>& stop, const protocol::Admission& admission, RunResult& result);
+  class Lockstep;  // the loop after admission, in agent_runtime.cpp
 
   bus::Participant& participant_;
   RuntimeConfig config_;
@@ -91,7 +91,8 @@ class AgentRuntime {
   std::shared_ptr<bus::Signal> admission_signal_;
   std::unique_ptr<bus::Writer<protocol::AgentHello>> hellos_;
   std::unique_ptr<bus::Reader<protocol::Admission>> admissions_;
-  bus::WriterId world_;  ///< the participant whose admission let this agent in: frames come from it alone
+  bus::WriterId
+      world_;  ///< the participant whose admission let this agent in (the lockstep's frame gate takes frames from it)
   Assignment assignment_;
   std::unique_ptr<reactive::Behaviour> behaviour_;
 };

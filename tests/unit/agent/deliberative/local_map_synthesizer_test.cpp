@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/iterators.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
@@ -53,7 +54,7 @@ TEST(LocalMapSynthesizer, WindowGapAndNavigabilityMatchReferences) {
   executive::MappingSystem map = test::full_map(h);
   map.record_pose(kRobot);
   const LocalMapSynthesizer synthesizer(kBody, 1.0);
-  const LocalMap local = synthesizer.synthesize(map, kRobot, {4.55, 2.95});
+  const LocalMap local = synthesizer.synthesize(map.known_map(), kRobot, {4.55, 2.95});
   EXPECT_EQ(local.offset, (CellIndex{20, 30}));
   ASSERT_EQ(local.rows(), 21);
   ASSERT_EQ(local.cols(), 21);
@@ -74,25 +75,51 @@ TEST(LocalMapSynthesizer, WindowGapAndNavigabilityMatchReferences) {
   EXPECT_GT(local.navigable.cast<int>().sum(), 300);
 }
 
+TEST(LocalMapSynthesizer, OccupiableIsTheWorldsSingleCellAnswer) {
+  // A ramp at exactly slope kappa with a step of exactly eps halfway, beside the bumps and the block: the pairs across
+  // the step are ties (|dh| = eps + kappa |r - q|). The agent judges each cell of its window as the world judges one
+  // cell (core cell_occupiable) on the same heights, and a cell whose ball lies inside the window as the world judges
+  // it on the whole terrain.
+  Heightmap h = bumpy_terrain();
+  for (int r = 30; r < 40; ++r)
+    for (int c = 30; c < 40; ++c) h(r, c) = kBody.kappa * 0.1 * (c - 30) + (c >= 35 ? kBody.eps_m : 0.0);
+  executive::MappingSystem map = test::full_map(h);
+  map.record_pose(kRobot);
+  const LocalMap local = LocalMapSynthesizer(kBody, 1.0).synthesize(map.known_map(), kRobot, {4.55, 2.95});
+  const int ball = 2;  // delta / 2 = 0.2 m = 2 cells
+  int inside = 0, not_occupiable = 0;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      const bool agent = local.occupiable(r, c) != 0;
+      EXPECT_EQ(agent, cell_occupiable(local.heights, {r, c}, kBody, OccupancyMethod::kPairs)) << r << ", " << c;
+      not_occupiable += !agent;
+      if (r < ball || c < ball || r >= local.rows() - ball || c >= local.cols() - ball) continue;
+      ++inside;
+      EXPECT_EQ(agent, cell_occupiable(h, local.to_global({r, c}), kBody)) << r << ", " << c;
+    }
+  EXPECT_EQ(inside, 17 * 17);
+  EXPECT_GT(not_occupiable, 10);  // the block and the bumps' steps are judged, not only flat ground
+}
+
 TEST(LocalMapSynthesizer, LocalGoalIsTheTargetInsideOrWhereTheLineLeaves) {
   const executive::MappingSystem map = test::full_map(Heightmap(kWorld, 0.0));
   const LocalMapSynthesizer synthesizer(kBody, 1.0);
   // Inside: the target's own cell (32, 45).
-  LocalMap local = synthesizer.synthesize(map, kRobot, {4.55, 2.75});
+  LocalMap local = synthesizer.synthesize(map.known_map(), kRobot, {4.55, 2.75});
   EXPECT_EQ(local.to_global(local.goal), (CellIndex{32, 45}));
   EXPECT_TRUE(local.goal_is_target);
   // Due east and off the grid: the line leaves at x = 5.05 on the robot's row -> (30, 50).
-  local = synthesizer.synthesize(map, kRobot, {10.0, 2.95});
+  local = synthesizer.synthesize(map.known_map(), kRobot, {10.0, 2.95});
   EXPECT_EQ(local.to_global(local.goal), (CellIndex{30, 50}));
   EXPECT_FALSE(local.goal_is_target);
   // East-north-east: dx = 3, dy = 1.5 leaves the east side at t = 1/3, y = 3.45 -> row 59 - 34 = 25.
-  local = synthesizer.synthesize(map, kRobot, {7.05, 4.45});
+  local = synthesizer.synthesize(map.known_map(), kRobot, {7.05, 4.45});
   EXPECT_EQ(local.to_global(local.goal), (CellIndex{25, 50}));
   // Due south-west through the corner of the window: (40, 30).
-  local = synthesizer.synthesize(map, kRobot, {2.05, 0.95});
+  local = synthesizer.synthesize(map.known_map(), kRobot, {2.05, 0.95});
   EXPECT_EQ(local.to_global(local.goal), (CellIndex{40, 30}));
   // A target on a cell boundary maps through the world grid: x = 4.5 lies in col 45 for the world.
-  local = synthesizer.synthesize(map, kRobot, {4.5, 2.95});
+  local = synthesizer.synthesize(map.known_map(), kRobot, {4.5, 2.95});
   EXPECT_EQ(local.to_global(local.goal), *kWorld.cell_at({4.5, 2.95}));
 }
 
@@ -103,7 +130,7 @@ TEST(LocalMapSynthesizer, LocalOriginIsTheTrajectoryCellNearestTheBoundary) {
   // west side (x = 3.05 = 4.05 - 1).
   for (int c = 10; c <= 40; ++c) map.record_pose(kWorld.cell_center({30, c}));
   const LocalMapSynthesizer synthesizer(kBody, 1.0);
-  LocalMap local = synthesizer.synthesize(map, kRobot, {7.0, 2.95});
+  LocalMap local = synthesizer.synthesize(map.known_map(), kRobot, {7.0, 2.95});
   ASSERT_TRUE(local.origin.has_value());
   EXPECT_EQ(local.to_global(*local.origin), (CellIndex{30, 30}));
 
@@ -112,7 +139,7 @@ TEST(LocalMapSynthesizer, LocalOriginIsTheTrajectoryCellNearestTheBoundary) {
   tie.record_pose(kWorld.cell_center({20, 40}));
   tie.record_pose(kWorld.cell_center({30, 30}));
   tie.record_pose(kRobot);
-  local = synthesizer.synthesize(tie, kRobot, {7.0, 2.95});
+  local = synthesizer.synthesize(tie.known_map(), kRobot, {7.0, 2.95});
   EXPECT_EQ(local.to_global(*local.origin), (CellIndex{20, 40}));
 
   // A wall across row 30 at cols 33..34 (and rows 20..40) cuts cols 30..32 off: the nearest navigable cell wins.
@@ -120,7 +147,7 @@ TEST(LocalMapSynthesizer, LocalOriginIsTheTrajectoryCellNearestTheBoundary) {
     for (int c = 33; c <= 34; ++c) h(r, c) = 2.0;
   executive::MappingSystem walled = test::full_map(h);
   for (int c = 10; c <= 40; ++c) walled.record_pose(kWorld.cell_center({30, c}));
-  local = synthesizer.synthesize(walled, kRobot, {7.0, 2.95});
+  local = synthesizer.synthesize(walled.known_map(), kRobot, {7.0, 2.95});
   ASSERT_TRUE(local.origin.has_value());
   EXPECT_EQ(local.navigable(local.origin->row, local.origin->col), 1);
   // Col 37 is the first east of the wall whose ball (radius 2 cells) holds no wall cell.
@@ -135,7 +162,7 @@ TEST(LocalMapSynthesizer, UnknownCellsAreNeverOccupiableNorTargets) {
     for (int tc = 2; tc <= 3; ++tc) map.integrate_tile(test::cut_tile(h, 16, tr, tc));
   map.record_pose(kRobot);
   const LocalMapSynthesizer synthesizer(kBody, 1.0);
-  const LocalMap local = synthesizer.synthesize(map, kRobot, {7.0, 2.95});
+  const LocalMap local = synthesizer.synthesize(map.known_map(), kRobot, {7.0, 2.95});
   // Window cols 30..50: cols 30, 31 unknown. Ball radius 2 cells: cols 30..33 are blind.
   for (int r = 0; r < local.rows(); ++r) {
     for (int c = 0; c < local.cols(); ++c) {
@@ -169,7 +196,7 @@ TEST(LocalMapSynthesizer, ScannedMapsNeverLetTheRobotOntoUnknownCells) {
   ASSERT_GT(map.known_cells(), 500);
   ASSERT_LT(map.known_cells(), kWorld.size());
   const LocalMapSynthesizer synthesizer(kBody, 2.5);
-  const LocalMap local = synthesizer.synthesize(map, kRobot, {7.0, 2.95});
+  const LocalMap local = synthesizer.synthesize(map.known_map(), kRobot, {7.0, 2.95});
   const auto ball = disc_offsets(kBody.delta_m / (2.0 * kWorld.cell_size_m));
   long long unknown = 0, navigable = 0;
   for (int r = 0; r < local.rows(); ++r)
@@ -214,7 +241,8 @@ TEST(LocalMapSynthesizer, AScannedMapsGoalAndPathAvoidCellsItCannotJudge) {
       if (!(r == 31 && c == 64)) map.assume_ground(kWorld.cell_center({r, c}), 0.0, 0.0);
   map.record_pose(kRobot);
   const LocalMapSynthesizer synthesizer(kBody, 2.5);                         // ball radius 2 cells; window cols 15..65
-  const LocalMap local = synthesizer.synthesize(map, kRobot, {7.05, 2.95});  // the target (30, 70), off the window
+  const LocalMap local =
+      synthesizer.synthesize(map.known_map(), kRobot, {7.05, 2.95});  // the target (30, 70), off the window
   const CellIndex exit = local.to_local({30, 65});
   ASSERT_EQ(local.blind(exit.row, exit.col), 1);  // (31, 64) lies within its ball
   // Judged cells reachable through judged cells end before the hole: (29, 64), (30, 63) and (31, 63) hold it in
@@ -235,7 +263,7 @@ TEST(LocalMapSynthesizer, AScannedMapsGoalAndPathAvoidCellsItCannotJudge) {
   executive::MappingSystem small(kWorld, 16, sensor_defaults(SensorKind::kLaser));
   for (const CellIndex o : disc_offsets(2.0))
     small.assume_ground(kWorld.cell_center({30 + o.row, 40 + o.col}), 0.0, 0.0);
-  const LocalMap boxed = synthesizer.synthesize(small, kRobot, {7.05, 2.95});
+  const LocalMap boxed = synthesizer.synthesize(small.known_map(), kRobot, {7.05, 2.95});
   ASSERT_EQ(boxed.blind(boxed.robot.row, boxed.robot.col), 0);
   EXPECT_EQ(boxed.to_global(boxed.goal), (CellIndex{30, 42}));
   EXPECT_EQ(boxed.passable, boxed.known);
@@ -244,7 +272,7 @@ TEST(LocalMapSynthesizer, AScannedMapsGoalAndPathAvoidCellsItCannotJudge) {
   executive::MappingSystem exact(kWorld, 16);
   for (int r = 27; r <= 33; ++r)
     for (int c = 25; c < 80; ++c) exact.assume_ground(kWorld.cell_center({r, c}), 0.0, 0.0);
-  const LocalMap whole = synthesizer.synthesize(exact, kRobot, {7.05, 2.95});
+  const LocalMap whole = synthesizer.synthesize(exact.known_map(), kRobot, {7.05, 2.95});
   EXPECT_EQ(whole.to_global(whole.goal), (CellIndex{30, 65}));
   EXPECT_EQ(whole.passable, whole.known);
 }

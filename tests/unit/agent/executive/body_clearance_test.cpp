@@ -66,6 +66,38 @@ TEST(BodyClearance, KeepClearTakesTheDiscsOutAndReconnects) {
   EXPECT_GT(inside, 0);
 }
 
+TEST(BodyClearance, KeepOffTakesOutTheCellsAHalfCellDiscWould) {
+  // A corridor of rows 14..25 between walls: cells taken out may cut it. Each trial takes a few cells out (the robot's
+  // own and off-window ones among them) and compares with keep_clear on discs of half a cell around their centres,
+  // which leave out exactly those cells (other cell centres are a whole cell away).
+  Heightmap h(kGrid, 0.0);
+  for (int r = 0; r < 40; ++r)
+    for (int c = 0; c < 40; ++c)
+      if (r < 14 || r > 25) h(r, c) = 5.0;
+  const deliberative::LocalMap base = test::make_local_map(h, Heightmap(kGrid, 0.0), kNav, {20, 5}, std::nullopt);
+  const Position robot = base.center({20, 5});
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> index(-2, 41), count(1, 12);
+  long long taken = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    std::vector<CellIndex> cells;
+    std::vector<BodyClearance> discs;
+    for (int i = count(rng); i > 0; --i) {
+      const CellIndex cell = trial % 10 == 0 && i == 1 ? CellIndex{20, 5} : CellIndex{index(rng) / 2 + 10, index(rng)};
+      cells.push_back(cell);
+      discs.push_back({1, kGrid.cell_center(cell), 0.5 * kGrid.cell_size_m});
+    }
+    deliberative::LocalMap off = base, clear = base;
+    const long long removed = keep_off(off, cells);
+    EXPECT_EQ(removed, keep_clear(clear, robot, discs)) << "trial " << trial;
+    EXPECT_EQ(off.occupiable, clear.occupiable) << "trial " << trial;
+    EXPECT_EQ(off.navigable, clear.navigable) << "trial " << trial;
+    EXPECT_NE(off.occupiable(20, 5), 0);  // never the robot's own cell
+    taken += removed;
+  }
+  EXPECT_GT(taken, 500);  // the trials took cells out, not only off-window and wall cells
+}
+
 TEST(BodyClearance, TheActionManagerNeverChoosesATargetTheWorldWouldRefuse) {
   // Random neighbours around a robot on flat ground: whatever path it follows, a motion the action manager returns
   // ends clear of every disc (the world's rule 2.5 with a disc of both radii) and, for a higher-id neighbour, at

@@ -58,11 +58,10 @@ RobotType type_with(const std::string& depositor) {
 Heightmap after(const LocalMap& map, const DepositionPlan& plan, const RobotType& type) {
   Heightmap h = map.heights;
   for (const Deposit& d : plan.deposits) {
-    const DepositShape s =
-        type.depositor.kind == DepositorKind::kCube
-            ? cube_column_shape(h.geometry(), d.centre, *type.depositor.cube_size_m,
-                                static_cast<int>(std::lround(d.volume_m3 / 0.001)))
-            : cone_pile_shape(h, d.centre, d.volume_m3, type.depositor.repose_deg);
+    const DepositShape s = type.depositor.kind == DepositorKind::kCube
+                               ? cube_column_shape(h.geometry(), d.centre, *type.depositor.cube_size_m,
+                                                   static_cast<int>(std::lround(d.volume_m3 / 0.001)))
+                               : cone_pile_shape(h, d.centre, d.volume_m3, type.depositor.repose_deg);
     EXPECT_TRUE(s.on_grid);
     for (const CellRise& r : s.rises) h(r.cell) += r.rise_m;
   }

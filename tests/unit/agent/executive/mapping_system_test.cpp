@@ -265,7 +265,8 @@ TEST(MappingSystem, RefusesAbsurdScans) {
   // Points off the grid are left out, not an error.
   map.integrate_scan({{-5.0F, 0.0F, -0.5F}, {0.0F, 0.0F, -0.5F}}, origin);
   EXPECT_EQ(map.known_cells(), 1);
-  EXPECT_THROW(MappingSystem(GridGeometry{40000, 10, 0.0, 0.0, 0.1}, 16, sensor_defaults(SensorKind::kLaser)), InvalidArgument);
+  EXPECT_THROW(MappingSystem(GridGeometry{40000, 10, 0.0, 0.0, 0.1}, 16, sensor_defaults(SensorKind::kLaser)),
+               InvalidArgument);
 }
 
 TEST(MappingSystem, AssumedGroundFillsOnlyUnknownCellsUnderTheBody) {

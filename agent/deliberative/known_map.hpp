@@ -1,0 +1,25 @@
+#pragma once
+// What the agent knows of the world, as the deliberative layer reads it. The executive's mapping system fills it
+// (executive::MappingSystem::known_map()); the local map synthesizer reads it and never sees the mapping system, so
+// the layers point one way: executive -> deliberative.
+
+#include <vector>
+
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/types.hpp"
+
+namespace marsala::agent::deliberative {
+
+/// A read-only view of the agent's own map of the world grid; it refers to the map that made it and lives no longer.
+struct KnownMap {
+  const Heightmap& heights;                  ///< the world grid: known cells hold the sensed heights [m], unknown 0
+  const CellMask& known;                     ///< 1 where the cell has been sensed at least once
+  const CellMask& assumed;                   ///< 1 where the cell is only assumed (ground under the body), not sensed
+  const std::vector<CellIndex>& trajectory;  ///< cells stood on, oldest first (world indices)
+  bool scanned = false;                      ///< built from range scans (holes, shadows), not ground-truth tiles
+
+  /// The world grid.
+  const GridGeometry& geometry() const { return heights.geometry(); }
+};
+
+}  // namespace marsala::agent::deliberative

@@ -1,0 +1,74 @@
+#pragma once
+// The frame gate: which sensor frame the agent takes during the lockstep, and what it does with it
+// (docs/runtime.md#lockstep). Pure: no bus traffic, no clock.
+//
+//   not from the world it was admitted to, not addressed to it, too far ahead, or not sane -> ignored (the problem)
+//   run_over                                                                                -> the run is over
+//   the step already answered (the world did not get the answer)                            -> the same request again
+//   a step before the one answered                                                          -> stale
+//   otherwise                                                                               -> decide, then answered()
+
+#include <cstdint>
+#include <string>
+
+#include "marsala/bus/bus.hpp"
+#include "marsala/core/assignment.hpp"
+#include "marsala/core/sensor_spec.hpp"
+#include "marsala/protocol/messages.hpp"
+
+namespace marsala::agent::runtime {
+
+/// A frame further ahead of the last step answered is not the world's: no run goes on for a million steps while an
+/// agent waits for its next frame [steps].
+inline constexpr std::uint64_t kMaxStepsAhead = 1000000;
+
+/// Empty when a frame addressed to this agent can be trusted to describe the world of `assignment`: a finite pose on
+/// the grid, finite height and material, tiles that fit the grid, a scan only for a scanning sensor with points within
+/// its reach, finite neighbours; otherwise the problem. A frame with a problem is ignored whole, before any of it
+/// reaches the behaviour (which would throw half-way through).
+std::string frame_problem(const protocol::SensorFrame& frame, const Assignment& assignment, const SensorSpec& sensor);
+
+/// What the gate makes of one frame.
+enum class FrameCall {
+  kIgnored,  ///< not this run's, or not sane: the problem says why
+  kRunOver,  ///< the run is over
+  kRepeat,   ///< the frame of the step already answered: send last_request() again, never a second decision
+  kStale,    ///< a step before the one answered
+  kDecide,   ///< a new step: decide, send, then answered()
+};
+
+/// A frame's call and, when ignored, why.
+struct FrameJudgement {
+  FrameCall call = FrameCall::kIgnored;
+  std::string problem;  ///< kIgnored: why, for the operator
+};
+
+/// Judges the frames of one admitted agent; see the header.
+class FrameGate {
+ public:
+  /// Frames for agent `agent_id` of `assignment`, sensing with `sensor`, written by `world` (the participant whose
+  /// admission let the agent in).
+  FrameGate(std::uint32_t agent_id, Assignment assignment, SensorSpec sensor, bus::WriterId world);
+
+  /// What to do with `frame`, written by participant `from`.
+  FrameJudgement judge(const protocol::SensorFrame& frame, const bus::WriterId& from) const;
+  /// The world now speaks from participant `world` (restarted from its log, docs/runtime.md#resume).
+  void set_world(const bus::WriterId& world) { world_ = world; }
+  /// The participant frames are taken from.
+  const bus::WriterId& world() const { return world_; }
+  /// The request sent for the frame of `step`, repeated when that frame comes again.
+  void answered(std::uint64_t step, protocol::ActionRequest request);
+  /// The last request sent (empty before the first).
+  const protocol::ActionRequest& last_request() const { return last_request_; }
+
+ private:
+  std::uint32_t agent_id_;
+  Assignment assignment_;
+  SensorSpec sensor_;
+  bus::WriterId world_;
+  bool answered_any_ = false;
+  std::uint64_t last_answered_ = 0;       // the step of last_request_
+  protocol::ActionRequest last_request_;  // repeated when the world sends the frame of its step again
+};
+
+}  // namespace marsala::agent::runtime

@@ -1,0 +1,73 @@
+#include "marsala/agent/runtime/world_watch.hpp"
+
+#include <algorithm>
+
+namespace marsala::agent::runtime {
+namespace {
+
+double seconds(WorldWatch::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+}  // namespace
+
+WorldWatch::WorldWatch(Clock::time_point now, std::chrono::milliseconds world_timeout,
+                       std::chrono::milliseconds hello_period)
+    : world_timeout_(world_timeout),
+      hello_period_(hello_period),
+      deadline_(now + world_timeout),
+      last_frame_at_(now),
+      next_hello_(now + kRehelloAfter),
+      last_sign_(now),
+      last_turn_(now) {}
+
+WatchTurn WorldWatch::turn(Clock::time_point now, const std::function<bool()>& writer_alive) {
+  WatchTurn turn;
+  // A turn takes at most the loop's stop poll: a much longer gap means this process was not running (stopped,
+  // starved), and what it could not see is no sign that the world is gone; its DDS readers may still hold the world's
+  // writer as not alive until the next lease renewal, so the world gets a fresh grace period. The agent also asks the
+  // world at once whether it still counts it in: frames queued before the pause may still arrive and look fresh,
+  // while the world may have dropped it meanwhile (docs/runtime.md#re-admission).
+  const bool was_paused = now - last_turn_ >= kProcessPause;
+  if (was_paused) last_sign_ = now;
+  if (sign_since_turn_ || writer_alive()) {
+    sign_since_turn_ = false;
+    world_seen_ = true;
+    last_sign_ = now;
+  } else if (world_seen_ && now - last_sign_ >= kWorldGrace) {
+    turn.state = WorldState::kWorldGone;
+    turn.silent_s = seconds(now - last_sign_);
+    return turn;
+  }
+  if (now >= deadline_) {
+    turn.state = WorldState::kWorldTimeout;
+    return turn;
+  }
+  if (was_paused) {
+    turn.paused_s = seconds(now - last_turn_);
+    turn.hello = true;
+    asked_ = true;
+    next_hello_ = now + hello_period_;
+  }
+  last_turn_ = now;
+  if (now - last_frame_at_ >= kRehelloAfter && now >= next_hello_) {
+    if (!asked_) turn.no_frame_s = seconds(now - last_frame_at_);
+    turn.hello = true;
+    asked_ = true;
+    next_hello_ = now + hello_period_;
+  }
+  return turn;
+}
+
+bool WorldWatch::frame(Clock::time_point now) {
+  sign_since_turn_ = true;
+  last_frame_at_ = now;
+  deadline_ = now + world_timeout_;
+  const bool was_asking = asked_;
+  asked_ = false;
+  return was_asking;
+}
+
+WorldWatch::Clock::time_point WorldWatch::wake_by() const {
+  return asked_ ? std::min(deadline_, next_hello_) : deadline_;
+}
+
+}  // namespace marsala::agent::runtime

@@ -1,0 +1,75 @@
+#pragma once
+// The world watch: whether the world this agent was admitted to is still there, during the lockstep
+// (docs/runtime.md#dropping-agents, #re-admission). Pure: the loop passes the clock in and does the talking.
+//
+//   sign of life      a frame taken, an answer to a hello, or the world's frame writer alive (DDS liveliness)
+//   world gone        the world was seen once, then no sign for kWorldGrace           -> kWorldGone
+//   silence limit     no frame taken for world_timeout                                 -> kWorldTimeout
+//   process paused    a turn kProcessPause after the last one: the process itself did not run; the world gets a
+//                     fresh grace period and is asked at once whether it still counts this agent in (a hello)
+//   no frame          kRehelloAfter without a frame: a hello every hello_period until a frame comes
+
+#include <chrono>
+#include <functional>
+#include <optional>
+
+namespace marsala::agent::runtime {
+
+/// How long the world's frame writer may stay not alive before the agent concludes the world is gone [s]: longer than
+/// the pauses a world must survive (5 s, docs/runtime.md#dropping-agents), so an agent learns of a dead world within
+/// about 7 s (the 1 s DDS lease, then this) instead of world_timeout.
+inline constexpr std::chrono::seconds kWorldGrace{6};
+/// A gap this long between two turns of the agent's loop means the process itself did not run [s].
+inline constexpr std::chrono::seconds kProcessPause{1};
+/// How long without a frame before the agent says hello again [s]: the world answers whether it still counts the agent
+/// in (a pause longer than the world's grace dropped it; docs/runtime.md#re-admission).
+inline constexpr std::chrono::seconds kRehelloAfter{2};
+
+/// What the watch concluded on one turn.
+enum class WorldState { kWatching, kWorldGone, kWorldTimeout };
+
+/// What one turn of the loop must do, and why.
+struct WatchTurn {
+  WorldState state = WorldState::kWatching;
+  double silent_s = 0.0;             ///< kWorldGone: how long no sign of the world came [s]
+  bool hello = false;                ///< say hello now: ask the world whether it still counts this agent in
+  std::optional<double> paused_s;    ///< set when the process did not run for this long before this turn [s]
+  std::optional<double> no_frame_s;  ///< set when this turn's hello is the first of a silence this long [s]
+};
+
+/// Watches the world's signs of life during the lockstep; see the header.
+class WorldWatch {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  /// Starts watching at `now`: the silence limit is world_timeout from now, hellos go every hello_period once frames
+  /// stop for kRehelloAfter.
+  WorldWatch(Clock::time_point now, std::chrono::milliseconds world_timeout, std::chrono::milliseconds hello_period);
+
+  /// One turn of the loop at `now`. `writer_alive` (the world's frame writer's DDS liveliness) is asked only when no
+  /// frame or answer came since the last turn: it spares the status query on the per-step path.
+  WatchTurn turn(Clock::time_point now, const std::function<bool()>& writer_alive);
+  /// True when a hello went out since the last frame: only then may an answer speak for the world.
+  bool asked() const { return asked_; }
+  /// The world answered a hello: a sign of life.
+  void answered() { sign_since_turn_ = true; }
+  /// A frame was taken at `now`: a sign of life, the silence limit starts again. True when a hello had gone out since
+  /// the last frame (frames are back).
+  bool frame(Clock::time_point now);
+  /// The latest time the loop may wait until before its next turn: the silence limit, or the next hello while asking.
+  Clock::time_point wake_by() const;
+
+ private:
+  std::chrono::milliseconds world_timeout_;
+  std::chrono::milliseconds hello_period_;
+  Clock::time_point deadline_;       // no frame by then: kWorldTimeout
+  Clock::time_point last_frame_at_;  // the last frame taken
+  Clock::time_point next_hello_;     // no hello before then
+  Clock::time_point last_sign_;      // the last sign of life (or the end of a pause of this process)
+  Clock::time_point last_turn_;      // the previous turn
+  bool asked_ = false;               // a hello went out since the last frame
+  bool world_seen_ = false;          // some sign of life came once
+  bool sign_since_turn_ = false;     // a frame or an answer came since the last turn
+};
+
+}  // namespace marsala::agent::runtime

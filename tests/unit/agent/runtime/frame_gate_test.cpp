@@ -1,0 +1,116 @@
+// The frame gate without a bus: which frames an agent takes, repeats, calls stale or ignores
+// (docs/runtime.md#lockstep).
+
+#include "marsala/agent/runtime/frame_gate.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace marsala::agent::runtime {
+namespace {
+
+bus::WriterId writer(std::uint8_t first) {
+  bus::WriterId id;
+  id.prefix[0] = first;
+  return id;
+}
+
+Assignment ten_by_twenty() {
+  Assignment a;
+  a.world = {10, 20, 0.0, 0.0, 0.5};  // 10 m x 5 m
+  a.tile_size = 16;
+  return a;
+}
+
+protocol::SensorFrame frame(std::uint64_t step, std::uint32_t agent_id = 7) {
+  protocol::SensorFrame f;
+  f.agent_id = agent_id;
+  f.step = step;
+  f.x_m = 2.25;
+  f.y_m = 1.25;
+  return f;
+}
+
+FrameGate gate() { return FrameGate(7, ten_by_twenty(), SensorSpec{}, writer(1)); }
+
+TEST(FrameGate, TakesOnlyTheAdmittingWorldsFramesForThisAgent) {
+  const FrameGate g = gate();
+  EXPECT_EQ(g.judge(frame(1), writer(1)).call, FrameCall::kDecide);
+  const FrameJudgement stranger = g.judge(frame(1), writer(2));
+  EXPECT_EQ(stranger.call, FrameCall::kIgnored);
+  EXPECT_NE(stranger.problem.find("written by participant " + writer(2).to_string()), std::string::npos);
+  EXPECT_NE(stranger.problem.find("(" + writer(1).to_string() + ")"), std::string::npos);
+  const FrameJudgement other = g.judge(frame(1, 8), writer(1));
+  EXPECT_EQ(other.call, FrameCall::kIgnored);
+  EXPECT_EQ(other.problem, "addressed to agent 8");
+}
+
+TEST(FrameGate, AWorldResumedFromItsLogSpeaksFromItsNewParticipant) {
+  FrameGate g = gate();
+  g.set_world(writer(3));
+  EXPECT_EQ(g.world(), writer(3));
+  EXPECT_EQ(g.judge(frame(1), writer(3)).call, FrameCall::kDecide);
+  EXPECT_EQ(g.judge(frame(1), writer(1)).call, FrameCall::kIgnored);
+}
+
+TEST(FrameGate, RepeatsTheAnsweredStepAndCallsEarlierOnesStale) {
+  FrameGate g = gate();
+  protocol::ActionRequest request;
+  request.agent_id = 7;
+  request.step = 5;
+  request.move = true;
+  request.target_x_m = 2.75;
+  g.answered(5, request);
+  EXPECT_EQ(g.judge(frame(5), writer(1)).call, FrameCall::kRepeat);
+  EXPECT_EQ(g.last_request().step, 5u);
+  EXPECT_EQ(g.last_request().target_x_m, 2.75);
+  EXPECT_EQ(g.judge(frame(4), writer(1)).call, FrameCall::kStale);
+  EXPECT_EQ(g.judge(frame(6), writer(1)).call, FrameCall::kDecide);
+  // The run-over frame ends the run whatever its step.
+  protocol::SensorFrame over = frame(3);
+  over.run_over = true;
+  EXPECT_EQ(g.judge(over, writer(1)).call, FrameCall::kRunOver);
+}
+
+TEST(FrameGate, AFrameAMillionStepsAheadIsNotTheWorlds) {
+  FrameGate g = gate();
+  // Before the first answer, any step is the first.
+  EXPECT_EQ(g.judge(frame(5 + 2 * kMaxStepsAhead), writer(1)).call, FrameCall::kDecide);
+  g.answered(5, {});
+  EXPECT_EQ(g.judge(frame(5 + kMaxStepsAhead), writer(1)).call, FrameCall::kDecide);
+  const FrameJudgement far = g.judge(frame(6 + kMaxStepsAhead), writer(1));
+  EXPECT_EQ(far.call, FrameCall::kIgnored);
+  EXPECT_EQ(far.problem, "step 1000006 is more than 1000000 steps ahead of the last one answered (5)");
+}
+
+TEST(FrameGate, IgnoresFramesThatDoNotDescribeTheWorld) {
+  const FrameGate g = gate();
+  protocol::SensorFrame off = frame(1);
+  off.x_m = 10.5;  // east of the 10 m grid
+  EXPECT_EQ(g.judge(off, writer(1)).problem, "pose (10.5, 1.25) m is not on the grid");
+  protocol::SensorFrame material = frame(1);
+  material.material_m3 = -1.0;
+  EXPECT_EQ(g.judge(material, writer(1)).call, FrameCall::kIgnored);
+  protocol::SensorFrame scan = frame(1);
+  scan.scanned = true;
+  EXPECT_EQ(g.judge(scan, writer(1)).problem, "a scan for a robot whose sensor is 'ground_truth'");
+  protocol::SensorFrame points = frame(1);
+  points.points.push_back({0.0f, 0.0f, 0.0f});
+  EXPECT_EQ(g.judge(points, writer(1)).problem, "1 scan points in a frame without a scan");
+  protocol::SensorFrame neighbour = frame(1);
+  neighbour.neighbours.push_back({3, {std::nan(""), 1.0}, 0.0, 0.5});
+  EXPECT_EQ(g.judge(neighbour, writer(1)).call, FrameCall::kIgnored);
+  protocol::SensorFrame wide = frame(1);
+  wide.neighbours.push_back({3, {1.0, 1.0}, 0.0, 2e3});
+  EXPECT_EQ(g.judge(wide, writer(1)).problem, "neighbour 3 has a body radius of 2000 m, not in [0, 1000] m");
+  protocol::SensorFrame tile = frame(1);
+  tile.tiles.push_back({0, 0, 10, 16, std::vector<double>(160, 0.0)});
+  EXPECT_EQ(g.judge(tile, writer(1)).call, FrameCall::kDecide);
+  tile.tiles.back().heights.pop_back();
+  EXPECT_EQ(g.judge(tile, writer(1)).call, FrameCall::kIgnored);
+}
+
+}  // namespace
+}  // namespace marsala::agent::runtime
