@@ -125,7 +125,6 @@ std::unique_ptr<Participant> make_participant(const BusConfig& config) {
   check_security(config.security);
   if (config.domain_id < 0 || config.domain_id > 232)
     throw InvalidArgument(fmt::format("DDS domain id must be in 0..232, got {}", config.domain_id));
-
   if (const std::string profile = resolve_profile(config.vendor, config.profile); !profile.empty()) {
     const std::string value = config.vendor == Vendor::kCyclone ? "file://" + profile : profile;
     ::setenv(profile_variable(config.vendor), value.c_str(), 1);

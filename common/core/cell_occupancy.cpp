@@ -59,7 +59,6 @@ bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const Navigabilit
   if (!terrain.contains(cell))
     throw InvalidArgument(
         fmt::format("cell_occupiable: cell {} is off the {} x {} grid", cell, terrain.rows(), terrain.cols()));
-
   const std::vector<CellIndex> offsets = disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m()));
   if (method == OccupancyMethod::kAutomatic)
     method = offsets.size() <= kMaxPairBallCells ? OccupancyMethod::kPairs : OccupancyMethod::kWindow;

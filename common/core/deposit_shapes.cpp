@@ -121,7 +121,6 @@ DepositShape cone_pile_shape(const Heightmap& terrain, Position dump, double vol
         "cone pile at {}: volume {} m^3 must be finite and >= 0, the angle of repose {} deg in (0, 90), the dump "
         "point finite",
         dump, volume_m3, repose_deg));
-
   DepositShape shape;
   const GridGeometry& grid = terrain.geometry();
   const std::optional<CellIndex> at = grid.cell_at(dump);

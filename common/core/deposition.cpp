@@ -49,7 +49,6 @@ CellMask path_footprint(const GridGeometry& grid, const std::vector<CellIndex>& 
   CellMask footprint = CellMask::Zero(grid.rows, grid.cols);
   for (const CellIndex p : path) {
     if (!grid.contains(p)) throw InvalidArgument(fmt::format("path cell {} is off the grid", p));
-
     for (DiscIterator it(grid, p, delta_m / 2.0); !it.is_past_end(); ++it) footprint((*it).row, (*it).col) = 1;
   }
   return footprint;

@@ -39,7 +39,6 @@ Enum enum_from_string(const EnumName<Enum> (&names)[N], const std::string& name,
     valid += (valid.empty() ? "" : ", ") + std::string(n.name);
   }
   throw InvalidArgument(fmt::format("unknown {} '{}'; valid: {}", kind, name, valid));
-
 }
 
 }  // namespace marsala

@@ -7,7 +7,6 @@
 
 #include <fmt/format.h>
 
-
 namespace marsala {
 
 /// Root of every error the project throws on purpose.

@@ -170,9 +170,7 @@ std::optional<std::size_t> GoalVectorMap::nearest_free_tail(Position p, const st
 }
 
 std::optional<std::size_t> GoalVectorMap::next(std::size_t i) const {
-  if (i >= arrows_.size())
-    fail(fmt::format("arrow {} is out of range (the map has {} arrows)", i, arrows_.size()));
-
+  if (i >= arrows_.size()) fail(fmt::format("arrow {} is out of range (the map has {} arrows)", i, arrows_.size()));
   if (i + 1 < arrows_.size() && arrows_[i + 1].strip == arrows_[i].strip) return i + 1;
   return std::nullopt;
 }

@@ -38,23 +38,20 @@ Heightmap::Heightmap(GridGeometry geometry, HeightMatrix heights) : geometry_(ge
 }
 
 double Heightmap::at(CellIndex i) const {
-  if (!contains(i))
-    throw InvalidArgument(fmt::format("cell {} is off the {} x {} grid", i, rows(), cols()));
+  if (!contains(i)) throw InvalidArgument(fmt::format("cell {} is off the {} x {} grid", i, rows(), cols()));
   return heights_(i.row, i.col);
 }
 
 double& Heightmap::at(CellIndex i) {
-  if (!contains(i))
-    throw InvalidArgument(fmt::format("cell {} is off the {} x {} grid", i, rows(), cols()));
+  if (!contains(i)) throw InvalidArgument(fmt::format("cell {} is off the {} x {} grid", i, rows(), cols()));
   return heights_(i.row, i.col);
 }
 
 Heightmap Heightmap::window(CellIndex top_left, int rows, int cols) const {
   const CellIndex bottom_right{top_left.row + rows - 1, top_left.col + cols - 1};
   if (rows <= 0 || cols <= 0 || !contains(top_left) || !contains(bottom_right))
-    throw InvalidArgument(fmt::format("window {} x {} at {} leaves the {} x {} grid", rows, cols, top_left,
-                                      this->rows(), this->cols()));
-
+    throw InvalidArgument(
+        fmt::format("window {} x {} at {} leaves the {} x {} grid", rows, cols, top_left, this->rows(), this->cols()));
   GridGeometry g = geometry_;
   g.rows = rows;
   g.cols = cols;

@@ -55,12 +55,10 @@ Heightmap MarsProcessor::project(const Heightmap& h) const {
       const double v = h(r, c);
       if (!std::isfinite(v))
         throw InvalidArgument(fmt::format("MarsProcessor: height at cell (row {}, col {}) is not finite", r, c));
-
       max_abs = std::max(max_abs, std::abs(v));
     }
   if (const std::string problem = mars_problem(kappa_, h.cell_size_m(), max_abs, rows, cols); !problem.empty())
     throw InvalidArgument(fmt::format("MarsProcessor: {}", problem));
-
   detail::Problem pb;
   pb.h = h.data();
   pb.rows = rows;

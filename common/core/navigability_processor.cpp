@@ -14,8 +14,7 @@ namespace marsala {
 namespace {
 
 void require(bool ok, const char* name, double value, const char* rule) {
-  if (!ok)
-    throw InvalidArgument(fmt::format("NavigabilityProcessor: {} must be {}, got {}", name, rule, value));
+  if (!ok) throw InvalidArgument(fmt::format("NavigabilityProcessor: {} must be {}, got {}", name, rule, value));
 }
 
 void check_finite(const Heightmap& h) {
@@ -32,7 +31,6 @@ void check_finite(const Heightmap& h) {
 void check_origin(int rows, int cols, CellIndex origin) {
   if (origin.row < 0 || origin.row >= rows || origin.col < 0 || origin.col >= cols)
     throw InvalidArgument(fmt::format("NavigabilityProcessor: origin {} is off the {} x {} grid", origin, rows, cols));
-
 }
 
 }  // namespace

@@ -55,7 +55,6 @@ PlannerResult NavigablePathPlanner::plan(const Heightmap& gap, const CellMask& a
   if (allowed.rows() != rows || allowed.cols() != cols)
     throw InvalidArgument(fmt::format("planner: the allowed mask is {} x {} but the gap grid {} x {}", allowed.rows(),
                                       allowed.cols(), rows, cols));
-
   if (!gap.contains(start) || !gap.contains(goal))
     throw InvalidArgument(fmt::format("planner: start {} or goal {} is off the {} x {} map", start, goal, rows, cols));
   PlannerResult result;

@@ -5,7 +5,6 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
-
 #include "marsala/core/random.hpp"
 
 namespace marsala {

@@ -33,7 +33,6 @@ class NamedRegistry {
     std::string valid;
     for (const auto& [n, e] : entries_) valid += (valid.empty() ? "" : ", ") + n;
     throw InvalidArgument(fmt::format("unknown {} '{}'; valid: {}", kind_, name, valid.empty() ? "(none)" : valid));
-
   }
   /// The entry named `name`; throws as require() when it is unknown.
   const Entry& find(const std::string& name) const {

@@ -56,7 +56,6 @@ Enum from_wire(const EnumName<Enum> (&names)[N], std::uint8_t value, const char*
   for (const EnumName<Enum>& n : names)
     if (static_cast<std::uint8_t>(n.value) == value) return n.value;
   throw InvalidArgument(fmt::format("malformed sample: {} is not an {} (valid 0..{})", value, type, N - 1));
-
 }
 
 }  // namespace

@@ -9,7 +9,6 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
-
 #include "marsala/render/detail/colormap.hpp"
 #include "marsala/render/detail/raster.hpp"
 

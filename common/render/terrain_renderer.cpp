@@ -40,7 +40,6 @@ const std::vector<Rgb> kPalette{{228, 26, 28},  {40, 100, 220},  {60, 170, 60}, 
                                 {150, 70, 170}, {0, 200, 220},   {235, 50, 190}, {170, 230, 40},
                                 {150, 85, 35},  {250, 160, 200}, {0, 120, 120},  {180, 160, 255}};
 
-
 /// How grid cells map to pixels: `factor` x `factor` cells are averaged into one display cell, which is drawn
 /// as a `scale` x `scale` pixel square (one of the two is 1).
 struct Sampling {
@@ -519,7 +518,6 @@ Image compose(const TerrainLayer& layer, const Heightmap& map, const RenderOptio
   const std::string scale_label = format_length(bar_m);
   // "{:g}" as the scale bar: picture text, six significant digits as ever (the pixels must not change).
   const std::string caption = fmt::format("{} x {} cells of {:g} m", map.rows(), map.cols(), map.cell_size_m());
-
   const int scale_row_w = scale_px + 6 * font + detail::text_width(scale_label, font);
   const int bottom_h = pad + line + 2 * font + line + pad;
 

@@ -14,7 +14,6 @@
 #include <fmt/format.h>
 
 #include "marsala/core/error.hpp"
-
 #include "marsala/render/png_writer.hpp"
 #include "marsala/runlog/atomic_file.hpp"
 
@@ -93,11 +92,10 @@ void write_timelapse(const std::string& ffmpeg, const std::string& frames_dir, c
   const std::string out = (fs::path(frames_dir) / "timelapse.mp4").string();
   try {
     runlog::write_atomically(out, [&](const std::string& tmp) {
-      const int status = run_program({ffmpeg, "-y", "-loglevel", "error", "-framerate", "10", "-i",
-                                      (scratch / "%06d.png").string(), "-pix_fmt", "yuv420p", "-vf",
-                                      fmt::format("pad={}:{}:0:0:white", width_px + width_px % 2,
-                                                  height_px + height_px % 2),
-                                      "-f", "mp4", tmp});
+      const int status = run_program(
+          {ffmpeg, "-y", "-loglevel", "error", "-framerate", "10", "-i", (scratch / "%06d.png").string(), "-pix_fmt",
+           "yuv420p", "-vf", fmt::format("pad={}:{}:0:0:white", width_px + width_px % 2, height_px + height_px % 2),
+           "-f", "mp4", tmp});
       if (status != 0) throw IoError(fmt::format("ffmpeg failed (exit {}) making '{}'", status, out));
     });
   } catch (...) {

@@ -10,7 +10,6 @@
 
 #include "marsala/core/error.hpp"
 
-
 namespace marsala::runlog {
 
 /// Calls write(tmp) with tmp = "<path>.tmp", then renames tmp over `path`. Whatever write() throws, and IoError when

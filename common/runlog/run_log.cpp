@@ -12,7 +12,6 @@
 #include <fmt/format.h>
 
 #include "marsala/core/error.hpp"
-
 #include "marsala/runlog/crc32c.hpp"
 
 namespace marsala::runlog {
@@ -105,7 +104,8 @@ void RunLogWriter::append(const proto::LogRecord& record) {
 }
 
 void RunLogWriter::sync() {
-  if (fd_ >= 0 && ::fdatasync(fd_) != 0) throw IoError(fmt::format("{}: cannot sync the run log: {}", path_, errno_text()));
+  if (fd_ >= 0 && ::fdatasync(fd_) != 0)
+    throw IoError(fmt::format("{}: cannot sync the run log: {}", path_, errno_text()));
 }
 
 RunLogReader::RunLogReader(const std::string& path) : path_(path), in_(path, std::ios::binary) {
@@ -122,9 +122,9 @@ RunLogReader::RunLogReader(const std::string& path) : path_(path), in_(path, std
   if (!record.has_header()) throw ParseError(path, 0, "the first record is not a header");
   header_ = record.header();
   if (header_.format_version() != kFormatVersion)
-    throw ParseError(path, 0,
-                     fmt::format("format version {} is not the known version {}", header_.format_version(),
-                                 kFormatVersion));
+    throw ParseError(
+        path, 0,
+        fmt::format("format version {} is not the known version {}", header_.format_version(), kFormatVersion));
   first_record_ = offset_;
 }
 
@@ -133,8 +133,7 @@ bool RunLogReader::read_record(proto::LogRecord& record) {
   if (offset_ == file_bytes_) return false;
   const std::uint64_t left = file_bytes_ - offset_;
   if (left < kFrameBytes) {
-    tail_problem_ =
-        fmt::format("{}: truncated record at byte {} ({} bytes, not even its frame)", path_, offset_, left);
+    tail_problem_ = fmt::format("{}: truncated record at byte {} ({} bytes, not even its frame)", path_, offset_, left);
     return false;
   }
   char frame[kFrameBytes];

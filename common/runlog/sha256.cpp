@@ -8,7 +8,6 @@
 
 #include "marsala/core/error.hpp"
 
-
 namespace marsala::runlog {
 
 struct Sha256::Context {

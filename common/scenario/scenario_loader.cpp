@@ -90,7 +90,8 @@ TerrainSource to_terrain(const proto::TerrainSource& p, const Validator& check) 
     if (std::find(names.begin(), names.end(), p.generator()) == names.end()) {
       std::string valid;
       for (const auto& n : names) valid += (valid.empty() ? "" : ", ") + n;
-      check.fail("terrain.generator", fmt::format("unknown generator '{}'; valid generators: {}", p.generator(), valid));
+      check.fail("terrain.generator",
+                 fmt::format("unknown generator '{}'; valid generators: {}", p.generator(), valid));
     }
     t.method = p.generator();
     if (p.has_rows()) t.rows = p.rows();
@@ -505,16 +506,14 @@ void apply_override(google::protobuf::Message& message, const std::vector<std::s
   if (field->is_map())
     throw InvalidArgument(fmt::format("{}: '{}' is a map; edit the scenario file instead", where, name));
   if (last == is_message)
-    throw InvalidArgument(
-        is_message ? fmt::format("{}: '{}' is a message: name one of its fields ({})", where, name,
-                                 field_names(*field->message_type()))
-                   : fmt::format("{}: '{}' is a value: it has no fields", where, name));
+    throw InvalidArgument(is_message ? fmt::format("{}: '{}' is a message: name one of its fields ({})", where, name,
+                                                   field_names(*field->message_type()))
+                                     : fmt::format("{}: '{}' is a value: it has no fields", where, name));
   if (index && !field->is_repeated()) throw InvalidArgument(fmt::format("{}: '{}' is not repeated", where, name));
   if (field->is_repeated()) {
     const int size = reflection.FieldSize(message, field);
     if (index && *index >= size)
-      throw InvalidArgument(
-          fmt::format("{}: {}[{}] does not exist (the scenario has {})", where, name, *index, size));
+      throw InvalidArgument(fmt::format("{}: {}[{}] does not exist (the scenario has {})", where, name, *index, size));
     if (last)
       throw InvalidArgument(fmt::format("{}: repeated values cannot be set; edit the scenario file instead", where));
     for (int i = index.value_or(0); i < (index ? *index + 1 : size); ++i)
@@ -572,7 +571,6 @@ std::string read_scenario_text(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw IoError(fmt::format("cannot read scenario file '{}'", path));
-
   return text.str();
 }
 

@@ -298,8 +298,7 @@ class AscParser {
         p = end;
       }
       if (col < cols)
-        fail(line_no_,
-             fmt::format("too few values on data row {}: got {}, expected {} (ncols)", row + 1, col, cols));
+        fail(line_no_, fmt::format("too few values on data row {}: got {}, expected {} (ncols)", row + 1, col, cols));
       ++row;
     }
     if (row < rows)
@@ -365,8 +364,7 @@ void check_writable(const Heightmap& map) {
   for (int r = 0; r < map.rows(); ++r)
     for (int c = 0; c < map.cols(); ++c) {
       const double h = map(r, c);
-      if (std::isinf(h))
-        throw InvalidArgument(fmt::format("write_asc: infinite height at cell {}", CellIndex{r, c}));
+      if (std::isinf(h)) throw InvalidArgument(fmt::format("write_asc: infinite height at cell {}", CellIndex{r, c}));
       if (h == kWrittenNodata)
         throw InvalidArgument(
             fmt::format("write_asc: height -9999 at cell {} would read back as NODATA_value -9999", CellIndex{r, c}));
@@ -374,8 +372,7 @@ void check_writable(const Heightmap& map) {
 }
 
 void emit(const Heightmap& map, std::ostream& out) {
-  std::string buffer
- = fmt::format("ncols {}\nnrows {}\nxllcorner {}\nyllcorner {}\ncellsize {}\nNODATA_value -9999\n",
+  std::string buffer = fmt::format("ncols {}\nnrows {}\nxllcorner {}\nyllcorner {}\ncellsize {}\nNODATA_value -9999\n",
                                    map.cols(), map.rows(), format_double(map.geometry().xll_m),
                                    format_double(map.geometry().yll_m), format_double(map.cell_size_m()));
   constexpr std::size_t kFlushBytes = 1 << 20;
@@ -452,7 +449,6 @@ void fill_nodata(Heightmap& map) {
   if (missing == 0) return;
   if (missing == cells)
     throw InvalidArgument(fmt::format("fill_nodata: all {} cells are NODATA; nothing to fill from", cells));
-
 
   auto for_neighbours = [&](long long i, auto&& visit) {
     const int r = static_cast<int>(i / cols);

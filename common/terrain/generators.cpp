@@ -9,7 +9,6 @@
 #include <fmt/ranges.h>
 
 #include "marsala/core/error.hpp"
-
 #include "marsala/core/format.hpp"
 #include "marsala/core/random.hpp"
 #include "marsala/core/registry.hpp"
@@ -90,8 +89,8 @@ ParamDef param(std::string key, double fixed_default, double min, double max, bo
 }
 
 ParamDef scaled_param(std::string key, double fraction, double min, double max, std::string meaning) {
+  // The default's text is a description, not a value to read back: "3%", not the product's "3.0000000000000004%".
   return {std::move(key),
-          // A description, not a value to read back: "3%", not the product's "3.0000000000000004%".
           fmt::format("{:g}% of the map extent", 100.0 * fraction),
           [fraction](const Frame& f) { return fraction * f.extent_m; },
           min,
@@ -128,8 +127,9 @@ ParamValues resolve(const std::string& method, const GeneratorEntry& entry, cons
       throw InvalidArgument(fmt::format("terrain generator '{}': parameter '{}' = {} is out of range [{}, {}]", method,
                                         d.key, v, d.min, d.max));
     if (d.integer && v != std::floor(v))
-      throw InvalidArgument(fmt::format("terrain generator '{}': parameter '{}' = {} must be a whole number in [{}, {}]",
-                                        method, d.key, v, d.min, d.max));
+      throw InvalidArgument(
+          fmt::format("terrain generator '{}': parameter '{}' = {} must be a whole number in [{}, {}]", method, d.key,
+                      v, d.min, d.max));
     out[d.key] = v;
   }
   return out;
@@ -137,8 +137,8 @@ ParamValues resolve(const std::string& method, const GeneratorEntry& entry, cons
 
 void check_spec(const std::string& method, const GeneratorSpec& spec) {
   if (spec.rows <= 0 || spec.cols <= 0)
-    throw InvalidArgument(fmt::format("terrain generator '{}': grid size must be positive, got {} x {}", method,
-                                      spec.rows, spec.cols));
+    throw InvalidArgument(
+        fmt::format("terrain generator '{}': grid size must be positive, got {} x {}", method, spec.rows, spec.cols));
   if (static_cast<long long>(spec.rows) * spec.cols > kMaxCells)
     throw InvalidArgument(fmt::format("terrain generator '{}': grid of {} x {} cells exceeds the limit of {} cells",
                                       method, spec.rows, spec.cols, kMaxCells));
@@ -237,8 +237,8 @@ HeightMatrix fractal(const Frame& f, const Params& p) {
   const double amplitude = p.get("amplitude");
   const double wavelength = p.get("wavelength");
   if (wavelength < f.cs)
-    throw InvalidArgument(fmt::format("terrain generator 'fractal': wavelength {} m is shorter than one cell ({} m)",
-                                      wavelength, f.cs));
+    throw InvalidArgument(
+        fmt::format("terrain generator 'fractal': wavelength {} m is shorter than one cell ({} m)", wavelength, f.cs));
   HeightMatrix h = detail::gradient_fbm(f.rows, f.cols, f.cs, random::derive_seed(f.seed, 0x6662), p.count("octaves"),
                                         p.get("persistence"), wavelength);
   const double lo = h.minCoeff();

@@ -235,8 +235,7 @@ class GeoTiffReader {
       const auto [matrix_data, matrix_count] =
           custom_tag(kModelTransformationTag, TIFF_DOUBLE, "ModelTransformationTag");
       if (!matrix_data) return 1.0;
-      if (matrix_count != 16)
-        fail(fmt::format("ModelTransformationTag holds {} values, expected 16", matrix_count));
+      if (matrix_count != 16) fail(fmt::format("ModelTransformationTag holds {} values, expected 16", matrix_count));
       const auto* m = static_cast<const double*>(matrix_data);
       if (m[1] != 0.0 || m[4] != 0.0) fail("rotated or sheared rasters (ModelTransformationTag) are not supported");
       sx = std::abs(m[0]);
@@ -329,8 +328,7 @@ class GeoTiffReader {
     for (long long i = 0; i < cells; ++i) {
       const bool is_missing = std::isnan(h[i]) || (has_nodata_ && h[i] == nodata_);
       if (!is_missing) {
-        if (std::isinf(h[i]))
-          fail(fmt::format("infinite sample at row {}, column {}", i / width_, i % width_));
+        if (std::isinf(h[i])) fail(fmt::format("infinite sample at row {}, column {}", i / width_, i % width_));
         continue;
       }
       if (!options_.fill_nodata)
@@ -338,7 +336,6 @@ class GeoTiffReader {
             "NODATA cell at row {}, column {} (0-based); fill NODATA cells explicitly (--fill-nodata) to accept this "
             "file",
             i / width_, i % width_));
-
       h[i] = std::numeric_limits<double>::quiet_NaN();
       ++missing;
     }

@@ -9,7 +9,6 @@
 
 #include "marsala/core/error.hpp"
 
-
 namespace marsala::terrain {
 namespace {
 
@@ -70,8 +69,8 @@ Heightmap crop(const Heightmap& map, double x0_m, double y0_m, double width_m, d
   if (g.rows <= 0 || g.cols <= 0 ||
       !centres_in(g.xll_m, g.cell_size_m, g.cols, x0_m, x0_m + width_m, col_first, col_last) ||
       !centres_in(g.yll_m, g.cell_size_m, g.rows, y0_m, y0_m + height_m, south_first, south_last))
-    throw InvalidArgument(fmt::format("crop: no cell centre lies in [{}, {}) x [{}, {}) m", x0_m, x0_m + width_m, y0_m,
-                                      y0_m + height_m));
+    throw InvalidArgument(
+        fmt::format("crop: no cell centre lies in [{}, {}) x [{}, {}) m", x0_m, x0_m + width_m, y0_m, y0_m + height_m));
   const int top_row = g.rows - 1 - south_last;
   return map.window({top_row, col_first}, south_last - south_first + 1, col_last - col_first + 1);
 }
@@ -88,8 +87,8 @@ Heightmap resample_bilinear(const Heightmap& map, double cell_size_m) {
     throw InvalidArgument(fmt::format("resample_bilinear: a cell of {} m does not fit in the {} x {} m extent",
                                       cell_size_m, g.cols * g.cell_size_m, g.rows * g.cell_size_m));
   if (cols_real * rows_real > kMaxCells)
-    throw InvalidArgument(fmt::format("resample_bilinear: a cell of {} m would give {} x {} cells", cell_size_m,
-                                      cols_real, rows_real));
+    throw InvalidArgument(
+        fmt::format("resample_bilinear: a cell of {} m would give {} x {} cells", cell_size_m, cols_real, rows_real));
   GridGeometry out_geometry = g;
   out_geometry.cols = static_cast<int>(cols_real);
   out_geometry.rows = static_cast<int>(rows_real);

@@ -109,7 +109,8 @@ class Context {
     std::string config = uri != nullptr && *uri != '\0' ? std::string(uri) : std::string();
     const auto add = [&config](const std::string& fragment) { config += (config.empty() ? "" : ",") + fragment; };
     if (role == Role::kClient)
-      add(fmt::format("<Discovery><ParticipantIndex>none</ParticipantIndex><MaxAutoParticipantIndex>{}"
+      add(
+          fmt::format("<Discovery><ParticipantIndex>none</ParticipantIndex><MaxAutoParticipantIndex>{}"
                       "</MaxAutoParticipantIndex><SPDPInterval>1s</SPDPInterval></Discovery>",
                       kServerIndices));
     if (security.enabled())
@@ -126,8 +127,7 @@ class Context {
     const dds_entity_t domain = dds_create_domain(static_cast<dds_domainid_t>(domain_id_), config.c_str());
     // Another participant of this process made the domain already: this one shares its configuration.
     if (domain == DDS_RETCODE_PRECONDITION_NOT_MET) return;
-    if (domain < 0)
-      throw BusError(failure(fmt::format("creating domain {} with its settings", domain_id_), domain));
+    if (domain < 0) throw BusError(failure(fmt::format("creating domain {} with its settings", domain_id_), domain));
     domain_ = domain;
   }
 
@@ -238,7 +238,6 @@ class CycloneReader final : public Reader<T> {
     if (reader_ < 0) {
       dds_delete(subscriber_);
       throw BusError(failure(fmt::format("creating a reader for {}", TopicName<T>::value), reader_));
-
     }
   }
   // Cyclone waits for a running listener callback to return before the reader is gone.
@@ -345,7 +344,6 @@ class CycloneParticipant final : public ParticipantBase<CycloneParticipant> {
                     config.security.identity);
     else
       spdlog::debug("bus: Cyclone DDS participant in domain {}", config.domain_id);
-
   }
   Vendor vendor() const override { return Vendor::kCyclone; }
   int domain_id() const override { return context_->domain_id(); }

@@ -47,7 +47,6 @@ inline constexpr std::chrono::milliseconds kMaxBlocking{1000};
 /// Throws InvalidArgument for options no backend can honour (depth < 1).
 inline void check_options(const EndpointOptions& options) {
   if (options.depth < 1) throw InvalidArgument(fmt::format("bus endpoint depth must be >= 1, got {}", options.depth));
-
 }
 
 }  // namespace marsala::bus::detail

@@ -120,10 +120,10 @@ class Context {
     if (security.enabled()) secure(qos, security);
     participant_ = factory->create_participant(static_cast<dds::DomainId_t>(domain_id), qos);
     if (participant_ == nullptr)
-      throw BusError(fmt::format(
-          "Fast DDS: creating a participant in domain {} failed (see the Fast DDS log above; is "
-          "FASTRTPS_DEFAULT_PROFILES_FILE valid?)",
-          domain_id));
+      throw BusError(
+          fmt::format("Fast DDS: creating a participant in domain {} failed (see the Fast DDS log above; is "
+                      "FASTRTPS_DEFAULT_PROFILES_FILE valid?)",
+                      domain_id));
   }
   ~Context() {
     participant_->delete_contained_entities();
@@ -369,7 +369,6 @@ class FastDdsParticipant final : public ParticipantBase<FastDdsParticipant> {
                     config.security.identity);
     else
       spdlog::debug("bus: Fast DDS participant in domain {}", config.domain_id);
-
   }
   Vendor vendor() const override { return Vendor::kFastDds; }
   int domain_id() const override { return context_->domain_id(); }
