@@ -27,8 +27,9 @@ packages=(
   libcpp-httplib-dev nlohmann-json3-dev
   # multi-process tests run inside a private network namespace (unshare -n, ip link set lo up)
   iproute2 util-linux
-  # deploy/sweep.py (the sweep), jq for spawn.sh/demo.sh (marsala-world --check --json), the scalability plot
-  python3 jq gnuplot-nox
+  # deploy/marsala_tools (sweep, experiment, route search) and its tests (tests/python, ctest's tools.pytest), jq for
+  # spawn.sh/demo.sh (marsala-world --check --json), the sweep's and experiments' plots
+  python3 python3-pytest jq gnuplot-nox
   # the agent's OctoMap (agent/executive/mapping_system.cpp: scans of the laser and rgbd sensors)
   liboctomap-dev
   # DDS Security identities (deploy/security/make-identities.sh, spawn.sh --secure)

@@ -26,11 +26,11 @@ expect_usage_error() {  # expect_usage_error PATTERN ARGS...
   grep -q -- "$pattern" "$work/stderr.txt" || { cat "$work/stderr.txt"; fail "no '$pattern' in the message"; }
   [ ! -e "$work/bad" ] || fail "experiment.sh $* wrote $work/bad"
 }
-expect_usage_error "--vary is required" --scenario "$scenario" --values "0 1"
+expect_usage_error "arguments are required: --vary" --scenario "$scenario" --values "0 1"
 expect_usage_error "'abc' is not a finite number" --scenario "$scenario" --vary "$vary" --values "0 abc"
-expect_usage_error "distinct values" --scenario "$scenario" --vary "$vary" --values "0.1 0.1"
-expect_usage_error "--seeds needs a positive integer" --scenario "$scenario" --vary "$vary" --values 0 --seeds 0
-expect_usage_error "unknown argument '--team'" --scenario "$scenario" --vary "$vary" --values 0 --team 3
+expect_usage_error "'0.1 0.1' lists a value twice" --scenario "$scenario" --vary "$vary" --values "0.1 0.1"
+expect_usage_error "argument --seeds: '0' is not an integer" --scenario "$scenario" --vary "$vary" --values 0 --seeds 0
+expect_usage_error "unrecognized arguments: --team" --scenario "$scenario" --vary "$vary" --values 0 --team 3
 expect_usage_error "Localisation has no field 'noise'" --scenario "$scenario" --vary robot_type.localisation.noise \
   --values 0.1
 expect_usage_error "noise_sd_m: -1 must be in \[0, 10\] m" --scenario "$scenario" --vary "$vary" --values "0 -1"

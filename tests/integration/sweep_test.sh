@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# deploy/sweep.sh (the wrapper of deploy/sweep.py) end to end: bad arguments and a scenario marsala-world --check
+# deploy/sweep.sh (deploy/marsala_tools/sweep.py) end to end: bad arguments and a scenario marsala-world --check
 # rejects, the per-team aggregation on a hand-made CSV, a real two-run sweep of the ramp scenario (teams 1 and 2, one
 # seed), a re-run that appends nothing, a resume after a lost row, a sweep stopped mid-run, and the plot. ctest runs it
 # inside run_isolated.sh (a private network namespace with only lo, when permitted); the sweep runs its processes
@@ -31,18 +31,18 @@ expect_usage_error() {  # expect_usage_error PATTERN ARGS...
   grep -q -- "$pattern" "$work/stderr.txt" || { cat "$work/stderr.txt"; fail "sweep.sh $*: no '$pattern' message"; }
   [ ! -e "$work/bad" ] || fail "sweep.sh $* wrote $work/bad despite the usage error"
 }
-expect_usage_error "unknown argument '--bogus'" --scenario "$scenario" --bogus
-expect_usage_error "--teams needs a value" --scenario "$scenario" --teams
+expect_usage_error "unrecognized arguments: --bogus" --scenario "$scenario" --bogus
+expect_usage_error "argument --teams: expected one argument" --scenario "$scenario" --teams
 expect_usage_error "'x' is not a team size" --scenario "$scenario" --teams "1 x"
 expect_usage_error "'0' is not a team size" --scenario "$scenario" --teams "0 1"
 expect_usage_error "lists a team size twice" --scenario "$scenario" --teams "2 1 2"
 expect_usage_error "has 3 agent slots, fewer than the largest team (4)" --scenario "$scenario" --teams "1 4"
-expect_usage_error "--seeds N needs an integer N >= 1" --scenario "$scenario" --seeds 0
-expect_usage_error "not both" --scenario "$scenario" --seeds 2 --seed-list "1 2"
+expect_usage_error "argument --seeds: '0' is not an integer" --scenario "$scenario" --seeds 0
+expect_usage_error "not allowed with argument --seeds" --scenario "$scenario" --seeds 2 --seed-list "1 2"
 expect_usage_error "'-3' is not a seed" --scenario "$scenario" --seed-list "1 -3"
-expect_usage_error "cyclone or fastdds, got 'opensplice'" --scenario "$scenario" --dds opensplice
-expect_usage_error "--max-steps N needs an integer" --scenario "$scenario" --max-steps 1.5
-expect_usage_error "--jobs N needs an integer" --scenario "$scenario" --jobs 0
+expect_usage_error "invalid choice: 'opensplice'" --scenario "$scenario" --dds opensplice
+expect_usage_error "argument --max-steps: '1.5' is not an integer" --scenario "$scenario" --max-steps 1.5
+expect_usage_error "argument --jobs: '0' is not an integer in \[1, 64\]" --scenario "$scenario" --jobs 0
 expect_usage_error "not found" --scenario "$work/none.pbtxt"
 # A scenario the world would reject: exit 2 with marsala-world --check's message (file and field), nothing started.
 sed 's/robot_type: "husky" start { x_m: 5.05 y_m: 10.05 }/robot_type: "rover" start { x_m: 5.05 y_m: 10.05 }/' \
