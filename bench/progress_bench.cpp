@@ -9,8 +9,9 @@
 
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
-#include "marsala/world_server/completion.hpp"
-#include "marsala/world_server/world_state.hpp"
+#include "marsala/world_server/rules/completion.hpp"
+#include "marsala/world_server/rules/initial_state.hpp"
+#include "marsala/world_server/rules/world_state.hpp"
 
 namespace {
 

@@ -3,7 +3,7 @@
 #include <csignal>
 #include <iostream>
 
-#include "marsala/world_server/world_cli.hpp"
+#include "marsala/world_server/runtime/world_cli.hpp"
 
 namespace {
 

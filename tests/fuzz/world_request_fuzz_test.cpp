@@ -28,8 +28,8 @@
 #include "fuzz/fuzz_support.hpp"
 #include "marsala/core/deposit_shapes.hpp"
 #include "marsala/core/error.hpp"
-#include "marsala/world_server/arbiter.hpp"
-#include "marsala/world_server/step.hpp"
+#include "marsala/world_server/rules/arbiter.hpp"
+#include "marsala/world_server/rules/step.hpp"
 #include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server {

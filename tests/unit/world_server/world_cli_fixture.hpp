@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "marsala/world_server/world_cli.hpp"
+#include "marsala/world_server/runtime/world_cli.hpp"
 
 namespace marsala::world_server::testing {
 

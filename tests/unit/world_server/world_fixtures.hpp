@@ -7,8 +7,9 @@
 #include "marsala/core/heightmap.hpp"
 #include "marsala/protocol/messages.hpp"
 #include "marsala/scenario/scenario.hpp"
-#include "marsala/world_server/admission.hpp"
-#include "marsala/world_server/world_state.hpp"
+#include "marsala/world_server/rules/admission.hpp"
+#include "marsala/world_server/rules/initial_state.hpp"
+#include "marsala/world_server/rules/world_state.hpp"
 
 namespace marsala::world_server::testing {
 

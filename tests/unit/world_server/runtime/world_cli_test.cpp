@@ -1,0 +1,120 @@
+#include "marsala/world_server/runtime/world_cli.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "unit/world_server/fake_agent.hpp"
+#include "unit/world_server/world_cli_fixture.hpp"
+#include "unit/world_server/world_fixtures.hpp"
+
+namespace marsala::world_server {
+namespace {
+
+namespace fs = std::filesystem;
+
+using WorldCliTest = testing::WorldCliFixture;
+
+TEST_F(WorldCliTest, UsageErrorsExitWith2) {
+  EXPECT_EQ(run({}), 2);
+  EXPECT_NE(err_.str().find("--scenario (or --resume DIR) is required"), std::string::npos) << err_.str();
+  const std::string ok = write("ok.pbtxt", testing::small_scenario_text());
+  EXPECT_EQ(run({"--scenario", ok, "--frobnicate"}), 2);
+  EXPECT_EQ(run({"--scenario", ok, "--agents", "0"}), 2);
+  EXPECT_EQ(run({"--scenario", ok, "--dds", "opensplice"}), 2);
+  EXPECT_EQ(run({"--scenario", ok, "--domain", "300"}), 2);
+  EXPECT_EQ(run({"--scenario", ok, "--step-deadline", "0"}), 2);
+  EXPECT_EQ(run({"--resume", "somewhere", "--scenario", ok}), 2);  // a resume takes its scenario from the log
+  EXPECT_EQ(run({"--help"}), 0);
+  EXPECT_NE(out_.str().find("--admit-timeout"), std::string::npos);
+}
+
+// --step-deadline overrides the scenario's, as the world's own start-up check reports it.
+TEST_F(WorldCliTest, StepDeadlineOverridesTheScenarios) {
+  const std::string ok = write("ok.pbtxt", testing::small_scenario_text());
+  EXPECT_EQ(run({"--check", "--json", "--step-deadline", "2.5", ok}), 0) << err_.str();
+  EXPECT_NE(out_.str().find("\"step_deadline_s\": 2.5"), std::string::npos) << out_.str();
+}
+
+// --resume of a folder without a run log: one line naming it, exit 1.
+TEST_F(WorldCliTest, ResumingAFolderWithoutARunLogIsAnError) {
+  const std::string folder = std::filesystem::path(write("readme.txt", "no run here")).parent_path().string();
+  EXPECT_EQ(run({"--resume", folder}), 1);
+  EXPECT_NE(err_.str().find("no run.log there"), std::string::npos) << err_.str();
+}
+
+TEST_F(WorldCliTest, BadScenariosExitWith1OnOneLineNamingFileAndLine) {
+  const std::string bad = write("bad.pbtxt", "name: \"x\"\nterrain { generator: \"flat\" }\nagent { robot_type: }\n");
+  EXPECT_EQ(run({"--scenario", bad}), 1);
+  const std::string message = err_.str();
+  EXPECT_EQ(message.rfind("marsala-world: error: " + bad + ":3:", 0), 0u) << message;
+  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1);
+  EXPECT_EQ(run({"--scenario", (dir_ / "missing.pbtxt").string()}), 1);
+  EXPECT_NE(err_.str().find("cannot open scenario file"), std::string::npos) << err_.str();
+  const std::string ok = write("ok.pbtxt", testing::small_scenario_text());
+  EXPECT_EQ(run({"--scenario", ok, "--agents", "5", "--dds", "inprocess"}), 1);
+  EXPECT_NE(err_.str().find("exceeds the 3 agent slots"), std::string::npos) << err_.str();
+  EXPECT_EQ(run({"--scenario", ok, "--dds", "inprocess", "--domain", "49", "--admit-timeout", "0.1", "--quiet", "--out",
+                 (dir_ / "none").string()}),
+            1);
+  EXPECT_NE(err_.str().find("no agent admitted"), std::string::npos) << err_.str();
+}
+
+TEST_F(WorldCliTest, ARunThatReachesMaxStepsExitsWith3) {
+  const std::string scenario = write("small.pbtxt", testing::small_scenario_text());
+  const fs::path out = dir_ / "out";
+  int rc = -1;
+  std::thread world([&] {
+    rc = run({"--scenario", scenario, "--agents", "1", "--dds", "inprocess", "--domain", "48", "--out", out.string(),
+              "--quiet", "--max-steps", "3"});
+  });
+  testing::FakeAgentConfig c;
+  c.domain = 48;
+  c.id = 1;
+  c.session = 5;
+  c.body = testing::small_scenario().robot_for(1).body;
+  testing::FakeAgent agent(c);
+  world.join();
+  agent.join();
+  EXPECT_EQ(rc, 3) << err_.str();  // the exit code says how the run ended: max_steps
+  EXPECT_NE(out_.str().find("run small-d48: max_steps after 3 steps, 1 agents"), std::string::npos) << out_.str();
+  for (const char* name : {"summary.json", "terrain_initial.asc", "terrain_final.asc", "final.png", "events.log"})
+    EXPECT_TRUE(fs::exists(out / name)) << name;
+}
+
+TEST_F(WorldCliTest, SeedOverridesTheScenariosAndIsReported) {
+  const std::string scenario = write("small.pbtxt", testing::small_scenario_text("seed: 5\nstart_jitter_m: 0.3\n"));
+  EXPECT_EQ(run({"--scenario", scenario, "--seed", "abc"}), 2);
+  EXPECT_NE(out_.str().size() + err_.str().size(), 0u);
+  const fs::path out = dir_ / "out";
+  int rc = -1;
+  std::thread world([&] {
+    rc = run({"--scenario", scenario, "--agents", "1", "--dds", "inprocess", "--domain", "52", "--out", out.string(),
+              "--quiet", "--max-steps", "2", "--seed", "77"});
+  });
+  testing::FakeAgentConfig c;
+  c.domain = 52;
+  c.id = 1;
+  c.session = 5;
+  c.body = testing::small_scenario().robot_for(1).body;
+  testing::FakeAgent agent(c);
+  world.join();
+  agent.join();
+  EXPECT_EQ(rc, 3) << err_.str();  // max_steps
+  std::ifstream in(out / "summary.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("\"seed\": \"77\""), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("\"start_jitter_m\": 0.3"), std::string::npos) << text.str();
+  EXPECT_EQ(run({"--help"}), 0);
+  EXPECT_NE(out_.str().find("--seed"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace marsala::world_server

@@ -1,0 +1,73 @@
+#include "marsala/world_server/runtime/agent_links.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <exception>
+#include <utility>
+
+namespace marsala::world_server {
+
+template <typename T>
+void write_logged(bus::Writer<T>& writer, const T& sample, const char* what) {
+  try {
+    writer.write(sample);
+  } catch (const std::exception& e) {
+    spdlog::error("cannot publish {}: {}", what, e.what());
+  }
+}
+
+template void write_logged(bus::Writer<protocol::SensorFrame>&, const protocol::SensorFrame&, const char*);
+template void write_logged(bus::Writer<protocol::Admission>&, const protocol::Admission&, const char*);
+template void write_logged(bus::Writer<protocol::WorldStatus>&, const protocol::WorldStatus&, const char*);
+template void write_logged(bus::Writer<protocol::WorldEvent>&, const protocol::WorldEvent&, const char*);
+
+AgentLinks::AgentLinks(bus::Participant& participant, std::shared_ptr<bus::Signal> signal, std::string run_id,
+                       std::size_t slots)
+    : participant_(participant), signal_(std::move(signal)), run_id_(std::move(run_id)), links_(slots) {}
+
+void AgentLinks::open(const AgentRecord& a) {
+  AgentLink& link = links_[a.id - 1];
+  if (link.requests && link.session == a.session) return;
+  const std::string partition = protocol::partition_for(run_id_, a.id, a.session);
+  link = AgentLink{};
+  link.session = a.session;
+  link.frames = participant_.create_writer<protocol::SensorFrame>({partition, nullptr, bus::Durability::kVolatile, 64});
+  link.requests =
+      participant_.create_reader<protocol::ActionRequest>({partition, signal_, bus::Durability::kVolatile, 64});
+  spdlog::info("agent {} '{}' ({}) on partition {}", a.id, a.name, a.type.name, partition);
+}
+
+bool AgentLinks::connected(std::uint32_t id) const {
+  const AgentLink& link = links_[id - 1];
+  return link.requests && link.requests->alive_writers() >= 1;
+}
+
+bool AgentLinks::ready(std::uint32_t id) const {
+  const AgentLink& link = links_[id - 1];
+  return link.frames->matched_readers() >= 1 && link.requests->alive_writers() >= 1;
+}
+
+LivelinessVerdict AgentLinks::observe(std::uint32_t id, LivelinessWatch::Clock::time_point now) {
+  AgentLink& link = links_[id - 1];
+  return link.liveliness.observe(link.requests->alive_writers() >= 1, now);
+}
+
+std::vector<protocol::ActionRequest> AgentLinks::take(std::uint32_t id) {
+  AgentLink& link = links_[id - 1];
+  return link.requests ? link.requests->take() : std::vector<protocol::ActionRequest>{};
+}
+
+void AgentLinks::send(std::uint32_t id, protocol::SensorFrame frame) {
+  AgentLink& link = links_[id - 1];
+  link.frame = std::move(frame);
+  write_logged(*link.frames, *link.frame, "a sensor frame");
+}
+
+bool AgentLinks::resend(std::uint32_t id, std::uint64_t step) {
+  AgentLink& link = links_[id - 1];
+  if (!link.frame || link.frame->step != step) return false;
+  write_logged(*link.frames, *link.frame, "a sensor frame");
+  return true;
+}
+
+}  // namespace marsala::world_server

@@ -1,0 +1,67 @@
+#pragma once
+// The world's links to its admitted agents: per slot, the endpoints of the admitted session on its partition
+// (protocol::partition_for(run_id, id, session)): a SensorFrame writer and an ActionRequest reader, the liveliness
+// of the agent's request writer (liveliness.hpp) and the frame of the current step, for resends.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "marsala/bus/bus.hpp"
+#include "marsala/protocol/messages.hpp"
+#include "marsala/world_server/rules/world_state.hpp"
+#include "marsala/world_server/runtime/liveliness.hpp"
+
+namespace marsala::world_server {
+
+/// The endpoints of one admitted agent (process): its session's partition.
+struct AgentLink {
+  std::uint64_t session = 0;  ///< the session whose partition the endpoints use
+  std::unique_ptr<bus::Writer<protocol::SensorFrame>> frames;
+  std::unique_ptr<bus::Reader<protocol::ActionRequest>> requests;
+  LivelinessWatch liveliness;                  ///< of its request writer
+  std::optional<protocol::SensorFrame> frame;  ///< the current step's frame, for resends
+};
+
+/// Writes a sample; a failing write is logged, never fatal: one agent's broken link must not stop the world.
+template <typename T>
+void write_logged(bus::Writer<T>& writer, const T& sample, const char* what);
+
+/// Links of slots 1..slots; a slot has endpoints once open() was called for it.
+class AgentLinks {
+ public:
+  /// `signal` wakes the world when a request arrives on any link.
+  AgentLinks(bus::Participant& participant, std::shared_ptr<bus::Signal> signal, std::string run_id, std::size_t slots);
+
+  /// Opens the partition endpoints of `agent`'s admitted session, replacing another session's (a new link: its
+  /// liveliness starts unseen); nothing when they are open already.
+  void open(const AgentRecord& agent);
+  /// True when slot `id` has endpoints.
+  bool has(std::uint32_t id) const { return static_cast<bool>(links_[id - 1].requests); }
+  /// True when the request writer of slot `id`'s session is alive (false without endpoints).
+  bool connected(std::uint32_t id) const;
+  /// True when slot `id`'s frame writer has matched a reader and its request writer is alive.
+  bool ready(std::uint32_t id) const;
+  /// True when no request writer of slot `id` is alive any more.
+  bool gone(std::uint32_t id) const { return links_[id - 1].requests->alive_writers() == 0; }
+  /// Observes slot `id`'s request writer at `now` (liveliness.hpp).
+  LivelinessVerdict observe(std::uint32_t id, LivelinessWatch::Clock::time_point now);
+  /// Forgets a running liveliness grace of slot `id` (it was just admitted again).
+  void forgive(std::uint32_t id) { links_[id - 1].liveliness.forgive(); }
+  /// Takes the requests received on slot `id`'s partition (none without endpoints).
+  std::vector<protocol::ActionRequest> take(std::uint32_t id);
+  /// Sends `frame` to slot `id` and keeps it for resend().
+  void send(std::uint32_t id, protocol::SensorFrame frame);
+  /// Sends slot `id` its kept frame again when it is of `step`; false when it has none of that step.
+  bool resend(std::uint32_t id, std::uint64_t step);
+
+ private:
+  bus::Participant& participant_;
+  std::shared_ptr<bus::Signal> signal_;
+  std::string run_id_;
+  std::vector<AgentLink> links_;  ///< [id - 1]
+};
+
+}  // namespace marsala::world_server

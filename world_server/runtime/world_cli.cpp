@@ -1,0 +1,137 @@
+#include "marsala/world_server/runtime/world_cli.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdlib>
+#include <ostream>
+
+#include "marsala/bus/bus.hpp"
+#include "marsala/cli/command_line.hpp"
+#include "marsala/cli/logging.hpp"
+#include "marsala/core/error.hpp"
+#include "marsala/scenario/scenario.hpp"
+#include "marsala/scenario/terrain_builder.hpp"
+#include "marsala/world_server/records/run_outputs.hpp"
+#include "marsala/world_server/runtime/scenario_check.hpp"
+#include "marsala/world_server/runtime/world_runtime.hpp"
+
+namespace marsala::world_server {
+
+int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& stop, std::ostream& out,
+                  std::ostream& err) {
+  CLI::App app{
+      "marsala-world: the authoritative world server. Loads a scenario, admits agents over DDS, runs the\n"
+      "lockstep (frames, requests, validation in agent-id order) and writes summary.json, terrain_initial.asc,\n"
+      "terrain_final.asc, final.png, events.log, final_zoom.png (a close-up of what was built, unless it would\n"
+      "cover more than half the terrain) and goal_vector_map.png (when the scenario has one) into --out.\n"
+      "The run id (partition prefix) defaults to <scenario name>-d<domain>.\n"
+      "marsala-world --check [--json] SCENARIO validates the scenario as the world would at start, without\n"
+      "DDS, prints what the run would start from and exits 0 when valid, 2 when not.\n"
+      "Every run also writes run.log (every accepted change, checksummed) and snapshot.pb; after a crash,\n"
+      "marsala-world --resume DIR continues the run in DIR with its agents (docs/runtime.md#resume).\n"
+      "Exit codes: 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 1 error, 2 usage.",
+      "marsala-world"};
+  std::string scenario_path, check_path, resume_dir;
+  cli::DdsOptions dds;
+  RuntimeOptions options;
+  bool quiet = false, check = false, json = false;
+  CLI::Option* scenario_option =
+      app.add_option("--scenario", scenario_path, "scenario file (protobuf text format); required but with --check");
+  CLI::Option* check_option = app.add_flag(
+      "--check", check,
+      "validate the scenario as the world would at start (scenario, terrain, completion, slots, options) without\n"
+      "starting DDS, print what the run would start from and exit: 0 valid, 2 not (one line naming file and field)");
+  app.add_flag("--json", json, "with --check: print the report as one JSON object (idl/scenario_check.proto)")
+      ->needs(check_option);
+  app.add_option("SCENARIO", check_path, "with --check: the scenario file (or give --scenario)")
+      ->needs(check_option)
+      ->excludes(scenario_option);
+  app.add_option("--agents", options.agents, "agents to wait for, ids 1..N (default: every slot of the scenario)")
+      ->check(CLI::Range(1u, 100000u));
+  cli::add_dds_options(app, dds);
+  app.add_option("--out", options.out_dir, "output folder")->capture_default_str();
+  app.add_option("--run-id", options.run_id, "run id, the prefix of every agent partition");
+  app.add_option("--admit-timeout", options.admit_timeout_s, "seconds to wait for all agents")
+      ->check(CLI::Range(0.0, 86400.0))
+      ->capture_default_str();
+  app.add_option("--max-steps", options.max_steps, "override the scenario's max_steps")
+      ->check(CLI::Range(1ull, 1ull << 40));
+  app.add_option("--step-deadline", options.step_deadline_s,
+                 "override the scenario's step_deadline_s: how long a step waits for a dead or hung agent [s]")
+      ->check(CLI::Range(0.001, 3600.0));
+  std::uint64_t seed = 0;
+  const CLI::Option* seed_option =
+      app.add_option("--seed", seed, "override the scenario's seed (start jitter); summary.json reports the seed used");
+  app.add_option("--set", options.overrides,
+                 "change a field of the scenario, FIELD=VALUE, e.g. robot_type.body.sensing_range_m=5 (repeatable;\n"
+                 "every marsala-agent must get the same; recorded in run.log and summary.json)")
+      ->type_name("FIELD=VALUE");
+  CLI::Option* resume_option =
+      app.add_option(
+             "--resume", resume_dir,
+             "continue the run whose output folder is DIR after a crash of the world: its scenario, options and\n"
+             "state come from DIR/run.log (and snapshot.pb); the agents that were running reconnect")
+          ->excludes(scenario_option)
+          ->excludes(check_option);
+  app.add_option("--snapshot-every", options.snapshot_every, "write snapshot.pb after every N steps (0: never)")
+      ->check(CLI::Range(0ull, 1ull << 40))
+      ->capture_default_str();
+  app.add_option("--frames-every", options.frames_every,
+                 "a time-lapse: a PNG frame every K steps and the last into OUT/frames (frame_<step>.png), and\n"
+                 "OUT/frames/timelapse.mp4 of them when ffmpeg is on PATH")
+      ->check(cli::at_least_one())
+      ->type_name("K");
+  app.add_flag("--replace", options.replace,
+               "remove a previous run's files from --out before starting (without it such a folder is refused)")
+      ->excludes(resume_option);
+  app.add_flag("--quiet", quiet, "log warnings and errors only (--log-level warn)");
+  cli::LogOptions log_options;
+  cli::add_log_options(app, log_options);
+  app.callback([&] {
+    // --scenario is required of a run; a check takes its file either way; a resume reads it from the log.
+    if (scenario_option->count() == 0 && check_path.empty() && resume_option->count() == 0)
+      throw CLI::RequiredError(check ? "SCENARIO (or --scenario)" : "--scenario (or --resume DIR)");
+  });
+  if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-world", out, err)) return *code;
+
+  if (seed_option->count() > 0) options.seed = seed;
+  if (const char* path = std::getenv("PATH")) options.search_path = path;
+  if (check)
+    return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, dds.domain, json, out, err);
+  if (quiet && app.get_option("--log-level")->count() == 0) log_options.level = "warn";
+  const cli::LoggingScope logging("world", 0, log_options);
+  try {
+    WorldStart start;
+    if (!resume_dir.empty()) {
+      start = prepare_resume(resume_dir, options, dds.domain);
+    } else {
+      options.scenario_text = scenario::read_scenario_text(scenario_path);
+      if (options.replace) clear_run_files(options.out_dir);
+      const scenario::Scenario scenario =
+          scenario::parse_scenario(options.scenario_text, scenario_path, options.overrides);
+      start = prepare_world_start(scenario, scenario::build_terrain(scenario), options, dds.domain);
+    }
+    const auto participant =
+        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,
+                               bus::Security::of(dds.security, dds.identity, "world")});
+    WorldRuntime runtime(std::move(start), *participant);
+    const RunResult result = runtime.run(stop);
+    out << fmt::format("run {}: {} after {} steps{}, {} agents, terrain sha256 {}\n", runtime.run_id(),
+                       to_string(result.end_reason), result.steps,
+                       result.resumed_at_step ? fmt::format(" (resumed at step {})", *result.resumed_at_step) : "",
+                       result.admitted, result.terrain_sha256);
+    return exit_code(result.end_reason);
+  } catch (const Error& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return 1;
+  } catch (const std::bad_alloc&) {
+    cli::write_exit_error(err, "marsala-world: error: out of memory");
+    return 1;
+  } catch (const std::exception& e) {  // a library's own exception: still one line and exit 1, never an abort
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace marsala::world_server
