@@ -5,6 +5,8 @@
 #include <fstream>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "marsala/bus/detail/backends.hpp"
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
@@ -66,18 +68,20 @@ std::filesystem::path executable_dir() {
 /// Throws InvalidArgument unless `path` is a readable profile document of `vendor`.
 void check_profile(Vendor vendor, const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw InvalidArgument("DDS profile '" + path + "' (--dds-config / MARSALA_DDS_CONFIG) cannot be read");
+  if (!in)
+    throw InvalidArgument(fmt::format("DDS profile '{}' (--dds-config / MARSALA_DDS_CONFIG) cannot be read", path));
   std::string head(4096, '\0');
   in.read(head.data(), static_cast<std::streamsize>(head.size()));
   head.resize(static_cast<std::size_t>(in.gcount()));
   const bool cyclone = head.find("<CycloneDDS") != std::string::npos;
   const bool fastdds = head.find("<dds") != std::string::npos || head.find("<profiles") != std::string::npos;
   if (vendor == Vendor::kCyclone && !cyclone)
-    throw InvalidArgument("DDS profile '" + path + "' is not a Cyclone DDS profile (no <CycloneDDS> element)" +
-                          (fastdds ? ": it is a Fast DDS one; use --dds fastdds or a cyclone-*.xml" : ""));
+    throw InvalidArgument(fmt::format("DDS profile '{}' is not a Cyclone DDS profile (no <CycloneDDS> element){}", path,
+                                      fastdds ? ": it is a Fast DDS one; use --dds fastdds or a cyclone-*.xml" : ""));
   if (vendor == Vendor::kFastDds && !fastdds)
-    throw InvalidArgument("DDS profile '" + path + "' is not a Fast DDS profile (no <dds> or <profiles> element)" +
-                          (cyclone ? ": it is a Cyclone DDS one; use --dds cyclone or a fastdds-*.xml" : ""));
+    throw InvalidArgument(
+        fmt::format("DDS profile '{}' is not a Fast DDS profile (no <dds> or <profiles> element){}", path,
+                    cyclone ? ": it is a Cyclone DDS one; use --dds cyclone or a fastdds-*.xml" : ""));
 }
 
 }  // namespace
@@ -103,14 +107,15 @@ std::string resolve_profile(Vendor vendor, const std::string& given) {
 
 void check_security(const Security& security) {
   if (!security.enabled()) return;
-  if (security.identity.empty()) throw InvalidArgument("DDS Security: no identity given for " + security.dir);
+  if (security.identity.empty())
+    throw InvalidArgument(fmt::format("DDS Security: no identity given for {}", security.dir));
   for (const std::string& name : {std::string("ca.pem"), std::string("governance.p7s"), std::string("permissions.p7s"),
                                   security.identity + ".pem", security.identity + ".key"}) {
     const std::filesystem::path file = std::filesystem::path(security.dir) / name;
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec))
-      throw InvalidArgument("DDS Security: " + file.string() +
-                            " not found (make the folder with deploy/security/make-identities.sh)");
+      throw InvalidArgument(fmt::format(
+          "DDS Security: {} not found (make the folder with deploy/security/make-identities.sh)", file.string()));
   }
 }
 
@@ -119,7 +124,7 @@ std::unique_ptr<Participant> make_participant(const BusConfig& config) {
     throw InvalidArgument("DDS Security needs a DDS vendor (cyclone or fastdds), not inprocess");
   check_security(config.security);
   if (config.domain_id < 0 || config.domain_id > 232)
-    throw InvalidArgument("DDS domain id must be in 0..232, got " + std::to_string(config.domain_id));
+    throw InvalidArgument(fmt::format("DDS domain id must be in 0..232, got {}", config.domain_id));
   if (const std::string profile = resolve_profile(config.vendor, config.profile); !profile.empty()) {
     const std::string value = config.vendor == Vendor::kCyclone ? "file://" + profile : profile;
     ::setenv(profile_variable(config.vendor), value.c_str(), 1);

@@ -57,8 +57,8 @@ bool occupiable_by_window(const Heightmap& h, CellIndex cell, const Navigability
 bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
                      OccupancyMethod method) {
   if (!terrain.contains(cell))
-    throw InvalidArgument("cell_occupiable: cell " + fmt::format("{}", cell) + " is off the " +
-                          std::to_string(terrain.rows()) + " x " + std::to_string(terrain.cols()) + " grid");
+    throw InvalidArgument(
+        fmt::format("cell_occupiable: cell {} is off the {} x {} grid", cell, terrain.rows(), terrain.cols()));
   const std::vector<CellIndex> offsets = disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m()));
   if (method == OccupancyMethod::kAutomatic)
     method = offsets.size() <= kMaxPairBallCells ? OccupancyMethod::kPairs : OccupancyMethod::kWindow;

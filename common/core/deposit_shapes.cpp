@@ -81,9 +81,9 @@ std::vector<std::string> depositor_names() { return registry().names(); }
 
 DepositShape cube_column_shape(const GridGeometry& grid, Position centre, double side_m, int cubes) {
   if (!finite(centre) || !(side_m > 0.0) || !std::isfinite(side_m) || cubes < 0)
-    throw InvalidArgument("cube column at " + fmt::format("{}", centre) + ": side " + fmt::format("{}", side_m) +
-                          " m must be finite and > 0, the centre finite and the cube count (" +
-                          std::to_string(cubes) + ") >= 0");
+    throw InvalidArgument(fmt::format(
+        "cube column at {}: side {} m must be finite and > 0, the centre finite and the cube count ({}) >= 0", centre,
+        side_m, cubes));
   DepositShape shape;
   const double cs = grid.cell_size_m;
   const double half = 0.5 * side_m / cs;  // [cells]
@@ -117,9 +117,10 @@ long long whole_cubes(double volume_m3, double side_m) {
 DepositShape cone_pile_shape(const Heightmap& terrain, Position dump, double volume_m3, double repose_deg) {
   if (!finite(dump) || !std::isfinite(volume_m3) || !(volume_m3 >= 0.0) || !(repose_deg > 0.0) ||
       !(repose_deg < 90.0))
-    throw InvalidArgument("cone pile at " + fmt::format("{}", dump) + ": volume " + fmt::format("{}", volume_m3) +
-                          " m^3 must be finite and >= 0, the angle of repose " + fmt::format("{}", repose_deg) +
-                          " deg in (0, 90), the dump point finite");
+    throw InvalidArgument(fmt::format(
+        "cone pile at {}: volume {} m^3 must be finite and >= 0, the angle of repose {} deg in (0, 90), the dump "
+        "point finite",
+        dump, volume_m3, repose_deg));
   DepositShape shape;
   const GridGeometry& grid = terrain.geometry();
   const std::optional<CellIndex> at = grid.cell_at(dump);

@@ -11,11 +11,10 @@ namespace marsala {
 namespace {
 
 double checked_gap(const Heightmap& gap, CellIndex i) {
-  if (!gap.contains(i)) throw InvalidArgument("deposition target cell " + fmt::format("{}", i) + " is off the grid");
+  if (!gap.contains(i)) throw InvalidArgument(fmt::format("deposition target cell {} is off the grid", i));
   const double g = gap(i);
   if (!(g >= 0.0) || !std::isfinite(g))
-    throw InvalidArgument("MARS gap at cell " + fmt::format("{}", i) + " is " + std::to_string(g) +
-                          "; a gap is finite and >= 0");
+    throw InvalidArgument(fmt::format("MARS gap at cell {} is {}; a gap is finite and >= 0", i, g));
   return g;
 }
 
@@ -32,9 +31,8 @@ double deposition_target_volume(const Heightmap& gap, const std::vector<CellInde
 
 double deposition_target_volume(const Heightmap& gap, const CellMask& footprint) {
   if (footprint.rows() != gap.rows() || footprint.cols() != gap.cols())
-    throw InvalidArgument("footprint mask is " + std::to_string(footprint.rows()) + " x " +
-                          std::to_string(footprint.cols()) + " but the gap grid is " + std::to_string(gap.rows()) +
-                          " x " + std::to_string(gap.cols()));
+    throw InvalidArgument(fmt::format("footprint mask is {} x {} but the gap grid is {} x {}", footprint.rows(),
+                                      footprint.cols(), gap.rows(), gap.cols()));
   double sum_m = 0.0;
   for (SubmapIterator it(gap.geometry(), {0, 0}, gap.rows(), gap.cols()); !it.is_past_end(); ++it)
     if (footprint((*it).row, (*it).col) != 0) sum_m += checked_gap(gap, *it);
@@ -47,10 +45,10 @@ double deposition_target_volume(const Heightmap& gap) {
 
 CellMask path_footprint(const GridGeometry& grid, const std::vector<CellIndex>& path, double delta_m) {
   if (!(delta_m > 0.0) || !std::isfinite(delta_m))
-    throw InvalidArgument("body length delta must be finite and > 0, got " + std::to_string(delta_m));
+    throw InvalidArgument(fmt::format("body length delta must be finite and > 0, got {}", delta_m));
   CellMask footprint = CellMask::Zero(grid.rows, grid.cols);
   for (const CellIndex p : path) {
-    if (!grid.contains(p)) throw InvalidArgument("path cell " + fmt::format("{}", p) + " is off the grid");
+    if (!grid.contains(p)) throw InvalidArgument(fmt::format("path cell {} is off the grid", p));
     for (DiscIterator it(grid, p, delta_m / 2.0); !it.is_past_end(); ++it) footprint((*it).row, (*it).col) = 1;
   }
   return footprint;

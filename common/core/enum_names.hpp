@@ -9,6 +9,8 @@
 #include <cstddef>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "marsala/core/error.hpp"
 
 namespace marsala {
@@ -36,7 +38,7 @@ Enum enum_from_string(const EnumName<Enum> (&names)[N], const std::string& name,
     if (name == n.name) return n.value;
     valid += (valid.empty() ? "" : ", ") + std::string(n.name);
   }
-  throw InvalidArgument("unknown " + std::string(kind) + " '" + name + "'; valid: " + valid);
+  throw InvalidArgument(fmt::format("unknown {} '{}'; valid: {}", kind, name, valid));
 }
 
 }  // namespace marsala

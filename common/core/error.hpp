@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <fmt/format.h>
+
 namespace marsala {
 
 /// Root of every error the project throws on purpose.
@@ -18,7 +20,7 @@ class ParseError : public Error {
  public:
   /// `file`: path as given; `line`: 1-based line number, 0 when not line-oriented.
   ParseError(const std::string& file, int line, const std::string& problem)
-      : Error(file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + problem),
+      : Error(line > 0 ? fmt::format("{}:{}: {}", file, line, problem) : fmt::format("{}: {}", file, problem)),
         file_(file),
         line_(line) {}
   const std::string& file() const { return file_; }

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
@@ -18,10 +17,12 @@ constexpr EnumName<Heading> kHeadingNames[] = {
 // extent forgive this much [m].
 constexpr double kTolM = 1e-9;
 
-[[noreturn]] void fail(const std::string& problem) { throw InvalidArgument("goal vector map: " + problem); }
+[[noreturn]] void fail(const std::string& problem) {
+  throw InvalidArgument(fmt::format("goal vector map: {}", problem));
+}
 
 void check_finite(const char* field, double v) {
-  if (!std::isfinite(v)) fail(std::string(field) + " is " + fmt::format("{}", v) + ", not a finite number");
+  if (!std::isfinite(v)) fail(fmt::format("{} is {}, not a finite number", field, v));
 }
 
 bool along_x(Heading h) { return h == Heading::kEast || h == Heading::kWest; }
@@ -47,27 +48,20 @@ GoalVectorMap::GoalVectorMap(const GoalVectorMapSpec& spec, const GridGeometry& 
   const double cs = grid.cell_size_m;
   if (grid.rows <= 0 || grid.cols <= 0 || !std::isfinite(cs) || !(cs > 0.0) || !std::isfinite(grid.xll_m) ||
       !std::isfinite(grid.yll_m))
-    fail("the grid " + std::to_string(grid.rows) + " x " + std::to_string(grid.cols) + " with cell size " +
-         fmt::format("{}", cs) + " m is not a valid grid");
-  const std::string rect = "[" + fmt::format("{}", spec.area.x0) + ", " + fmt::format("{}", spec.area.x1) + "] x [" +
-                           fmt::format("{}", spec.area.y0) + ", " + fmt::format("{}", spec.area.y1) + "] m";
+    fail(fmt::format("the grid {} x {} with cell size {} m is not a valid grid", grid.rows, grid.cols, cs));
   if (!(spec.area.x0 < spec.area.x1) || !(spec.area.y0 < spec.area.y1))
-    fail("the rectangle " + rect + " is empty (needs x0_m < x1_m and y0_m < y1_m)");
+    fail(fmt::format("the rectangle {} is empty (needs x0_m < x1_m and y0_m < y1_m)", spec.area));
   const double gx1 = grid.xll_m + grid.cols * cs;
   const double gy1 = grid.yll_m + grid.rows * cs;
   if (spec.area.x0 < grid.xll_m - kTolM || spec.area.x1 > gx1 + kTolM || spec.area.y0 < grid.yll_m - kTolM ||
       spec.area.y1 > gy1 + kTolM)
-    fail("the rectangle " + rect + " is not inside the grid [" + fmt::format("{}", grid.xll_m) + ", " +
-         fmt::format("{}", gx1) + "] x [" + fmt::format("{}", grid.yll_m) + ", " + fmt::format("{}", gy1) + "] m");
-  if (!(spec.strip_width_m > 0.0)) fail("strip_width_m is " + fmt::format("{}", spec.strip_width_m) + ", must be > 0");
-  if (!(spec.arrow_length_m > 0.0))
-    fail("arrow_length_m is " + fmt::format("{}", spec.arrow_length_m) + ", must be > 0");
+    fail(fmt::format("the rectangle {} is not inside the grid {}", spec.area, Rect{grid.xll_m, grid.yll_m, gx1, gy1}));
+  if (!(spec.strip_width_m > 0.0)) fail(fmt::format("strip_width_m is {}, must be > 0", spec.strip_width_m));
+  if (!(spec.arrow_length_m > 0.0)) fail(fmt::format("arrow_length_m is {}, must be > 0", spec.arrow_length_m));
   if (spec.strip_width_m < cs - kTolM)
-    fail("strip_width_m " + fmt::format("{}", spec.strip_width_m) + " m is narrower than one cell (" +
-         fmt::format("{}", cs) + " m)");
+    fail(fmt::format("strip_width_m {} m is narrower than one cell ({} m)", spec.strip_width_m, cs));
   if (spec.arrow_length_m < cs - kTolM)
-    fail("arrow_length_m " + fmt::format("{}", spec.arrow_length_m) + " m is shorter than one cell (" +
-         fmt::format("{}", cs) + " m)");
+    fail(fmt::format("arrow_length_m {} m is shorter than one cell ({} m)", spec.arrow_length_m, cs));
 
   const Heading heading = spec.heading;
   const bool ax = along_x(heading);
@@ -98,10 +92,10 @@ GoalVectorMap::GoalVectorMap(const GoalVectorMapSpec& spec, const GridGeometry& 
   strips_ = pieces(across_hi - across_lo, w);
   const double last_band_lo = across_lo + (strips_ - 1) * w;
   if (across_hi - last_band_lo < cs - kTolM)
-    fail("strip " + std::to_string(strips_ - 1) + " of " + std::to_string(strips_) + " is only " +
-         fmt::format("{}", across_hi - last_band_lo) + " m wide, narrower than one cell (" + fmt::format("{}", cs) +
-         " m): the site is " + fmt::format("{}", across_hi - across_lo) + " m across heading " + to_string(heading) +
-         " with strip_width_m " + fmt::format("{}", w) + " m");
+    fail(fmt::format(
+        "strip {} of {} is only {} m wide, narrower than one cell ({} m): the site is {} m across heading {} with "
+        "strip_width_m {} m",
+        strips_ - 1, strips_, across_hi - last_band_lo, cs, across_hi - across_lo, to_string(heading), w));
   std::vector<double> lines(static_cast<std::size_t>(strips_));
   for (int i = 0; i < strips_; ++i) {
     const double lo = across_lo + i * w;
@@ -137,8 +131,10 @@ GoalVectorMap::GoalVectorMap(const GoalVectorMapSpec& spec, const GridGeometry& 
          (travelled(n) - travelled(kept.back()) < cs - kTolM || advance(kept.back(), n) < cs - kTolM))
     kept.pop_back();
   if (advance(kept.back(), n) < cs - kTolM)
-    fail("the site is only " + fmt::format("{}", extent) + " m long along heading " + to_string(heading) +
-         ": its upwind and downwind cells are less than one cell (" + fmt::format("{}", cs) + " m) apart");
+    fail(fmt::format(
+        "the site is only {} m long along heading {}: its upwind and downwind cells are less than one cell ({} m) "
+        "apart",
+        extent, to_string(heading), cs));
   kept.push_back(n);
 
   arrows_.reserve(static_cast<std::size_t>(strips_) * (kept.size() - 1));
@@ -157,8 +153,7 @@ GoalVectorMap::GoalVectorMap(const GoalVectorMapSpec& spec, const GridGeometry& 
 
 std::optional<std::size_t> GoalVectorMap::nearest_free_tail(Position p, const std::vector<bool>& excluded) const {
   if (!std::isfinite(p.x) || !std::isfinite(p.y))
-    fail("nearest_free_tail from (" + fmt::format("{}", p.x) + ", " + fmt::format("{}", p.y) +
-         ") m: not a finite position");
+    fail(fmt::format("nearest_free_tail from {}: not a finite position", p));
   std::optional<std::size_t> best;
   double best_d2 = 0.0;
   for (std::size_t i = 0; i < arrows_.size(); ++i) {
@@ -175,8 +170,7 @@ std::optional<std::size_t> GoalVectorMap::nearest_free_tail(Position p, const st
 }
 
 std::optional<std::size_t> GoalVectorMap::next(std::size_t i) const {
-  if (i >= arrows_.size())
-    fail("arrow " + std::to_string(i) + " is out of range (the map has " + std::to_string(arrows_.size()) + " arrows)");
+  if (i >= arrows_.size()) fail(fmt::format("arrow {} is out of range (the map has {} arrows)", i, arrows_.size()));
   if (i + 1 < arrows_.size() && arrows_[i + 1].strip == arrows_[i].strip) return i + 1;
   return std::nullopt;
 }

@@ -11,9 +11,9 @@ namespace {
 
 void check_geometry(const GridGeometry& g) {
   if (g.rows <= 0 || g.cols <= 0)
-    throw InvalidArgument("grid size must be positive, got " + std::to_string(g.rows) + " x " + std::to_string(g.cols));
+    throw InvalidArgument(fmt::format("grid size must be positive, got {} x {}", g.rows, g.cols));
   if (!(g.cell_size_m > 0.0) || !std::isfinite(g.cell_size_m))
-    throw InvalidArgument("cell size must be a positive finite number of metres, got " + std::to_string(g.cell_size_m));
+    throw InvalidArgument(fmt::format("cell size must be a positive finite number of metres, got {}", g.cell_size_m));
   if (!std::isfinite(g.xll_m) || !std::isfinite(g.yll_m)) throw InvalidArgument("grid corner must be finite");
 }
 
@@ -38,25 +38,20 @@ Heightmap::Heightmap(GridGeometry geometry, HeightMatrix heights) : geometry_(ge
 }
 
 double Heightmap::at(CellIndex i) const {
-  if (!contains(i))
-    throw InvalidArgument("cell " + fmt::format("{}", i) + " is off the " + std::to_string(rows()) + " x " +
-                          std::to_string(cols()) + " grid");
+  if (!contains(i)) throw InvalidArgument(fmt::format("cell {} is off the {} x {} grid", i, rows(), cols()));
   return heights_(i.row, i.col);
 }
 
 double& Heightmap::at(CellIndex i) {
-  if (!contains(i))
-    throw InvalidArgument("cell " + fmt::format("{}", i) + " is off the " + std::to_string(rows()) + " x " +
-                          std::to_string(cols()) + " grid");
+  if (!contains(i)) throw InvalidArgument(fmt::format("cell {} is off the {} x {} grid", i, rows(), cols()));
   return heights_(i.row, i.col);
 }
 
 Heightmap Heightmap::window(CellIndex top_left, int rows, int cols) const {
   const CellIndex bottom_right{top_left.row + rows - 1, top_left.col + cols - 1};
   if (rows <= 0 || cols <= 0 || !contains(top_left) || !contains(bottom_right))
-    throw InvalidArgument("window " + std::to_string(rows) + " x " + std::to_string(cols) + " at " +
-                          fmt::format("{}", top_left) + " leaves the " + std::to_string(this->rows()) + " x " +
-                          std::to_string(this->cols()) + " grid");
+    throw InvalidArgument(
+        fmt::format("window {} x {} at {} leaves the {} x {} grid", rows, cols, top_left, this->rows(), this->cols()));
   GridGeometry g = geometry_;
   g.rows = rows;
   g.cols = cols;

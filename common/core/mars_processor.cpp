@@ -40,7 +40,7 @@ std::string mars_problem(double kappa, double cell_size_m, double max_abs_height
 
 MarsProcessor::MarsProcessor(double kappa) : kappa_(kappa) {
   if (!std::isfinite(kappa) || !(kappa > 0.0))
-    throw InvalidArgument("MarsProcessor: kappa must be finite and > 0, got " + std::to_string(kappa));
+    throw InvalidArgument(fmt::format("MarsProcessor: kappa must be finite and > 0, got {}", kappa));
 }
 
 Heightmap MarsProcessor::project(const Heightmap& h) const {
@@ -48,18 +48,17 @@ Heightmap MarsProcessor::project(const Heightmap& h) const {
   const int rows = h.rows(), cols = h.cols();
   if (rows <= 0 || cols <= 0) return out;
   if (h.size() >= std::numeric_limits<std::int32_t>::max())
-    throw InvalidArgument("MarsProcessor: a grid of " + std::to_string(h.size()) + " cells is too large");
+    throw InvalidArgument(fmt::format("MarsProcessor: a grid of {} cells is too large", h.size()));
   double max_abs = 0.0;
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < cols; ++c) {
       const double v = h(r, c);
       if (!std::isfinite(v))
-        throw InvalidArgument("MarsProcessor: height at cell (row " + std::to_string(r) + ", col " + std::to_string(c) +
-                              ") is not finite");
+        throw InvalidArgument(fmt::format("MarsProcessor: height at cell (row {}, col {}) is not finite", r, c));
       max_abs = std::max(max_abs, std::abs(v));
     }
   if (const std::string problem = mars_problem(kappa_, h.cell_size_m(), max_abs, rows, cols); !problem.empty())
-    throw InvalidArgument("MarsProcessor: " + problem);
+    throw InvalidArgument(fmt::format("MarsProcessor: {}", problem));
   detail::Problem pb;
   pb.h = h.data();
   pb.rows = rows;

@@ -14,9 +14,7 @@ namespace marsala {
 namespace {
 
 void require(bool ok, const char* name, double value, const char* rule) {
-  if (!ok)
-    throw InvalidArgument(std::string("NavigabilityProcessor: ") + name + " must be " + rule + ", got " +
-                          fmt::format("{}", value));
+  if (!ok) throw InvalidArgument(fmt::format("NavigabilityProcessor: {} must be {}, got {}", name, rule, value));
 }
 
 void check_finite(const Heightmap& h) {
@@ -25,15 +23,14 @@ void check_finite(const Heightmap& h) {
   for (long long i = 0; i < n; ++i)
     if (!std::isfinite(heights[i])) {
       const CellIndex cell{static_cast<int>(i / h.cols()), static_cast<int>(i % h.cols())};
-      throw InvalidArgument("NavigabilityProcessor: height at cell " + fmt::format("{}", cell) + " is not finite (" +
-                            fmt::format("{}", heights[i]) + ")");
+      throw InvalidArgument(
+          fmt::format("NavigabilityProcessor: height at cell {} is not finite ({})", cell, heights[i]));
     }
 }
 
 void check_origin(int rows, int cols, CellIndex origin) {
   if (origin.row < 0 || origin.row >= rows || origin.col < 0 || origin.col >= cols)
-    throw InvalidArgument("NavigabilityProcessor: origin " + fmt::format("{}", origin) + " is off the " +
-                          std::to_string(rows) + " x " + std::to_string(cols) + " grid");
+    throw InvalidArgument(fmt::format("NavigabilityProcessor: origin {} is off the {} x {} grid", origin, rows, cols));
 }
 
 }  // namespace

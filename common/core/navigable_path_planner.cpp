@@ -44,18 +44,17 @@ PlannerParams default_planner_params(double delta_m, double cell_size_m) {
 NavigablePathPlanner::NavigablePathPlanner(PlannerParams params) : params_(params) {
   if (!(params.alpha >= 0.0) || !std::isfinite(params.alpha) || !(params.beta >= 0.0) || !std::isfinite(params.beta) ||
       !(params.delta_m > 0.0) || !std::isfinite(params.delta_m))
-    throw InvalidArgument("planner: alpha (" + std::to_string(params.alpha) + ") and beta (" +
-                          std::to_string(params.beta) + ") must be finite and >= 0, delta (" +
-                          std::to_string(params.delta_m) + " m) finite and > 0");
+    throw InvalidArgument(
+        fmt::format("planner: alpha ({}) and beta ({}) must be finite and >= 0, delta ({} m) finite and > 0",
+                    params.alpha, params.beta, params.delta_m));
 }
 
 PlannerResult NavigablePathPlanner::plan(const Heightmap& gap, const CellMask& allowed, CellIndex start,
                                          CellIndex goal) const {
   const int rows = gap.rows(), cols = gap.cols();
   if (allowed.rows() != rows || allowed.cols() != cols)
-    throw InvalidArgument("planner: the allowed mask is " + std::to_string(allowed.rows()) + " x " +
-                          std::to_string(allowed.cols()) + " but the gap grid " + std::to_string(rows) + " x " +
-                          std::to_string(cols));
+    throw InvalidArgument(fmt::format("planner: the allowed mask is {} x {} but the gap grid {} x {}", allowed.rows(),
+                                      allowed.cols(), rows, cols));
   if (!gap.contains(start) || !gap.contains(goal))
     throw InvalidArgument(fmt::format("planner: start {} or goal {} is off the {} x {} map", start, goal, rows, cols));
   PlannerResult result;

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/core/random.hpp"
 
 namespace marsala {
@@ -63,8 +64,7 @@ std::optional<double> first_hit(const Heightmap& terrain, Point3 origin, Point3 
 
 Point3 sensor_origin(const Heightmap& terrain, double x_m, double y_m, const SensorSpec& sensor) {
   const std::optional<CellIndex> cell = terrain.cell_at({x_m, y_m});
-  if (!cell) throw InvalidArgument("ray caster: sensor position (" + std::to_string(x_m) + ", " + std::to_string(y_m) +
-                                   ") m is off the grid");
+  if (!cell) throw InvalidArgument(fmt::format("ray caster: sensor position {} is off the grid", Position{x_m, y_m}));
   return {x_m, y_m, terrain(*cell) + sensor.mount_height_m};
 }
 
@@ -75,7 +75,7 @@ std::uint64_t scan_seed(std::uint64_t run_seed, std::uint32_t agent_id, std::uin
 std::vector<ScanPoint> cast_scan(const Heightmap& terrain, Point3 origin, double heading_rad, const SensorSpec& sensor,
                                  std::uint64_t seed) {
   const std::string problem = sensor_problem(sensor);
-  if (!problem.empty()) throw InvalidArgument("ray caster: sensor " + problem);
+  if (!problem.empty()) throw InvalidArgument(fmt::format("ray caster: sensor {}", problem));
   if (!sensor.casts_rays()) return {};
   const double deg = kPi / 180.0;
   const bool wraps = sensor.horizontal_fov_deg >= 360.0;

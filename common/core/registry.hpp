@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "marsala/core/error.hpp"
 
 namespace marsala {
@@ -22,7 +24,7 @@ class NamedRegistry {
   /// Registers an entry; throws InvalidArgument when the name is empty or taken.
   void add(const std::string& name, Entry entry) {
     if (name.empty() || entries_.count(name) != 0)
-      throw InvalidArgument(kind_ + " name '" + name + "' is empty or already registered");
+      throw InvalidArgument(fmt::format("{} name '{}' is empty or already registered", kind_, name));
     entries_.emplace(name, std::move(entry));
   }
   /// Throws InvalidArgument "unknown <kind> 'name'; valid: a, b" when `name` is not registered.
@@ -30,7 +32,7 @@ class NamedRegistry {
     if (contains(name)) return;
     std::string valid;
     for (const auto& [n, e] : entries_) valid += (valid.empty() ? "" : ", ") + n;
-    throw InvalidArgument("unknown " + kind_ + " '" + name + "'; valid: " + (valid.empty() ? "(none)" : valid));
+    throw InvalidArgument(fmt::format("unknown {} '{}'; valid: {}", kind_, name, valid.empty() ? "(none)" : valid));
   }
   /// The entry named `name`; throws as require() when it is unknown.
   const Entry& find(const std::string& name) const {

@@ -55,8 +55,7 @@ template <typename Enum, std::size_t N>
 Enum from_wire(const EnumName<Enum> (&names)[N], std::uint8_t value, const char* type) {
   for (const EnumName<Enum>& n : names)
     if (static_cast<std::uint8_t>(n.value) == value) return n.value;
-  throw InvalidArgument("malformed sample: " + std::to_string(value) + " is not an " + type + " (valid 0.." +
-                        std::to_string(N - 1) + ")");
+  throw InvalidArgument(fmt::format("malformed sample: {} is not an {} (valid 0..{})", value, type, N - 1));
 }
 
 }  // namespace

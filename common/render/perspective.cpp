@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/render/detail/colormap.hpp"
 #include "marsala/render/detail/raster.hpp"
 
@@ -56,29 +57,25 @@ Surface reduce(const Heightmap& map, const std::optional<Heightmap>& deposit) {
 void check(const Heightmap& map, const PerspectiveOptions& o) {
   if (map.rows() == 0 || map.cols() == 0) throw InvalidArgument("render_perspective: empty heightmap");
   if (!(o.elevation_deg > 0.0 && o.elevation_deg <= 90.0))
-    throw InvalidArgument("render_perspective: elevation_deg must be in (0, 90], got " +
-                          std::to_string(o.elevation_deg));
+    throw InvalidArgument(fmt::format("render_perspective: elevation_deg must be in (0, 90], got {}", o.elevation_deg));
   if (!(o.vertical_exaggeration > 0.0) || !std::isfinite(o.vertical_exaggeration))
     throw InvalidArgument("render_perspective: vertical_exaggeration must be a finite number > 0");
   if (!std::isfinite(o.azimuth_deg)) throw InvalidArgument("render_perspective: azimuth_deg must be finite");
   if (o.width_px < 16 || o.width_px > 8192 || o.height_px < 16 || o.height_px > 8192)
-    throw InvalidArgument("render_perspective: picture size must be within [16, 8192] px, got " +
-                          std::to_string(o.width_px) + " x " + std::to_string(o.height_px));
+    throw InvalidArgument(fmt::format("render_perspective: picture size must be within [16, 8192] px, got {} x {}",
+                                      o.width_px, o.height_px));
   for (int r = 0; r < map.rows(); ++r)
     for (int c = 0; c < map.cols(); ++c)
       if (!std::isfinite(map(r, c)))
-        throw InvalidArgument("render_perspective: height of cell (" + std::to_string(r) + ", " + std::to_string(c) +
-                              ") is not finite");
+        throw InvalidArgument(fmt::format("render_perspective: height of cell {} is not finite", CellIndex{r, c}));
   if (o.deposit) {
     if (o.deposit->rows() != map.rows() || o.deposit->cols() != map.cols())
-      throw InvalidArgument("render_perspective: the deposit grid is " + std::to_string(o.deposit->rows()) + " x " +
-                            std::to_string(o.deposit->cols()) + ", the terrain " + std::to_string(map.rows()) + " x " +
-                            std::to_string(map.cols()));
+      throw InvalidArgument(fmt::format("render_perspective: the deposit grid is {} x {}, the terrain {} x {}",
+                                        o.deposit->rows(), o.deposit->cols(), map.rows(), map.cols()));
     for (int r = 0; r < map.rows(); ++r)
       for (int c = 0; c < map.cols(); ++c)
         if (!std::isfinite((*o.deposit)(r, c)))
-          throw InvalidArgument("render_perspective: deposit of cell (" + std::to_string(r) + ", " + std::to_string(c) +
-                                ") is not finite");
+          throw InvalidArgument(fmt::format("render_perspective: deposit of cell {} is not finite", CellIndex{r, c}));
   }
 }
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
@@ -40,8 +39,6 @@ constexpr Rgb kHalo{30, 30, 30};
 const std::vector<Rgb> kPalette{{228, 26, 28},  {40, 100, 220},  {60, 170, 60},  {255, 127, 0},
                                 {150, 70, 170}, {0, 200, 220},   {235, 50, 190}, {170, 230, 40},
                                 {150, 85, 35},  {250, 160, 200}, {0, 120, 120},  {180, 160, 255}};
-
-std::string size_name(long long r, long long c) { return std::to_string(r) + " x " + std::to_string(c); }
 
 /// How grid cells map to pixels: `factor` x `factor` cells are averaged into one display cell, which is drawn
 /// as a `scale` x `scale` pixel square (one of the two is 1).
@@ -124,36 +121,33 @@ void validate(const Heightmap& map, const RenderOptions& o) {
   for (int r = 0; r < map.rows(); ++r)
     for (int c = 0; c < map.cols(); ++c)
       if (!std::isfinite(map(r, c)))
-        throw InvalidArgument("render_terrain: height at cell " + fmt::format("{}", CellIndex{r, c}) +
-                              " is not finite");
+        throw InvalidArgument(fmt::format("render_terrain: height at cell {} is not finite", CellIndex{r, c}));
   if (o.max_size_px < 1 || o.max_size_px > kMaxSizePx)
-    throw InvalidArgument("render_terrain: max_size_px = " + std::to_string(o.max_size_px) + " is outside [1, " +
-                          std::to_string(kMaxSizePx) + "]");
+    throw InvalidArgument(
+        fmt::format("render_terrain: max_size_px = {} is outside [1, {}]", o.max_size_px, kMaxSizePx));
   if (o.navigable && (o.navigable->rows() != map.rows() || o.navigable->cols() != map.cols()))
-    throw InvalidArgument("render_terrain: navigable mask is " + size_name(o.navigable->rows(), o.navigable->cols()) +
-                          " but the heightmap is " + size_name(map.rows(), map.cols()));
+    throw InvalidArgument(fmt::format("render_terrain: navigable mask is {} x {} but the heightmap is {} x {}",
+                                      o.navigable->rows(), o.navigable->cols(), map.rows(), map.cols()));
   if (o.gap) {
     if (o.gap->rows() != map.rows() || o.gap->cols() != map.cols())
-      throw InvalidArgument("render_terrain: gap map is " + size_name(o.gap->rows(), o.gap->cols()) +
-                            " but the heightmap is " + size_name(map.rows(), map.cols()));
+      throw InvalidArgument(fmt::format("render_terrain: gap map is {} x {} but the heightmap is {} x {}",
+                                        o.gap->rows(), o.gap->cols(), map.rows(), map.cols()));
     for (int r = 0; r < map.rows(); ++r)
       for (int c = 0; c < map.cols(); ++c)
         if (!std::isfinite((*o.gap)(r, c)))
-          throw InvalidArgument("render_terrain: gap at cell " + fmt::format("{}", CellIndex{r, c}) + " is not finite");
+          throw InvalidArgument(fmt::format("render_terrain: gap at cell {} is not finite", CellIndex{r, c}));
   }
   for (const CellIndex m : o.markers)
     if (!map.contains(m))
-      throw InvalidArgument("render_terrain: marker " + fmt::format("{}", CellIndex{m.row, m.col}) + " is off the " +
-                            size_name(map.rows(), map.cols()) + " grid");
+      throw InvalidArgument(
+          fmt::format("render_terrain: marker {} is off the {} x {} grid", m, map.rows(), map.cols()));
   if (o.labels && (o.labels->rows() != map.rows() || o.labels->cols() != map.cols()))
-    throw InvalidArgument("render_terrain: label grid is " + size_name(o.labels->rows(), o.labels->cols()) +
-                          " but the heightmap is " + size_name(map.rows(), map.cols()));
+    throw InvalidArgument(fmt::format("render_terrain: label grid is {} x {} but the heightmap is {} x {}",
+                                      o.labels->rows(), o.labels->cols(), map.rows(), map.cols()));
   if (!(o.label_alpha >= 0.0 && o.label_alpha <= 1.0))
-    throw InvalidArgument("render_terrain: label_alpha = " + std::to_string(o.label_alpha) + " is outside [0, 1]");
-  const auto check = [](bool ok, const std::string& what, std::size_t i) {
-    if (!ok)
-      throw InvalidArgument("render_terrain: " + what + " " + std::to_string(i) +
-                            " has a non-finite or negative value");
+    throw InvalidArgument(fmt::format("render_terrain: label_alpha = {} is outside [0, 1]", o.label_alpha));
+  const auto check = [](bool ok, const char* what, std::size_t i) {
+    if (!ok) throw InvalidArgument(fmt::format("render_terrain: {} {} has a non-finite or negative value", what, i));
   };
   const auto finite = [](Position p) { return std::isfinite(p.x) && std::isfinite(p.y); };
   const auto width_ok = [](double w) { return std::isfinite(w) && w >= 0.0; };
@@ -395,21 +389,17 @@ double nice_ceil(double x) {
   return 10.0 * p;
 }
 
+// Legend numbers with a fixed count of decimals (fmt's fixed form prints what printf's "%.*f" printed, so the
+// pictures keep their pixels).
 std::string format_fixed(double v, int decimals) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  std::string s = buf;
+  std::string s = fmt::format("{:.{}f}", v, decimals);
   if (s == "-0" || s.rfind("-0.", 0) == 0) {
     if (s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);  // no "-0.00"
   }
   return s;
 }
 
-std::string format_length(double metres) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%g m", metres);
-  return buf;
-}
+std::string format_length(double metres) { return fmt::format("{:g} m", metres); }
 
 struct Tick {
   double value;
@@ -526,9 +516,8 @@ Image compose(const TerrainLayer& layer, const Heightmap& map, const RenderOptio
   const double bar_m = nice_floor(0.25 * tw * metres_per_px);
   const int scale_px = std::max(1, static_cast<int>(std::lround(bar_m / metres_per_px)));
   const std::string scale_label = format_length(bar_m);
-  char caption_buf[96];
-  std::snprintf(caption_buf, sizeof caption_buf, "%d x %d cells of %g m", map.rows(), map.cols(), map.cell_size_m());
-  const std::string caption = caption_buf;
+  // "{:g}" as the scale bar: picture text, six significant digits as ever (the pixels must not change).
+  const std::string caption = fmt::format("{} x {} cells of {:g} m", map.rows(), map.cols(), map.cell_size_m());
   const int scale_row_w = scale_px + 6 * font + detail::text_width(scale_label, font);
   const int bottom_h = pad + line + 2 * font + line + pad;
 

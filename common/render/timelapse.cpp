@@ -7,10 +7,11 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <utility>
+
+#include <fmt/format.h>
 
 #include "marsala/core/error.hpp"
 #include "marsala/render/png_writer.hpp"
@@ -33,38 +34,32 @@ int run_program(const std::vector<std::string>& args) {
   argv.push_back(nullptr);
   pid_t pid = 0;
   if (::posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0)
-    throw IoError("cannot start '" + args[0] + "'");
+    throw IoError(fmt::format("cannot start '{}'", args[0]));
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) throw IoError("cannot wait for '" + args[0] + "'");
+    if (errno != EINTR) throw IoError(fmt::format("cannot wait for '{}'", args[0]));
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
-std::string numbered(const char* pattern, std::uint64_t n) {
-  char text[64];
-  std::snprintf(text, sizeof text, pattern, static_cast<unsigned long long>(n));
-  return text;
 }
 
 }  // namespace
 
-std::string frame_file_name(std::uint64_t step) { return numbered("frame_%06llu.png", step); }
+std::string frame_file_name(std::uint64_t step) { return fmt::format("frame_{:06}.png", step); }
 
 void check_fresh_frames_dir(const std::string& dir, const std::string& what) {
   std::error_code ec;
   if (!fs::exists(dir, ec)) return;
-  if (!fs::is_directory(dir, ec)) throw IoError("frames folder '" + dir + "' is not a folder");
+  if (!fs::is_directory(dir, ec)) throw IoError(fmt::format("frames folder '{}' is not a folder", dir));
   std::vector<std::string> found;
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
     const bool frame = name.size() > 10 && name.rfind("frame_", 0) == 0 && name.substr(name.size() - 4) == ".png";
     if (frame || name == "timelapse.mp4") found.push_back(name);
   }
-  if (ec) throw IoError("cannot list frames folder '" + dir + "': " + ec.message());
+  if (ec) throw IoError(fmt::format("cannot list frames folder '{}': {}", dir, ec.message()));
   if (found.empty()) return;
   std::sort(found.begin(), found.end());
-  throw IoError("frames folder '" + dir + "' already holds " + what + " (" + std::to_string(found.size()) + " file" +
-                (found.size() == 1 ? "" : "s") + ", e.g. " + found.front() + "); give another --out or empty it");
+  throw IoError(fmt::format("frames folder '{}' already holds {} ({} file{}, e.g. {}); give another --out or empty it",
+                            dir, what, found.size(), found.size() == 1 ? "" : "s", found.front()));
 }
 
 std::string find_ffmpeg(const std::string& search_path) {
@@ -89,20 +84,19 @@ void write_timelapse(const std::string& ffmpeg, const std::string& frames_dir, c
   std::error_code ec;
   fs::remove_all(scratch, ec);
   fs::create_directories(scratch, ec);
-  if (ec) throw IoError("cannot create '" + scratch.string() + "': " + ec.message());
+  if (ec) throw IoError(fmt::format("cannot create '{}': {}", scratch.string(), ec.message()));
   for (std::size_t k = 0; k < frames.size(); ++k) {
-    fs::create_symlink(fs::path("..") / frames[k], scratch / numbered("%06llu.png", k), ec);
-    if (ec) throw IoError("cannot link '" + frames[k] + "' in '" + scratch.string() + "': " + ec.message());
+    fs::create_symlink(fs::path("..") / frames[k], scratch / fmt::format("{:06}.png", k), ec);
+    if (ec) throw IoError(fmt::format("cannot link '{}' in '{}': {}", frames[k], scratch.string(), ec.message()));
   }
   const std::string out = (fs::path(frames_dir) / "timelapse.mp4").string();
   try {
     runlog::write_atomically(out, [&](const std::string& tmp) {
-      const int status = run_program({ffmpeg, "-y", "-loglevel", "error", "-framerate", "10", "-i",
-                                      (scratch / "%06d.png").string(), "-pix_fmt", "yuv420p", "-vf",
-                                      "pad=" + std::to_string(width_px + width_px % 2) + ":" +
-                                          std::to_string(height_px + height_px % 2) + ":0:0:white",
-                                      "-f", "mp4", tmp});
-      if (status != 0) throw IoError("ffmpeg failed (exit " + std::to_string(status) + ") making '" + out + "'");
+      const int status = run_program(
+          {ffmpeg, "-y", "-loglevel", "error", "-framerate", "10", "-i", (scratch / "%06d.png").string(), "-pix_fmt",
+           "yuv420p", "-vf", fmt::format("pad={}:{}:0:0:white", width_px + width_px % 2, height_px + height_px % 2),
+           "-f", "mp4", tmp});
+      if (status != 0) throw IoError(fmt::format("ffmpeg failed (exit {}) making '{}'", status, out));
     });
   } catch (...) {
     fs::remove_all(scratch, ec);
@@ -115,7 +109,7 @@ FrameWriter::FrameWriter(std::string dir, std::uint64_t every) : dir_(std::move(
   if (every_ == 0) throw InvalidArgument("a frame every 0 steps: K must be at least 1");
   std::error_code ec;
   fs::create_directories(dir_, ec);
-  if (ec) throw IoError("cannot create frames folder '" + dir_ + "': " + ec.message());
+  if (ec) throw IoError(fmt::format("cannot create frames folder '{}': {}", dir_, ec.message()));
   // Frames already there (a resumed run's) belong to the same time-lapse: in step order (the names sort so), and
   // their sizes count for the video's.
   for (const fs::directory_entry& e : fs::directory_iterator(dir_, ec)) {
@@ -133,7 +127,7 @@ FrameWriter::FrameWriter(std::string dir, std::uint64_t every) : dir_(std::move(
       height_px_ = std::max(height_px_, be32(20));
     }
   }
-  if (ec) throw IoError("cannot list frames folder '" + dir_ + "': " + ec.message());
+  if (ec) throw IoError(fmt::format("cannot list frames folder '{}': {}", dir_, ec.message()));
   std::sort(names_.begin(), names_.end());
 }
 

@@ -6,6 +6,8 @@
 #include <string>
 #include <system_error>
 
+#include <fmt/format.h>
+
 #include "marsala/core/error.hpp"
 
 namespace marsala::runlog {
@@ -28,7 +30,7 @@ void write_atomically(const std::string& path, Write&& write) {
   if (ec) {
     std::error_code ignored;
     fs::remove(tmp, ignored);
-    throw IoError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
+    throw IoError(fmt::format("cannot rename '{}' to '{}': {}", tmp, path, ec.message()));
   }
 }
 

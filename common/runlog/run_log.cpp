@@ -9,6 +9,8 @@
 #include <cstring>
 #include <utility>
 
+#include <fmt/format.h>
+
 #include "marsala/core/error.hpp"
 #include "marsala/runlog/crc32c.hpp"
 
@@ -51,7 +53,7 @@ RunLogWriter::~RunLogWriter() {
 
 RunLogWriter RunLogWriter::create(const std::string& path, proto::LogHeader header) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) throw IoError(path + ": cannot create the run log: " + errno_text());
+  if (fd < 0) throw IoError(fmt::format("{}: cannot create the run log: {}", path, errno_text()));
   RunLogWriter writer(fd, path, 0);
   writer.write_all(std::string(kMagic, kMagicBytes));
   writer.bytes_ = kMagicBytes;
@@ -64,10 +66,10 @@ RunLogWriter RunLogWriter::create(const std::string& path, proto::LogHeader head
 
 RunLogWriter RunLogWriter::continue_at(const std::string& path, std::uint64_t good_bytes) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
-  if (fd < 0) throw IoError(path + ": cannot open the run log to continue it: " + errno_text());
+  if (fd < 0) throw IoError(fmt::format("{}: cannot open the run log to continue it: {}", path, errno_text()));
   RunLogWriter writer(fd, path, good_bytes);
   if (::ftruncate(fd, static_cast<off_t>(good_bytes)) != 0 || ::lseek(fd, static_cast<off_t>(good_bytes), SEEK_SET) < 0)
-    throw IoError(path + ": cannot cut the run log at byte " + std::to_string(good_bytes) + ": " + errno_text());
+    throw IoError(fmt::format("{}: cannot cut the run log at byte {}: {}", path, good_bytes, errno_text()));
   return writer;
 }
 
@@ -80,19 +82,19 @@ void RunLogWriter::write_all(const std::string& data) {
       const std::string why = n < 0 ? errno_text() : "nothing written";
       // Leave the log ending at its last whole record, so that a reader never meets this torn one.
       if (::ftruncate(fd_, static_cast<off_t>(bytes_)) == 0) ::lseek(fd_, static_cast<off_t>(bytes_), SEEK_SET);
-      throw IoError(path_ + ": cannot append to the run log at byte " + std::to_string(bytes_) + ": " + why);
+      throw IoError(fmt::format("{}: cannot append to the run log at byte {}: {}", path_, bytes_, why));
     }
     done += static_cast<std::size_t>(n);
   }
 }
 
 void RunLogWriter::append(const proto::LogRecord& record) {
-  if (fd_ < 0) throw IoError(path_ + ": the run log is closed");
+  if (fd_ < 0) throw IoError(fmt::format("{}: the run log is closed", path_));
   std::string payload;
-  if (!record.SerializeToString(&payload)) throw IoError(path_ + ": cannot serialize a run-log record");
+  if (!record.SerializeToString(&payload)) throw IoError(fmt::format("{}: cannot serialize a run-log record", path_));
   if (payload.size() > kMaxRecordBytes)
-    throw IoError(path_ + ": a run-log record of " + std::to_string(payload.size()) + " bytes exceeds the limit of " +
-                  std::to_string(kMaxRecordBytes));
+    throw IoError(fmt::format("{}: a run-log record of {} bytes exceeds the limit of {}", path_, payload.size(),
+                              kMaxRecordBytes));
   frame_.clear();
   put_u32(frame_, static_cast<std::uint32_t>(payload.size()));
   put_u32(frame_, crc32c(payload.data(), payload.size()));
@@ -102,69 +104,69 @@ void RunLogWriter::append(const proto::LogRecord& record) {
 }
 
 void RunLogWriter::sync() {
-  if (fd_ >= 0 && ::fdatasync(fd_) != 0) throw IoError(path_ + ": cannot sync the run log: " + errno_text());
+  if (fd_ >= 0 && ::fdatasync(fd_) != 0)
+    throw IoError(fmt::format("{}: cannot sync the run log: {}", path_, errno_text()));
 }
 
 RunLogReader::RunLogReader(const std::string& path) : path_(path), in_(path, std::ios::binary) {
-  if (!in_) throw IoError(path + ": cannot open the run log");
+  if (!in_) throw IoError(fmt::format("{}: cannot open the run log", path));
   in_.seekg(0, std::ios::end);
   file_bytes_ = static_cast<std::uint64_t>(in_.tellg());
   in_.seekg(0);
   char magic[kMagicBytes];
   if (!in_.read(magic, kMagicBytes) || std::memcmp(magic, kMagic, kMagicBytes) != 0)
-    throw ParseError(path, 0, "not a run log: it does not start with \"" + std::string(kMagic) + "\"");
+    throw ParseError(path, 0, fmt::format("not a run log: it does not start with \"{}\"", kMagic));
   offset_ = kMagicBytes;
   proto::LogRecord record;
-  if (!read_record(record)) throw ParseError(path, 0, "no intact header record: " + tail_problem_);
+  if (!read_record(record)) throw ParseError(path, 0, fmt::format("no intact header record: {}", tail_problem_));
   if (!record.has_header()) throw ParseError(path, 0, "the first record is not a header");
   header_ = record.header();
   if (header_.format_version() != kFormatVersion)
-    throw ParseError(path, 0,
-                     "format version " + std::to_string(header_.format_version()) + " is not the known version " +
-                         std::to_string(kFormatVersion));
+    throw ParseError(
+        path, 0,
+        fmt::format("format version {} is not the known version {}", header_.format_version(), kFormatVersion));
   first_record_ = offset_;
 }
 
 bool RunLogReader::read_record(proto::LogRecord& record) {
   tail_problem_.clear();
   if (offset_ == file_bytes_) return false;
-  const std::string where = path_ + ": ";
-  const std::string at = " at byte " + std::to_string(offset_);
   const std::uint64_t left = file_bytes_ - offset_;
   if (left < kFrameBytes) {
-    tail_problem_ = where + "truncated record" + at + " (" + std::to_string(left) + " bytes, not even its frame)";
+    tail_problem_ = fmt::format("{}: truncated record at byte {} ({} bytes, not even its frame)", path_, offset_, left);
     return false;
   }
   char frame[kFrameBytes];
   in_.clear();
   in_.seekg(static_cast<std::streamoff>(offset_));
   if (!in_.read(frame, kFrameBytes)) {
-    tail_problem_ = where + "cannot read the record" + at;
+    tail_problem_ = fmt::format("{}: cannot read the record at byte {}", path_, offset_);
     return false;
   }
   const std::uint32_t length = get_u32(frame);
   const std::uint32_t crc = get_u32(frame + 4);
   if (length > kMaxRecordBytes) {
-    tail_problem_ = where + "damaged record" + at + ": length " + std::to_string(length) + " exceeds " +
-                    std::to_string(kMaxRecordBytes) + " bytes";
+    tail_problem_ = fmt::format("{}: damaged record at byte {}: length {} exceeds {} bytes", path_, offset_, length,
+                                kMaxRecordBytes);
     return false;
   }
   if (left - kFrameBytes < length) {
-    tail_problem_ = where + "truncated record" + at + " (" + std::to_string(left - kFrameBytes) + " of " +
-                    std::to_string(length) + " payload bytes)";
+    tail_problem_ = fmt::format("{}: truncated record at byte {} ({} of {} payload bytes)", path_, offset_,
+                                left - kFrameBytes, length);
     return false;
   }
   payload_.resize(length);
   if (length > 0 && !in_.read(payload_.data(), length)) {
-    tail_problem_ = where + "cannot read the record" + at;
+    tail_problem_ = fmt::format("{}: cannot read the record at byte {}", path_, offset_);
     return false;
   }
   if (crc32c(payload_.data(), payload_.size()) != crc) {
-    tail_problem_ = where + "damaged record" + at + ": checksum mismatch";
+    tail_problem_ = fmt::format("{}: damaged record at byte {}: checksum mismatch", path_, offset_);
     return false;
   }
   if (!record.ParseFromString(payload_) || record.record_case() == proto::LogRecord::RECORD_NOT_SET) {
-    tail_problem_ = where + "damaged record" + at + ": its checksum holds but it is not a record";
+    tail_problem_ =
+        fmt::format("{}: damaged record at byte {}: its checksum holds but it is not a record", path_, offset_);
     return false;
   }
   offset_ += kFrameBytes + length;
@@ -175,13 +177,13 @@ bool RunLogReader::next(proto::LogRecord& record) {
   const std::uint64_t start = offset_;
   if (!read_record(record)) {
     if (!tail_problem_.empty())
-      tail_problem_ += "; " + std::to_string(file_bytes_ - offset_) + " bytes after the last good record";
+      tail_problem_ += fmt::format("; {} bytes after the last good record", file_bytes_ - offset_);
     return false;
   }
   if (record.has_header()) {
     offset_ = start;
-    tail_problem_ = path_ + ": a second header at byte " + std::to_string(offset_) + "; " +
-                    std::to_string(file_bytes_ - offset_) + " bytes after the last good record";
+    tail_problem_ = fmt::format("{}: a second header at byte {}; {} bytes after the last good record", path_, offset_,
+                                file_bytes_ - offset_);
     return false;
   }
   return true;
@@ -189,9 +191,8 @@ bool RunLogReader::next(proto::LogRecord& record) {
 
 void RunLogReader::seek(std::uint64_t offset) {
   if (offset < first_record_ || offset > file_bytes_)
-    throw InvalidArgument(path_ + ": cannot continue reading at byte " + std::to_string(offset) +
-                          ": its records lie between bytes " + std::to_string(first_record_) + " and " +
-                          std::to_string(file_bytes_));
+    throw InvalidArgument(fmt::format("{}: cannot continue reading at byte {}: its records lie between bytes {} and {}",
+                                      path_, offset, first_record_, file_bytes_));
   offset_ = offset;
   tail_problem_.clear();
 }

@@ -4,6 +4,8 @@
 
 #include <cstring>
 
+#include <fmt/format.h>
+
 #include "marsala/core/error.hpp"
 
 namespace marsala::runlog {
@@ -21,7 +23,7 @@ Sha256::~Sha256() = default;
 
 void Sha256::update(const void* data, std::size_t size) {
   if (size > 0 && EVP_DigestUpdate(context_->md.get(), data, size) != 1)
-    throw IoError("sha256: libcrypto failed to hash " + std::to_string(size) + " bytes");
+    throw IoError(fmt::format("sha256: libcrypto failed to hash {} bytes", size));
 }
 
 std::array<std::uint8_t, 32> Sha256::finish() {

@@ -90,13 +90,14 @@ TerrainSource to_terrain(const proto::TerrainSource& p, const Validator& check) 
     if (std::find(names.begin(), names.end(), p.generator()) == names.end()) {
       std::string valid;
       for (const auto& n : names) valid += (valid.empty() ? "" : ", ") + n;
-      check.fail("terrain.generator", "unknown generator '" + p.generator() + "'; valid generators: " + valid);
+      check.fail("terrain.generator",
+                 fmt::format("unknown generator '{}'; valid generators: {}", p.generator(), valid));
     }
     t.method = p.generator();
     if (p.has_rows()) t.rows = p.rows();
     if (p.has_cols()) t.cols = p.cols();
-    if (t.rows <= 0) check.fail("terrain.rows", std::to_string(t.rows) + " must be > 0");
-    if (t.cols <= 0) check.fail("terrain.cols", std::to_string(t.cols) + " must be > 0");
+    if (t.rows <= 0) check.fail("terrain.rows", fmt::format("{} must be > 0", t.rows));
+    if (t.cols <= 0) check.fail("terrain.cols", fmt::format("{} must be > 0", t.cols));
     if (p.has_cell_size_m()) t.cell_size_m = check.positive("terrain.cell_size_m", p.cell_size_m());
     if (p.has_seed()) t.seed = p.seed();
     for (const auto& [key, value] : p.params()) t.params[key] = check.finite("terrain.params['" + key + "']", value);
@@ -490,29 +491,31 @@ void apply_override(google::protobuf::Message& message, const std::vector<std::s
     const std::string digits = name.substr(open + 1, name.size() - open - 2);
     if (name.back() != ']' || digits.empty() || digits.size() > 6 ||
         !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c) != 0; }))
-      throw InvalidArgument(where + ": '" + name + "' is not FIELD or FIELD[INDEX]");
+      throw InvalidArgument(fmt::format("{}: '{}' is not FIELD or FIELD[INDEX]", where, name));
     index = std::stoi(digits);
     name = name.substr(0, open);
   }
   const google::protobuf::Descriptor& type = *message.GetDescriptor();
   const FieldDescriptor* field = type.FindFieldByName(name);
   if (field == nullptr)
-    throw InvalidArgument(where + ": " + type.name() + " has no field '" + name + "'; valid: " + field_names(type));
+    throw InvalidArgument(
+        fmt::format("{}: {} has no field '{}'; valid: {}", where, type.name(), name, field_names(type)));
   const google::protobuf::Reflection& reflection = *message.GetReflection();
   const bool last = part + 1 == parts.size();
   const bool is_message = field->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE;
-  if (field->is_map()) throw InvalidArgument(where + ": '" + name + "' is a map; edit the scenario file instead");
+  if (field->is_map())
+    throw InvalidArgument(fmt::format("{}: '{}' is a map; edit the scenario file instead", where, name));
   if (last == is_message)
-    throw InvalidArgument(where + ": '" + name + "' is " + (is_message ? "a message: name one of its fields (" +
-                                                                             field_names(*field->message_type()) + ")"
-                                                                       : "a value: it has no fields"));
-  if (index && !field->is_repeated()) throw InvalidArgument(where + ": '" + name + "' is not repeated");
+    throw InvalidArgument(is_message ? fmt::format("{}: '{}' is a message: name one of its fields ({})", where, name,
+                                                   field_names(*field->message_type()))
+                                     : fmt::format("{}: '{}' is a value: it has no fields", where, name));
+  if (index && !field->is_repeated()) throw InvalidArgument(fmt::format("{}: '{}' is not repeated", where, name));
   if (field->is_repeated()) {
     const int size = reflection.FieldSize(message, field);
     if (index && *index >= size)
-      throw InvalidArgument(where + ": " + name + "[" + std::to_string(*index) + "] does not exist (the scenario has " +
-                            std::to_string(size) + ")");
-    if (last) throw InvalidArgument(where + ": repeated values cannot be set; edit the scenario file instead");
+      throw InvalidArgument(fmt::format("{}: {}[{}] does not exist (the scenario has {})", where, name, *index, size));
+    if (last)
+      throw InvalidArgument(fmt::format("{}: repeated values cannot be set; edit the scenario file instead", where));
     for (int i = index.value_or(0); i < (index ? *index + 1 : size); ++i)
       apply_override(*reflection.MutableRepeatedMessage(&message, field, i), parts, part + 1, value, where);
     return;
@@ -524,25 +527,27 @@ void apply_override(google::protobuf::Message& message, const std::vector<std::s
   // A scalar: the text format's own parser, as if the file said `name: value` (strings may go without quotes).
   std::string literal = value;
   if (field->cpp_type() == FieldDescriptor::CPPTYPE_STRING && (literal.empty() || literal.front() != '"'))
-    literal = "\"" + literal + "\"";
+    literal = fmt::format("\"{}\"", literal);
   google::protobuf::TextFormat::Parser parser;
   FirstErrorCollector errors;  // keeps protobuf's own message off stderr: ours says it
   parser.RecordErrorsTo(&errors);
   if (!parser.ParseFieldValueFromString(literal, field, &message))
-    throw InvalidArgument(where + ": '" + value + "' is not a valid " + field->cpp_type_name() + " for '" + name + "'");
+    throw InvalidArgument(
+        fmt::format("{}: '{}' is not a valid {} for '{}'", where, value, field->cpp_type_name(), name));
 }
 
 void apply_overrides(proto::Scenario& message, const std::vector<std::string>& overrides) {
   for (const std::string& override : overrides) {
-    const std::string where = "--set '" + override + "'";
+    const std::string where = fmt::format("--set '{}'", override);
     const std::size_t equals = override.find('=');
-    if (equals == std::string::npos || equals == 0) throw InvalidArgument(where + ": expected FIELD=VALUE");
+    if (equals == std::string::npos || equals == 0)
+      throw InvalidArgument(fmt::format("{}: expected FIELD=VALUE", where));
     const std::string path = override.substr(0, equals);
-    if (path.back() == '.') throw InvalidArgument(where + ": the field path ends with '.'");
+    if (path.back() == '.') throw InvalidArgument(fmt::format("{}: the field path ends with '.'", where));
     std::vector<std::string> parts;
     std::stringstream names(path);
     for (std::string part; std::getline(names, part, '.');) {
-      if (part.empty()) throw InvalidArgument(where + ": empty field name in '" + path + "'");
+      if (part.empty()) throw InvalidArgument(fmt::format("{}: empty field name in '{}'", where, path));
       parts.push_back(part);
     }
     apply_override(message, parts, 0, override.substr(equals + 1), where);
@@ -562,10 +567,10 @@ Scenario parse_scenario(const std::string& text, const std::string& source_name,
 
 std::string read_scenario_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("cannot open scenario file '" + path + "'");
+  if (!in) throw IoError(fmt::format("cannot open scenario file '{}'", path));
   std::ostringstream text;
   text << in.rdbuf();
-  if (in.bad()) throw IoError("cannot read scenario file '" + path + "'");
+  if (in.bad()) throw IoError(fmt::format("cannot read scenario file '{}'", path));
   return text.str();
 }
 

@@ -27,8 +27,8 @@ Heightmap read_terrain_file(const Scenario& s) {
   const std::string path = resolve_terrain_path(s);
   std::error_code ec;
   if (!fs::is_regular_file(path, ec))
-    throw IoError("scenario " + s.source_path + ": terrain.file '" + s.terrain.file + "' not found (looked for " +
-                  path + ")");
+    throw IoError(
+        fmt::format("scenario {}: terrain.file '{}' not found (looked for {})", s.source_path, s.terrain.file, path));
   Heightmap map = is_tiff(path) ? terrain::read_geotiff(path) : terrain::read_asc(path);
   const TerrainSource& t = s.terrain;
   if (t.has_crop) map = terrain::crop(map, t.crop_x0_m, t.crop_y0_m, t.crop_width_m, t.crop_height_m);
@@ -73,7 +73,7 @@ Heightmap build_terrain(const Scenario& s) {
       map = terrain::generate_terrain(s.terrain.method, spec);
     }
   } catch (const InvalidArgument& e) {
-    throw InvalidArgument("scenario " + s.source_path + ": terrain: " + e.what());
+    throw InvalidArgument(fmt::format("scenario {}: terrain: {}", s.source_path, e.what()));
   }
   check_magnitudes(s, map);
   check_placement(s, map.geometry());
@@ -81,41 +81,34 @@ Heightmap build_terrain(const Scenario& s) {
 }
 
 void check_placement(const Scenario& s, const GridGeometry& g) {
-  const double x1 = g.xll_m + g.cols * g.cell_size_m;
-  const double y1 = g.yll_m + g.rows * g.cell_size_m;
-  const std::string extent = "[" + fmt::format("{}", g.xll_m) + ", " + fmt::format("{}", x1) + "] x [" +
-                             fmt::format("{}", g.yll_m) + ", " + fmt::format("{}", y1) + "] m";
+  const Rect extent{g.xll_m, g.yll_m, g.xll_m + g.cols * g.cell_size_m, g.yll_m + g.rows * g.cell_size_m};
   const auto fail = [&](const std::string& field, const std::string& problem) {
-    throw InvalidArgument("scenario " + s.source_path + ": " + field + ": " + problem + " (terrain " + extent + ")");
+    throw InvalidArgument(fmt::format("scenario {}: {}: {} (terrain {})", s.source_path, field, problem, extent));
   };
-  const auto on_grid = [&](const std::string& field, double x, double y) {
-    if (!g.cell_at({x, y}))
-      fail(field, "(" + fmt::format("{}", x) + ", " + fmt::format("{}", y) + ") is off the terrain");
+  // The off-terrain text keeps its unit-less "(x, y)": scenario tests and scripts look for it verbatim.
+  const auto on_grid = [&](const std::string& field, Position p) {
+    if (!g.cell_at(p)) fail(field, fmt::format("({}, {}) is off the terrain", p.x, p.y));
   };
   for (std::size_t i = 0; i < s.slots.size(); ++i) {
     const AgentSlot& slot = s.slots[i];
-    const std::string field = "agent[" + std::to_string(i) + "] (agent " + std::to_string(slot.id) + ")";
-    on_grid(field + ".start", slot.start.x, slot.start.y);
-    on_grid(field + ".target", slot.target.x, slot.target.y);
+    const std::string field = fmt::format("agent[{}] (agent {})", i, slot.id);
+    on_grid(field + ".start", slot.start);
+    on_grid(field + ".target", slot.target);
   }
-  on_grid("base", s.base.centre.x, s.base.centre.y);
-  const auto inside = [&](const std::string& field, double x0, double y0, double xa, double ya) {
-    if (x0 < g.xll_m || xa > x1 || y0 < g.yll_m || ya > y1)
-      fail(field, "[" + fmt::format("{}", x0) + ", " + fmt::format("{}", xa) + "] x [" + fmt::format("{}", y0) + ", " +
-                      fmt::format("{}", ya) + "] m is not inside the terrain");
+  on_grid("base", s.base.centre);
+  const auto inside = [&](const std::string& field, const Rect& r) {
+    if (r.x0 < extent.x0 || r.x1 > extent.x1 || r.y0 < extent.y0 || r.y1 > extent.y1)
+      fail(field, fmt::format("{} is not inside the terrain", r));
   };
   switch (s.completion) {
-    case CompletionKind::kAgentsAtGoal: inside("goal", s.goal.area.x0, s.goal.area.y0, s.goal.area.x1, s.goal.area.y1); break;
+    case CompletionKind::kAgentsAtGoal: inside("goal", s.goal.area); break;
     case CompletionKind::kPayloadPath:
-      on_grid("payload_path.from", s.payload_path.from.x, s.payload_path.from.y);
-      on_grid("payload_path.to", s.payload_path.to.x, s.payload_path.to.y);
+      on_grid("payload_path.from", s.payload_path.from);
+      on_grid("payload_path.to", s.payload_path.to);
       break;
-    case CompletionKind::kLevelSite: inside("site", s.site.area.x0, s.site.area.y0, s.site.area.x1, s.site.area.y1); break;
+    case CompletionKind::kLevelSite: inside("site", s.site.area); break;
   }
-  if (s.has_goal_vector_map) {
-    const GoalVectorMapSpec& m = s.goal_vector_map;
-    inside("goal_vector_map", m.area.x0, m.area.y0, m.area.x1, m.area.y1);
-  }
+  if (s.has_goal_vector_map) inside("goal_vector_map", s.goal_vector_map.area);
 }
 
 }  // namespace marsala::scenario

@@ -18,7 +18,10 @@
 #include <utility>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 
 namespace marsala::terrain {
 namespace {
@@ -64,6 +67,8 @@ std::string quote(std::string_view token) {
   return out + "'";
 }
 
+// A header number as the data rows write theirs: to_chars' shortest form, which is not fmt's "{}" (1e+06, not
+// 1000000), so written files keep their bytes.
 std::string format_double(double value) {
   char buf[64];
   const auto result = std::to_chars(buf, buf + sizeof buf, value);
@@ -176,15 +181,15 @@ class AscParser {
     bool is_center = false;
     const int slot = slot_of(key, is_center);
     if (slot < 0)
-      fail(line_no_, "unknown header key " + quote(key) +
-                         " (expected ncols, nrows, xllcorner|xllcenter, yllcorner|yllcenter, cellsize, "
-                         "NODATA_value)");
+      fail(line_no_, fmt::format("unknown header key {} (expected ncols, nrows, xllcorner|xllcenter, "
+                                 "yllcorner|yllcenter, cellsize, NODATA_value)",
+                                 quote(key)));
     HeaderEntry& entry = header_[slot];
     if (entry.seen)
-      fail(line_no_, "duplicate header key " + quote(key) + " (already given as " + quote(entry.key) + " on line " +
-                         std::to_string(entry.line) + ")");
+      fail(line_no_, fmt::format("duplicate header key {} (already given as {} on line {})", quote(key),
+                                 quote(entry.key), entry.line));
     while (e < line.size() && is_blank(line[e])) ++e;
-    if (e == line.size()) fail(line_no_, "header key " + quote(key) + " has no value");
+    if (e == line.size()) fail(line_no_, fmt::format("header key {} has no value", quote(key)));
     double value = 0.0;
     const char* end = nullptr;
     const char* first = line.data() + e;
@@ -192,25 +197,25 @@ class AscParser {
     const NumberStatus status = parse_number(first, last, value, &end);
     const std::string_view token(first, static_cast<std::size_t>(end - first));
     if (status == NumberStatus::kInvalid)
-      fail(line_no_, "value of header key " + quote(key) + " is not a number: " + quote(token));
+      fail(line_no_, fmt::format("value of header key {} is not a number: {}", quote(key), quote(token)));
     if (status == NumberStatus::kOutOfRange)
-      fail(line_no_, "value of header key " + quote(key) + " is out of range: " + quote(token));
+      fail(line_no_, fmt::format("value of header key {} is out of range: {}", quote(key), quote(token)));
     if (status == NumberStatus::kNonFinite)
-      fail(line_no_, "value of header key " + quote(key) + " must be finite, got " + quote(token));
+      fail(line_no_, fmt::format("value of header key {} must be finite, got {}", quote(key), quote(token)));
     for (const char* p = end; p < last; ++p)
       if (!is_blank(*p))
-        fail(line_no_, "trailing garbage after the value of header key " + quote(key) + ": " +
-                           quote(std::string_view(p, static_cast<std::size_t>(last - p))));
+        fail(line_no_, fmt::format("trailing garbage after the value of header key {}: {}", quote(key),
+                                   quote(std::string_view(p, static_cast<std::size_t>(last - p)))));
     if (slot == kNcols || slot == kNrows) {
       long long integer = 0;
       const auto result = std::from_chars(token.data(), token.data() + token.size(), integer);
       if (result.ec != std::errc() || result.ptr != token.data() + token.size())
-        fail(line_no_, "header key " + quote(key) + " must be a positive integer, got " + quote(token));
-      if (integer <= 0) fail(line_no_, "header key " + quote(key) + " must be positive, got " + quote(token));
-      if (integer > INT_MAX) fail(line_no_, "header key " + quote(key) + " is too large: " + quote(token));
+        fail(line_no_, fmt::format("header key {} must be a positive integer, got {}", quote(key), quote(token)));
+      if (integer <= 0) fail(line_no_, fmt::format("header key {} must be positive, got {}", quote(key), quote(token)));
+      if (integer > INT_MAX) fail(line_no_, fmt::format("header key {} is too large: {}", quote(key), quote(token)));
     }
     if (slot == kCellsize && !(value > 0.0))
-      fail(line_no_, "header key " + quote(key) + " must be positive, got " + quote(token));
+      fail(line_no_, fmt::format("header key {} must be positive, got {}", quote(key), quote(token)));
     entry.seen = true;
     entry.line = line_no_;
     entry.is_center = is_center;
@@ -236,7 +241,7 @@ class AscParser {
     static const char* kNames[] = {"ncols", "nrows", "xllcorner (or xllcenter)", "yllcorner (or yllcenter)",
                                    "cellsize"};
     for (int slot = kNcols; slot < kNodata; ++slot)
-      if (!header_[slot].seen) fail(line, std::string("missing header key '") + kNames[slot] + "' " + where);
+      if (!header_[slot].seen) fail(line, fmt::format("missing header key '{}' {}", kNames[slot], where));
   }
 
   Heightmap parse_data(bool have_line, std::string_view line) {
@@ -263,8 +268,8 @@ class AscParser {
       }
       if (row == rows) reject_extra_content(line, rows);
       if (pending_blank_line != 0)
-        fail(pending_blank_line, "empty line where data row " + std::to_string(row + 1) + " of " +
-                                     std::to_string(rows) + " was expected (one row per line)");
+        fail(pending_blank_line,
+             fmt::format("empty line where data row {} of {} was expected (one row per line)", row + 1, rows));
       // A line of L characters holds at most (L + 1) / 2 values: never grow by more than that, whatever
       // ncols claims (a row that cannot fit is reported as too short below).
       const std::size_t base = heights.size();
@@ -277,16 +282,15 @@ class AscParser {
         while (p < last && is_blank(*p)) ++p;
         if (p == last) break;
         if (col == cols)
-          fail(line_no_, "too many values on data row " + std::to_string(row + 1) + ": expected " +
-                             std::to_string(cols) + " (ncols)");
+          fail(line_no_, fmt::format("too many values on data row {}: expected {} (ncols)", row + 1, cols));
         double value = 0.0;
         const char* end = nullptr;
         const NumberStatus status = parse_number(p, last, value, &end);
         if (status != NumberStatus::kOk) reject_value(status, std::string_view(p, end - p), row, col);
         if (has_nodata && value == nodata) {
           if (!options_.fill_nodata)
-            fail(line_no_, "NODATA value " + quote(std::string_view(p, end - p)) + " at data row " +
-                               std::to_string(row + 1) + ", column " + std::to_string(col + 1) + "; " + kFillHint);
+            fail(line_no_, fmt::format("NODATA value {} at data row {}, column {}; {}",
+                                       quote(std::string_view(p, end - p)), row + 1, col + 1, kFillHint));
           value = std::numeric_limits<double>::quiet_NaN();
           ++nodata_cells;
         }
@@ -294,13 +298,12 @@ class AscParser {
         p = end;
       }
       if (col < cols)
-        fail(line_no_, "too few values on data row " + std::to_string(row + 1) + ": got " + std::to_string(col) +
-                           ", expected " + std::to_string(cols) + " (ncols)");
+        fail(line_no_, fmt::format("too few values on data row {}: got {}, expected {} (ncols)", row + 1, col, cols));
       ++row;
     }
     if (row < rows)
       fail(pending_blank_line != 0 ? pending_blank_line : line_no_ + 1,
-           "too few data rows: got " + std::to_string(row) + ", expected " + std::to_string(rows) + " (nrows)");
+           fmt::format("too few data rows: got {}, expected {} (nrows)", row, rows));
 
     GridGeometry geometry;
     geometry.rows = rows;
@@ -311,8 +314,9 @@ class AscParser {
     // A centre near the double limits puts the corner half a cell beyond them.
     for (const auto& [slot, corner] : {std::pair{kXll, geometry.xll_m}, std::pair{kYll, geometry.yll_m}})
       if (!std::isfinite(corner))
-        fail(header_[slot].line, "header key " + quote(header_[slot].key) +
-                                     " puts the grid's lower-left corner half a cell beyond the range of doubles");
+        fail(header_[slot].line,
+             fmt::format("header key {} puts the grid's lower-left corner half a cell beyond the range of doubles",
+                         quote(header_[slot].key)));
     Heightmap map(geometry, HeightMatrix(Eigen::Map<const HeightMatrix>(heights.data(), rows, cols)));
     if (nodata_cells > 0) {
       if (nodata_cells == announced) fail(0, "every cell is NODATA; there is nothing to fill from");
@@ -322,10 +326,10 @@ class AscParser {
   }
 
   [[noreturn]] void reject_value(NumberStatus status, std::string_view token, int row, int col) const {
-    const std::string where = " at data row " + std::to_string(row + 1) + ", column " + std::to_string(col + 1);
-    if (status == NumberStatus::kNonFinite) fail(line_no_, "non-finite height " + quote(token) + where);
-    if (status == NumberStatus::kOutOfRange) fail(line_no_, "height out of range " + quote(token) + where);
-    fail(line_no_, "not a number: " + quote(token) + where);
+    const char* what = status == NumberStatus::kNonFinite    ? "non-finite height "
+                       : status == NumberStatus::kOutOfRange ? "height out of range "
+                                                             : "not a number: ";
+    fail(line_no_, fmt::format("{}{} at data row {}, column {}", what, quote(token), row + 1, col + 1));
   }
 
   [[noreturn]] void reject_extra_content(std::string_view line, int rows) const {
@@ -333,8 +337,8 @@ class AscParser {
     double value = 0.0;
     const char* end = nullptr;
     if (parse_number(token.data(), token.data() + token.size(), value, &end) == NumberStatus::kOk)
-      fail(line_no_, "too many data rows: expected " + std::to_string(rows) + " (nrows)");
-    fail(line_no_, "trailing garbage after the last data row: " + quote(line));
+      fail(line_no_, fmt::format("too many data rows: expected {} (nrows)", rows));
+    fail(line_no_, fmt::format("trailing garbage after the last data row: {}", quote(line)));
   }
 
   std::string_view text_;
@@ -348,7 +352,7 @@ class AscParser {
 std::string read_stream(std::istream& in, const std::string& source_name) {
   std::ostringstream buffer;
   if (in.peek() != std::char_traits<char>::eof()) buffer << in.rdbuf();
-  if (in.bad()) throw IoError("cannot read '" + source_name + "'");
+  if (in.bad()) throw IoError(fmt::format("cannot read '{}'", source_name));
   return std::move(buffer).str();
 }
 
@@ -360,20 +364,17 @@ void check_writable(const Heightmap& map) {
   for (int r = 0; r < map.rows(); ++r)
     for (int c = 0; c < map.cols(); ++c) {
       const double h = map(r, c);
-      if (std::isinf(h))
-        throw InvalidArgument("write_asc: infinite height at cell (" + std::to_string(r) + ", " + std::to_string(c) +
-                              ")");
+      if (std::isinf(h)) throw InvalidArgument(fmt::format("write_asc: infinite height at cell {}", CellIndex{r, c}));
       if (h == kWrittenNodata)
-        throw InvalidArgument("write_asc: height -9999 at cell (" + std::to_string(r) + ", " + std::to_string(c) +
-                              ") would read back as NODATA_value -9999");
+        throw InvalidArgument(
+            fmt::format("write_asc: height -9999 at cell {} would read back as NODATA_value -9999", CellIndex{r, c}));
     }
 }
 
 void emit(const Heightmap& map, std::ostream& out) {
-  std::string buffer = "ncols " + std::to_string(map.cols()) + "\nnrows " + std::to_string(map.rows()) +
-                       "\nxllcorner " + format_double(map.geometry().xll_m) + "\nyllcorner " +
-                       format_double(map.geometry().yll_m) + "\ncellsize " + format_double(map.cell_size_m()) +
-                       "\nNODATA_value -9999\n";
+  std::string buffer = fmt::format("ncols {}\nnrows {}\nxllcorner {}\nyllcorner {}\ncellsize {}\nNODATA_value -9999\n",
+                                   map.cols(), map.rows(), format_double(map.geometry().xll_m),
+                                   format_double(map.geometry().yll_m), format_double(map.cell_size_m()));
   constexpr std::size_t kFlushBytes = 1 << 20;
   buffer.reserve(kFlushBytes + 64);
   char number[64];
@@ -403,16 +404,16 @@ Heightmap parse_asc(std::istream& in, const std::string& source_name, const AscR
 
 Heightmap read_asc(const std::string& path, const AscReadOptions& options) {
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw IoError("cannot read '" + path + "': it is a directory");
+  if (std::filesystem::is_directory(path, ec)) throw IoError(fmt::format("cannot read '{}': it is a directory", path));
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("cannot open '" + path + "': " + std::strerror(errno));
+  if (!in) throw IoError(fmt::format("cannot open '{}': {}", path, std::strerror(errno)));
   in.seekg(0, std::ios::end);
   const std::streamoff size = in.tellg();
   in.seekg(0, std::ios::beg);
-  if (size < 0) throw IoError("cannot read '" + path + "'");
+  if (size < 0) throw IoError(fmt::format("cannot read '{}'", path));
   std::string text(static_cast<std::size_t>(size), '\0');
   in.read(text.data(), size);
-  if (in.gcount() != size) throw IoError("cannot read '" + path + "': short read");
+  if (in.gcount() != size) throw IoError(fmt::format("cannot read '{}': short read", path));
   return AscParser(text, path, options).parse();
 }
 
@@ -425,10 +426,10 @@ void write_asc(const Heightmap& map, std::ostream& out) {
 void write_asc(const Heightmap& map, const std::string& path) {
   check_writable(map);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw IoError("cannot open '" + path + "' for writing: " + std::strerror(errno));
+  if (!out) throw IoError(fmt::format("cannot open '{}' for writing: {}", path, std::strerror(errno)));
   emit(map, out);
   out.close();
-  if (!out) throw IoError("failed to write '" + path + "'");
+  if (!out) throw IoError(fmt::format("failed to write '{}'", path));
 }
 
 void fill_nodata(Heightmap& map) {
@@ -447,7 +448,7 @@ void fill_nodata(Heightmap& map) {
     }
   if (missing == 0) return;
   if (missing == cells)
-    throw InvalidArgument("fill_nodata: all " + std::to_string(cells) + " cells are NODATA; nothing to fill from");
+    throw InvalidArgument(fmt::format("fill_nodata: all {} cells are NODATA; nothing to fill from", cells));
 
   auto for_neighbours = [&](long long i, auto&& visit) {
     const int r = static_cast<int>(i / cols);

@@ -6,6 +6,8 @@
 #include <functional>
 #include <utility>
 
+#include <fmt/ranges.h>
+
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/core/random.hpp"
@@ -22,12 +24,6 @@ constexpr long long kMaxCells = 1LL << 28;
 constexpr double kMaxLength = 1e7;  // [m]
 constexpr double kMaxHeight = 1e4;  // [m]
 constexpr double kEdgeTol = 1e-9;   // [m], platform edges: west/south inclusive, east/north exclusive
-
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
-  return out;
-}
 
 /// The grid a generator fills, with its physical size [m].
 struct Frame {
@@ -83,7 +79,7 @@ using GeneratorRegistry = NamedRegistry<GeneratorEntry>;
 ParamDef param(std::string key, double fixed_default, double min, double max, bool integer, std::string meaning,
                std::string unit) {
   return {std::move(key),
-          fmt::format("{:g}", fixed_default),
+          fmt::to_string(fixed_default),
           [fixed_default](const Frame&) { return fixed_default; },
           min,
           max,
@@ -93,8 +89,9 @@ ParamDef param(std::string key, double fixed_default, double min, double max, bo
 }
 
 ParamDef scaled_param(std::string key, double fraction, double min, double max, std::string meaning) {
+  // The default's text is a description, not a value to read back: "3%", not the product's "3.0000000000000004%".
   return {std::move(key),
-          fmt::format("{:g}", 100.0 * fraction) + "% of the map extent",
+          fmt::format("{:g}% of the map extent", 100.0 * fraction),
           [fraction](const Frame& f) { return fraction * f.extent_m; },
           min,
           max,
@@ -111,8 +108,11 @@ ParamValues resolve(const std::string& method, const GeneratorEntry& entry, cons
     if (!known) {
       std::vector<std::string> keys;
       for (const auto& d : entry.params) keys.push_back(d.key);
-      throw InvalidArgument("terrain generator '" + method + "': unknown parameter '" + key +
-                            "'; valid parameters: " + (keys.empty() ? std::string("(none)") : join(keys)));
+      throw InvalidArgument(
+          keys.empty()
+              ? fmt::format("terrain generator '{}': unknown parameter '{}'; valid parameters: (none)", method, key)
+              : fmt::format("terrain generator '{}': unknown parameter '{}'; valid parameters: {}", method, key,
+                            fmt::join(keys, ", ")));
     }
   }
   ParamValues out;
@@ -123,29 +123,28 @@ ParamValues resolve(const std::string& method, const GeneratorEntry& entry, cons
       continue;
     }
     const double v = it->second;
-    const std::string range = "[" + fmt::format("{:g}", d.min) + ", " + fmt::format("{:g}", d.max) + "]";
     if (!(v >= d.min && v <= d.max))
-      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key +
-                            "' = " + fmt::format("{:g}", v) + " is out of range " + range);
+      throw InvalidArgument(fmt::format("terrain generator '{}': parameter '{}' = {} is out of range [{}, {}]", method,
+                                        d.key, v, d.min, d.max));
     if (d.integer && v != std::floor(v))
-      throw InvalidArgument("terrain generator '" + method + "': parameter '" + d.key +
-                            "' = " + fmt::format("{:g}", v) + " must be a whole number in " + range);
+      throw InvalidArgument(
+          fmt::format("terrain generator '{}': parameter '{}' = {} must be a whole number in [{}, {}]", method, d.key,
+                      v, d.min, d.max));
     out[d.key] = v;
   }
   return out;
 }
 
 void check_spec(const std::string& method, const GeneratorSpec& spec) {
-  const std::string where = "terrain generator '" + method + "': ";
   if (spec.rows <= 0 || spec.cols <= 0)
-    throw InvalidArgument(where + "grid size must be positive, got " + std::to_string(spec.rows) + " x " +
-                          std::to_string(spec.cols));
+    throw InvalidArgument(
+        fmt::format("terrain generator '{}': grid size must be positive, got {} x {}", method, spec.rows, spec.cols));
   if (static_cast<long long>(spec.rows) * spec.cols > kMaxCells)
-    throw InvalidArgument(where + "grid of " + std::to_string(spec.rows) + " x " + std::to_string(spec.cols) +
-                          " cells exceeds the limit of " + std::to_string(kMaxCells) + " cells");
+    throw InvalidArgument(fmt::format("terrain generator '{}': grid of {} x {} cells exceeds the limit of {} cells",
+                                      method, spec.rows, spec.cols, kMaxCells));
   if (!(spec.cell_size_m > 0.0 && spec.cell_size_m <= kMaxLength))
-    throw InvalidArgument(where + "cell size must be in (0, " + fmt::format("{:g}", kMaxLength) + "] m, got " +
-                          fmt::format("{:g}", spec.cell_size_m));
+    throw InvalidArgument(fmt::format("terrain generator '{}': cell size must be in (0, {}] m, got {}", method,
+                                      kMaxLength, spec.cell_size_m));
 }
 
 // Cell-centre coordinates with the lower-left corner at (0, 0) [m].
@@ -238,8 +237,8 @@ HeightMatrix fractal(const Frame& f, const Params& p) {
   const double amplitude = p.get("amplitude");
   const double wavelength = p.get("wavelength");
   if (wavelength < f.cs)
-    throw InvalidArgument("terrain generator 'fractal': wavelength " + fmt::format("{:g}", wavelength) +
-                          " m is shorter than one cell (" + fmt::format("{:g}", f.cs) + " m)");
+    throw InvalidArgument(
+        fmt::format("terrain generator 'fractal': wavelength {} m is shorter than one cell ({} m)", wavelength, f.cs));
   HeightMatrix h = detail::gradient_fbm(f.rows, f.cols, f.cs, random::derive_seed(f.seed, 0x6662), p.count("octaves"),
                                         p.get("persistence"), wavelength);
   const double lo = h.minCoeff();
@@ -257,8 +256,8 @@ HeightMatrix craters(const Frame& f, const Params& p) {
   const double r_min = p.get("radius_min");
   const double r_max = p.get("radius_max");
   if (r_min > r_max)
-    throw InvalidArgument("terrain generator 'craters': radius_min " + fmt::format("{:g}", r_min) +
-                          " m exceeds radius_max " + fmt::format("{:g}", r_max) + " m");
+    throw InvalidArgument(
+        fmt::format("terrain generator 'craters': radius_min {} m exceeds radius_max {} m", r_min, r_max));
   const double depth = p.get("depth");
   const double rim_height = p.get("rim_height");
   random::Rng rng(random::derive_seed(f.seed, 0x63726174));
@@ -442,9 +441,8 @@ std::vector<std::string> generator_names() { return registry().names(); }
 std::vector<std::string> generator_parameter_help(const std::string& method) {
   std::vector<std::string> lines;
   for (const auto& d : registry().find(method).params) {
-    const std::string range = "[" + fmt::format("{:g}", d.min) + ", " + fmt::format("{:g}", d.max) + "]";
-    lines.push_back(d.key + " (default " + d.default_text + "): " + d.meaning + "; valid " +
-                    (d.integer ? "whole numbers in " : "") + range + " [" + d.unit + "]");
+    lines.push_back(fmt::format("{} (default {}): {}; valid {}[{}, {}] [{}]", d.key, d.default_text, d.meaning,
+                                d.integer ? "whole numbers in " : "", d.min, d.max, d.unit));
   }
   return lines;
 }

@@ -18,6 +18,8 @@
 #include <system_error>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "marsala/core/error.hpp"
 #include "marsala/terrain/asc_io.hpp"
 
@@ -73,9 +75,10 @@ struct TiffMessages {
 int on_tiff_error(TIFF*, void* user_data, const char* module, const char* fmt, va_list ap) {
   auto* messages = static_cast<TiffMessages*>(user_data);
   if (messages->first_error.empty()) {
+    // libtiff hands over a printf format and its va_list: only vsnprintf can expand them.
     char text[512];
     std::vsnprintf(text, sizeof text, fmt, ap);
-    messages->first_error = (module && *module ? std::string(module) + ": " : std::string()) + text;
+    messages->first_error = module && *module ? fmt::format("{}: {}", module, text) : std::string(text);
   }
   return 1;
 }
@@ -115,22 +118,23 @@ class GeoTiffReader {
   [[noreturn]] void fail(const std::string& problem) const { throw ParseError(path_, 0, problem); }
 
   std::string libtiff_says() const {
-    return messages_.first_error.empty() ? std::string() : " (libtiff: " + messages_.first_error + ")";
+    return messages_.first_error.empty() ? std::string() : fmt::format(" (libtiff: {})", messages_.first_error);
   }
 
   void open() {
     std::error_code ec;
-    if (std::filesystem::is_directory(path_, ec)) throw IoError("cannot read '" + path_ + "': it is a directory");
+    if (std::filesystem::is_directory(path_, ec))
+      throw IoError(fmt::format("cannot read '{}': it is a directory", path_));
     {
       std::ifstream probe(path_, std::ios::binary);
-      if (!probe) throw IoError("cannot open '" + path_ + "': " + std::strerror(errno));
+      if (!probe) throw IoError(fmt::format("cannot open '{}': {}", path_, std::strerror(errno)));
     }
     std::unique_ptr<TIFFOpenOptions, OptionsFreer> open_options(TIFFOpenOptionsAlloc());
-    if (!open_options) throw IoError("cannot allocate libtiff options to read '" + path_ + "'");
+    if (!open_options) throw IoError(fmt::format("cannot allocate libtiff options to read '{}'", path_));
     TIFFOpenOptionsSetErrorHandlerExtR(open_options.get(), on_tiff_error, &messages_);
     TIFFOpenOptionsSetWarningHandlerExtR(open_options.get(), on_tiff_warning, &messages_);
     tif_.reset(TIFFOpenExt(path_.c_str(), "r", open_options.get()));
-    if (!tif_) fail("not a readable TIFF file" + libtiff_says());
+    if (!tif_) fail(fmt::format("not a readable TIFF file{}", libtiff_says()));
   }
 
   void read_layout() {
@@ -138,11 +142,11 @@ class GeoTiffReader {
     uint32_t width = 0, height = 0;
     if (!TIFFGetField(tif, TIFFTAG_IMAGEWIDTH, &width) || !TIFFGetField(tif, TIFFTAG_IMAGELENGTH, &height))
       fail("TIFF without image width or length");
-    if (width == 0 || height == 0) fail("empty raster: " + std::to_string(width) + " x " + std::to_string(height));
+    if (width == 0 || height == 0) fail(fmt::format("empty raster: {} x {}", width, height));
     if (width > static_cast<uint32_t>(std::numeric_limits<int>::max()) ||
         height > static_cast<uint32_t>(std::numeric_limits<int>::max()) ||
         static_cast<long long>(width) * height > kMaxCells)
-      fail("raster too large: " + std::to_string(width) + " x " + std::to_string(height));
+      fail(fmt::format("raster too large: {} x {}", width, height));
     width_ = width;
     height_ = height;
 
@@ -152,8 +156,7 @@ class GeoTiffReader {
     TIFFGetFieldDefaulted(tif, TIFFTAG_SAMPLEFORMAT, &format);
     TIFFGetFieldDefaulted(tif, TIFFTAG_COMPRESSION, &compression);
     if (samples != 1)
-      fail("the raster has " + std::to_string(samples) +
-           " bands (samples per pixel); an elevation raster has exactly one");
+      fail(fmt::format("the raster has {} bands (samples per pixel); an elevation raster has exactly one", samples));
     if (format == SAMPLEFORMAT_IEEEFP && bits == 32)
       kind_ = SampleKind::kFloat32;
     else if (format == SAMPLEFORMAT_IEEEFP && bits == 64)
@@ -165,19 +168,19 @@ class GeoTiffReader {
     else if (format == SAMPLEFORMAT_INT && bits == 32)
       kind_ = SampleKind::kInt32;
     else
-      fail("unsupported sample format: " + std::to_string(bits) + "-bit " + format_name(format) +
-           " (supported: float32, float64, int16, uint16, int32)");
+      fail(fmt::format("unsupported sample format: {}-bit {} (supported: float32, float64, int16, uint16, int32)", bits,
+                       format_name(format)));
     if (!TIFFIsCODECConfigured(compression))
-      fail("compression scheme " + std::to_string(compression) + " is not supported by this libtiff");
+      fail(fmt::format("compression scheme {} is not supported by this libtiff", compression));
     // A damaged header can claim a raster of gigabytes in a file of a few bytes: uncompressed samples must fit in
     // the file before their raster is allocated.
     std::error_code ec;
     const std::uintmax_t file_bytes = std::filesystem::file_size(path_, ec);
     const std::uintmax_t raster_bytes = static_cast<std::uintmax_t>(width_) * height_ * sample_bytes(kind_);
     if (compression == COMPRESSION_NONE && !ec && raster_bytes > file_bytes)
-      fail("the header declares " + std::to_string(width_) + " x " + std::to_string(height_) +
-           " uncompressed samples (" + std::to_string(raster_bytes) + " bytes) in a file of " +
-           std::to_string(file_bytes) + " bytes: truncated or damaged");
+      fail(fmt::format(
+          "the header declares {} x {} uncompressed samples ({} bytes) in a file of {} bytes: truncated or damaged",
+          width_, height_, raster_bytes, file_bytes));
   }
 
   static std::string format_name(uint16_t format) {
@@ -187,7 +190,7 @@ class GeoTiffReader {
       case SAMPLEFORMAT_IEEEFP: return "floating point";
       case SAMPLEFORMAT_COMPLEXINT: return "complex integer";
       case SAMPLEFORMAT_COMPLEXIEEEFP: return "complex floating point";
-      default: return "sample format " + std::to_string(format);
+      default: return fmt::format("sample format {}", format);
     }
   }
 
@@ -197,8 +200,8 @@ class GeoTiffReader {
     const TIFFField* field = TIFFFindField(tif, tag, TIFF_ANY);
     if (!field) return {nullptr, 0};
     if (TIFFFieldDataType(field) != expected)
-      fail(std::string(name) + " has TIFF type " + std::to_string(TIFFFieldDataType(field)) + ", expected " +
-           std::to_string(expected));
+      fail(fmt::format("{} has TIFF type {}, expected {}", name, static_cast<int>(TIFFFieldDataType(field)),
+                       static_cast<int>(expected)));
     void* data = nullptr;
     uint32_t count = 0;
     int found = 0;
@@ -214,7 +217,7 @@ class GeoTiffReader {
       found = TIFFGetField(tif, tag, &data);
       count = data ? static_cast<uint32_t>(std::strlen(static_cast<const char*>(data)) + 1) : 0;
     } else {
-      fail(std::string(name) + " is registered in an unexpected way by this libtiff");
+      fail(fmt::format("{} is registered in an unexpected way by this libtiff", name));
     }
     if (!found || !data) return {nullptr, 0};
     return {data, count};
@@ -224,7 +227,7 @@ class GeoTiffReader {
     const auto [scale_data, scale_count] = custom_tag(kModelPixelScaleTag, TIFF_DOUBLE, "ModelPixelScaleTag");
     double sx = 1.0, sy = 1.0;
     if (scale_data) {
-      if (scale_count < 2) fail("ModelPixelScaleTag holds " + std::to_string(scale_count) + " values, expected 3");
+      if (scale_count < 2) fail(fmt::format("ModelPixelScaleTag holds {} values, expected 3", scale_count));
       const auto* scale = static_cast<const double*>(scale_data);
       sx = scale[0];
       sy = scale[1];
@@ -232,17 +235,16 @@ class GeoTiffReader {
       const auto [matrix_data, matrix_count] =
           custom_tag(kModelTransformationTag, TIFF_DOUBLE, "ModelTransformationTag");
       if (!matrix_data) return 1.0;
-      if (matrix_count != 16)
-        fail("ModelTransformationTag holds " + std::to_string(matrix_count) + " values, expected 16");
+      if (matrix_count != 16) fail(fmt::format("ModelTransformationTag holds {} values, expected 16", matrix_count));
       const auto* m = static_cast<const double*>(matrix_data);
       if (m[1] != 0.0 || m[4] != 0.0) fail("rotated or sheared rasters (ModelTransformationTag) are not supported");
       sx = std::abs(m[0]);
       sy = std::abs(m[5]);
     }
     if (!(sx > 0.0) || !(sy > 0.0) || !std::isfinite(sx) || !std::isfinite(sy))
-      fail("pixel size must be positive and finite, got " + std::to_string(sx) + " x " + std::to_string(sy));
+      fail(fmt::format("pixel size must be positive and finite, got {} x {}", sx, sy));
     if (std::abs(sx - sy) > 1e-9 * std::max(sx, sy))
-      fail("pixels are not square: " + std::to_string(sx) + " x " + std::to_string(sy) + " m; resample first");
+      fail(fmt::format("pixels are not square: {} x {} m; resample first", sx, sy));
     return sx;
   }
 
@@ -259,7 +261,7 @@ class GeoTiffReader {
     double nodata = 0.0;
     const auto result = std::from_chars(value.data(), value.data() + value.size(), nodata);
     if (value.empty() || result.ec == std::errc::invalid_argument || result.ptr != value.data() + value.size())
-      fail("GDAL_NODATA tag is not a number: '" + std::string(value) + "'");
+      fail(fmt::format("GDAL_NODATA tag is not a number: '{}'", value));
     has_nodata_ = true;
     // NaN here means NaN cells, which are missing anyway. A float32 raster stores its NODATA rounded to
     // float ("-3.40282e+38" names the float nearest to it), so compare in float there, as GDAL does.
@@ -275,8 +277,7 @@ class GeoTiffReader {
     if (rows_per_strip == 0 || rows_per_strip > height_) rows_per_strip = height_;
     const uint32_t strips_needed = (height_ + rows_per_strip - 1) / rows_per_strip;
     if (TIFFNumberOfStrips(tif) < strips_needed)
-      fail("the file holds " + std::to_string(TIFFNumberOfStrips(tif)) + " strips, " + std::to_string(strips_needed) +
-           " are needed");
+      fail(fmt::format("the file holds {} strips, {} are needed", TIFFNumberOfStrips(tif), strips_needed));
     const std::size_t bytes = static_cast<std::size_t>(sample_bytes(kind_));
     std::vector<unsigned char> buffer(static_cast<std::size_t>(rows_per_strip) * width_ * bytes);
     for (uint32_t strip = 0; strip < strips_needed; ++strip) {
@@ -286,8 +287,8 @@ class GeoTiffReader {
       const tmsize_t wanted = static_cast<tmsize_t>(samples * bytes);
       const tmsize_t got = TIFFReadEncodedStrip(tif, strip, buffer.data(), wanted);
       if (got < wanted)
-        fail("cannot decode strip " + std::to_string(strip) + " (rows " + std::to_string(row0) + ".." +
-             std::to_string(row0 + rows - 1) + "): data missing or damaged" + libtiff_says());
+        fail(fmt::format("cannot decode strip {} (rows {}..{}): data missing or damaged{}", strip, row0,
+                         row0 + rows - 1, libtiff_says()));
       convert(kind_, buffer.data(), samples, out + static_cast<std::size_t>(row0) * width_);
     }
   }
@@ -310,8 +311,8 @@ class GeoTiffReader {
         const tmsize_t needed = static_cast<tmsize_t>((static_cast<std::size_t>(rows - 1) * tile_width + cols) * bytes);
         const tmsize_t got = TIFFReadEncodedTile(tif, tile, buffer.data(), tile_bytes);
         if (got < needed)
-          fail("cannot decode the tile at row " + std::to_string(y) + ", column " + std::to_string(x) +
-               ": data missing or damaged" + libtiff_says());
+          fail(fmt::format("cannot decode the tile at row {}, column {}: data missing or damaged{}", y, x,
+                           libtiff_says()));
         for (uint32_t r = 0; r < rows; ++r)
           convert(kind_, buffer.data() + static_cast<std::size_t>(r) * tile_width * bytes, cols,
                   out + static_cast<std::size_t>(y + r) * width_ + x);
@@ -327,13 +328,14 @@ class GeoTiffReader {
     for (long long i = 0; i < cells; ++i) {
       const bool is_missing = std::isnan(h[i]) || (has_nodata_ && h[i] == nodata_);
       if (!is_missing) {
-        if (std::isinf(h[i]))
-          fail("infinite sample at row " + std::to_string(i / width_) + ", column " + std::to_string(i % width_));
+        if (std::isinf(h[i])) fail(fmt::format("infinite sample at row {}, column {}", i / width_, i % width_));
         continue;
       }
       if (!options_.fill_nodata)
-        fail("NODATA cell at row " + std::to_string(i / width_) + ", column " + std::to_string(i % width_) +
-             " (0-based); fill NODATA cells explicitly (--fill-nodata) to accept this file");
+        fail(fmt::format(
+            "NODATA cell at row {}, column {} (0-based); fill NODATA cells explicitly (--fill-nodata) to accept this "
+            "file",
+            i / width_, i % width_));
       h[i] = std::numeric_limits<double>::quiet_NaN();
       ++missing;
     }

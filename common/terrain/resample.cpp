@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "marsala/core/error.hpp"
 
 namespace marsala::terrain {
@@ -60,36 +62,33 @@ Heightmap crop(const Heightmap& map, double x0_m, double y0_m, double width_m, d
   if (!std::isfinite(x0_m) || !std::isfinite(y0_m) || !std::isfinite(width_m) || !std::isfinite(height_m))
     throw InvalidArgument("crop: the rectangle must be finite");
   if (!(width_m > 0.0) || !(height_m > 0.0))
-    throw InvalidArgument("crop: width and height must be positive, got " + std::to_string(width_m) + " x " +
-                          std::to_string(height_m) + " m");
+    throw InvalidArgument(fmt::format("crop: width and height must be positive, got {} x {} m", width_m, height_m));
   const GridGeometry& g = map.geometry();
-  const std::string rect = "[" + std::to_string(x0_m) + ", " + std::to_string(x0_m + width_m) + ") x [" +
-                           std::to_string(y0_m) + ", " + std::to_string(y0_m + height_m) + ") m";
   int col_first = 0, col_last = 0, south_first = 0, south_last = 0;
   // Rows are counted from the south here: cell_center's y is yll + (rows - r - 0.5) * cs.
   if (g.rows <= 0 || g.cols <= 0 ||
       !centres_in(g.xll_m, g.cell_size_m, g.cols, x0_m, x0_m + width_m, col_first, col_last) ||
       !centres_in(g.yll_m, g.cell_size_m, g.rows, y0_m, y0_m + height_m, south_first, south_last))
-    throw InvalidArgument("crop: no cell centre lies in " + rect);
+    throw InvalidArgument(
+        fmt::format("crop: no cell centre lies in [{}, {}) x [{}, {}) m", x0_m, x0_m + width_m, y0_m, y0_m + height_m));
   const int top_row = g.rows - 1 - south_last;
   return map.window({top_row, col_first}, south_last - south_first + 1, col_last - col_first + 1);
 }
 
 Heightmap resample_bilinear(const Heightmap& map, double cell_size_m) {
   if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m))
-    throw InvalidArgument("resample_bilinear: cell size must be positive and finite, got " +
-                          std::to_string(cell_size_m) + " m");
+    throw InvalidArgument(
+        fmt::format("resample_bilinear: cell size must be positive and finite, got {} m", cell_size_m));
   const GridGeometry& g = map.geometry();
   if (g.rows <= 0 || g.cols <= 0) throw InvalidArgument("resample_bilinear: the heightmap is empty");
   const double cols_real = std::floor(g.cols * g.cell_size_m / cell_size_m + kCountTolerance);
   const double rows_real = std::floor(g.rows * g.cell_size_m / cell_size_m + kCountTolerance);
   if (cols_real < 1.0 || rows_real < 1.0)
-    throw InvalidArgument("resample_bilinear: a cell of " + std::to_string(cell_size_m) + " m does not fit in the " +
-                          std::to_string(g.cols * g.cell_size_m) + " x " + std::to_string(g.rows * g.cell_size_m) +
-                          " m extent");
+    throw InvalidArgument(fmt::format("resample_bilinear: a cell of {} m does not fit in the {} x {} m extent",
+                                      cell_size_m, g.cols * g.cell_size_m, g.rows * g.cell_size_m));
   if (cols_real * rows_real > kMaxCells)
-    throw InvalidArgument("resample_bilinear: a cell of " + std::to_string(cell_size_m) + " m would give " +
-                          std::to_string(cols_real) + " x " + std::to_string(rows_real) + " cells");
+    throw InvalidArgument(
+        fmt::format("resample_bilinear: a cell of {} m would give {} x {} cells", cell_size_m, cols_real, rows_real));
   GridGeometry out_geometry = g;
   out_geometry.cols = static_cast<int>(cols_real);
   out_geometry.rows = static_cast<int>(rows_real);

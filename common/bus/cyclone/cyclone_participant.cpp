@@ -3,6 +3,7 @@
 // Readers take samples on Cyclone's listener thread, convert them and queue them (detail::ReaderQueue).
 
 #include <dds/dds.h>
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -59,7 +60,7 @@ struct CycloneType<WorldEvent> {
 };
 
 std::string failure(const std::string& what, dds_return_t rc) {
-  return "Cyclone DDS: " + what + " failed: " + dds_strretcode(rc);
+  return fmt::format("Cyclone DDS: {} failed: {}", what, dds_strretcode(rc));
 }
 
 /// Owns a qos object for the duration of an endpoint's creation.
@@ -84,7 +85,7 @@ class Context {
     participant_ = dds_create_participant(static_cast<dds_domainid_t>(domain_id), nullptr, nullptr);
     if (participant_ < 0) {
       if (domain_ > 0) dds_delete(domain_);
-      throw BusError(failure("creating a participant in domain " + std::to_string(domain_id), participant_));
+      throw BusError(failure(fmt::format("creating a participant in domain {}", domain_id), participant_));
     }
   }
   ~Context() {
@@ -108,8 +109,10 @@ class Context {
     std::string config = uri != nullptr && *uri != '\0' ? std::string(uri) : std::string();
     const auto add = [&config](const std::string& fragment) { config += (config.empty() ? "" : ",") + fragment; };
     if (role == Role::kClient)
-      add("<Discovery><ParticipantIndex>none</ParticipantIndex><MaxAutoParticipantIndex>" +
-          std::to_string(kServerIndices) + "</MaxAutoParticipantIndex><SPDPInterval>1s</SPDPInterval></Discovery>");
+      add(
+          fmt::format("<Discovery><ParticipantIndex>none</ParticipantIndex><MaxAutoParticipantIndex>{}"
+                      "</MaxAutoParticipantIndex><SPDPInterval>1s</SPDPInterval></Discovery>",
+                      kServerIndices));
     if (security.enabled())
       add(fmt::format(
           R"(<Security><Authentication><Library path="dds_security_auth" initFunction="init_authentication" )"
@@ -120,12 +123,11 @@ class Context {
           R"(<Governance>{0}governance.p7s</Governance><Permissions>{0}permissions.p7s</Permissions></AccessControl>)"
           R"(<Cryptographic><Library path="dds_security_crypto" initFunction="init_crypto" )"
           R"(finalizeFunction="finalize_crypto"/></Cryptographic></Security>)",
-          "file:" + std::filesystem::absolute(security.dir).string() + "/", security.identity));
+          fmt::format("file:{}/", std::filesystem::absolute(security.dir).string()), security.identity));
     const dds_entity_t domain = dds_create_domain(static_cast<dds_domainid_t>(domain_id_), config.c_str());
     // Another participant of this process made the domain already: this one shares its configuration.
     if (domain == DDS_RETCODE_PRECONDITION_NOT_MET) return;
-    if (domain < 0)
-      throw BusError(failure("creating domain " + std::to_string(domain_id_) + " with its settings", domain));
+    if (domain < 0) throw BusError(failure(fmt::format("creating domain {} with its settings", domain_id_), domain));
     domain_ = domain;
   }
 
@@ -138,7 +140,7 @@ class Context {
     auto it = topics_.find(name);
     if (it != topics_.end()) return it->second;
     const dds_entity_t t = dds_create_topic(participant_, CycloneType<T>::descriptor(), name.c_str(), nullptr, nullptr);
-    if (t < 0) throw BusError(failure("creating topic " + name, t));
+    if (t < 0) throw BusError(failure(fmt::format("creating topic {}", name), t));
     topics_.emplace(name, t);
     return t;
   }
@@ -172,7 +174,7 @@ class CycloneWriter final : public Writer<T> {
     Qos pub_qos;
     set_partition(pub_qos.get(), options.partition);
     publisher_ = dds_create_publisher(context_->participant(), pub_qos.get(), nullptr);
-    if (publisher_ < 0) throw BusError(failure("creating a publisher for " + label(options), publisher_));
+    if (publisher_ < 0) throw BusError(failure(fmt::format("creating a publisher for {}", label(options)), publisher_));
     Qos qos;
     set_common_qos(qos.get(), options);
     // Late joiners get the last `depth` samples of a transient-local writer, and only the latest of a volatile one
@@ -184,7 +186,7 @@ class CycloneWriter final : public Writer<T> {
     writer_ = dds_create_writer(publisher_, topic, qos.get(), nullptr);
     if (writer_ < 0) {
       dds_delete(publisher_);
-      throw BusError(failure("creating a writer for " + label(options), writer_));
+      throw BusError(failure(fmt::format("creating a writer for {}", label(options)), writer_));
     }
   }
   // Deleting the publisher deletes its writer; Cyclone lingers briefly to deliver unacknowledged samples.
@@ -194,7 +196,7 @@ class CycloneWriter final : public Writer<T> {
     cyclone::Storage storage;
     const typename CycloneType<T>::Msg msg = cyclone::to_msg(sample, storage);
     const dds_return_t rc = dds_write(writer_, &msg);
-    if (rc < 0) throw BusError(failure(std::string("writing ") + TopicName<T>::value, rc));
+    if (rc < 0) throw BusError(failure(fmt::format("writing {}", TopicName<T>::value), rc));
   }
 
   int matched_readers() const override {
@@ -205,7 +207,7 @@ class CycloneWriter final : public Writer<T> {
 
  private:
   static std::string label(const EndpointOptions& options) {
-    return std::string(TopicName<T>::value) + " in partition '" + options.partition + "'";
+    return fmt::format("{} in partition '{}'", TopicName<T>::value, options.partition);
   }
 
   std::shared_ptr<Context> context_;
@@ -224,7 +226,7 @@ class CycloneReader final : public Reader<T> {
     set_partition(sub_qos.get(), options.partition);
     subscriber_ = dds_create_subscriber(context_->participant(), sub_qos.get(), nullptr);
     if (subscriber_ < 0)
-      throw BusError(failure(std::string("creating a subscriber for ") + TopicName<T>::value, subscriber_));
+      throw BusError(failure(fmt::format("creating a subscriber for {}", TopicName<T>::value), subscriber_));
     Qos qos;
     set_common_qos(qos.get(), options);
     dds_listener_t* listener = dds_create_listener(this);
@@ -235,7 +237,7 @@ class CycloneReader final : public Reader<T> {
     dds_delete_listener(listener);
     if (reader_ < 0) {
       dds_delete(subscriber_);
-      throw BusError(failure(std::string("creating a reader for ") + TopicName<T>::value, reader_));
+      throw BusError(failure(fmt::format("creating a reader for {}", TopicName<T>::value), reader_));
     }
   }
   // Cyclone waits for a running listener callback to return before the reader is gone.
@@ -337,8 +339,11 @@ class CycloneParticipant final : public ParticipantBase<CycloneParticipant> {
  public:
   explicit CycloneParticipant(const BusConfig& config)
       : context_(std::make_shared<Context>(config.domain_id, config.role, config.security)) {
-    spdlog::debug("bus: Cyclone DDS participant in domain {}{}", config.domain_id,
-                  config.security.enabled() ? ", secured as " + config.security.identity : std::string());
+    if (config.security.enabled())
+      spdlog::debug("bus: Cyclone DDS participant in domain {}, secured as {}", config.domain_id,
+                    config.security.identity);
+    else
+      spdlog::debug("bus: Cyclone DDS participant in domain {}", config.domain_id);
   }
   Vendor vendor() const override { return Vendor::kCyclone; }
   int domain_id() const override { return context_->domain_id(); }

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "marsala/bus/bus.hpp"
 #include "marsala/core/error.hpp"
 
@@ -44,7 +46,7 @@ inline constexpr std::chrono::milliseconds kMaxBlocking{1000};
 
 /// Throws InvalidArgument for options no backend can honour (depth < 1).
 inline void check_options(const EndpointOptions& options) {
-  if (options.depth < 1) throw InvalidArgument("bus endpoint depth must be >= 1, got " + std::to_string(options.depth));
+  if (options.depth < 1) throw InvalidArgument(fmt::format("bus endpoint depth must be >= 1, got {}", options.depth));
 }
 
 }  // namespace marsala::bus::detail

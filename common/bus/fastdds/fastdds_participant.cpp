@@ -7,6 +7,7 @@
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastrtps/attributes/LibrarySettingsAttributes.h>
 #include <fastrtps/xmlparser/XMLProfileManager.h>
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -119,8 +120,10 @@ class Context {
     if (security.enabled()) secure(qos, security);
     participant_ = factory->create_participant(static_cast<dds::DomainId_t>(domain_id), qos);
     if (participant_ == nullptr)
-      throw BusError("Fast DDS: creating a participant in domain " + std::to_string(domain_id) +
-                     " failed (see the Fast DDS log above; is FASTRTPS_DEFAULT_PROFILES_FILE valid?)");
+      throw BusError(
+          fmt::format("Fast DDS: creating a participant in domain {} failed (see the Fast DDS log above; is "
+                      "FASTRTPS_DEFAULT_PROFILES_FILE valid?)",
+                      domain_id));
   }
   ~Context() {
     participant_->delete_contained_entities();
@@ -180,9 +183,9 @@ class Context {
     if (it != topics_.end()) return it->second;
     dds::TypeSupport type(new typename FastDdsType<T>::PubSub());
     if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK)
-      throw BusError("Fast DDS: registering type " + type.get_type_name() + " failed");
+      throw BusError(fmt::format("Fast DDS: registering type {} failed", type.get_type_name()));
     dds::Topic* t = participant_->create_topic(name, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
-    if (t == nullptr) throw BusError("Fast DDS: creating topic " + name + " failed");
+    if (t == nullptr) throw BusError(fmt::format("Fast DDS: creating topic {} failed", name));
     topics_.emplace(name, t);
     return t;
   }
@@ -219,7 +222,8 @@ class FastDdsWriter final : public Writer<T> {
     dds::PublisherQos pub_qos = participant->get_default_publisher_qos();
     if (!options.partition.empty()) pub_qos.partition().push_back(options.partition.c_str());
     publisher_ = participant->create_publisher(pub_qos);
-    if (publisher_ == nullptr) throw BusError("Fast DDS: creating a publisher for " + label(options) + " failed");
+    if (publisher_ == nullptr)
+      throw BusError(fmt::format("Fast DDS: creating a publisher for {} failed", label(options)));
     dds::DataWriterQos qos = publisher_->get_default_datawriter_qos();
     set_common_qos(qos, options);
     qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;  // every writer (topics.hpp)
@@ -231,7 +235,7 @@ class FastDdsWriter final : public Writer<T> {
     writer_ = publisher_->create_datawriter(topic, qos);
     if (writer_ == nullptr) {
       participant->delete_publisher(publisher_);
-      throw BusError("Fast DDS: creating a writer for " + label(options) + " failed");
+      throw BusError(fmt::format("Fast DDS: creating a writer for {} failed", label(options)));
     }
   }
   ~FastDdsWriter() override {
@@ -241,7 +245,7 @@ class FastDdsWriter final : public Writer<T> {
 
   void write(const T& sample) override {
     typename FastDdsType<T>::Msg msg = fastdds::to_msg(sample);
-    if (!writer_->write(&msg)) throw BusError(std::string("Fast DDS: writing ") + TopicName<T>::value + " failed");
+    if (!writer_->write(&msg)) throw BusError(fmt::format("Fast DDS: writing {} failed", TopicName<T>::value));
   }
 
   int matched_readers() const override {
@@ -253,7 +257,7 @@ class FastDdsWriter final : public Writer<T> {
 
  private:
   static std::string label(const EndpointOptions& options) {
-    return std::string(TopicName<T>::value) + " in partition '" + options.partition + "'";
+    return fmt::format("{} in partition '{}'", TopicName<T>::value, options.partition);
   }
 
   std::shared_ptr<Context> context_;
@@ -273,7 +277,7 @@ class FastDdsReader final : public Reader<T> {
     if (!options.partition.empty()) sub_qos.partition().push_back(options.partition.c_str());
     subscriber_ = participant->create_subscriber(sub_qos);
     if (subscriber_ == nullptr)
-      throw BusError(std::string("Fast DDS: creating a subscriber for ") + TopicName<T>::value + " failed");
+      throw BusError(fmt::format("Fast DDS: creating a subscriber for {} failed", TopicName<T>::value));
     dds::DataReaderQos qos = subscriber_->get_default_datareader_qos();
     set_common_qos(qos, options);  // RELIABLE set explicitly: Fast DDS 2.9 readers default to BEST_EFFORT
     qos.durability().kind = options.durability == Durability::kTransientLocal ? dds::TRANSIENT_LOCAL_DURABILITY_QOS
@@ -285,7 +289,7 @@ class FastDdsReader final : public Reader<T> {
     reader_ = subscriber_->create_datareader(topic, qos, &listener_);
     if (reader_ == nullptr) {
       participant->delete_subscriber(subscriber_);
-      throw BusError(std::string("Fast DDS: creating a reader for ") + TopicName<T>::value + " failed");
+      throw BusError(fmt::format("Fast DDS: creating a reader for {} failed", TopicName<T>::value));
     }
   }
   ~FastDdsReader() override {
@@ -360,8 +364,11 @@ class FastDdsParticipant final : public ParticipantBase<FastDdsParticipant> {
  public:
   explicit FastDdsParticipant(const BusConfig& config)
       : context_(std::make_shared<Context>(config.domain_id, config.role, config.security)) {
-    spdlog::debug("bus: Fast DDS participant in domain {}{}", config.domain_id,
-                  config.security.enabled() ? ", secured as " + config.security.identity : std::string());
+    if (config.security.enabled())
+      spdlog::debug("bus: Fast DDS participant in domain {}, secured as {}", config.domain_id,
+                    config.security.identity);
+    else
+      spdlog::debug("bus: Fast DDS participant in domain {}", config.domain_id);
   }
   Vendor vendor() const override { return Vendor::kFastDds; }
   int domain_id() const override { return context_->domain_id(); }
