@@ -258,7 +258,7 @@ render::RenderOptions final_picture_options(const WorldState& state, const RunIn
       o.legend_entries.push_back({"goal", kWhite, render::LegendSwatch::kOutline});
       if (g.target_radius_m > 0.0) {  // each agent's own target: the ring it must end in
         for (const AgentRecord& a : state.agents)
-          if (a.admitted) o.circles.push_back({{a.target.x, a.target.y}, g.target_radius_m, kToGreen, 0.0});
+          if (a.admitted) o.circles.push_back({a.target, g.target_radius_m, kToGreen, 0.0});
         o.legend_entries.push_back(
             {fmt::format("targets ({:g} m)", g.target_radius_m), kToGreen, render::LegendSwatch::kRing});
       }

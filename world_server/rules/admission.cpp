@@ -145,8 +145,8 @@ protocol::Admission admission_message(const WorldState& state, const protocol::A
   m.assignment.base_radius_m = state.base.radius_m;
   if (state.has_agent(m.agent_id)) {
     const AgentRecord& a = state.agent(m.agent_id);
-    m.assignment.start = {a.start.x, a.start.y};
-    m.assignment.target = {a.target.x, a.target.y};
+    m.assignment.start = a.start;
+    m.assignment.target = a.target;
   }
   return m;
 }
