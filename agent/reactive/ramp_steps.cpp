@@ -74,6 +74,11 @@ const executive::MappingSystem& RampSteps::map() const {
   return modules_->map;
 }
 
+const executive::RefusedCells& RampSteps::refused() const {
+  if (!modules_) throw InvalidArgument("ramp steps: no refused cells before admission");
+  return *memory_.refused;
+}
+
 void RampSteps::admit(const protocol::Admission& admission) {
   context_.assignment = assignment_from(context_, admission);
   const GridGeometry world = context_.assignment.world;
@@ -90,6 +95,12 @@ void RampSteps::admit(const protocol::Admission& admission) {
   const std::size_t streak_cells =
       context_.type.sensor.casts_rays() ? static_cast<std::size_t>(world.rows) * world.cols : 0;
   memory_.gap_streaks.assign(streak_cells, {});
+  // A refused cell comes back once its ball reads differently: by more than the map's noise margin, at least half a
+  // cube layer (the least another robot's deposit changes a cell).
+  const double ball_cells = build.delta_m / (2.0 * world.cell_size_m);
+  const double change = std::max(deposits.gap_margin_m, 0.5 * deposits.cube_layer_m);
+  memory_.refused.emplace(body.navigability.delta_m / (2.0 * world.cell_size_m), change, kRefusedMotionSteps);
+  memory_.refused_depositions.emplace(ball_cells, change, kRefusedMotionSteps);
   PlannerParams router = planner;
   router.alpha = 0.0;
   router.beta = 1.0;
@@ -112,6 +123,7 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
   modules_->map.set_registration(registration_);
   remember_result(frame);
   update_map(frame);
+  learn_refusals(frame);
   BuildView view = synthesize_view(frame);
   keep_clear(frame, view);
   trace.window_offset = view.local.offset;
@@ -141,12 +153,34 @@ void RampSteps::remember_result(const protocol::SensorFrame& frame) {
           modules_->map.record_built(r.cell, r.rise_m);
     }
   }
-  // A motion the world refused (its target not occupiable for this body, though the robot's map said it was: a
-  // scanned map's error) is not asked again for a while; the same frame would otherwise ask it again every step.
-  if (rejected && sent.motion) memory_.refused[*sent.motion] = frame.step + kRefusedMotionSteps;
+  // A refusal is information (docs/runtime.md#refused-requests): which cell, and whether the terrain was the reason.
+  // The world names cells in its own grid; the map registers them shifted by the localisation offset.
+  memory_.refusal.reset();
+  if (rejected) {
+    const auto named = executive::cell_named(frame.last_reason);
+    CellIndex cell = sent.motion.value_or(CellIndex{});
+    if (named) cell = {named->row + registration_.row, named->col + registration_.col};
+    const auto starts = [&](const char* word) { return frame.last_reason.rfind(word, 0) == 0; };
+    const bool motion = !starts("deposit") && !starts("refill") && !starts("robot type");  // rules 1, 2
+    if (sent.motion && motion)
+      memory_.refusal = Memory::Refusal{cell, executive::refused_for_terrain(frame.last_reason), true};
+    else if (named && !motion)
+      memory_.refusal = Memory::Refusal{cell, false, false};
+  }
   sent = Sent{};
-  for (auto it = memory_.refused.begin(); it != memory_.refused.end();)
-    it = it->second <= frame.step ? memory_.refused.erase(it) : std::next(it);
+}
+
+void RampSteps::learn_refusals(const protocol::SensorFrame& frame) {
+  const executive::MappingSystem& map = modules_->map;
+  memory_.refused->update(map.heights(), map.known(), frame.step);
+  memory_.refused_depositions->update(map.heights(), map.known(), frame.step);
+  if (!memory_.refusal) return;
+  const Memory::Refusal& r = *memory_.refusal;
+  executive::RefusedCells& cells = r.motion ? *memory_.refused : *memory_.refused_depositions;
+  if (r.terrain)
+    cells.refuse_terrain(r.cell, map.heights(), map.known());
+  else
+    cells.refuse_for_now(r.cell, frame.step);
 }
 
 void RampSteps::update_map(const protocol::SensorFrame& frame) {
@@ -177,11 +211,8 @@ void RampSteps::keep_clear(const protocol::SensorFrame& frame, BuildView& view) 
   memory_.corridor = view.local.navigable;
   memory_.terrain_occupiable = view.local.occupiable;
   executive::keep_clear(view.local, view.robot, memory_.others);
-  if (memory_.refused.empty()) return;
-  std::vector<CellIndex> refused;
-  refused.reserve(memory_.refused.size());
-  for (const auto& [cell, until] : memory_.refused) refused.push_back(cell);
-  executive::keep_off(view.local, refused);
+  if (memory_.refused->empty()) return;
+  executive::keep_off(view.local, memory_.refused->cells());
 }
 
 bool RampSteps::plan_path(const deliberative::LocalMap& local, BuildTrace& trace) {
@@ -265,6 +296,10 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
     terrain_only.navigable = memory_.corridor;
   }
   if (context_.type.sensor.casts_rays()) clear_unconfirmed_gap(terrain_only);
+  for (const CellIndex g : memory_.refused_depositions->cells()) {
+    const CellIndex p = terrain_only.to_local(g);
+    if (terrain_only.contains(p)) terrain_only.gap(p.row, p.col) = 0.0;
+  }
   trace.deposition = modules_->depositor->plan(modules_->depositions, terrain_only, ahead, at, frame.material_m3,
                                                neighbourhood(frame));
   auto& deposits = trace.deposition.deposits;

@@ -8,9 +8,10 @@
 // robot's body are taken out (executive/body_clearance.hpp): every route and motion then keeps clear of the
 // neighbours the frame shows. Depositions are judged on the terrain alone (the masks before the neighbours were
 // taken out: what stays occupiable and connected does not depend on where the others stand this step), and never
-// on the base station's pad. A motion target the world refused is left out of the local map for kRefusedMotionSteps
-// (a scanned map can hold a cell occupiable that is not; without this the robot asked for it every step). Then, by
-// its state, one of:
+// on the base station's pad. A motion the world refused is left out of the local map (executive/refused_cells.hpp):
+// a cell refused as not occupiable until the robot's map around it changes, one refused for a neighbour's body for
+// kRefusedMotionSteps; a deposition cell the world refused is no deposition target for as long. Then, by its state,
+// one of:
 //   build_step()   plan a deposition path to the local goal (once per frame); a motion along it is possible -> move
 //                  and deposit ahead (kAdvance); blocked, but depositions within reach -> deposit in place (kBuild);
 //                  blocked and nothing to deposit (the gap left is under the robot) -> retreat_step() (kRetreat)
@@ -24,7 +25,6 @@
 // behaviour's.
 
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -37,6 +37,7 @@
 #include "marsala/agent/executive/body_clearance.hpp"
 #include "marsala/agent/executive/deposition_manager.hpp"
 #include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/agent/executive/refused_cells.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
 #include "marsala/protocol/messages.hpp"
 
@@ -56,7 +57,8 @@ inline constexpr int kFreshScans = 3;
 /// surface by a step's height now and then (hits near a riser), and a gap filled on such a reading is a bump others
 /// build around [scans].
 inline constexpr int kConfirmScans = 3;
-/// A motion target the world refused is left out of the robot's local map for this many steps.
+/// A motion target or deposition cell the world refused for a reason other than the terrain (a neighbour's body) is
+/// left out of the robot's local map for this many steps [steps].
 inline constexpr std::uint64_t kRefusedMotionSteps = 40;
 
 /// What the building steps did: the robot moved along the path, deposited in place, or is backing off.
@@ -102,6 +104,9 @@ class RampSteps {
   bool admitted() const { return modules_ != nullptr; }
   /// The agent's own map; throws InvalidArgument before admission.
   const executive::MappingSystem& map() const;
+  /// The motion targets the world refused that the robot holds out (world indices as its map registers them);
+  /// throws InvalidArgument before admission.
+  const executive::RefusedCells& refused() const;
   /// Where the terrain of the next frames is registered (executive::MappingSystem::set_registration); kept across
   /// admissions.
   void set_registration(CellIndex offset);
@@ -152,7 +157,7 @@ class RampSteps {
   /// What the request being built sends (the last move()'s and deposit()'s): for the map once the world accepts it
   /// (MappingSystem::record_built), for the deposit limit and the refused cells when it refuses it.
   struct Sent {
-    std::optional<CellIndex> motion;  ///< the world cell the request moves to
+    std::optional<CellIndex> motion;  ///< the world cell the request moves to (as the map registers it)
     std::vector<Deposition> layers;
     std::vector<Deposit> deposits;
   };
@@ -163,7 +168,16 @@ class RampSteps {
     /// request with deposits, the next ones carry at most half as many (none after one), until one is accepted, so a
     /// mismatch never repeats the same request forever. -1: no limit.
     int deposit_limit = -1;
-    std::map<CellIndex, std::uint64_t> refused;    ///< motion targets the world refused -> avoided until this step
+    std::optional<executive::RefusedCells> refused;              ///< motion targets the world refused
+    std::optional<executive::RefusedCells> refused_depositions;  ///< deposition cells the world refused
+    /// The last frame's refusal, recorded once this frame's scan is in the map: the cell, whether for the terrain
+    /// (else for now) and whether a motion (else a deposition).
+    struct Refusal {
+      CellIndex cell;
+      bool terrain = false;
+      bool motion = false;
+    };
+    std::optional<Refusal> refusal;
     std::vector<GapStreak> gap_streaks;            ///< scanned maps, per world cell (row-major): count_gap_scans()
     bool deposited_since_blocked = false;          ///< the retreat deposited since the path was last blocked
     int idle_retreat_moves = 0;                    ///< retreat moves without work since
@@ -175,6 +189,7 @@ class RampSteps {
   // look()'s steps, in order.
   void remember_result(const protocol::SensorFrame& frame);              // what the world made of the last request
   void update_map(const protocol::SensorFrame& frame);                   // tiles, scan and the ground under the body
+  void learn_refusals(const protocol::SensorFrame& frame);               // the world's refusals on the new map
   BuildView synthesize_view(const protocol::SensorFrame& frame);         // target, local map, the gap to work on
   void keep_clear(const protocol::SensorFrame& frame, BuildView& view);  // the neighbours and the refused cells
   void deposit(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position at, std::size_t from,

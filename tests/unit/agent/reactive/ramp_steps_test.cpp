@@ -11,6 +11,7 @@
 
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/core/ray_caster.hpp"
 #include "marsala/core/sensor_spec.hpp"
 #include "unit/agent/agent_test_support.hpp"
@@ -99,7 +100,10 @@ TEST(RampSteps, BuildStepAdvancesAlongThePathOnFlatGround) {
   EXPECT_TRUE(q.depositions.empty());
 }
 
-TEST(RampSteps, AMotionTheWorldRefusedIsLeftOutOfTheLocalMapForAWhile) {
+// docs/runtime.md#refused-requests: a motion the world refused as not occupiable is information. The robot (still
+// where it was, its map unchanged) never asks for that cell again, however many steps pass; once its map reads the
+// cell's ball differently (another robot built there), it may.
+TEST(RampSteps, ACellTheWorldRefusedIsNotRequestedAgainUntilTheMapAroundItChanges) {
   const auto owned = admitted_steps();
   RampSteps& steps = *owned;
   BuildTrace trace;
@@ -113,25 +117,52 @@ TEST(RampSteps, AMotionTheWorldRefusedIsLeftOutOfTheLocalMapForAWhile) {
   };
   EXPECT_NE(view.local.occupiable(local(view).row, local(view).col), 0);
 
-  // The world refused it: the robot (still where it was) leaves that cell out and goes elsewhere.
+  // The world refused it, naming the cell.
+  protocol::SensorFrame f = frame(steps, 1, {1.05, 3.05});
+  f.last_result = protocol::ActionResult::kRejected;
+  f.last_reason = fmt::format("target cell ({}, {}) is not occupiable for this body", refused.row, refused.col);
+  for (std::uint64_t step = 1; step < 1 + 5 * kRefusedMotionSteps; ++step) {
+    if (step > 1) f = frame(steps, step, {1.05, 3.05});
+    trace = BuildTrace{};
+    view = steps.look(f, trace);
+    ASSERT_TRUE(steps.refused().contains(refused)) << "step " << step;
+    EXPECT_EQ(view.local.occupiable(local(view).row, local(view).col), 0);
+    q = empty(steps, f);
+    (void)steps.build_step(view.local, f, trace, q);
+    if (q.move) {
+      EXPECT_NE(*steps.map().geometry().cell_at({q.target_x_m, q.target_y_m}), refused) << "step " << step;
+    }
+  }
+  // Another robot raised a cell of its ball: the map changed there, the cell is judged again.
+  Heightmap built = test::platform_world();
+  built(refused.row, refused.col + 1) += 0.05;
+  trace = BuildTrace{};
+  view = steps.look(test::full_frame(steps.context(), 1000, {1.05, 3.05}, 1.0, built), trace);
+  EXPECT_FALSE(steps.refused().contains(refused));
+}
+
+// A motion refused for a neighbour's body (rule 2.5) depends on where the others stand: held out for a while only.
+TEST(RampSteps, AMotionRefusedForANeighboursBodyIsLeftOutForAWhile) {
+  const auto owned = admitted_steps();
+  RampSteps& steps = *owned;
+  BuildTrace trace;
+  const protocol::SensorFrame f0 = frame(steps, 0, {1.05, 3.05});
+  BuildView view = steps.look(f0, trace);
+  protocol::ActionRequest q = empty(steps, f0);
+  ASSERT_EQ(steps.build_step(view.local, f0, trace, q), BuildPhase::kAdvance);
+  const CellIndex refused = *steps.map().geometry().cell_at({q.target_x_m, q.target_y_m});
   protocol::SensorFrame f1 = frame(steps, 1, {1.05, 3.05});
   f1.last_result = protocol::ActionResult::kRejected;
+  f1.last_reason = "motion ends 0.9 m from agent 2, whose body it would overlap (bodies need 1 m)";
   trace = BuildTrace{};
   view = steps.look(f1, trace);
-  EXPECT_EQ(view.local.occupiable(local(view).row, local(view).col), 0);
-  EXPECT_EQ(view.local.navigable(local(view).row, local(view).col), 0);
-  q = empty(steps, f1);
-  steps.build_step(view.local, f1, trace, q);
-  if (q.move) {
-    EXPECT_NE(*steps.map().geometry().cell_at({q.target_x_m, q.target_y_m}), refused);
-  }
-  // Until kRefusedMotionSteps have passed.
+  EXPECT_TRUE(steps.refused().contains(refused));
   trace = BuildTrace{};
   view = steps.look(frame(steps, 1 + kRefusedMotionSteps - 1, {1.05, 3.05}), trace);
-  EXPECT_EQ(view.local.occupiable(local(view).row, local(view).col), 0);
+  EXPECT_TRUE(steps.refused().contains(refused));
   trace = BuildTrace{};
   view = steps.look(frame(steps, 1 + kRefusedMotionSteps, {1.05, 3.05}), trace);
-  EXPECT_NE(view.local.occupiable(local(view).row, local(view).col), 0);
+  EXPECT_FALSE(steps.refused().contains(refused));
 }
 
 TEST(RampSteps, BuildStepBlockedAtTheFootBuildsInPlace) {

@@ -1,0 +1,80 @@
+#include "marsala/agent/executive/refused_cells.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
+#include "marsala/core/iterators.hpp"
+
+namespace marsala::agent::executive {
+
+std::optional<CellIndex> cell_named(const std::string& reason) {
+  // The world's reasons name cells as "cell (r, c)" (docs/runtime.md#validation).
+  const std::size_t at = reason.find("cell (");
+  if (at == std::string::npos) return std::nullopt;
+  int row = 0, col = 0;
+  if (std::sscanf(reason.c_str() + at, "cell (%d, %d)", &row, &col) != 2) return std::nullopt;
+  return CellIndex{row, col};
+}
+
+bool refused_for_terrain(const std::string& reason) {
+  return reason.find("not occupiable") != std::string::npos;
+}
+
+RefusedCells::RefusedCells(double ball_radius_cells, double change_m, std::uint64_t hold_steps)
+    : change_m_(change_m), hold_steps_(hold_steps) {
+  if (!(ball_radius_cells >= 0.0) || !std::isfinite(ball_radius_cells) || !(change_m > 0.0) ||
+      !std::isfinite(change_m) || hold_steps == 0)
+    throw InvalidArgument(fmt::format("refused cells: ball radius {} cells, change {} m or hold {} steps out of range",
+                                      ball_radius_cells, change_m, hold_steps));
+  offsets_ = disc_offsets(ball_radius_cells);
+}
+
+std::vector<double> RefusedCells::ball(CellIndex cell, const Heightmap& heights, const CellMask& known) const {
+  std::vector<double> out;
+  out.reserve(offsets_.size());
+  for (const CellIndex o : offsets_) {
+    const CellIndex p{cell.row + o.row, cell.col + o.col};
+    const bool on = heights.contains(p) && known(p.row, p.col) != 0;
+    out.push_back(on ? heights(p) : std::numeric_limits<double>::quiet_NaN());
+  }
+  return out;
+}
+
+bool RefusedCells::changed(const std::vector<double>& before, const std::vector<double>& now) const {
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    if (std::isnan(before[i]) != std::isnan(now[i])) return true;
+    if (!std::isnan(before[i]) && std::abs(now[i] - before[i]) > change_m_) return true;
+  }
+  return false;
+}
+
+void RefusedCells::refuse_terrain(CellIndex cell, const Heightmap& heights, const CellMask& known) {
+  ++refusals_;
+  cells_[cell] = Entry{0, ball(cell, heights, known)};
+}
+
+void RefusedCells::refuse_for_now(CellIndex cell, std::uint64_t step) {
+  ++refusals_;
+  Entry& e = cells_[cell];
+  if (e.ball.empty()) e.until_step = std::max(e.until_step, step + hold_steps_);  // a terrain refusal stays one
+}
+
+void RefusedCells::update(const Heightmap& heights, const CellMask& known, std::uint64_t step) {
+  for (auto it = cells_.begin(); it != cells_.end();) {
+    const Entry& e = it->second;
+    const bool over = e.ball.empty() ? e.until_step <= step : changed(e.ball, ball(it->first, heights, known));
+    it = over ? cells_.erase(it) : std::next(it);
+  }
+}
+
+std::vector<CellIndex> RefusedCells::cells() const {
+  std::vector<CellIndex> out;
+  out.reserve(cells_.size());
+  for (const auto& [cell, entry] : cells_) out.push_back(cell);
+  return out;
+}
+
+}  // namespace marsala::agent::executive

@@ -1,0 +1,71 @@
+#pragma once
+// Refused cells (docs/runtime.md#refused-requests): what the world's refusals taught the robot. A motion the world
+// refused because a cell is not occupiable for the body (rules 2.3 and 2.4) says the robot's map is wrong around that
+// cell: the cell stays out of the robot's local map until the map around it changes (a scan reads its ball
+// differently, the robot or another builds there), so the same request is never sent again on the same map. A motion
+// refused for another reason (a neighbour's body, rule 2.5) depends on where the others stand: it is held out for a
+// number of steps only. A deposition refused on a named cell (under a robot, out of reach) is no deposition target
+// for as long.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "marsala/core/heightmap.hpp"
+#include "marsala/core/types.hpp"
+
+namespace marsala::agent::executive {
+
+/// The cell (world index) a refusal reason names ("... cell (r, c) ..."), if any.
+std::optional<CellIndex> cell_named(const std::string& reason);
+
+/// True when the reason says a cell is not occupiable for the body (rules 2.3, 2.4): the terrain there, not the
+/// neighbours.
+bool refused_for_terrain(const std::string& reason);
+
+/// The cells a robot must not ask for again, and why.
+class RefusedCells {
+ public:
+  /// ball_radius_cells: the body's ball (delta / (2 cs)) [cells], whose cells decide occupancy; change_m: the least
+  /// change of a known height in the ball that counts as new information [m] (a scanned map's noise margin; > 0);
+  /// hold_steps: how long a refusal that does not depend on the terrain holds [steps]. Throws InvalidArgument on a
+  /// negative radius, a change that is not finite and > 0, or hold_steps 0.
+  RefusedCells(double ball_radius_cells, double change_m, std::uint64_t hold_steps);
+
+  /// The world refused a motion into `cell` (world index, as the map registers it) for the terrain: remembered with
+  /// the map's heights and known mask of its ball, until they change (update()).
+  void refuse_terrain(CellIndex cell, const Heightmap& heights, const CellMask& known);
+  /// The world refused a request for a reason that does not depend on the terrain: `cell` held out until `step` +
+  /// hold_steps.
+  void refuse_for_now(CellIndex cell, std::uint64_t step);
+  /// Forgets the terrain refusals whose ball the map now reads differently (a known height moved by more than
+  /// change_m, or a cell became known or unknown) and the others once their hold has passed at `step`.
+  void update(const Heightmap& heights, const CellMask& known, std::uint64_t step);
+
+  /// True when no cell is held out.
+  bool empty() const { return cells_.empty(); }
+  /// True when `cell` (world index) is held out.
+  bool contains(CellIndex cell) const { return cells_.count(cell) != 0; }
+  /// The held-out cells, ascending (world indices).
+  std::vector<CellIndex> cells() const;
+  /// How many refusals were recorded so far [count].
+  long long refusals() const { return refusals_; }
+
+ private:
+  struct Entry {
+    std::uint64_t until_step = 0;  ///< a hold for a reason other than the terrain; 0 for a terrain refusal
+    std::vector<double> ball;      ///< a terrain refusal: the ball's heights when refused, NaN where unknown [m]
+  };
+  std::vector<double> ball(CellIndex cell, const Heightmap& heights, const CellMask& known) const;
+  bool changed(const std::vector<double>& before, const std::vector<double>& now) const;
+
+  std::vector<CellIndex> offsets_;
+  double change_m_;
+  std::uint64_t hold_steps_;
+  std::map<CellIndex, Entry> cells_;
+  long long refusals_ = 0;
+};
+
+}  // namespace marsala::agent::executive

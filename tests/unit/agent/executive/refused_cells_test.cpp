@@ -1,0 +1,82 @@
+// Refused cells (agent/executive/refused_cells.hpp): what the world's refusals teach a robot, on small maps.
+
+#include "marsala/agent/executive/refused_cells.hpp"
+
+#include <gtest/gtest.h>
+
+#include "marsala/core/error.hpp"
+
+namespace marsala::agent::executive {
+namespace {
+
+Heightmap flat(double h = 0.0) { return Heightmap({20, 20, 0.0, 0.0, 0.1}, h); }
+CellMask all_known() { return CellMask::Ones(20, 20); }
+
+TEST(RefusedCells, ReadsTheCellTheWorldsReasonsName) {
+  // The reasons of docs/runtime.md#validation, rules 2.3, 2.4, 3.5 and 3d.8.
+  EXPECT_EQ(cell_named("target cell (99, 158) is not occupiable for this body"), (CellIndex{99, 158}));
+  EXPECT_EQ(cell_named("motion passes through cell (3, 4), not occupiable for this body"), (CellIndex{3, 4}));
+  EXPECT_EQ(cell_named("deposition cell (7, 12) is under agent 2"), (CellIndex{7, 12}));
+  EXPECT_EQ(cell_named("deposit at (1.05, 2.05) m raises cell (5, 6), under agent 1"), (CellIndex{5, 6}));
+  EXPECT_FALSE(cell_named("motion of 0.3 m exceeds max_step_m 0.2").has_value());
+  EXPECT_FALSE(cell_named("").has_value());
+  EXPECT_TRUE(refused_for_terrain("target cell (99, 158) is not occupiable for this body"));
+  EXPECT_TRUE(refused_for_terrain("motion passes through cell (3, 4), not occupiable for this body"));
+  EXPECT_FALSE(refused_for_terrain("motion ends 0.8 m from agent 2, whose body it would overlap (bodies need 1 m)"));
+}
+
+TEST(RefusedCells, ATerrainRefusalHoldsUntilTheMapAroundTheCellChanges) {
+  RefusedCells refused(2.0, 0.01, 40);
+  Heightmap h = flat();
+  CellMask known = all_known();
+  refused.refuse_terrain({10, 10}, h, known);
+  // The same map for ever: the cell stays out, however many steps pass.
+  for (std::uint64_t step = 1; step < 1000; step += 97) {
+    refused.update(h, known, step);
+    EXPECT_TRUE(refused.contains({10, 10})) << step;
+  }
+  // A change within the map's noise margin, or outside the ball (2 cells), is no news.
+  h(10, 11) = 0.009;
+  h(10, 13) = 1.0;
+  refused.update(h, known, 2000);
+  EXPECT_TRUE(refused.contains({10, 10}));
+  // A height in the ball read differently (another robot built there) is.
+  h(11, 11) = 0.05;
+  refused.update(h, known, 2001);
+  EXPECT_FALSE(refused.contains({10, 10}));
+  EXPECT_TRUE(refused.empty());
+
+  // So is a cell of the ball that became known (or unknown).
+  known(8, 10) = 0;
+  refused.refuse_terrain({10, 10}, h, known);
+  known(8, 10) = 1;
+  refused.update(h, known, 2002);
+  EXPECT_FALSE(refused.contains({10, 10}));
+  EXPECT_EQ(refused.refusals(), 2);
+}
+
+TEST(RefusedCells, AnotherRefusalHoldsForItsStepsAndATerrainRefusalStaysOne) {
+  RefusedCells refused(2.0, 0.01, 40);
+  const Heightmap h = flat();
+  const CellMask known = all_known();
+  refused.refuse_for_now({3, 3}, 100);
+  refused.update(h, known, 139);
+  EXPECT_TRUE(refused.contains({3, 3}));
+  refused.update(h, known, 140);
+  EXPECT_FALSE(refused.contains({3, 3}));
+
+  refused.refuse_terrain({5, 5}, h, known);
+  refused.refuse_for_now({5, 5}, 100);
+  refused.update(h, known, 5000);
+  EXPECT_TRUE(refused.contains({5, 5}));
+  EXPECT_EQ(refused.cells(), (std::vector<CellIndex>{{5, 5}}));
+}
+
+TEST(RefusedCells, RefusesBadParameters) {
+  EXPECT_THROW(RefusedCells(-1.0, 0.01, 40), InvalidArgument);
+  EXPECT_THROW(RefusedCells(2.0, 0.0, 40), InvalidArgument);
+  EXPECT_THROW(RefusedCells(2.0, 0.01, 0), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace marsala::agent::executive
