@@ -29,6 +29,23 @@ constexpr std::size_t kVoxelsPerCell = 8;
 constexpr double kEdgeBand = 0.1;
 constexpr double kEdgeBandNoise = 3.0;
 constexpr double kMaxEdgeBand = 0.3;
+/// A hit this close to a cell edge lies on it, within the precision of a scan's float offsets [m]; a sensor whose
+/// noise is smaller places it there only when the ray struck a face standing on the edge (docs/runtime.md#mapping).
+constexpr double kOnEdgeM = 1e-5;
+
+/// The cell whose face a hit on a cell edge struck: the one the ray enters there (a step along its horizontal
+/// direction); nullopt when the ray is (nearly) vertical or the hit lies on no edge.
+std::optional<CellIndex> face_cell(const GridGeometry& g, Point3 o, Point3 hit) {
+  const double dx = hit.x - o.x, dy = hit.y - o.y, run = std::hypot(dx, dy);
+  if (!(run > 0.0)) return std::nullopt;
+  const double cs = g.cell_size_m;
+  const double u = (hit.x - g.xll_m) / cs, v = (hit.y - g.yll_m) / cs;
+  const double eu = std::abs(u - std::round(u)) * cs, ev = std::abs(v - std::round(v)) * cs;
+  const bool on_u = eu < kOnEdgeM && std::abs(dx) > kOnEdgeM * run, on_v = ev < kOnEdgeM && std::abs(dy) > kOnEdgeM * run;
+  if (!on_u && !on_v) return std::nullopt;
+  const double step = 10.0 * kOnEdgeM / run;
+  return g.cell_at({hit.x + step * dx, hit.y + step * dy});
+}
 
 /// Where a ray from `o` to `p` entered the column of `cell` (the cell holding p): the cell it crossed just before and
 /// the ray's height at the crossing [m]; nullopt when the ray starts inside that column.
@@ -151,7 +168,13 @@ struct MappingSystem::Octree {
 /// One scan's hits binned into the octree's voxels: the points to insert, the cells with hits and their bounding rows
 /// and columns (max_row < 0: none).
 struct MappingSystem::ScanBatch {
+  /// A hit on the face of a cell standing on a cell edge: the cell is at least that high [m].
+  struct Face {
+    CellIndex cell;
+    double z_m;
+  };
   octomap::Pointcloud cloud;
+  std::vector<Face> faces;
   std::vector<std::size_t> touched;  ///< cells (row-major) with a voxel first hit in this scan
   int min_row;
   int max_row;
@@ -273,17 +296,26 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   octree_->tree.insertPointCloud(batch.cloud, tree_point(g, origin.x, origin.y, origin.z), -1.0, true, true);
   octree_->tree.updateInnerOccupancy();
   octree_->settle(batch.touched);
-  if (batch.max_row < 0) return;
-  rederive_heights(batch);
+  if (batch.max_row >= 0) rederive_heights(batch);
   for (std::size_t index : batch.touched)
     for (Octree::VoxelHits& v : octree_->hits[index]) v.hits_in_scan = 0;
+  // A face's hit bounds its cell from below for good (terrain only rises), as the robot's own construction does.
+  for (const ScanBatch::Face& f : batch.faces) {
+    const long long index = static_cast<long long>(f.cell.row) * g.cols + f.cell.col;
+    double& least = built_.try_emplace(index, f.z_m).first->second;
+    least = std::max(least, f.z_m);
+    heights_(f.cell) = known_(f.cell.row, f.cell.col) != 0 && assumed_(f.cell.row, f.cell.col) == 0
+                           ? std::max(heights_(f.cell), least)
+                           : least;
+    mark_known(f.cell.row, f.cell.col);
+  }
 }
 
 MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& points, Point3 origin) {
   const GridGeometry& g = heights_.geometry();
   const double cs = g.cell_size_m;
   const double z_limit = 0.99 * kOctreeHalfVoxels * cs;
-  ScanBatch batch{{}, {}, g.rows, -1, g.cols, -1};
+  ScanBatch batch{{}, {}, {}, g.rows, -1, g.cols, -1};
   batch.cloud.reserve(points.size());
   // A hit on a wall between two cells lies on their common edge, and range noise puts it on either side: in the
   // lower cell's column it would read as a surface high above that cell. Hits within kEdgeBand of a cell edge are
@@ -294,6 +326,19 @@ MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& p
     if (!cell || std::abs(hit.z) >= z_limit) continue;
     const double range = std::sqrt(double{p.x_m} * p.x_m + double{p.y_m} * p.y_m + double{p.z_m} * p.z_m);
     const double spread = kEdgeBandNoise * sensor_.noise_sd_at(range);  // where noise may carry the hit [m]
+    if (spread < kOnEdgeM) {
+      // A noise-free hit on a cell edge struck the face of the cell the ray enters there (a wall's side): that cell
+      // is at least as high. Placed by the band below, it would be left out, and a wall seen only from the side
+      // (above the sensor) would never be mapped.
+      if (const auto face = face_cell(g, origin, hit)) {
+        const Position in = g.cell_center(*face);
+        const Position at{std::clamp(hit.x, in.x - 0.49 * cs, in.x + 0.49 * cs),
+                          std::clamp(hit.y, in.y - 0.49 * cs, in.y + 0.49 * cs)};
+        batch.cloud.push_back(tree_point(g, at.x, at.y, hit.z));
+        batch.faces.push_back({*face, hit.z});
+        continue;
+      }
+    }
     const double band = std::max(kEdgeBand * cs, spread);
     if (band > kMaxEdgeBand * cs + 1e-12 || near_cell_edge(g, hit, band) || behind_edge(origin, hit, *cell, spread))
       continue;

@@ -325,6 +325,35 @@ TEST(MappingSystem, AHitTooNoisyToPlaceInACellIsLeftOut) {
   EXPECT_TRUE(map.is_known({27, 29}));   // x 2.915
 }
 
+// A noise-free sensor before a 1.5 m wall whose face lies exactly on a cell edge (x = 4 m, cols 40 on): every hit on
+// the face lies on the edge. The sensor (0.5 m up) sees no higher than its top elevation, so the face is all it sees
+// of the wall: its column is known at least as high as the highest face hit (the truth is higher), never as the
+// ground; the cells before it read the ground. Expected from the geometry alone: the highest face hit is at
+// 0.5 m + d tan(top elevation), d the distance from the sensor to the face.
+TEST(MappingSystem, ANoiseFreeWallOnACellEdgeIsMapped) {
+  Heightmap truth(GridGeometry{60, 100, 0.0, 0.0, 0.1}, 0.0);
+  for (int r = 0; r < 60; ++r)
+    for (int c = 40; c < 100; ++c) truth(r, c) = 1.5;
+  for (const SensorKind kind : {SensorKind::kRgbd, SensorKind::kLaser}) {
+    SensorSpec sensor = sensor_defaults(kind);
+    sensor.noise_sd_m = 0.0;
+    sensor.noise_sd_per_m2 = 0.0;
+    MappingSystem map(truth.geometry(), 16, sensor);
+    const double x = 2.05, d = 4.0 - x;
+    scan_into(map, truth, x, 3.05, 0.0, 1);  // facing east
+    const double top_hit = std::min(1.5, 0.5 + d * std::tan(sensor.vertical_max_deg * M_PI / 180.0));
+    ASSERT_TRUE(map.is_known({29, 40})) << to_string(kind);
+    EXPECT_GT(map.heights()(29, 40), top_hit - 0.1) << to_string(kind);
+    EXPECT_LE(map.heights()(29, 40), 1.5 + 1e-6) << to_string(kind);
+    for (int c = 25; c < 40; ++c) {
+      if (map.is_known({29, c})) {
+        EXPECT_NEAR(map.heights()(29, c), 0.0, 1e-6) << to_string(kind) << " col " << c;
+      }
+    }
+    EXPECT_FALSE(map.is_known({29, 45})) << to_string(kind);  // the top lies above every ray
+  }
+}
+
 // hit_within(cell, n): one of the last n scans hit the cell's surface.
 TEST(MappingSystem, HitWithinSaysWhetherARecentScanHitTheCell) {
   MappingSystem map(GridGeometry{60, 60, 0.0, 0.0, 0.1}, 16, sensor_defaults(SensorKind::kLaser));
