@@ -90,6 +90,10 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
       if (assumed(r, c) != 0) local.gap(r, c) = 0.0;
 
   local.robot = local.to_local(*map.geometry().cell_at(robot));
+  // A scanned map may hold the robot's own cell not occupiable (a reading that changed under it, a face beside it);
+  // the world lets a robot drive out of its own cell (docs/runtime.md#rule-2-motion), so it counts as occupiable and
+  // the robot keeps its way out instead of standing still for good.
+  if (map.scanned) local.occupiable(local.robot.row, local.robot.col) = 1;
   local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
   local.origin = local_origin(local, map.trajectory, robot, sensing_range_m_);
   const auto [goal, is_target] = local_goal(local, robot, target);

@@ -33,18 +33,26 @@ constexpr double kMaxEdgeBand = 0.3;
 /// noise is smaller places it there only when the ray struck a face standing on the edge (docs/runtime.md#mapping).
 constexpr double kOnEdgeM = 1e-5;
 
-/// The cell whose face a hit on a cell edge struck: the one the ray enters there (a step along its horizontal
-/// direction); nullopt when the ray is (nearly) vertical or the hit lies on no edge.
-std::optional<CellIndex> face_cell(const GridGeometry& g, Point3 o, Point3 hit) {
+/// The cell whose face a hit struck, when the ray's horizontal path crosses a cell edge within within_m [m] of the
+/// hit (range noise moves a hit along its ray): the cell the ray enters at the crossing nearest to the hit; nullopt
+/// when the ray is (nearly) vertical or crosses no edge that near.
+std::optional<CellIndex> face_cell(const GridGeometry& g, Point3 o, Point3 hit, double within_m) {
   const double dx = hit.x - o.x, dy = hit.y - o.y, run = std::hypot(dx, dy);
   if (!(run > 0.0)) return std::nullopt;
-  const double cs = g.cell_size_m;
-  const double u = (hit.x - g.xll_m) / cs, v = (hit.y - g.yll_m) / cs;
-  const double eu = std::abs(u - std::round(u)) * cs, ev = std::abs(v - std::round(v)) * cs;
-  const bool on_u = eu < kOnEdgeM && std::abs(dx) > kOnEdgeM * run, on_v = ev < kOnEdgeM && std::abs(dy) > kOnEdgeM * run;
-  if (!on_u && !on_v) return std::nullopt;
-  const double step = 10.0 * kOnEdgeM / run;
-  return g.cell_at({hit.x + step * dx, hit.y + step * dy});
+  const double cs = g.cell_size_m, ux = dx / run, uy = dy / run;
+  double best = std::numeric_limits<double>::infinity(), along = 0.0;
+  // The nearest grid line of each axis is the nearest crossing with that axis's lines (signed distance along the ray).
+  if (std::abs(ux) > 1e-9) {
+    const double s = (g.xll_m + std::round((hit.x - g.xll_m) / cs) * cs - hit.x) / ux;
+    if (std::abs(s) < best) best = std::abs(s), along = s;
+  }
+  if (std::abs(uy) > 1e-9) {
+    const double s = (g.yll_m + std::round((hit.y - g.yll_m) / cs) * cs - hit.y) / uy;
+    if (std::abs(s) < best) best = std::abs(s), along = s;
+  }
+  if (!(best <= within_m)) return std::nullopt;
+  const double past = along + 10.0 * kOnEdgeM;  // just past the crossing, in the cell the ray enters
+  return g.cell_at({hit.x + past * ux, hit.y + past * uy});
 }
 
 /// Where a ray from `o` to `p` entered the column of `cell` (the cell holding p): the cell it crossed just before and
@@ -207,6 +215,7 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       tile_size_(other.tile_size_),
       registration_(other.registration_),
       built_(other.built_),
+      face_floor_(other.face_floor_),
       sensor_(other.sensor_),
       trajectory_(other.trajectory_),
       octree_(other.octree_ ? std::make_unique<Octree>(*other.octree_) : nullptr) {}
@@ -302,12 +311,17 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   // A face's hit bounds its cell from below for good (terrain only rises), as the robot's own construction does.
   for (const ScanBatch::Face& f : batch.faces) {
     const long long index = static_cast<long long>(f.cell.row) * g.cols + f.cell.col;
-    double& least = built_.try_emplace(index, f.z_m).first->second;
+    double& least = face_floor_.try_emplace(index, f.z_m).first->second;
     least = std::max(least, f.z_m);
-    heights_(f.cell) = known_(f.cell.row, f.cell.col) != 0 && assumed_(f.cell.row, f.cell.col) == 0
-                           ? std::max(heights_(f.cell), least)
-                           : least;
+    // A surface read at or above the face stays; else the cell is a bound, no surface: never a deposition target.
+    const bool surface = known_(f.cell.row, f.cell.col) != 0 && assumed_(f.cell.row, f.cell.col) == 0 &&
+                         heights_(f.cell) >= least;
+    if (!surface) {
+      const auto built = built_.find(index);
+      heights_(f.cell) = built == built_.end() ? least : std::max(least, built->second);
+    }
     mark_known(f.cell.row, f.cell.col);
+    assumed_(f.cell.row, f.cell.col) = surface ? 0 : 1;
   }
 }
 
@@ -326,11 +340,15 @@ MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& p
     if (!cell || std::abs(hit.z) >= z_limit) continue;
     const double range = std::sqrt(double{p.x_m} * p.x_m + double{p.y_m} * p.y_m + double{p.z_m} * p.z_m);
     const double spread = kEdgeBandNoise * sensor_.noise_sd_at(range);  // where noise may carry the hit [m]
-    if (spread < kOnEdgeM) {
-      // A noise-free hit on a cell edge struck the face of the cell the ray enters there (a wall's side): that cell
-      // is at least as high. Placed by the band below, it would be left out, and a wall seen only from the side
-      // (above the sensor) would never be mapped.
-      if (const auto face = face_cell(g, origin, hit)) {
+    // A face hit (docs/runtime.md#mapping): a noise-free hit on a cell edge, or a hit whose ray did not descend (a
+    // top face is only ever hit from above): it struck the face of the cell the ray enters at the edge, that cell is
+    // at least as high. Placed by the band below, a wall's face hits would be left out or land in the column before
+    // it, and a wall seen only from the side (above the sensor) would never be mapped.
+    const bool exact = spread < kOnEdgeM, rising = hit.z >= origin.z;
+    if (exact || rising) {
+      const auto face = face_cell(g, origin, hit, exact ? kOnEdgeM : spread);
+      if (!face && rising) continue;  // farther from every edge than noise carries a hit: an outlier
+      if (face && spread <= kMaxEdgeBand * cs + 1e-12) {
         const Position in = g.cell_center(*face);
         const Position at{std::clamp(hit.x, in.x - 0.49 * cs, in.x + 0.49 * cs),
                           std::clamp(hit.y, in.y - 0.49 * cs, in.y + 0.49 * cs)};
@@ -386,9 +404,16 @@ void MappingSystem::rederive_heights(const ScanBatch& batch) {
       const Octree::VoxelHits* top = octree_->surface(index, key, hit);
       if (hit) hit_scan_[index] = scans_;
       if (!top) continue;  // every voxel it had was carved free since: keep what the map said
-      const auto built = built_.find(static_cast<long long>(row) * g.cols + col);
+      const long long key_rc = static_cast<long long>(row) * g.cols + col;
+      const auto built = built_.find(key_rc);
       heights_(row, col) = built == built_.end() ? top->estimate_m : std::max(top->estimate_m, built->second);
       mark_known(row, col);
+      // A face above the reading: the reading was the face's, not the cell's top (a bound, no surface).
+      const auto face = face_floor_.find(key_rc);
+      if (face != face_floor_.end() && face->second > top->estimate_m) {
+        heights_(row, col) = std::max(heights_(row, col), face->second);
+        assumed_(row, col) = 1;
+      }
     }
 }
 
@@ -396,6 +421,11 @@ bool MappingSystem::hit_within(CellIndex cell, int scans) const {
   if (hit_scan_.empty() || !heights_.contains(cell)) return false;
   const int last = hit_scan_[static_cast<std::size_t>(cell.row) * heights_.cols() + cell.col];
   return last > 0 && scans_ - last < scans;
+}
+
+int MappingSystem::last_hit_scan(CellIndex cell) const {
+  if (hit_scan_.empty() || !heights_.contains(cell)) return 0;
+  return hit_scan_[static_cast<std::size_t>(cell.row) * heights_.cols() + cell.col];
 }
 
 void MappingSystem::record_built(CellIndex cell, double rise_m) {

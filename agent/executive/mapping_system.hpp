@@ -79,7 +79,8 @@ class MappingSystem {
   /// 1 where the cell has been sensed at least once.
   const CellMask& known() const { return known_; }
   bool is_known(CellIndex cell) const { return heights_.contains(cell) && known_(cell.row, cell.col) != 0; }
-  /// 1 where the cell is known only by assume_ground(): no sensor has observed it (never a deposition target).
+  /// 1 where the cell's height is no surface a sensor read (never a deposition target): ground assume_ground() put
+  /// under the body, or a lower bound from a face seen from below (its top above every ray that reached it).
   const CellMask& assumed() const { return assumed_; }
   /// Number of known cells.
   long long known_cells() const { return known_count_; }
@@ -88,6 +89,8 @@ class MappingSystem {
   /// True when one of the last `scans` scans hit the cell (its surface, not only rays through its column): what it
   /// says there is current. Others may have built there since an older scan (docs/runtime.md#mapping).
   bool hit_within(CellIndex cell, int scans) const;
+  /// The scan (1, 2, ...) that last hit the cell's surface, 0 when none did or the cell is off the grid.
+  int last_hit_scan(CellIndex cell) const;
   /// Cells stood on, oldest first, consecutive repeats removed (global indices).
   const std::vector<CellIndex>& trajectory() const { return trajectory_; }
   /// The world grid.
@@ -117,6 +120,7 @@ class MappingSystem {
   int tile_size_;
   CellIndex registration_{0, 0};
   std::unordered_map<long long, double> built_;  ///< record_built(): the least height of a cell (row-major index) [m]
+  std::unordered_map<long long, double> face_floor_;  ///< the highest face hit of a cell (row-major index) [m]
   SensorSpec sensor_;
   std::vector<CellIndex> trajectory_;
   std::unique_ptr<Octree> octree_;  // made at the first scan

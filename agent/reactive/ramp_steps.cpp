@@ -12,6 +12,7 @@
 #include "marsala/core/deposit_shapes.hpp"
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/iterators.hpp"
 #include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::agent::reactive {
@@ -95,6 +96,7 @@ void RampSteps::admit(const protocol::Admission& admission) {
   const std::size_t streak_cells =
       context_.type.sensor.casts_rays() ? static_cast<std::size_t>(world.rows) * world.cols : 0;
   memory_.gap_streaks.assign(streak_cells, {});
+  memory_.others_near.assign(streak_cells, 0);
   // A refused cell comes back once its ball reads differently: by more than the map's noise margin, at least half a
   // cube layer (the least another robot's deposit changes a cell).
   const double ball_cells = build.delta_m / (2.0 * world.cell_size_m);
@@ -200,7 +202,10 @@ BuildView RampSteps::synthesize_view(const protocol::SensorFrame& frame) {
   const Position target = goal.value_or(robot);  // nothing left to build towards: stay
   BuildView view{modules_->synthesizer.synthesize(modules_->map.known_map(), robot, target), robot, target};
   clear_pad_gap(view.local);
-  if (context_.type.sensor.casts_rays()) count_gap_scans(view.local, frame.scanned);
+  if (context_.type.sensor.casts_rays()) {
+    mark_others_near(frame);
+    count_gap_scans(view.local, frame.scanned);
+  }
   return view;
 }
 
@@ -244,11 +249,30 @@ void RampSteps::count_gap_scans(const deliberative::LocalMap& local, bool scanne
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c) {
       const CellIndex g = local.to_global({r, c});
-      if (!(local.gap(r, c) > margin) || !map.hit_within(g, kFreshScans)) continue;
+      if (!(local.gap(r, c) > margin) || !current(g)) continue;
       GapStreak& streak = memory_.gap_streaks[static_cast<std::size_t>(g.row) * cols + g.col];
       streak.scans = streak.last_scan == map.scans() - 1 ? streak.scans + 1 : 1;
       streak.last_scan = map.scans();
     }
+}
+
+void RampSteps::mark_others_near(const protocol::SensorFrame& frame) {
+  const executive::MappingSystem& map = modules_->map;
+  const RobotBody& body = context_.type.body;
+  for (const Neighbour& n : frame.neighbours) {
+    if (!std::isfinite(n.position.x) || !std::isfinite(n.position.y)) continue;
+    const auto cell = map.geometry().cell_at(n.position);
+    if (!cell) continue;
+    for (DiscIterator it(map.geometry(), *cell, body.reach_m + body.max_step_m); !it.is_past_end(); ++it)
+      memory_.others_near[static_cast<std::size_t>((*it).row) * map.geometry().cols + (*it).col] = map.scans();
+  }
+}
+
+bool RampSteps::current(CellIndex cell) const {
+  const executive::MappingSystem& map = modules_->map;
+  if (map.hit_within(cell, kFreshScans)) return true;
+  const int last = map.last_hit_scan(cell);
+  return last > 0 && memory_.others_near[static_cast<std::size_t>(cell.row) * map.geometry().cols + cell.col] < last;
 }
 
 void RampSteps::clear_unconfirmed_gap(deliberative::LocalMap& local) const {

@@ -179,6 +179,9 @@ class RampSteps {
     };
     std::optional<Refusal> refusal;
     std::vector<GapStreak> gap_streaks;            ///< scanned maps, per world cell (row-major): count_gap_scans()
+    /// Scanned maps, per world cell (row-major): the map's scan count when a neighbour last stood within reach of it
+    /// (mark_others_near()); 0: never.
+    std::vector<int> others_near;
     bool deposited_since_blocked = false;          ///< the retreat deposited since the path was last blocked
     int idle_retreat_moves = 0;                    ///< retreat moves without work since
     std::vector<executive::BodyClearance> others;  ///< the last frame's neighbours
@@ -199,6 +202,12 @@ class RampSteps {
   /// A scanned map: counts, per cell of the window, the scans in a row that showed its gap (beyond the margin) on a
   /// surface a recent scan hit (kFreshScans, kConfirmScans).
   void count_gap_scans(const deliberative::LocalMap& local, bool scanned);
+  /// A scanned map: marks the cells within a step and a reach of each neighbour the frame shows (where it may build).
+  void mark_others_near(const protocol::SensorFrame& frame);
+  /// A scanned map: true when what the map says of `cell` (world index) is current: one of the last kFreshScans scans
+  /// hit it, or a scan hit it and no neighbour came within reach of it since (only this robot built there, and its
+  /// own construction is in its map).
+  bool current(CellIndex cell) const;
   /// A scanned map: no work where the gap is not confirmed: on a cell no recent scan hit (others may have built there
   /// since) or whose gap fewer than kConfirmScans scans in a row showed (one scan's misread surface is no gap). The
   /// path is still planned on the whole gap.

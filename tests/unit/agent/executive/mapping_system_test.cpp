@@ -345,6 +345,7 @@ TEST(MappingSystem, ANoiseFreeWallOnACellEdgeIsMapped) {
     ASSERT_TRUE(map.is_known({29, 40})) << to_string(kind);
     EXPECT_GT(map.heights()(29, 40), top_hit - 0.1) << to_string(kind);
     EXPECT_LE(map.heights()(29, 40), 1.5 + 1e-6) << to_string(kind);
+    EXPECT_TRUE(map.assumed()(29, 40)) << to_string(kind);  // a bound, not its surface: never a deposition target
     for (int c = 25; c < 40; ++c) {
       if (map.is_known({29, c})) {
         EXPECT_NEAR(map.heights()(29, c), 0.0, 1e-6) << to_string(kind) << " col " << c;
@@ -352,6 +353,27 @@ TEST(MappingSystem, ANoiseFreeWallOnACellEdgeIsMapped) {
     }
     EXPECT_FALSE(map.is_known({29, 45})) << to_string(kind);  // the top lies above every ray
   }
+}
+
+// A noisy camera 1 m before the same wall: the face hits it places in the wall's column came up to it from below (the
+// sensor is 0.5 m up), so the column's reading is a lower bound, no surface: marked so (never a deposition target).
+// The ground before the wall, hit from above, is a surface.
+TEST(MappingSystem, AFaceSeenFromBelowIsABoundNotASurface) {
+  Heightmap truth(GridGeometry{60, 100, 0.0, 0.0, 0.1}, 0.0);
+  for (int r = 0; r < 60; ++r)
+    for (int c = 40; c < 100; ++c) truth(r, c) = 1.5;
+  MappingSystem map(truth.geometry(), 16, sensor_defaults(SensorKind::kRgbd));
+  for (std::uint64_t k = 1; k <= 5; ++k) scan_into(map, truth, 2.95, 3.05, 0.0, k);
+  int bounds = 0;
+  for (int r = 20; r <= 40; ++r) {
+    if (!map.is_known({r, 40})) continue;
+    EXPECT_GT(map.heights()(r, 40), 0.5) << r;  // the highest face hits: above the sensor
+    EXPECT_TRUE(map.assumed()(r, 40)) << r;
+    ++bounds;
+  }
+  EXPECT_GT(bounds, 3);
+  ASSERT_TRUE(map.is_known({29, 36}));
+  EXPECT_FALSE(map.assumed()(29, 36));
 }
 
 // hit_within(cell, n): one of the last n scans hit the cell's surface.
