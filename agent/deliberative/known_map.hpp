@@ -14,7 +14,7 @@ namespace marsala::agent::deliberative {
 struct KnownMap {
   const Heightmap& heights;                  ///< the world grid: known cells hold the sensed heights [m], unknown 0
   const CellMask& known;                     ///< 1 where the cell has been sensed at least once
-  const CellMask& assumed;                   ///< 1 where the height is no sensed surface (assumed ground, a face seen from below)
+  const CellMask& assumed;                   ///< 1 where no sensor read the surface (assumed ground, a bound)
   const std::vector<CellIndex>& trajectory;  ///< cells stood on, oldest first (world indices)
   bool scanned = false;                      ///< built from range scans (holes, shadows), not ground-truth tiles
 

@@ -229,6 +229,26 @@ TEST(LocalMapSynthesizer, ScannedMapsNeverLetTheRobotOntoUnknownCells) {
     }
 }
 
+// A robot whose own cell is not occupiable in its map (a 0.5 m column read beside it): the world lets it drive out of
+// its cell (docs/runtime.md#rule-2-motion). On a scanned map its cell counts as occupiable, so the cells around it stay
+// navigable and it can leave; on a ground-truth map (exact: the world judges the same cells) it is left as it is.
+TEST(LocalMapSynthesizer, AScannedMapKeepsTheRobotsWayOutOfItsOwnCell) {
+  Heightmap h(kWorld, 0.0);
+  h(30, 41) = 0.5;  // in the robot's ball (delta 0.4 m: 2 cells), a step far beyond eps + kappa cs
+  const CellMask known = CellMask::Ones(kWorld.rows, kWorld.cols);
+  const CellMask assumed = CellMask::Zero(kWorld.rows, kWorld.cols);
+  const std::vector<CellIndex> trajectory{{30, 40}};
+  ASSERT_FALSE(cell_occupiable(h, {30, 40}, kBody));
+  const LocalMapSynthesizer synthesizer(kBody, 2.5);
+  for (const bool scanned : {true, false}) {
+    const LocalMap local = synthesizer.synthesize({h, known, assumed, trajectory, scanned}, kRobot, {7.0, 2.95});
+    EXPECT_EQ(local.occupiable(local.robot.row, local.robot.col), scanned ? 1 : 0);
+    const CellIndex west{local.robot.row, local.robot.col - 3};  // occupiable ground beside the robot's ball
+    ASSERT_EQ(local.occupiable(west.row, west.col), 1);
+    EXPECT_EQ(local.navigable(west.row, west.col), scanned ? 1 : 0);
+  }
+}
+
 // A scanned map whose goal (where the line to the target leaves the window) cannot be judged yet: a hole in the
 // known corridor lies within its body ball. The robot heads for the nearest known cell that can be judged and
 // reaches it through such cells only (LocalMap::passable); before, it followed the blind cells along the edge of its

@@ -380,5 +380,42 @@ TEST(RampSteps, AScanningRobotFillsAGapOnlyOnceItsLastScansAgree) {
   EXPECT_FALSE(q.depositions.empty());
 }
 
+// docs/runtime.md#mapping: a gap stays current after the scans stop hitting it (the robot turned away, built cells hide
+// it) as long as no other robot came within reach of it: only this robot can have built there. A laser robot before a
+// 0.3 m step confirms the gap with 3 scans, then gets frames whose scans hit nothing: it still fills the gap. The same
+// robot does not when a neighbour stood on the gap in two of those frames (gone again when it decides): the neighbour
+// may have built there.
+TEST(RampSteps, AGapStaysCurrentUntilAnotherRobotComesNearIt) {
+  for (const bool neighbour : {false, true}) {
+    AgentContext c = test::agent_context(3, test::husky());
+    c.type.sensor = sensor_defaults(SensorKind::kLaser);
+    RampSteps steps(c);
+    Heightmap h = test::platform_world();
+    for (int r = 0; r < h.rows(); ++r)
+      for (int col = 70; col < h.cols(); ++col) h(r, col) = 0.3;
+    steps.admit(test::admission_on(c, h.geometry(), kTarget, kBase));
+    const Position robot{6.05, 3.05};
+    const Point3 origin = sensor_origin(h, robot.x, robot.y, c.type.sensor);
+    bool deposits = false;
+    for (std::uint64_t step = 0; step < 7; ++step) {
+      protocol::SensorFrame f;
+      f.agent_id = 3;
+      f.step = step;
+      f.x_m = robot.x;
+      f.y_m = robot.y;
+      f.material_m3 = 1.0;
+      f.scanned = true;
+      if (step < 3) f.points = cast_scan(h, origin, 0.0, c.type.sensor, step + 1);  // then scans that hit nothing
+      if ((step == 3 || step == 4) && neighbour) f.neighbours.push_back({2, {7.05, 3.05}, 0.3, 0.5});  // then gone
+      BuildTrace trace;
+      const BuildView view = steps.look(f, trace);
+      protocol::ActionRequest q = empty(steps, f);
+      (void)steps.build_step(view.local, f, trace, q);
+      if (step == 6) deposits = !q.depositions.empty();
+    }
+    EXPECT_EQ(deposits, !neighbour) << (neighbour ? "with" : "without") << " a neighbour";
+  }
+}
+
 }  // namespace
 }  // namespace marsala::agent::reactive
