@@ -1,5 +1,6 @@
 #include "marsala/agent/executive/refused_cells.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -43,17 +44,18 @@ std::vector<double> RefusedCells::ball(CellIndex cell, const Heightmap& heights,
   return out;
 }
 
-bool RefusedCells::changed(const std::vector<double>& before, const std::vector<double>& now) const {
+bool RefusedCells::changed(const std::vector<double>& before, const std::vector<double>& now, double change_m) {
   for (std::size_t i = 0; i < before.size(); ++i) {
     if (std::isnan(before[i]) != std::isnan(now[i])) return true;
-    if (!std::isnan(before[i]) && std::abs(now[i] - before[i]) > change_m_) return true;
+    if (!std::isnan(before[i]) && std::abs(now[i] - before[i]) > change_m) return true;
   }
   return false;
 }
 
 void RefusedCells::refuse_terrain(CellIndex cell, const Heightmap& heights, const CellMask& known) {
   ++refusals_;
-  cells_[cell] = Entry{0, ball(cell, heights, known)};
+  const int earlier = terrain_refusals_[cell]++;
+  cells_[cell] = Entry{0, ball(cell, heights, known), std::ldexp(change_m_, std::min(earlier, 20))};
 }
 
 void RefusedCells::refuse_for_now(CellIndex cell, std::uint64_t step) {
@@ -65,7 +67,8 @@ void RefusedCells::refuse_for_now(CellIndex cell, std::uint64_t step) {
 void RefusedCells::update(const Heightmap& heights, const CellMask& known, std::uint64_t step) {
   for (auto it = cells_.begin(); it != cells_.end();) {
     const Entry& e = it->second;
-    const bool over = e.ball.empty() ? e.until_step <= step : changed(e.ball, ball(it->first, heights, known));
+    const bool over =
+        e.ball.empty() ? e.until_step <= step : changed(e.ball, ball(it->first, heights, known), e.change_m);
     it = over ? cells_.erase(it) : std::next(it);
   }
 }

@@ -35,7 +35,8 @@ class RefusedCells {
   RefusedCells(double ball_radius_cells, double change_m, std::uint64_t hold_steps);
 
   /// The world refused a motion into `cell` (world index, as the map registers it) for the terrain: remembered with
-  /// the map's heights and known mask of its ball, until they change (update()).
+  /// the map's heights and known mask of its ball, until they change (update()). Each earlier terrain refusal of the
+  /// same cell doubles the change that counts (a noisy map that flickers there earns no new try each time).
   void refuse_terrain(CellIndex cell, const Heightmap& heights, const CellMask& known);
   /// The world refused a request for a reason that does not depend on the terrain: `cell` held out until `step` +
   /// hold_steps.
@@ -57,14 +58,16 @@ class RefusedCells {
   struct Entry {
     std::uint64_t until_step = 0;  ///< a hold for a reason other than the terrain; 0 for a terrain refusal
     std::vector<double> ball;      ///< a terrain refusal: the ball's heights when refused, NaN where unknown [m]
+    double change_m = 0.0;         ///< a terrain refusal: the change of a height that releases it [m]
   };
   std::vector<double> ball(CellIndex cell, const Heightmap& heights, const CellMask& known) const;
-  bool changed(const std::vector<double>& before, const std::vector<double>& now) const;
+  static bool changed(const std::vector<double>& before, const std::vector<double>& now, double change_m);
 
   std::vector<CellIndex> offsets_;
   double change_m_;
   std::uint64_t hold_steps_;
   std::map<CellIndex, Entry> cells_;
+  std::map<CellIndex, int> terrain_refusals_;  ///< terrain refusals per cell so far [count]
   long long refusals_ = 0;
 };
 

@@ -55,6 +55,24 @@ TEST(RefusedCells, ATerrainRefusalHoldsUntilTheMapAroundTheCellChanges) {
   EXPECT_EQ(refused.refusals(), 2);
 }
 
+// A cell refused again after its map changed needs twice the change the time after: 0.01, 0.02, 0.04 m.
+TEST(RefusedCells, EachRepeatedTerrainRefusalAsksForAChangeTwiceAsLarge) {
+  RefusedCells refused(2.0, 0.01, 40);
+  Heightmap h = flat();
+  const CellMask known = all_known();
+  double level = 0.0;
+  for (const double needed : {0.01, 0.02, 0.04}) {
+    refused.refuse_terrain({10, 10}, h, known);
+    h(10, 11) = level + 0.9 * needed;
+    refused.update(h, known, 1);
+    EXPECT_TRUE(refused.contains({10, 10})) << needed;
+    h(10, 11) = level + 1.1 * needed;
+    refused.update(h, known, 2);
+    EXPECT_FALSE(refused.contains({10, 10})) << needed;
+    level = h(10, 11);
+  }
+}
+
 TEST(RefusedCells, AnotherRefusalHoldsForItsStepsAndATerrainRefusalStaysOne) {
   RefusedCells refused(2.0, 0.01, 40);
   const Heightmap h = flat();
