@@ -330,6 +330,27 @@ TEST(RampSteps, AfterARejectedRequestWithDepositsTheNextCarriesAtMostHalfAsManyU
   EXPECT_EQ(deposits_with(protocol::ActionResult::kAccepted), full);
 }
 
+/// The platform world with a 0.3 m step instead of the 1.5 m platform: its top lies below the laser (0.5 m up), which
+/// sees no higher than 10 degrees up.
+Heightmap step_world() {
+  Heightmap h = test::platform_world();
+  for (int r = 0; r < h.rows(); ++r)
+    for (int col = 70; col < h.cols(); ++col) h(r, col) = 0.3;
+  return h;
+}
+
+/// A scanning robot's frame of `step` at `robot` [m], with 1 m^3 on board and no points yet.
+protocol::SensorFrame scan_frame(std::uint64_t step, Position robot) {
+  protocol::SensorFrame f;
+  f.agent_id = 3;
+  f.step = step;
+  f.x_m = robot.x;
+  f.y_m = robot.y;
+  f.material_m3 = 1.0;
+  f.scanned = true;
+  return f;
+}
+
 // A laser robot before a 0.3 m step: the MARS gap in front of it is real, but it fills it only once its last 3 scans
 // in a row all showed it on cells they hit (kConfirmScans): one scan's misread step is no gap. Each frame here
 // carries a scan of the same terrain from the same pose; the first two frames request no deposition, the third does,
@@ -338,21 +359,13 @@ TEST(RampSteps, AScanningRobotFillsAGapOnlyOnceItsLastScansAgree) {
   AgentContext c = test::agent_context(3, test::husky());
   c.type.sensor = sensor_defaults(SensorKind::kLaser);
   RampSteps steps(c);
-  Heightmap h = test::platform_world();  // with a 0.3 m step instead of the 1.5 m platform: its top lies below the
-  for (int r = 0; r < h.rows(); ++r)     // laser (0.5 m up), which sees no higher than 10 degrees up
-    for (int col = 70; col < h.cols(); ++col) h(r, col) = 0.3;
+  const Heightmap h = step_world();
   steps.admit(test::admission_on(c, h.geometry(), kTarget, kBase));
   const Position robot{6.05, 3.05};
   const Point3 origin = sensor_origin(h, robot.x, robot.y, c.type.sensor);
   bool deposited_before_third = false;
   for (std::uint64_t step = 0; step < 3; ++step) {
-    protocol::SensorFrame f;
-    f.agent_id = 3;
-    f.step = step;
-    f.x_m = robot.x;
-    f.y_m = robot.y;
-    f.material_m3 = 1.0;
-    f.scanned = true;
+    protocol::SensorFrame f = scan_frame(step, robot);
     f.points = cast_scan(h, origin, 0.0, c.type.sensor, step + 1);
     BuildTrace trace;
     const BuildView view = steps.look(f, trace);
@@ -390,21 +403,13 @@ TEST(RampSteps, AGapStaysCurrentUntilAnotherRobotComesNearIt) {
     AgentContext c = test::agent_context(3, test::husky());
     c.type.sensor = sensor_defaults(SensorKind::kLaser);
     RampSteps steps(c);
-    Heightmap h = test::platform_world();
-    for (int r = 0; r < h.rows(); ++r)
-      for (int col = 70; col < h.cols(); ++col) h(r, col) = 0.3;
+    const Heightmap h = step_world();
     steps.admit(test::admission_on(c, h.geometry(), kTarget, kBase));
     const Position robot{6.05, 3.05};
     const Point3 origin = sensor_origin(h, robot.x, robot.y, c.type.sensor);
     bool deposits = false;
     for (std::uint64_t step = 0; step < 7; ++step) {
-      protocol::SensorFrame f;
-      f.agent_id = 3;
-      f.step = step;
-      f.x_m = robot.x;
-      f.y_m = robot.y;
-      f.material_m3 = 1.0;
-      f.scanned = true;
+      protocol::SensorFrame f = scan_frame(step, robot);
       if (step < 3) f.points = cast_scan(h, origin, 0.0, c.type.sensor, step + 1);  // then scans that hit nothing
       if ((step == 3 || step == 4) && neighbour) f.neighbours.push_back({2, {7.05, 3.05}, 0.3, 0.5});  // then gone
       BuildTrace trace;
