@@ -314,8 +314,8 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
     double& least = face_floor_.try_emplace(index, f.z_m).first->second;
     least = std::max(least, f.z_m);
     // A surface read at or above the face stays; else the cell is a bound, no surface: never a deposition target.
-    const bool surface = known_(f.cell.row, f.cell.col) != 0 && assumed_(f.cell.row, f.cell.col) == 0 &&
-                         heights_(f.cell) >= least;
+    const bool surface =
+        known_(f.cell.row, f.cell.col) != 0 && assumed_(f.cell.row, f.cell.col) == 0 && heights_(f.cell) >= least;
     if (!surface) {
       const auto built = built_.find(index);
       heights_(f.cell) = built == built_.end() ? least : std::max(least, built->second);

@@ -20,9 +20,7 @@ std::optional<CellIndex> cell_named(const std::string& reason) {
   return CellIndex{row, col};
 }
 
-bool refused_for_terrain(const std::string& reason) {
-  return reason.find("not occupiable") != std::string::npos;
-}
+bool refused_for_terrain(const std::string& reason) { return reason.find("not occupiable") != std::string::npos; }
 
 RefusedCells::RefusedCells(double ball_radius_cells, double change_m, std::uint64_t hold_steps)
     : change_m_(change_m), hold_steps_(hold_steps) {
