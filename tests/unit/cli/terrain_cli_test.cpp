@@ -57,7 +57,7 @@ class TerrainCli : public ::testing::Test {
 TEST_F(TerrainCli, HelpOnEverySubcommand) {
   const CliRun top = run("--help");
   EXPECT_EQ(top.exit_code, 0);
-  for (const char* sub : {"generate", "import", "info", "mars", "navigable", "render", "route"}) {
+  for (const char* sub : {"generate", "import", "info", "mars", "navigable", "render", "route", "compare"}) {
     EXPECT_NE(top.out.find(sub), std::string::npos) << sub;
     const CliRun r = run(std::string(sub) + " --help");
     EXPECT_EQ(r.exit_code, 0) << sub;
