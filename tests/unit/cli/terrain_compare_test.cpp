@@ -2,29 +2,17 @@
 // its text and JSON, the body taken from a scenario, and bad input (exit 2, one line naming the file).
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <string>
+
+#include "unit/cli/terrain_cli_fixture.hpp"
 
 namespace marsala {
 namespace {
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::CliRun;
 
 std::string source_dir() {
   const char* dir = std::getenv("MARSALA_SOURCE_DIR");
@@ -37,36 +25,17 @@ const char* const kTrue = "0 0 0 0 0\n0 0 0 1 0\n0 0 0 0 0\n0 0 0 0 0\n";
 // The robot's map: (0, 0) unknown, the block missed (read 0), (3, 4) read 0.1 m too high.
 const char* const kBelieved = "-9999 0 0 0 0\n0 0 0 0 0\n0 0 0 0 0\n0 0 0 0 0.1\n";
 
-class TerrainCompare : public ::testing::Test {
+class TerrainCompare : public test::TerrainCliFixture {
  protected:
   void SetUp() override {
-    dir_ = ::testing::TempDir() + "terrain_compare_" +
-           ::testing::UnitTest::GetInstance()->current_test_info()->name() + "/";
-    ASSERT_EQ(std::system(("mkdir -p '" + dir_ + "'").c_str()), 0);
+    TerrainCliFixture::SetUp();
     write("true.asc", std::string(kHeader) + kTrue);
     write("believed.asc", std::string(kHeader) + kBelieved);
-  }
-
-  std::string path(const std::string& name) const { return dir_ + name; }
-
-  CliRun run(const std::string& args) const {
-    const std::string out = path("stdout.txt"), err = path("stderr.txt");
-    const std::string command = std::string(MARSALA_TERRAIN_BIN) + " " + args + " >'" + out + "' 2>'" + err + "'";
-    const int status = std::system(command.c_str());
-    CliRun r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
   }
 
   CliRun compare(const std::string& believed, const std::string& truth, const std::string& more = "") const {
     return run("compare '" + path(believed) + "' '" + path(truth) + "' " + more);
   }
-
-  void write(const std::string& name, const std::string& text) const { std::ofstream(path(name)) << text; }
-
-  std::string dir_;
 };
 
 TEST_F(TerrainCompare, CountsKnownCellsErrorsAndCellsBelievedPassableThatAreNot) {

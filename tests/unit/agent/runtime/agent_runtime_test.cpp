@@ -152,23 +152,34 @@ TEST(AgentRuntime, HelloAdmissionLockstepAndRunOver) {
   EXPECT_EQ(agent.config().name, "agent-4");
 }
 
+/// A ramp builder (agent 4) dumping its map into `dir`, run against the scripted world of `domain` admitting it to
+/// run `run_id` for 3 steps (with frames or not).
+RunResult run_dumping_agent(int domain, const std::filesystem::path& dir, const std::string& run_id,
+                            bool send_frames) {
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, domain});
+  RuntimeConfig c = config(4, "ramp_builder");
+  dump_maps_into(std::make_shared<MapDump>(dir.string()), c);
+  AgentRuntime agent(*participant, c);
+  std::atomic<bool> stop{false};
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, domain});
+  ScriptedWorld world{*world_participant, 4, 0, nullptr};
+  const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+  world.run(
+      [&](const protocol::AgentHello& hello) {
+        protocol::Admission a = admission_for(hello, h);
+        a.run_id = run_id;
+        return a;
+      },
+      3, send_frames);
+  return running.get();
+}
+
 TEST(AgentRuntime, DumpsItsMapWhenTheRunIsOverAndRefusesAFolderOfAnotherRun) {
   const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "agent_runtime_dump";
   std::filesystem::remove_all(dir);
-  const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
-  {
-    auto participant = bus::make_participant({bus::Vendor::kInProcess, 121});
-    RuntimeConfig c = config(4, "ramp_builder");
-    dump_maps_into(std::make_shared<MapDump>(dir.string()), c);
-    AgentRuntime agent(*participant, c);
-    std::atomic<bool> stop{false};
-    auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
-    auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 121});
-    ScriptedWorld world{*world_participant, 4, 0, nullptr};
-    world.run([&](const protocol::AgentHello& hello) { return admission_for(hello, h); }, 3);
-    const RunResult r = running.get();
-    ASSERT_EQ(r.outcome, RunOutcome::kRunOver) << r.message;
-  }
+  const RunResult first = run_dumping_agent(121, dir, "rt", true);
+  ASSERT_EQ(first.outcome, RunOutcome::kRunOver) << first.message;
   // The world sent every tile of its flat 0 m grid at step 0: every cell known, at 0 m.
   const MapRecord record = read_map_record((dir / "agent-4-map.json").string());
   EXPECT_EQ(record.run_id, "rt");
@@ -183,22 +194,7 @@ TEST(AgentRuntime, DumpsItsMapWhenTheRunIsOverAndRefusesAFolderOfAnotherRun) {
 
   // Another run ("rt2") into the same folder: refused once admitted, nothing sent, the first run's files untouched.
   const auto before = std::filesystem::last_write_time(dir / "agent-4-height.asc");
-  auto participant = bus::make_participant({bus::Vendor::kInProcess, 122});
-  RuntimeConfig c = config(4, "ramp_builder");
-  dump_maps_into(std::make_shared<MapDump>(dir.string()), c);
-  AgentRuntime agent(*participant, c);
-  std::atomic<bool> stop{false};
-  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
-  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 122});
-  ScriptedWorld world{*world_participant, 4, 0, nullptr};
-  world.run(
-      [&](const protocol::AgentHello& hello) {
-        protocol::Admission a = admission_for(hello, h);
-        a.run_id = "rt2";
-        return a;
-      },
-      3, false);
-  const RunResult r = running.get();
+  const RunResult r = run_dumping_agent(122, dir, "rt2", false);
   EXPECT_EQ(r.outcome, RunOutcome::kOutputRefused);
   EXPECT_NE(r.message.find("agent-4-map.json holds a map of run 'rt'"), std::string::npos) << r.message;
   EXPECT_EQ(r.requests, 0u);
