@@ -1,7 +1,7 @@
 // marsala-agent: one robot of a MARSala run. Reads its body and behaviour from its slot of the scenario, says hello
 // to marsala-world over DDS, then answers every sensor frame with one action request until the run is over.
 // Exit codes: 0 run over (or stopped by a signal), 1 error (one line on stderr), 2 usage, or a --dump-map folder that
-// holds another run's maps (docs/runtime.md#mapping).
+// holds another run's maps (docs/runtime.md#seeing-the-map).
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
 
 #include "marsala/agent/runtime/agent_runtime.hpp"
 #include "marsala/core/error.hpp"
@@ -104,8 +104,7 @@ MapDump::MapDump(std::string dir) : dir_(std::move(dir)) {
     throw InvalidArgument(fmt::format("--dump-map {}: not a folder", dir_));
   fs::create_directories(dir_, ec);
   if (ec) throw InvalidArgument(fmt::format("--dump-map {}: cannot create it: {}", dir_, ec.message()));
-  if (::access(dir_.c_str(), W_OK | X_OK) != 0)
-    throw InvalidArgument(fmt::format("--dump-map {}: not writable", dir_));
+  if (::access(dir_.c_str(), W_OK | X_OK) != 0) throw InvalidArgument(fmt::format("--dump-map {}: not writable", dir_));
   for (const fs::path& p : records_in(dir_)) (void)read_map_record(p.string());
 }
 
@@ -149,8 +148,12 @@ void dump_maps_into(std::shared_ptr<const MapDump> dump, RuntimeConfig& config) 
       spdlog::info("agent {}: --dump-map: its behaviour keeps no map; nothing written", c.agent_id);
       return;
     }
-    const MapDumpInfo info{result.run_id, c.agent_id, c.name, result.last_step,
-                           failed ? std::string("error") : to_string(result.outcome), to_string(c.type.sensor.kind)};
+    const MapDumpInfo info{result.run_id,
+                           c.agent_id,
+                           c.name,
+                           result.last_step,
+                           failed ? std::string("error") : to_string(result.outcome),
+                           to_string(c.type.sensor.kind)};
     dump->write(*map, info);
     spdlog::info("agent {}: map of step {} written to {}", c.agent_id, result.last_step, dump->height_path(c.agent_id));
   };

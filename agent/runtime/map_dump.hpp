@@ -1,6 +1,6 @@
 #pragma once
-// marsala-agent --dump-map DIR (docs/runtime.md#mapping): the robot's own map when its admitted run ends, for any
-// reason (run over, a signal, the world gone), so that its quality can be seen (`marsala-terrain compare`):
+// marsala-agent --dump-map DIR (docs/runtime.md#seeing-the-map): the robot's own map when its admitted run ends, for
+// any reason (run over, a signal, the world gone), so that its quality can be seen (`marsala-terrain compare`):
 //
 //   DIR/agent-<id>-height.asc  the heights the robot believes [m] on the world grid, NODATA_value -9999 where it
 //                              knows nothing (ESRI ASCII grid, the conventions of the run's terrain_final.asc)

@@ -36,11 +36,10 @@ NavigabilityParams scenario_body(const CompareCommand& c) {
     if (t.name == c.robot_type || (c.robot_type.empty() && s.robot_types.size() == 1)) return t.body.navigability;
     names.push_back(t.name);
   }
-  throw InputError(c.robot_type.empty()
-                       ? fmt::format("{} has several robot types ({}): give --robot-type", c.scenario_path,
-                                     fmt::join(names, ", "))
-                       : fmt::format("{} has no robot type '{}'; it has: {}", c.scenario_path, c.robot_type,
-                                     fmt::join(names, ", ")));
+  throw InputError(c.robot_type.empty() ? fmt::format("{} has several robot types ({}): give --robot-type",
+                                                      c.scenario_path, fmt::join(names, ", "))
+                                        : fmt::format("{} has no robot type '{}'; it has: {}", c.scenario_path,
+                                                      c.robot_type, fmt::join(names, ", ")));
 }
 
 std::string comparison_text(const CompareCommand& c, const NavigabilityParams& body, const terrain::MapComparison& m) {
@@ -53,9 +52,9 @@ std::string comparison_text(const CompareCommand& c, const NavigabilityParams& b
       "error      median {:.4f} m, p95 {:.4f} m, max {:.4f} m (absolute, over the known cells)\n"
       "passable   {} cells believed passable for kappa {}, delta {} m, eps {} m; {} of them ({:.1f} %) are not on the "
       "true map ({} cells passable there)\n",
-      c.believed_path, c.true_path, m.known_cells, m.cells, 100.0 * m.known_fraction(), m.median_error_m,
-      m.p95_error_m, m.max_error_m, m.believed_passable, body.kappa, body.delta_m, body.eps_m, m.believed_passable_not,
-      wrong_percent, m.true_passable);
+      c.believed_path, c.true_path, m.known_cells, m.cells, 100.0 * m.known_fraction(), m.median_error_m, m.p95_error_m,
+      m.max_error_m, m.believed_passable, body.kappa, body.delta_m, body.eps_m, m.believed_passable_not, wrong_percent,
+      m.true_passable);
 }
 
 nlohmann::ordered_json comparison_json(const CompareCommand& c, const NavigabilityParams& body,
@@ -86,8 +85,7 @@ void define_compare(CLI::App& app, CompareCommand& c) {
   c.cmd->add_option("believed", c.believed_path, "the robot's map, .asc")->required();
   c.cmd->add_option("true", c.true_path, "the true terrain, .asc (every cell known)")->required();
   auto* scenario = c.cmd->add_option("--scenario", c.scenario_path, "take the body of a robot type of this scenario");
-  c.cmd->add_option("--robot-type", c.robot_type, "with --scenario: the type (default: its only one)")
-      ->needs(scenario);
+  c.cmd->add_option("--robot-type", c.robot_type, "with --scenario: the type (default: its only one)")->needs(scenario);
   c.cmd->add_option("--set", c.overrides, "with --scenario: FIELD=VALUE, as the run had it (repeatable)")
       ->needs(scenario);
   for (CLI::Option* o :
@@ -107,8 +105,8 @@ void run_compare(const CompareCommand& c, std::ostream& out) {
   for (int r = 0; r < truth.rows(); ++r)
     for (int col = 0; col < truth.cols(); ++col)
       if (std::isnan(truth(r, col)))
-        throw InputError(fmt::format("{}: cell {} is NODATA: the true map must know every cell", c.true_path,
-                                     CellIndex{r, col}));
+        throw InputError(
+            fmt::format("{}: cell {} is NODATA: the true map must know every cell", c.true_path, CellIndex{r, col}));
   terrain::MapComparison m;
   try {
     m = terrain::compare_maps(believed, truth, body);

@@ -1,8 +1,8 @@
 #pragma once
 // `marsala-terrain compare BELIEVED TRUE`: a robot's map (an agent's --dump-map, NODATA = unknown) against the true
 // terrain (the run's terrain_final.asc): known cells, absolute height error over them, cells believed passable for a
-// robot body that are not (terrain/map_comparison.hpp; docs/runtime.md#mapping). Include it only from files that link
-// marsala::cli.
+// robot body that are not (terrain/map_comparison.hpp; docs/runtime.md#seeing-the-map). Include it only from files that
+// link marsala::cli.
 
 #include <ostream>
 #include <string>
@@ -24,13 +24,13 @@ class InputError : public Error {
 /// The compare subcommand: its options (define_compare binds them) and its CLI11 subcommand.
 struct CompareCommand {
   CLI::App* cmd = nullptr;
-  std::string believed_path;         ///< the robot's map (.asc; NODATA cells unknown)
-  std::string true_path;             ///< the true terrain (.asc, every cell known)
-  NavigabilityParams body;           ///< the body "passable" is judged for (default: ramp.pbtxt's builder)
-  std::string scenario_path;         ///< or the body of a robot type of this scenario
-  std::string robot_type;            ///< that type's name (default: the scenario's only type)
+  std::string believed_path;           ///< the robot's map (.asc; NODATA cells unknown)
+  std::string true_path;               ///< the true terrain (.asc, every cell known)
+  NavigabilityParams body;             ///< the body "passable" is judged for (default: ramp.pbtxt's builder)
+  std::string scenario_path;           ///< or the body of a robot type of this scenario
+  std::string robot_type;              ///< that type's name (default: the scenario's only type)
   std::vector<std::string> overrides;  ///< --set FIELD=VALUE on the scenario, as the run had them
-  bool json = false;                 ///< one JSON object instead of text
+  bool json = false;                   ///< one JSON object instead of text
 };
 
 /// Adds the compare subcommand to `app`, bound to `c` (which must outlive the parse).

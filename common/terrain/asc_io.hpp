@@ -27,7 +27,8 @@ struct AscReadOptions {
   bool keep_nodata = false;  ///< read NODATA cells as NaN (a map with unknown cells; every cell may be NODATA)
 };
 
-/// Reads an ESRI ASCII grid [m] (NODATA cells as `options` say); throws ParseError("file:line: problem") or IoError (cannot open/read).
+/// Reads an ESRI ASCII grid [m] (NODATA cells as `options` say); throws ParseError("file:line: problem") or IoError
+/// (cannot open/read).
 Heightmap read_asc(const std::string& path, const AscReadOptions& options = {});
 
 /// Same as read_asc from a stream; `source_name` is used in messages.

@@ -40,7 +40,8 @@ CellMask believed_passable(const Heightmap& believed, const NavigabilityParams& 
   for (int r = 0; r < believed.rows(); ++r)
     for (int c = 0; c < believed.cols(); ++c) {
       const double h = believed(r, c);
-      if (std::isinf(h)) throw InvalidArgument(fmt::format("believed map: infinite height at cell {}", CellIndex{r, c}));
+      if (std::isinf(h))
+        throw InvalidArgument(fmt::format("believed map: infinite height at cell {}", CellIndex{r, c}));
       if (std::isnan(h)) {
         unknown(r, c) = 1;
         filled(r, c) = 0.0;
@@ -65,7 +66,8 @@ MapComparison compare_maps(const Heightmap& believed, const Heightmap& truth, co
   for (int r = 0; r < truth.rows(); ++r)
     for (int c = 0; c < truth.cols(); ++c)
       if (!std::isfinite(truth(r, c)))
-        throw InvalidArgument(fmt::format("true map: height {} at cell {} is not finite", truth(r, c), CellIndex{r, c}));
+        throw InvalidArgument(
+            fmt::format("true map: height {} at cell {} is not finite", truth(r, c), CellIndex{r, c}));
   MapComparison result;
   result.cells = believed.size();
   std::vector<double> errors;

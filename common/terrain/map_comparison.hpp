@@ -1,7 +1,7 @@
 #pragma once
-// How well a robot's own map matches the true terrain (docs/runtime.md#mapping, `marsala-terrain compare`): the map
-// holds the heights the robot believes [m], NaN where it knows nothing (its dump, agent-<id>-height.asc, reads so with
-// AscReadOptions::keep_nodata); the truth is a complete grid of the same cells (the run's terrain_final.asc).
+// How well a robot's own map matches the true terrain (docs/runtime.md#seeing-the-map, `marsala-terrain compare`): the
+// map holds the heights the robot believes [m], NaN where it knows nothing (its dump, agent-<id>-height.asc, reads so
+// with AscReadOptions::keep_nodata); the truth is a complete grid of the same cells (the run's terrain_final.asc).
 //
 // "Passable" is occupiable for a robot body (ARCHITECTURE.md, grid conventions; cell_occupancy.hpp): on the believed
 // map a cell is passable when it is known, no unknown cell lies within delta/2 of its centre (the robot cannot judge a

@@ -29,7 +29,8 @@ run_id=$(jq -r .run_id "$out/summary.json")
 jq -e --arg run "$run_id" '.run_id == $run and .agent_id == 1 and .end == "run_over" and .sensor == "laser" and
   .height_file == "agent-1-height.asc" and .cells == 11200' "$maps/agent-1-map.json" >/dev/null ||
   { cat "$maps/agent-1-map.json"; fail "the record does not describe agent 1's map of run $run_id"; }
-known=$(awk 'NR > 6 { for (i = 1; i <= NF; i++) if ($i != "-9999") n++ } END { print n + 0 }' "$maps/agent-1-height.asc")
+known=$(awk 'NR > 6 { for (i = 1; i <= NF; i++) if ($i != "-9999") n++ } END { print n + 0 }' \
+  "$maps/agent-1-height.asc")
 [ "$known" = "$(jq .known_cells "$maps/agent-1-map.json")" ] ||
   fail "the map has $known known cells, its record says $(jq .known_cells "$maps/agent-1-map.json")"
 "$bin/marsala-terrain" compare "$maps/agent-1-height.asc" "$out/terrain_final.asc" \

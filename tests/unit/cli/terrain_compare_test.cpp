@@ -98,10 +98,11 @@ TEST_F(TerrainCompare, BadInputExitsTwoWithOneLineNamingTheFile) {
   struct Case {
     std::string believed, truth, named;
   };
-  for (const Case& c : {Case{"small.asc", "true.asc", "small.asc against"}, Case{"ragged.asc", "true.asc", "ragged.asc:8:"},
-                        Case{"nan.asc", "true.asc", "nan.asc:7:"}, Case{"believed.asc", "nan.asc", "nan.asc:7:"},
-                        Case{"believed.asc", "holes.asc", "holes.asc: cell (0, 0) is NODATA"},
-                        Case{"missing.asc", "true.asc", "missing.asc"}}) {
+  for (const Case& c :
+       {Case{"small.asc", "true.asc", "small.asc against"}, Case{"ragged.asc", "true.asc", "ragged.asc:8:"},
+        Case{"nan.asc", "true.asc", "nan.asc:7:"}, Case{"believed.asc", "nan.asc", "nan.asc:7:"},
+        Case{"believed.asc", "holes.asc", "holes.asc: cell (0, 0) is NODATA"},
+        Case{"missing.asc", "true.asc", "missing.asc"}}) {
     const CliRun r = compare(c.believed, c.truth);
     EXPECT_EQ(r.exit_code, 2) << c.believed << " " << c.truth << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

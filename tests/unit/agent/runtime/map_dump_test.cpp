@@ -36,7 +36,9 @@ Heightmap terrain() {
   return h;
 }
 
-MapDumpInfo info(const std::string& run_id, std::uint32_t id) { return {run_id, id, "husky-1", 42, "run_over", "laser"}; }
+MapDumpInfo info(const std::string& run_id, std::uint32_t id) {
+  return {run_id, id, "husky-1", 42, "run_over", "laser"};
+}
 
 TEST(MapDump, MakesAMissingFolderAndRefusesWhatIsNoFolder) {
   const fs::path dir = fresh_dir() / "deeper" / "maps";
@@ -96,7 +98,7 @@ TEST(MapDump, AFolderHoldsTheMapsOfOneRun) {
     dump.write(map.known_map(), info("run-a", 1));
     dump.write(map.known_map(), info("run-a", 2));
   }
-  const MapDump again(dir.string());  // a folder of readable records is fine at start-up
+  const MapDump again(dir.string());              // a folder of readable records is fine at start-up
   EXPECT_EQ(again.problem_for_run("run-a"), "");  // the same run (a restarted agent) may write again
   const std::string problem = again.problem_for_run("run-b");
   EXPECT_NE(problem.find((dir / "agent-1-map.json").string()), std::string::npos) << problem;
