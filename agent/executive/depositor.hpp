@@ -5,13 +5,13 @@
 //   "layer": the manager's whole cube layers per cell (Deposition), as always;
 //   "cube":  columns of cubes of side s centred on wanted cells, in path order (contour crafting), each column as
 //            tall as every cell of its footprint still wants (never above the MARS height);
-//   "cone":  piles of granular material: among dump points on wanted cells within reach and a few volumes, the pile
-//            (predicted with the world's own cone_pile_shape on the local map) that puts most volume under the MARS
-//            height on the path's footprint, with no cell above the MARS height of the local map (kConeRoundingM for
-//            rounding) and no cell it may not raise (checked on a pile 1e-6 bigger, so that rounding in the world's
-//            frame cannot reach one); up to kMaxConesPerStep piles a step. Under the local MARS height is under the
-//            world's deposit bound, the MARS of the initial terrain (docs/runtime.md#deposit-bound): filled only up to
-//            it, the terrain never lifts its own bound, so piles cannot creep above it.
+//   "cone":  piles of granular material: among dump points on wanted cells within reach and a few volumes (the
+//            largest pile that fits among them), the pile (predicted with the world's own cone_pile_shape on the
+//            local map) that puts most volume under the MARS height on the path's footprint, with no cell above the
+//            MARS height of the local map (kConeRoundingM for rounding) and no cell it may not raise (checked on a
+//            pile 1e-6 bigger, so that rounding in the world's frame cannot reach one); up to kMaxConesPerStep piles
+//            a step. Under the local MARS height is under the world's deposit bound, the MARS of the initial terrain
+//            (docs/runtime.md#deposit-bound): filled only up to it, the terrain never lifts its own bound.
 // Every depositor keeps the manager's way-back check (the longest prefix of its deposits that keeps it).
 // The behaviours see only DepositionPlan.
 
