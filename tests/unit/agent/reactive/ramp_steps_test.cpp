@@ -339,6 +339,15 @@ Heightmap step_world() {
   return h;
 }
 
+/// Steps of agent 3, a laser robot, admitted on `h` with the target on the platform.
+std::unique_ptr<RampSteps> laser_steps(const Heightmap& h) {
+  AgentContext c = test::agent_context(3, test::husky());
+  c.type.sensor = sensor_defaults(SensorKind::kLaser);
+  auto steps = std::make_unique<RampSteps>(c);
+  steps->admit(test::admission_on(c, h.geometry(), kTarget, kBase));
+  return steps;
+}
+
 /// A scanning robot's frame of `step` at `robot` [m], with 1 m^3 on board and no points yet.
 protocol::SensorFrame scan_frame(std::uint64_t step, Position robot) {
   protocol::SensorFrame f;
@@ -356,17 +365,16 @@ protocol::SensorFrame scan_frame(std::uint64_t step, Position robot) {
 // carries a scan of the same terrain from the same pose; the first two frames request no deposition, the third does,
 // and a robot with exact sensing at the same pose at its first.
 TEST(RampSteps, AScanningRobotFillsAGapOnlyOnceItsLastScansAgree) {
-  AgentContext c = test::agent_context(3, test::husky());
-  c.type.sensor = sensor_defaults(SensorKind::kLaser);
-  RampSteps steps(c);
   const Heightmap h = step_world();
-  steps.admit(test::admission_on(c, h.geometry(), kTarget, kBase));
+  const auto owned = laser_steps(h);
+  RampSteps& steps = *owned;
+  const SensorSpec& laser = steps.context().type.sensor;
   const Position robot{6.05, 3.05};
-  const Point3 origin = sensor_origin(h, robot.x, robot.y, c.type.sensor);
+  const Point3 origin = sensor_origin(h, robot.x, robot.y, laser);
   bool deposited_before_third = false;
   for (std::uint64_t step = 0; step < 3; ++step) {
     protocol::SensorFrame f = scan_frame(step, robot);
-    f.points = cast_scan(h, origin, 0.0, c.type.sensor, step + 1);
+    f.points = cast_scan(h, origin, 0.0, laser, step + 1);
     BuildTrace trace;
     const BuildView view = steps.look(f, trace);
     protocol::ActionRequest q = empty(steps, f);
@@ -400,17 +408,16 @@ TEST(RampSteps, AScanningRobotFillsAGapOnlyOnceItsLastScansAgree) {
 // may have built there.
 TEST(RampSteps, AGapStaysCurrentUntilAnotherRobotComesNearIt) {
   for (const bool neighbour : {false, true}) {
-    AgentContext c = test::agent_context(3, test::husky());
-    c.type.sensor = sensor_defaults(SensorKind::kLaser);
-    RampSteps steps(c);
     const Heightmap h = step_world();
-    steps.admit(test::admission_on(c, h.geometry(), kTarget, kBase));
+    const auto owned = laser_steps(h);
+    RampSteps& steps = *owned;
+    const SensorSpec& laser = steps.context().type.sensor;
     const Position robot{6.05, 3.05};
-    const Point3 origin = sensor_origin(h, robot.x, robot.y, c.type.sensor);
+    const Point3 origin = sensor_origin(h, robot.x, robot.y, laser);
     bool deposits = false;
     for (std::uint64_t step = 0; step < 7; ++step) {
       protocol::SensorFrame f = scan_frame(step, robot);
-      if (step < 3) f.points = cast_scan(h, origin, 0.0, c.type.sensor, step + 1);  // then scans that hit nothing
+      if (step < 3) f.points = cast_scan(h, origin, 0.0, laser, step + 1);  // then scans that hit nothing
       if ((step == 3 || step == 4) && neighbour) f.neighbours.push_back({2, {7.05, 3.05}, 0.3, 0.5});  // then gone
       BuildTrace trace;
       const BuildView view = steps.look(f, trace);
