@@ -100,6 +100,18 @@ TEST(RampSteps, BuildStepAdvancesAlongThePathOnFlatGround) {
   EXPECT_TRUE(q.depositions.empty());
 }
 
+/// The world cell of the motion the steps request at their first frame, at (1.05, 3.05) on the platform world (an
+/// advance); the view of that frame in `view`.
+CellIndex first_motion_cell(RampSteps& steps, BuildView& view) {
+  BuildTrace trace;
+  const protocol::SensorFrame f0 = frame(steps, 0, {1.05, 3.05});
+  view = steps.look(f0, trace);
+  protocol::ActionRequest q = empty(steps, f0);
+  EXPECT_EQ(steps.build_step(view.local, f0, trace, q), BuildPhase::kAdvance);
+  EXPECT_TRUE(q.move);
+  return *steps.map().geometry().cell_at({q.target_x_m, q.target_y_m});
+}
+
 // docs/runtime.md#refused-requests: a motion the world refused as not occupiable is information. The robot (still
 // where it was, its map unchanged) never asks for that cell again, however many steps pass; once its map reads the
 // cell's ball differently (another robot built there), it may.
@@ -107,11 +119,9 @@ TEST(RampSteps, ACellTheWorldRefusedIsNotRequestedAgainUntilTheMapAroundItChange
   const auto owned = admitted_steps();
   RampSteps& steps = *owned;
   BuildTrace trace;
-  const protocol::SensorFrame f0 = frame(steps, 0, {1.05, 3.05});
-  BuildView view = steps.look(f0, trace);
-  protocol::ActionRequest q = empty(steps, f0);
-  ASSERT_EQ(steps.build_step(view.local, f0, trace, q), BuildPhase::kAdvance);
-  const CellIndex refused = *steps.map().geometry().cell_at({q.target_x_m, q.target_y_m});
+  BuildView view;
+  const CellIndex refused = first_motion_cell(steps, view);
+  protocol::ActionRequest q;
   const auto local = [&](const BuildView& v) {
     return CellIndex{refused.row - v.local.offset.row, refused.col - v.local.offset.col};
   };
@@ -146,11 +156,9 @@ TEST(RampSteps, AMotionRefusedForANeighboursBodyIsLeftOutForAWhile) {
   const auto owned = admitted_steps();
   RampSteps& steps = *owned;
   BuildTrace trace;
-  const protocol::SensorFrame f0 = frame(steps, 0, {1.05, 3.05});
-  BuildView view = steps.look(f0, trace);
-  protocol::ActionRequest q = empty(steps, f0);
-  ASSERT_EQ(steps.build_step(view.local, f0, trace, q), BuildPhase::kAdvance);
-  const CellIndex refused = *steps.map().geometry().cell_at({q.target_x_m, q.target_y_m});
+  BuildView view;
+  const CellIndex refused = first_motion_cell(steps, view);
+  protocol::ActionRequest q;
   protocol::SensorFrame f1 = frame(steps, 1, {1.05, 3.05});
   f1.last_result = protocol::ActionResult::kRejected;
   f1.last_reason = "motion ends 0.9 m from agent 2, whose body it would overlap (bodies need 1 m)";
