@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "marsala/agent/deliberative/home_route.hpp"
 #include "marsala/agent/executive/depositor.hpp"
 #include "marsala/agent/executive/lane.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
@@ -429,17 +430,22 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
   const double radius = context_.assignment.base_radius_m - kBaseMarginM;
   if (distance(robot, base) <= radius) {
     request.refill = trace.refill = true;
+    memory_.home.clear();
     return true;
   }
-  // Where to go: the navigable cell within the base radius nearest the robot; else the navigable cell nearest the
-  // base when that is nearer than the robot by at least a cell; else the oldest navigable cell of the trajectory in
-  // the window (the way the robot came from the base).
+  // Where to go: the navigable cell within the base radius nearest the robot; else, once this trip has taken the way
+  // home (below), along it; else the navigable cell nearest the base when that is nearer than the robot by at least a
+  // cell; else (the window holds no way nearer: a pocket whose exit lies beyond it) the way home over the robot's own
+  // map, kept for the rest of the trip (heading for the nearest cell again would lead back into the pocket); else the
+  // oldest navigable cell of the trajectory in the window (the way the robot came from the base).
   constexpr double kNone = std::numeric_limits<double>::infinity();
   std::optional<CellIndex> goal = best_navigable_cell(
       local, kNone, [&](Position p) { return distance(p, base) <= radius ? distance(p, robot) : kNone; });
+  if (!goal && !memory_.home.empty()) goal = home_goal(local);
   if (!goal)
     goal = best_navigable_cell(local, distance(robot, base) - local.geometry().cell_size_m,
                                [&](Position p) { return distance(p, base); });
+  if (!goal) goal = home_goal(local);
   if (!goal) goal = oldest_navigable_trajectory_cell(local);
   if (!goal) return false;
   trace.plan = modules_->router.plan(local.gap, local.navigable, local.robot, *goal);
@@ -449,10 +455,32 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
     move(*motion, trace, request);
     if (distance(motion->target, base) <= radius) {
       request.refill = trace.refill = true;
+      memory_.home.clear();
       return true;
     }
   }
   return false;
+}
+
+std::optional<CellIndex> RampSteps::home_goal(const deliberative::LocalMap& local) {
+  const auto on_route = [&] {
+    for (const CellIndex g : memory_.home)
+      if (std::abs(g.row - local.to_global(local.robot).row) <= 1 && std::abs(g.col - local.to_global(local.robot).col) <= 1)
+        return true;
+    return false;
+  };
+  if (memory_.home.empty() || !on_route()) {
+    const RobotBody& body = context_.type.body;
+    const auto route = deliberative::home_route(modules_->map.known_map(), body.navigability,
+                                                local.to_global(local.robot), context_.assignment.base,
+                                                context_.assignment.base_radius_m - kBaseMarginM, body.sensing_range_m);
+    memory_.home = route.value_or(std::vector<CellIndex>{});
+  }
+  for (auto it = memory_.home.rbegin(); it != memory_.home.rend(); ++it) {
+    const CellIndex p = local.to_local(*it);
+    if (local.contains(p) && p != local.robot && local.navigable(p.row, p.col) != 0) return p;
+  }
+  return std::nullopt;
 }
 
 }  // namespace marsala::agent::reactive

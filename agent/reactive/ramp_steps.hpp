@@ -187,6 +187,7 @@ class RampSteps {
     std::vector<executive::BodyClearance> others;  ///< the last frame's neighbours
     CellMask corridor;                             ///< the last local map's navigable cells, neighbours not taken out
     CellMask terrain_occupiable;                   ///< and its occupiable cells
+    std::vector<CellIndex> home;                   ///< the way home of this trip (world cells), empty: not planned
   };
 
   // look()'s steps, in order.
@@ -212,6 +213,9 @@ class RampSteps {
   /// since) or whose gap fewer than kConfirmScans scans in a row showed (one scan's misread surface is no gap). The
   /// path is still planned on the whole gap.
   void clear_unconfirmed_gap(deliberative::LocalMap& local) const;
+  /// On the way back: the cell of the way home (deliberative/home_route.hpp, planned when the trip has none or the
+  /// robot left it) farthest along it that the robot can reach in its window; nullopt when bodies cut it there.
+  std::optional<CellIndex> home_goal(const deliberative::LocalMap& local);
   static std::optional<CellIndex> farthest_navigable_from_goal(const deliberative::LocalMap& local);
 
   AgentContext context_;
