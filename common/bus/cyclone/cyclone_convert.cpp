@@ -242,6 +242,7 @@ marsala_wire_ActionRequest to_msg(const ActionRequest& in, Storage& storage) {
   out.deposits = borrow_seq<dds_sequence_marsala_wire_Deposit>(storage.deposits);
   out.refill = in.refill;
   out.state = borrow(in.state);
+  out.waiting_for = borrow(in.waiting_for);
   return out;
 }
 
@@ -272,6 +273,7 @@ ActionRequest from_msg(const marsala_wire_ActionRequest& in) {
   }
   out.refill = in.refill;
   out.state = copy(in.state);
+  out.waiting_for = copy(in.waiting_for);
   return out;
 }
 

@@ -215,6 +215,7 @@ wire::ActionRequest to_msg(const ActionRequest& in) {
   }
   out.refill(in.refill);
   out.state(in.state);
+  out.waiting_for(in.waiting_for);
   return out;
 }
 
@@ -243,6 +244,7 @@ ActionRequest from_msg(const wire::ActionRequest& in) {
   }
   out.refill = in.refill();
   out.state = in.state();
+  out.waiting_for = in.waiting_for();
   return out;
 }
 
