@@ -29,7 +29,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       "DDS, prints what the run would start from and exits 0 when valid, 2 when not.\n"
       "Every run also writes run.log (every accepted change, checksummed) and snapshot.pb; after a crash,\n"
       "marsala-world --resume DIR continues the run in DIR with its agents (docs/runtime.md#resume).\n"
-      "Exit codes: 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 1 error, 2 usage.",
+      "Exit codes: 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled, 1 error, 2 usage or a\n"
+      "scenario the world refuses at start (as --check).",
       "marsala-world"};
   std::string scenario_path, check_path, resume_dir;
   cli::DdsOptions dds;
@@ -105,11 +106,16 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
     if (!resume_dir.empty()) {
       start = prepare_resume(resume_dir, options, dds.domain);
     } else {
-      options.scenario_text = scenario::read_scenario_text(scenario_path);
-      if (options.replace) clear_run_files(options.out_dir);
-      const scenario::Scenario scenario =
-          scenario::parse_scenario(options.scenario_text, scenario_path, options.overrides);
-      start = prepare_world_start(scenario, scenario::build_terrain(scenario), options, dds.domain);
+      try {
+        options.scenario_text = scenario::read_scenario_text(scenario_path);
+        if (options.replace) clear_run_files(options.out_dir);
+        const scenario::Scenario scenario =
+            scenario::parse_scenario(options.scenario_text, scenario_path, options.overrides);
+        start = prepare_world_start(scenario, scenario::build_terrain(scenario), options, dds.domain);
+      } catch (const Error& e) {  // refused at start, as --check refuses it (docs/runtime.md#exit-codes)
+        cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+        return kExitInvalidScenario;
+      }
     }
     const auto participant =
         bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,

@@ -49,16 +49,16 @@ TEST_F(WorldCliTest, ResumingAFolderWithoutARunLogIsAnError) {
   EXPECT_NE(err_.str().find("no run.log there"), std::string::npos) << err_.str();
 }
 
-TEST_F(WorldCliTest, BadScenariosExitWith1OnOneLineNamingFileAndLine) {
+TEST_F(WorldCliTest, BadScenariosExitWith2OnOneLineNamingFileAndLine) {
   const std::string bad = write("bad.pbtxt", "name: \"x\"\nterrain { generator: \"flat\" }\nagent { robot_type: }\n");
-  EXPECT_EQ(run({"--scenario", bad}), 1);
+  EXPECT_EQ(run({"--scenario", bad}), 2);
   const std::string message = err_.str();
   EXPECT_EQ(message.rfind("marsala-world: error: " + bad + ":3:", 0), 0u) << message;
   EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1);
-  EXPECT_EQ(run({"--scenario", (dir_ / "missing.pbtxt").string()}), 1);
+  EXPECT_EQ(run({"--scenario", (dir_ / "missing.pbtxt").string()}), 2);
   EXPECT_NE(err_.str().find("cannot open scenario file"), std::string::npos) << err_.str();
   const std::string ok = write("ok.pbtxt", testing::small_scenario_text());
-  EXPECT_EQ(run({"--scenario", ok, "--agents", "5", "--dds", "inprocess"}), 1);
+  EXPECT_EQ(run({"--scenario", ok, "--agents", "5", "--dds", "inprocess"}), 2);
   EXPECT_NE(err_.str().find("exceeds the 3 agent slots"), std::string::npos) << err_.str();
   EXPECT_EQ(run({"--scenario", ok, "--dds", "inprocess", "--domain", "49", "--admit-timeout", "0.1", "--quiet", "--out",
                  (dir_ / "none").string()}),
@@ -114,6 +114,55 @@ TEST_F(WorldCliTest, SeedOverridesTheScenariosAndIsReported) {
   EXPECT_NE(text.str().find("\"start_jitter_m\": 0.3"), std::string::npos) << text.str();
   EXPECT_EQ(run({"--help"}), 0);
   EXPECT_NE(out_.str().find("--seed"), std::string::npos);
+}
+
+TEST_F(WorldCliTest, ARunWithoutProgressEndsStalledWith6AndAnAccount) {
+  // A walker on the way to a goal it needs 12 steps to reach: its motions are no progress, so with stall_steps 4 the
+  // run ends before step 4 is applied.
+  const std::string scenario = write("small.pbtxt", testing::small_scenario_text("stall_steps: 4\n"));
+  const fs::path out = dir_ / "out";
+  int rc = -1;
+  std::thread world([&] {
+    rc = run({"--scenario", scenario, "--agents", "1", "--dds", "inprocess", "--domain", "53", "--out", out.string(),
+              "--quiet", "--max-steps", "50"});
+  });
+  testing::FakeAgentConfig c;
+  c.domain = 53;
+  c.id = 1;
+  c.session = 5;
+  c.body = testing::small_scenario().robot_for(1).body;
+  testing::FakeAgent agent(c);
+  world.join();
+  agent.join();
+  EXPECT_EQ(rc, 6) << err_.str();
+  EXPECT_NE(out_.str().find("run small-d53: stalled after 4 steps"), std::string::npos) << out_.str();
+  std::ifstream in(out / "summary.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  for (const char* field : {"\"end_reason\": \"stalled\"", "\"stall_steps\": 4", "\"quiet_since_step\": 0",
+                            "\"state\": \"walking\"", "\"waiting_for\": \"its target?\"", "\"material_m3\""})
+    EXPECT_NE(text.str().find(field), std::string::npos) << field << " in\n" << text.str();
+  std::ifstream events(out / "events.log");
+  std::stringstream log;
+  log << events.rdbuf();
+  EXPECT_NE(log.str().find("stalled: agent 1 walking with"), std::string::npos) << log.str();
+}
+
+TEST_F(WorldCliTest, ATeamThatDoesNotFitWhereItStartsIsRefusedWith2) {
+  const std::string text = testing::small_scenario_text();
+  const std::string crowded = text.substr(0, text.find("x_m: 2.55")) + "x_m: 1.55" + text.substr(text.find("x_m: 2.55") + 9);
+  const std::string scenario = write("crowded.pbtxt", crowded);
+  EXPECT_EQ(run({"--check", scenario}), 2);
+  EXPECT_NE(err_.str().find("agent[1] (agent 2).start: (1.55, 1.05) m: its body (1 m) overlaps agent 1's"),
+            std::string::npos)
+      << err_.str();
+  EXPECT_EQ(run({"--scenario", scenario, "--dds", "inprocess", "--out", (dir_ / "out").string()}), 2);
+  const std::string refused = err_.str();
+  EXPECT_EQ(std::count(refused.begin(), refused.end(), '\n'), 1) << refused;
+  EXPECT_EQ(run({"--check", "--agents", "1", scenario}), 0) << err_.str();  // agent 1 alone fits
+  const std::string stall = write("stall.pbtxt", testing::small_scenario_text("stall_steps: -3\n"));
+  EXPECT_EQ(run({"--check", stall}), 2);
+  EXPECT_NE(err_.str().find("stall_steps: -3 must be 0 (never) or in 1..1000000000"), std::string::npos) << err_.str();
 }
 
 }  // namespace
