@@ -62,8 +62,7 @@ WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, R
           fmt::format("scenario {}: robot type '{}': construction kappa: {}", s.source_path, type.name, problem));
   }
   if (const std::string problem = team_fit_problem(s, terrain, agents); !problem.empty())
-    throw InvalidArgument(fmt::format("scenario {}: {}; the team of {} does not fit where the scenario starts it",
-                                      s.source_path, problem, agents));
+    throw InvalidArgument(fmt::format("the team does not fit on its base: {}", problem));
   if (!o.out_dir.empty() && !o.replace) check_fresh_output_dir(o.out_dir);
   start.state = make_world_state(start.scenario, std::move(terrain), agents);
   return start;

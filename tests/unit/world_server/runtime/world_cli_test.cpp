@@ -148,18 +148,22 @@ TEST_F(WorldCliTest, ARunWithoutProgressEndsStalledWith6AndAnAccount) {
   EXPECT_NE(log.str().find("stalled: agent 1 walking with"), std::string::npos) << log.str();
 }
 
-TEST_F(WorldCliTest, ATeamThatDoesNotFitWhereItStartsIsRefusedWith2) {
+TEST_F(WorldCliTest, ATeamThatDoesNotFitOnItsBaseIsRefusedWith2) {
+  // The small scenario's 1 m robots all start on the base (radius 0.5 m): three do not fit there, two do.
   const std::string text = testing::small_scenario_text();
-  const std::string crowded = text.substr(0, text.find("x_m: 2.55")) + "x_m: 1.55" + text.substr(text.find("x_m: 2.55") + 9);
+  std::string crowded = text;
+  for (const char* start : {"start { x_m: 1.05 y_m: 1.05 }", "start { x_m: 2.55 y_m: 1.05 }", "start { x_m: 1.05 y_m: 3.05 }"})
+    crowded.replace(crowded.find(start), std::string(start).size(), "start { x_m: 0.55 y_m: 0.55 }");
   const std::string scenario = write("crowded.pbtxt", crowded);
   EXPECT_EQ(run({"--check", scenario}), 2);
-  EXPECT_NE(err_.str().find("agent[1] (agent 2).start: (1.55, 1.05) m: its body (1 m) overlaps agent 1's"),
+  EXPECT_NE(err_.str().find("the team does not fit on its base: agent (3 robots): only 2 of their bodies"),
             std::string::npos)
       << err_.str();
   EXPECT_EQ(run({"--scenario", scenario, "--dds", "inprocess", "--out", (dir_ / "out").string()}), 2);
   const std::string refused = err_.str();
   EXPECT_EQ(std::count(refused.begin(), refused.end(), '\n'), 1) << refused;
-  EXPECT_EQ(run({"--check", "--agents", "1", scenario}), 0) << err_.str();  // agent 1 alone fits
+  EXPECT_NE(refused.find("agent (3 robots)"), std::string::npos) << refused;
+  EXPECT_EQ(run({"--check", "--agents", "2", scenario}), 0) << err_.str();
   const std::string stall = write("stall.pbtxt", testing::small_scenario_text("stall_steps: -3\n"));
   EXPECT_EQ(run({"--check", stall}), 2);
   EXPECT_NE(err_.str().find("stall_steps: -3 must be 0 (never) or in 1..1000000000"), std::string::npos) << err_.str();
