@@ -8,9 +8,9 @@ namespace marsala::world_server {
 
 /// What the world remembers of a run's activity; part of the world state (snapshots keep it).
 struct StallWatch {
-  double best_progress = 0.0;        ///< the highest progress seen after a step [0, 1]
-  std::uint64_t quiet_since = 0;     ///< the first step after the last one that raised the progress or changed terrain
-  std::uint64_t longest_quiet = 0;   ///< the longest stretch of such steps the run has had so far [steps]
+  double best_progress = 0.0;       ///< the highest progress seen after a step [0, 1]
+  std::uint64_t quiet_since = 0;    ///< the first step after the last one that raised the progress or changed terrain
+  std::uint64_t longest_quiet = 0;  ///< the longest stretch of such steps the run has had so far [steps]
 };
 
 /// Progress must rise by more than this to count (rounding of the progress measure) [1].

@@ -53,7 +53,8 @@ std::string start_placement_problem(const scenario::Scenario& scenario, const He
       const double other_delta_m = scenario.robot_for(other).body.navigability.delta_m;
       if (overlap(start, body.delta_m, q, other_delta_m))
         return fmt::format("{}: {}: its body ({} m) overlaps agent {}'s, at {} ({:.2f} m apart, the bodies need {} m)",
-                           field, start, body.delta_m, other, q, distance(start, q), 0.5 * (body.delta_m + other_delta_m));
+                           field, start, body.delta_m, other, q, distance(start, q),
+                           0.5 * (body.delta_m + other_delta_m));
     }
   }
   return "";

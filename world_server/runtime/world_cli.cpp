@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <ostream>
+#include <utility>
 
 #include "marsala/bus/bus.hpp"
 #include "marsala/cli/command_line.hpp"
@@ -16,6 +17,18 @@
 #include "marsala/world_server/runtime/world_runtime.hpp"
 
 namespace marsala::world_server {
+namespace {
+
+/// The start of a new run of `scenario_path`: the scenario read, parsed and checked as --check does, the terrain
+/// built, a previous run's files removed from --out with --replace. Throws what the world refuses at start.
+WorldStart fresh_start(const std::string& scenario_path, RuntimeOptions options, int domain) {
+  options.scenario_text = scenario::read_scenario_text(scenario_path);
+  if (options.replace) clear_run_files(options.out_dir);
+  const scenario::Scenario scenario = scenario::parse_scenario(options.scenario_text, scenario_path, options.overrides);
+  return prepare_world_start(scenario, scenario::build_terrain(scenario), std::move(options), domain);
+}
+
+}  // namespace
 
 int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& stop, std::ostream& out,
                   std::ostream& err) {
@@ -107,11 +120,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       start = prepare_resume(resume_dir, options, dds.domain);
     } else {
       try {
-        options.scenario_text = scenario::read_scenario_text(scenario_path);
-        if (options.replace) clear_run_files(options.out_dir);
-        const scenario::Scenario scenario =
-            scenario::parse_scenario(options.scenario_text, scenario_path, options.overrides);
-        start = prepare_world_start(scenario, scenario::build_terrain(scenario), options, dds.domain);
+        start = fresh_start(scenario_path, options, dds.domain);
       } catch (const Error& e) {  // refused at start, as --check refuses it (docs/runtime.md#exit-codes)
         cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
         return kExitInvalidScenario;

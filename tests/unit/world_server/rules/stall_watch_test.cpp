@@ -60,8 +60,8 @@ TEST(StallWatch, OnlyAProgressAboveTheBestSoFarCounts) {
   StallWatch w;
   observe_step(w, 0, 0.5, false);  // rises from 0
   EXPECT_EQ(w.quiet_since, 1u);
-  observe_step(w, 1, 0.25, false);  // falls (an agent left the goal)
-  observe_step(w, 2, 0.5, false);   // back to the best: no rise
+  observe_step(w, 1, 0.25, false);         // falls (an agent left the goal)
+  observe_step(w, 2, 0.5, false);          // back to the best: no rise
   observe_step(w, 3, 0.5 + 1e-13, false);  // rounding, no rise
   EXPECT_EQ(w.quiet_since, 1u);
   EXPECT_EQ(quiet_steps(w, 4), 3u);

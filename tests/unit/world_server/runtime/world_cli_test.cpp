@@ -19,7 +19,26 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using WorldCliTest = testing::WorldCliFixture;
+/// The command-line fixture with a walking fake agent beside the world.
+class WorldCliTest : public testing::WorldCliFixture {
+ protected:
+  /// Runs marsala-world with `args` on the in-process bus of `domain` beside one walking fake agent in slot 1 of the
+  /// small scenario (--agents 1 --quiet added); returns the world's exit code.
+  int run_beside_walker(int domain, std::vector<std::string> args) {
+    args.insert(args.end(), {"--agents", "1", "--dds", "inprocess", "--domain", std::to_string(domain), "--quiet"});
+    int rc = -1;
+    std::thread world([&] { rc = run(args); });
+    testing::FakeAgentConfig c;
+    c.domain = domain;
+    c.id = 1;
+    c.session = 5;
+    c.body = testing::small_scenario().robot_for(1).body;
+    testing::FakeAgent agent(c);
+    world.join();
+    agent.join();
+    return rc;
+  }
+};
 
 TEST_F(WorldCliTest, UsageErrorsExitWith2) {
   EXPECT_EQ(run({}), 2);
@@ -69,20 +88,9 @@ TEST_F(WorldCliTest, BadScenariosExitWith2OnOneLineNamingFileAndLine) {
 TEST_F(WorldCliTest, ARunThatReachesMaxStepsExitsWith3) {
   const std::string scenario = write("small.pbtxt", testing::small_scenario_text());
   const fs::path out = dir_ / "out";
-  int rc = -1;
-  std::thread world([&] {
-    rc = run({"--scenario", scenario, "--agents", "1", "--dds", "inprocess", "--domain", "48", "--out", out.string(),
-              "--quiet", "--max-steps", "3"});
-  });
-  testing::FakeAgentConfig c;
-  c.domain = 48;
-  c.id = 1;
-  c.session = 5;
-  c.body = testing::small_scenario().robot_for(1).body;
-  testing::FakeAgent agent(c);
-  world.join();
-  agent.join();
-  EXPECT_EQ(rc, 3) << err_.str();  // the exit code says how the run ended: max_steps
+  // The exit code says how the run ended: max_steps.
+  EXPECT_EQ(run_beside_walker(48, {"--scenario", scenario, "--out", out.string(), "--max-steps", "3"}), 3)
+      << err_.str();
   EXPECT_NE(out_.str().find("run small-d48: max_steps after 3 steps, 1 agents"), std::string::npos) << out_.str();
   for (const char* name : {"summary.json", "terrain_initial.asc", "terrain_final.asc", "final.png", "events.log"})
     EXPECT_TRUE(fs::exists(out / name)) << name;
@@ -93,20 +101,9 @@ TEST_F(WorldCliTest, SeedOverridesTheScenariosAndIsReported) {
   EXPECT_EQ(run({"--scenario", scenario, "--seed", "abc"}), 2);
   EXPECT_NE(out_.str().size() + err_.str().size(), 0u);
   const fs::path out = dir_ / "out";
-  int rc = -1;
-  std::thread world([&] {
-    rc = run({"--scenario", scenario, "--agents", "1", "--dds", "inprocess", "--domain", "52", "--out", out.string(),
-              "--quiet", "--max-steps", "2", "--seed", "77"});
-  });
-  testing::FakeAgentConfig c;
-  c.domain = 52;
-  c.id = 1;
-  c.session = 5;
-  c.body = testing::small_scenario().robot_for(1).body;
-  testing::FakeAgent agent(c);
-  world.join();
-  agent.join();
-  EXPECT_EQ(rc, 3) << err_.str();  // max_steps
+  EXPECT_EQ(run_beside_walker(52, {"--scenario", scenario, "--out", out.string(), "--max-steps", "2", "--seed", "77"}),
+            3)
+      << err_.str();  // max_steps
   std::ifstream in(out / "summary.json");
   std::stringstream text;
   text << in.rdbuf();
@@ -121,20 +118,8 @@ TEST_F(WorldCliTest, ARunWithoutProgressEndsStalledWith6AndAnAccount) {
   // run ends before step 4 is applied.
   const std::string scenario = write("small.pbtxt", testing::small_scenario_text("stall_steps: 4\n"));
   const fs::path out = dir_ / "out";
-  int rc = -1;
-  std::thread world([&] {
-    rc = run({"--scenario", scenario, "--agents", "1", "--dds", "inprocess", "--domain", "53", "--out", out.string(),
-              "--quiet", "--max-steps", "50"});
-  });
-  testing::FakeAgentConfig c;
-  c.domain = 53;
-  c.id = 1;
-  c.session = 5;
-  c.body = testing::small_scenario().robot_for(1).body;
-  testing::FakeAgent agent(c);
-  world.join();
-  agent.join();
-  EXPECT_EQ(rc, 6) << err_.str();
+  EXPECT_EQ(run_beside_walker(53, {"--scenario", scenario, "--out", out.string(), "--max-steps", "50"}), 6)
+      << err_.str();
   EXPECT_NE(out_.str().find("run small-d53: stalled after 4 steps"), std::string::npos) << out_.str();
   std::ifstream in(out / "summary.json");
   std::stringstream text;
@@ -152,7 +137,8 @@ TEST_F(WorldCliTest, ATeamThatDoesNotFitOnItsBaseIsRefusedWith2) {
   // The small scenario's 1 m robots all start on the base (radius 0.5 m): three do not fit there, two do.
   const std::string text = testing::small_scenario_text();
   std::string crowded = text;
-  for (const char* start : {"start { x_m: 1.05 y_m: 1.05 }", "start { x_m: 2.55 y_m: 1.05 }", "start { x_m: 1.05 y_m: 3.05 }"})
+  for (const char* start :
+       {"start { x_m: 1.05 y_m: 1.05 }", "start { x_m: 2.55 y_m: 1.05 }", "start { x_m: 1.05 y_m: 3.05 }"})
     crowded.replace(crowded.find(start), std::string(start).size(), "start { x_m: 0.55 y_m: 0.55 }");
   const std::string scenario = write("crowded.pbtxt", crowded);
   EXPECT_EQ(run({"--check", scenario}), 2);
