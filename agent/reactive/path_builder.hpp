@@ -121,7 +121,7 @@ class PathBuilder final : public Behaviour {
   double return_below_m3_ = 0.0;  // less material than this (one deposition task) on board: back to the base [m^3]
   PathState state_ = PathState::kWaitAdmission;
   PathBuilderTrace trace_;
-  std::string waiting_for_;  // what the last decision waits for (waiting_for.hpp), set where its state is chosen
+  std::string waiting_for_;         // what the last decision waits for (waiting_for.hpp), set where its state is chosen
   ReturnProgress return_progress_;  // how long the return to the base has come no nearer
 };
 

@@ -91,7 +91,7 @@ class RampBuilder final : public Behaviour {
   double return_below_m3_ = 0.0;  // less material than this (one cube) on board: back to the base [m^3]
   RampState state_ = RampState::kWaitAdmission;
   RampBuilderTrace trace_;
-  std::string waiting_for_;  // what the last decision waits for (waiting_for.hpp)
+  std::string waiting_for_;         // what the last decision waits for (waiting_for.hpp)
   ReturnProgress return_progress_;  // how long the return to the base has come no nearer
 };
 

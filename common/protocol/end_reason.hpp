@@ -17,8 +17,8 @@ enum class EndReason {
 };
 
 /// marsala-world's exit code for a run that ended for `reason` and wrote its outputs (docs/runtime.md#exit-codes):
-/// 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled. 1 (an error) and 2 (usage, or a run refused at start) are
-/// not end reasons.
+/// 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled. 1 (an error) and 2 (usage, or a run refused at
+/// start) are not end reasons.
 int exit_code(EndReason reason);
 
 /// "signal", "completed", "max_steps", "no_live_agents", "stalled".

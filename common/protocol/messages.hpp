@@ -98,6 +98,7 @@ struct AgentStatus {
   std::uint32_t missed = 0;    ///< steps whose deadline passed without its request
   bool alive = true;
   bool at_goal = false;
+  std::string waiting_for;  ///< what its latest request said it waits for, as the world keeps it
 };
 
 /// World -> everyone, once per step (transient-local, so a late monitor sees the latest at once).

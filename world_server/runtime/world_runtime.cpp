@@ -77,6 +77,7 @@ protocol::WorldStatus world_status(const WorldState& state, bool running, bool c
     as.missed = a.missed;
     as.alive = a.alive;
     as.at_goal = a.alive && at_goal(state, a);
+    as.waiting_for = a.waiting_for;
     s.agents.push_back(std::move(as));
   }
   return s;

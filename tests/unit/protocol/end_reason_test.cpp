@@ -32,7 +32,8 @@ TEST(EndReason, AnUnknownNameListsTheValidOnes) {
     end_reason_from_string("finished");
     FAIL() << "no throw";
   } catch (const InvalidArgument& e) {
-    EXPECT_STREQ(e.what(), "unknown end reason 'finished'; valid: signal, completed, max_steps, no_live_agents, stalled");
+    EXPECT_STREQ(e.what(),
+                 "unknown end reason 'finished'; valid: signal, completed, max_steps, no_live_agents, stalled");
   }
   EXPECT_EQ(to_string(static_cast<EndReason>(42)), "unknown");
 }

@@ -48,7 +48,7 @@ TEST(WaitingFor, ReturnProgressCountsFramesWithoutGettingNearer) {
   EXPECT_EQ(p.observe(20.2), 1);   // farther
   EXPECT_EQ(p.observe(19.97), 2);  // nearer by less than kMinGainM
   EXPECT_EQ(p.observe(20.0), 3);
-  EXPECT_EQ(p.observe(19.9), 0);   // nearer: a new best
+  EXPECT_EQ(p.observe(19.9), 0);  // nearer: a new best
   EXPECT_EQ(p.observe(19.9), 1);
   p.reset();
   EXPECT_EQ(p.observe(30.0), 0);
