@@ -1,6 +1,7 @@
 // marsala-agent: one robot of a MARSala run. Reads its body and behaviour from its slot of the scenario, says hello
 // to marsala-world over DDS, then answers every sensor frame with one action request until the run is over.
-// Exit codes: 0 run over (or stopped by a signal), 1 error (one line on stderr), 2 usage.
+// Exit codes: 0 run over (or stopped by a signal), 1 error (one line on stderr), 2 usage, or a --dump-map folder that
+// holds another run's maps (docs/runtime.md#seeing-the-map).
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -10,11 +11,13 @@
 #include <csignal>
 #include <exception>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "marsala/agent/runtime/agent_runtime.hpp"
+#include "marsala/agent/runtime/map_dump.hpp"
 #include "marsala/cli/command_line.hpp"
 #include "marsala/cli/logging.hpp"
 #include "marsala/scenario/scenario.hpp"
@@ -72,11 +75,23 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--world-timeout", world_timeout_s, "give up when no frame comes for this long [s]")
       ->check(CLI::PositiveNumber);
+  std::string dump_dir;
+  app.add_option("--dump-map", dump_dir,
+                 "when its admitted run ends, write the robot's map into DIR: agent-<id>-height.asc (NODATA: unknown)\n"
+                 "and agent-<id>-map.json; a DIR holding another run's maps is refused (exit 2)")
+      ->type_name("DIR");
   if (const auto code = marsala::cli::parse_command_line(app, argc, argv, "marsala-agent", std::cout, std::cerr))
     return *code;
 
   const std::uint32_t id = id_text == "auto" ? 0u : static_cast<std::uint32_t>(std::stoul(id_text));
   marsala::cli::setup_logging("agent", id, log_options);
+  std::shared_ptr<agent::runtime::MapDump> dump;
+  try {
+    if (!dump_dir.empty()) dump = std::make_shared<agent::runtime::MapDump>(dump_dir);
+  } catch (const Error& e) {
+    marsala::cli::write_exit_error(std::cerr, fmt::format("marsala-agent: {}", e.what()));
+    return marsala::cli::kExitUsage;
+  }
   try {
     const scenario::Scenario s = scenario::load_scenario(scenario_file, overrides);
     const RobotType& type = id != 0 ? s.robot_for(id) : any_slot_type(s, robot_type);
@@ -96,6 +111,7 @@ int main(int argc, char** argv) {
     if (s.has_goal_vector_map) config.goal_vector_map = s.goal_vector_map;
     config.admit_timeout = std::chrono::milliseconds(static_cast<long long>(admit_timeout_s * 1000.0));
     config.world_timeout = std::chrono::milliseconds(static_cast<long long>(world_timeout_s * 1000.0));
+    if (dump) agent::runtime::dump_maps_into(dump, config);
 
     if (!dds.security.empty() && id == 0 && dds.identity.empty())
       throw InvalidArgument(
@@ -109,6 +125,10 @@ int main(int argc, char** argv) {
     std::signal(SIGTERM, on_signal);
     const agent::runtime::RunResult result = agent.run(g_stop);
     if (result.outcome == agent::runtime::RunOutcome::kRunOver) return 0;
+    if (result.outcome == agent::runtime::RunOutcome::kOutputRefused) {
+      marsala::cli::write_exit_error(std::cerr, fmt::format("marsala-agent: agent {}: {}", id, result.message));
+      return marsala::cli::kExitUsage;
+    }
     if (result.outcome == agent::runtime::RunOutcome::kStopped) {
       spdlog::info("agent {}: {}", id, result.message);
       return 0;

@@ -6,9 +6,9 @@
 #
 # Usage: deploy/spawn.sh --scenario FILE --agents N [--dds cyclone|fastdds] [--agent-dds cyclone|fastdds]
 #                        [--out DIR [--replace]] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N]
-#                        [--quiet] [--secure] [--frames-every K] [--set FIELD=VALUE ...]
+#                        [--quiet] [--secure] [--frames-every K] [--dump-maps] [--set FIELD=VALUE ...]
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
-#                 folder that holds another run's files, unless --replace removes them (and logs/) first
+#                 folder that holds another run's files, unless --replace removes them (and logs/, maps/) first
 #   --dds         vendor of every process (default $MARSALA_DDS, else cyclone); --agent-dds overrides it for the agents
 #   --domain      DDS domain id (default $MARSALA_DOMAIN, else a random one on which no world answers within 1 s)
 #   --monitor     also run `marsala-monitor tail` in the foreground output (instead of the progress line)
@@ -16,6 +16,10 @@
 #   --timeout     give up (and stop everything) after S seconds of wall time (default 1800)
 #   --frames-every a time-lapse: marsala-world draws OUT/frames/frame_<step>.png every K steps and the last, and
 #                 OUT/frames/timelapse.mp4 when ffmpeg is installed
+#   --dump-maps   every agent writes its own final map into OUT/maps (marsala-agent --dump-map OUT/maps):
+#                 agent-<id>-height.asc (NODATA where it knows nothing) and agent-<id>-map.json; see how good it is
+#                 with `marsala-terrain compare OUT/maps/agent-<id>-height.asc OUT/terrain_final.asc` (--replace
+#                 removes the previous run's maps; an agent refuses maps of another run, exit 2)
 #   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
 #   --set         change a field of the scenario for this run, e.g. --set robot_type.body.sensing_range_m=5
 #                 (repeatable; passed to marsala-world and every marsala-agent; summary.json lists them)
@@ -30,7 +34,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
 scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0 frames_every=""
-replace=0 secure=0 set_args=()
+replace=0 secure=0 dump_maps=0 set_args=()
 usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; }  # the whole header comment
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -49,6 +53,7 @@ while [ $# -gt 0 ]; do
     --quiet) quiet=1; shift ;;
     --replace) replace=1; shift ;;
     --secure) secure=1; shift ;;
+    --dump-maps) dump_maps=1; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "spawn.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
@@ -86,7 +91,7 @@ fi
 
 # A run never mixes its outputs with another's: the world refuses a folder holding a run; with --replace it removes
 # that run's files itself (marsala-world --replace knows the list), and the agents' old logs go here.
-[ "$replace" -eq 1 ] && [ -d "$out" ] && rm -rf -- "$out/logs"
+[ "$replace" -eq 1 ] && [ -d "$out" ] && rm -rf -- "$out/logs" "$out/maps"
 
 # Secured: identities made anew for this run's processes (docs/runtime.md#security).
 sec_args=()
@@ -104,6 +109,8 @@ world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$do
 [ "$quiet" -eq 1 ] && world_args+=(--quiet)
 seed_args=()
 [ -n "$seed" ] && seed_args=(--seed "$seed")
+agent_args=()
+[ "$dump_maps" -eq 1 ] && agent_args=(--dump-map "$out/maps")
 world_args+=("${seed_args[@]}" "${set_args[@]}")
 
 # The world's own start-up checks with the run's arguments (scenario, terrain, completion, slots, --agents), before
@@ -132,7 +139,7 @@ world_pid=$!
 pids+=("$world_pid")
 for id in $(seq 1 "$agents"); do
   "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds "$agent_dds" --domain "$domain" \
-    "${seed_args[@]}" "${set_args[@]}" "${sec_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
+    "${seed_args[@]}" "${set_args[@]}" "${sec_args[@]}" "${agent_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
   pids+=("$!")
 done
 [ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain; logs in $out/logs"
@@ -160,6 +167,16 @@ while kill -0 "$world_pid" 2>/dev/null; do
 done
 world_rc=0
 wait "$world_pid" || world_rc=$?
+if [ "$dump_maps" -eq 1 ]; then
+  # The agents write their maps on the run-over frame and exit: give them up to 10 s before the cleanup stops them
+  # (stopped, they still write theirs, within its 0.5 s).
+  for _ in $(seq 1 100); do
+    alive=0
+    for pid in "${pids[@]:1:$agents}"; do kill -0 "$pid" 2>/dev/null && alive=1; done
+    [ "$alive" -eq 0 ] && break
+    sleep 0.1
+  done
+fi
 if [ -n "$progress_pid" ]; then
   # It ends by itself on the world's last status; a world that died without one leaves it waiting: stop it.
   for _ in $(seq 1 20); do kill -0 "$progress_pid" 2>/dev/null || break; sleep 0.1; done

@@ -109,6 +109,32 @@ class CubeDepositor final : public Depositor {
   double side_m_;
 };
 
+/// The largest pile [m^3] dumped at `dump` [m] on `heights` whose every cell stays within what it may still take
+/// (`remaining` [m] per cell of the window, row-major; negative: it may not rise at all; at most `max_rise_m`), and
+/// that reaches no cell of the window's outermost ring (beyond it the map is not known). A pile at apex z raises the
+/// cells whose base h(p) + slope |p - dump| lies below z, each to z - slope |p - dump|: the pile fits when z stays at
+/// or below every cell's base plus what the cell may take, so the largest apex is the least of those, and its volume
+/// follows (as cone_pile_shape() fills, up to rounding).
+double largest_pile_m3(const Heightmap& heights, const std::vector<double>& remaining, Position dump, double slope,
+                       double max_rise_m) {
+  const int rows = heights.rows(), cols = heights.cols();
+  std::vector<double> base(remaining.size());
+  double apex = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const std::size_t i = static_cast<std::size_t>(r) * cols + c;
+      const Position centre = heights.cell_center({r, c});
+      base[i] = heights(r, c) + slope * distance(centre, dump);
+      const bool edge = r == 0 || c == 0 || r == rows - 1 || c == cols - 1;
+      const double may = edge ? 0.0 : std::min(remaining[i], max_rise_m);
+      apex = std::min(apex, base[i] + std::max(may, 0.0));
+    }
+  double fill_m = 0.0;
+  for (const double b : base) fill_m += std::max(0.0, apex - b);
+  const double cs = heights.cell_size_m();
+  return fill_m * cs * cs;
+}
+
 class ConeDepositor final : public Depositor {
  public:
   explicit ConeDepositor(double repose_deg) : repose_deg_(repose_deg) {}
@@ -118,8 +144,6 @@ class ConeDepositor final : public Depositor {
                       const std::vector<CellIndex>& path, Position robot, double material_m3,
                       const Neighbourhood& neighbours) const override {
     const DepositionParams& p = manager.params();
-    const double cs = map.geometry().cell_size_m, area = cs * cs;
-    const double overshoot_m = kConeOvershootFraction * p.navigability.eps_m;
     const auto index = [&](CellIndex c) { return static_cast<std::size_t>(c.row) * map.cols() + c.col; };
     // What each cell may still take [m]: its MARS gap where it may be raised at all, negative where it may not.
     std::vector<double> remaining(static_cast<std::size_t>(map.rows()) * map.cols(), -1.0);
@@ -134,51 +158,14 @@ class ConeDepositor final : public Depositor {
     double budget = budget_m3(manager, material_m3);
     std::vector<Placed> placed;
     for (int pile = 0; pile < kMaxConesPerStep && budget > kMinVolumeM3; ++pile) {
-      struct Best {
-        double fill_m3 = 0.0;
-        double band_m3 = 0.0;  // the part of fill_m3 on the path's footprint
-        Position dump;
-        double volume_m3 = 0.0;
-        DepositShape shape;
-      } best;
+      Choice best;
       int points = 0;
       for (const WantedCell& w : wanted) {
         if (points >= kConeDumpPoints) break;
-        const double here = remaining[index(w.cell)];
         const Position dump = map.center(w.cell);
-        if (!(here > 0.0) || !(distance(dump, robot) <= p.reach_m)) continue;
+        if (!(remaining[index(w.cell)] > 0.0) || !(distance(dump, robot) <= p.reach_m)) continue;
         ++points;
-        std::vector<double> volumes;
-        for (double v = budget; volumes.size() < kVolumeHalvings; v *= 0.5) volumes.push_back(v);
-        if (here * area < budget) volumes.push_back(here * area);  // fills this cell alone when the pile stays in it
-        for (const double v : volumes) {
-          if (!(v > kMinVolumeM3)) continue;
-          DepositShape shape = cone_pile_shape(heights, dump, v, repose_deg_);
-          if (!shape.on_grid) continue;  // the pile reaches the window's edge: beyond it the map is not known
-          double fill = 0.0, band = 0.0;
-          bool ok = true;
-          for (const CellRise& r : shape.rises) {
-            const double may = remaining[index(r.cell)];
-            if (may < 0.0 || r.rise_m > may + overshoot_m || r.rise_m > p.max_height_m) {
-              ok = false;
-              break;
-            }
-            fill += std::min(r.rise_m, may) * area;
-            if (in_band[index(r.cell)]) band += std::min(r.rise_m, may) * area;
-          }
-          // Most of the pile must land under the MARS height: material spent above it is lost to the structure.
-          if (!ok || fill < kMinFillFraction * v || !(band > best.band_m3 + 1e-12)) continue;
-          // The world computes the pile on its own copy of the terrain, in its own frame: a cell at the pile's edge
-          // may rise there by rounding. A slightly bigger pile covers every cell this one could (the cells rising
-          // grow with the volume), so it must not reach a cell this robot may not raise either.
-          const DepositShape guard = cone_pile_shape(heights, dump, v * (1.0 + kGuardFraction), repose_deg_);
-          if (!guard.on_grid) continue;
-          bool guarded = true;
-          for (const CellRise& r : guard.rises)
-            if (remaining[index(r.cell)] < 0.0) guarded = false;
-          if (!guarded) continue;
-          best = {fill, band, dump, v, std::move(shape)};
-        }
+        consider(heights, remaining, in_band, dump, budget, p.max_height_m, best);
       }
       if (!(best.band_m3 > 0.0)) break;
       Placed pile_placed{{best.dump.x, best.dump.y, best.volume_m3}, {}};
@@ -194,11 +181,59 @@ class ConeDepositor final : public Depositor {
   }
 
  private:
+  /// The best pile found so far.
+  struct Choice {
+    double band_m3 = 0.0;  // its volume on the path's footprint [m^3]
+    Position dump;
+    double volume_m3 = 0.0;
+    DepositShape shape;
+  };
+
+  /// The piles dumped at `dump` that fit against `best`: the largest that fits (its apex at the MARS height where
+  /// the cells' caps allow), the budget and its halvings, and what fills the dump cell alone; the one with most
+  /// volume on the path's footprint wins.
+  void consider(const Heightmap& heights, const std::vector<double>& remaining, const std::vector<std::uint8_t>& in_band,
+                Position dump, double budget, double max_rise_m, Choice& best) const {
+    const double area = heights.cell_size_m() * heights.cell_size_m();
+    const auto index = [&](CellIndex c) { return static_cast<std::size_t>(c.row) * heights.cols() + c.col; };
+    std::vector<double> volumes{
+        std::min(budget, largest_pile_m3(heights, remaining, dump, slope_, max_rise_m) * (1.0 - kShrinkFraction))};
+    for (double v = budget; volumes.size() <= kVolumeHalvings; v *= 0.5) volumes.push_back(v);
+    const double here = remaining[index(*heights.geometry().cell_at(dump))] * area;
+    if (here < budget) volumes.push_back(here);  // fills the dump cell alone when the pile stays in it
+    for (const double v : volumes) {
+      if (!(v > kMinVolumeM3)) continue;
+      DepositShape shape = cone_pile_shape(heights, dump, v, repose_deg_);
+      if (!shape.on_grid) continue;  // the pile reaches the window's edge: beyond it the map is not known
+      double band = 0.0;
+      bool ok = true;
+      for (const CellRise& r : shape.rises) {
+        const double may = remaining[index(r.cell)];
+        if (may < 0.0 || r.rise_m > may + kConeRoundingM || r.rise_m > max_rise_m) {
+          ok = false;
+          break;
+        }
+        if (in_band[index(r.cell)]) band += std::min(r.rise_m, may) * area;
+      }
+      if (!ok || !(band > best.band_m3 + 1e-12)) continue;
+      // The world computes the pile on its own copy of the terrain, in its own frame: a cell at the pile's edge
+      // may rise there by rounding. A slightly bigger pile covers every cell this one could (the cells rising
+      // grow with the volume), so it must not reach a cell this robot may not raise either.
+      const DepositShape guard = cone_pile_shape(heights, dump, v * (1.0 + kGuardFraction), repose_deg_);
+      bool guarded = guard.on_grid;
+      for (const CellRise& r : guard.rises)
+        if (remaining[index(r.cell)] < 0.0) guarded = false;
+      if (!guarded) continue;
+      best = {band, dump, v, std::move(shape)};
+    }
+  }
+
   static constexpr double kMinVolumeM3 = 1e-7;  // smaller piles are not worth a deposit [m^3]
-  static constexpr std::size_t kVolumeHalvings = 6;  // volumes tried: the budget, half of it, ... 1/32 of it
-  static constexpr double kMinFillFraction = 0.75;
+  static constexpr std::size_t kVolumeHalvings = 6;  // volumes tried besides: the budget, half of it, ... 1/32 of it
   static constexpr double kGuardFraction = 1e-6;  // the guard pile's extra volume, relative
+  static constexpr double kShrinkFraction = 4e-6;  // the largest pile, a little smaller: its guard fits too
   double repose_deg_;
+  double slope_ = std::tan(repose_deg_ * 3.14159265358979323846 / 180.0);
 };
 
 using DepositorRegistry = Registry<Depositor, const RobotType&>;

@@ -5,11 +5,13 @@
 //   "layer": the manager's whole cube layers per cell (Deposition), as always;
 //   "cube":  columns of cubes of side s centred on wanted cells, in path order (contour crafting), each column as
 //            tall as every cell of its footprint still wants (never above the MARS height);
-//   "cone":  piles of granular material: among dump points on wanted cells within reach and a few volumes, the pile
-//            (predicted with the world's own cone_pile_shape on the local map) that puts most volume under the MARS
-//            height on the path's footprint, with at least 75 % of it under the MARS height anywhere, no cell more
-//            than kConeOvershootFraction * eps above it, and no cell it may not raise (checked on a pile 1e-6 bigger,
-//            so that rounding in the world's frame cannot reach one); up to kMaxConesPerStep piles a step.
+//   "cone":  piles of granular material: among dump points on wanted cells within reach and a few volumes (the
+//            largest pile that fits among them), the pile (predicted with the world's own cone_pile_shape on the
+//            local map) that puts most volume under the MARS height on the path's footprint, with no cell above the
+//            MARS height of the local map (kConeRoundingM for rounding) and no cell it may not raise (checked on a
+//            pile 1e-6 bigger, so that rounding in the world's frame cannot reach one); up to kMaxConesPerStep piles
+//            a step. Under the local MARS height is under the world's deposit bound, the MARS of the initial terrain
+//            (docs/runtime.md#deposit-bound): filled only up to it, the terrain never lifts its own bound.
 // Every depositor keeps the manager's way-back check (the longest prefix of its deposits that keeps it).
 // The behaviours see only DepositionPlan.
 
@@ -22,10 +24,11 @@
 
 namespace marsala::agent::executive {
 
-/// A cone may overshoot the MARS height by at most this fraction of the construction's eps [1].
-inline constexpr double kConeOvershootFraction = 0.1;
+/// A cone pile may rise above the local map's MARS height by at most this much: rounding only, never an overshoot
+/// that would lift the bound of the cells around it [m].
+inline constexpr double kConeRoundingM = 1e-9;
 /// Most piles a cone depositor places in one step.
-inline constexpr int kMaxConesPerStep = 3;
+inline constexpr int kMaxConesPerStep = 8;
 /// Dump points tried per pile: the first wanted cells within reach, in path order.
 inline constexpr int kConeDumpPoints = 12;
 

@@ -8,10 +8,12 @@
 // clock, no unseeded randomness), so it is testable without DDS and a run is reproducible bit for bit.
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "marsala/agent/agent_context.hpp"
+#include "marsala/agent/deliberative/known_map.hpp"
 #include "marsala/core/registry.hpp"
 #include "marsala/protocol/messages.hpp"
 
@@ -38,6 +40,10 @@ class Behaviour {
   /// Where the robot believes the terrain of its next frames lies (executive::MappingSystem::set_registration);
   /// behaviours without a map ignore it.
   virtual void set_registration(CellIndex /*offset*/) {}
+  /// The robot's own map as it stands (executive::MappingSystem::known_map(), valid while this behaviour lives and
+  /// decides nothing more); nullopt before admission and for behaviours that keep no map. Read-only: for outputs
+  /// (marsala-agent --dump-map) and tests.
+  virtual std::optional<deliberative::KnownMap> known_map() const { return std::nullopt; }
 };
 
 /// Behaviours by name; each is made from the agent's context (admission still empty).

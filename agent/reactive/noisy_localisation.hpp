@@ -39,6 +39,7 @@ class NoisyLocalisation final : public Behaviour {
   std::string waiting_for() const override { return inner_->waiting_for(); }
   void on_admission(const protocol::Admission& admission) override;
   protocol::ActionRequest decide(const protocol::SensorFrame& frame) override;
+  std::optional<deliberative::KnownMap> known_map() const override { return inner_->known_map(); }
 
   /// The error of the last frame decided [m], as drawn.
   Position last_error() const { return error_; }

@@ -97,6 +97,9 @@ class PathBuilder final : public Behaviour {
   std::string waiting_for() const override { return waiting_for_; }
   void on_admission(const protocol::Admission& admission) override;
   void set_registration(CellIndex offset) override { steps_.set_registration(offset); }
+  std::optional<deliberative::KnownMap> known_map() const override {
+    return steps_.admitted() ? std::optional<deliberative::KnownMap>(steps_.map().known_map()) : std::nullopt;
+  }
   protocol::ActionRequest decide(const protocol::SensorFrame& frame) override;
 
   PathState state() const { return state_; }

@@ -57,7 +57,8 @@ std::string to_string(RunOutcome outcome) {
                                                     {RunOutcome::kRefused, "refused"},
                                                     {RunOutcome::kAdmitTimeout, "admit_timeout"},
                                                     {RunOutcome::kWorldTimeout, "world_timeout"},
-                                                    {RunOutcome::kWorldGone, "world_gone"}};
+                                                    {RunOutcome::kWorldGone, "world_gone"},
+                                                    {RunOutcome::kOutputRefused, "output_refused"}};
   return enum_to_string(kNames, outcome);
 }
 
@@ -316,10 +317,33 @@ class AgentRuntime::Lockstep {
   DecisionCosts costs_;
 };
 
+void AgentRuntime::end_admitted(const RunResult& result, bool failed) const {
+  if (config_.on_end) config_.on_end(*this, result, failed);
+}
+
 RunResult AgentRuntime::run(const std::atomic<bool>& stop) {
   RunResult result;
   protocol::Admission admission;
-  if (admit(stop, result, admission)) Lockstep(*this, admission, result).run(stop);
+  if (admit(stop, result, admission)) {
+    const std::string refusal = config_.on_admitted ? config_.on_admitted(result.run_id) : std::string();
+    if (!refusal.empty()) {
+      result.outcome = RunOutcome::kOutputRefused;
+      result.message = refusal;
+      result.final_state = behaviour_->state_name();
+      return result;
+    }
+    try {
+      Lockstep(*this, admission, result).run(stop);
+    } catch (...) {
+      try {
+        end_admitted(result, true);
+      } catch (const std::exception& e) {
+        spdlog::error("agent {}: at the end of a failed run: {}", config_.agent_id, e.what());
+      }
+      throw;
+    }
+    end_admitted(result, false);
+  }
   result.final_state = behaviour_->state_name();
   return result;
 }

@@ -26,6 +26,9 @@
 
 namespace marsala::agent::runtime {
 
+class AgentRuntime;
+struct RunResult;
+
 /// Who the agent is and how patient it is.
 struct RuntimeConfig {
   std::uint32_t agent_id = 0;                        ///< the scenario slot; 0: any free slot of `type` (--id auto)
@@ -39,11 +42,17 @@ struct RuntimeConfig {
   std::chrono::milliseconds admit_timeout{60000};    ///< give up when not admitted by then
   std::chrono::milliseconds world_timeout{60000};    ///< give up when no frame comes for this long
   std::function<void(std::uint32_t)> on_assigned;    ///< called with the slot an --id auto agent was given (logging)
+  /// Called once admitted, with the run's id: a non-empty answer refuses the run on the agent's side (kOutputRefused,
+  /// the answer as message; e.g. a --dump-map folder holding another run's maps).
+  std::function<std::string(const std::string& run_id)> on_admitted;
+  /// Called once when an admitted run ends, whatever ended it (`failed`: an error is about to be thrown), with the
+  /// agent (its config and behaviour as they stand) and the result so far (e.g. --dump-map writes the robot's map).
+  std::function<void(const AgentRuntime&, const RunResult&, bool failed)> on_end;
 };
 
 /// Why run() returned.
-enum class RunOutcome { kRunOver, kStopped, kRefused, kAdmitTimeout, kWorldTimeout, kWorldGone };
-/// "run_over", "stopped", "refused", "admit_timeout", "world_timeout", "world_gone".
+enum class RunOutcome { kRunOver, kStopped, kRefused, kAdmitTimeout, kWorldTimeout, kWorldGone, kOutputRefused };
+/// "run_over", "stopped", "refused", "admit_timeout", "world_timeout", "world_gone", "output_refused".
 std::string to_string(RunOutcome outcome);
 
 /// What happened in a run.
@@ -79,9 +88,12 @@ class AgentRuntime {
   RunResult run(const std::atomic<bool>& stop);
 
   const RuntimeConfig& config() const { return config_; }
+  /// The robot's behaviour (made anew when an --id auto agent is given its slot).
+  const reactive::Behaviour& behaviour() const { return *behaviour_; }
 
  private:
   bool admit(const std::atomic<bool>& stop, RunResult& result, protocol::Admission& admission);
+  void end_admitted(const RunResult& result, bool failed) const;
   void make_behaviour();
   class Lockstep;  // the loop after admission, in agent_runtime.cpp
 

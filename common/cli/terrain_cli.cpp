@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "marsala/cli/command_line.hpp"
+#include "marsala/cli/terrain_compare.hpp"
 #include "marsala/core/deposition.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
@@ -686,6 +687,7 @@ struct TerrainCommands {
   RenderCommand render;
   Render3dCommand render3d;
   RouteCommand route;
+  CompareCommand compare;
 };
 
 /// Runs the subcommand the command line chose.
@@ -698,13 +700,15 @@ void run_chosen(TerrainCommands& c, std::ostream& out) {
   else if (*c.render.cmd) run_render(c.render, out);
   else if (*c.route.cmd) run_route(c.route, out);
   else if (*c.render3d.cmd) run_render3d(c.render3d, out);
+  else if (*c.compare.cmd) run_compare(c.compare, out);
 }
 
 }  // namespace
 
 int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
-      "marsala-terrain: generate, import, inspect and render terrains; compute MARS and navigability.\n"
+      "marsala-terrain: generate, import, inspect and render terrains; compute MARS and navigability; compare a\n"
+      "robot's map with the true terrain.\n"
       "Heights are metres; files are ESRI ASCII grids (.asc); GeoTIFF (.tif) is accepted as input.",
       "marsala-terrain"};
   app.require_subcommand(1);
@@ -718,12 +722,16 @@ int run_terrain_cli(int argc, const char* const* argv, std::ostream& out, std::o
   define_render(app, commands.render);
   define_render3d(app, commands.render3d);
   define_route(app, commands.route);
+  define_compare(app, commands.compare);
   if (const auto code = parse_command_line(app, argc, argv, "marsala-terrain", out, err)) return *code;
 
   try {
     run_chosen(commands, out);
   } catch (const UsageError& e) {
     err << fmt::format("marsala-terrain: {} (run with --help for usage)\n", e.what());
+    return kExitUsage;
+  } catch (const InputError& e) {
+    err << fmt::format("marsala-terrain: {}\n", e.what());
     return kExitUsage;
   } catch (const Error& e) {
     err << fmt::format("marsala-terrain: {}\n", e.what());

@@ -32,6 +32,10 @@ struct DepositShape {
   double volume_m3 = 0.0;       ///< sum of rise * cs^2 over `rises` [m^3]
 };
 
+/// A deposit may leave a cell at most this fraction of its robot's construction eps above the world's deposit bound,
+/// the MARS bound of the initial terrain (docs/runtime.md#deposit-bound) [1].
+inline constexpr double kDepositOvershootFraction = 0.1;
+
 /// Tolerance of cone_pile_shape's volume: |volume_m3 - V| <= kConeVolumeRelTolerance * V (rounding only: the apex
 /// is solved exactly, not iterated).
 inline constexpr double kConeVolumeRelTolerance = 1e-9;

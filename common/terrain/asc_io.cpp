@@ -288,7 +288,7 @@ class AscParser {
         const NumberStatus status = parse_number(p, last, value, &end);
         if (status != NumberStatus::kOk) reject_value(status, std::string_view(p, end - p), row, col);
         if (has_nodata && value == nodata) {
-          if (!options_.fill_nodata)
+          if (!options_.fill_nodata && !options_.keep_nodata)
             fail(line_no_, fmt::format("NODATA value {} at data row {}, column {}; {}",
                                        quote(std::string_view(p, end - p)), row + 1, col + 1, kFillHint));
           value = std::numeric_limits<double>::quiet_NaN();
@@ -318,7 +318,7 @@ class AscParser {
              fmt::format("header key {} puts the grid's lower-left corner half a cell beyond the range of doubles",
                          quote(header_[slot].key)));
     Heightmap map(geometry, HeightMatrix(Eigen::Map<const HeightMatrix>(heights.data(), rows, cols)));
-    if (nodata_cells > 0) {
+    if (nodata_cells > 0 && !options_.keep_nodata) {
       if (nodata_cells == announced) fail(0, "every cell is NODATA; there is nothing to fill from");
       fill_nodata(map);
     }

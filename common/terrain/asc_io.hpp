@@ -20,12 +20,15 @@
 
 namespace marsala::terrain {
 
-/// How to treat NODATA cells: the policy is an error (naming file, line, column) unless fill_nodata is set.
+/// How to treat NODATA cells: the policy is an error (naming file, line, column) unless fill_nodata or keep_nodata
+/// is set.
 struct AscReadOptions {
   bool fill_nodata = false;  ///< fill NODATA cells with fill_nodata() instead of refusing the file
+  bool keep_nodata = false;  ///< read NODATA cells as NaN (a map with unknown cells; every cell may be NODATA)
 };
 
-/// Reads an ESRI ASCII grid [m]; throws ParseError("file:line: problem") or IoError (cannot open/read).
+/// Reads an ESRI ASCII grid [m] (NODATA cells as `options` say); throws ParseError("file:line: problem") or IoError
+/// (cannot open/read).
 Heightmap read_asc(const std::string& path, const AscReadOptions& options = {});
 
 /// Same as read_asc from a stream; `source_name` is used in messages.

@@ -1,11 +1,13 @@
 #include "marsala/world_server/rules/world_state.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "marsala/core/deposit_shapes.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
+#include "marsala/core/mars_processor.hpp"
 
 namespace marsala::world_server {
 
@@ -67,6 +69,16 @@ WorldState world_state_at(const scenario::Scenario& scenario, Heightmap terrain,
     a.z_m = height_under(s.terrain, a.position.x, a.position.y);
     a.heading_rad = initial_heading_rad(a);
     s.agents.push_back(std::move(a));
+  }
+  // docs/runtime.md#deposit-bound: one MARS of the initial terrain, at the slope of the flattest structure any robot
+  // of the team builds (the highest bound), so every robot may build what any other builds for. Only deposits (cube
+  // and cone robots) are judged by it: a team of layer robots does not pay for it.
+  const auto deposits = [](const AgentRecord& a) { return a.type.depositor.kind != DepositorKind::kLayer; };
+  if (std::any_of(s.agents.begin(), s.agents.end(), deposits)) {
+    s.deposit_bound_kappa = construction_params(s.agents.front().type).kappa;
+    for (const AgentRecord& a : s.agents)
+      s.deposit_bound_kappa = std::min(s.deposit_bound_kappa, construction_params(a.type).kappa);
+    s.deposit_bound = MarsProcessor(s.deposit_bound_kappa).project(s.terrain);
   }
   return s;
 }

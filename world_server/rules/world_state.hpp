@@ -117,6 +117,11 @@ struct WorldState {
   std::uint32_t rejected_motions = 0;    ///< requests rejected by a motion rule (docs/runtime.md#rule-2-motion)
   std::uint64_t stall_steps = 0;         ///< the scenario's: quiet steps after which the run stalls; 0 never [steps]
   StallWatch stall;                      ///< progress and terrain activity, for the stall detector
+  /// The highest any deposit may leave a cell (docs/runtime.md#deposit-bound): the MARS bound of the initial terrain
+  /// at deposit_bound_kappa, computed once by world_state_at(), so the team's own deposits cannot raise it. Empty
+  /// when the team has no cube or cone robot, or in a state not made by world_state_at(): no bound is checked [m].
+  Heightmap deposit_bound;
+  double deposit_bound_kappa = 0.0;  ///< the smallest construction kappa of the team's robot types [m/m]
 
   /// True when `id` names an agent slot of this run.
   bool has_agent(std::uint32_t id) const { return id >= 1 && id <= agents.size(); }
@@ -135,7 +140,9 @@ void check_agent_count(const scenario::Scenario& scenario, std::uint32_t agent_c
 /// The state before its first step, from starts decided above this unit (initial_state.hpp: start jitter,
 /// completion check): `terrain`, the scenario's goal, base, tile size and completion (its check not set up yet), and
 /// slots 1..starts.size() (none admitted), slot i + 1 at starts[i] [m]. Throws InvalidArgument when starts.size() is 0
-/// or exceeds the scenario's slots, or when a cube depositor is narrower than a cell.
+/// or exceeds the scenario's slots, or when a cube depositor is narrower than a cell. When a slot's robot has a cube or
+/// cone depositor, computes the deposit bound: MARS of `terrain` at the smallest construction kappa of slots
+/// 1..starts.size() (throws InvalidArgument when MARS cannot be computed for it).
 WorldState world_state_at(const scenario::Scenario& scenario, Heightmap terrain, const std::vector<Position>& starts);
 
 /// Height of the cell under (x, y) [m], or NaN when off the grid.

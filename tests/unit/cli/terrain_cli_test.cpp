@@ -11,53 +11,20 @@
 #include <string>
 
 #include "marsala/terrain/asc_io.hpp"
+#include "unit/cli/terrain_cli_fixture.hpp"
 
 namespace marsala {
 namespace {
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
+using test::CliRun;
+using test::slurp;
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class TerrainCli : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ =
-        ::testing::TempDir() + "terrain_cli_" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + "/";
-    ASSERT_EQ(std::system(("mkdir -p '" + dir_ + "'").c_str()), 0);
-  }
-
-  std::string path(const std::string& name) const { return dir_ + name; }
-
-  CliRun run(const std::string& args) const {
-    const std::string out = path("stdout.txt"), err = path("stderr.txt");
-    const std::string command = std::string(MARSALA_TERRAIN_BIN) + " " + args + " >'" + out + "' 2>'" + err + "'";
-    const int status = std::system(command.c_str());
-    CliRun r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-  }
-
-  void write(const std::string& name, const std::string& text) const { std::ofstream(path(name)) << text; }
-
-  std::string dir_;
-};
+class TerrainCli : public test::TerrainCliFixture {};
 
 TEST_F(TerrainCli, HelpOnEverySubcommand) {
   const CliRun top = run("--help");
   EXPECT_EQ(top.exit_code, 0);
-  for (const char* sub : {"generate", "import", "info", "mars", "navigable", "render", "route"}) {
+  for (const char* sub : {"generate", "import", "info", "mars", "navigable", "render", "route", "compare"}) {
     EXPECT_NE(top.out.find(sub), std::string::npos) << sub;
     const CliRun r = run(std::string(sub) + " --help");
     EXPECT_EQ(r.exit_code, 0) << sub;

@@ -234,6 +234,27 @@ TEST(AscRead, FillsNodataWhenAllowed) {
   EXPECT_EQ(map(1, 2), 6.0);
 }
 
+TEST(AscRead, KeepsNodataAsNanWhenAsked) {
+  AscReadOptions keep;
+  keep.keep_nodata = true;
+  const Heightmap map = parse(std::string(kHeader3x2) + "NODATA_value -9999\n1 -9999 3\n4 5 -9999.0\n", keep);
+  EXPECT_TRUE(std::isnan(map(0, 1)));
+  EXPECT_TRUE(std::isnan(map(1, 2)));
+  EXPECT_EQ(map(0, 0), 1.0);
+  EXPECT_EQ(map(1, 1), 5.0);
+  // A map that knows nothing is still a map; NaN tokens stay an error.
+  const Heightmap none = parse(std::string(kHeader3x2) + "NODATA_value -1\n-1 -1 -1\n-1 -1 -1\n", keep);
+  EXPECT_TRUE(none.heights().array().isNaN().all());
+  expect_parse_error(std::string(kHeader3x2) + "NODATA_value -9999\n1 nan 3\n4 5 6\n", 7, "non-finite", keep);
+  // What write_asc writes for NaN reads back as NaN.
+  std::ostringstream out;
+  write_asc(map, out);
+  std::istringstream in(out.str());
+  const Heightmap back = parse_asc(in, "back.asc", keep);
+  EXPECT_TRUE(std::isnan(back(0, 1)));
+  EXPECT_EQ(back(1, 1), 5.0);
+}
+
 TEST(AscRead, HeaderPromisingMoreThanTheDataDoesNotAllocateIt) {
   expect_parse_error("ncols 2000000000\nnrows 2000000000\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n", 6,
                      "too few values on data row 1");

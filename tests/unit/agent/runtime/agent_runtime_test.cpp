@@ -5,13 +5,16 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <filesystem>
 #include <chrono>
 #include <functional>
 #include <future>
 #include <limits>
 #include <thread>
 
+#include "marsala/agent/runtime/map_dump.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/terrain/asc_io.hpp"
 #include "unit/agent/agent_test_support.hpp"
 
 namespace marsala::agent::runtime {
@@ -147,6 +150,56 @@ TEST(AgentRuntime, HelloAdmissionLockstepAndRunOver) {
   }
   EXPECT_NE(agent.config().session, 0u);
   EXPECT_EQ(agent.config().name, "agent-4");
+}
+
+/// A ramp builder (agent 4) dumping its map into `dir`, run against the scripted world of `domain` admitting it to
+/// run `run_id` for 3 steps (with frames or not).
+RunResult run_dumping_agent(int domain, const std::filesystem::path& dir, const std::string& run_id,
+                            bool send_frames) {
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, domain});
+  RuntimeConfig c = config(4, "ramp_builder");
+  dump_maps_into(std::make_shared<MapDump>(dir.string()), c);
+  AgentRuntime agent(*participant, c);
+  std::atomic<bool> stop{false};
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, domain});
+  ScriptedWorld world{*world_participant, 4, 0, nullptr};
+  const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+  world.run(
+      [&](const protocol::AgentHello& hello) {
+        protocol::Admission a = admission_for(hello, h);
+        a.run_id = run_id;
+        return a;
+      },
+      3, send_frames);
+  return running.get();
+}
+
+TEST(AgentRuntime, DumpsItsMapWhenTheRunIsOverAndRefusesAFolderOfAnotherRun) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "agent_runtime_dump";
+  std::filesystem::remove_all(dir);
+  const RunResult first = run_dumping_agent(121, dir, "rt", true);
+  ASSERT_EQ(first.outcome, RunOutcome::kRunOver) << first.message;
+  // The world sent every tile of its flat 0 m grid at step 0: every cell known, at 0 m.
+  const MapRecord record = read_map_record((dir / "agent-4-map.json").string());
+  EXPECT_EQ(record.run_id, "rt");
+  EXPECT_EQ(record.step, 3u);
+  EXPECT_EQ(record.known_cells, 800);
+  terrain::AscReadOptions keep;
+  keep.keep_nodata = true;
+  const Heightmap map = terrain::read_asc((dir / "agent-4-height.asc").string(), keep);
+  EXPECT_EQ(map.rows(), 20);
+  EXPECT_EQ(map.cols(), 40);
+  EXPECT_EQ(map.heights().cwiseAbs().maxCoeff(), 0.0);
+
+  // Another run ("rt2") into the same folder: refused once admitted, nothing sent, the first run's files untouched.
+  const auto before = std::filesystem::last_write_time(dir / "agent-4-height.asc");
+  const RunResult r = run_dumping_agent(122, dir, "rt2", false);
+  EXPECT_EQ(r.outcome, RunOutcome::kOutputRefused);
+  EXPECT_NE(r.message.find("agent-4-map.json holds a map of run 'rt'"), std::string::npos) << r.message;
+  EXPECT_EQ(r.requests, 0u);
+  EXPECT_EQ(read_map_record((dir / "agent-4-map.json").string()).run_id, "rt");
+  EXPECT_EQ(std::filesystem::last_write_time(dir / "agent-4-height.asc"), before);
 }
 
 TEST(AgentRuntime, IgnoresFramesNotFromItsWorldOrThatMakeNoSense) {

@@ -36,7 +36,7 @@ class PersistenceTest : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  WorldState initial() const { return make_world_state(scenario_, flat_terrain(), 3); }
+  WorldState initial() const { return make_world_state(scenario_, terrain_, 3); }
   std::string log_path() const { return (dir_ / kRunLogFile).string(); }
 
   /// Runs `steps` steps, writing run.log (and snapshot.pb after step `snapshot_after`, when > 0). Returns the state.
@@ -96,6 +96,7 @@ class PersistenceTest : public ::testing::Test {
   }
 
   scenario::Scenario scenario_;
+  Heightmap terrain_ = flat_terrain();
   fs::path dir_;
 };
 
@@ -151,6 +152,9 @@ robot_type { name: "piler" behaviour: "scripted"
   text.replace(text.find("robot_type: \"tester\" start { x_m: 2.55"), 20, "robot_type: \"cuber\"");
   text.replace(text.find("robot_type: \"tester\" start { x_m: 1.05 y_m: 3.05"), 20, "robot_type: \"piler\"");
   scenario_ = scenario::parse_scenario(text, "mixed.pbtxt");
+  // Deposits are judged against the MARS bound of the initial terrain (docs/runtime.md#deposit-bound): a 3 m tower in
+  // the south-east corner lifts it above 1.3 m everywhere, so the flat ground around the robots may be built on.
+  terrain_(39, 39) = 3.0;
   ASSERT_EQ(initial().agent(2).type.depositor.kind, DepositorKind::kCube);
   ASSERT_EQ(initial().agent(3).type.depositor.kind, DepositorKind::kCone);
   const WorldState live = record(40);

@@ -7,6 +7,7 @@
 
 #include "marsala/core/deposit_shapes.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/mars_processor.hpp"
 #include "marsala/world_server/rules/arbiter.hpp"
 #include "unit/world_server/world_fixtures.hpp"
 
@@ -54,9 +55,13 @@ const GridGeometry kGrid{40, 40, 0.0, 0.0, 0.1};
 
 class DepositsTest : public ::testing::Test {
  protected:
+  // These tests are about the shapes and rules 3d.1-3d.9 on flat ground, whose MARS bound (the flat ground itself)
+  // would refuse every deposit: their bound stands 10 m high. Rule 3d.10 has its own tests (DepositBound below).
   DepositsTest()
       : scenario_(scenario::parse_scenario(kScenario, "deposits.pbtxt")),
-        state_(admitted_state(scenario_, flat_terrain(), 3)) {}
+        state_(admitted_state(scenario_, flat_terrain(), 3)) {
+    state_.deposit_bound = flat_terrain(10.0);
+  }
   protocol::ActionRequest deposit(std::uint32_t id, std::vector<Deposit> deposits) {
     protocol::ActionRequest r = request_for(state_, id);
     r.deposits = std::move(deposits);
@@ -198,6 +203,95 @@ TEST_F(DepositsTest, ConeRulesRejectWithTheirReasons) {
   expect_rejected(deposit(2, {{3.85, 1.05, 0.01}}), "would leave the grid");
   // Any volume is fine for a cone (no whole cubes).
   EXPECT_TRUE(validate_request(state_, 2, deposit(2, {{2.85, 2.05, 0.0012345}})).accepted);
+}
+
+// Rule 3d.10 (docs/runtime.md#deposit-bound): deposits are judged against the MARS bound of the initial terrain, which
+// the team's own deposits cannot raise. The terrain: flat ground at 0 m with a one-cell hole 0.2 m deep at cell
+// (20, 28), (2.85, 1.95), 0.9 m north of the cone robot (agent 2). Its MARS bound at kappa 0.3: the hole's
+// neighbours are 0.1 m away, so P = 0 - 0.3 * 0.1 = -0.03 m over the hole and 0 m everywhere else. One cell alone
+// holds a pile until its apex reaches the neighbours' base, 0 + tan(34 deg) * 0.1 = 0.067 m: every pile below
+// (0.067 + 0.2) * 0.01 = 0.00267 m^3 fills the hole alone, its apex at -0.2 + V / 0.01 m.
+class DepositBound : public ::testing::Test {
+ protected:
+  static Heightmap holed() {
+    Heightmap h = flat_terrain();
+    h(kHole) = -0.2;
+    return h;
+  }
+  DepositBound()
+      : scenario_(scenario::parse_scenario(kScenario, "deposits.pbtxt")),
+        state_(admitted_state(scenario_, holed(), 3)) {}
+  protocol::ActionRequest pile(double volume_m3) {
+    protocol::ActionRequest r = request_for(state_, 2);
+    r.deposits = {{kGrid.cell_center(kHole).x, kGrid.cell_center(kHole).y, volume_m3}};
+    return r;
+  }
+  static constexpr CellIndex kHole{20, 28};
+  static constexpr double kBoundM = -0.03;    // P over the hole [m]
+  static constexpr double kAllowedM = 0.005;  // 0.1 eps of the cone robot's body (eps 0.05 m) [m]
+  scenario::Scenario scenario_;
+  WorldState state_;
+};
+
+TEST_F(DepositBound, IsTheInitialTerrainsMarsAtTheTeamsKappa) {
+  EXPECT_EQ(state_.deposit_bound_kappa, 0.3);
+  ASSERT_EQ(state_.deposit_bound.rows(), 40);
+  EXPECT_NEAR(state_.deposit_bound(kHole), kBoundM, 1e-9);
+  EXPECT_NEAR(state_.deposit_bound(0, 0), 0.0, 1e-12);
+  EXPECT_NEAR(state_.deposit_bound(kHole.row, kHole.col + 1), 0.0, 1e-12);
+}
+
+TEST_F(DepositBound, APileWithinTheBoundIsAcceptedOneAboveItIsRefused) {
+  // Apex -0.2 + 0.165 = -0.035 m: under the bound.
+  const Verdict under = validate_request(state_, 2, pile(0.00165));
+  ASSERT_TRUE(under.accepted) << under.reason;
+  // Apex -0.2 + 0.1745 = -0.0255 m: 0.0045 m above the bound, within 0.1 eps.
+  EXPECT_TRUE(validate_request(state_, 2, pile(0.001745)).accepted);
+  // Apex -0.2 + 0.1755 = -0.0245 m: 0.0055 m above the bound.
+  const Verdict over = validate_request(state_, 2, pile(0.001755));
+  EXPECT_FALSE(over.accepted);
+  EXPECT_EQ(over.rule, 3);
+  EXPECT_NE(over.reason.find("would leave cell (20, 28) at -0.0245"), std::string::npos) << over.reason;
+  EXPECT_NE(over.reason.find("above the deposit bound -0.03 m (MARS of the initial terrain at kappa 0.3), more than "
+                             "0.005"),
+            std::string::npos)
+      << over.reason;
+}
+
+TEST_F(DepositBound, PilesCannotRaiseTheBound) {
+  // Earlier construction (as piles judged against the current terrain left it) raised the hole's eight neighbours by
+  // 0.05 m: the current terrain's MARS over the hole is now 0.05 - 0.03 = 0.02 m, 0.05 m above the initial one.
+  for (int dr = -1; dr <= 1; ++dr)
+    for (int dc = -1; dc <= 1; ++dc)
+      if (dr != 0 || dc != 0) state_.terrain(kHole.row + dr, kHole.col + dc) += 0.05;
+  const Heightmap current_bound = MarsProcessor(0.3).project(state_.terrain);
+  ASSERT_NEAR(current_bound(kHole), 0.02, 1e-9);
+  // A pile with its apex at 0 m: 0.02 m under the current terrain's MARS, 0.03 m above the initial terrain's.
+  const DepositShape shape = cone_pile_shape(state_.terrain, kGrid.cell_center(kHole), 0.002, 34.0);
+  ASSERT_EQ(shape.rises.size(), 1u);
+  ASSERT_NEAR(state_.terrain(kHole) + shape.rises[0].rise_m, 0.0, 1e-12);
+  ASSERT_LE(state_.terrain(kHole) + shape.rises[0].rise_m, current_bound(kHole) + kAllowedM);
+  const Verdict v = validate_request(state_, 2, pile(0.002));
+  EXPECT_FALSE(v.accepted);
+  EXPECT_NE(v.reason.find("above the deposit bound -0.03 m"), std::string::npos) << v.reason;
+}
+
+TEST_F(DepositBound, ACubeColumnIsJudgedByTheSameBound) {
+  // One 0.1 m cube on flat ground 0.8 m east of agent 1: 0.1 m above the bound (0 m there).
+  protocol::ActionRequest r = request_for(state_, 1);
+  const Position at = kGrid.cell_center({30, 18});
+  r.deposits = {{at.x, at.y, 0.001}};
+  const Verdict v = validate_request(state_, 1, r);
+  EXPECT_FALSE(v.accepted);
+  EXPECT_NE(v.reason.find("above the deposit bound 0 m"), std::string::npos) << v.reason;
+}
+
+TEST(DepositBoundStart, ATeamOfLayerRobotsHasNoBound) {
+  std::string text = kScenario;
+  for (const char* kind : {"depositor { name: \"cube\" cube_size_m: 0.1 }", "depositor { name: \"cone\" repose_deg: 34 }"})
+    text.replace(text.find(kind), std::string(kind).size(), "");
+  const WorldState state = make_world_state(scenario::parse_scenario(text, "layers.pbtxt"), flat_terrain(), 3);
+  EXPECT_EQ(state.deposit_bound.size(), 0);
 }
 
 TEST(DepositorStart, ACubeNarrowerThanACellIsRefusedAtStart) {
