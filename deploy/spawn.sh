@@ -26,8 +26,9 @@
 #   --secure      DDS Security: a CA and an identity per process in OUT/security (deploy/security/make-identities.sh,
 #                 made anew each run), every process authenticated, access-controlled and encrypted (domain <= 230)
 # Exit codes: marsala-world's for a run that ended: 0 completed, 3 max_steps, 4 no_live_agents, 5 stopped by a
-#             signal (the summary is written in every case); 1 the world failed or wrote no summary or the binaries
-#             are missing; 2 usage error or a run that `marsala-world --check` rejects (nothing started); 130 stopped.
+#             signal, 6 stalled (no progress and no terrain change for the scenario's stall_steps: the account at the
+#             end says what each robot waited for) (the summary is written in every case); 1 the world failed or
+#             wrote no summary or the binaries are missing; 2 usage error or a run that `marsala-world --check` rejects (nothing started); 130 stopped.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
@@ -182,9 +183,10 @@ if [ -n "$progress_pid" ]; then
   kill -TERM "$progress_pid" 2>/dev/null || true
   wait "$progress_pid" 2>/dev/null || true
 fi
-# 0 completed, 3 max_steps, 4 no_live_agents, 5 signal: the run ended and wrote its outputs (docs/runtime.md).
+# 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled: the run ended and wrote its outputs
+# (docs/runtime.md).
 case "$world_rc" in
-  0|3|4|5) ;;
+  0|3|4|5|6) ;;
   *)
     echo "spawn.sh: marsala-world exited with $world_rc; last lines of its log:" >&2
     tail -n 20 "$out/logs/world.log" >&2

@@ -11,6 +11,7 @@
 
 #include "marsala/monitor/progress.hpp"
 #include "marsala/monitor/world_gate.hpp"
+#include "marsala/protocol/end_reason.hpp"
 
 namespace marsala::monitor {
 namespace {
@@ -81,6 +82,13 @@ class TailPrinter {
     late_events_.clear();
     print_status(*final_);
     out_ << format_run_summary(*final_) << '\n';
+    // A run that did not complete: what each robot waited for (the account of a stall, docs/runtime.md#stall).
+    const bool waiting = std::any_of(final_->agents.begin(), final_->agents.end(),
+                                     [](const protocol::AgentStatus& a) { return a.alive && !a.waiting_for.empty(); });
+    if (!final_->completed && (stalled_ || waiting)) {
+      out_ << (stalled_ ? "stalled: " : "") << "what each robot waited for at the end:\n";
+      for (const std::string& line : format_waiting(*final_)) out_ << "  " << line << '\n';
+    }
     out_.flush();
   }
 
@@ -119,7 +127,10 @@ class TailPrinter {
   }
 
   void print_event(const protocol::WorldEvent& event) {
-    if (event.kind == protocol::EventKind::kRunOver) run_over_printed_ = true;
+    if (event.kind == protocol::EventKind::kRunOver) {
+      run_over_printed_ = true;
+      stalled_ = protocol::find_end_reason(event.detail) == protocol::EndReason::kStalled;
+    }
     out_ << format_event(event, options_.format) << '\n';
   }
 
@@ -134,6 +145,7 @@ class TailPrinter {
   std::set<std::string> ignored_runs_;
   LinePacing pacing_;  ///< which step lines are printed (--every, --interval); the final one always is
   bool run_over_printed_ = false;
+  bool stalled_ = false;  ///< the run_over event named the end reason 'stalled'
 };
 
 }  // namespace

@@ -147,6 +147,16 @@ std::string format_run_summary(const protocol::WorldStatus& status) {
                      accepted, rejected, missed, progress);
 }
 
+std::vector<std::string> format_waiting(const protocol::WorldStatus& status) {
+  std::vector<std::string> lines;
+  for (const protocol::AgentStatus* a : agents_by_id(status))
+    if (a->alive)
+      lines.push_back(fmt::format("agent {} {}, {:.3f} m3 on board, at ({:.2f}, {:.2f}) m: {}", a->agent_id,
+                                  state_of(*a), a->material_m3, a->x_m, a->y_m,
+                                  a->waiting_for.empty() ? std::string("(nothing said)") : printable(a->waiting_for)));
+  return lines;
+}
+
 std::string format_event(const protocol::WorldEvent& event, const FormatOptions& options) {
   const std::string who = event.agent_id == 0 ? std::string("world") : fmt::format("agent {}", event.agent_id);
   const std::string volume =
@@ -174,6 +184,8 @@ std::vector<std::string> format_status_table(const protocol::WorldStatus& status
         "{:>3} {:<12} {:<11} {:8.2f} {:8.2f} {:7.3f} {:7.4f} {:7.4f} {:>5} {:>4} {:>4} {:<5} {:<4}", a->agent_id,
         cut(printable(a->name), 12), cut(state_of(*a), 11), a->x_m, a->y_m, a->z_m, a->material_m3, a->deposited_m3,
         a->accepted, a->rejected, a->missed, yes_no(a->alive), yes_no(a->at_goal))));
+    if (a->alive && !a->waiting_for.empty())
+      lines.push_back(fmt::format("    waiting for: {}", printable(a->waiting_for)));
     material_m3 += a->material_m3;
     deposited_m3 += a->deposited_m3;
     accepted += a->accepted;

@@ -50,6 +50,10 @@ std::string format_event(const protocol::WorldEvent& event, const FormatOptions&
 /// The status table: run line, column header, one row per agent in the order given, a totals row.
 std::vector<std::string> format_status_table(const protocol::WorldStatus& status);
 
+/// What each live agent of `status` waits for, one line each by id: "agent 3 return_to_base, 0.371 m3 on board, at
+/// (154.38, 127.62) m: no nearer the base (20.6 m) for 2510 steps" ("(nothing said)" when it said nothing).
+std::vector<std::string> format_waiting(const protocol::WorldStatus& status);
+
 /// The agents of `status` in id order (the world sends them so; sorting keeps columns and tables stable whatever
 /// arrives).
 std::vector<const protocol::AgentStatus*> agents_by_id(const protocol::WorldStatus& status);

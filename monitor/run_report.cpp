@@ -28,10 +28,25 @@ std::string why_not(const std::string& end_reason) {
       case protocol::EndReason::kMaxSteps: return "it reached its step limit (max_steps)";
       case protocol::EndReason::kNoLiveAgents: return "every agent was dropped (no_live_agents)";
       case protocol::EndReason::kSignal: return "it was stopped by a signal (signal)";
+      case protocol::EndReason::kStalled: return "it stopped making progress (stalled)";
       case protocol::EndReason::kCompleted: break;
     }
   }
   return fmt::format("it ended with '{}'", printable(end_reason));
+}
+
+/// The stall account of a summary: the quiet stretch, then one line per robot.
+std::string stall_account(const proto::StallAccount& stall) {
+  std::string out = fmt::format(
+      "  stalled: no rise of the progress and no terrain change for {} steps, since step {}; what each robot waited "
+      "for:\n",
+      stall.stall_steps(), stall.quiet_since_step());
+  for (const proto::StalledAgent& a : stall.agents())
+    out += fmt::format("    agent {} {}, {:.3f} m3 on board, at ({:.2f}, {:.2f}, {:.2f}) m: {}\n", a.agent_id(),
+                       a.state().empty() ? std::string("(no state)") : printable(a.state()), a.material_m3(), a.x_m(),
+                       a.y_m(), a.z_m(),
+                       a.waiting_for().empty() ? std::string("(nothing said)") : printable(a.waiting_for()));
+  return out;
 }
 
 }  // namespace
@@ -64,6 +79,7 @@ std::string run_report(const std::string& dir) {
   const std::string detail =
       s.progress_detail().empty() ? std::string() : fmt::format(": {}", printable(s.progress_detail()));
   out += fmt::format("  progress {:.1f} %{}\n", 100.0 * s.progress(), detail);
+  if (s.has_stall()) out += stall_account(s.stall());
 
   std::vector<std::string> pictures, others;
   std::error_code ec;

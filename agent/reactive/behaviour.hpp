@@ -34,6 +34,9 @@ class Behaviour {
   /// admission, for another agent's frame, or for a frame whose tiles do not fit the grid. On a run_over frame
   /// it returns an empty request and the behaviour is done.
   virtual protocol::ActionRequest decide(const protocol::SensorFrame& frame) = 0;
+  /// What the last decision waits for, in a few words ("front neighbour 7 at 1.4 m (hold)"); "" when nothing holds it
+  /// up. Sent in every request (ActionRequest::waiting_for) for the world's stall account.
+  virtual std::string waiting_for() const { return ""; }
   /// Where the robot believes the terrain of its next frames lies (executive::MappingSystem::set_registration);
   /// behaviours without a map ignore it.
   virtual void set_registration(CellIndex /*offset*/) {}

@@ -36,6 +36,7 @@ class NoisyLocalisation final : public Behaviour {
 
   std::string name() const override { return inner_->name(); }
   std::string state_name() const override { return inner_->state_name(); }
+  std::string waiting_for() const override { return inner_->waiting_for(); }
   void on_admission(const protocol::Admission& admission) override;
   protocol::ActionRequest decide(const protocol::SensorFrame& frame) override;
   std::optional<deliberative::KnownMap> known_map() const override { return inner_->known_map(); }

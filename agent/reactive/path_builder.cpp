@@ -76,6 +76,7 @@ protocol::ActionRequest PathBuilder::decide(const protocol::SensorFrame& frame) 
   check_frame(steps_.context(), frame);
   trace_ = PathBuilderTrace{};
   trace_.before = state_;
+  waiting_for_.clear();
   protocol::ActionRequest request = empty_request(steps_.context(), frame, "");
   if (frame.run_over || state_ == PathState::kDone) {
     state_ = PathState::kDone;
@@ -92,14 +93,27 @@ protocol::ActionRequest PathBuilder::decide(const protocol::SensorFrame& frame) 
     if (state_ != PathState::kReturnToBase && (frame.material_m3 < return_below_m3_ - 1e-12 || at_goal))
       state_ = PathState::kReturnToBase;
     if (state_ == PathState::kReturnToBase) {
-      if (steps_.return_step(view.local, frame, trace_, request)) state_ = PathState::kAdvance;
+      const double to_base_m = distance(here, steps_.context().assignment.base);
+      const int no_nearer = return_progress_.observe(to_base_m);
+      if (steps_.return_step(view.local, frame, trace_, request)) {
+        state_ = PathState::kAdvance;
+        return_progress_.reset();
+      }
+      waiting_for_ = return_waiting_text(trace_, request, close_by(frame), no_nearer, to_base_m);
     } else {
       pipeline_step(view, frame, request);
     }
   }
   trace_.after = state_;
   request.state = to_string(state_);
+  request.waiting_for = waiting_for_;
   return request;
+}
+
+std::string PathBuilder::close_by(const protocol::SensorFrame& frame) const {
+  const RobotBody& body = steps_.context().type.body;
+  return robots_close_by(frame.neighbours, {frame.x_m, frame.y_m}, 0.5 * body.navigability.delta_m,
+                         body.navigability.delta_m);
 }
 
 void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFrame& frame,
@@ -107,23 +121,36 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
   const PipelinePlace place = pipeline_.place(view.robot, view.target);
   trace_.role = place.role;
   if (place.role != PipelineRole::kActive)
-    if (const auto other = oncoming(view, frame)) return yield_step(view, other->position, request);
+    if (const auto other = oncoming(view, frame)) {
+      waiting_for_ = fmt::format("robot {} on its way back at {:.1f} m (yield)", other->agent_id,
+                                 distance(other->position, view.robot));
+      return yield_step(view, other->position, request);
+    }
   switch (place.role) {
     case PipelineRole::kActive:
       if (state_ == PathState::kRetreat) {
         state_ = state_of(steps_.retreat_step(view.local, frame, trace_, request));
       } else if (const auto phase = steps_.build_step(view.local, frame, trace_, request)) {
         state_ = state_of(*phase);
+      } else {
+        waiting_for_ = build_waiting_text(close_by(frame));
       }
       return;
-    case PipelineRole::kFollow: follow_step(view, place.front->position, request); return;
+    case PipelineRole::kFollow:
+      follow_step(view, place.front->position, request);
+      if (!request.move) waiting_for_ = front_neighbour_text(*place.front, view.robot, "follow");
+      return;
     case PipelineRole::kHold:
       state_ = PathState::kHold;
+      waiting_for_ = front_neighbour_text(*place.front, view.robot, "hold");
       // A front neighbour that stays put as long as this robot has waited may be waiting for it to make way (a
       // robot on its way back that has not got far enough to be seen returning): step aside, off its line to the base.
       if (still_steps_ >= kPatienceSteps) yield_step(view, place.front->position, request);
       return;
-    case PipelineRole::kBackOff: back_off_step(view, place.front->position, request); return;
+    case PipelineRole::kBackOff:
+      waiting_for_ = front_neighbour_text(*place.front, view.robot, "back off");
+      back_off_step(view, place.front->position, request);
+      return;
   }
 }
 

@@ -39,6 +39,7 @@
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/agent/reactive/pipeline.hpp"
 #include "marsala/agent/reactive/ramp_steps.hpp"
+#include "marsala/agent/reactive/waiting_for.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
 
 namespace marsala::agent::reactive {
@@ -93,6 +94,7 @@ class PathBuilder final : public Behaviour {
 
   std::string name() const override { return "path_builder"; }
   std::string state_name() const override { return to_string(state_); }
+  std::string waiting_for() const override { return waiting_for_; }
   void on_admission(const protocol::Admission& admission) override;
   void set_registration(CellIndex offset) override { steps_.set_registration(offset); }
   std::optional<deliberative::KnownMap> known_map() const override {
@@ -113,6 +115,7 @@ class PathBuilder final : public Behaviour {
   void back_off_step(const BuildView& view, Position front, protocol::ActionRequest& request);
   std::optional<Neighbour> oncoming(const BuildView& view, const protocol::SensorFrame& frame) const;
   void yield_step(const BuildView& view, Position from, protocol::ActionRequest& request);
+  std::string close_by(const protocol::SensorFrame& frame) const;  // robots_close_by() within a body length
 
   RampSteps steps_;
   PipelineTracker pipeline_;
@@ -121,6 +124,8 @@ class PathBuilder final : public Behaviour {
   double return_below_m3_ = 0.0;  // less material than this (one deposition task) on board: back to the base [m^3]
   PathState state_ = PathState::kWaitAdmission;
   PathBuilderTrace trace_;
+  std::string waiting_for_;         // what the last decision waits for (waiting_for.hpp), set where its state is chosen
+  ReturnProgress return_progress_;  // how long the return to the base has come no nearer
 };
 
 }  // namespace marsala::agent::reactive

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <utility>
 
 #include "marsala/core/enum_names.hpp"
@@ -58,12 +59,17 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
   check_frame(steps_.context(), frame);
   trace_ = RampBuilderTrace{};
   trace_.before = state_;
+  waiting_for_.clear();
   protocol::ActionRequest request = empty_request(steps_.context(), frame, "");
   if (frame.run_over || state_ == RampState::kDone) {
     state_ = RampState::kDone;
   } else {
     const BuildView view = steps_.look(frame, trace_);
     const deliberative::LocalMap& local = view.local;
+    const RobotBody& body = steps_.context().type.body;
+    const auto close_by = [&] {
+      return robots_close_by(frame.neighbours, view.robot, 0.5 * body.navigability.delta_m, body.navigability.delta_m);
+    };
     if (state_ == RampState::kSurvey) state_ = RampState::kAdvance;
     // At the goal: on the local goal's cell, which is the target's cell, or the nearest the robot can get to a
     // target off the grid.
@@ -74,16 +80,26 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
       if (state_ != RampState::kReturnToBase && frame.material_m3 < return_below_m3_ - 1e-12)
         state_ = RampState::kReturnToBase;
       if (state_ == RampState::kReturnToBase) {
-        if (steps_.return_step(local, frame, trace_, request)) state_ = RampState::kAdvance;
+        const Position base = steps_.context().assignment.base;
+        const double to_base_m = std::hypot(view.robot.x - base.x, view.robot.y - base.y);
+        const int no_nearer = return_progress_.observe(to_base_m);
+        if (steps_.return_step(local, frame, trace_, request)) {
+          state_ = RampState::kAdvance;
+          return_progress_.reset();
+        }
+        waiting_for_ = return_waiting_text(trace_, request, close_by(), no_nearer, to_base_m);
       } else if (state_ == RampState::kRetreat) {
         state_ = state_of(steps_.retreat_step(local, frame, trace_, request));
       } else if (const auto phase = steps_.build_step(local, frame, trace_, request)) {
         state_ = state_of(*phase);
+      } else {
+        waiting_for_ = build_waiting_text(close_by());
       }
     }
   }
   trace_.after = state_;
   request.state = to_string(state_);
+  request.waiting_for = waiting_for_;
   return request;
 }
 

@@ -35,6 +35,7 @@
 #include "marsala/agent/executive/mapping_system.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/agent/reactive/ramp_steps.hpp"
+#include "marsala/agent/reactive/waiting_for.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
 
 namespace marsala::agent::reactive {
@@ -75,6 +76,7 @@ class RampBuilder final : public Behaviour {
 
   std::string name() const override { return "ramp_builder"; }
   std::string state_name() const override { return to_string(state_); }
+  std::string waiting_for() const override { return waiting_for_; }
   void on_admission(const protocol::Admission& admission) override;
   void set_registration(CellIndex offset) override { steps_.set_registration(offset); }
   std::optional<deliberative::KnownMap> known_map() const override {
@@ -92,6 +94,8 @@ class RampBuilder final : public Behaviour {
   double return_below_m3_ = 0.0;  // less material than this (one cube) on board: back to the base [m^3]
   RampState state_ = RampState::kWaitAdmission;
   RampBuilderTrace trace_;
+  std::string waiting_for_;         // what the last decision waits for (waiting_for.hpp)
+  ReturnProgress return_progress_;  // how long the return to the base has come no nearer
 };
 
 }  // namespace marsala::agent::reactive

@@ -8,7 +8,8 @@ namespace {
 constexpr EnumName<EndReason> kEndReasonNames[] = {{EndReason::kSignal, "signal"},
                                                    {EndReason::kCompleted, "completed"},
                                                    {EndReason::kMaxSteps, "max_steps"},
-                                                   {EndReason::kNoLiveAgents, "no_live_agents"}};
+                                                   {EndReason::kNoLiveAgents, "no_live_agents"},
+                                                   {EndReason::kStalled, "stalled"}};
 
 }  // namespace
 
@@ -18,6 +19,7 @@ int exit_code(EndReason reason) {
     case EndReason::kMaxSteps: return 3;
     case EndReason::kNoLiveAgents: return 4;
     case EndReason::kSignal: return 5;
+    case EndReason::kStalled: return 6;
   }
   return 1;
 }

@@ -13,14 +13,15 @@ enum class EndReason {
   kCompleted,     ///< "completed": the scenario's completion holds
   kMaxSteps,      ///< "max_steps": the step limit was reached
   kNoLiveAgents,  ///< "no_live_agents": every admitted agent was dropped
+  kStalled,       ///< "stalled": neither progress nor terrain changed for the scenario's stall_steps steps
 };
 
 /// marsala-world's exit code for a run that ended for `reason` and wrote its outputs (docs/runtime.md#exit-codes):
-/// 0 completed, 3 max_steps, 4 no_live_agents, 5 signal. 1 (an error) and 2 (usage, or a run refused at start) are
-/// not end reasons.
+/// 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled. 1 (an error) and 2 (usage, or a run refused at
+/// start) are not end reasons.
 int exit_code(EndReason reason);
 
-/// "signal", "completed", "max_steps", "no_live_agents".
+/// "signal", "completed", "max_steps", "no_live_agents", "stalled".
 std::string to_string(EndReason reason);
 /// The reason named `name`; throws InvalidArgument listing the valid names.
 EndReason end_reason_from_string(const std::string& name);

@@ -78,6 +78,9 @@ struct ActionRequest {
   std::vector<Deposit> deposits;        ///< same, for a cube or cone depositor: the world gives them their shape
   bool refill = false;                  ///< top up material (only at the base station)
   std::string state;                    ///< the behaviour's state name, for the monitor
+  /// What keeps the robot from going on, in a few words ("front neighbour 7 at 1.4 m (hold)"); empty when nothing
+  /// does. For people (the world's stall account); the world keeps a bounded, printable copy.
+  std::string waiting_for;
 };
 
 /// One agent as the world sees it, for status and the monitor.
@@ -95,6 +98,7 @@ struct AgentStatus {
   std::uint32_t missed = 0;    ///< steps whose deadline passed without its request
   bool alive = true;
   bool at_goal = false;
+  std::string waiting_for;  ///< what its latest request said it waits for, as the world keeps it
 };
 
 /// World -> everyone, once per step (transient-local, so a late monitor sees the latest at once).

@@ -77,6 +77,12 @@ struct BaseStation {
   double radius_m = 1.0;
 };
 
+/// Default of Scenario::stall_steps: over 6 times the longest stretch without progress or terrain change of the
+/// shipped runs (317 steps, site_rough with 11 robots; README "Stalls") [steps].
+inline constexpr std::uint64_t kDefaultStallSteps = 2000;
+/// The largest stall_steps a scenario may give [steps].
+inline constexpr std::uint64_t kMaxStallSteps = 1000000000;
+
 /// A whole scenario.
 struct Scenario {
   std::string name;
@@ -94,6 +100,9 @@ struct Scenario {
   double start_jitter_m = 0.0;  ///< the world moves each start by up to this much (seeded) [m]
   BaseStation base;
   std::uint64_t max_steps = 5000;
+  /// The run ends "stalled" after this many steps without a rise of its progress or a change of its terrain; 0: never
+  /// (docs/runtime.md#stall) [steps].
+  std::uint64_t stall_steps = kDefaultStallSteps;
   double step_deadline_s = 10.0;
   std::int32_t tile_size = 16;
   std::uint64_t seed = 1;

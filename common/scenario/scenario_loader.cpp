@@ -411,6 +411,11 @@ void read_run_settings(const proto::Scenario& p, Scenario& s, const Validator& c
   }
   if (p.has_max_steps()) s.max_steps = p.max_steps();
   if (s.max_steps == 0) check.fail("max_steps", "must be >= 1");
+  if (p.has_stall_steps()) {
+    if (p.stall_steps() < 0 || static_cast<std::uint64_t>(p.stall_steps()) > kMaxStallSteps)
+      check.fail("stall_steps", fmt::format("{} must be 0 (never) or in 1..{}", p.stall_steps(), kMaxStallSteps));
+    s.stall_steps = static_cast<std::uint64_t>(p.stall_steps());
+  }
   if (p.has_step_deadline_s()) s.step_deadline_s = check.positive("step_deadline_s", p.step_deadline_s());
   if (p.has_tile_size()) s.tile_size = p.tile_size();
   if (s.tile_size < 1 || s.tile_size > 4096) check.fail("tile_size", fmt::format("{} must be in 1..4096", s.tile_size));

@@ -18,7 +18,7 @@ class Summary:
     idle_steps: int              # steps in which no robot deposited
     site_level_fraction: float   # the final level fraction (level_site runs)
     rejected_requests: int
-    end_reason: str              # completed, max_steps, no_live_agents, signal, ...
+    end_reason: str              # completed, max_steps, no_live_agents, signal, stalled
     completion: str              # the scenario's completion kind: payload_path, level_site, ...
     sites: list                  # [(from_m, to_m)] the construction sites along the payload's final path [m]
 
@@ -71,8 +71,8 @@ def csv_word(text):
 
 
 # marsala-world's exit codes for a run that ended with its summary written (spawn.sh passes them on): completed,
-# max_steps, no_live_agents, stopped by a signal (spawn.sh's --timeout).
-ENDED_EXIT_CODES = (0, 3, 4, 5)
+# max_steps, no_live_agents, stopped by a signal (spawn.sh's --timeout), stalled.
+ENDED_EXIT_CODES = (0, 3, 4, 5, 6)
 
 
 def run_summary(run_dir, exit_code):

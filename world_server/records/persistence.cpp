@@ -50,6 +50,7 @@ proto::LoggedRequest logged(const Submission& s, bool accepted, const std::vecto
     }
   q.set_refill(r.refill);
   q.set_state(r.state);
+  q.set_waiting_for(kept_waiting_for(r.waiting_for));  // bounded: run.log never grows with what an agent sends
   q.set_accepted(accepted);
   return q;
 }
@@ -70,6 +71,7 @@ Submission submission(const proto::LoggedRequest& q) {
   for (const proto::LoggedDeposit& d : q.deposits()) r.deposits.push_back({{d.x_m(), d.y_m()}, d.volume_m3()});
   r.refill = q.refill();
   r.state = q.state();
+  r.waiting_for = q.waiting_for();
   return s;
 }
 
@@ -168,6 +170,9 @@ proto::Snapshot make_snapshot(const WorldState& state, const std::string& run_id
   s.set_close_passes(state.close_passes);
   s.set_overlap_pair_steps(state.overlap_pair_steps);
   s.set_rejected_motions(state.rejected_motions);
+  s.set_stall_best_progress(state.stall.best_progress);
+  s.set_stall_quiet_since(state.stall.quiet_since);
+  s.set_stall_longest_quiet(state.stall.longest_quiet);
   s.set_check_met(state.check.met);
   s.set_check_level_fraction(state.check.level_fraction);
   s.set_check_evaluations(state.check.evaluations);
@@ -199,6 +204,7 @@ proto::Snapshot make_snapshot(const WorldState& state, const std::string& run_id
     p->set_deposited_m3(a.deposited_m3);
     p->set_at_goal(a.at_goal);
     p->set_state(a.state);
+    p->set_waiting_for(a.waiting_for);
     p->set_last_result(static_cast<std::uint32_t>(a.last_result));
     p->set_last_reason(a.last_reason);
     p->set_heading_rad(a.heading_rad);
@@ -255,6 +261,9 @@ void restore_snapshot(WorldState& state, const proto::Snapshot& s, const std::st
   state.close_passes = s.close_passes();
   state.overlap_pair_steps = s.overlap_pair_steps();
   state.rejected_motions = s.rejected_motions();
+  state.stall.best_progress = s.stall_best_progress();
+  state.stall.quiet_since = s.stall_quiet_since();
+  state.stall.longest_quiet = s.stall_longest_quiet();
   state.unattributed_rejections = s.unattributed_rejections();
   state.surplus_requests = s.surplus_requests();
   state.resumes = s.resumes();
@@ -283,6 +292,7 @@ void restore_snapshot(WorldState& state, const proto::Snapshot& s, const std::st
     a.deposited_m3 = p.deposited_m3();
     a.at_goal = p.at_goal();
     a.state = p.state();
+    a.waiting_for = p.waiting_for();
     a.last_result = static_cast<protocol::ActionResult>(p.last_result());
     a.last_reason = p.last_reason();
     if (p.has_heading_rad() && !std::isfinite(p.heading_rad()))

@@ -91,6 +91,24 @@ struct WorldBox {
   }
 };
 
+/// The stall account of summary.json: the quiet stretch and every live robot as it stood.
+void fill_stall_account(const WorldState& state, proto::StallAccount& account) {
+  account.set_stall_steps(static_cast<std::uint32_t>(state.stall_steps));
+  account.set_quiet_since_step(static_cast<std::uint32_t>(state.stall.quiet_since));
+  account.set_best_progress(state.stall.best_progress);
+  for (const AgentRecord& a : state.agents) {
+    if (!a.alive) continue;
+    proto::StalledAgent* p = account.add_agents();
+    p->set_agent_id(a.id);
+    p->set_state(a.state);
+    p->set_material_m3(a.material_m3);
+    p->set_x_m(a.position.x);
+    p->set_y_m(a.position.y);
+    p->set_z_m(a.z_m);
+    p->set_waiting_for(a.waiting_for);
+  }
+}
+
 /// "140.25" (no trailing zeros, no rounding noise of the cell arithmetic).
 std::string summary_text(const WorldState& state, const RunInfo& info, const FinalTerrainReport& report) {
   proto::RunSummary s;
@@ -136,6 +154,7 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
     p->set_z_m(a.z_m);
     p->set_material_m3(a.material_m3);
     p->set_state(a.state);
+    p->set_waiting_for(a.waiting_for);
   }
   s.set_admitted(admitted);
   s.set_dropped(dropped);
@@ -153,6 +172,9 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_close_passes(state.close_passes);
   s.set_overlap_pair_steps(state.overlap_pair_steps);
   s.set_rejected_motions(state.rejected_motions);
+  s.set_stall_steps(static_cast<std::uint32_t>(state.stall_steps));
+  s.set_longest_quiet_steps(static_cast<std::uint32_t>(state.stall.longest_quiet));
+  if (info.end_reason == protocol::EndReason::kStalled) fill_stall_account(state, *s.mutable_stall());
   std::uint32_t readmissions = 0;
   for (const AgentRecord& a : state.agents) readmissions += a.readmissions;
   s.set_readmissions(readmissions);

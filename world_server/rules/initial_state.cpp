@@ -16,6 +16,7 @@ WorldState make_world_state(const scenario::Scenario& scenario, Heightmap terrai
                                     scenario.start_jitter_m, scenario.seed));
   WorldState state = world_state_at(scenario, std::move(terrain), starts);
   start_completion_check(state);
+  state.stall.best_progress = progress(state);  // a rise counts from where the run starts
   return state;
 }
 

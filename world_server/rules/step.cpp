@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bitset>
+#include <string>
 
 #include "marsala/core/format.hpp"
 #include "marsala/world_server/rules/arbiter.hpp"
@@ -68,6 +69,7 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
     answered = true;
     first = r;
     agent.state = r->state.substr(0, kMaxStateChars);
+    agent.waiting_for = kept_waiting_for(r->waiting_for);
     const Verdict verdict = validate_request(state, agent.id, *r);
     if (verdict.accepted) {
       apply_request(state, *r, verdict, changed_cells);
@@ -182,8 +184,18 @@ StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submiss
     }
   }
   out.completed = is_completed(state);
+  observe_step(state.stall, state.step, progress(state), !changed_cells.empty());
   ++state.step;
   return out;
+}
+
+std::string kept_waiting_for(const std::string& text) {
+  std::string kept = text.substr(0, kMaxWaitingForChars);
+  for (char& ch : kept) {
+    const auto byte = static_cast<unsigned char>(ch);
+    if (byte < 0x20 || byte > 0x7e) ch = '?';
+  }
+  return kept;
 }
 
 StepOutcome apply_step(WorldState& state, const std::vector<protocol::ActionRequest>& requests) {

@@ -50,8 +50,15 @@ struct StepOutcome {
 /// counts in state.idle_steps. Then z of every agent, tile versions, at_goal (event kAtGoal when reached); for
 /// payload_path and level_site runs the changed cells are recorded in the completion check, which is evaluated when
 /// (step + 1) % check_every_steps == 0 and the terrain of its area changed since its previous evaluation; then
-/// completion; finally state.step += 1.
+/// completion; the stall detector observes the step (progress after it, terrain changed); finally state.step += 1.
 StepOutcome apply_step(WorldState& state, const std::vector<Submission>& submissions);
+
+/// The longest waiting_for the world keeps of a request [characters].
+inline constexpr std::size_t kMaxWaitingForChars = 160;
+
+/// What the world keeps of a request's waiting_for (docs/runtime.md#stall): its first kMaxWaitingForChars bytes,
+/// each byte outside printable ASCII (0x20..0x7e) replaced by '?'. Idempotent.
+std::string kept_waiting_for(const std::string& text);
 
 /// Same, with each request taken as arriving on its own agent's partition (channel = request.agent_id).
 StepOutcome apply_step(WorldState& state, const std::vector<protocol::ActionRequest>& requests);

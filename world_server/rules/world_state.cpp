@@ -43,6 +43,7 @@ WorldState world_state_at(const scenario::Scenario& scenario, Heightmap terrain,
   s.base = scenario.base;
   s.tile_size = scenario.tile_size;
   s.seed = scenario.seed;
+  s.stall_steps = scenario.stall_steps;
   s.tile_versions.assign(static_cast<std::size_t>(s.tiles().tile_count()), 0);
   s.depositor = AgentIdGrid::Zero(s.terrain.rows(), s.terrain.cols());
   s.completion = scenario.completion;

@@ -12,6 +12,7 @@
 #include "marsala/protocol/messages.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/world_server/rules/occupancy_cache.hpp"
+#include "marsala/world_server/rules/stall_watch.hpp"
 #include "marsala/world_server/rules/tile_layout.hpp"
 
 namespace marsala::world_server {
@@ -46,6 +47,7 @@ struct AgentRecord {
   double deposited_m3 = 0.0;        ///< material placed [m^3]
   bool at_goal = false;
   std::string state;  ///< the behaviour's state from its latest request
+  std::string waiting_for;  ///< what its latest request said it waits for, bounded and printable (step.hpp)
 
   protocol::ActionResult last_result = protocol::ActionResult::kNone;  ///< for its next frame
   std::string last_reason;
@@ -113,6 +115,8 @@ struct WorldState {
   std::uint64_t close_passes = 0;        ///< pairs of robots whose bodies began to overlap in a step [count]
   std::uint64_t overlap_pair_steps = 0;  ///< (step, pair) with overlapping bodies after the step [count]
   std::uint32_t rejected_motions = 0;    ///< requests rejected by a motion rule (docs/runtime.md#rule-2-motion)
+  std::uint64_t stall_steps = 0;         ///< the scenario's: quiet steps after which the run stalls; 0 never [steps]
+  StallWatch stall;                      ///< progress and terrain activity, for the stall detector
   /// The highest any deposit may leave a cell (docs/runtime.md#deposit-bound): the MARS bound of the initial terrain
   /// at deposit_bound_kappa, computed once by world_state_at(), so the team's own deposits cannot raise it. Empty
   /// when the team has no cube or cone robot, or in a state not made by world_state_at(): no bound is checked [m].

@@ -139,6 +139,7 @@ proto::ScenarioCheck to_message(const WorldStart& start) {
   set_point(m.mutable_base(), state.base.centre.x, state.base.centre.y);
   m.set_base_radius_m(state.base.radius_m);
   m.set_max_steps(start.options.max_steps);
+  m.set_stall_steps(s.stall_steps);
   m.set_seed(s.seed);
   m.set_start_jitter_m(s.start_jitter_m);
   m.set_step_deadline_s(start.options.step_deadline_s);
@@ -225,9 +226,10 @@ std::string scenario_check_text(const WorldStart& start) {
   }
   out << "base: " << point(state.base.centre.x, state.base.centre.y) << " m, radius " << number(state.base.radius_m)
       << " m\n";
-  out << "max_steps " << start.options.max_steps << ", seed " << s.seed << ", start_jitter_m "
-      << number(s.start_jitter_m) << ", step_deadline_s " << number(start.options.step_deadline_s) << ", tile_size "
-      << state.tile_size << ", run id " << start.options.run_id << "\n";
+  out << "max_steps " << start.options.max_steps << ", stall_steps " << s.stall_steps << ", seed " << s.seed
+      << ", start_jitter_m " << number(s.start_jitter_m) << ", step_deadline_s "
+      << number(start.options.step_deadline_s) << ", tile_size " << state.tile_size << ", run id "
+      << start.options.run_id << "\n";
   return out.str();
 }
 

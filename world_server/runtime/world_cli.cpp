@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <ostream>
+#include <utility>
 
 #include "marsala/bus/bus.hpp"
 #include "marsala/cli/command_line.hpp"
@@ -16,6 +17,18 @@
 #include "marsala/world_server/runtime/world_runtime.hpp"
 
 namespace marsala::world_server {
+namespace {
+
+/// The start of a new run of `scenario_path`: the scenario read, parsed and checked as --check does, the terrain
+/// built, a previous run's files removed from --out with --replace. Throws what the world refuses at start.
+WorldStart fresh_start(const std::string& scenario_path, RuntimeOptions options, int domain) {
+  options.scenario_text = scenario::read_scenario_text(scenario_path);
+  if (options.replace) clear_run_files(options.out_dir);
+  const scenario::Scenario scenario = scenario::parse_scenario(options.scenario_text, scenario_path, options.overrides);
+  return prepare_world_start(scenario, scenario::build_terrain(scenario), std::move(options), domain);
+}
+
+}  // namespace
 
 int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& stop, std::ostream& out,
                   std::ostream& err) {
@@ -29,7 +42,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       "DDS, prints what the run would start from and exits 0 when valid, 2 when not.\n"
       "Every run also writes run.log (every accepted change, checksummed) and snapshot.pb; after a crash,\n"
       "marsala-world --resume DIR continues the run in DIR with its agents (docs/runtime.md#resume).\n"
-      "Exit codes: 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 1 error, 2 usage.",
+      "Exit codes: 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled, 1 error, 2 usage or a\n"
+      "scenario the world refuses at start (as --check).",
       "marsala-world"};
   std::string scenario_path, check_path, resume_dir;
   cli::DdsOptions dds;
@@ -105,11 +119,12 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
     if (!resume_dir.empty()) {
       start = prepare_resume(resume_dir, options, dds.domain);
     } else {
-      options.scenario_text = scenario::read_scenario_text(scenario_path);
-      if (options.replace) clear_run_files(options.out_dir);
-      const scenario::Scenario scenario =
-          scenario::parse_scenario(options.scenario_text, scenario_path, options.overrides);
-      start = prepare_world_start(scenario, scenario::build_terrain(scenario), options, dds.domain);
+      try {
+        start = fresh_start(scenario_path, options, dds.domain);
+      } catch (const Error& e) {  // refused at start, as --check refuses it (docs/runtime.md#exit-codes)
+        cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+        return kExitInvalidScenario;
+      }
     }
     const auto participant =
         bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,

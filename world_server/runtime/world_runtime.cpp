@@ -77,6 +77,7 @@ protocol::WorldStatus world_status(const WorldState& state, bool running, bool c
     as.missed = a.missed;
     as.alive = a.alive;
     as.at_goal = a.alive && at_goal(state, a);
+    as.waiting_for = a.waiting_for;
     s.agents.push_back(std::move(as));
   }
   return s;
@@ -397,6 +398,7 @@ struct WorldRuntime::Impl {
     if (is_completed(state)) return protocol::EndReason::kCompleted;
     if (state.step >= options.max_steps) return protocol::EndReason::kMaxSteps;
     if (state.live_ids().empty()) return protocol::EndReason::kNoLiveAgents;
+    if (stalled(state.stall, state.step, state.stall_steps)) return protocol::EndReason::kStalled;
     return std::nullopt;
   }
 
@@ -499,6 +501,17 @@ struct WorldRuntime::Impl {
     reconnect_agents(stop);
   }
 
+  /// A stalled run: why, in the log and events.log, with one line per live robot (docs/runtime.md#stall).
+  void report_stall() {
+    note(fmt::format("stalled: no rise of the progress ({:.4f}) and no terrain change for {} steps, since step {}",
+                     state.stall.best_progress, quiet_steps(state.stall, state.step), state.stall.quiet_since));
+    for (const AgentRecord& a : state.agents)
+      if (a.alive)
+        note(fmt::format("stalled: agent {} {} with {:.3f} m3 at {}, waiting for: {}", a.id,
+                         a.state.empty() ? std::string("(no state)") : a.state, a.material_m3, a.position,
+                         a.waiting_for.empty() ? std::string("(nothing said)") : a.waiting_for));
+  }
+
   /// What summary.json reports besides the state.
   RunInfo run_info(protocol::EndReason end_reason, double wall_seconds, double cpu_ms) const {
     RunInfo info;
@@ -533,6 +546,7 @@ struct WorldRuntime::Impl {
     publish_status(true, false, 0.0);
     const protocol::EndReason end_reason = lockstep(stop, start);
     const double cpu_steps_ms = process_cpu_ms() - cpu_before_ms;
+    if (end_reason == protocol::EndReason::kStalled) report_stall();
 
     RunResult result;
     result.end_reason = end_reason;

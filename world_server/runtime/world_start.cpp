@@ -17,6 +17,7 @@
 #include "marsala/world_server/records/persistence.hpp"
 #include "marsala/world_server/records/run_outputs.hpp"
 #include "marsala/world_server/rules/initial_state.hpp"
+#include "marsala/world_server/rules/team_fit.hpp"
 
 namespace marsala::world_server {
 
@@ -60,6 +61,8 @@ WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, R
       throw InvalidArgument(
           fmt::format("scenario {}: robot type '{}': construction kappa: {}", s.source_path, type.name, problem));
   }
+  if (const std::string problem = team_fit_problem(s, terrain, agents); !problem.empty())
+    throw InvalidArgument(fmt::format("the team does not fit on its base: {}", problem));
   if (!o.out_dir.empty() && !o.replace) check_fresh_output_dir(o.out_dir);
   start.state = make_world_state(start.scenario, std::move(terrain), agents);
   return start;

@@ -242,6 +242,7 @@ marsala_wire_ActionRequest to_msg(const ActionRequest& in, Storage& storage) {
   out.deposits = borrow_seq<dds_sequence_marsala_wire_Deposit>(storage.deposits);
   out.refill = in.refill;
   out.state = borrow(in.state);
+  out.waiting_for = borrow(in.waiting_for);
   return out;
 }
 
@@ -272,6 +273,7 @@ ActionRequest from_msg(const marsala_wire_ActionRequest& in) {
   }
   out.refill = in.refill;
   out.state = copy(in.state);
+  out.waiting_for = copy(in.waiting_for);
   return out;
 }
 
@@ -294,6 +296,7 @@ marsala_wire_WorldStatus to_msg(const WorldStatus& in, Storage& storage) {
     agent.agent_id = a.agent_id;
     agent.name = borrow(a.name);
     agent.state = borrow(a.state);
+    agent.waiting_for = borrow(a.waiting_for);
     agent.x_m = a.x_m;
     agent.y_m = a.y_m;
     agent.z_m = a.z_m;
@@ -330,6 +333,7 @@ WorldStatus from_msg(const marsala_wire_WorldStatus& in) {
     agent.agent_id = a.agent_id;
     agent.name = copy(a.name);
     agent.state = copy(a.state);
+    agent.waiting_for = copy(a.waiting_for);
     agent.x_m = a.x_m;
     agent.y_m = a.y_m;
     agent.z_m = a.z_m;

@@ -215,6 +215,7 @@ wire::ActionRequest to_msg(const ActionRequest& in) {
   }
   out.refill(in.refill);
   out.state(in.state);
+  out.waiting_for(in.waiting_for);
   return out;
 }
 
@@ -243,6 +244,7 @@ ActionRequest from_msg(const wire::ActionRequest& in) {
   }
   out.refill = in.refill();
   out.state = in.state();
+  out.waiting_for = in.waiting_for();
   return out;
 }
 
@@ -265,6 +267,7 @@ wire::WorldStatus to_msg(const WorldStatus& in) {
     agent.agent_id(a.agent_id);
     agent.name(a.name);
     agent.state(a.state);
+    agent.waiting_for(a.waiting_for);
     agent.x_m(a.x_m);
     agent.y_m(a.y_m);
     agent.z_m(a.z_m);
@@ -299,6 +302,7 @@ WorldStatus from_msg(const wire::WorldStatus& in) {
     agent.agent_id = a.agent_id();
     agent.name = a.name();
     agent.state = a.state();
+    agent.waiting_for = a.waiting_for();
     agent.x_m = a.x_m();
     agent.y_m = a.y_m();
     agent.z_m = a.z_m();

@@ -278,6 +278,27 @@ TEST_F(RunReport, ARunThatDidNotCompleteSaysWhy) {
   EXPECT_NE(report.find("progress 87.3 %: site 87.3 % level (100.0 % needed)\n"), std::string::npos) << report;
 }
 
+TEST_F(RunReport, AStalledRunTellsWhatEachRobotWaitedFor) {
+  write_summary(R"json({"scenario": "path_gale", "completed": false, "end_reason": "stalled", "steps": 6621,
+    "wall_seconds": 70.0, "agents": 2, "admitted": 2, "completion": "payload_path", "progress": 0.035,
+    "stall": {"stall_steps": 2000, "quiet_since_step": 4621, "best_progress": 0.035, "agents": [
+      {"agent_id": 1, "state": "return_to_base", "material_m3": 0.947, "x_m": 151.125, "y_m": 127.375, "z_m": 17.68,
+       "waiting_for": "no nearer the base (18.9 m) for 2565 steps: robots 2 at 1.2 m close by"},
+      {"agent_id": 2, "state": "hold\u0007", "material_m3": 1, "x_m": 152.375, "y_m": 127.375, "z_m": 17.45}]}})json");
+  const std::string report = run_report(dir_.string());
+  EXPECT_EQ(report.substr(0, report.find('\n')),
+            "path_gale did not complete: it stopped making progress (stalled), after 6621 steps in 70.0 s (admission "
+            "0.0 s)");
+  EXPECT_NE(
+      report.find("  stalled: no rise of the progress and no terrain change for 2000 steps, since step 4621; "
+                  "what each robot waited for:\n"
+                  "    agent 1 return_to_base, 0.947 m3 on board, at (151.12, 127.38, 17.68) m: no nearer the base "
+                  "(18.9 m) for 2565 steps: robots 2 at 1.2 m close by\n"
+                  "    agent 2 hold?, 1.000 m3 on board, at (152.38, 127.38, 17.45) m: (nothing said)\n"),
+      std::string::npos)
+      << report;
+}
+
 TEST_F(RunReport, AMissingOrBrokenSummaryIsAnErrorNamingTheFile) {
   EXPECT_THROW(run_report(dir_.string()), IoError);
   write_summary("{\"steps\": \"many\"");

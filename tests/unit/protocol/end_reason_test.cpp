@@ -11,7 +11,8 @@ TEST(EndReason, NamesAreTheDocumentedStringsAndReadBack) {
   const std::pair<EndReason, const char*> names[] = {{EndReason::kSignal, "signal"},
                                                      {EndReason::kCompleted, "completed"},
                                                      {EndReason::kMaxSteps, "max_steps"},
-                                                     {EndReason::kNoLiveAgents, "no_live_agents"}};
+                                                     {EndReason::kNoLiveAgents, "no_live_agents"},
+                                                     {EndReason::kStalled, "stalled"}};
   for (const auto& [reason, name] : names) {
     EXPECT_EQ(to_string(reason), name);
     EXPECT_EQ(end_reason_from_string(name), reason);
@@ -23,6 +24,7 @@ TEST(EndReason, ExitCodesSayHowTheRunEnded) {
   EXPECT_EQ(exit_code(EndReason::kMaxSteps), 3);
   EXPECT_EQ(exit_code(EndReason::kNoLiveAgents), 4);
   EXPECT_EQ(exit_code(EndReason::kSignal), 5);
+  EXPECT_EQ(exit_code(EndReason::kStalled), 6);
 }
 
 TEST(EndReason, AnUnknownNameListsTheValidOnes) {
@@ -30,7 +32,8 @@ TEST(EndReason, AnUnknownNameListsTheValidOnes) {
     end_reason_from_string("finished");
     FAIL() << "no throw";
   } catch (const InvalidArgument& e) {
-    EXPECT_STREQ(e.what(), "unknown end reason 'finished'; valid: signal, completed, max_steps, no_live_agents");
+    EXPECT_STREQ(e.what(),
+                 "unknown end reason 'finished'; valid: signal, completed, max_steps, no_live_agents, stalled");
   }
   EXPECT_EQ(to_string(static_cast<EndReason>(42)), "unknown");
 }

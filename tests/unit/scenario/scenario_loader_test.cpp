@@ -414,5 +414,19 @@ TEST(ScenarioLoader, BadSensorsNameTheRobotTypeAndField) {
   EXPECT_NE(what.find("robot_type[0].sensor: ground_truth takes no parameters"), std::string::npos) << what;
 }
 
+TEST(ScenarioLoader, StallStepsDefaultsAndRange) {
+  EXPECT_EQ(parse_scenario(kMinimal, "t.pbtxt").stall_steps, kDefaultStallSteps);
+  EXPECT_EQ(parse_scenario(std::string(kMinimal) + "stall_steps: 0", "t.pbtxt").stall_steps, 0u);  // never
+  EXPECT_EQ(parse_scenario(std::string(kMinimal) + "stall_steps: 1", "t.pbtxt").stall_steps, 1u);
+  EXPECT_EQ(parse_scenario(std::string(kMinimal) + "stall_steps: 1000000000", "t.pbtxt").stall_steps, 1000000000u);
+  EXPECT_EQ(parse_scenario(kMinimal, "t.pbtxt", {"stall_steps=25"}).stall_steps, 25u);
+  // One line naming the field, for a negative and an absurd value, from the file and from --set.
+  EXPECT_EQ(invalid(std::string(kMinimal) + "stall_steps: -5"),
+            "scenario t.pbtxt: stall_steps: -5 must be 0 (never) or in 1..1000000000");
+  EXPECT_EQ(invalid(std::string(kMinimal) + "stall_steps: 1000000001"),
+            "scenario t.pbtxt: stall_steps: 1000000001 must be 0 (never) or in 1..1000000000");
+  EXPECT_NE(invalid_override({"stall_steps=-1"}).find("stall_steps: -1 must be 0 (never)"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace marsala::scenario

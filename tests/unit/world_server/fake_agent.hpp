@@ -106,6 +106,7 @@ class FakeAgent {
     r.session = config_.session;
     r.step = f.step;
     r.state = "walking";
+    r.waiting_for = "its target\n";  // the world keeps it printable
     const double dx = a.assignment.target.x - f.x_m, dy = a.assignment.target.y - f.y_m;
     const double d = std::sqrt(dx * dx + dy * dy);
     if (d > 0.0) {

@@ -79,6 +79,7 @@ class PersistenceTest : public ::testing::Test {
           r.target_y_m = a.position.y;
         }
         r.refill = random() % 7 == 0;
+        if (k % 3 == 0) r.waiting_for = "waits\x01 in step " + std::to_string(k);  // kept as "waits? in step k"
         submissions.push_back({id, r});
         if (random() % 11 == 0) submissions.push_back({id, r});  // a duplicate, rejected
       }
@@ -198,6 +199,26 @@ TEST_F(PersistenceTest, ASnapshotAndTheLogAfterItRebuildTheSameState) {
       apply_step(*w, std::vector<protocol::ActionRequest>{r});
     }
     EXPECT_EQ(fingerprint(a), fingerprint(b)) << k;
+  }
+}
+
+// The stall watch and what each agent waits for (docs/runtime.md#stall) are state: a snapshot and the log after it
+// rebuild them, so a resumed run stalls at the step the uninterrupted one would.
+TEST_F(PersistenceTest, TheStallWatchAndWaitingForSurviveASnapshotAndTheLog) {
+  const WorldState live = record(40, 23);
+  EXPECT_GT(live.stall.longest_quiet, 0u);
+  EXPECT_GT(live.stall.best_progress, 0.0);
+  EXPECT_EQ(live.agent(1).waiting_for, "waits? in step 39");
+  for (const bool with_snapshot : {true, false}) {
+    if (!with_snapshot) fs::remove(dir_ / kSnapshotFile);
+    runlog::RunLogReader reader(log_path());
+    const RebuiltState rebuilt = rebuild_state(dir_.string(), initial(), reader);
+    EXPECT_EQ(rebuilt.snapshot_step, with_snapshot ? 23u : 0u);
+    EXPECT_EQ(rebuilt.state.stall.quiet_since, live.stall.quiet_since);
+    EXPECT_EQ(rebuilt.state.stall.longest_quiet, live.stall.longest_quiet);
+    EXPECT_EQ(rebuilt.state.stall.best_progress, live.stall.best_progress);
+    for (std::uint32_t id = 1; id <= 3; ++id)
+      EXPECT_EQ(rebuilt.state.agent(id).waiting_for, live.agent(id).waiting_for) << "agent " << id;
   }
 }
 

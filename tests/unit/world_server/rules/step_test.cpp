@@ -395,5 +395,35 @@ TEST(ApplyStep, ReachingTheGoalCompletesTheRun) {
   EXPECT_THROW(drop_agent(w, 9, "test"), InvalidArgument);
 }
 
+TEST(ApplyStep, KeepsABoundedPrintableWaitingFor) {
+  const scenario::Scenario s = small_scenario();
+  WorldState state = admitted_state(s, flat_terrain(), 2);
+  protocol::ActionRequest one = request_for(state, 1), two = request_for(state, 2);
+  one.waiting_for = "front neighbour 2 at 1.5 m (hold)";
+  two.waiting_for = std::string("bell\a tab\t \xff") + std::string(100000, 'x');
+  apply_step(state, std::vector<protocol::ActionRequest>{one, two});
+  EXPECT_EQ(state.agent(1).waiting_for, "front neighbour 2 at 1.5 m (hold)");
+  const std::string& kept = state.agent(2).waiting_for;
+  ASSERT_EQ(kept.size(), kMaxWaitingForChars);
+  EXPECT_EQ(kept.substr(0, 13), "bell? tab? ?x");
+  EXPECT_TRUE(std::all_of(kept.begin(), kept.end(), [](char c) { return c >= 0x20 && c <= 0x7e; }));
+  EXPECT_EQ(kept_waiting_for(kept), kept);  // idempotent: run.log keeps what the state keeps
+}
+
+TEST(ApplyStep, TheStallDetectorSeesDepositsButNotMotions) {
+  const scenario::Scenario s = small_scenario("stall_steps: 3\n");
+  WorldState state = admitted_state(s, flat_terrain(), 1);
+  EXPECT_EQ(state.stall_steps, 3u);
+  apply_step(state, std::vector<protocol::ActionRequest>{move_to(state, 1, 1.25, 1.05)});
+  apply_step(state, std::vector<protocol::ActionRequest>{move_to(state, 1, 1.45, 1.05)});
+  EXPECT_EQ(quiet_steps(state.stall, state.step), 2u);  // motions are no progress (agents_at_goal: none there)
+  apply_step(state, std::vector<protocol::ActionRequest>{with_deposition(request_for(state, 1), 2.15, 1.05, kLayer)});
+  EXPECT_EQ(quiet_steps(state.stall, state.step), 0u);
+  for (int i = 0; i < 3; ++i) apply_step(state, std::vector<protocol::ActionRequest>{request_for(state, 1)});
+  EXPECT_TRUE(stalled(state.stall, state.step, state.stall_steps));
+  EXPECT_EQ(state.stall.quiet_since, 3u);
+  EXPECT_EQ(state.stall.longest_quiet, 3u);
+}
+
 }  // namespace
 }  // namespace marsala::world_server

@@ -76,21 +76,23 @@ TEST_F(ScenarioCheckTest, TheRampScenarioIsValidAndReportedInFull) {
   const std::string ramp = shipped("ramp.pbtxt");
   ASSERT_EQ(run({"--check", ramp}), 0) << err_.str();
   EXPECT_EQ(err_.str(), "");
-  EXPECT_EQ(out_.str(),
-            "scenario ramp (" + ramp +
-                "): valid\n"
-                "terrain: 200 x 300 cells of 0.1 m, x [0, 30] y [0, 20] m, heights [0, 1.5] m (generator platform)\n"
-                "robot types (1):\n"
-                "  husky: behaviour ramp_builder, kappa 0.3, delta_m 1, eps_m 0.05, max_step_m 0.2, cube_size_m 0.05, "
-                "goal_synthesizer fixed_target, sensor ground_truth, depositor layer\n"
-                "slots (3; the world waits for agents 1..3):\n"
-                "  1 husky: start (5.05, 7.05) target (22.05, 7.05)\n"
-                "  2 husky: start (5.05, 10.05) target (22.05, 10.05)\n"
-                "  3 husky: start (5.05, 13.05) target (22.05, 13.05)\n"
-                "completion: agents_at_goal, goal x [18, 28] y [3, 17] m, min_height_m 1.4, each agent within 0.25 m of its "
-                "target\n"
-                "base: (3.05, 10.05) m, radius 1.5 m\n"
-                "max_steps 4000, seed 1, start_jitter_m 0, step_deadline_s 10, tile_size 16, run id ramp-d0\n");
+  EXPECT_EQ(
+      out_.str(),
+      "scenario ramp (" + ramp +
+          "): valid\n"
+          "terrain: 200 x 300 cells of 0.1 m, x [0, 30] y [0, 20] m, heights [0, 1.5] m (generator platform)\n"
+          "robot types (1):\n"
+          "  husky: behaviour ramp_builder, kappa 0.3, delta_m 1, eps_m 0.05, max_step_m 0.2, cube_size_m 0.05, "
+          "goal_synthesizer fixed_target, sensor ground_truth, depositor layer\n"
+          "slots (3; the world waits for agents 1..3):\n"
+          "  1 husky: start (5.05, 7.05) target (22.05, 7.05)\n"
+          "  2 husky: start (5.05, 10.05) target (22.05, 10.05)\n"
+          "  3 husky: start (5.05, 13.05) target (22.05, 13.05)\n"
+          "completion: agents_at_goal, goal x [18, 28] y [3, 17] m, min_height_m 1.4, each agent within 0.25 m of its "
+          "target\n"
+          "base: (3.05, 10.05) m, radius 1.5 m\n"
+          "max_steps 4000, stall_steps 2000, seed 1, start_jitter_m 0, step_deadline_s 10, tile_size 16, run id "
+          "ramp-d0\n");
   // --scenario FILE works as well as the positional SCENARIO.
   const std::string positional = out_.str();
   ASSERT_EQ(run({"--check", "--scenario", ramp}), 0) << err_.str();

@@ -19,7 +19,26 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using WorldCliTest = testing::WorldCliFixture;
+/// The command-line fixture with a walking fake agent beside the world.
+class WorldCliTest : public testing::WorldCliFixture {
+ protected:
+  /// Runs marsala-world with `args` on the in-process bus of `domain` beside one walking fake agent in slot 1 of the
+  /// small scenario (--agents 1 --quiet added); returns the world's exit code.
+  int run_beside_walker(int domain, std::vector<std::string> args) {
+    args.insert(args.end(), {"--agents", "1", "--dds", "inprocess", "--domain", std::to_string(domain), "--quiet"});
+    int rc = -1;
+    std::thread world([&] { rc = run(args); });
+    testing::FakeAgentConfig c;
+    c.domain = domain;
+    c.id = 1;
+    c.session = 5;
+    c.body = testing::small_scenario().robot_for(1).body;
+    testing::FakeAgent agent(c);
+    world.join();
+    agent.join();
+    return rc;
+  }
+};
 
 TEST_F(WorldCliTest, UsageErrorsExitWith2) {
   EXPECT_EQ(run({}), 2);
@@ -49,16 +68,16 @@ TEST_F(WorldCliTest, ResumingAFolderWithoutARunLogIsAnError) {
   EXPECT_NE(err_.str().find("no run.log there"), std::string::npos) << err_.str();
 }
 
-TEST_F(WorldCliTest, BadScenariosExitWith1OnOneLineNamingFileAndLine) {
+TEST_F(WorldCliTest, BadScenariosExitWith2OnOneLineNamingFileAndLine) {
   const std::string bad = write("bad.pbtxt", "name: \"x\"\nterrain { generator: \"flat\" }\nagent { robot_type: }\n");
-  EXPECT_EQ(run({"--scenario", bad}), 1);
+  EXPECT_EQ(run({"--scenario", bad}), 2);
   const std::string message = err_.str();
   EXPECT_EQ(message.rfind("marsala-world: error: " + bad + ":3:", 0), 0u) << message;
   EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1);
-  EXPECT_EQ(run({"--scenario", (dir_ / "missing.pbtxt").string()}), 1);
+  EXPECT_EQ(run({"--scenario", (dir_ / "missing.pbtxt").string()}), 2);
   EXPECT_NE(err_.str().find("cannot open scenario file"), std::string::npos) << err_.str();
   const std::string ok = write("ok.pbtxt", testing::small_scenario_text());
-  EXPECT_EQ(run({"--scenario", ok, "--agents", "5", "--dds", "inprocess"}), 1);
+  EXPECT_EQ(run({"--scenario", ok, "--agents", "5", "--dds", "inprocess"}), 2);
   EXPECT_NE(err_.str().find("exceeds the 3 agent slots"), std::string::npos) << err_.str();
   EXPECT_EQ(run({"--scenario", ok, "--dds", "inprocess", "--domain", "49", "--admit-timeout", "0.1", "--quiet", "--out",
                  (dir_ / "none").string()}),
@@ -69,20 +88,9 @@ TEST_F(WorldCliTest, BadScenariosExitWith1OnOneLineNamingFileAndLine) {
 TEST_F(WorldCliTest, ARunThatReachesMaxStepsExitsWith3) {
   const std::string scenario = write("small.pbtxt", testing::small_scenario_text());
   const fs::path out = dir_ / "out";
-  int rc = -1;
-  std::thread world([&] {
-    rc = run({"--scenario", scenario, "--agents", "1", "--dds", "inprocess", "--domain", "48", "--out", out.string(),
-              "--quiet", "--max-steps", "3"});
-  });
-  testing::FakeAgentConfig c;
-  c.domain = 48;
-  c.id = 1;
-  c.session = 5;
-  c.body = testing::small_scenario().robot_for(1).body;
-  testing::FakeAgent agent(c);
-  world.join();
-  agent.join();
-  EXPECT_EQ(rc, 3) << err_.str();  // the exit code says how the run ended: max_steps
+  // The exit code says how the run ended: max_steps.
+  EXPECT_EQ(run_beside_walker(48, {"--scenario", scenario, "--out", out.string(), "--max-steps", "3"}), 3)
+      << err_.str();
   EXPECT_NE(out_.str().find("run small-d48: max_steps after 3 steps, 1 agents"), std::string::npos) << out_.str();
   for (const char* name : {"summary.json", "terrain_initial.asc", "terrain_final.asc", "final.png", "events.log"})
     EXPECT_TRUE(fs::exists(out / name)) << name;
@@ -93,20 +101,9 @@ TEST_F(WorldCliTest, SeedOverridesTheScenariosAndIsReported) {
   EXPECT_EQ(run({"--scenario", scenario, "--seed", "abc"}), 2);
   EXPECT_NE(out_.str().size() + err_.str().size(), 0u);
   const fs::path out = dir_ / "out";
-  int rc = -1;
-  std::thread world([&] {
-    rc = run({"--scenario", scenario, "--agents", "1", "--dds", "inprocess", "--domain", "52", "--out", out.string(),
-              "--quiet", "--max-steps", "2", "--seed", "77"});
-  });
-  testing::FakeAgentConfig c;
-  c.domain = 52;
-  c.id = 1;
-  c.session = 5;
-  c.body = testing::small_scenario().robot_for(1).body;
-  testing::FakeAgent agent(c);
-  world.join();
-  agent.join();
-  EXPECT_EQ(rc, 3) << err_.str();  // max_steps
+  EXPECT_EQ(run_beside_walker(52, {"--scenario", scenario, "--out", out.string(), "--max-steps", "2", "--seed", "77"}),
+            3)
+      << err_.str();  // max_steps
   std::ifstream in(out / "summary.json");
   std::stringstream text;
   text << in.rdbuf();
@@ -114,6 +111,48 @@ TEST_F(WorldCliTest, SeedOverridesTheScenariosAndIsReported) {
   EXPECT_NE(text.str().find("\"start_jitter_m\": 0.3"), std::string::npos) << text.str();
   EXPECT_EQ(run({"--help"}), 0);
   EXPECT_NE(out_.str().find("--seed"), std::string::npos);
+}
+
+TEST_F(WorldCliTest, ARunWithoutProgressEndsStalledWith6AndAnAccount) {
+  // A walker on the way to a goal it needs 12 steps to reach: its motions are no progress, so with stall_steps 4 the
+  // run ends before step 4 is applied.
+  const std::string scenario = write("small.pbtxt", testing::small_scenario_text("stall_steps: 4\n"));
+  const fs::path out = dir_ / "out";
+  EXPECT_EQ(run_beside_walker(53, {"--scenario", scenario, "--out", out.string(), "--max-steps", "50"}), 6)
+      << err_.str();
+  EXPECT_NE(out_.str().find("run small-d53: stalled after 4 steps"), std::string::npos) << out_.str();
+  std::ifstream in(out / "summary.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  for (const char* field : {"\"end_reason\": \"stalled\"", "\"stall_steps\": 4", "\"quiet_since_step\": 0",
+                            "\"state\": \"walking\"", "\"waiting_for\": \"its target?\"", "\"material_m3\""})
+    EXPECT_NE(text.str().find(field), std::string::npos) << field << " in\n" << text.str();
+  std::ifstream events(out / "events.log");
+  std::stringstream log;
+  log << events.rdbuf();
+  EXPECT_NE(log.str().find("stalled: agent 1 walking with"), std::string::npos) << log.str();
+}
+
+TEST_F(WorldCliTest, ATeamThatDoesNotFitOnItsBaseIsRefusedWith2) {
+  // The small scenario's 1 m robots all start on the base (radius 0.5 m): three do not fit there, two do.
+  const std::string text = testing::small_scenario_text();
+  std::string crowded = text;
+  for (const char* start :
+       {"start { x_m: 1.05 y_m: 1.05 }", "start { x_m: 2.55 y_m: 1.05 }", "start { x_m: 1.05 y_m: 3.05 }"})
+    crowded.replace(crowded.find(start), std::string(start).size(), "start { x_m: 0.55 y_m: 0.55 }");
+  const std::string scenario = write("crowded.pbtxt", crowded);
+  EXPECT_EQ(run({"--check", scenario}), 2);
+  EXPECT_NE(err_.str().find("the team does not fit on its base: agent (3 robots): only 2 of their bodies"),
+            std::string::npos)
+      << err_.str();
+  EXPECT_EQ(run({"--scenario", scenario, "--dds", "inprocess", "--out", (dir_ / "out").string()}), 2);
+  const std::string refused = err_.str();
+  EXPECT_EQ(std::count(refused.begin(), refused.end(), '\n'), 1) << refused;
+  EXPECT_NE(refused.find("agent (3 robots)"), std::string::npos) << refused;
+  EXPECT_EQ(run({"--check", "--agents", "2", scenario}), 0) << err_.str();
+  const std::string stall = write("stall.pbtxt", testing::small_scenario_text("stall_steps: -3\n"));
+  EXPECT_EQ(run({"--check", stall}), 2);
+  EXPECT_NE(err_.str().find("stall_steps: -3 must be 0 (never) or in 1..1000000000"), std::string::npos) << err_.str();
 }
 
 }  // namespace
