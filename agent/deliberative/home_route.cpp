@@ -9,9 +9,9 @@
 #include <queue>
 #include <utility>
 
+#include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
-#include "marsala/core/iterators.hpp"
 #include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::agent::deliberative {
@@ -40,16 +40,9 @@ CellMask judged_occupiable(const KnownMap& map, const NavigabilityParams& body, 
   const int rows = box.bottom - box.top + 1, cols = box.right - box.left + 1;
   const Heightmap heights = map.heights.window({box.top, box.left}, rows, cols);
   CellMask occupiable = NavigabilityProcessor(body).occupiable(heights);
-  const auto ball = disc_offsets(body.delta_m / (2.0 * map.geometry().cell_size_m));
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c) {
-      if (map.known(box.top + r, box.left + c) != 0) continue;
-      for (const CellIndex o : ball) {
-        const int pr = r - o.row, pc = c - o.col;
-        if (pr >= 0 && pc >= 0 && pr < rows && pc < cols) occupiable(pr, pc) = 0;
-      }
-    }
-  return occupiable;
+  const CellMask blind =
+      blind_cells(map.known.block(box.top, box.left, rows, cols), body.delta_m / (2.0 * map.geometry().cell_size_m));
+  return (occupiable.array() != 0 && blind.array() == 0).cast<std::uint8_t>();
 }
 
 }  // namespace

@@ -6,9 +6,9 @@
 #include <limits>
 #include <string>
 
+#include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
-#include "marsala/core/iterators.hpp"
 
 namespace marsala::agent::deliberative {
 namespace {
@@ -65,22 +65,13 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
 
   local.gap = mars_.gap(local.heights);
   local.occupiable = navigability_.occupiable(local.heights);
-  local.blind = CellMask::Zero(w.rows, w.cols);
-  if (!all_known) {
-    // A ball that holds an unknown cell cannot be judged: treat its centre as not occupiable.
-    const auto ball = disc_offsets(params().delta_m / (2.0 * local.geometry().cell_size_m));
-    for (int r = 0; r < w.rows; ++r)
-      for (int c = 0; c < w.cols; ++c) {
-        if (local.known(r, c) != 0) continue;
-        local.gap(r, c) = 0.0;
-        for (const CellIndex o : ball) {
-          const CellIndex p{r - o.row, c - o.col};
-          if (!local.contains(p)) continue;
-          local.blind(p.row, p.col) = 1;
-          local.occupiable(p.row, p.col) = 0;
-        }
-      }
-  }
+  // A ball that holds an unknown cell cannot be judged: treat its centre as not occupiable. No gap on unknown cells.
+  local.blind = blind_cells(local.known, params().delta_m / (2.0 * local.geometry().cell_size_m));
+  for (int r = 0; r < w.rows; ++r)
+    for (int c = 0; c < w.cols; ++c) {
+      if (local.blind(r, c) != 0) local.occupiable(r, c) = 0;
+      if (local.known(r, c) == 0) local.gap(r, c) = 0.0;
+    }
 
   // Ground the map only assumes (under and around the robot's body: KnownMap::assumed) is no deposition
   // target: building on it would never show in the map.

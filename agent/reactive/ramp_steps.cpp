@@ -463,16 +463,14 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
 }
 
 std::optional<CellIndex> RampSteps::home_goal(const deliberative::LocalMap& local) {
-  const auto on_route = [&] {
-    for (const CellIndex g : memory_.home)
-      if (std::abs(g.row - local.to_global(local.robot).row) <= 1 && std::abs(g.col - local.to_global(local.robot).col) <= 1)
-        return true;
-    return false;
-  };
-  if (memory_.home.empty() || !on_route()) {
+  const CellIndex at = local.to_global(local.robot);
+  const bool on_route = std::any_of(memory_.home.begin(), memory_.home.end(), [&](CellIndex g) {
+    return std::abs(g.row - at.row) <= 1 && std::abs(g.col - at.col) <= 1;
+  });
+  if (!on_route) {  // also when the trip has no way home yet
     const RobotBody& body = context_.type.body;
-    const auto route = deliberative::home_route(modules_->map.known_map(), body.navigability,
-                                                local.to_global(local.robot), context_.assignment.base,
+    const auto route = deliberative::home_route(modules_->map.known_map(), body.navigability, at,
+                                                context_.assignment.base,
                                                 context_.assignment.base_radius_m - kBaseMarginM, body.sensing_range_m);
     memory_.home = route.value_or(std::vector<CellIndex>{});
   }

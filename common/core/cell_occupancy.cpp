@@ -66,4 +66,20 @@ bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const Navigabilit
                                            : occupiable_by_window(terrain, cell, params, offsets);
 }
 
+CellMask blind_cells(const CellMask& known, double radius_cells) {
+  CellMask blind = CellMask::Zero(known.rows(), known.cols());
+  if (known.minCoeff() != 0) return blind;
+  const std::vector<CellIndex> ball = disc_offsets(radius_cells);
+  for (int r = 0; r < known.rows(); ++r)
+    for (int c = 0; c < known.cols(); ++c) {
+      if (known(r, c) != 0) continue;
+      // The ball is symmetric: the cells whose ball holds (r, c) are those within it of (r, c).
+      for (const CellIndex& o : ball) {
+        const int pr = r - o.row, pc = c - o.col;
+        if (pr >= 0 && pc >= 0 && pr < known.rows() && pc < known.cols()) blind(pr, pc) = 1;
+      }
+    }
+  return blind;
+}
+
 }  // namespace marsala

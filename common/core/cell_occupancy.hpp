@@ -20,4 +20,9 @@ enum class OccupancyMethod {
 bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
                      OccupancyMethod method = OccupancyMethod::kAutomatic);
 
+/// 1 where the body ball of a cell (radius_cells = delta / (2 cs), disc_offsets) holds a cell that `known` marks 0:
+/// whether such a cell is occupiable cannot be judged (an agent's map, a robot's believed map). Cells off the mask do
+/// not count. Sized as `known`.
+CellMask blind_cells(const CellMask& known, double radius_cells);
+
 }  // namespace marsala

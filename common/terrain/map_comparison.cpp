@@ -6,9 +6,9 @@
 
 #include <fmt/format.h>
 
+#include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
-#include "marsala/core/iterators.hpp"
 #include "marsala/core/navigability_processor.hpp"
 #include "marsala/core/statistics.hpp"
 
@@ -47,18 +47,10 @@ CellMask believed_passable(const Heightmap& believed, const NavigabilityParams& 
         filled(r, c) = 0.0;
       }
     }
-  CellMask passable = processor.occupiable(filled);
-  const std::vector<CellIndex> ball = disc_offsets(body.delta_m / (2.0 * believed.cell_size_m()));
-  for (int r = 0; r < believed.rows(); ++r)
-    for (int c = 0; c < believed.cols(); ++c) {
-      if (unknown(r, c) == 0) continue;
-      // The ball is symmetric: the cells whose ball holds (r, c) are those within it of (r, c).
-      for (const CellIndex& o : ball) {
-        const CellIndex p{r + o.row, c + o.col};
-        if (believed.contains(p)) passable(p.row, p.col) = 0;
-      }
-    }
-  return passable;
+  const CellMask passable = processor.occupiable(filled);
+  const CellMask known = (unknown.array() == 0).cast<std::uint8_t>();
+  const CellMask blind = blind_cells(known, body.delta_m / (2.0 * believed.cell_size_m()));
+  return (passable.array() != 0 && blind.array() == 0).cast<std::uint8_t>();
 }
 
 MapComparison compare_maps(const Heightmap& believed, const Heightmap& truth, const NavigabilityParams& body) {

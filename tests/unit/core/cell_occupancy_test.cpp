@@ -92,5 +92,26 @@ TEST(CellOccupiable, OffGridThrows) {
   EXPECT_THROW(cell_occupiable(Heightmap(g, 0.0), {0, -1}, {}), InvalidArgument);
 }
 
+TEST(BlindCells, AreTheCellsWhoseBallHoldsAnUnknownCell) {
+  std::mt19937 rng(3);
+  std::bernoulli_distribution unknown(0.03);
+  for (const double radius : {0.0, 1.0, 2.5, 4.0}) {
+    CellMask known(23, 31);
+    for (int r = 0; r < known.rows(); ++r)
+      for (int c = 0; c < known.cols(); ++c) known(r, c) = unknown(rng) ? 0 : 1;
+    const CellMask blind = blind_cells(known, radius);
+    // From the definition: any unknown cell at a centre distance of at most the radius (tie tolerance 1e-9 cells^2).
+    for (int r = 0; r < known.rows(); ++r)
+      for (int c = 0; c < known.cols(); ++c) {
+        bool expected = false;
+        for (int q = 0; q < known.rows() && !expected; ++q)
+          for (int p = 0; p < known.cols() && !expected; ++p)
+            expected = known(q, p) == 0 && (q - r) * (q - r) + (p - c) * (p - c) <= radius * radius + 1e-9;
+        EXPECT_EQ(blind(r, c) != 0, expected) << "radius " << radius << " cell " << r << "," << c;
+      }
+  }
+  EXPECT_EQ(blind_cells(CellMask::Ones(5, 5), 3.0).maxCoeff(), 0);
+}
+
 }  // namespace
 }  // namespace marsala
