@@ -106,6 +106,8 @@ int run(int argc, char** argv) {
 
   int attacks_sent = 0;
   constexpr int kAttacks = 8;
+  constexpr int kHonestSteps = 4;
+  int honest_after = 0;
   const auto deadline = std::chrono::steady_clock::now() + 120s;
   while (std::chrono::steady_clock::now() < deadline) {
     signal->wait_for(100ms);
@@ -114,15 +116,21 @@ int run(int argc, char** argv) {
       if (attacks_sent > 0)
         std::cout << "rogue: step " << frame.step << " previous request " << protocol::to_string(frame.last_result)
                   << (frame.last_reason.empty() ? "" : ": " + frame.last_reason) << std::endl;
-      if (attacks_sent == kAttacks) {
-        std::cout << "rogue: done, leaving" << std::endl;
-        return 0;
-      }
       protocol::ActionRequest valid;
       valid.agent_id = id;
       valid.session = hello.session;
       valid.step = frame.step;
       valid.state = "rogue";
+      if (attacks_sent == kAttacks) {
+        // Stay a few honest steps before leaving: a copy still in flight when the participant goes away would be
+        // read only after the world dropped the rogue, and a dropped agent's requests are discarded unread.
+        if (++honest_after == kHonestSteps) {
+          std::cout << "rogue: done, leaving" << std::endl;
+          return 0;
+        }
+        requests->write(valid);
+        continue;
+      }
       bool spoof = false;
       std::string what;
       const protocol::ActionRequest bad =

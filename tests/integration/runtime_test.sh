@@ -124,7 +124,10 @@ case "$case_name" in
     # The second copy is noted as a repeat when it arrives before the step is applied, else as a request for a past
     # step (the first copy completed the step's answers): a race of the two writes, ignored either way.
     grep -Eq "agent 2: request for step [0-9]+ repeated; the first stands|agent 2: request for past step [0-9]+ dropped" \
-      "$out/events.log" || fail "the identical duplicate was not noted"
+      "$out/events.log" || {
+      tail -12 "$out/logs/rogue.log"; grep '"agent":2\|agent 2' "$out/events.log" | tail -12
+      fail "the identical duplicate was not noted"
+    }
     echo "ok: $sent attacks; rogue charged $(entry 2 rejected), forged $(field unattributed_rejections "$s"), victim 0;" \
       "honest agent completed in $(field steps "$s") steps"
     ;;
