@@ -8,7 +8,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <memory>
@@ -54,7 +56,7 @@ int main(int argc, char** argv) {
   marsala::cli::LogOptions log_options;
   marsala::cli::DdsOptions dds;
   std::string id_text, robot_type;
-  double admit_timeout_s = 60.0, world_timeout_s = 60.0;
+  double admit_timeout_s = 60.0, world_timeout_s = 600.0;
   app.add_option("--scenario", scenario_file, "scenario file (protobuf text format)")->required();
   app.add_option("--id", id_text,
                  "agent id: the scenario slot, 1..N, or `auto`: the world assigns the lowest free slot of the robot\n"
@@ -73,8 +75,19 @@ int main(int argc, char** argv) {
   marsala::cli::add_log_options(app, log_options);
   app.add_option("--admit-timeout", admit_timeout_s, "give up when not admitted within this [s]")
       ->check(CLI::PositiveNumber);
-  app.add_option("--world-timeout", world_timeout_s, "give up when no frame comes for this long [s]")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--world-timeout", world_timeout_s,
+                 "give up when no frame comes for this long [s] (0: never); a silent world (paused, cut off,\n"
+                 "restarted with --resume) is waited for until then, never given up on earlier")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            return !text.empty() && *end == '\0' && std::isfinite(v) && v >= 0.0 && v <= 1e9
+                       ? std::string()
+                       : fmt::format("must be a number of seconds >= 0 (0: wait forever), not '{}'", text);
+          },
+          "S >= 0"));
   std::string dump_dir;
   app.add_option("--dump-map", dump_dir,
                  "when its admitted run ends, write the robot's map into DIR: agent-<id>-height.asc (NODATA: unknown)\n"

@@ -57,7 +57,6 @@ std::string to_string(RunOutcome outcome) {
                                                     {RunOutcome::kRefused, "refused"},
                                                     {RunOutcome::kAdmitTimeout, "admit_timeout"},
                                                     {RunOutcome::kWorldTimeout, "world_timeout"},
-                                                    {RunOutcome::kWorldGone, "world_gone"},
                                                     {RunOutcome::kOutputRefused, "output_refused"}};
   return enum_to_string(kNames, outcome);
 }
@@ -71,8 +70,10 @@ std::uint64_t random_session() {
 
 AgentRuntime::AgentRuntime(bus::Participant& participant, RuntimeConfig config)
     : participant_(participant), config_(std::move(config)) {
-  if (config_.hello_period.count() <= 0 || config_.admit_timeout.count() <= 0 || config_.world_timeout.count() <= 0)
-    throw InvalidArgument(fmt::format("agent {}: hello period and timeouts must be positive", config_.agent_id));
+  if (config_.hello_period.count() <= 0 || config_.admit_timeout.count() <= 0 || config_.world_timeout.count() < 0)
+    throw InvalidArgument(
+        fmt::format("agent {}: the hello period and admit timeout must be positive, the world timeout not negative",
+                    config_.agent_id));
   if (config_.session == 0) config_.session = random_session();
   // Made at once, so that an unknown behaviour fails before any traffic; an agent that asks for any slot (agent_id
   // 0) makes it again once its admission names the slot.
@@ -182,7 +183,7 @@ class AgentRuntime::Lockstep {
         gate_(agent.config_.agent_id, agent.assignment_, agent.config_.type.sensor, agent.world_),
         watch_(Clock::now(), agent.config_.world_timeout, agent.config_.hello_period) {}
 
-  /// Until the run is over, the world is gone, silent or no longer counts this agent in, or `stop`.
+  /// Until the run is over, the world is silent for world_timeout or no longer counts this agent in, or `stop`.
   void run(const std::atomic<bool>& stop) {
     while (!stop.load()) {
       const Clock::time_point now = Clock::now();
@@ -198,22 +199,24 @@ class AgentRuntime::Lockstep {
  private:
   std::uint32_t id() const { return agent_.config_.agent_id; }
 
-  /// The world watch's turn: false (and the outcome) when the world is gone or silent; says hello when it asks.
+  /// The world watch's turn: false (and the outcome) at the silence limit; says a silence once, and hello when it asks.
   bool world_still_there(Clock::time_point now) {
     const WatchTurn turn = watch_.turn(now, [this] { return frames_->alive_writers() >= 1; });
-    if (turn.state == WorldState::kWorldGone) {
-      result_.outcome = RunOutcome::kWorldGone;
-      result_.message =
-          fmt::format("the world is gone: no frame, no answer and its frame writer not alive for {} s (last step {})",
-                      turn.silent_s, result_.last_step);
-      return false;
-    }
     if (turn.state == WorldState::kWorldTimeout) {
       result_.outcome = RunOutcome::kWorldTimeout;
-      result_.message = fmt::format("no sensor frame for {} s (last step {})",
+      result_.message = fmt::format("no sensor frame for {} s (last step {}; --world-timeout)",
                                     agent_.config_.world_timeout.count() / 1000.0, result_.last_step);
       return false;
     }
+    if (turn.silent_s)
+      spdlog::warn(
+          "agent {}: the world is silent: no frame, no answer and its frame writer not alive for {} s (last step {}); "
+          "keeping this robot's state and asking until {}",
+          id(), *turn.silent_s, result_.last_step,
+          agent_.config_.world_timeout.count() == 0
+              ? std::string("the world answers (--world-timeout 0)")
+              : fmt::format("{} s without a frame (--world-timeout)", agent_.config_.world_timeout.count() / 1000.0));
+    if (turn.heard_s) spdlog::info("agent {}: the world is heard again after {} s of silence", id(), *turn.heard_s);
     if (turn.paused_s)
       spdlog::info(
           "agent {}: this process did not run for {} s; asking the world whether it still counts this agent in", id(),

@@ -3,8 +3,8 @@
 //
 //   hello every hello_period on the default partition  ──▶  world
 //   admission (this id and session)                    ◀──  world      (refused: kRefused; none: kAdmitTimeout)
-//   frames on partition_for(run, id, session)          ◀──  world      (none for world_timeout -> kWorldTimeout;
-//                                                                       its writer gone for 6 s -> kWorldGone)
+//   frames on partition_for(run, id, session)          ◀──  world      (none for world_timeout -> kWorldTimeout; a
+//                                                                       silent world is waited for, never given up)
 //   one request per frame, same step                   ──▶  world      (run_over frame -> kRunOver; the frame of
 //                                                                       the step already answered: the same request)
 //   no frame for 2 s: hello again                      ──▶  world      (refused, e.g. dropped for good: kRefused;
@@ -15,8 +15,8 @@
 
 #include <atomic>
 #include <chrono>
-#include <functional>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -40,7 +40,7 @@ struct RuntimeConfig {
   std::optional<GoalVectorMapSpec> goal_vector_map;  ///< the scenario's, for the "goal_vector_map" synthesizer
   std::chrono::milliseconds hello_period{200};       ///< between hellos until admitted
   std::chrono::milliseconds admit_timeout{60000};    ///< give up when not admitted by then
-  std::chrono::milliseconds world_timeout{60000};    ///< give up when no frame comes for this long
+  std::chrono::milliseconds world_timeout{600000};   ///< give up when no frame comes for this long; 0: never
   std::function<void(std::uint32_t)> on_assigned;    ///< called with the slot an --id auto agent was given (logging)
   /// Called once admitted, with the run's id: a non-empty answer refuses the run on the agent's side (kOutputRefused,
   /// the answer as message; e.g. a --dump-map folder holding another run's maps).
@@ -51,21 +51,21 @@ struct RuntimeConfig {
 };
 
 /// Why run() returned.
-enum class RunOutcome { kRunOver, kStopped, kRefused, kAdmitTimeout, kWorldTimeout, kWorldGone, kOutputRefused };
-/// "run_over", "stopped", "refused", "admit_timeout", "world_timeout", "world_gone", "output_refused".
+enum class RunOutcome { kRunOver, kStopped, kRefused, kAdmitTimeout, kWorldTimeout, kOutputRefused };
+/// "run_over", "stopped", "refused", "admit_timeout", "world_timeout", "output_refused".
 std::string to_string(RunOutcome outcome);
 
 /// What happened in a run.
 struct RunResult {
   RunOutcome outcome = RunOutcome::kStopped;
-  std::string message;          ///< one line for the operator
-  std::string run_id;           ///< from the admission
-  std::uint64_t frames = 0;     ///< frames received [count]
-  std::uint64_t requests = 0;   ///< requests sent [count]
-  std::uint64_t rejected = 0;   ///< frames reporting the previous request rejected [count]
-  std::uint64_t last_step = 0;  ///< step of the last frame
-  std::uint64_t ignored_frames = 0;  ///< frames not from the world it was admitted to, or inconsistent [count]
-  std::string final_state;      ///< the behaviour's state at the end
+  std::string message;                  ///< one line for the operator
+  std::string run_id;                   ///< from the admission
+  std::uint64_t frames = 0;             ///< frames received [count]
+  std::uint64_t requests = 0;           ///< requests sent [count]
+  std::uint64_t rejected = 0;           ///< frames reporting the previous request rejected [count]
+  std::uint64_t last_step = 0;          ///< step of the last frame
+  std::uint64_t ignored_frames = 0;     ///< frames not from the world it was admitted to, or inconsistent [count]
+  std::string final_state;              ///< the behaviour's state at the end
   double decision_cpu_median_ms = 0.0;  ///< median CPU time of the behaviour's decision of one step [ms]
   double cpu_ms_per_step = 0.0;  ///< the process's CPU time (all threads, DDS's too) from its first decision to the
                                  ///< run-over frame, per request sent [ms]
@@ -78,7 +78,8 @@ std::uint64_t random_session();
 class AgentRuntime {
  public:
   /// Makes the behaviour at once, so an unknown name fails before any traffic (InvalidArgument listing the valid
-  /// names). Throws InvalidArgument when agent_id is 0 or a period or timeout is not positive.
+  /// names). Throws InvalidArgument when the hello period or admit timeout is not positive or the world timeout is
+  /// negative.
   AgentRuntime(bus::Participant& participant, RuntimeConfig config);
   ~AgentRuntime();
 

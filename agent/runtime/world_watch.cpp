@@ -7,13 +7,18 @@ namespace {
 
 double seconds(WorldWatch::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
+/// The silence limit from `now`: world_timeout later, or never for 0.
+WorldWatch::Clock::time_point limit_from(WorldWatch::Clock::time_point now, std::chrono::milliseconds world_timeout) {
+  return world_timeout.count() == 0 ? WorldWatch::Clock::time_point::max() : now + world_timeout;
+}
+
 }  // namespace
 
 WorldWatch::WorldWatch(Clock::time_point now, std::chrono::milliseconds world_timeout,
                        std::chrono::milliseconds hello_period)
     : world_timeout_(world_timeout),
       hello_period_(hello_period),
-      deadline_(now + world_timeout),
+      deadline_(limit_from(now, world_timeout)),
       last_frame_at_(now),
       next_hello_(now + kRehelloAfter),
       last_sign_(now),
@@ -29,13 +34,15 @@ WatchTurn WorldWatch::turn(Clock::time_point now, const std::function<bool()>& w
   const bool was_paused = now - last_turn_ >= kProcessPause;
   if (was_paused) last_sign_ = now;
   if (sign_since_turn_ || writer_alive()) {
+    if (silence_said_) turn.heard_s = seconds(now - last_sign_);
+    silence_said_ = false;
     sign_since_turn_ = false;
     world_seen_ = true;
     last_sign_ = now;
-  } else if (world_seen_ && now - last_sign_ >= kWorldGrace) {
-    turn.state = WorldState::kWorldGone;
+  } else if (world_seen_ && !silence_said_ && now - last_sign_ >= kWorldGrace) {
+    // Said once; the agent keeps its state and keeps asking (docs/runtime.md#silence).
     turn.silent_s = seconds(now - last_sign_);
-    return turn;
+    silence_said_ = true;
   }
   if (now >= deadline_) {
     turn.state = WorldState::kWorldTimeout;
@@ -60,7 +67,7 @@ WatchTurn WorldWatch::turn(Clock::time_point now, const std::function<bool()>& w
 bool WorldWatch::frame(Clock::time_point now) {
   sign_since_turn_ = true;
   last_frame_at_ = now;
-  deadline_ = now + world_timeout_;
+  deadline_ = limit_from(now, world_timeout_);
   const bool was_asking = asked_;
   asked_ = false;
   return was_asking;

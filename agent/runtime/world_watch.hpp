@@ -3,8 +3,9 @@
 // (docs/runtime.md#dropping-agents, #re-admission). Pure: the loop passes the clock in and does the talking.
 //
 //   sign of life      a frame taken, an answer to a hello, or the world's frame writer alive (DDS liveliness)
-//   world gone        the world was seen once, then no sign for kWorldGrace           -> kWorldGone
-//   silence limit     no frame taken for world_timeout                                 -> kWorldTimeout
+//   world silent      the world was seen once, then no sign for kWorldGrace: said once (silent_s); the agent keeps
+//                     its state and keeps asking: a paused, cut-off or resumed world finds it again
+//   silence limit     no frame taken for world_timeout (0: none)                       -> kWorldTimeout
 //   process paused    a turn kProcessPause after the last one: the process itself did not run; the world gets a
 //                     fresh grace period and is asked at once whether it still counts this agent in (a hello)
 //   no frame          kRehelloAfter without a frame: a hello every hello_period until a frame comes
@@ -15,9 +16,9 @@
 
 namespace marsala::agent::runtime {
 
-/// How long the world's frame writer may stay not alive before the agent concludes the world is gone [s]: longer than
-/// the pauses a world must survive (5 s, docs/runtime.md#dropping-agents), so an agent learns of a dead world within
-/// about 7 s (the 1 s DDS lease, then this) instead of world_timeout.
+/// How long without any sign of the world (its frame writer not alive, no frame, no answer) before the agent says once
+/// that the world is silent [s]. Silence never ends the run on the agent's side: only the world's word (run over,
+/// refused) or world_timeout does (docs/runtime.md#silence).
 inline constexpr std::chrono::seconds kWorldGrace{6};
 /// A gap this long between two turns of the agent's loop means the process itself did not run [s].
 inline constexpr std::chrono::seconds kProcessPause{1};
@@ -26,12 +27,13 @@ inline constexpr std::chrono::seconds kProcessPause{1};
 inline constexpr std::chrono::seconds kRehelloAfter{2};
 
 /// What the watch concluded on one turn.
-enum class WorldState { kWatching, kWorldGone, kWorldTimeout };
+enum class WorldState { kWatching, kWorldTimeout };
 
 /// What one turn of the loop must do, and why.
 struct WatchTurn {
   WorldState state = WorldState::kWatching;
-  double silent_s = 0.0;             ///< kWorldGone: how long no sign of the world came [s]
+  std::optional<double> silent_s;    ///< set once per silence, when no sign of the world came for kWorldGrace [s]
+  std::optional<double> heard_s;     ///< set when a sign of the world ends a silence said before, that long [s]
   bool hello = false;                ///< say hello now: ask the world whether it still counts this agent in
   std::optional<double> paused_s;    ///< set when the process did not run for this long before this turn [s]
   std::optional<double> no_frame_s;  ///< set when this turn's hello is the first of a silence this long [s]
@@ -42,8 +44,8 @@ class WorldWatch {
  public:
   using Clock = std::chrono::steady_clock;
 
-  /// Starts watching at `now`: the silence limit is world_timeout from now, hellos go every hello_period once frames
-  /// stop for kRehelloAfter.
+  /// Starts watching at `now`: the silence limit is world_timeout from now (0: no limit), hellos go every hello_period
+  /// once frames stop for kRehelloAfter.
   WorldWatch(Clock::time_point now, std::chrono::milliseconds world_timeout, std::chrono::milliseconds hello_period);
 
   /// One turn of the loop at `now`. `writer_alive` (the world's frame writer's DDS liveliness) is asked only when no
@@ -62,7 +64,7 @@ class WorldWatch {
  private:
   std::chrono::milliseconds world_timeout_;
   std::chrono::milliseconds hello_period_;
-  Clock::time_point deadline_;       // no frame by then: kWorldTimeout
+  Clock::time_point deadline_;       // no frame by then: kWorldTimeout (max(): never)
   Clock::time_point last_frame_at_;  // the last frame taken
   Clock::time_point next_hello_;     // no hello before then
   Clock::time_point last_sign_;      // the last sign of life (or the end of a pause of this process)
@@ -70,6 +72,7 @@ class WorldWatch {
   bool asked_ = false;               // a hello went out since the last frame
   bool world_seen_ = false;          // some sign of life came once
   bool sign_since_turn_ = false;     // a frame or an answer came since the last turn
+  bool silence_said_ = false;        // the current silence was said (silent_s)
 };
 
 }  // namespace marsala::agent::runtime

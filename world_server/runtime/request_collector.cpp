@@ -18,8 +18,9 @@ void RequestCollector::read_partitions(const WorldState& state, RequestSelection
 
 Collected RequestCollector::collect(const WorldState& state, double deadline_s, const std::atomic<bool>& stop,
                                     const CollectDuties& duties) {
-  const Clock::time_point deadline =
+  Clock::time_point deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(deadline_s));
+  Clock::time_point last_wake = Clock::now();
   Clock::time_point next_resend = Clock::now() + kResendInterval;
   RequestSelection selection(state.agents.size());
   Collected collected;
@@ -31,6 +32,10 @@ Collected RequestCollector::collect(const WorldState& state, double deadline_s, 
       duties.check_liveliness();
       next_liveliness_check_ = now + kLivelinessPoll;
     }
+    // A wait lasts at most kPollInterval: a longer gap is time this process did not run, in which no agent could be
+    // heard; a held step waits for its team without a deadline. Neither is charged to the agents.
+    if (now - last_wake >= kWorldPause || (duties.held && duties.held())) deadline += now - last_wake;
+    last_wake = now;
     const std::vector<std::uint32_t> live = state.live_ids();
     if (selection.all_answered(live)) break;
     if (stop || now >= deadline) break;

@@ -29,12 +29,17 @@ inline constexpr std::chrono::milliseconds kResendInterval{500};
 inline constexpr std::chrono::milliseconds kLivelinessPoll{50};
 /// Longest single wait, so that a stop request is seen promptly even when no sample arrives.
 inline constexpr std::chrono::milliseconds kPollInterval{100};
+/// A gap this long between two wake-ups of a step's wait means the world's process did not run (SIGSTOP, a starved
+/// machine): the gap does not count against the step deadline, so a paused world charges no agent a miss.
+inline constexpr std::chrono::seconds kWorldPause{1};
 
 /// What the runtime does while a step waits; the state it changes (admissions, drops) is the one being collected for.
 struct CollectDuties {
   std::function<void()> on_wake;                  ///< at every wake-up: hellos (taken at their own pace)
   std::function<void()> check_liveliness;         ///< every kLivelinessPoll
   std::function<void(std::uint32_t)> send_frame;  ///< an agent without a frame of this step gets its first
+  /// True while the step is held (no live agent heard: docs/runtime.md#silence): the deadline does not run meanwhile.
+  std::function<bool()> held;
 };
 
 /// What one step collected.
@@ -53,8 +58,9 @@ class RequestCollector {
   RequestCollector(AgentLinks& links, std::shared_ptr<bus::Signal> signal)
       : links_(links), signal_(std::move(signal)) {}
 
-  /// The requests of state.step's live agents until all answered, `deadline_s` passes, or `stop`. Requests of a
-  /// dropped agent's partition are read and discarded.
+  /// The requests of state.step's live agents until all answered, `deadline_s` passes, or `stop`; the time the
+  /// world's process did not run (kWorldPause) and the time the step is held are not counted. Requests of a dropped
+  /// agent's partition are read and discarded.
   Collected collect(const WorldState& state, double deadline_s, const std::atomic<bool>& stop,
                     const CollectDuties& duties);
 

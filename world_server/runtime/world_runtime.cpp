@@ -26,6 +26,7 @@
 #include "marsala/world_server/runtime/admission_gate.hpp"
 #include "marsala/world_server/runtime/agent_links.hpp"
 #include "marsala/world_server/runtime/request_collector.hpp"
+#include "marsala/world_server/runtime/team_silence.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -140,7 +141,8 @@ struct WorldRuntime::Impl {
         state(std::move(start.state)),
         resume(std::move(start.resume)),
         resume_step(state.step),
-        recorder(recorder_setup(options, resume)) {
+        recorder(recorder_setup(options, resume)),
+        silence(std::chrono::milliseconds(static_cast<long long>(options.silence_timeout_s * 1000.0))) {
     sensing.emplace(state);
     last_rejection.resize(state.agents.size());
   }
@@ -271,9 +273,36 @@ struct WorldRuntime::Impl {
     }
   }
 
-  /// Drops every live agent whose request writer was alive and has not been alive again for kLivelinessGrace.
+  /// The team-silence rule (team_silence.hpp, docs/runtime.md#silence): true while the step is held because no live
+  /// agent is heard; each live agent's liveliness grace then starts afresh when the hold ends.
+  bool hold_for_silence(Clock::time_point now) {
+    const std::vector<std::uint32_t> live = state.live_ids();
+    const bool heard = !run_started || live.empty() ||
+                       std::any_of(live.begin(), live.end(), [&](std::uint32_t id) { return links->connected(id); });
+    const double silent_s = silence.silent_s(now);
+    switch (silence.observe(heard, now)) {
+      case SilenceVerdict::kStarted:
+        note(fmt::format(
+            "no live agent heard (not one request writer alive): step {} held until one is, for up to {}", state.step,
+            options.silence_timeout_s > 0 ? fmt::format("{} s (--silence-timeout)", options.silence_timeout_s)
+                                          : std::string("ever (--silence-timeout 0)")));
+        break;
+      case SilenceVerdict::kEnded: note(fmt::format("agents heard again after {:.1f} s of silence", silent_s)); break;
+      case SilenceVerdict::kGivenUp:
+        note(fmt::format("no live agent heard for {} s (--silence-timeout): the drop rules apply", silent_s));
+        break;
+      default: break;
+    }
+    if (!silence.held()) return false;
+    for (std::uint32_t id : live) links->forgive(id);
+    return true;
+  }
+
+  /// Drops every live agent whose request writer was alive and has not been alive again for kLivelinessGrace, unless
+  /// the whole team is silent (hold_for_silence()).
   void check_liveliness() {
     const Clock::time_point now = Clock::now();
+    if (hold_for_silence(now)) return;
     for (std::uint32_t id : state.live_ids()) {
       switch (links->observe(id, now)) {
         case LivelinessVerdict::kSteady: break;
@@ -431,7 +460,7 @@ struct WorldRuntime::Impl {
   /// status.
   protocol::EndReason lockstep(const std::atomic<bool>& stop, Clock::time_point start) {
     const CollectDuties duties{[this] { service_hellos(); }, [this] { check_liveliness(); },
-                               [this](std::uint32_t id) { send_frame(id, false); }};
+                               [this](std::uint32_t id) { send_frame(id, false); }, [this] { return silence.held(); }};
     for (;;) {
       recorder.frame(state, scenario.name, false);
       if (const auto end = end_before_step(stop)) return *end;
@@ -584,6 +613,7 @@ struct WorldRuntime::Impl {
   std::optional<ResumeInfo> resume;
   std::uint64_t resume_step = 0;  ///< the step a resumed run continued at
   RunRecorder recorder;           ///< run.log, snapshots, events.log, frames, final outputs
+  TeamSilence silence;            ///< whether the step is held for a silent team
   std::optional<SensingService> sensing;
   AdmissionGate gate;
   std::shared_ptr<bus::Signal> signal;

@@ -23,6 +23,7 @@ struct RuntimeOptions {
   double step_deadline_s = 0.0;         ///< 0 = the scenario's step_deadline_s [s]
   std::string out_dir = "out/run";      ///< summary.json, terrain_*.asc, final*.png, goal_vector_map.png, events.log
   double linger_s = 2.0;                ///< after the run_over frames, wait up to this long for agents to leave [s]
+  double silence_timeout_s = 600.0;     ///< how long a step is held while no live agent is heard; 0 = for ever [s]
   std::optional<std::uint64_t> seed;    ///< overrides the scenario's seed (start jitter; reported in summary.json)
   std::uint64_t snapshot_every = 1000;  ///< write snapshot.pb after every this many steps; 0 = never
   std::uint64_t frames_every = 0;       ///< a PNG frame every this many steps and the last in out_dir/frames; 0 = none

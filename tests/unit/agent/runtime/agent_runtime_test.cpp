@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <filesystem>
 #include <chrono>
+#include <filesystem>
 #include <functional>
 #include <future>
 #include <limits>
@@ -154,8 +154,7 @@ TEST(AgentRuntime, HelloAdmissionLockstepAndRunOver) {
 
 /// A ramp builder (agent 4) dumping its map into `dir`, run against the scripted world of `domain` admitting it to
 /// run `run_id` for 3 steps (with frames or not).
-RunResult run_dumping_agent(int domain, const std::filesystem::path& dir, const std::string& run_id,
-                            bool send_frames) {
+RunResult run_dumping_agent(int domain, const std::filesystem::path& dir, const std::string& run_id, bool send_frames) {
   auto participant = bus::make_participant({bus::Vendor::kInProcess, domain});
   RuntimeConfig c = config(4, "ramp_builder");
   dump_maps_into(std::make_shared<MapDump>(dir.string()), c);
@@ -468,8 +467,10 @@ TEST(AgentRuntime, RejectsBadConfigurationBeforeAnyTraffic) {
   EXPECT_THROW(AgentRuntime(*participant, config(0, "dancer")), InvalidArgument);
   EXPECT_THROW(AgentRuntime(*participant, config(1, "dancer")), InvalidArgument);
   RuntimeConfig c = config(1);
-  c.world_timeout = 0ms;
+  c.world_timeout = -1ms;
   EXPECT_THROW(AgentRuntime(*participant, c), InvalidArgument);
+  c.world_timeout = 0ms;  // 0: wait for a silent world for ever
+  EXPECT_NO_THROW(AgentRuntime(*participant, c));
   EXPECT_EQ(to_string(RunOutcome::kAdmitTimeout), "admit_timeout");
   EXPECT_NE(random_session(), 0u);
   EXPECT_NE(random_session(), random_session());

@@ -1,4 +1,4 @@
-// The world watch on a clock the test moves: liveliness, the grace after the last sign, the silence limit, pauses of
+// The world watch on a clock the test moves: liveliness, the silence said after the grace, the silence limit, pauses of
 // the process and the hellos of a silence, each against times worked out from docs/runtime.md's rules.
 
 #include "marsala/agent/runtime/world_watch.hpp"
@@ -25,14 +25,42 @@ TEST(WorldWatch, NeverSeenWorldIsNeverGoneButTimesOut) {
   EXPECT_EQ(watch.turn(kT0 + 20s, kNotAlive).state, WorldState::kWorldTimeout);
 }
 
-TEST(WorldWatch, SeenWorldIsGoneAfterTheGraceWithoutSign) {
+TEST(WorldWatch, ASeenWorldSilentForTheGraceIsSaidOnceAndNeverGivenUp) {
   WorldWatch watch = watch_from_t0();
   ASSERT_EQ(watch.turn(kT0 + 100ms, kAlive).state, WorldState::kWatching);  // the last sign, at 0.1 s
-  for (auto t = 200ms; t < 100ms + kWorldGrace; t += 100ms)
+  int said = 0;
+  for (auto t = 200ms; t < 100ms + kWorldGrace; t += 100ms) {
+    const WatchTurn turn = watch.turn(kT0 + t, kNotAlive);
+    ASSERT_EQ(turn.state, WorldState::kWatching) << t.count() << " ms";
+    said += turn.silent_s.has_value();
+  }
+  EXPECT_EQ(said, 0);
+  const WatchTurn silent = watch.turn(kT0 + 100ms + kWorldGrace, kNotAlive);
+  EXPECT_EQ(silent.state, WorldState::kWatching);
+  ASSERT_TRUE(silent.silent_s.has_value());
+  EXPECT_DOUBLE_EQ(*silent.silent_s, 6.0);
+  // Silent on: never said again, and only the silence limit (20 s after the start: no frame ever came) ends it.
+  for (auto t = 200ms + kWorldGrace; t < 20s; t += 100ms) {
+    const WatchTurn turn = watch.turn(kT0 + t, kNotAlive);
+    ASSERT_EQ(turn.state, WorldState::kWatching) << t.count() << " ms";
+    ASSERT_FALSE(turn.silent_s.has_value()) << t.count() << " ms";
+  }
+  // Heard again at 19.9 s: the silence lasted from the last sign at 0.1 s.
+  const WatchTurn heard = watch.turn(kT0 + 19900ms, kAlive);
+  ASSERT_TRUE(heard.heard_s.has_value());
+  EXPECT_DOUBLE_EQ(*heard.heard_s, 19.8);
+  EXPECT_EQ(watch.turn(kT0 + 20s, kAlive).state, WorldState::kWorldTimeout);
+}
+
+TEST(WorldWatch, ZeroWorldTimeoutWaitsForEver) {
+  WorldWatch watch(kT0, 0ms, 200ms);
+  ASSERT_EQ(watch.turn(kT0 + 100ms, kAlive).state, WorldState::kWatching);
+  // A day of silence, a turn every 100 ms: no limit ends it, and the next wake-up is the next hello (200 ms on).
+  for (auto t = 200ms; t < 24h; t += 100ms)
     ASSERT_EQ(watch.turn(kT0 + t, kNotAlive).state, WorldState::kWatching) << t.count() << " ms";
-  const WatchTurn gone = watch.turn(kT0 + 100ms + kWorldGrace, kNotAlive);
-  EXPECT_EQ(gone.state, WorldState::kWorldGone);
-  EXPECT_DOUBLE_EQ(gone.silent_s, 6.0);
+  const auto last = kT0 + 24h - 100ms;
+  EXPECT_GT(watch.wake_by(), last);
+  EXPECT_LE(watch.wake_by(), last + 200ms);
 }
 
 TEST(WorldWatch, FramesAndAnswersAreSignsWithoutAskingLiveliness) {
@@ -48,11 +76,11 @@ TEST(WorldWatch, FramesAndAnswersAreSignsWithoutAskingLiveliness) {
     ASSERT_EQ(watch.turn(kT0 + t, counted).state, WorldState::kWatching) << t.count() << " ms";
   }
   EXPECT_EQ(queries, 0);
-  // No sign since: the query is made every turn, and the world is gone a grace after the last answer.
+  // No sign since: the query is made every turn, and the world is said silent a grace after the last answer.
   for (auto t = 10100ms; t < 10s + kWorldGrace; t += 100ms)
-    ASSERT_EQ(watch.turn(kT0 + t, counted).state, WorldState::kWatching) << t.count() << " ms";
+    ASSERT_FALSE(watch.turn(kT0 + t, counted).silent_s.has_value()) << t.count() << " ms";
   EXPECT_EQ(queries, 59);
-  EXPECT_EQ(watch.turn(kT0 + 10s + kWorldGrace, counted).state, WorldState::kWorldGone);
+  EXPECT_TRUE(watch.turn(kT0 + 10s + kWorldGrace, counted).silent_s.has_value());
 }
 
 TEST(WorldWatch, APauseOfTheProcessGivesAFreshGraceAndAsksAtOnce) {
@@ -67,8 +95,8 @@ TEST(WorldWatch, APauseOfTheProcessGivesAFreshGraceAndAsksAtOnce) {
   EXPECT_FALSE(after_pause.no_frame_s.has_value());  // the pause's hello, not a silence's first
   EXPECT_TRUE(watch.asked());
   for (auto t = 5600ms; t < 5500ms + kWorldGrace; t += 100ms)
-    ASSERT_EQ(watch.turn(kT0 + t, kNotAlive).state, WorldState::kWatching) << t.count() << " ms";
-  EXPECT_EQ(watch.turn(kT0 + 5500ms + kWorldGrace, kNotAlive).state, WorldState::kWorldGone);
+    ASSERT_FALSE(watch.turn(kT0 + t, kNotAlive).silent_s.has_value()) << t.count() << " ms";
+  EXPECT_TRUE(watch.turn(kT0 + 5500ms + kWorldGrace, kNotAlive).silent_s.has_value());
 }
 
 TEST(WorldWatch, ASilenceAsksEveryHelloPeriodUntilAFrame) {
