@@ -8,7 +8,8 @@
 #                        [--out DIR [--replace]] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N]
 #                        [--quiet] [--secure] [--frames-every K] [--dump-maps] [--set FIELD=VALUE ...]
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
-#                 folder that holds another run's files, unless --replace removes them (and logs/, maps/) first
+#                 folder that holds another run's files, unless --replace removes them (and logs/, maps/) first, and
+#                 a folder a live (or paused) world holds, --replace or not (exit 2 naming its pid)
 #   --dds         vendor of every process (default $MARSALA_DDS, else cyclone); --agent-dds overrides it for the agents
 #   --domain      DDS domain id (default $MARSALA_DOMAIN, else a random one on which no world answers within 1 s)
 #   --monitor     also run `marsala-monitor tail` in the foreground output (instead of the progress line)
@@ -89,6 +90,12 @@ if [ -z "$domain" ]; then
   done
 fi
 
+# A folder a world holds (OUT/world.lock, flock: a run goes on there, or is paused) is refused before anything in it
+# is touched (docs/runtime.md#run-folders); the world checks it again itself.
+if [ -e "$out/world.lock" ] && ! flock -n "$out/world.lock" true 2>/dev/null; then
+  echo "spawn.sh: output folder '$out' is in use by marsala-world pid $(head -c 20 "$out/world.lock" | tr -dc 0-9): a run goes on there, or is paused; wait for its end, stop it, or give another --out" >&2
+  exit 2
+fi
 # A run never mixes its outputs with another's: the world refuses a folder holding a run; with --replace it removes
 # that run's files itself (marsala-world --replace knows the list), and the agents' old logs go here.
 [ "$replace" -eq 1 ] && [ -d "$out" ] && rm -rf -- "$out/logs" "$out/maps"

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cstdlib>
+#include <optional>
 #include <ostream>
 #include <utility>
 
@@ -12,6 +13,7 @@
 #include "marsala/core/error.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
+#include "marsala/world_server/records/output_lock.hpp"
 #include "marsala/world_server/records/run_outputs.hpp"
 #include "marsala/world_server/runtime/scenario_check.hpp"
 #include "marsala/world_server/runtime/world_runtime.hpp"
@@ -28,6 +30,21 @@ WorldStart fresh_start(const std::string& scenario_path, RuntimeOptions options,
   return prepare_world_start(scenario, scenario::build_terrain(scenario), std::move(options), domain);
 }
 
+/// Locks the run's output folder into `lock` (docs/runtime.md#run-folders); the exit code when it cannot: 2 (one line
+/// naming the holder's pid) when another world holds it, 1 when the folder or its lock file cannot be made.
+std::optional<int> lock_folder(std::optional<OutputLock>& lock, const std::string& dir, std::ostream& err) {
+  try {
+    lock.emplace(dir);
+    return std::nullopt;
+  } catch (const FolderInUse& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return cli::kExitUsage;
+  } catch (const Error& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return 1;
+  }
+}
+
 }  // namespace
 
 int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& stop, std::ostream& out,
@@ -42,6 +59,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       "DDS, prints what the run would start from and exits 0 when valid, 2 when not.\n"
       "Every run also writes run.log (every accepted change, checksummed) and snapshot.pb; after a crash,\n"
       "marsala-world --resume DIR continues the run in DIR with its agents (docs/runtime.md#resume).\n"
+      "A world holds its folder (DIR/world.lock) while it runs: a second world, --resume or --replace there exits 2.\n"
       "Exit codes: 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled, 1 error, 2 usage or a\n"
       "scenario the world refuses at start (as --check).",
       "marsala-world"};
@@ -73,6 +91,11 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   app.add_option("--step-deadline", options.step_deadline_s,
                  "override the scenario's step_deadline_s: how long a step waits for a dead or hung agent [s]")
       ->check(CLI::Range(0.001, 3600.0));
+  app.add_option("--silence-timeout", options.silence_timeout_s,
+                 "how long a step is held while no live agent is heard at all (the world's host cut off, or the\n"
+                 "whole team) before the drop rules apply [s]; 0: for ever (docs/runtime.md#silence)")
+      ->check(CLI::Range(0.0, 1e9))
+      ->capture_default_str();
   std::uint64_t seed = 0;
   const CLI::Option* seed_option =
       app.add_option("--seed", seed, "override the scenario's seed (start jitter); summary.json reports the seed used");
@@ -114,6 +137,9 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
     return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, dds.domain, json, out, err);
   if (quiet && app.get_option("--log-level")->count() == 0) log_options.level = "warn";
   const cli::LoggingScope logging("world", 0, log_options);
+  // The folder is this process's from here to its exit, before --replace clears it or --resume reads it.
+  std::optional<OutputLock> lock;
+  if (const auto code = lock_folder(lock, resume_dir.empty() ? options.out_dir : resume_dir, err)) return *code;
   try {
     WorldStart start;
     if (!resume_dir.empty()) {
