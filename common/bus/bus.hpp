@@ -158,13 +158,16 @@ class Participant {
 /// participant discovering every other, a run of N agents pays N^2 discovery and liveliness messages (at 120
 /// agents on 2 cores that alone saturated the machine and admission stalled at 44 of 120).
 enum class Role {
-  kServer,  ///< world, monitor, tools: takes a participant index below kServerIndices when one is free, and finds
-            ///< every participant on the domain (the profile's whole unicast probe range)
+  kServer,  ///< monitor, tools: takes the first free participant index from kServerIndices up, so that any number
+            ///< of them leave indices 0..kServerIndices-1 to the world, and finds every participant on the domain
+            ///< (the profile's whole unicast probe range)
   kClient,  ///< agent: finds only the participants at indices 0..kServerIndices-1 and the ones that find it; takes
             ///< no index there (Cyclone: ParticipantIndex none; Fast DDS: ports from index kServerIndices up)
+  kWorld,   ///< the world: the lowest free participant index (below kServerIndices unless participants of other
+            ///< programs hold them all), and finds every participant on the domain
 };
 
-/// Participant indices kept for servers: a client announces itself to these only.
+/// Participant indices kept for the world: a client announces itself to these only.
 inline constexpr int kServerIndices = 4;
 
 /// DDS Security for a participant (docs/runtime.md#security): the folder deploy/security/make-identities.sh made

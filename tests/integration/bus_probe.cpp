@@ -192,7 +192,7 @@ int main(int argc, char** argv) {
     auto participant = make_participant({vendor_from_string(args.get("dds", "cyclone")),
                                          args.number("domain", 0),
                                          {},
-                                         role == "client" ? Role::kClient : Role::kServer,
+                                         role == "client" ? Role::kClient : Role::kWorld,
                                          {args.get("security", ""), args.get("identity", "")}});
     if (args.mode == "write") return run_write(*participant, args);
     if (args.mode == "read") return run_read(*participant, args);

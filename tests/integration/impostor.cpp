@@ -5,7 +5,8 @@
 // status: they come from a participant that is not the run's world (docs/runtime.md#who-wrote-it).
 //
 // Usage: marsala-impostor VENDOR DOMAIN AGENTS TIMEOUT_S
-//   Prints "impostor ready" once it hears the world's admissions (start the agents after that). Exits 0 once it has forged for AGENTS admitted agents, 1 when TIMEOUT_S passed first.
+//   Prints "impostor ready" once it hears the world's admissions (start the agents after that). Exits 0 once it has
+//   forged for AGENTS admitted agents, 1 when TIMEOUT_S passed first.
 #include <chrono>
 #include <cstdint>
 #include <iostream>
@@ -54,7 +55,8 @@ int run(int argc, char** argv) {
   const int domain = std::stoi(argv[2]);
   const std::size_t agents = std::stoul(argv[3]);
   const auto deadline = Clock::now() + std::chrono::seconds(std::stoi(argv[4]));
-  auto participant = bus::make_participant({vendor, domain});
+  // In the world's role: at an index the agents probe, so that its forgeries do reach them.
+  auto participant = bus::make_participant({vendor, domain, {}, bus::Role::kWorld});
   std::cout << "impostor is participant " << participant->id().to_string() << std::endl;
   auto signal = std::make_shared<bus::Signal>();
   auto admissions = participant->create_reader<protocol::Admission>({"", signal, bus::Durability::kVolatile, 64});

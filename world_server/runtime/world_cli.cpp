@@ -153,7 +153,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       }
     }
     const auto participant =
-        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,
+        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kWorld,
                                bus::Security::of(dds.security, dds.identity, "world")});
     WorldRuntime runtime(std::move(start), *participant);
     const RunResult result = runtime.run(stop);

@@ -59,6 +59,9 @@ struct CycloneType<WorldEvent> {
   static const dds_topic_descriptor_t* descriptor() { return &marsala_wire_WorldEvent_desc; }
 };
 
+/// How many participant indices a server tries from kServerIndices up before it takes the profile's own choice.
+constexpr int kServerTries = 32;
+
 std::string failure(const std::string& what, dds_return_t rc) {
   return fmt::format("Cyclone DDS: {} failed: {}", what, dds_strretcode(rc));
 }
@@ -81,7 +84,8 @@ class Qos {
 class Context {
  public:
   Context(int domain_id, Role role, const Security& security) : domain_id_(domain_id) {
-    if (role == Role::kClient || security.enabled()) create_domain(role, security);
+    if (role == Role::kServer && open_server(security)) return;
+    if (role == Role::kClient || security.enabled()) create_domain(role, security, -1);
     participant_ = dds_create_participant(static_cast<dds_domainid_t>(domain_id), nullptr, nullptr);
     if (participant_ < 0) {
       if (domain_ > 0) dds_delete(domain_);
@@ -99,12 +103,35 @@ class Context {
   int domain_id() const { return domain_id_; }
 
  private:
+  /// A server (monitor, tool): the first free participant index from kServerIndices up (Cyclone has no "first free
+  /// from N": each index is tried, quietly), so that any number of servers leave the indices the agents probe to the
+  /// world (docs/runtime.md#discovery-star). False when kServerTries indices are all taken (or the profile fails):
+  /// the caller then makes the participant as the profile says, with Cyclone's own messages.
+  bool open_server(const Security& security) {
+    const std::uint32_t mask = dds_get_log_mask();
+    dds_set_log_mask(DDS_LC_FATAL);  // a taken index is expected, not an error to print
+    for (int index = kServerIndices; index < kServerIndices + kServerTries; ++index) {
+      try {
+        create_domain(Role::kServer, security, index);
+      } catch (const BusError&) {
+        continue;
+      }
+      participant_ = dds_create_participant(static_cast<dds_domainid_t>(domain_id_), nullptr, nullptr);
+      if (participant_ >= 0) break;
+      if (domain_ > 0) dds_delete(domain_);
+      domain_ = 0;
+    }
+    dds_set_log_mask(mask);
+    return participant_ >= 0;
+  }
+
   /// The domain with this participant's settings on top of the profile (CYCLONEDDS_URI). A client: no participant
   /// index, so no other participant's unicast probes reach it; probes of its own only to the servers' indices
   /// 0..kServerIndices-1 (Cyclone probes the indices below MaxAutoParticipantIndex); its SPDP every second, so a
-  /// world that restarts finds its agents within a second (they announce; the world cannot probe them). Secured:
-  /// the three DDS Security plugins Debian ships with libddsc, with the identity's files.
-  void create_domain(Role role, const Security& security) {
+  /// world that restarts finds its agents within a second (they announce; the world cannot probe them). A server
+  /// (monitor, tool): the index `fixed_index` (>= kServerIndices; -1: the profile's). Secured: the three DDS Security
+  /// plugins Debian ships with libddsc, with the identity's files.
+  void create_domain(Role role, const Security& security, int fixed_index) {
     const char* uri = std::getenv("CYCLONEDDS_URI");
     std::string config = uri != nullptr && *uri != '\0' ? std::string(uri) : std::string();
     const auto add = [&config](const std::string& fragment) { config += (config.empty() ? "" : ",") + fragment; };
@@ -113,6 +140,8 @@ class Context {
           fmt::format("<Discovery><ParticipantIndex>none</ParticipantIndex><MaxAutoParticipantIndex>{}"
                       "</MaxAutoParticipantIndex><SPDPInterval>1s</SPDPInterval></Discovery>",
                       kServerIndices));
+    if (fixed_index >= 0)
+      add(fmt::format("<Discovery><ParticipantIndex>{}</ParticipantIndex></Discovery>", fixed_index));
     if (security.enabled())
       add(fmt::format(
           R"(<Security><Authentication><Library path="dds_security_auth" initFunction="init_authentication" )"
@@ -148,7 +177,7 @@ class Context {
  private:
   int domain_id_;
   dds_entity_t domain_ = 0;  ///< a client's own domain entity; 0 when the participant uses the default one
-  dds_entity_t participant_;
+  dds_entity_t participant_ = -1;
   std::mutex mutex_;
   std::map<std::string, dds_entity_t> topics_;
 };

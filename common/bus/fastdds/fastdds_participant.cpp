@@ -117,6 +117,7 @@ class Context {
     auto* factory = dds::DomainParticipantFactory::get_instance();
     dds::DomainParticipantQos qos = factory->get_default_participant_qos();
     if (role == Role::kClient) make_client(qos);
+    if (role == Role::kServer) leave_world_indices(qos);
     if (security.enabled()) secure(qos, security);
     participant_ = factory->create_participant(static_cast<dds::DomainId_t>(domain_id), qos);
     if (participant_ == nullptr)
@@ -140,10 +141,7 @@ class Context {
   /// index kServerIndices (the next free one from there), so no server index is taken and no other client's probes
   /// reach it; its initial peers are probed at the servers' indices 0..kServerIndices-1 only.
   static void make_client(dds::DomainParticipantQos& qos) {
-    qos.wire_protocol().participant_id = kServerIndices;
-    // Fast DDS moves a busy port up one index at a time, 100 times by default: the 101st client of a host would get
-    // no discovery port at all and be found by nobody (measured: agents 102..120 of a 120-agent run never admitted).
-    qos.wire_protocol().builtin.mutation_tries = 1000;
+    leave_world_indices(qos);
     for (std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface>& transport :
          qos.transport().user_transports) {
       const auto udp = std::dynamic_pointer_cast<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(transport);
@@ -152,6 +150,15 @@ class Context {
       client->maxInitialPeersRange = std::min<std::uint32_t>(client->maxInitialPeersRange, kServerIndices);
       transport = client;
     }
+  }
+
+  /// Ports from participant index kServerIndices up (the next free one from there): the world's indices are left to
+  /// it (a client's or a server's, docs/runtime.md#discovery-star).
+  static void leave_world_indices(dds::DomainParticipantQos& qos) {
+    qos.wire_protocol().participant_id = kServerIndices;
+    // Fast DDS moves a busy port up one index at a time, 100 times by default: the 101st client of a host would get
+    // no discovery port at all and be found by nobody (measured: agents 102..120 of a 120-agent run never admitted).
+    qos.wire_protocol().builtin.mutation_tries = 1000;
   }
 
   /// DDS Security with the builtin plugins Fast DDS is built with, the identity's files.
@@ -325,11 +332,15 @@ class FastDdsReader final : public Reader<T> {
         dds::SampleInfo info;
         while (reader->take_next_sample(&msg, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
           if (info.valid_data && filter.passes(info.source_timestamp.to_ns()))
-            convert_sample([&] { return Received<T>{fastdds::from_msg(msg), writer_of(info)}; }, received, malformed,
-                           [](const std::string& what, std::uint64_t total) {
-                             spdlog::warn("bus (fastdds): dropped a malformed sample of {} ({} so far): {}",
-                                          TopicName<T>::value, total, what);
-                           });
+            convert_sample(
+                [&] {
+                  return Received<T>{fastdds::from_msg(msg), writer_of(info)};
+                },
+                received, malformed,
+                [](const std::string& what, std::uint64_t total) {
+                  spdlog::warn("bus (fastdds): dropped a malformed sample of {} ({} so far): {}", TopicName<T>::value,
+                               total, what);
+                });
         queue.push(std::move(received));
       } catch (const std::exception& e) {
         spdlog::error("bus (fastdds): dropping samples of {}: {}", TopicName<T>::value, e.what());
