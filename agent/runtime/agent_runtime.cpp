@@ -271,12 +271,17 @@ class AgentRuntime::Lockstep {
     switch (judgement.call) {
       case FrameCall::kRunOver: run_over(frame); return true;
       case FrameCall::kRepeat:
-        // The world did not get (or not yet) the answer: the same request again, never a second decision.
-        spdlog::debug("agent {}: the frame of step {} again; repeating its request", id(), frame.step);
-        requests_->write(gate_.last_request());
+        // The world did not get (or not yet) the answer, or went back to a step this agent answered (a resume cut
+        // its log's damaged tail): the same request again, never a second decision.
+        if (frame.step < result_.last_answered && power_of_ten(++result_.repeated_past))
+          spdlog::warn(
+              "agent {}: the world went back to step {} (this agent answered up to {}); repeating its "
+              "requests from there ({} so far)",
+              id(), frame.step, result_.last_answered, result_.repeated_past);
+        requests_->write(*gate_.request_for(frame.step));
         return false;
       case FrameCall::kStale:
-        spdlog::warn("agent {}: ignoring a stale frame for step {}", id(), frame.step);
+        spdlog::debug("agent {}: ignoring a late copy of the frame of step {}", id(), frame.step);
         return false;
       default: decide(frame); return false;
     }
@@ -289,6 +294,7 @@ class AgentRuntime::Lockstep {
     protocol::ActionRequest request = costs_.measure([&] { return behaviour.decide(frame); });
     requests_->write(request);
     ++result_.requests;
+    result_.last_answered = frame.step;
     gate_.answered(frame.step, std::move(request));
     if (behaviour.state_name() != before)
       spdlog::debug("agent {}: step {}: {} -> {}", id(), frame.step, before, behaviour.state_name());

@@ -58,14 +58,16 @@ std::string to_string(RunOutcome outcome);
 /// What happened in a run.
 struct RunResult {
   RunOutcome outcome = RunOutcome::kStopped;
-  std::string message;                  ///< one line for the operator
-  std::string run_id;                   ///< from the admission
-  std::uint64_t frames = 0;             ///< frames received [count]
-  std::uint64_t requests = 0;           ///< requests sent [count]
-  std::uint64_t rejected = 0;           ///< frames reporting the previous request rejected [count]
-  std::uint64_t last_step = 0;          ///< step of the last frame
-  std::uint64_t ignored_frames = 0;     ///< frames not from the world it was admitted to, or inconsistent [count]
-  std::string final_state;              ///< the behaviour's state at the end
+  std::string message;               ///< one line for the operator
+  std::string run_id;                ///< from the admission
+  std::uint64_t frames = 0;          ///< frames received [count]
+  std::uint64_t requests = 0;        ///< requests sent [count]
+  std::uint64_t rejected = 0;        ///< frames reporting the previous request rejected [count]
+  std::uint64_t last_step = 0;       ///< step of the last frame
+  std::uint64_t last_answered = 0;   ///< step of the last new decision sent
+  std::uint64_t repeated_past = 0;   ///< requests repeated for steps before last_answered (the world went back) [count]
+  std::uint64_t ignored_frames = 0;  ///< frames not from the world it was admitted to, or inconsistent [count]
+  std::string final_state;           ///< the behaviour's state at the end
   double decision_cpu_median_ms = 0.0;  ///< median CPU time of the behaviour's decision of one step [ms]
   double cpu_ms_per_step = 0.0;  ///< the process's CPU time (all threads, DDS's too) from its first decision to the
                                  ///< run-over frame, per request sent [ms]

@@ -1,5 +1,6 @@
 #include "marsala/agent/runtime/frame_gate.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -51,14 +52,26 @@ FrameJudgement FrameGate::judge(const protocol::SensorFrame& frame, const bus::W
   if (!problem.empty()) return {FrameCall::kIgnored, std::move(problem)};
   if (frame.run_over) return {FrameCall::kRunOver, {}};
   if (answered_any_ && frame.step == last_answered_) return {FrameCall::kRepeat, {}};
-  if (answered_any_ && frame.step < last_answered_) return {FrameCall::kStale, {}};
+  if (answered_any_ && frame.step < last_answered_) {
+    if (from == answered_world_) return {FrameCall::kStale, {}};
+    if (request_for(frame.step)) return {FrameCall::kRepeat, {}};
+  }
   return {FrameCall::kDecide, {}};
 }
 
 void FrameGate::answered(std::uint64_t step, protocol::ActionRequest request) {
+  while (!sent_.empty() && sent_.back().first >= step) sent_.pop_back();
+  sent_.emplace_back(step, std::move(request));
+  if (sent_.size() > kRequestHistory) sent_.pop_front();
   answered_any_ = true;
   last_answered_ = step;
-  last_request_ = std::move(request);
+  answered_world_ = world_;
+}
+
+const protocol::ActionRequest* FrameGate::request_for(std::uint64_t step) const {
+  const auto it = std::lower_bound(sent_.begin(), sent_.end(), step,
+                                   [](const auto& sent, std::uint64_t s) { return sent.first < s; });
+  return it != sent_.end() && it->first == step ? &it->second : nullptr;
 }
 
 }  // namespace marsala::agent::runtime

@@ -55,23 +55,53 @@ TEST(FrameGate, AWorldResumedFromItsLogSpeaksFromItsNewParticipant) {
   EXPECT_EQ(g.judge(frame(1), writer(1)).call, FrameCall::kIgnored);
 }
 
-TEST(FrameGate, RepeatsTheAnsweredStepAndCallsEarlierOnesStale) {
+TEST(FrameGate, RepeatsEveryAnsweredStepItKeeps) {
   FrameGate g = gate();
-  protocol::ActionRequest request;
-  request.agent_id = 7;
-  request.step = 5;
-  request.move = true;
-  request.target_x_m = 2.75;
-  g.answered(5, request);
+  const auto request_of = [](std::uint64_t step) {
+    protocol::ActionRequest request;
+    request.agent_id = 7;
+    request.step = step;
+    request.move = true;
+    request.target_x_m = 0.25 * static_cast<double>(step);
+    return request;
+  };
+  for (std::uint64_t step = 3; step <= 5; ++step) g.answered(step, request_of(step));
   EXPECT_EQ(g.judge(frame(5), writer(1)).call, FrameCall::kRepeat);
-  EXPECT_EQ(g.last_request().step, 5u);
-  EXPECT_EQ(g.last_request().target_x_m, 2.75);
+  ASSERT_NE(g.request_for(5), nullptr);
+  EXPECT_EQ(g.request_for(5)->target_x_m, 1.25);
+  // A late copy of an earlier frame from the same world: stale.
   EXPECT_EQ(g.judge(frame(4), writer(1)).call, FrameCall::kStale);
-  EXPECT_EQ(g.judge(frame(6), writer(1)).call, FrameCall::kDecide);
+  // The world restarted and went back (a resume cut its log's tail): the requests of those steps again, never new
+  // decisions.
+  g.set_world(writer(2));
+  EXPECT_EQ(g.judge(frame(4), writer(2)).call, FrameCall::kRepeat);
+  ASSERT_NE(g.request_for(3), nullptr);
+  EXPECT_EQ(g.request_for(3)->target_x_m, 0.75);
+  // A step before any kept is decided anew; so is the next step.
+  EXPECT_EQ(g.judge(frame(2), writer(2)).call, FrameCall::kDecide);
+  EXPECT_EQ(g.request_for(2), nullptr);
+  EXPECT_EQ(g.judge(frame(6), writer(2)).call, FrameCall::kDecide);
   // The run-over frame ends the run whatever its step.
   protocol::SensorFrame over = frame(3);
   over.run_over = true;
-  EXPECT_EQ(g.judge(over, writer(1)).call, FrameCall::kRunOver);
+  EXPECT_EQ(g.judge(over, writer(2)).call, FrameCall::kRunOver);
+  // Deciding step 4 again forgets the requests of 4 and 5: they were never applied in this world's history.
+  g.answered(4, request_of(40));
+  EXPECT_EQ(g.request_for(4)->step, 40u);
+  EXPECT_EQ(g.request_for(5), nullptr);
+  EXPECT_EQ(g.judge(frame(5), writer(2)).call, FrameCall::kDecide);
+  EXPECT_EQ(g.judge(frame(3), writer(2)).call, FrameCall::kStale);  // answered since by this world: a late copy
+  EXPECT_EQ(g.request_for(3)->target_x_m, 0.75);
+}
+
+TEST(FrameGate, KeepsTheLastRequestsOnly) {
+  FrameGate g = gate();
+  for (std::uint64_t step = 1; step <= kRequestHistory + 10; ++step) g.answered(step, {});
+  EXPECT_EQ(g.request_for(10), nullptr);
+  EXPECT_NE(g.request_for(11), nullptr);  // the oldest of the kRequestHistory kept
+  g.set_world(writer(2));
+  EXPECT_EQ(g.judge(frame(10), writer(2)).call, FrameCall::kDecide);
+  EXPECT_EQ(g.judge(frame(11), writer(2)).call, FrameCall::kRepeat);
 }
 
 TEST(FrameGate, AFrameAMillionStepsAheadIsNotTheWorlds) {
