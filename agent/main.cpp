@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
             const double v = std::strtod(text.c_str(), &end);
             return !text.empty() && *end == '\0' && std::isfinite(v) && v >= 0.0 && v <= 1e9
                        ? std::string()
-                       : fmt::format("must be a number of seconds >= 0 (0: wait forever), not '{}'", text);
+                       : fmt::format("must be a number of seconds from 0 to 1e9 (0: wait forever), not '{}'", text);
           },
           "S >= 0"));
   std::string dump_dir;

@@ -9,7 +9,8 @@
 #   resume-late      the world SIGKILLed, resumed 60 s later with the agents still running; then killed again, a byte
 #                    flipped near run.log's end, resumed: the damaged tail is cut and named, and the run ends on the
 #                    uninterrupted terrain
-#   monitors-first   eight marsala-monitor tail started before the world: the agents find it, same terrain
+#   monitors-first   eight marsala-monitor tail started before the world: the agents find it, same terrain (and a bad
+#                    --world-timeout: one line naming it, exit 2)
 #   world-cut        namespace hosts on a bridge (LAN profile): the world's host cut off 30 s, same terrain
 #   agent-cut        the agents' host cut off 60 s, then back: the team waits (the world hears no agent), every robot
 #                    rejoins, same terrain
@@ -145,6 +146,13 @@ EOF
     grep -q "the world went back to step" "$out/logs/agent-1.log" || echo "note: the cut held no step agent 1 had answered"
     ;;
   monitors-first)
+    # Bad input first: a --world-timeout that is negative or not a number is one line naming it, exit 2.
+    for bad in -1 soon; do
+      rc=0
+      "$bin/marsala-agent" --scenario "$scenario" --id 1 --world-timeout "$bad" >/dev/null 2>"$work/bad.log" || rc=$?
+      [ "$rc" -eq 2 ] && [ "$(wc -l <"$work/bad.log")" -eq 1 ] && grep -q -- "--world-timeout.*'$bad'" "$work/bad.log" ||
+        { cat "$work/bad.log"; fail "--world-timeout $bad: exit $rc, not one line naming it and exit 2"; }
+    done
     sha=$(reference)
     monitors=()
     for i in 1 2 3 4 5 6 7 8; do

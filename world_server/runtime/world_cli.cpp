@@ -30,6 +30,24 @@ WorldStart fresh_start(const std::string& scenario_path, RuntimeOptions options,
   return prepare_world_start(scenario, scenario::build_terrain(scenario), std::move(options), domain);
 }
 
+/// The options of how long the world waits (--silence-timeout) and what it records besides the run (--snapshot-every,
+/// --frames-every).
+void add_timing_and_record_options(CLI::App& app, RuntimeOptions& options) {
+  app.add_option("--silence-timeout", options.silence_timeout_s,
+                 "how long a step is held while no live agent is heard at all (the world's host cut off, or the\n"
+                 "whole team) before the drop rules apply [s]; 0: for ever (docs/runtime.md#silence)")
+      ->check(CLI::Range(0.0, 1e9))
+      ->capture_default_str();
+  app.add_option("--snapshot-every", options.snapshot_every, "write snapshot.pb after every N steps (0: never)")
+      ->check(CLI::Range(0ull, 1ull << 40))
+      ->capture_default_str();
+  app.add_option("--frames-every", options.frames_every,
+                 "a time-lapse: a PNG frame every K steps and the last into OUT/frames (frame_<step>.png), and\n"
+                 "OUT/frames/timelapse.mp4 of them when ffmpeg is on PATH")
+      ->check(cli::at_least_one())
+      ->type_name("K");
+}
+
 /// Locks the run's output folder into `lock` (docs/runtime.md#run-folders); the exit code when it cannot: 2 (one line
 /// naming the holder's pid) when another world holds it, 1 when the folder or its lock file cannot be made.
 std::optional<int> lock_folder(std::optional<OutputLock>& lock, const std::string& dir, std::ostream& err) {
@@ -91,11 +109,6 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   app.add_option("--step-deadline", options.step_deadline_s,
                  "override the scenario's step_deadline_s: how long a step waits for a dead or hung agent [s]")
       ->check(CLI::Range(0.001, 3600.0));
-  app.add_option("--silence-timeout", options.silence_timeout_s,
-                 "how long a step is held while no live agent is heard at all (the world's host cut off, or the\n"
-                 "whole team) before the drop rules apply [s]; 0: for ever (docs/runtime.md#silence)")
-      ->check(CLI::Range(0.0, 1e9))
-      ->capture_default_str();
   std::uint64_t seed = 0;
   const CLI::Option* seed_option =
       app.add_option("--seed", seed, "override the scenario's seed (start jitter); summary.json reports the seed used");
@@ -110,14 +123,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
              "state come from DIR/run.log (and snapshot.pb); the agents that were running reconnect")
           ->excludes(scenario_option)
           ->excludes(check_option);
-  app.add_option("--snapshot-every", options.snapshot_every, "write snapshot.pb after every N steps (0: never)")
-      ->check(CLI::Range(0ull, 1ull << 40))
-      ->capture_default_str();
-  app.add_option("--frames-every", options.frames_every,
-                 "a time-lapse: a PNG frame every K steps and the last into OUT/frames (frame_<step>.png), and\n"
-                 "OUT/frames/timelapse.mp4 of them when ffmpeg is on PATH")
-      ->check(cli::at_least_one())
-      ->type_name("K");
+  add_timing_and_record_options(app, options);
   app.add_flag("--replace", options.replace,
                "remove a previous run's files from --out before starting (without it such a folder is refused)")
       ->excludes(resume_option);
