@@ -53,6 +53,13 @@ start_agents() {
     pids+=($!)
   done
 }
+# start_mid_run: the reference's terrain into sha, then the run (world and agents) until agent 1 has deposited.
+start_mid_run() {
+  sha=$(reference)
+  start_world --scenario "$scenario" --agents 3 --out "$out"
+  start_agents
+  mid_run
+}
 # mid_run: waits until agent 1 has deposited (events.log is written live).
 mid_run() {
   for _ in $(seq 1 3000); do grep -q '"agent":1,"kind":"deposited"' "$out/events.log" 2>/dev/null && return 0; sleep 0.02; done
@@ -73,22 +80,10 @@ refused_with_pid() {
   [ "$1" -eq 2 ] || { cat "$2"; fail "a second start on a folder in use exited $1, not 2"; }
   [ "$(wc -l <"$2")" -eq 1 ] && grep -q "in use by marsala-world pid $3" "$2" || { cat "$2"; fail "no one line naming pid $3"; }
 }
-# bridge_lab: hosts h1 (the world, 10.78.0.1) and h2 (the agents) on a bridge, in namespaces of this test's own;
-# cut HOST / reconnect HOST detach its port from the bridge and attach it again (a cable pulled at the switch).
+# bridge_lab: hosts h1 (the world) and h2 (the agents) on a bridge (lib.sh bridge_hosts), the LAN profile; cut HOST /
+# reconnect HOST detach its port from the bridge and attach it again (a cable pulled at the switch).
 bridge_lab() {
-  ip link set lo up
-  mkdir -p /run/netns && mount -t tmpfs tmpfs /run/netns || { echo "SKIP: cannot mount /run/netns"; exit 77; }
-  ip link add br0 type bridge 2>/dev/null || { echo "SKIP: cannot make a bridge here"; exit 77; }
-  ip link set br0 up
-  for i in 1 2; do
-    ip netns add "h$i"
-    ip link add "port$i" type veth peer name eth0 netns "h$i" || { echo "SKIP: cannot make veth pairs here"; exit 77; }
-    ip link set "port$i" master br0 up
-    ip -n "h$i" link set lo up
-    ip -n "h$i" addr add "10.78.0.$i/24" dev eth0
-    ip -n "h$i" link set eth0 up multicast on
-    ip -n "h$i" route add 224.0.0.0/4 dev eth0
-  done
+  bridge_hosts 10.78.0 2
   world_host=h1 agent_host=h2 dds_config=(--dds-config "$root/deploy/dds/cyclone-lan.xml")
 }
 cut() { ip link set "port${1#h}" nomaster; }
@@ -98,10 +93,7 @@ out="$work/run"
 mkdir -p "$out/logs"
 case "$case_name" in
   world-pause)
-    sha=$(reference)
-    start_world --scenario "$scenario" --agents 3 --out "$out"
-    start_agents
-    mid_run
+    start_mid_run
     kill -STOP "$world"
     # A paused world still owns its folder: a second --resume, and spawn.sh --replace, are refused.
     rc=0
@@ -117,10 +109,7 @@ case "$case_name" in
     finish "$sha" "world paused 30 s, a second --resume and a --replace refused meanwhile"
     ;;
   resume-late)
-    sha=$(reference)
-    start_world --scenario "$scenario" --agents 3 --out "$out"
-    start_agents
-    mid_run
+    start_mid_run
     kill -KILL "$world"
     wait "$world" 2>/dev/null || true
     sleep 60
@@ -167,10 +156,7 @@ EOF
     ;;
   world-cut|agent-cut)
     bridge_lab
-    sha=$(reference)
-    start_world --scenario "$scenario" --agents 3 --out "$out"
-    start_agents
-    mid_run
+    start_mid_run
     host=$world_host seconds=30
     [ "$case_name" = agent-cut ] && host=$agent_host seconds=60
     cut "$host"

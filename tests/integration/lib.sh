@@ -16,3 +16,23 @@ test_workspace() {
   fail() { echo "FAIL ($case_name): $*" >&2; exit 1; }
   export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
 }
+# bridge_hosts PREFIX COUNT, as root inside network and mount namespaces of the test's own: hosts h1..hCOUNT (network
+# namespaces, lo up) joined by the bridge br0, host i at PREFIX.i/24 on its eth0 with multicast routed there, plugged
+# into the bridge by port<i> (detach it, `ip link set port<i> nomaster`, to cut the host off). Exits 77 (skipped) where
+# /run/netns cannot be mounted or bridges or veth pairs cannot be made.
+bridge_hosts() {
+  ip link set lo up
+  mkdir -p /run/netns && mount -t tmpfs tmpfs /run/netns || { echo "SKIP: cannot mount /run/netns"; exit 77; }
+  ip link add br0 type bridge 2>/dev/null || { echo "SKIP: cannot make a bridge here"; exit 77; }
+  ip link set br0 up
+  local i
+  for i in $(seq 1 "$2"); do
+    ip netns add "h$i"
+    ip link add "port$i" type veth peer name eth0 netns "h$i" || { echo "SKIP: cannot make veth pairs here"; exit 77; }
+    ip link set "port$i" master br0 up
+    ip -n "h$i" link set lo up
+    ip -n "h$i" addr add "$1.$i/24" dev eth0
+    ip -n "h$i" link set eth0 up multicast on
+    ip -n "h$i" route add 224.0.0.0/4 dev eth0
+  done
+}

@@ -20,19 +20,8 @@ if [ "${MARSALA_MULTIHOST_INNER:-}" != 1 ]; then
 fi
 work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-multihost-$case_name.XXXXXX")"
 trap '[ -n "${MARSALA_KEEP_WORK:-}" ] || rm -rf "$work"' EXIT
-ip link set lo up
-mkdir -p /run/netns && mount -t tmpfs tmpfs /run/netns || { echo "SKIP: cannot mount /run/netns"; exit 77; }
-ip link add br0 type bridge 2>/dev/null || { echo "SKIP: cannot make a bridge here"; exit 77; }
-ip link set br0 up
-for i in 1 2 3; do
-  ip netns add "h$i"
-  ip link add "veth$i" type veth peer name eth0 netns "h$i" || { echo "SKIP: cannot make veth pairs here"; exit 77; }
-  ip link set "veth$i" master br0 up
-  ip -n "h$i" link set lo up
-  ip -n "h$i" addr add "10.77.0.$i/24" dev eth0
-  ip -n "h$i" link set eth0 up multicast on
-  ip -n "h$i" route add 224.0.0.0/4 dev eth0
-done
+. "$root/tests/integration/lib.sh"  # bridge_hosts
+bridge_hosts 10.77.0 3
 
 # The reference: the same team on loopback (in this namespace, which has lo only).
 MARSALA_BUILD_DIR="$(dirname "$bin")" "$root/deploy/spawn.sh" --scenario "$scenario" --agents 5 --domain "$domain" \
