@@ -21,6 +21,7 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <map>
 #include <mutex>
@@ -155,7 +156,10 @@ class Context {
   /// Ports from participant index kServerIndices up (the next free one from there): the world's indices are left to
   /// it (a client's or a server's, docs/runtime.md#discovery-star).
   static void leave_world_indices(dds::DomainParticipantQos& qos) {
-    qos.wire_protocol().participant_id = kServerIndices;
+    // Each participant of this process its own id (the id is part of the GUID prefix: two participants of one process
+    // with one id collide); another process's ports are skipped by the mutation below.
+    static std::atomic<std::int32_t> next_id{kServerIndices};
+    qos.wire_protocol().participant_id = next_id++;
     // Fast DDS moves a busy port up one index at a time, 100 times by default: the 101st client of a host would get
     // no discovery port at all and be found by nobody (measured: agents 102..120 of a 120-agent run never admitted).
     qos.wire_protocol().builtin.mutation_tries = 1000;
