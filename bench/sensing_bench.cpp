@@ -1,18 +1,28 @@
 // The cost of ray-cast sensing and OctoMap mapping per robot step at the default resolutions (docs/runtime.md#sensing):
 //   scan:    the world's ray casting of one scan (common/core/ray_caster.hpp), laser and rgbd;
 //   insert:  the agent's OctoMap insertion of one scan and the heightmap derivation (MappingSystem::integrate_scan);
-//   step:    both, for a robot that moves 0.2 m per step along a line, scanning every step.
+//   step:    both, for a robot that moves 0.2 m per step along a line, scanning every step;
+//   ScanningRobotStep: a scanning robot's whole step in a real run (the ramp scenario, 3 robots, seed 1, in one
+//            process, tests/support/lockstep_sim.hpp), per robot and step over steps 100..299 (robots driving to the
+//            platform's wall and building before it): medians of the scan (the world's frame, its ray casting), the
+//            insertion into the octree, the height map's derivation, the decision (the behaviour's decide() less its
+//            mapping) and the whole step (frame + decide()); their sum is a robot's step (docs/runtime.md#mapping).
 // Terrain: the ramp scenario's platform (1.5 m high) on a 30 x 20 m grid of 0.1 m cells, and a generated "mix"
 // terrain of the same size; the robot 3 m before the platform, facing it. Medians of repetitions (bench/run.sh).
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <string>
 #include <vector>
 
 #include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/core/cpu_time.hpp"
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/ray_caster.hpp"
+#include "marsala/scenario/terrain_builder.hpp"
 #include "marsala/terrain/generators.hpp"
+#include "support/lockstep_sim.hpp"
 
 namespace {
 
@@ -94,9 +104,61 @@ void sensors_and_terrains(benchmark::internal::Benchmark* b) {
   b->Unit(benchmark::kMillisecond);
 }
 
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// The shipped ramp scenario with every robot scanning: each robot's frame and decision timed by the sim, and a shadow
+// map fed the same frames (the behaviour's own mapping calls) splits the mapping off the decision.
+void BM_ScanningRobotStep(benchmark::State& state) {
+  const std::string sensor = kSensorNames[state.range(0)];
+  constexpr std::uint64_t kFrom = 100, kTo = 300;
+  std::vector<double> scan, insertion, heights, decision, whole;
+  for (auto _ : state) {
+    scenario::Scenario s = scenario::load_scenario(std::string(MARSALA_SOURCE_DIR) + "/deploy/scenarios/ramp.pbtxt",
+                                                   {"robot_type.sensor.name=" + sensor});
+    s.seed = 1;
+    test::LockstepSim sim(s, scenario::build_terrain(s), 3);
+    const RobotType& type = sim.state().agents.front().type;
+    std::vector<agent::executive::MappingSystem> shadows(3, agent::executive::MappingSystem(
+                                                                sim.state().terrain.geometry(), 16, type.sensor));
+    std::vector<test::LockstepSim::AgentStepCost> costs;
+    while (sim.state().step < kTo) {
+      const bool timed = sim.state().step >= kFrom;
+      sim.step_timed(costs);
+      for (const auto& c : costs) {
+        agent::executive::MappingSystem& map = shadows[c.agent_id - 1];
+        const Position robot{c.frame.x_m, c.frame.y_m};
+        const double began = thread_cpu_ms();
+        map.integrate(c.frame.tiles, robot);
+        if (c.frame.scanned)
+          map.integrate_scan(c.frame.points, agent::executive::believed_sensor_origin(robot, c.frame.z_m, type.sensor));
+        map.assume_ground(robot, c.frame.z_m, 0.5 * type.body.navigability.delta_m + type.body.max_step_m);
+        const double mapping = thread_cpu_ms() - began;
+        if (!timed || !c.frame.scanned) continue;
+        scan.push_back(c.frame_ms);
+        insertion.push_back(map.last_scan_cost().insertion_ms);
+        heights.push_back(map.last_scan_cost().heights_ms);
+        decision.push_back(std::max(0.0, c.decide_ms - mapping));
+        whole.push_back(c.frame_ms + c.decide_ms);
+      }
+    }
+  }
+  state.counters["scan_ms"] = median_of(scan);
+  state.counters["insertion_ms"] = median_of(insertion);
+  state.counters["heights_ms"] = median_of(heights);
+  state.counters["decision_ms"] = median_of(decision);
+  state.counters["step_ms"] = median_of(whole);
+  state.counters["robot_steps"] = static_cast<double>(whole.size());
+  state.SetLabel(sensor + " robots on ramp.pbtxt, steps 100..299");
+}
+
 BENCHMARK(BM_Scan)->Apply(sensors_and_terrains);
 BENCHMARK(BM_InsertAndDerive)->Apply(sensors_and_terrains);
 BENCHMARK(BM_RobotStep)->Apply(sensors_and_terrains)->Iterations(100);
+BENCHMARK(BM_ScanningRobotStep)->Arg(0)->Arg(1)->Iterations(1)->Unit(benchmark::kSecond);
 
 }  // namespace
 

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "marsala/agent/executive/detail/voxel_occupancy.hpp"
+#include "marsala/core/cpu_time.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 
@@ -297,10 +298,12 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
     octree_ = std::make_unique<Octree>(g);
     octree_->hits.resize(static_cast<std::size_t>(g.size()));
   }
+  const double began_ms = thread_cpu_ms();
   const ScanBatch batch = bin_hits(points, origin);
   // Rays carve free space up to each end voxel, which becomes more likely occupied (OctoMap's log-odds update).
   // Only leaves are ever read, so no inner node is kept (detail/voxel_occupancy.hpp).
   octree_->tree.insert(batch.cloud, tree_point(g, origin.x, origin.y, origin.z));
+  const double inserted_ms = thread_cpu_ms();
   octree_->settle(batch.touched);
   if (batch.max_row >= 0) rederive_heights(batch);
   for (std::size_t index : batch.touched)
@@ -320,6 +323,7 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
     mark_known(f.cell.row, f.cell.col);
     assumed_(f.cell.row, f.cell.col) = surface ? 0 : 1;
   }
+  last_scan_cost_ = {inserted_ms - began_ms, thread_cpu_ms() - inserted_ms};
 }
 
 MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& points, Point3 origin) {

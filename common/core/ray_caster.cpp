@@ -91,12 +91,19 @@ std::vector<ScanPoint> cast_scan(const Heightmap& terrain, Point3 origin, double
   random::Rng rng(seed);
   std::vector<ScanPoint> points;
   points.reserve(static_cast<std::size_t>(azimuths * elevations / 2));
+  // The elevations' cosines and sines, once per scan rather than once per ray (the same values).
+  std::vector<double> cos_e(static_cast<std::size_t>(elevations)), sin_e(static_cast<std::size_t>(elevations));
+  for (long long j = 0; j < elevations; ++j) {
+    const double e = (sensor.vertical_min_deg + static_cast<double>(j) * sensor.vertical_resolution_deg) * deg;
+    cos_e[static_cast<std::size_t>(j)] = std::cos(e);
+    sin_e[static_cast<std::size_t>(j)] = std::sin(e);
+  }
   for (long long i = 0; i < azimuths; ++i) {
     const double a = azimuth0 + static_cast<double>(i) * sensor.horizontal_resolution_deg * deg;
     const double ca = std::cos(a), sa = std::sin(a);
     for (long long j = 0; j < elevations; ++j) {
-      const double e = (sensor.vertical_min_deg + static_cast<double>(j) * sensor.vertical_resolution_deg) * deg;
-      const Point3 dir{std::cos(e) * ca, std::cos(e) * sa, std::sin(e)};
+      const std::size_t at = static_cast<std::size_t>(j);
+      const Point3 dir{cos_e[at] * ca, cos_e[at] * sa, sin_e[at]};
       // One deviate per ray, hit or not, so a change of the terrain far away leaves the noise of other rays alone.
       const double z = normal(rng);
       const std::optional<double> hit = first_hit(terrain, origin, dir, sensor.max_range_m);
