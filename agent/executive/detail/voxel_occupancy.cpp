@@ -1,5 +1,7 @@
 #include "marsala/agent/executive/detail/voxel_occupancy.hpp"
 
+#include <cmath>
+
 namespace marsala::agent::executive::detail {
 namespace {
 
@@ -50,21 +52,19 @@ const VoxelOccupancy::Voxel* VoxelOccupancy::find(const octomap::OcTreeKey& key)
   const long long index = column_index(key);
   if (index < 0) {
     const auto it = outside_.find(packed(key));
-    return it == outside_.end() || !it->second.exists ? nullptr : &it->second;
+    return it == outside_.end() || std::isnan(it->second.log_odds) ? nullptr : &it->second;
   }
   const Column& column = columns_[static_cast<std::size_t>(index)];
   const int at = static_cast<int>(key[2]) - column.z0;
   if (at < 0 || at >= static_cast<int>(column.voxels.size())) return nullptr;
   const Voxel& v = column.voxels[static_cast<std::size_t>(at)];
-  return v.exists ? &v : nullptr;
+  return std::isnan(v.log_odds) ? nullptr : &v;
 }
 
-void VoxelOccupancy::update(const octomap::OcTreeKey& key, float change) {
+void VoxelOccupancy::update(Voxel& v, float change) {
   // OccupancyOcTreeBase::updateNode (early abort at a clamping threshold) and updateNodeLogOdds: a new leaf starts at
   // log-odds 0, the change is added in float, then clamped.
-  Voxel& v = voxel(key);
-  if (!v.exists) {
-    v.exists = true;
+  if (std::isnan(v.log_odds)) {
     v.log_odds = 0.0f;
     ++leaves_;
   } else if ((change >= 0 && v.log_odds >= keys_.getClampingThresMaxLog()) ||
@@ -81,7 +81,6 @@ void VoxelOccupancy::update(const octomap::OcTreeKey& key, float change) {
 void VoxelOccupancy::insert(const octomap::Pointcloud& points, const octomap::point3d& origin) {
   ++scan_;
   hits_.clear();
-  misses_.clear();
   // computeDiscreteUpdate: each end voxel once, in the order first met, its centre the ray's end; the end voxels are
   // the occupied set (the key of a voxel's centre is the voxel).
   std::vector<octomap::point3d> ends;
@@ -101,19 +100,20 @@ void VoxelOccupancy::insert(const octomap::Pointcloud& points, const octomap::po
     v.hit_scan = scan_;
     hits_.push_back(key);
   }
-  // computeUpdate: the voxels each ray crosses (its end excluded) are the free set, less the occupied ones.
+  // computeUpdate: the voxels each ray crosses (its end excluded) are the free set, less the occupied ones. Each
+  // voxel is updated once per scan, so the order of the updates does not matter (OctoMap walks its hash sets): a
+  // crossed voxel is updated when first met, the occupied ones (all known by now) after.
+  const float miss = keys_.getProbMissLog();
   for (const octomap::point3d& end : ends) {
     if (!keys_.computeRayKeys(origin, end, ray_)) continue;
     for (const octomap::OcTreeKey& key : ray_) {
       Voxel& v = voxel(key);
       if (v.hit_scan == scan_ || v.miss_scan == scan_) continue;
       v.miss_scan = scan_;
-      misses_.push_back(key);
+      update(v, miss);
     }
   }
-  // Each key once, so the order of the updates does not matter (OctoMap walks its hash sets).
-  for (const octomap::OcTreeKey& key : misses_) update(key, keys_.getProbMissLog());
-  for (const octomap::OcTreeKey& key : hits_) update(key, keys_.getProbHitLog());
+  for (const octomap::OcTreeKey& key : hits_) update(voxel(key), keys_.getProbHitLog());
 }
 
 bool VoxelOccupancy::occupied(const octomap::OcTreeKey& key) const {

@@ -8,6 +8,7 @@
 #include <octomap/OcTree.h>
 
 #include <cstdint>
+#include <limits>
 #include <unordered_map>
 #include <vector>
 
@@ -34,8 +35,7 @@ class VoxelOccupancy {
 
  private:
   struct Voxel {
-    float log_odds = 0.0f;
-    bool exists = false;
+    float log_odds = std::numeric_limits<float>::quiet_NaN();  ///< NaN: no leaf yet
     std::uint32_t miss_scan = 0;  ///< the last scan that counted it crossed
     std::uint32_t hit_scan = 0;   ///< the last scan that counted it occupied
     std::uint32_t end_scan = 0;   ///< the last scan with a point in it
@@ -47,7 +47,7 @@ class VoxelOccupancy {
   Voxel& voxel(const octomap::OcTreeKey& key);  // made (not yet a leaf) when new
   const Voxel* find(const octomap::OcTreeKey& key) const;
   long long column_index(const octomap::OcTreeKey& key) const;  // -1 outside the grid's columns
-  void update(const octomap::OcTreeKey& key, float change);
+  void update(Voxel& v, float change);
 
   octomap::OcTree keys_;  ///< an empty tree: OctoMap's key arithmetic, rays and log-odds parameters
   octomap::KeyRay ray_;
@@ -56,7 +56,7 @@ class VoxelOccupancy {
   std::unordered_map<std::uint64_t, Voxel> outside_;  ///< voxels of columns beyond the array
   std::uint32_t scan_ = 0;
   std::size_t leaves_ = 0;
-  std::vector<octomap::OcTreeKey> hits_, misses_;  ///< this scan's (reused)
+  std::vector<octomap::OcTreeKey> hits_;  ///< this scan's end voxels (reused)
 };
 
 }  // namespace marsala::agent::executive::detail
