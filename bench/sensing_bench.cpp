@@ -2,6 +2,9 @@
 //   scan:    the world's ray casting of one scan (common/core/ray_caster.hpp), laser and rgbd;
 //   insert:  the agent's OctoMap insertion of one scan and the heightmap derivation (MappingSystem::integrate_scan);
 //   step:    both, for a robot that moves 0.2 m per step along a line, scanning every step;
+//   OctreeInsertion: the baseline in the same run: one scan's points into an octomap::OcTree (insertPointCloud, lazy,
+//            then updateInnerOccupancy, as the mapping system did before) against the flat leaves that replaced it
+//            (agent/executive/detail/voxel_occupancy.hpp), both holding the 10 scans before;
 //   ScanningRobotStep: a scanning robot's whole step in a real run (the ramp scenario, 3 robots, seed 1, in one
 //            process, tests/support/lockstep_sim.hpp), per robot and step over steps 100..299 (robots driving to the
 //            platform's wall and building before it): medians of the scan (the world's frame, its ray casting), the
@@ -17,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "marsala/agent/executive/detail/voxel_occupancy.hpp"
 #include "marsala/agent/executive/mapping_system.hpp"
 #include "marsala/core/cpu_time.hpp"
 #include "marsala/core/heightmap.hpp"
@@ -81,6 +85,59 @@ void BM_InsertAndDerive(benchmark::State& state) {
   }
   state.counters["points"] = static_cast<double>(scan.size());
   state.SetLabel(std::string(kSensorNames[state.range(0)]) + " on " + kTerrainNames[state.range(1)]);
+}
+
+// The scans of InsertAndDerive's robot (10 steps on its way, then the measured one) as clouds in the octree's frame.
+std::vector<octomap::Pointcloud> clouds_on_the_way(const Heightmap& terrain, const SensorSpec& sensor,
+                                                   std::vector<octomap::point3d>& origins) {
+  std::vector<octomap::Pointcloud> clouds;
+  const GridGeometry& g = terrain.geometry();
+  for (int k = 0; k <= 10; ++k) {
+    const Point3 o = sensor_origin(terrain, k < 10 ? 13.05 + 0.2 * k : 15.05, 10.05, sensor);
+    octomap::Pointcloud cloud;
+    for (const ScanPoint& p : cast_scan(terrain, o, 0.0, sensor, scan_seed(1, 1, k)))
+      cloud.push_back(static_cast<float>(o.x + p.x_m - g.xll_m), static_cast<float>(o.y + p.y_m - g.yll_m),
+                      static_cast<float>(o.z + p.z_m));
+    clouds.push_back(cloud);
+    origins.emplace_back(static_cast<float>(o.x - g.xll_m), static_cast<float>(o.y - g.yll_m),
+                         static_cast<float>(o.z));
+  }
+  return clouds;
+}
+
+// range(0): sensor, range(1): 0 the OcTree (before), 1 the flat leaves (now); on the platform terrain.
+void BM_OctreeInsertion(benchmark::State& state) {
+  const Heightmap terrain = terrain_named(0);
+  const SensorSpec sensor = sensor_defaults(sensor_kind(kSensorNames[state.range(0)]));
+  std::vector<octomap::point3d> origins;
+  const std::vector<octomap::Pointcloud> clouds = clouds_on_the_way(terrain, sensor, origins);
+  const double cs = terrain.cell_size_m();
+  octomap::OcTree tree(cs);
+  tree.setClampingThresMin(0.4);
+  agent::executive::detail::VoxelOccupancy flat(cs, terrain.rows(), terrain.cols(), 0.4);
+  for (int k = 0; k < 10; ++k) {
+    tree.insertPointCloud(clouds[k], origins[k], -1.0, true, true);
+    tree.updateInnerOccupancy();
+    flat.insert(clouds[k], origins[k]);
+  }
+  for (auto _ : state) {
+    if (state.range(1) == 0) {
+      state.PauseTiming();
+      octomap::OcTree copy(tree);
+      state.ResumeTiming();
+      copy.insertPointCloud(clouds[10], origins[10], -1.0, true, true);
+      copy.updateInnerOccupancy();
+      benchmark::DoNotOptimize(copy.size());
+    } else {
+      state.PauseTiming();
+      agent::executive::detail::VoxelOccupancy copy(flat);
+      state.ResumeTiming();
+      copy.insert(clouds[10], origins[10]);
+      benchmark::DoNotOptimize(copy.leaves());
+    }
+  }
+  state.counters["points"] = static_cast<double>(clouds[10].size());
+  state.SetLabel(std::string(kSensorNames[state.range(0)]) + (state.range(1) == 0 ? ": OcTree" : ": flat leaves"));
 }
 
 // A robot step: the world's scan, then the agent's insertion and derivation, moving 0.2 m per step.
@@ -160,6 +217,7 @@ void BM_ScanningRobotStep(benchmark::State& state) {
 
 BENCHMARK(BM_Scan)->Apply(sensors_and_terrains);
 BENCHMARK(BM_InsertAndDerive)->Apply(sensors_and_terrains);
+BENCHMARK(BM_OctreeInsertion)->Args({0, 0})->Args({0, 1})->Args({1, 0})->Args({1, 1})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RobotStep)->Apply(sensors_and_terrains)->Iterations(100);
 BENCHMARK(BM_ScanningRobotStep)->Arg(0)->Arg(1)->Arg(2)->Iterations(1)->Unit(benchmark::kSecond);
 
