@@ -138,12 +138,12 @@ def stats_rows(rows):
 
 
 def plot_script(args, stats_csv):
-    """gnuplot: a row per scenario, panels steps, volume, median map error against the noise, a line per sensor."""
+    """gnuplot: a row per scenario, panels steps, volume, p95 map error against the noise, a line per sensor."""
     colours = {"ground_truth": "#1f77b4", "rgbd": "#d62728", "laser": "#2ca02c"}
-    panels = (("steps (mean)", 6), ("deposited volume [m^3] (mean)", 7), ("map median error [mm] (mean)", 9))
+    panels = (("steps (mean)", 6), ("deposited volume [m^3] (mean)", 7), ("map p95 error [mm] (mean)", 10))
     script = (f"set terminal pngcairo size 1200,{420 * len(args.scenarios)} font \",10\" noenhanced\n"
               f"set output '{args.out}/sensing.png'\nset datafile separator ','\nset grid\nset key top left\n"
-              f"set multiplot layout {len(args.scenarios)},3 title 'sensing: steps, volume and map error against "
+              f"set multiplot layout {len(args.scenarios)},3 title 'sensing: steps, volume and map error (95th percentile) against "
               "localisation noise'\nset xlabel 'localisation noise sd [m]'\n"
               "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n")
     for scenario in args.scenarios:
