@@ -36,3 +36,13 @@ bridge_hosts() {
     ip -n "h$i" route add 224.0.0.0/4 dev eth0
   done
 }
+# expect_tool_usage_error TOOL WORK PATTERN ARGS...: TOOL --out WORK/bad ARGS exits 2 with PATTERN on stderr and
+# writes nothing (fail MESSAGE must be defined)
+expect_tool_usage_error() {
+  local tool="$1" work="$2" pattern="$3" rc=0
+  shift 3
+  "$tool" --out "$work/bad" "$@" >"$work/stdout.txt" 2>"$work/stderr.txt" || rc=$?
+  [ "$rc" -eq 2 ] || { cat "$work/stderr.txt"; fail "$(basename "$tool") $* exited $rc, expected 2"; }
+  grep -q -- "$pattern" "$work/stderr.txt" || { cat "$work/stderr.txt"; fail "$(basename "$tool") $*: no '$pattern'"; }
+  [ ! -e "$work/bad" ] || fail "$(basename "$tool") $* wrote $work/bad"
+}
