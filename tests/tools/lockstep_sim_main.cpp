@@ -181,7 +181,9 @@ RunResult run_one(marsala::scenario::Scenario s, const marsala::Heightmap& initi
     r.band_width_m = world_server::construction_band_width_m(st);
     r.outside_band_m3 = world_server::deposited_outside_band_m3(
         initial, st.terrain,
-        world_server::construction_band(st.check.route.route, st.terrain.rows(), st.terrain.cols(),
+        world_server::construction_band(
+            world_server::band_route_cells(st, world_server::payload_path(st.terrain, st.payload_path)),
+            st.terrain.rows(), st.terrain.cols(),
                                         st.terrain.cell_size_m(), r.band_width_m));
   }
   fmt::print("{} agents {} seed {}: {} after {} steps, {:.3f} m3, outside band {:.3f} m3, progress {:.4f}, last "

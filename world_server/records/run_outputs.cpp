@@ -67,7 +67,7 @@ FinalTerrainReport final_terrain_report(const WorldState& state, const RunInfo& 
     report.band_width_m = construction_band_width_m(state);
     report.outside_band_m3 = deposited_outside_band_m3(
         info.initial_terrain, state.terrain,
-        construction_band(state.check.route.route, state.terrain.rows(), state.terrain.cols(),
+        construction_band(band_route_cells(state, report.route), state.terrain.rows(), state.terrain.cols(),
                           state.terrain.cell_size_m(), report.band_width_m));
   }
   if (state.completion == scenario::CompletionKind::kLevelSite)

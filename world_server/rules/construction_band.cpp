@@ -14,6 +14,10 @@ double construction_band_width_m(const WorldState& state) {
   return width;
 }
 
+const std::vector<CellIndex>& band_route_cells(const WorldState& state, const std::optional<PayloadRoute>& final_path) {
+  return final_path ? final_path->cells : state.check.route.route;
+}
+
 CellMask construction_band(const std::vector<CellIndex>& route, int rows, int cols, double cell_size_m,
                            double width_m) {
   CellMask band = CellMask::Zero(rows, cols);

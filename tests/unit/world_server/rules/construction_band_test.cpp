@@ -74,6 +74,15 @@ TEST(ConstructionBand, RandomRoutesAgreeWithTheDistanceDefinition) {
   }
 }
 
+TEST(ConstructionBand, FollowsThePayloadsFinalPathWhenItHasOneElseThePlannedRoute) {
+  WorldState state;
+  state.check.route.route = {{0, 0}, {1, 1}};
+  EXPECT_EQ(band_route_cells(state, std::nullopt), state.check.route.route);
+  PayloadRoute final_path;
+  final_path.cells = {{5, 5}, {5, 6}, {5, 7}};
+  EXPECT_EQ(band_route_cells(state, final_path), final_path.cells);
+}
+
 TEST(ConstructionBand, TerrainsOfDifferentSizesAreRefused) {
   const Heightmap a(GridGeometry{4, 4, 0.0, 0.0, 1.0}, 0.0), b(GridGeometry{4, 5, 0.0, 0.0, 1.0}, 0.0);
   EXPECT_THROW(deposited_outside_band_m3(a, b, CellMask::Zero(4, 4)), InvalidArgument);
