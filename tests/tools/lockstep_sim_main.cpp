@@ -286,6 +286,9 @@ int main(int argc, char** argv) {
   } catch (const ParseError& e) {  // a scenario file that does not parse
     std::cerr << "marsala-lockstep-sim: " << e.what() << "\n";
     return 2;
+  } catch (const IoError& e) {  // a scenario, terrain or --csv file that cannot be read or written
+    std::cerr << "marsala-lockstep-sim: " << e.what() << "\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "marsala-lockstep-sim: " << e.what() << "\n";
     return 1;
