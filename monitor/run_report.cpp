@@ -70,6 +70,9 @@ std::string run_report(const std::string& dir) {
   std::string goal;
   if (s.completion() == "payload_path")
     goal = s.path_found() ? fmt::format(", payload path {:.1f} m", s.path_length_m()) : ", no payload path yet";
+  if (s.construction_band_width_m() > 0.0)
+    goal += fmt::format(", {:.3f} m3 outside the {:.1f} m construction band", s.deposited_outside_band_m3(),
+                        s.construction_band_width_m());
   if (s.completion() == "level_site") goal = fmt::format(", site {:.1f} % level", 100.0 * s.site_level_fraction());
   out += fmt::format("  agents {} ({} admitted, {} dropped), {:.3f} m3 deposited{}\n", s.agents(), s.admitted(),
                      s.dropped(), s.deposited_volume_m3(), goal);

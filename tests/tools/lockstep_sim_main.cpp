@@ -1,11 +1,18 @@
 // marsala-lockstep-sim: a scenario run in one process (tests/support/lockstep_sim.hpp), for sweeps and for looking
-// inside a run: prints one line at the end (steps, end, volume, progress, terrain sha256) and, with --show, every
-// robot's state, position, material and request at the chosen steps.
+// inside a run: prints one line at the end of each run (steps, end, volume, volume outside the construction band,
+// progress, terrain sha256) and, with --show, every robot's state, position, material and request at the chosen
+// steps. Lists of team sizes and seeds (--agents 1,2,6-12 --seeds 1-5) make a sweep: one run after the other, a CSV
+// row each (--csv), and a table per team size at the end.
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -17,6 +24,7 @@
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
 #include "marsala/terrain/asc_io.hpp"
+#include "marsala/world_server/rules/construction_band.hpp"
 
 namespace {
 
@@ -88,67 +96,203 @@ void reach_base(const LockstepSim& sim) {
   }
 }
 
+
+/// "1-5", "1,3,6-12": the listed numbers, in order, each at least 1; throws InvalidArgument naming `option`.
+std::vector<std::uint64_t> parse_list(const std::string& text, const std::string& option) {
+  std::vector<std::uint64_t> out;
+  std::size_t at = 0;
+  const auto bad = [&]() {
+    return marsala::InvalidArgument(
+        fmt::format("{} '{}': expected numbers >= 1 and ranges, e.g. 1,2,6-12", option, text));
+  };
+  while (at <= text.size()) {
+    const std::size_t end = std::min(text.find(',', at), text.size());
+    const std::string item = text.substr(at, end - at);
+    const std::size_t dash = item.find('-');
+    try {
+      std::size_t used = 0, used2 = 0;
+      const std::string first = item.substr(0, dash);
+      const unsigned long long a = std::stoull(first, &used);
+      const unsigned long long b = dash == std::string::npos ? a : std::stoull(item.substr(dash + 1), &used2);
+      if (used != first.size() || (dash != std::string::npos && used2 != item.size() - dash - 1) || a < 1 || b < a ||
+          b - a > 100000 || first.find_first_not_of("0123456789") != std::string::npos)
+        throw bad();
+      for (unsigned long long v = a; v <= b; ++v) out.push_back(v);
+    } catch (const std::logic_error&) {
+      throw bad();
+    }
+    at = end + 1;
+  }
+  return out;
+}
+
+/// What one run ended with.
+struct RunResult {
+  std::uint32_t agents = 0;
+  std::uint64_t seed = 0;
+  std::string end;
+  std::uint64_t steps = 0;
+  double volume_m3 = 0.0;
+  double outside_band_m3 = 0.0;  // payload_path runs: raised outside the construction band (construction_band.hpp)
+  double band_width_m = 0.0;
+  double progress = 0.0;
+  std::string sha256;
+};
+
+/// What to run and print.
+struct RunOptions {
+  std::uint64_t max_steps = 0;    // 0: the scenario's
+  std::uint64_t stall_steps = 0;  // 0: never
+  std::set<std::uint64_t> shown;
+  std::string write_dir;
+};
+
+RunResult run_one(marsala::scenario::Scenario s, const marsala::Heightmap& initial, std::uint32_t agents,
+                  std::uint64_t seed, const RunOptions& o) {
+  using namespace marsala;
+  s.seed = seed;
+  if (agents == 0 || agents > s.slots.size())
+    throw InvalidArgument(fmt::format("--agents {}: the scenario has {} slots", agents, s.slots.size()));
+  const std::uint64_t max_steps = o.max_steps > 0 ? o.max_steps : s.max_steps;
+  LockstepSim sim(s, initial, agents);
+  std::uint64_t last_change = 0;
+  RunResult r;
+  r.agents = agents, r.seed = seed, r.end = "max_steps";
+  while (sim.state().step < max_steps) {
+    if (world_server::is_completed(sim.state())) {
+      r.end = "completed";
+      break;
+    }
+    const auto outcome = sim.step();
+    if (!outcome.changed_tiles.empty()) last_change = sim.state().step;
+    if (o.shown.count(sim.state().step) > 0) show(sim);
+    if (o.stall_steps > 0 && sim.state().step - last_change >= o.stall_steps) {
+      r.end = "stalled";
+      break;
+    }
+  }
+  if (o.shown.count(0) > 0) show(sim), reach_base(sim);
+  const auto& st = sim.state();
+  r.steps = st.step;
+  r.volume_m3 = st.deposited_volume_m3;
+  r.progress = world_server::progress(st);
+  r.sha256 = runlog::terrain_sha256(st.terrain);
+  if (st.completion == scenario::CompletionKind::kPayloadPath) {
+    r.band_width_m = world_server::construction_band_width_m(st);
+    r.outside_band_m3 = world_server::deposited_outside_band_m3(
+        initial, st.terrain,
+        world_server::construction_band(
+            world_server::band_route_cells(st, world_server::payload_path(st.terrain, st.payload_path)),
+            st.terrain.rows(), st.terrain.cols(),
+                                        st.terrain.cell_size_m(), r.band_width_m));
+  }
+  fmt::print("{} agents {} seed {}: {} after {} steps, {:.3f} m3, outside band {:.3f} m3, progress {:.4f}, last "
+             "change {}, rejected motions {}, sha256 {}\n",
+             s.name, agents, seed, r.end, st.step, st.deposited_volume_m3, r.outside_band_m3, r.progress, last_change,
+             st.rejected_motions, r.sha256);
+  std::fflush(stdout);
+  if (!o.write_dir.empty()) {
+    terrain::write_asc(st.terrain, o.write_dir + "/terrain_final.asc");
+    Heightmap built = st.terrain;
+    for (int row = 0; row < built.rows(); ++row)
+      for (int c = 0; c < built.cols(); ++c) built(row, c) -= initial(row, c);
+    terrain::write_asc(built, o.write_dir + "/built.asc");
+  }
+  return r;
+}
+
+std::string csv_row(const std::string& scenario, const RunResult& r) {
+  return fmt::format("{},{},{},{},{},{:.3f},{:.3f},{:.1f},{:.4f},{}\n", scenario, r.agents, r.seed, r.end, r.steps,
+                     r.volume_m3, r.outside_band_m3, r.band_width_m, r.progress, r.sha256);
+}
+
+/// Per team size: runs, completed, mean / min / max of steps, volume and volume outside the band.
+void print_team_table(const std::vector<RunResult>& results) {
+  std::map<std::uint32_t, std::vector<const RunResult*>> teams;
+  for (const RunResult& r : results) teams[r.agents].push_back(&r);
+  fmt::print("agents runs completed | steps mean min max | m3 mean min max | outside band m3 mean\n");
+  for (const auto& [agents, runs] : teams) {
+    double steps = 0, volume = 0, outside = 0, smin = 1e300, smax = 0, vmin = 1e300, vmax = 0;
+    int completed = 0;
+    for (const RunResult* r : runs) {
+      completed += r->end == "completed" ? 1 : 0;
+      steps += r->steps, volume += r->volume_m3, outside += r->outside_band_m3;
+      smin = std::min(smin, double(r->steps)), smax = std::max(smax, double(r->steps));
+      vmin = std::min(vmin, r->volume_m3), vmax = std::max(vmax, r->volume_m3);
+    }
+    const double n = static_cast<double>(runs.size());
+    fmt::print("{:6} {:4} {:9} | {:5.0f} {:5.0f} {:5.0f} | {:6.1f} {:6.1f} {:6.1f} | {:6.1f}\n", agents, runs.size(),
+               completed, steps / n, smin, smax, volume / n, vmin, vmax, outside / n);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace marsala;
-  CLI::App app{"marsala-lockstep-sim: a scenario run in one process, without a bus"};
-  std::string scenario_file;
-  std::uint32_t agents = 0;
-  std::uint64_t max_steps = 0, stall_steps = 0;
+  CLI::App app{"marsala-lockstep-sim: a scenario run in one process, without a bus; lists of team sizes and seeds "
+               "make a sweep"};
+  std::string scenario_file, agents_text, seeds_text, csv_file;
   std::optional<std::uint64_t> seed;
   std::vector<std::string> overrides;
   std::vector<std::uint64_t> show_steps;
-  std::string write_dir;
+  RunOptions o;
   app.add_option("--scenario", scenario_file, "scenario file")->required();
-  app.add_option("--agents", agents, "agents (default: every slot)");
+  app.add_option("--agents", agents_text, "team sizes, e.g. 5 or 1,2,3,6-12 (default: every slot)");
   app.add_option("--seed", seed, "run seed");
-  app.add_option("--max-steps", max_steps, "step limit (default: the scenario's)");
-  app.add_option("--stall-steps", stall_steps, "end after this many steps without a terrain change (0: never)");
+  app.add_option("--seeds", seeds_text, "run seeds, e.g. 1-5 (instead of --seed)");
+  app.add_option("--csv", csv_file,
+                 "write one row per run: scenario,agents,seed,end_reason,steps,volume_m3,outside_band_m3,"
+                 "band_width_m,progress,terrain_sha256 (FILE.partial while the sweep runs)");
+  app.add_option("--max-steps", o.max_steps, "step limit (default: the scenario's)");
+  app.add_option("--stall-steps", o.stall_steps, "end after this many steps without a terrain change (0: never)");
   app.add_option("--set", overrides, "FIELD=VALUE");
-  app.add_option("--write", write_dir, "write terrain_final.asc and built.asc (final - initial) into this folder");
+  app.add_option("--write", o.write_dir, "write terrain_final.asc and built.asc (final - initial) into this folder");
   app.add_option("--show", show_steps, "print every robot after these steps");
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-lockstep-sim", std::cout, std::cerr))
     return *code;
+  std::vector<RunResult> results;
   try {
-    scenario::Scenario s = scenario::load_scenario(scenario_file, overrides);
-    if (seed) s.seed = *seed;
-    if (agents == 0) agents = static_cast<std::uint32_t>(s.slots.size());
-    if (max_steps == 0) max_steps = s.max_steps;
+    const scenario::Scenario s = scenario::load_scenario(scenario_file, overrides);
+    if (seed && !seeds_text.empty()) throw InvalidArgument("--seed and --seeds: give one of them");
+    const std::vector<std::uint64_t> seeds =
+        !seeds_text.empty() ? parse_list(seeds_text, "--seeds") : std::vector<std::uint64_t>{seed.value_or(s.seed)};
+    const std::vector<std::uint64_t> teams = !agents_text.empty() ? parse_list(agents_text, "--agents")
+                                                                  : std::vector<std::uint64_t>{s.slots.size()};
+    for (const std::uint64_t n : teams)
+      if (n > s.slots.size())
+        throw InvalidArgument(fmt::format("--agents {}: the scenario has {} slots", n, s.slots.size()));
+    o.shown = std::set<std::uint64_t>(show_steps.begin(), show_steps.end());
     const Heightmap initial = scenario::build_terrain(s);
-    LockstepSim sim(s, initial, agents);
-    const std::set<std::uint64_t> shown(show_steps.begin(), show_steps.end());
-    std::uint64_t last_change = 0;
-    std::string end = "max_steps";
-    while (sim.state().step < max_steps) {
-      if (world_server::is_completed(sim.state())) {
-        end = "completed";
-        break;
-      }
-      const auto outcome = sim.step();
-      if (!outcome.changed_tiles.empty()) last_change = sim.state().step;
-      if (shown.count(sim.state().step) > 0) show(sim);
-      if (stall_steps > 0 && sim.state().step - last_change >= stall_steps) {
-        end = "stalled";
-        break;
-      }
+    std::ofstream csv;
+    if (!csv_file.empty()) {
+      csv.open(csv_file + ".partial");
+      if (!csv) throw IoError(fmt::format("--csv {}: cannot be written", csv_file));
+      csv << "scenario,agents,seed,end_reason,steps,volume_m3,outside_band_m3,band_width_m,progress,terrain_sha256\n";
     }
-    if (shown.count(0) > 0) show(sim), reach_base(sim);
-    const auto& st = sim.state();
-    fmt::print("{} agents {} seed {}: {} after {} steps, {:.3f} m3, progress {:.4f}, last change {}, rejected motions "
-               "{}, sha256 {}\n",
-               s.name, agents, s.seed, end, st.step, st.deposited_volume_m3, world_server::progress(st), last_change,
-               st.rejected_motions, runlog::terrain_sha256(st.terrain));
-    if (!write_dir.empty()) {
-      terrain::write_asc(st.terrain, write_dir + "/terrain_final.asc");
-      Heightmap built = st.terrain;
-      for (int r = 0; r < built.rows(); ++r)
-        for (int c = 0; c < built.cols(); ++c) built(r, c) -= initial(r, c);
-      terrain::write_asc(built, write_dir + "/built.asc");
+    for (const std::uint64_t n : teams)
+      for (const std::uint64_t sd : seeds) {
+        results.push_back(run_one(s, initial, static_cast<std::uint32_t>(n), sd, o));
+        if (csv.is_open()) csv << csv_row(s.name, results.back()) << std::flush;
+      }
+    if (csv.is_open()) {
+      csv.close();
+      std::filesystem::rename(csv_file + ".partial", csv_file);
     }
-    return end == "completed" ? 0 : 3;
+    if (results.size() > 1) print_team_table(results);
+  } catch (const InvalidArgument& e) {  // bad options or scenario values
+    std::cerr << "marsala-lockstep-sim: " << e.what() << "\n";
+    return 2;
+  } catch (const ParseError& e) {  // a scenario file that does not parse
+    std::cerr << "marsala-lockstep-sim: " << e.what() << "\n";
+    return 2;
+  } catch (const IoError& e) {  // a scenario, terrain or --csv file that cannot be read or written
+    std::cerr << "marsala-lockstep-sim: " << e.what() << "\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "marsala-lockstep-sim: " << e.what() << "\n";
     return 1;
   }
+  const bool all = std::all_of(results.begin(), results.end(), [](const RunResult& r) { return r.end == "completed"; });
+  return all ? 0 : 3;
 }

@@ -23,6 +23,7 @@
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/terrain/asc_io.hpp"
 #include "marsala/world_server/rules/arbiter.hpp"
+#include "marsala/world_server/rules/construction_band.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -49,6 +50,8 @@ struct FinalTerrainReport {
   std::optional<PayloadRoute> route;       ///< payload_path only
   std::vector<ConstructionSite> sites;     ///< payload_path with a route and the initial terrain known
   double site_fraction = 0.0;              ///< level_site only
+  double band_width_m = 0.0;               ///< payload_path with the initial terrain known: the construction band
+  double outside_band_m3 = 0.0;            ///< and the volume raised outside it (construction_band.hpp)
 };
 
 FinalTerrainReport final_terrain_report(const WorldState& state, const RunInfo& info) {
@@ -59,6 +62,14 @@ FinalTerrainReport final_terrain_report(const WorldState& state, const RunInfo& 
       info.initial_terrain.cols() == state.terrain.cols())
     report.sites = construction_sites(info.initial_terrain, state.terrain, *report.route,
                                       state.payload_path.navigability.delta_m);
+  if (state.completion == scenario::CompletionKind::kPayloadPath && info.initial_terrain.rows() == state.terrain.rows() &&
+      info.initial_terrain.cols() == state.terrain.cols()) {
+    report.band_width_m = construction_band_width_m(state);
+    report.outside_band_m3 = deposited_outside_band_m3(
+        info.initial_terrain, state.terrain,
+        construction_band(band_route_cells(state, report.route), state.terrain.rows(), state.terrain.cols(),
+                          state.terrain.cell_size_m(), report.band_width_m));
+  }
   if (state.completion == scenario::CompletionKind::kLevelSite)
     report.site_fraction = site_level_fraction(state.terrain, state.site);
   return report;
@@ -181,6 +192,8 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_path_found(report.route.has_value());
   s.set_path_length_m(report.route ? report.route->length_m : 0.0);
   s.set_site_level_fraction(report.site_fraction);
+  s.set_construction_band_width_m(report.band_width_m);
+  s.set_deposited_outside_band_m3(report.outside_band_m3);
   for (const ConstructionSite& site : report.sites) {
     proto::ConstructionSite* p = s.add_construction_sites();
     p->set_from_m(site.from_m);

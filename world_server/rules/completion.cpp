@@ -16,6 +16,7 @@
 #include "marsala/core/navigability_processor.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
 #include "marsala/world_server/rules/arbiter.hpp"
+#include "marsala/world_server/rules/construction_band.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -234,13 +235,7 @@ RouteGap plan_route_gap(const Heightmap& terrain, const scenario::PayloadPath& p
   if (!plan.found) throw Error(fmt::format("payload route from {} to {}: the planner found none", from, to));
   RouteGap out;
   out.route = std::move(plan.path);
-  CellMask band = CellMask::Zero(terrain.rows(), terrain.cols());
-  const std::vector<CellIndex> ball = disc_offsets(body.delta_m / (2.0 * cs));
-  for (const CellIndex& c : out.route)
-    for (const CellIndex& o : ball) {
-      const CellIndex n{c.row + o.row, c.col + o.col};
-      if (terrain.contains(n)) band(n.row, n.col) = 1;
-    }
+  const CellMask band = construction_band(out.route, terrain.rows(), terrain.cols(), cs, body.delta_m);
   for (int r = 0; r < terrain.rows(); ++r)
     for (int c = 0; c < terrain.cols(); ++c)
       if (band(r, c) != 0) {

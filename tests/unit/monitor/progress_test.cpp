@@ -248,6 +248,15 @@ TEST_F(RunReport, ACompletedPathRun) {
             "  everything else in " + d + ": events.log, logs/, run.log, summary.json\n");
 }
 
+TEST_F(RunReport, SaysWhatLandedOutsideTheConstructionBand) {
+  write_summary(R"({"scenario": "path_gale", "completed": true, "end_reason": "completed", "steps": 3500,
+    "agents": 1, "admitted": 1, "deposited_volume_m3": 30.361, "completion": "payload_path", "path_found": true,
+    "path_length_m": 40.0, "progress": 1, "construction_band_width_m": 3, "deposited_outside_band_m3": 4.5})");
+  EXPECT_NE(run_report(dir_.string()).find(", payload path 40.0 m, 4.500 m3 outside the 3.0 m construction band\n"),
+            std::string::npos)
+      << run_report(dir_.string());
+}
+
 TEST_F(RunReport, SaysWhereTheTimeLapseIs) {
   write_summary(R"({"scenario": "ramp", "completed": true, "end_reason": "completed", "steps": 275,
     "wall_seconds": 2.0, "agents": 3, "admitted": 3, "completion": "agents_at_goal", "progress": 1})");
