@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "marsala/agent/deliberative/home_route.hpp"
 #include "marsala/agent/executive/depositor.hpp"
 #include "marsala/agent/executive/lane.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
@@ -349,6 +350,56 @@ std::optional<executive::Motion> RampSteps::step_back(const deliberative::LocalM
   return advance(local, route.path, robot);
 }
 
+std::optional<executive::Motion> RampSteps::step_away(const deliberative::LocalMap& local, Position robot,
+                                                      Position from) const {
+  const double near = 2.0 * context_.type.body.navigability.delta_m;
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  const auto away = best_navigable_cell(local, -distance(robot, from) - 1e-9, [&](Position p) {
+    return distance(p, robot) <= near ? -distance(p, from) : kNone;
+  });
+  if (!away) return std::nullopt;
+  const auto route = modules_->router.plan(local.gap, local.navigable, local.robot, *away);
+  if (!route.found) return std::nullopt;
+  return advance(local, route.path, robot);
+}
+
+bool RampSteps::keep_out_of(deliberative::LocalMap& local, Position robot, const std::vector<Lane>& lanes) {
+  const auto in_lane = [&](Position p) {
+    return std::any_of(lanes.begin(), lanes.end(), [&](const Lane& lane) { return lane.contains(p); });
+  };
+  if (lanes.empty()) return false;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c)
+      if (local.occupiable(r, c) != 0 && CellIndex{r, c} != local.robot && in_lane(local.center({r, c})))
+        local.occupiable(r, c) = 0;
+  local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
+  return in_lane(robot);
+}
+
+std::optional<executive::Motion> RampSteps::leave_lanes(const deliberative::LocalMap& local, Position robot,
+                                                        const std::vector<Lane>& lanes) const {
+  // Breadth first through navigable cells: the first outside every lane is the nearest by route.
+  std::vector<CellIndex> queue{local.robot};
+  CellMask seen = CellMask::Zero(local.rows(), local.cols());
+  seen(local.robot.row, local.robot.col) = 1;
+  for (std::size_t i = 0; i < queue.size(); ++i) {
+    const CellIndex at = queue[i];
+    const Position p = local.center(at);
+    if (i > 0 && std::none_of(lanes.begin(), lanes.end(), [&](const Lane& lane) { return lane.contains(p); })) {
+      const auto route = modules_->router.plan(local.gap, local.navigable, local.robot, at);
+      return route.found ? advance(local, route.path, robot) : std::nullopt;
+    }
+    for (int dr = -1; dr <= 1; ++dr)
+      for (int dc = -1; dc <= 1; ++dc) {
+        const CellIndex next{at.row + dr, at.col + dc};
+        if (!local.contains(next) || local.navigable(next.row, next.col) == 0 || seen(next.row, next.col) != 0) continue;
+        seen(next.row, next.col) = 1;
+        queue.push_back(next);
+      }
+  }
+  return std::nullopt;
+}
+
 std::optional<CellIndex> RampSteps::farthest_navigable_from_goal(const deliberative::LocalMap& local) {
   const Position goal = local.center(local.goal);
   return best_navigable_cell(local, -distance(local.center(local.robot), goal),
@@ -370,14 +421,17 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
   const double radius = context_.assignment.base_radius_m - kBaseMarginM;
   if (distance(robot, base) <= radius) {
     request.refill = trace.refill = true;
+    memory_.home.clear();
     return true;
   }
-  // Where to go: the navigable cell within the base radius nearest the robot; else the navigable cell nearest the
-  // base when that is nearer than the robot by at least a cell; else the oldest navigable cell of the trajectory in
-  // the window (the way the robot came from the base).
+  // Where to go: the navigable cell within the base radius nearest the robot; else along the way home over the
+  // robot's own map; else (bodies cut it in the window) the navigable cell nearest the base when that is nearer than
+  // the robot by at least a cell; else the oldest navigable cell of the trajectory in the window (the way the robot
+  // came from the base).
   constexpr double kNone = std::numeric_limits<double>::infinity();
   std::optional<CellIndex> goal = best_navigable_cell(
       local, kNone, [&](Position p) { return distance(p, base) <= radius ? distance(p, robot) : kNone; });
+  if (!goal) goal = home_goal(local);
   if (!goal)
     goal = best_navigable_cell(local, distance(robot, base) - local.geometry().cell_size_m,
                                [&](Position p) { return distance(p, base); });
@@ -390,10 +444,32 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
     move(*motion, trace, request);
     if (distance(motion->target, base) <= radius) {
       request.refill = trace.refill = true;
+      memory_.home.clear();
       return true;
     }
   }
   return false;
+}
+
+std::optional<CellIndex> RampSteps::home_goal(const deliberative::LocalMap& local) {
+  const auto on_route = [&] {
+    for (const CellIndex g : memory_.home)
+      if (std::abs(g.row - local.to_global(local.robot).row) <= 1 && std::abs(g.col - local.to_global(local.robot).col) <= 1)
+        return true;
+    return false;
+  };
+  if (memory_.home.empty() || !on_route()) {
+    const RobotBody& body = context_.type.body;
+    const auto route = deliberative::home_route(modules_->map.known_map(), body.navigability,
+                                                local.to_global(local.robot), context_.assignment.base,
+                                                context_.assignment.base_radius_m - kBaseMarginM, body.sensing_range_m);
+    memory_.home = route.value_or(std::vector<CellIndex>{});
+  }
+  for (auto it = memory_.home.rbegin(); it != memory_.home.rend(); ++it) {
+    const CellIndex p = local.to_local(*it);
+    if (local.contains(p) && p != local.robot && local.navigable(p.row, p.col) != 0) return p;
+  }
+  return std::nullopt;
 }
 
 }  // namespace marsala::agent::reactive

@@ -37,6 +37,7 @@
 #include "marsala/agent/executive/body_clearance.hpp"
 #include "marsala/agent/executive/deposition_manager.hpp"
 #include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/agent/reactive/right_of_way.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
 #include "marsala/protocol/messages.hpp"
 
@@ -130,6 +131,18 @@ class RampSteps {
   /// nullopt when there is none or no route to it.
   std::optional<executive::Motion> step_back(const deliberative::LocalMap& local, Position robot) const;
 
+  /// A step away from a robot at `from` [m] (giving way, reactive/right_of_way.hpp): towards the navigable cell within
+  /// two body lengths farthest from it, when that is farther than the robot stands; nullopt when there is none.
+  std::optional<executive::Motion> step_away(const deliberative::LocalMap& local, Position robot, Position from) const;
+
+  /// Keeps out of the lanes of robots with the right of way (right_of_way.hpp): their cells leave `local`'s
+  /// occupiable and navigable cells (not the robot's own). True when the robot stands in one of them.
+  static bool keep_out_of(deliberative::LocalMap& local, Position robot, const std::vector<Lane>& lanes);
+  /// A step out of the lanes: towards the navigable cell outside them nearest the robot (route length); nullopt when
+  /// there is none in the window.
+  std::optional<executive::Motion> leave_lanes(const deliberative::LocalMap& local, Position robot,
+                                               const std::vector<Lane>& lanes) const;
+
   /// Advance, build or start retreating (see the header); nullopt, with nothing requested, when no deposition path
   /// leads through known cells (the behaviour's state stays: wait for the map to grow).
   std::optional<BuildPhase> build_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,
@@ -170,6 +183,7 @@ class RampSteps {
     std::vector<executive::BodyClearance> others;  ///< the last frame's neighbours
     CellMask corridor;                             ///< the last local map's navigable cells, neighbours not taken out
     CellMask terrain_occupiable;                   ///< and its occupiable cells
+    std::vector<CellIndex> home;                   ///< the way home of this trip (world cells), empty: not planned
   };
 
   // look()'s steps, in order.
@@ -188,6 +202,9 @@ class RampSteps {
   /// since) or whose gap fewer than kConfirmScans scans in a row showed (one scan's misread surface is no gap). The
   /// path is still planned on the whole gap.
   void clear_unconfirmed_gap(deliberative::LocalMap& local) const;
+  /// On the way back: the cell of the way home (deliberative/home_route.hpp, planned when the trip has none or the
+  /// robot left it) farthest along it that the robot can reach in its window; nullopt when bodies cut it there.
+  std::optional<CellIndex> home_goal(const deliberative::LocalMap& local);
   static std::optional<CellIndex> farthest_navigable_from_goal(const deliberative::LocalMap& local);
 
   AgentContext context_;

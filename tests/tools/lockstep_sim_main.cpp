@@ -16,6 +16,7 @@
 #include "marsala/core/navigability_processor.hpp"
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
+#include "marsala/terrain/asc_io.hpp"
 
 namespace {
 
@@ -98,12 +99,14 @@ int main(int argc, char** argv) {
   std::optional<std::uint64_t> seed;
   std::vector<std::string> overrides;
   std::vector<std::uint64_t> show_steps;
+  std::string write_dir;
   app.add_option("--scenario", scenario_file, "scenario file")->required();
   app.add_option("--agents", agents, "agents (default: every slot)");
   app.add_option("--seed", seed, "run seed");
   app.add_option("--max-steps", max_steps, "step limit (default: the scenario's)");
   app.add_option("--stall-steps", stall_steps, "end after this many steps without a terrain change (0: never)");
   app.add_option("--set", overrides, "FIELD=VALUE");
+  app.add_option("--write", write_dir, "write terrain_final.asc and built.asc (final - initial) into this folder");
   app.add_option("--show", show_steps, "print every robot after these steps");
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-lockstep-sim", std::cout, std::cerr))
     return *code;
@@ -112,7 +115,8 @@ int main(int argc, char** argv) {
     if (seed) s.seed = *seed;
     if (agents == 0) agents = static_cast<std::uint32_t>(s.slots.size());
     if (max_steps == 0) max_steps = s.max_steps;
-    LockstepSim sim(s, scenario::build_terrain(s), agents);
+    const Heightmap initial = scenario::build_terrain(s);
+    LockstepSim sim(s, initial, agents);
     const std::set<std::uint64_t> shown(show_steps.begin(), show_steps.end());
     std::uint64_t last_change = 0;
     std::string end = "max_steps";
@@ -135,6 +139,13 @@ int main(int argc, char** argv) {
                "{}, sha256 {}\n",
                s.name, agents, s.seed, end, st.step, st.deposited_volume_m3, world_server::progress(st), last_change,
                st.rejected_motions, runlog::terrain_sha256(st.terrain));
+    if (!write_dir.empty()) {
+      terrain::write_asc(st.terrain, write_dir + "/terrain_final.asc");
+      Heightmap built = st.terrain;
+      for (int r = 0; r < built.rows(); ++r)
+        for (int c = 0; c < built.cols(); ++c) built(r, c) -= initial(r, c);
+      terrain::write_asc(built, write_dir + "/built.asc");
+    }
     return end == "completed" ? 0 : 3;
   } catch (const std::exception& e) {
     std::cerr << "marsala-lockstep-sim: " << e.what() << "\n";
