@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -18,7 +19,8 @@ constexpr EnumName<RampState> kRampStateNames[] = {{RampState::kWaitAdmission, "
                                                    {RampState::kRetreat, "retreat"},
                                                    {RampState::kReturnToBase, "return_to_base"},
                                                    {RampState::kAtGoal, "at_goal"},
-                                                   {RampState::kDone, "done"}};
+                                                   {RampState::kDone, "done"},
+                                                   {RampState::kGiveWay, "give_way"}};
 
 RampState state_of(BuildPhase phase) {
   switch (phase) {
@@ -31,6 +33,14 @@ RampState state_of(BuildPhase phase) {
 
 }  // namespace
 
+double give_way_contact_m(const RobotBody& body) {
+  return 2.0 * body.navigability.delta_m + 2.0 * body.max_step_m;
+}
+
+int give_way_frames(const RobotBody& body) {
+  return static_cast<int>(std::ceil(2.0 * body.navigability.delta_m / body.max_step_m));
+}
+
 std::string to_string(RampState state) { return enum_to_string(kRampStateNames, state); }
 
 RampState ramp_state_from_string(const std::string& name) {
@@ -38,7 +48,10 @@ RampState ramp_state_from_string(const std::string& name) {
 }
 
 RampBuilder::RampBuilder(const AgentContext& context, RampBuilderOptions options)
-    : steps_(context, std::move(options.planner)) {}
+    : steps_(context, std::move(options.planner)),
+      right_of_way_(context.agent_id, give_way_contact_m(context.type.body),
+                    1.5 * context.type.body.navigability.delta_m,
+                    give_way_frames(context.type.body)) {}
 
 const executive::MappingSystem& RampBuilder::map() const {
   if (!steps_.admitted()) throw InvalidArgument("ramp builder: no map before admission");
@@ -64,8 +77,8 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
   if (frame.run_over || state_ == RampState::kDone) {
     state_ = RampState::kDone;
   } else {
-    const BuildView view = steps_.look(frame, trace_);
-    const deliberative::LocalMap& local = view.local;
+    BuildView view = steps_.look(frame, trace_);
+    deliberative::LocalMap& local = view.local;
     const RobotBody& body = steps_.context().type.body;
     const auto close_by = [&] {
       return robots_close_by(frame.neighbours, view.robot, 0.5 * body.navigability.delta_m, body.navigability.delta_m);
@@ -73,9 +86,27 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
     if (state_ == RampState::kSurvey) state_ = RampState::kAdvance;
     // At the goal: on the local goal's cell, which is the target's cell, or the nearest the robot can get to a
     // target off the grid.
-    if (local.goal == local.robot) {
+    const bool at_goal = local.goal == local.robot;
+    const Position going = state_ == RampState::kReturnToBase ? steps_.context().assignment.base : view.target;
+    right_of_way_.observe(view.robot, frame.neighbours, at_goal,
+                          std::hypot(going.x - view.robot.x, going.y - view.robot.y), 0.5 * body.max_step_m);
+    const std::vector<Lane> lanes =
+        right_of_way_.lanes(3.0 * body.navigability.delta_m, 0.5 * body.navigability.delta_m + body.max_step_m);
+    const bool in_lane =
+        std::any_of(lanes.begin(), lanes.end(), [&](const Lane& lane) { return lane.contains(view.robot); });
+    if (!in_lane) RampSteps::keep_out_of(local, view.robot, lanes);
+    if (in_lane) {
+      state_ = RampState::kGiveWay;
+      if (const auto out = steps_.leave_lanes(local, view.robot, lanes)) steps_.move(*out, trace_, request);
+    } else if (const auto from = right_of_way_.giving_way()) {
+      state_ = RampState::kGiveWay;
+      if (const auto motion = steps_.step_away(local, view.robot, *from)) steps_.move(*motion, trace_, request);
+    } else if (at_goal) {
       state_ = RampState::kAtGoal;
+    } else if (right_of_way_.holding()) {
+      state_ = RampState::kGiveWay;  // holds still: nothing requested
     } else {
+      if (state_ == RampState::kGiveWay) state_ = RampState::kAdvance;
       if (state_ == RampState::kAtGoal) state_ = RampState::kAdvance;
       if (state_ != RampState::kReturnToBase && frame.material_m3 < return_below_m3_ - 1e-12)
         state_ = RampState::kReturnToBase;
