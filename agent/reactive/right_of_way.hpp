@@ -84,13 +84,16 @@ class RightOfWay {
     Position heading{0.0, 0.0};  ///< unit vector of its last motion, (0, 0) before one
     double radius_m = 0.0;
     Loiter loiter;
+    long long frame = 0;  ///< the frame it was last seen in
   };
   std::uint32_t self_id_;
   double contact_m_;
   double loiter_m_;
   int give_way_frames_;
   Loiter self_;
-  std::map<std::uint32_t, Seen> seen_;  // the neighbours of the last frame
+  std::map<std::uint32_t, Seen> seen_;  // every neighbour seen, as last seen
+  long long frame_ = 0;                 // frames observed
+  std::map<std::uint32_t, Position> given_to_;  // at the goal: where each robot stood when this one gave way to it
   std::optional<Position> from_;
   int frames_left_ = 0;
   double best_to_go_m_ = 0.0;

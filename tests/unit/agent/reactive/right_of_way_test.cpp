@@ -9,17 +9,36 @@ namespace {
 
 Neighbour at(std::uint32_t id, double x, double y) { return {id, {x, y}, 0.0, 0.3}; }
 
-TEST(RightOfWay, ARobotAtItsGoalGivesWayToOneThatHoldsBesideIt) {
+TEST(RightOfWay, ARobotAtItsGoalGivesWayOnceToOneThatWaitsBesideIt) {
   RightOfWay parked(1, 1.6, 0.9, 6);
-  int first = -1;
-  for (int frame = 0; frame < 200 && first < 0; ++frame) {
-    // The other robot goes to and fro between two points 1.4 m apart, 24 frames a cycle, then holds still from
-    // frame 100 (it made no way).
-    const double t = (frame % 24) / 12.0, f = frame >= 100 ? 0.0 : (t <= 1.0 ? t : 2.0 - t);
-    parked.observe({2.7, 1.7}, {at(2, 2.1 + 0.2 * f, 2.3 + 1.4 * f)}, true, 0.0, 0.1);
-    if (parked.giving_way()) first = frame;
+  int first = -1, episodes = 0;
+  bool was_giving = false;
+  for (int frame = 0; frame < 300; ++frame) {
+    // The other robot drives along y = 4 (out of contact, 0.2 m a frame) until frame 100, then stands beside the
+    // parked one for good (it waits for it: the way it wants runs through it).
+    const Neighbour other = frame < 100 ? at(2, 0.2 * frame - 10.0, 4.0) : at(2, 2.1, 2.3);
+    parked.observe({2.7, 1.7}, {other}, true, 0.0, 0.1);
+    const bool giving = parked.giving_way().has_value();
+    if (giving && first < 0) first = frame;
+    if (giving && !was_giving) ++episodes;
+    was_giving = giving;
   }
+  // It has waited kStillFrames frames after arriving in frame 100; one episode only: where the other still waits
+  // after it, it waits for something else.
   EXPECT_EQ(first, 100 + kStillFrames);
+  EXPECT_EQ(episodes, 1);
+}
+
+TEST(RightOfWay, ARobotParkedOutOfRangeForAWhileDoesNotHoldAgainWhenSeenAgain) {
+  RightOfWay r(2, 1.6, 0.9, 6);
+  // Robot 1 is parked at (2, 1); robot 2 stands beside it, goes out of range for 30 frames and comes back: robot 1
+  // has stood still all along (more than a hold lasts), so it holds for no one and robot 2 never gives way to it.
+  for (int frame = 0; frame < 200; ++frame) {
+    const bool away = frame >= 60 && frame < 90;
+    r.observe(away ? Position{9.0, 1.0} : Position{3.0, 1.0}, away ? std::vector<Neighbour>{} : std::vector{at(1, 2.0, 1.0)},
+              false, 5.0, 0.1);
+    if (frame >= 2 * (kStillFrames + 6)) EXPECT_FALSE(r.giving_way().has_value()) << frame;
+  }
 }
 
 TEST(RightOfWay, TwoRobotsParkedAtTheirGoalsSideBySideStayParked) {
