@@ -59,8 +59,32 @@ struct Case {
   std::string text;  // what to print when it fails
 };
 
+/// True when every robot can drive from its start to its target keeping its body clear of the bodies of robots
+/// standing on every other start and target (a well-formed field: robots that wait at their starts or stand on their
+/// targets block nobody), as the agents judge clearance (body_clearance.hpp: the two radii and a step). Only then is a
+/// case solvable whatever order the robots arrive in; the right of way needs no more (docs/runtime.md#right-of-way).
+bool well_formed(const Heightmap& terrain, const RobotBody& body, const std::vector<scenario::AgentSlot>& slots) {
+  const CellMask occupiable = NavigabilityProcessor(body.navigability).occupiable(terrain);
+  // The two radii, a step (the disc around a lower id) and a step more: a robot parked "on" its target stands within
+  // the target radius of it (a cell here).
+  const double keep_m = body.navigability.delta_m + 2.0 * body.max_step_m;
+  for (const auto& slot : slots) {
+    CellMask free = occupiable;
+    for (int r = 0; r < free.rows(); ++r)
+      for (int c = 0; c < free.cols(); ++c)
+        for (const auto& other : slots)
+          for (const Position e : {other.start, other.target})
+            if (other.id != slot.id && std::hypot(terrain.cell_center({r, c}).x - e.x, terrain.cell_center({r, c}).y - e.y) <= keep_m + 1e-9) free(r, c) = 0;
+    const CellIndex from = *terrain.cell_at(slot.start), to = *terrain.cell_at(slot.target);
+    if (free(from.row, from.col) == 0 || NavigabilityProcessor::navigable_from(free, from)(to.row, to.col) == 0)
+      return false;
+  }
+  return true;
+}
+
 /// A random case: robots start and end on open cells (clear of walls by a body length) at least 1.5 bodies from
-/// every other start and target, all in one navigable region. nullopt when the draw finds no room.
+/// every other start and target, on a well-formed field. nullopt when the draw finds no room or the field is not
+/// well formed.
 std::optional<Case> random_case(std::uint64_t seed) {
   std::mt19937 rng(static_cast<std::uint32_t>(seed));
   Case k{{}, field(rng, std::uniform_int_distribution<int>(2, 5)(rng)), ""};
@@ -92,13 +116,7 @@ std::optional<Case> random_case(std::uint64_t seed) {
     if (!start || !target) return std::nullopt;
     s.slots.push_back({static_cast<std::uint32_t>(i + 1), type.name, *start, *target});
   }
-  const CellMask navigable =
-      NavigabilityProcessor(type.body.navigability).navigable(k.terrain, *k.terrain.geometry().cell_at(s.slots[0].start));
-  for (const auto& slot : s.slots)
-    for (const Position p : {slot.start, slot.target}) {
-      const CellIndex c = *k.terrain.geometry().cell_at(p);
-      if (navigable(c.row, c.col) == 0) return std::nullopt;
-    }
+  if (!well_formed(k.terrain, type.body, s.slots)) return std::nullopt;
   s.completion = scenario::CompletionKind::kAgentsAtGoal;
   s.goal.area = {0.0, 0.0, kCols * kCell, kRows * kCell};
   s.goal.target_radius_m = kCell;
@@ -110,45 +128,69 @@ std::optional<Case> random_case(std::uint64_t seed) {
   return k;
 }
 
-/// Runs `k` with its first `robots` slots (or only slot `only` when > 0) for at most `steps`; true when complete.
-bool completes(const Case& k, std::uint64_t steps, std::uint32_t only = 0) {
+/// Runs slot `id` of `k` alone (as agent 1) for at most `steps`; true when it ends on its target.
+bool completes_alone(const Case& k, std::uint64_t steps, std::uint32_t id) {
   scenario::Scenario s = k.scenario;
-  if (only > 0) {
-    s.slots = {s.slots[only - 1]};
-    s.slots[0].id = 1;
-  }
+  s.slots = {s.slots[id - 1]};
+  s.slots[0].id = 1;
   LockstepSim sim(s, k.terrain, static_cast<std::uint32_t>(s.slots.size()));
   while (sim.state().step < steps && !world_server::is_completed(sim.state())) sim.step();
   return world_server::is_completed(sim.state());
 }
 
+/// An environment variable as a number, or `fallback` when it is not set.
+long long env_number(const char* name, long long fallback) {
+  const char* v = std::getenv(name);
+  return v != nullptr ? std::atoll(v) : fallback;
+}
+
+/// Runs the whole team of `k` for at most `steps`; with `every` > 0 prints every robot each `every` steps (to look
+/// inside one case: MARSALA_LIVENESS_SEED, MARSALA_LIVENESS_EVERY). True when every robot ends on its target.
+bool team_completes(const Case& k, std::uint64_t steps, long long every) {
+  LockstepSim sim(k.scenario, k.terrain, static_cast<std::uint32_t>(k.scenario.slots.size()));
+  while (sim.state().step < steps && !world_server::is_completed(sim.state())) {
+    sim.step();
+    if (every <= 0 || sim.state().step % static_cast<std::uint64_t>(every) != 0) continue;
+    std::string line;
+    for (const auto& a : sim.state().agents) line += fmt::format(" {}@{} {}", a.id, a.position, a.state);
+    fmt::print("{}:{}\n", sim.state().step, line);
+  }
+  return world_server::is_completed(sim.state());
+}
+
+// The property: on a well-formed field, a team whose every robot reaches its target alone reaches all targets
+// together. A case that fails is looked at robot by robot: when one of them cannot do it alone either (the builder
+// then builds its way, not drives it), the case says nothing about the right of way and does not count; every
+// counted case must complete. MARSALA_LIVENESS_RUNS sets the number of counted runs (default 200).
 TEST(Liveness, RobotsInCorridorsAlwaysReachTheirTargets) {
-  const int kRuns = std::getenv("MARSALA_LIVENESS_RUNS") ? std::atoi(std::getenv("MARSALA_LIVENESS_RUNS")) : 200;
-  constexpr std::uint64_t kSteps = 600;  // the longest route is about 30 m, 150 steps, alone
-  int runs = 0, failed = 0;
-  for (std::uint64_t seed = 1; runs < kRuns; ++seed) {
-    auto k = random_case(seed);
-    if (!k) continue;
-    if (std::getenv("MARSALA_LIVENESS_SEED") && std::to_string(seed) != std::getenv("MARSALA_LIVENESS_SEED")) continue;
-    ++runs;
-    LockstepSim sim(k->scenario, k->terrain, static_cast<std::uint32_t>(k->scenario.slots.size()));
-    while (sim.state().step < kSteps && !world_server::is_completed(sim.state())) {
-      sim.step();
-      if (std::getenv("MARSALA_LIVENESS_SEED") && sim.state().step % std::atoi(std::getenv("MARSALA_LIVENESS_EVERY") ? std::getenv("MARSALA_LIVENESS_EVERY") : "20") == 0) {
-        std::string line;
-        for (const auto& a : sim.state().agents)
-          line += fmt::format(" {}@({:.2f},{:.2f}){} {}", a.id, a.position.x, a.position.y, a.state, a.last_reason);
-        fmt::print("{}:{}\n", sim.state().step, line);
+  const long long wanted = env_number("MARSALA_LIVENESS_RUNS", 200), only = env_number("MARSALA_LIVENESS_SEED", 0);
+  const long long every = only > 0 ? env_number("MARSALA_LIVENESS_EVERY", 20) : 0;
+  constexpr std::uint64_t kSteps = 600;  // the longest route is about 15 m, 75 steps, alone
+  long long runs = 0, failed = 0, not_alone = 0;
+  for (std::uint64_t seed = only > 0 ? static_cast<std::uint64_t>(only) : 1; runs < wanted; ++seed) {
+    const auto k = random_case(seed);
+    if (!k) {
+      if (only > 0) break;
+      continue;
+    }
+    if (team_completes(*k, kSteps, every)) {
+      ++runs;
+    } else {
+      std::vector<std::uint32_t> alone_fail;
+      for (const auto& slot : k->scenario.slots)
+        if (!completes_alone(*k, kSteps, slot.id)) alone_fail.push_back(slot.id);
+      if (!alone_fail.empty()) {
+        ++not_alone;
+      } else {
+        ++runs, ++failed;
+        ADD_FAILURE() << k->text << ": not all on their targets after " << kSteps << " steps";
       }
     }
-    if (world_server::is_completed(sim.state())) continue;
-    ++failed;
-    std::string where;
-    for (const auto& a : sim.state().agents)
-      where += fmt::format(" {}@{}({}{})", a.id, a.position, a.state, completes(*k, kSteps, a.id) ? "" : ", fails alone");
-    ADD_FAILURE() << k->text << ": not all on their targets after " << kSteps << " steps:" << where;
+    if (only > 0) break;
   }
-  EXPECT_EQ(failed, 0) << "of " << runs << " runs";
+  EXPECT_EQ(failed, 0) << "of " << runs << " runs (" << not_alone
+                       << " more cases left out: a robot of them fails alone)";
+  fmt::print("liveness: {} runs, {} failed, {} cases left out (a robot fails alone)\n", runs, failed, not_alone);
 }
 
 }  // namespace
