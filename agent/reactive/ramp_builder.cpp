@@ -89,7 +89,7 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
     const bool at_goal = local.goal == local.robot;
     const Position going = state_ == RampState::kReturnToBase ? steps_.context().assignment.base : view.target;
     right_of_way_.observe(view.robot, frame.neighbours, at_goal,
-                          std::hypot(going.x - view.robot.x, going.y - view.robot.y), 0.5 * body.max_step_m);
+                          std::hypot(going.x - view.robot.x, going.y - view.robot.y), 0.5 * body.max_step_m, worked_);
     const std::vector<Lane> lanes =
         right_of_way_.lanes(3.0 * body.navigability.delta_m, 0.5 * body.navigability.delta_m + body.max_step_m);
     const bool in_lane =
@@ -129,6 +129,7 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
     }
   }
   trace_.after = state_;
+  worked_ = !request.depositions.empty() || !request.deposits.empty() || request.refill;
   request.state = to_string(state_);
   request.waiting_for = waiting_for_;
   return request;

@@ -27,9 +27,9 @@ void RightOfWay::Loiter::update(Position p, double radius_m) {
 }
 
 void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, double to_go_m,
-                         double step_m) {
+                         double step_m, bool worked) {
   self_.update(self, loiter_m_);
-  if (at_goal || to_go_m < best_to_go_m_ - step_m || no_progress_ < 0) {
+  if (at_goal || worked || to_go_m < best_to_go_m_ - step_m || no_progress_ < 0) {
     best_to_go_m_ = to_go_m, no_progress_ = 0;
   } else {
     ++no_progress_;

@@ -1,26 +1,18 @@
 #pragma once
-// Right of way among solid robots (docs/runtime.md#right-of-way), from proximity sensing alone. Robots that stand
-// still side by side may be waiting for each other (each one's way runs through the other's body); nothing outside
-// them changes that, so one of them must give way, and all of them must agree which without talking:
+// Right of way among solid robots (docs/runtime.md#right-of-way: the rules and their invariant), from proximity
+// sensing alone. Robots that stand still side by side may be waiting for each other (each one's way runs through the
+// other's body); nothing outside them changes that, so one of them must give way, and all of them must agree which
+// without talking:
 //
-//   - a robot has loitered (stayed within loiter_m of where it stood, moving or not) for kStillFrames frames and a
-//     neighbour within contact range holds still (it has stood still for kStillFrames frames, and no longer than a
-//     hold lasts: one parked at its goal for good waits for nobody): they are in contact;
-//   - the lower agent id goes first: a robot in contact with a lower id gives way; a robot at its goal (done, it
-//     loses nothing by moving) gives way to any robot in contact;
-//   - giving way is an episode of give_way_frames frames (three times as long at the goal) in which the robot steps
-//     away from the robot it gives way to (the behaviour's step), then it carries on; its loitering counts from
-//     zero again;
-//   - a robot that has made no way for kStuckFrames frames (it may try and back off in turn, which no neighbour can
-//     tell from wandering) with a neighbour in contact holds still for kStillFrames + an episode, so that the
-//     neighbour sees it wait: then one of them gives way by the rules above;
-//   - a neighbour of lower id that is on its way (it moved within kMovingFrames frames) has its lane ahead reserved
-//     (lanes()): a robot keeps out of it and leaves it when it stands in it, so two robots that meet head on in a
-//     corridor do not meet again and again.
-//
-// Progress: of the robots in contact, the lowest id never gives way, and every robot in contact with it steps away
-// from it, so its way clears unless walls and robots that do not move close it; a robot that gives way has stood
-// still, so it gives away no progress it was making.
+//   - the lower agent id goes first; a robot at its goal has the lowest priority (it loses nothing by moving);
+//   - a neighbour of lower id that is on its way (moved within kMovingFrames frames) has its lane ahead reserved
+//     (lanes()): a robot keeps out of it and leaves it when it stands in it;
+//   - a robot that has made no way for kStuckFrames frames (and did no work in place) with a neighbour in contact
+//     holds still for kStillFrames + an episode, so that the neighbour sees it wait;
+//   - a robot that has loitered kStillFrames frames gives way (steps away for an episode) to a neighbour in contact
+//     that holds (has stood still kStillFrames to kStillFrames + an episode frames): to a lower id only, or, at its
+//     goal, to any id, also to one that loiters beside it, for three episodes and once per spot where it waits;
+//   - neighbours keep their record out of range (one parked all along does not seem to start holding again).
 
 #include <cstdint>
 #include <map>
@@ -57,9 +49,11 @@ class RightOfWay {
   /// unless contact_m and loiter_m are finite and > 0 and give_way_frames >= 1.
   RightOfWay(std::uint32_t self_id, double contact_m, double loiter_m, int give_way_frames);
 
-  /// One frame: where this robot stands and its neighbours (the frame's), at_goal when it is done, and how far it
-  /// still has to go to where it is going [m] (`step_m` [m]: what counts as progress).
-  void observe(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, double to_go_m, double step_m);
+  /// One frame: where this robot stands and its neighbours (the frame's), at_goal when it is done, how far it still
+  /// has to go to where it is going [m] (`step_m` [m]: what counts as progress), and `worked` when its last request
+  /// deposited or refilled (work in place is progress too: a builder is not waiting).
+  void observe(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, double to_go_m, double step_m,
+               bool worked = false);
   /// True while the robot holds still (made no way with a neighbour in contact; see the header).
   bool holding() const { return hold_left_ > 0; }
   /// Where the robot it gives way to stood when the episode began [m], while an episode lasts; else nullopt.

@@ -41,6 +41,21 @@ TEST(RightOfWay, ARobotParkedOutOfRangeForAWhileDoesNotHoldAgainWhenSeenAgain) {
   }
 }
 
+TEST(RightOfWay, ARobotThatMakesNoWayHoldsUnlessItBuilds) {
+  RightOfWay idle(2, 1.6, 0.9, 6), builder(2, 1.6, 0.9, 6);
+  int idle_first = -1;
+  for (int frame = 0; frame < 100; ++frame) {
+    // Both stand 1 m from robot 3, 5 m from where they go, and come no nearer; the builder deposits every frame.
+    idle.observe({1.0, 1.0}, {at(3, 2.0, 1.0)}, false, 5.0, 0.1);
+    builder.observe({1.0, 1.0}, {at(3, 2.0, 1.0)}, false, 5.0, 0.1, true);
+    if (idle.holding() && idle_first < 0) idle_first = frame;
+    EXPECT_FALSE(builder.holding()) << frame;
+  }
+  // The first frame has no distance to beat and counts as a frame without progress: kStuckFrames of them end with
+  // frame kStuckFrames - 1.
+  EXPECT_EQ(idle_first, kStuckFrames - 1);
+}
+
 TEST(RightOfWay, TwoRobotsParkedAtTheirGoalsSideBySideStayParked) {
   RightOfWay a(1, 1.6, 0.9, 6), b(2, 1.6, 0.9, 6);
   for (int frame = 0; frame < 300; ++frame) {
