@@ -31,6 +31,12 @@ RampState state_of(BuildPhase phase) {
   return RampState::kAdvance;
 }
 
+/// What a robot keeping the right of way waits for: "right of way: <what>", and the robots close by when any are.
+std::string right_of_way_text(const std::string& what, const std::string& close_by) {
+  return close_by.empty() ? fmt::format("right of way: {}", what)
+                          : fmt::format("right of way: {}; robots {} close by", what, close_by);
+}
+
 }  // namespace
 
 double give_way_contact_m(const RobotBody& body) {
@@ -51,7 +57,8 @@ RampBuilder::RampBuilder(const AgentContext& context, RampBuilderOptions options
     : steps_(context, std::move(options.planner)),
       right_of_way_(context.agent_id, give_way_contact_m(context.type.body),
                     1.5 * context.type.body.navigability.delta_m,
-                    give_way_frames(context.type.body)) {}
+                    give_way_frames(context.type.body)),
+      keeps_right_of_way_(context.right_of_way) {}
 
 const executive::MappingSystem& RampBuilder::map() const {
   if (!steps_.admitted()) throw InvalidArgument("ramp builder: no map before admission");
@@ -88,23 +95,29 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
     // target off the grid.
     const bool at_goal = local.goal == local.robot;
     const Position going = state_ == RampState::kReturnToBase ? steps_.context().assignment.base : view.target;
-    right_of_way_.observe(view.robot, frame.neighbours, at_goal,
-                          std::hypot(going.x - view.robot.x, going.y - view.robot.y), 0.5 * body.max_step_m, worked_);
+    if (keeps_right_of_way_)
+      right_of_way_.observe(view.robot, frame.neighbours, at_goal,
+                            std::hypot(going.x - view.robot.x, going.y - view.robot.y), 0.5 * body.max_step_m, worked_);
     const std::vector<Lane> lanes =
-        right_of_way_.lanes(3.0 * body.navigability.delta_m, 0.5 * body.navigability.delta_m + body.max_step_m);
+        keeps_right_of_way_
+            ? right_of_way_.lanes(3.0 * body.navigability.delta_m, 0.5 * body.navigability.delta_m + body.max_step_m)
+            : std::vector<Lane>{};
     const bool in_lane =
         std::any_of(lanes.begin(), lanes.end(), [&](const Lane& lane) { return lane.contains(view.robot); });
     if (!in_lane) RampSteps::keep_out_of(local, view.robot, lanes);
     if (in_lane) {
       state_ = RampState::kGiveWay;
       if (const auto out = steps_.leave_lanes(local, view.robot, lanes)) steps_.move(*out, trace_, request);
+      waiting_for_ = right_of_way_text("leaving a lower id's lane", close_by());
     } else if (const auto from = right_of_way_.giving_way()) {
       state_ = RampState::kGiveWay;
       if (const auto motion = steps_.step_away(local, view.robot, *from)) steps_.move(*motion, trace_, request);
+      waiting_for_ = right_of_way_text("giving way", close_by());
     } else if (at_goal) {
       state_ = RampState::kAtGoal;
     } else if (right_of_way_.holding()) {
       state_ = RampState::kGiveWay;  // holds still: nothing requested
+      waiting_for_ = right_of_way_text(fmt::format("holding still, no way for {} steps", kStuckFrames), close_by());
     } else {
       if (state_ == RampState::kGiveWay) state_ = RampState::kAdvance;
       if (state_ == RampState::kAtGoal) state_ = RampState::kAdvance;

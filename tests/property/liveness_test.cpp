@@ -133,7 +133,7 @@ bool completes_alone(const Case& k, std::uint64_t steps, std::uint32_t id) {
   scenario::Scenario s = k.scenario;
   s.slots = {s.slots[id - 1]};
   s.slots[0].id = 1;
-  LockstepSim sim(s, k.terrain, static_cast<std::uint32_t>(s.slots.size()));
+  LockstepSim sim(s, k.terrain, static_cast<std::uint32_t>(s.slots.size()), true);
   while (sim.state().step < steps && !world_server::is_completed(sim.state())) sim.step();
   return world_server::is_completed(sim.state());
 }
@@ -144,10 +144,11 @@ long long env_number(const char* name, long long fallback) {
   return v != nullptr ? std::atoll(v) : fallback;
 }
 
-/// Runs the whole team of `k` for at most `steps`; with `every` > 0 prints every robot each `every` steps (to look
-/// inside one case: MARSALA_LIVENESS_SEED, MARSALA_LIVENESS_EVERY). True when every robot ends on its target.
-bool team_completes(const Case& k, std::uint64_t steps, long long every) {
-  LockstepSim sim(k.scenario, k.terrain, static_cast<std::uint32_t>(k.scenario.slots.size()));
+/// Runs the whole team of `k` for at most `steps`, keeping the right of way when `right_of_way`; with `every` > 0
+/// prints every robot each `every` steps (to look inside one case: MARSALA_LIVENESS_SEED, MARSALA_LIVENESS_EVERY).
+/// True when every robot ends on its target.
+bool team_completes(const Case& k, std::uint64_t steps, bool right_of_way, long long every) {
+  LockstepSim sim(k.scenario, k.terrain, static_cast<std::uint32_t>(k.scenario.slots.size()), right_of_way);
   while (sim.state().step < steps && !world_server::is_completed(sim.state())) {
     sim.step();
     if (every <= 0 || sim.state().step % static_cast<std::uint64_t>(every) != 0) continue;
@@ -161,10 +162,12 @@ bool team_completes(const Case& k, std::uint64_t steps, long long every) {
 // The property: on a well-formed field, a team whose every robot reaches its target alone reaches all targets
 // together. A case that fails is looked at robot by robot: when one of them cannot do it alone either (the builder
 // then builds its way, not drives it), the case says nothing about the right of way and does not count; every
-// counted case must complete. MARSALA_LIVENESS_RUNS sets the number of counted runs (default 200).
+// counted case must complete. MARSALA_LIVENESS_RUNS sets the number of counted runs (default 200),
+// MARSALA_LIVENESS_PROTOCOL=0 runs the teams without the right of way (the test then fails).
 TEST(Liveness, RobotsInCorridorsAlwaysReachTheirTargets) {
   const long long wanted = env_number("MARSALA_LIVENESS_RUNS", 200), only = env_number("MARSALA_LIVENESS_SEED", 0);
   const long long every = only > 0 ? env_number("MARSALA_LIVENESS_EVERY", 20) : 0;
+  const bool right_of_way = env_number("MARSALA_LIVENESS_PROTOCOL", 1) != 0;  // 0: without it, to see the test fail
   constexpr std::uint64_t kSteps = 600;  // the longest route is about 15 m, 75 steps, alone
   long long runs = 0, failed = 0, not_alone = 0;
   for (std::uint64_t seed = only > 0 ? static_cast<std::uint64_t>(only) : 1; runs < wanted; ++seed) {
@@ -173,7 +176,7 @@ TEST(Liveness, RobotsInCorridorsAlwaysReachTheirTargets) {
       if (only > 0) break;
       continue;
     }
-    if (team_completes(*k, kSteps, every)) {
+    if (team_completes(*k, kSteps, right_of_way, every)) {
       ++runs;
     } else {
       std::vector<std::uint32_t> alone_fail;

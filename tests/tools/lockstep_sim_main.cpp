@@ -30,10 +30,11 @@ void show(const LockstepSim& sim) {
     const auto& a = st.agent(q.agent_id);
     double dep = 0.0;
     for (const auto& d : q.depositions) dep += d.height_m;
-    fmt::print("  {:3} {:15} ({:.3f}, {:.3f}) z {:.2f} mat {:.3f} last {} {} | move {} ({:.3f}, {:.3f}) deps {} {}\n",
+    fmt::print("  {:3} {:15} ({:.3f}, {:.3f}) z {:.2f} mat {:.3f} last {} {} | move {} ({:.3f}, {:.3f}) deps {} {}{}{}\n",
                a.id, q.state, a.position.x, a.position.y, a.z_m, a.material_m3,
                static_cast<int>(a.last_result), a.last_reason, q.move, q.target_x_m, q.target_y_m,
-               q.depositions.size() + q.deposits.size(), q.refill ? "refill" : "");
+               q.depositions.size() + q.deposits.size(), q.refill ? "refill" : "",
+               q.waiting_for.empty() ? "" : " | waits: ", q.waiting_for);
     if (const auto* pb = dynamic_cast<const marsala::agent::reactive::PathBuilder*>(&sim.behaviour(q.agent_id))) {
       const auto& t = pb->last_trace();
       const auto front = pb->pipeline().front({a.position.x, a.position.y}, a.target);
@@ -108,6 +109,8 @@ int main(int argc, char** argv) {
   app.add_option("--set", overrides, "FIELD=VALUE");
   app.add_option("--write", write_dir, "write terrain_final.asc and built.asc (final - initial) into this folder");
   app.add_option("--show", show_steps, "print every robot after these steps");
+  bool right_of_way = false;
+  app.add_flag("--right-of-way", right_of_way, "ramp builders keep the right of way (docs/runtime.md#right-of-way)");
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-lockstep-sim", std::cout, std::cerr))
     return *code;
   try {
@@ -116,7 +119,7 @@ int main(int argc, char** argv) {
     if (agents == 0) agents = static_cast<std::uint32_t>(s.slots.size());
     if (max_steps == 0) max_steps = s.max_steps;
     const Heightmap initial = scenario::build_terrain(s);
-    LockstepSim sim(s, initial, agents);
+    LockstepSim sim(s, initial, agents, right_of_way);
     const std::set<std::uint64_t> shown(show_steps.begin(), show_steps.end());
     std::uint64_t last_change = 0;
     std::string end = "max_steps";
