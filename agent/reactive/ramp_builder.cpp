@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -18,7 +19,8 @@ constexpr EnumName<RampState> kRampStateNames[] = {{RampState::kWaitAdmission, "
                                                    {RampState::kRetreat, "retreat"},
                                                    {RampState::kReturnToBase, "return_to_base"},
                                                    {RampState::kAtGoal, "at_goal"},
-                                                   {RampState::kDone, "done"}};
+                                                   {RampState::kDone, "done"},
+                                                   {RampState::kGiveWay, "give_way"}};
 
 RampState state_of(BuildPhase phase) {
   switch (phase) {
@@ -29,7 +31,21 @@ RampState state_of(BuildPhase phase) {
   return RampState::kAdvance;
 }
 
+/// What a robot keeping the right of way waits for: "right of way: <what>", and the robots close by when any are.
+std::string right_of_way_text(const std::string& what, const std::string& close_by) {
+  return close_by.empty() ? fmt::format("right of way: {}", what)
+                          : fmt::format("right of way: {}; robots {} close by", what, close_by);
+}
+
 }  // namespace
+
+double give_way_contact_m(const RobotBody& body) {
+  return 2.0 * body.navigability.delta_m + 2.0 * body.max_step_m;
+}
+
+int give_way_frames(const RobotBody& body) {
+  return static_cast<int>(std::ceil(2.0 * body.navigability.delta_m / body.max_step_m));
+}
 
 std::string to_string(RampState state) { return enum_to_string(kRampStateNames, state); }
 
@@ -38,7 +54,11 @@ RampState ramp_state_from_string(const std::string& name) {
 }
 
 RampBuilder::RampBuilder(const AgentContext& context, RampBuilderOptions options)
-    : steps_(context, std::move(options.planner)) {}
+    : steps_(context, std::move(options.planner)),
+      right_of_way_(context.agent_id, give_way_contact_m(context.type.body),
+                    1.5 * context.type.body.navigability.delta_m,
+                    give_way_frames(context.type.body)),
+      keeps_right_of_way_(context.right_of_way) {}
 
 const executive::MappingSystem& RampBuilder::map() const {
   if (!steps_.admitted()) throw InvalidArgument("ramp builder: no map before admission");
@@ -64,8 +84,8 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
   if (frame.run_over || state_ == RampState::kDone) {
     state_ = RampState::kDone;
   } else {
-    const BuildView view = steps_.look(frame, trace_);
-    const deliberative::LocalMap& local = view.local;
+    BuildView view = steps_.look(frame, trace_);
+    deliberative::LocalMap& local = view.local;
     const RobotBody& body = steps_.context().type.body;
     const auto close_by = [&] {
       return robots_close_by(frame.neighbours, view.robot, 0.5 * body.navigability.delta_m, body.navigability.delta_m);
@@ -73,9 +93,33 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
     if (state_ == RampState::kSurvey) state_ = RampState::kAdvance;
     // At the goal: on the local goal's cell, which is the target's cell, or the nearest the robot can get to a
     // target off the grid.
-    if (local.goal == local.robot) {
+    const bool at_goal = local.goal == local.robot;
+    const Position going = state_ == RampState::kReturnToBase ? steps_.context().assignment.base : view.target;
+    if (keeps_right_of_way_)
+      right_of_way_.observe(view.robot, frame.neighbours, at_goal,
+                            std::hypot(going.x - view.robot.x, going.y - view.robot.y), 0.5 * body.max_step_m, worked_);
+    const std::vector<Lane> lanes =
+        keeps_right_of_way_
+            ? right_of_way_.lanes(3.0 * body.navigability.delta_m, 0.5 * body.navigability.delta_m + body.max_step_m)
+            : std::vector<Lane>{};
+    const bool in_lane =
+        std::any_of(lanes.begin(), lanes.end(), [&](const Lane& lane) { return lane.contains(view.robot); });
+    if (!in_lane) RampSteps::keep_out_of(local, view.robot, lanes);
+    if (in_lane) {
+      state_ = RampState::kGiveWay;
+      if (const auto out = steps_.leave_lanes(local, view.robot, lanes)) steps_.move(*out, trace_, request);
+      waiting_for_ = right_of_way_text("leaving a lower id's lane", close_by());
+    } else if (const auto from = right_of_way_.giving_way()) {
+      state_ = RampState::kGiveWay;
+      if (const auto motion = steps_.step_away(local, view.robot, *from)) steps_.move(*motion, trace_, request);
+      waiting_for_ = right_of_way_text("giving way", close_by());
+    } else if (at_goal) {
       state_ = RampState::kAtGoal;
+    } else if (right_of_way_.holding()) {
+      state_ = RampState::kGiveWay;  // holds still: nothing requested
+      waiting_for_ = right_of_way_text(fmt::format("holding still, no way for {} steps", kStuckFrames), close_by());
     } else {
+      if (state_ == RampState::kGiveWay) state_ = RampState::kAdvance;
       if (state_ == RampState::kAtGoal) state_ = RampState::kAdvance;
       if (state_ != RampState::kReturnToBase && frame.material_m3 < return_below_m3_ - 1e-12)
         state_ = RampState::kReturnToBase;
@@ -98,6 +142,7 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
     }
   }
   trace_.after = state_;
+  worked_ = !request.depositions.empty() || !request.deposits.empty() || request.refill;
   request.state = to_string(state_);
   request.waiting_for = waiting_for_;
   return request;

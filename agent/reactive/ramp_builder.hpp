@@ -13,6 +13,8 @@
 //   any            --robot on the local goal's cell (the target's cell, or the nearest cell to a target off
 //                    the grid)----------------------------------------------------> kAtGoal   (empty requests)
 //   kAtGoal        --robot off it--------------------------------------------> kAdvance
+//   any but kReturnToBase --giving way (right_of_way.hpp: stood still in contact with a lower id, or at the goal
+//                    with anyone): a step away from that robot, for an episode of frames ---------> kGiveWay
 //   any other      --material below one cube---------------------------------> kReturnToBase
 //   kReturnToBase  --retrace the trajectory through navigable cells; at the base: refill --> kAdvance
 //   kAdvance/kBuild: a motion along the path is possible -> move (and deposit ahead)       --> kAdvance
@@ -36,6 +38,7 @@
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/agent/reactive/ramp_steps.hpp"
 #include "marsala/agent/reactive/waiting_for.hpp"
+#include "marsala/agent/reactive/right_of_way.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
 
 namespace marsala::agent::reactive {
@@ -50,9 +53,15 @@ enum class RampState : std::uint8_t {
   kReturnToBase = 5,
   kAtGoal = 6,
   kDone = 7,
+  kGiveWay = 8,
 };
-/// "wait_admission", "survey", "advance", "build", "retreat", "return_to_base", "at_goal", "done".
+/// "wait_admission", "survey", "advance", "build", "retreat", "return_to_base", "at_goal", "done", "give_way".
 std::string to_string(RampState state);
+/// Robots of this body whose centres lie nearer than this are in contact (right_of_way.hpp): their bodies, a step
+/// each and a body of slack (a robot that tries and backs off in turn is not always at its nearest) [m].
+double give_way_contact_m(const RobotBody& body);
+/// Frames of one giving-way episode: two body lengths of steps.
+int give_way_frames(const RobotBody& body);
 /// The inverse of to_string; throws InvalidArgument listing the valid names.
 RampState ramp_state_from_string(const std::string& name);
 
@@ -92,6 +101,9 @@ class RampBuilder final : public Behaviour {
 
  private:
   RampSteps steps_;
+  RightOfWay right_of_way_;
+  bool keeps_right_of_way_ = false;  // the context's right_of_way: else none of the protocol's steps are taken
+  bool worked_ = false;  // the last request deposited or refilled: building is progress, not waiting
   double return_below_m3_ = 0.0;  // less material than this (one cube) on board: back to the base [m^3]
   RampState state_ = RampState::kWaitAdmission;
   RampBuilderTrace trace_;

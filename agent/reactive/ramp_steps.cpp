@@ -411,6 +411,56 @@ std::optional<executive::Motion> RampSteps::step_back(const deliberative::LocalM
   return advance(local, route.path, robot);
 }
 
+std::optional<executive::Motion> RampSteps::step_away(const deliberative::LocalMap& local, Position robot,
+                                                      Position from) const {
+  const double near = 2.0 * context_.type.body.navigability.delta_m;
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  const auto away = best_navigable_cell(local, -distance(robot, from) - 1e-9, [&](Position p) {
+    return distance(p, robot) <= near ? -distance(p, from) : kNone;
+  });
+  if (!away) return std::nullopt;
+  const auto route = modules_->router.plan(local.gap, local.navigable, local.robot, *away);
+  if (!route.found) return std::nullopt;
+  return advance(local, route.path, robot);
+}
+
+bool RampSteps::keep_out_of(deliberative::LocalMap& local, Position robot, const std::vector<Lane>& lanes) {
+  const auto in_lane = [&](Position p) {
+    return std::any_of(lanes.begin(), lanes.end(), [&](const Lane& lane) { return lane.contains(p); });
+  };
+  if (lanes.empty()) return false;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c)
+      if (local.occupiable(r, c) != 0 && CellIndex{r, c} != local.robot && in_lane(local.center({r, c})))
+        local.occupiable(r, c) = 0;
+  local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
+  return in_lane(robot);
+}
+
+std::optional<executive::Motion> RampSteps::leave_lanes(const deliberative::LocalMap& local, Position robot,
+                                                        const std::vector<Lane>& lanes) const {
+  // Breadth first through navigable cells: the first outside every lane is the nearest by route.
+  std::vector<CellIndex> queue{local.robot};
+  CellMask seen = CellMask::Zero(local.rows(), local.cols());
+  seen(local.robot.row, local.robot.col) = 1;
+  for (std::size_t i = 0; i < queue.size(); ++i) {
+    const CellIndex at = queue[i];
+    const Position p = local.center(at);
+    if (i > 0 && std::none_of(lanes.begin(), lanes.end(), [&](const Lane& lane) { return lane.contains(p); })) {
+      const auto route = modules_->router.plan(local.gap, local.navigable, local.robot, at);
+      return route.found ? advance(local, route.path, robot) : std::nullopt;
+    }
+    for (int dr = -1; dr <= 1; ++dr)
+      for (int dc = -1; dc <= 1; ++dc) {
+        const CellIndex next{at.row + dr, at.col + dc};
+        if (!local.contains(next) || local.navigable(next.row, next.col) == 0 || seen(next.row, next.col) != 0) continue;
+        seen(next.row, next.col) = 1;
+        queue.push_back(next);
+      }
+  }
+  return std::nullopt;
+}
+
 std::optional<CellIndex> RampSteps::farthest_navigable_from_goal(const deliberative::LocalMap& local) {
   const Position goal = local.center(local.goal);
   return best_navigable_cell(local, -distance(local.center(local.robot), goal),

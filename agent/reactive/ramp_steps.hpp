@@ -38,6 +38,7 @@
 #include "marsala/agent/executive/deposition_manager.hpp"
 #include "marsala/agent/executive/mapping_system.hpp"
 #include "marsala/agent/executive/refused_cells.hpp"
+#include "marsala/agent/reactive/right_of_way.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
 #include "marsala/protocol/messages.hpp"
 
@@ -137,6 +138,18 @@ class RampSteps {
   /// the local goal; when another robot cuts the way there, towards the navigable cell farthest from the local goal;
   /// nullopt when there is none or no route to it.
   std::optional<executive::Motion> step_back(const deliberative::LocalMap& local, Position robot) const;
+
+  /// A step away from a robot at `from` [m] (giving way, reactive/right_of_way.hpp): towards the navigable cell within
+  /// two body lengths farthest from it, when that is farther than the robot stands; nullopt when there is none.
+  std::optional<executive::Motion> step_away(const deliberative::LocalMap& local, Position robot, Position from) const;
+
+  /// Keeps out of the lanes of robots with the right of way (right_of_way.hpp): their cells leave `local`'s
+  /// occupiable and navigable cells (not the robot's own). True when the robot stands in one of them.
+  static bool keep_out_of(deliberative::LocalMap& local, Position robot, const std::vector<Lane>& lanes);
+  /// A step out of the lanes: towards the navigable cell outside them nearest the robot (route length); nullopt when
+  /// there is none in the window.
+  std::optional<executive::Motion> leave_lanes(const deliberative::LocalMap& local, Position robot,
+                                               const std::vector<Lane>& lanes) const;
 
   /// Advance, build or start retreating (see the header); nullopt, with nothing requested, when no deposition path
   /// leads through known cells (the behaviour's state stays: wait for the map to grow).

@@ -38,10 +38,11 @@ void show(const LockstepSim& sim) {
     const auto& a = st.agent(q.agent_id);
     double dep = 0.0;
     for (const auto& d : q.depositions) dep += d.height_m;
-    fmt::print("  {:3} {:15} ({:.3f}, {:.3f}) z {:.2f} mat {:.3f} last {} {} | move {} ({:.3f}, {:.3f}) deps {} {}\n",
+    fmt::print("  {:3} {:15} ({:.3f}, {:.3f}) z {:.2f} mat {:.3f} last {} {} | move {} ({:.3f}, {:.3f}) deps {} {}{}{}\n",
                a.id, q.state, a.position.x, a.position.y, a.z_m, a.material_m3,
                static_cast<int>(a.last_result), a.last_reason, q.move, q.target_x_m, q.target_y_m,
-               q.depositions.size() + q.deposits.size(), q.refill ? "refill" : "");
+               q.depositions.size() + q.deposits.size(), q.refill ? "refill" : "",
+               q.waiting_for.empty() ? "" : " | waits: ", q.waiting_for);
     if (const auto* pb = dynamic_cast<const marsala::agent::reactive::PathBuilder*>(&sim.behaviour(q.agent_id))) {
       const auto& t = pb->last_trace();
       const auto front = pb->pipeline().front({a.position.x, a.position.y}, a.target);
@@ -145,6 +146,7 @@ struct RunOptions {
   std::uint64_t stall_steps = 0;  // 0: never
   std::set<std::uint64_t> shown;
   std::string write_dir;
+  bool right_of_way = false;  // ramp builders keep the right of way
 };
 
 RunResult run_one(marsala::scenario::Scenario s, const marsala::Heightmap& initial, std::uint32_t agents,
@@ -154,7 +156,7 @@ RunResult run_one(marsala::scenario::Scenario s, const marsala::Heightmap& initi
   if (agents == 0 || agents > s.slots.size())
     throw InvalidArgument(fmt::format("--agents {}: the scenario has {} slots", agents, s.slots.size()));
   const std::uint64_t max_steps = o.max_steps > 0 ? o.max_steps : s.max_steps;
-  LockstepSim sim(s, initial, agents);
+  LockstepSim sim(s, initial, agents, o.right_of_way);
   std::uint64_t last_change = 0;
   RunResult r;
   r.agents = agents, r.seed = seed, r.end = "max_steps";
@@ -249,6 +251,7 @@ int main(int argc, char** argv) {
   app.add_option("--set", overrides, "FIELD=VALUE");
   app.add_option("--write", o.write_dir, "write terrain_final.asc and built.asc (final - initial) into this folder");
   app.add_option("--show", show_steps, "print every robot after these steps");
+  app.add_flag("--right-of-way", o.right_of_way, "ramp builders keep the right of way (docs/runtime.md#right-of-way)");
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-lockstep-sim", std::cout, std::cerr))
     return *code;
   std::vector<RunResult> results;

@@ -1,0 +1,107 @@
+#include "marsala/agent/reactive/right_of_way.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "marsala/core/error.hpp"
+
+namespace marsala::agent::reactive {
+
+RightOfWay::RightOfWay(std::uint32_t self_id, double contact_m, double loiter_m, int give_way_frames)
+    : self_id_(self_id), contact_m_(contact_m), loiter_m_(loiter_m), give_way_frames_(give_way_frames) {
+  if (!(contact_m > 0.0) || !std::isfinite(contact_m) || !(loiter_m > 0.0) || !std::isfinite(loiter_m) ||
+      give_way_frames < 1)
+    throw InvalidArgument(fmt::format(
+        "right of way: contact range {} m and loitering radius {} m must be finite and > 0, episodes ({} frames) >= 1",
+        contact_m, loiter_m, give_way_frames));
+}
+
+void RightOfWay::Loiter::update(Position p, double radius_m) {
+  if (frames >= 0 && std::hypot(p.x - anchor.x, p.y - anchor.y) <= radius_m) {
+    ++frames;
+  } else {
+    anchor = p, frames = 0;
+  }
+}
+
+void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, double to_go_m,
+                         double step_m, bool worked) {
+  self_.update(self, loiter_m_);
+  if (at_goal || worked || to_go_m < best_to_go_m_ - step_m || no_progress_ < 0) {
+    best_to_go_m_ = to_go_m, no_progress_ = 0;
+  } else {
+    ++no_progress_;
+  }
+  if (hold_left_ > 0) --hold_left_;
+  ++frame_;
+  // A neighbour keeps its record while out of range: one that comes back where it stood has stood still all along
+  // (a robot parked at its goal does not start to "hold" again each time another comes back into range).
+  for (const Neighbour& n : neighbours) {
+    const auto old = seen_.find(n.agent_id);
+    Seen s{n.position, 0, {0.0, 0.0}, n.radius_m, {}, frame_};
+    if (old != seen_.end()) {
+      const double dx = n.position.x - old->second.at.x, dy = n.position.y - old->second.at.y;
+      const double moved = std::hypot(dx, dy);
+      s.still = moved == 0.0 ? old->second.still + (frame_ - old->second.frame) : 0;
+      s.heading = moved > 0.0 ? Position{dx / moved, dy / moved} : old->second.heading;
+      s.loiter = old->second.loiter;
+    }
+    s.loiter.update(n.position, loiter_m_);
+    seen_[n.agent_id] = s;
+  }
+  const bool contact = std::any_of(seen_.begin(), seen_.end(), [&](const auto& kv) {
+    return kv.second.frame == frame_ && std::hypot(kv.second.at.x - self.x, kv.second.at.y - self.y) <= contact_m_;
+  });
+  if (no_progress_ >= kStuckFrames && contact && hold_left_ == 0 && frames_left_ == 0) {
+    hold_left_ = kStillFrames + give_way_frames_;
+    no_progress_ = 0, best_to_go_m_ = to_go_m;
+  }
+  if (frames_left_ > 0 && --frames_left_ > 0) return;
+  from_.reset();
+  if (self_.frames < kStillFrames) return;
+  // In contact: this robot has loitered long enough, the other holds still (it has stood still at least kStillFrames
+  // and no longer than a hold: a robot parked at its goal waits for nobody), near enough. The lowest id goes first; a
+  // robot at its goal gives way to anyone, and for longer (the other must get past before it comes back). Of several to give way to,
+  // the nearest (ties: the lower id, map order).
+  double nearest = contact_m_;
+  std::uint32_t to_id = 0;
+  for (const auto& [id, s] : seen_) {
+    // Waits: holds still (at least kStillFrames and no longer than a hold: a robot parked at its goal waits for
+    // nobody); to a robot at its goal, also one that has loitered that long (it tries and backs off in turn).
+    const bool holds = s.still >= kStillFrames && s.still <= kStillFrames + give_way_frames_;
+    const bool waits = holds || (at_goal && s.loiter.frames >= kStillFrames);
+    if (s.frame != frame_ || !waits || (!at_goal && id > self_id_) || id == self_id_) continue;
+    // At its goal a robot gives way to a robot once where it stands: one that waits there again after the episode
+    // waits for something else (it is parked at its own goal, or this robot is not what blocks it).
+    const auto given = given_to_.find(id);
+    if (at_goal && given != given_to_.end() && std::hypot(s.at.x - given->second.x, s.at.y - given->second.y) <=
+                                                   loiter_m_ / 3.0)
+      continue;
+    const double d = std::hypot(s.at.x - self.x, s.at.y - self.y);
+    if (d <= nearest) nearest = d, from_ = s.at, to_id = id;
+  }
+  if (!from_) return;
+  if (at_goal) given_to_[to_id] = *from_;
+  frames_left_ = (at_goal ? 3 : 1) * give_way_frames_;
+  self_ = Loiter{};
+  hold_left_ = 0;
+}
+
+bool Lane::contains(Position p) const {
+  const double dx = to.x - from.x, dy = to.y - from.y, l2 = dx * dx + dy * dy;
+  const double t = l2 > 0.0 ? std::clamp(((p.x - from.x) * dx + (p.y - from.y) * dy) / l2, 0.0, 1.0) : 0.0;
+  return std::hypot(p.x - (from.x + t * dx), p.y - (from.y + t * dy)) <= radius_m;
+}
+
+std::vector<Lane> RightOfWay::lanes(double length_m, double clearance_m) const {
+  std::vector<Lane> out;
+  for (const auto& [id, s] : seen_) {
+    if (s.frame != frame_ || id >= self_id_ || s.still >= kMovingFrames || (s.heading.x == 0.0 && s.heading.y == 0.0)) continue;
+    out.push_back({s.at, {s.at.x + length_m * s.heading.x, s.at.y + length_m * s.heading.y}, s.radius_m + clearance_m});
+  }
+  return out;
+}
+
+}  // namespace marsala::agent::reactive

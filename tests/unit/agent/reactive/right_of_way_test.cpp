@@ -1,0 +1,112 @@
+#include "marsala/agent/reactive/right_of_way.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace marsala::agent::reactive {
+namespace {
+
+Neighbour at(std::uint32_t id, double x, double y) { return {id, {x, y}, 0.0, 0.3}; }
+
+TEST(RightOfWay, ARobotAtItsGoalGivesWayOnceToOneThatWaitsBesideIt) {
+  RightOfWay parked(1, 1.6, 0.9, 6);
+  int first = -1, episodes = 0;
+  bool was_giving = false;
+  for (int frame = 0; frame < 300; ++frame) {
+    // The other robot drives along y = 4 (out of contact, 0.2 m a frame) until frame 100, then stands beside the
+    // parked one for good (it waits for it: the way it wants runs through it).
+    const Neighbour other = frame < 100 ? at(2, 0.2 * frame - 10.0, 4.0) : at(2, 2.1, 2.3);
+    parked.observe({2.7, 1.7}, {other}, true, 0.0, 0.1);
+    const bool giving = parked.giving_way().has_value();
+    if (giving && first < 0) first = frame;
+    if (giving && !was_giving) ++episodes;
+    was_giving = giving;
+  }
+  // It has waited kStillFrames frames after arriving in frame 100; one episode only: where the other still waits
+  // after it, it waits for something else.
+  EXPECT_EQ(first, 100 + kStillFrames);
+  EXPECT_EQ(episodes, 1);
+}
+
+TEST(RightOfWay, ARobotParkedOutOfRangeForAWhileDoesNotHoldAgainWhenSeenAgain) {
+  RightOfWay r(2, 1.6, 0.9, 6);
+  // Robot 1 is parked at (2, 1); robot 2 stands beside it, goes out of range for 30 frames and comes back: robot 1
+  // has stood still all along (more than a hold lasts), so it holds for no one and robot 2 never gives way to it.
+  for (int frame = 0; frame < 200; ++frame) {
+    const bool away = frame >= 60 && frame < 90;
+    r.observe(away ? Position{9.0, 1.0} : Position{3.0, 1.0}, away ? std::vector<Neighbour>{} : std::vector{at(1, 2.0, 1.0)},
+              false, 5.0, 0.1);
+    if (frame >= 2 * (kStillFrames + 6)) EXPECT_FALSE(r.giving_way().has_value()) << frame;
+  }
+}
+
+TEST(RightOfWay, ARobotThatMakesNoWayHoldsUnlessItBuilds) {
+  RightOfWay idle(2, 1.6, 0.9, 6), builder(2, 1.6, 0.9, 6);
+  int idle_first = -1;
+  for (int frame = 0; frame < 100; ++frame) {
+    // Both stand 1 m from robot 3, 5 m from where they go, and come no nearer; the builder deposits every frame.
+    idle.observe({1.0, 1.0}, {at(3, 2.0, 1.0)}, false, 5.0, 0.1);
+    builder.observe({1.0, 1.0}, {at(3, 2.0, 1.0)}, false, 5.0, 0.1, true);
+    if (idle.holding() && idle_first < 0) idle_first = frame;
+    EXPECT_FALSE(builder.holding()) << frame;
+  }
+  // The first frame has no distance to beat and counts as a frame without progress: kStuckFrames of them end with
+  // frame kStuckFrames - 1.
+  EXPECT_EQ(idle_first, kStuckFrames - 1);
+}
+
+TEST(RightOfWay, TwoRobotsParkedAtTheirGoalsSideBySideStayParked) {
+  RightOfWay a(1, 1.6, 0.9, 6), b(2, 1.6, 0.9, 6);
+  for (int frame = 0; frame < 300; ++frame) {
+    a.observe({1.0, 1.0}, {at(2, 2.0, 1.0)}, true, 0.0, 0.1);
+    b.observe({2.0, 1.0}, {at(1, 1.0, 1.0)}, true, 0.0, 0.1);
+    // Both stand still from the first frame: each sees the other hold only in frames 16..22, and gives way then
+    // (each may be in the other's way); afterwards neither waits for anyone.
+    if (frame > kStillFrames + 6) {
+      EXPECT_FALSE(a.giving_way().has_value() && frame > 3 * (kStillFrames + 6)) << frame;
+    }
+  }
+}
+
+TEST(RightOfWay, TheLowerIdGoesFirstAndTheHigherGivesWay) {
+  RightOfWay low(1, 1.6, 0.9, 6), high(2, 1.6, 0.9, 6);
+  bool low_gave = false;
+  std::optional<Position> high_gave;
+  for (int frame = 0; frame < 40; ++frame) {
+    low.observe({1.0, 1.0}, {at(2, 2.0, 1.0)}, false, 5.0, 0.1);
+    high.observe({2.0, 1.0}, {at(1, 1.0, 1.0)}, false, 5.0, 0.1);
+    low_gave = low_gave || low.giving_way().has_value();
+    if (!high_gave) high_gave = high.giving_way();
+  }
+  EXPECT_FALSE(low_gave);
+  ASSERT_TRUE(high_gave);
+  EXPECT_DOUBLE_EQ(high_gave->x, 1.0);  // away from the robot it gives way to
+}
+
+TEST(RightOfWay, NobodyGivesWayToARobotOutOfContactOrOnItsWay) {
+  RightOfWay far(2, 1.6, 0.9, 6), moving(2, 1.6, 0.9, 6);
+  for (int frame = 0; frame < 60; ++frame) {
+    far.observe({5.0, 1.0}, {at(1, 1.0, 1.0)}, false, 5.0, 0.1);
+    moving.observe({2.0, 1.0}, {at(1, 0.1 * frame, 3.0)}, false, 5.0, 0.1);  // passing by, 0.1 m a frame
+    EXPECT_FALSE(far.giving_way());
+    EXPECT_FALSE(moving.giving_way());
+  }
+}
+
+TEST(RightOfWay, AMovingLowerIdReservesItsWayAhead) {
+  RightOfWay r(3, 1.6, 0.9, 6);
+  r.observe({5.0, 1.0}, {at(1, 1.0, 1.0), at(4, 1.0, 2.0)}, false, 5.0, 0.1);
+  r.observe({5.0, 1.0}, {at(1, 1.2, 1.0), at(4, 1.2, 2.0)}, false, 5.0, 0.1);
+  const auto lanes = r.lanes(3.0, 0.5);
+  ASSERT_EQ(lanes.size(), 1u);  // robot 4 has a higher id: no lane
+  EXPECT_TRUE(lanes[0].contains({4.0, 1.0}));
+  EXPECT_TRUE(lanes[0].contains({4.2, 1.7}));   // 0.7 m off the line: its radius 0.3 + 0.5
+  EXPECT_FALSE(lanes[0].contains({4.2, 1.9}));  // 0.9 m off
+  EXPECT_FALSE(lanes[0].contains({5.1, 1.0}));  // beyond 3 m ahead and the radius
+  for (int frame = 0; frame < kMovingFrames; ++frame) r.observe({5.0, 1.0}, {at(1, 1.2, 1.0)}, false, 5.0, 0.1);
+  EXPECT_TRUE(r.lanes(3.0, 0.5).empty());  // it stopped: no longer on its way
+}
+
+}  // namespace
+}  // namespace marsala::agent::reactive
