@@ -115,6 +115,9 @@ void RampSteps::admit(const protocol::Admission& admission) {
               static_cast<int>(std::ceil((body.reach_m + body.navigability.delta_m) / body.max_step_m)) + 1,
               executive::make_depositor(context_.type)});
   goal_ = deliberative::make_goal_synthesizer(context_.type.goal_synthesizer, context_);
+  // Free space bounds the cells it may deposit on from where it stands and its next steps (docs/runtime.md#mapping).
+  if (context_.type.sensor.casts_rays())
+    modules_->map.set_ceiling_range(body.reach_m + body.navigability.delta_m + body.max_step_m);
 }
 
 void RampSteps::set_registration(CellIndex offset) {
@@ -283,6 +286,8 @@ void RampSteps::clear_unconfirmed_gap(deliberative::LocalMap& local) const {
     for (int c = 0; c < local.cols(); ++c) {
       const CellIndex g = local.to_global({r, c});
       const GapStreak& streak = memory_.gap_streaks[static_cast<std::size_t>(g.row) * cols + g.col];
+      // A gap bounded by the latest scan's free space is the least the cell can want: no reading to confirm.
+      if (local.bounded.size() == local.gap.size() && local.bounded(r, c) != 0) continue;
       if (streak.last_scan != map.scans() || streak.scans < kConfirmScans) local.gap(r, c) = 0.0;
     }
 }
