@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -134,6 +135,16 @@ double quantile(const std::vector<double>& sorted, double q) {
   return sorted.empty() ? 0.0 : sorted[static_cast<std::size_t>(q * static_cast<double>(sorted.size() - 1))];
 }
 
+/// A generated "mix" terrain of n x n cells of 0.1 m.
+Heightmap mix_terrain(int n, std::uint64_t seed) {
+  terrain::GeneratorSpec spec;
+  spec.rows = n;
+  spec.cols = n;
+  spec.cell_size_m = 0.1;
+  spec.seed = seed;
+  return terrain::generate_terrain("mix", spec);
+}
+
 /// One scan of `truth` by `sensor` from (x, y), inserted from the true origin.
 void scan_into(MappingSystem& map, const Heightmap& truth, double x, double y, double heading, std::uint64_t seed) {
   const Point3 origin = sensor_origin(truth, x, y, map.sensor());
@@ -145,12 +156,7 @@ void scan_into(MappingSystem& map, const Heightmap& truth, double x, double y, d
 // with every scan, and the cells known after the first scan stay as good (each holds its latest reading). The numbers
 // are printed for docs/runtime.md#mapping.
 TEST(MappingSystem, ALaserMapConvergesToTheTerrainAsScansAccumulate) {
-  terrain::GeneratorSpec spec;
-  spec.rows = 120;
-  spec.cols = 120;
-  spec.cell_size_m = 0.1;
-  spec.seed = 7;
-  const Heightmap truth = terrain::generate_terrain("mix", spec);
+  const Heightmap truth = mix_terrain(120, 7);
   MappingSystem map(truth.geometry(), 16, sensor_defaults(SensorKind::kLaser));
 
   scan_into(map, truth, 2.05, 6.05, 0.0, 1);
@@ -403,12 +409,7 @@ TEST(MappingSystem, HitWithinSaysWhetherARecentScanHitTheCell) {
 // rays crossed above the surface), some pit that no ray reached the floor of is bounded below its rim, a cell no ray
 // crossed stays unbounded, and a deposit on an unread cell raises its ceiling by the rise without inventing a surface.
 TEST(MappingSystem, FreeSpaceBoundsTheCellsItsRaysCrossFromAbove) {
-  terrain::GeneratorSpec spec;
-  spec.rows = 80;
-  spec.cols = 80;
-  spec.cell_size_m = 0.1;
-  spec.seed = 11;
-  Heightmap truth = terrain::generate_terrain("mix", spec);
+  Heightmap truth = mix_terrain(80, 11);
   std::vector<CellIndex> pits;
   for (int r = 20; r < 60; r += 4)
     for (int c = 20; c < 70; c += 4) pits.push_back({r, c});
