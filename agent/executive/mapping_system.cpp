@@ -8,6 +8,8 @@
 #include <optional>
 #include <string>
 
+#include "marsala/agent/executive/detail/voxel_occupancy.hpp"
+#include "marsala/core/cpu_time.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 
@@ -106,11 +108,9 @@ struct MappingSystem::Octree {
     int hits_in_scan = 0;  ///< hits of the scan being integrated
   };
 
-  explicit Octree(double resolution_m) : tree(resolution_m) {
-    // The terrain rises under construction: a voxel carved free many times must turn occupied at its first hit
-    // (log-odds of a hit 0.85 > -log-odds of 0.4), not only after several scans as with OctoMap's default 0.12.
-    tree.setClampingThresMin(0.4);
-  }
+  // The terrain rises under construction: a voxel carved free many times must turn occupied at its first hit
+  // (log-odds of a hit 0.85 > -log-odds of 0.4), not only after several scans as with OctoMap's default 0.12.
+  explicit Octree(const GridGeometry& g) : tree(g.cell_size_m, g.rows, g.cols, 0.4) {}
 
   /// The hits of voxel key_z of cell `index` (row-major), made when new; a cell that has kVoxelsPerCell forgets its
   /// lowest one: the surface is the highest.
@@ -166,13 +166,12 @@ struct MappingSystem::Octree {
       }
       if (!v.has_estimate || (top && v.key_z <= top->key_z)) continue;
       key[2] = v.key_z;
-      const octomap::OcTreeNode* node = tree.search(key);
-      if (node && tree.isNodeOccupied(node)) top = &v;
+      if (tree.occupied(key)) top = &v;
     }
     return top ? top : top_any;
   }
 
-  octomap::OcTree tree;
+  detail::VoxelOccupancy tree;  ///< the octree's leaves (OctoMap's updates, held per grid column)
   std::vector<std::vector<VoxelHits>> hits;  ///< per cell (row-major)
 };
 
@@ -305,15 +304,16 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   ++scans_;
   if (hit_scan_.empty()) hit_scan_.assign(static_cast<std::size_t>(g.rows) * g.cols, 0);
   if (!octree_) {
-    octree_ = std::make_unique<Octree>(g.cell_size_m);
+    octree_ = std::make_unique<Octree>(g);
     octree_->hits.resize(static_cast<std::size_t>(g.size()));
   }
+  const double began_ms = thread_cpu_ms();
   const ScanBatch batch = bin_hits(points, origin);
   bound_from_free_space(points, origin);
   // Rays carve free space up to each end voxel, which becomes more likely occupied (OctoMap's log-odds update).
-  // Lazy: inner nodes are brought up to date once, after the whole scan (OctoMap's own advice for batches).
-  octree_->tree.insertPointCloud(batch.cloud, tree_point(g, origin.x, origin.y, origin.z), -1.0, true, true);
-  octree_->tree.updateInnerOccupancy();
+  // Only leaves are ever read, so no inner node is kept (detail/voxel_occupancy.hpp).
+  octree_->tree.insert(batch.cloud, tree_point(g, origin.x, origin.y, origin.z));
+  const double inserted_ms = thread_cpu_ms();
   octree_->settle(batch.touched);
   if (batch.max_row >= 0) rederive_heights(batch);
   for (std::size_t index : batch.touched)
@@ -333,6 +333,7 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
     mark_known(f.cell.row, f.cell.col);
     assumed_(f.cell.row, f.cell.col) = surface ? 0 : 1;
   }
+  last_scan_cost_ = {inserted_ms - began_ms, thread_cpu_ms() - inserted_ms};
 }
 
 MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& points, Point3 origin) {
@@ -372,7 +373,7 @@ MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& p
       continue;
     const octomap::point3d end = tree_point(g, hit.x, hit.y, hit.z);
     octomap::OcTreeKey key;
-    if (!octree_->tree.coordToKeyChecked(end, key)) continue;
+    if (!octree_->tree.key_of(end, key)) continue;
     batch.cloud.push_back(end);
     const std::size_t index = static_cast<std::size_t>(cell->row) * g.cols + cell->col;
     Octree::VoxelHits& voxel = octree_->voxel(index, key[2]);
@@ -409,7 +410,7 @@ void MappingSystem::rederive_heights(const ScanBatch& batch) {
       if (octree_->hits[index].empty()) continue;
       const Position centre = g.cell_center({row, col});
       octomap::OcTreeKey key;
-      if (!octree_->tree.coordToKeyChecked(tree_point(g, centre.x, centre.y, 0.0), key)) continue;
+      if (!octree_->tree.key_of(tree_point(g, centre.x, centre.y, 0.0), key)) continue;
       bool hit = false;
       const Octree::VoxelHits* top = octree_->surface(index, key, hit);
       if (hit) hit_scan_[index] = scans_;
@@ -514,7 +515,7 @@ void MappingSystem::assume_ground(Position pose, double ground_z_m, double radiu
     }
 }
 
-std::size_t MappingSystem::octree_leaves() const { return octree_ ? octree_->tree.getNumLeafNodes() : 0; }
+std::size_t MappingSystem::octree_leaves() const { return octree_ ? octree_->tree.leaves() : 0; }
 
 void MappingSystem::record_pose(Position pose) {
   const auto cell = std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;

@@ -111,6 +111,13 @@ class MappingSystem {
   }
   int tile_size() const { return tile_size_; }
   const SensorSpec& sensor() const { return sensor_; }
+  /// What the last integrate_scan() cost [ms, CPU time of this thread]: inserting its hits into the octree (binning
+  /// included), and deriving the heights (the cells it reached, its faces). For benchmarks (bench/sensing_bench).
+  struct ScanCost {
+    double insertion_ms = 0.0;
+    double heights_ms = 0.0;
+  };
+  const ScanCost& last_scan_cost() const { return last_scan_cost_; }
   /// Leaf voxels of the octree, 0 before the first scan (for benchmarks and tests).
   std::size_t octree_leaves() const;
 
@@ -140,6 +147,7 @@ class MappingSystem {
   SensorSpec sensor_;
   std::vector<CellIndex> trajectory_;
   std::unique_ptr<Octree> octree_;  // made at the first scan
+  ScanCost last_scan_cost_;
 };
 
 }  // namespace marsala::agent::executive

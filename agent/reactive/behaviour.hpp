@@ -40,6 +40,10 @@ class Behaviour {
   /// Where the robot believes the terrain of its next frames lies (executive::MappingSystem::set_registration);
   /// behaviours without a map ignore it.
   virtual void set_registration(CellIndex /*offset*/) {}
+  /// The part of the robot's localisation error the whole-cell registration leaves out [m] (believed position = the
+  /// frame's + this): its scans are inserted from the sensor origin it believes, so hits land displaced by the whole
+  /// error (docs/runtime.md#localisation-error); behaviours without a scanned map ignore it.
+  virtual void set_sub_cell_error(Position /*error_m*/) {}
   /// The robot's own map as it stands (executive::MappingSystem::known_map(), valid while this behaviour lives and
   /// decides nothing more); nullopt before admission and for behaviours that keep no map. Read-only: for outputs
   /// (marsala-agent --dump-map) and tests.

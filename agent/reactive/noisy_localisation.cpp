@@ -66,6 +66,9 @@ protocol::ActionRequest NoisyLocalisation::decide(const protocol::SensorFrame& f
   }
   offset_ = k;
   inner_->set_registration(k);
+  // Its scans measure offsets from where it truly is; it inserts them from where it believes its sensor is, the
+  // frame's position plus the whole error e: so hits land displaced by e, continuously, not by whole cells.
+  inner_->set_sub_cell_error({frame.x_m + error_.x - pose.x, frame.y_m + error_.y - pose.y});
   protocol::ActionRequest request = inner_->decide(believed);
   // What it asks its actuators for happens from where it truly is.
   if (request.move) {

@@ -7,6 +7,8 @@
 // whole window, so tiles received earlier are registered again from a cache). Its actuators carry out what it asked
 // from where it truly is: a motion to believed target T goes to T - k cs, a deposition on believed cell c lands on
 // world cell c - k (dropped when off the grid), a cube or cone deposit at believed point p at p - k cs.
+// A scanning robot's scans are the exception: they go in from the sensor origin it believes, true + e, so hits land
+// displaced by the whole error e, continuously (set_sub_cell_error: e - k cs).
 //
 // Within one frame pose, map and actions agree, as for a robot without error: what the error changes is where the
 // robot puts everything given in world coordinates (its target, the base station, the arrows of a goal vector map),

@@ -97,6 +97,7 @@ class PathBuilder final : public Behaviour {
   std::string waiting_for() const override { return waiting_for_; }
   void on_admission(const protocol::Admission& admission) override;
   void set_registration(CellIndex offset) override { steps_.set_registration(offset); }
+  void set_sub_cell_error(Position error_m) override { steps_.set_sub_cell_error(error_m); }
   std::optional<deliberative::KnownMap> known_map() const override {
     return steps_.admitted() ? std::optional<deliberative::KnownMap>(steps_.map().known_map()) : std::nullopt;
   }

@@ -192,8 +192,10 @@ void RampSteps::update_map(const protocol::SensorFrame& frame) {
   const Position robot{frame.x_m, frame.y_m};
   const SensorSpec& sensor = context_.type.sensor;
   modules_->map.integrate(frame.tiles, robot);
-  if (frame.scanned)
-    modules_->map.integrate_scan(frame.points, executive::believed_sensor_origin(robot, frame.z_m, sensor));
+  if (frame.scanned) {  // from where it believes its sensor is, to the sub-cell part of its localisation error
+    const Position sensor_at{robot.x + sub_cell_error_.x, robot.y + sub_cell_error_.y};
+    modules_->map.integrate_scan(frame.points, executive::believed_sensor_origin(sensor_at, frame.z_m, sensor));
+  }
   if (sensor.casts_rays())  // docs/runtime.md#mapping: the ground its body stands on and may step onto next
     modules_->map.assume_ground(robot, frame.z_m,
                                 0.5 * context_.type.body.navigability.delta_m + context_.type.body.max_step_m);

@@ -110,6 +110,9 @@ class RampSteps {
   /// Where the terrain of the next frames is registered (executive::MappingSystem::set_registration); kept across
   /// admissions.
   void set_registration(CellIndex offset);
+  /// The localisation error the registration leaves out [m]: scans are inserted from the frame's position plus this
+  /// (Behaviour::set_sub_cell_error); kept across admissions.
+  void set_sub_cell_error(Position error_m) { sub_cell_error_ = error_m; }
 
   /// Integrates the frame into the map, asks the goal synthesizer for the target and synthesizes the local map;
   /// records the window in `trace`. Only after admission.
@@ -223,6 +226,7 @@ class RampSteps {
   std::unique_ptr<deliberative::GoalSynthesizer> goal_;
   std::unique_ptr<Modules> modules_;  // made on admission, when the grid is known
   CellIndex registration_{0, 0};      // set_registration()
+  Position sub_cell_error_{0.0, 0.0};  // set_sub_cell_error() [m]
   double lane_offset_m_ = 0.0;        // set_lane()
   double corridor_width_m_ = 0.0;
   Memory memory_;

@@ -67,18 +67,37 @@ bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const Navigabilit
 }
 
 CellMask blind_cells(const CellMask& known, double radius_cells) {
-  CellMask blind = CellMask::Zero(known.rows(), known.cols());
-  if (known.minCoeff() != 0) return blind;
+  const int rows = static_cast<int>(known.rows()), cols = static_cast<int>(known.cols());
+  CellMask blind = CellMask::Zero(rows, cols);
+  if (known.size() == 0 || known.minCoeff() != 0) return blind;
+  // The ball as one span of columns per row offset: disc_offsets holds, for row offset dr, the columns
+  // [-half[dr], half[dr]] (a disc). A cell is blind when one of its ball's spans holds an unknown cell: counted by
+  // prefix sums of the unknown cells along each row, (2 reach + 1) look-ups per cell instead of one write per unknown
+  // cell and offset (the scanned maps' windows are half unknown).
   const std::vector<CellIndex> ball = disc_offsets(radius_cells);
-  for (int r = 0; r < known.rows(); ++r)
-    for (int c = 0; c < known.cols(); ++c) {
-      if (known(r, c) != 0) continue;
-      // The ball is symmetric: the cells whose ball holds (r, c) are those within it of (r, c).
-      for (const CellIndex& o : ball) {
-        const int pr = r - o.row, pc = c - o.col;
-        if (pr >= 0 && pc >= 0 && pr < known.rows() && pc < known.cols()) blind(pr, pc) = 1;
+  int reach = 0;
+  for (const CellIndex& o : ball) reach = std::max(reach, std::abs(o.row));
+  std::vector<int> half(static_cast<std::size_t>(2 * reach + 1), -1);
+  for (const CellIndex& o : ball) {
+    int& h = half[static_cast<std::size_t>(o.row + reach)];
+    h = std::max(h, std::abs(o.col));
+  }
+  const std::size_t stride = static_cast<std::size_t>(cols) + 1;
+  std::vector<int> unknown_before(static_cast<std::size_t>(rows) * stride, 0);  // row r, columns [0, c)
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      unknown_before[r * stride + c + 1] = unknown_before[r * stride + c] + (known(r, c) == 0 ? 1 : 0);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      for (int dr = -reach; dr <= reach; ++dr) {
+        const int y = r + dr, w = half[static_cast<std::size_t>(dr + reach)];
+        if (y < 0 || y >= rows || w < 0) continue;
+        const int c0 = std::max(0, c - w), c1 = std::min(cols - 1, c + w);
+        if (unknown_before[y * stride + c1 + 1] > unknown_before[y * stride + c0]) {
+          blind(r, c) = 1;
+          break;
+        }
       }
-    }
   return blind;
 }
 

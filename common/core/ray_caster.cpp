@@ -13,16 +13,45 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// A standard normal deviate (Box-Muller on the portable generator; libm's log, sqrt and cos).
-double normal(random::Rng& rng) {
-  const double u1 = 1.0 - rng.uniform();  // (0, 1]: log stays finite
-  const double u2 = rng.uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
+/// A standard normal deviate (Box-Muller on the portable generator; libm's log, sqrt and cos): its two uniforms are
+/// drawn for every ray, its value is worked out only for a ray that hit (the same value, without a log and a cosine
+/// for each miss).
+struct NormalDeviate {
+  double u1, u2;
+  explicit NormalDeviate(random::Rng& rng) : u1(1.0 - rng.uniform()), u2(rng.uniform()) {}  // u1 in (0, 1]
+  double value() const { return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2); }
+};
+
+/// first_hit(), knowing that no cell the ray can reach stands above ceiling_m [m]: a ray that does not descend and
+/// is above it can hit nothing more (a laser's upward rays end there instead of walking to their full range).
+std::optional<double> first_hit_below(const Heightmap& terrain, Point3 origin, Point3 d, double max_range_m,
+                                      double ceiling_m);
+
+/// The highest cell [m] within the square of half-side reach_m [m] around (x, y) (the cells a ray of that range can
+/// cross), -infinity when none is on the grid.
+double highest_within(const Heightmap& terrain, double x, double y, double reach_m) {
+  const GridGeometry& g = terrain.geometry();
+  const double cs = g.cell_size_m;
+  const auto col = [&](double at) { return static_cast<long long>(std::floor((at - g.xll_m) / cs)); };
+  const auto row = [&](double at) { return g.rows - 1 - static_cast<long long>(std::floor((at - g.yll_m) / cs)); };
+  const long long c0 = std::max(0LL, col(x - reach_m) - 1), c1 = std::min<long long>(g.cols - 1, col(x + reach_m) + 1);
+  const long long r0 = std::max(0LL, row(y + reach_m) - 1), r1 = std::min<long long>(g.rows - 1, row(y - reach_m) + 1);
+  double top = -kInf;
+  for (long long r = r0; r <= r1; ++r)
+    for (long long c = c0; c <= c1; ++c) top = std::max(top, terrain(static_cast<int>(r), static_cast<int>(c)));
+  return top;
 }
 
 }  // namespace
 
 std::optional<double> first_hit(const Heightmap& terrain, Point3 origin, Point3 d, double max_range_m) {
+  return first_hit_below(terrain, origin, d, max_range_m, kInf);
+}
+
+namespace {
+
+std::optional<double> first_hit_below(const Heightmap& terrain, Point3 origin, Point3 d, double max_range_m,
+                                      double ceiling_m) {
   const GridGeometry& g = terrain.geometry();
   const double cs = g.cell_size_m;
   // Grid coordinates: u east from the west edge, v north from the south edge [cells].
@@ -40,6 +69,7 @@ std::optional<double> first_hit(const Heightmap& terrain, Point3 origin, Point3 
 
   double t_enter = 0.0;
   for (;;) {
+    if (d.z >= 0.0 && origin.z + d.z * t_enter > ceiling_m) return std::nullopt;  // rising above every top
     const double h = terrain(static_cast<int>(g.rows - 1 - iv), static_cast<int>(iu));
     // Entering below this cell's top: the side face it came through (the start cell: the origin is inside it).
     if (origin.z + d.z * t_enter <= h) return t_enter <= max_range_m ? std::optional<double>(t_enter) : std::nullopt;
@@ -61,6 +91,8 @@ std::optional<double> first_hit(const Heightmap& terrain, Point3 origin, Point3 
     if (!on_grid(iu, iv)) return std::nullopt;
   }
 }
+
+}  // namespace
 
 Point3 sensor_origin(const Heightmap& terrain, double x_m, double y_m, const SensorSpec& sensor) {
   const std::optional<CellIndex> cell = terrain.cell_at({x_m, y_m});
@@ -89,19 +121,27 @@ std::vector<ScanPoint> cast_scan(const Heightmap& terrain, Point3 origin, double
   // The laser's azimuths start east; the camera's are centred on its heading.
   const double azimuth0 = sensor.kind == SensorKind::kRgbd ? heading_rad - 0.5 * sensor.horizontal_fov_deg * deg : 0.0;
   random::Rng rng(seed);
+  const double ceiling = highest_within(terrain, origin.x, origin.y, sensor.max_range_m);
   std::vector<ScanPoint> points;
   points.reserve(static_cast<std::size_t>(azimuths * elevations / 2));
+  // The elevations' cosines and sines, once per scan rather than once per ray (the same values).
+  std::vector<double> cos_e(static_cast<std::size_t>(elevations)), sin_e(static_cast<std::size_t>(elevations));
+  for (long long j = 0; j < elevations; ++j) {
+    const double e = (sensor.vertical_min_deg + static_cast<double>(j) * sensor.vertical_resolution_deg) * deg;
+    cos_e[static_cast<std::size_t>(j)] = std::cos(e);
+    sin_e[static_cast<std::size_t>(j)] = std::sin(e);
+  }
   for (long long i = 0; i < azimuths; ++i) {
     const double a = azimuth0 + static_cast<double>(i) * sensor.horizontal_resolution_deg * deg;
     const double ca = std::cos(a), sa = std::sin(a);
     for (long long j = 0; j < elevations; ++j) {
-      const double e = (sensor.vertical_min_deg + static_cast<double>(j) * sensor.vertical_resolution_deg) * deg;
-      const Point3 dir{std::cos(e) * ca, std::cos(e) * sa, std::sin(e)};
+      const std::size_t at = static_cast<std::size_t>(j);
+      const Point3 dir{cos_e[at] * ca, cos_e[at] * sa, sin_e[at]};
       // One deviate per ray, hit or not, so a change of the terrain far away leaves the noise of other rays alone.
-      const double z = normal(rng);
-      const std::optional<double> hit = first_hit(terrain, origin, dir, sensor.max_range_m);
+      const NormalDeviate deviate(rng);
+      const std::optional<double> hit = first_hit_below(terrain, origin, dir, sensor.max_range_m, ceiling);
       if (!hit || *hit < sensor.min_range_m) continue;
-      const double range = *hit + z * sensor.noise_sd_at(*hit);
+      const double range = *hit + deviate.value() * sensor.noise_sd_at(*hit);
       if (!(range > 0.0)) continue;
       points.push_back({static_cast<float>(dir.x * range), static_cast<float>(dir.y * range),
                         static_cast<float>(dir.z * range)});

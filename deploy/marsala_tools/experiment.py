@@ -59,6 +59,8 @@ def build_parser():
                    help="DDS vendor of every process (default cyclone)")
     p.add_argument("--label", help="the value's name on the plot (default: FIELD)")
     p.add_argument("--no-plot", dest="plot", action="store_false", help="skip OUT/experiment.png (it needs gnuplot)")
+    p.add_argument("--dump-maps", action="store_true",
+                   help="every agent writes its final map into the run's maps/ (spawn.sh --dump-maps)")
     return p
 
 
@@ -171,6 +173,8 @@ class Experiment:
                 "--timeout", str(a.timeout), "--agents", str(agents)]
         if a.max_steps:
             args += ["--max-steps", str(a.max_steps)]
+        if a.dump_maps:
+            args.append("--dump-maps")
         for override in overrides(a, value):
             args += ["--set", override]
         return runner.Job((value, seed), run_dir, args)

@@ -16,3 +16,13 @@ test_workspace() {
   fail() { echo "FAIL ($case_name): $*" >&2; exit 1; }
   export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
 }
+# expect_tool_usage_error TOOL WORK PATTERN ARGS...: TOOL --out WORK/bad ARGS exits 2 with PATTERN on stderr and
+# writes nothing (fail MESSAGE must be defined)
+expect_tool_usage_error() {
+  local tool="$1" work="$2" pattern="$3" rc=0
+  shift 3
+  "$tool" --out "$work/bad" "$@" >"$work/stdout.txt" 2>"$work/stderr.txt" || rc=$?
+  [ "$rc" -eq 2 ] || { cat "$work/stderr.txt"; fail "$(basename "$tool") $* exited $rc, expected 2"; }
+  grep -q -- "$pattern" "$work/stderr.txt" || { cat "$work/stderr.txt"; fail "$(basename "$tool") $*: no '$pattern'"; }
+  [ ! -e "$work/bad" ] || fail "$(basename "$tool") $* wrote $work/bad"
+}

@@ -16,6 +16,7 @@
 
 #include "marsala/agent/agent_context.hpp"
 #include "marsala/agent/reactive/behaviour.hpp"
+#include "marsala/core/cpu_time.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/world_server/rules/admission.hpp"
@@ -66,6 +67,32 @@ class LockstepSim {
   const agent::reactive::Behaviour& behaviour(std::uint32_t id) const { return *behaviours_.at(id - 1); }
   /// The requests of the last step, by agent id - 1.
   const std::vector<protocol::ActionRequest>& last_requests() const { return requests_; }
+
+  /// What one live agent's part of a step cost [ms, CPU time of this thread]: the world's frame for it (a scanning
+  /// robot's ray casting) and its behaviour's decision on that frame (mapping included), and the frame itself.
+  struct AgentStepCost {
+    std::uint32_t agent_id = 0;
+    double frame_ms = 0.0;
+    double decide_ms = 0.0;
+    protocol::SensorFrame frame;
+  };
+  /// step(), recording each live agent's costs in `costs` (cleared first); for benchmarks.
+  world_server::StepOutcome step_timed(std::vector<AgentStepCost>& costs) {
+    requests_.clear();
+    costs.clear();
+    for (std::uint32_t id : state_.live_ids()) {
+      AgentStepCost cost;
+      cost.agent_id = id;
+      double began = thread_cpu_ms();
+      cost.frame = sensing_->frame_for(state_, id);
+      cost.frame_ms = thread_cpu_ms() - began;
+      began = thread_cpu_ms();
+      requests_.push_back(behaviours_[id - 1]->decide(cost.frame));
+      cost.decide_ms = thread_cpu_ms() - began;
+      costs.push_back(std::move(cost));
+    }
+    return world_server::apply_step(state_, requests_);
+  }
 
   /// One lockstep step: every live agent's frame, its request, the world's step.
   world_server::StepOutcome step() {

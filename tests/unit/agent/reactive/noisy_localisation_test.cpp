@@ -5,12 +5,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
+#include <vector>
 
+#include "marsala/agent/executive/mapping_system.hpp"
 #include "marsala/agent/executive/pose_error.hpp"
 #include "marsala/agent/reactive/ramp_builder.hpp"
 #include "marsala/core/random.hpp"
+#include "marsala/core/ray_caster.hpp"
 #include "unit/agent/agent_test_support.hpp"
 
 namespace marsala::agent::reactive {
@@ -105,6 +109,59 @@ TEST(NoisyLocalisation, RegistrationOffsetRoundsTheErrorToWholeCells) {
   EXPECT_EQ(registration_offset({0.12, -0.12}, 0.25), (CellIndex{0, 0}));
   EXPECT_EQ(registration_offset({0.13, 0.13}, 0.25), (CellIndex{-1, 1}));  // believed north-east: row up, col right
   EXPECT_EQ(registration_offset({-0.4, -0.6}, 0.25), (CellIndex{2, -2}));
+}
+
+// A scanning robot's error acts on its hits continuously (docs/runtime.md#localisation-error): it believes it stands
+// at true + e and inserts the offsets it measured from its true pose from there, so every hit lands displaced by e,
+// not by the whole cells of its registration. The reference is a map built by hand from that definition (the error
+// drawn here, the sensor origin at true + e); a map whose scan went in at the whole-cell pose differs from it.
+TEST(NoisyLocalisation, AScanningRobotsHitsLandDisplacedByItsWholeError) {
+  Heightmap rough({80, 120, 0.0, 0.0, 0.1}, 0.0);
+  for (int r = 0; r < rough.rows(); ++r)
+    for (int c = 0; c < rough.cols(); ++c) rough(r, c) = 0.3 * std::sin(0.21 * c) + 0.2 * std::cos(0.17 * r);
+  int differ_from_cells = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    AgentContext context = noisy_context(0.05);
+    context.seed = seed;
+    context.type.sensor = sensor_defaults(SensorKind::kLaser);
+    NoisyLocalisation noisy(context, "ramp_builder");
+    noisy.on_admission(test::admission_on(context, rough.geometry(), {10.0, 4.0}, {1.0, 4.0}));
+
+    const Position truth{6.05, 4.05};
+    protocol::SensorFrame frame;
+    frame.agent_id = context.agent_id;
+    frame.x_m = truth.x;
+    frame.y_m = truth.y;
+    frame.z_m = rough(*rough.cell_at(truth));
+    frame.material_m3 = 1.0;
+    frame.scanned = true;
+    frame.points = cast_scan(rough, sensor_origin(rough, truth.x, truth.y, context.type.sensor), 0.0,
+                             context.type.sensor, scan_seed(1, context.agent_id, 0));
+    noisy.decide(frame);
+
+    const Position e =
+        executive::PoseError(context.type.localisation, random::derive_seed(seed, context.agent_id)).at(0);
+    const CellIndex k{-static_cast<int>(std::floor(0.5 + e.y / 0.1)), static_cast<int>(std::floor(0.5 + e.x / 0.1))};
+    const Position believed{truth.x + 0.1 * k.col, truth.y - 0.1 * k.row};
+    const double mount = context.type.sensor.mount_height_m;
+    const auto by_hand = [&](Position sensor_xy) {
+      executive::MappingSystem map(rough.geometry(), 16, context.type.sensor);
+      map.set_registration(k);
+      map.integrate({}, believed);
+      map.integrate_scan(frame.points, {sensor_xy.x, sensor_xy.y, frame.z_m + mount});
+      map.assume_ground(believed, frame.z_m,
+                        0.5 * context.type.body.navigability.delta_m + context.type.body.max_step_m);
+      return map;
+    };
+    const executive::MappingSystem whole = by_hand({truth.x + e.x, truth.y + e.y});
+    const executive::MappingSystem cells = by_hand(believed);
+    const deliberative::KnownMap got = *noisy.known_map();
+    ASSERT_GT(whole.known_cells(), 500) << seed;
+    EXPECT_TRUE(got.known == whole.known()) << "seed " << seed;
+    EXPECT_TRUE(got.heights.heights() == whole.heights().heights()) << "seed " << seed;
+    differ_from_cells += !(got.heights.heights() == cells.heights().heights()) || !(got.known == cells.known());
+  }
+  EXPECT_EQ(differ_from_cells, 6);  // no error drawn is a whole number of cells
 }
 
 }  // namespace
