@@ -153,6 +153,16 @@ EOF
     start_agents
     finish "$sha" "eight monitors started before the world"
     for pid in "${monitors[@]}"; do kill -TERM "$pid" 2>/dev/null || true; wait "$pid" 2>/dev/null || true; done
+    # Four participants of another program (ddsperf, cyclonedds-tools) hold indices 0..3: the world cannot take an
+    # index the agents probe, and says so rather than wait for agents that cannot find it.
+    others=()
+    for i in 1 2 3 4; do ddsperf -D 30 -i "$domain" sub >/dev/null 2>&1 & others+=($!); done
+    sleep 2
+    "$bin/marsala-world" --scenario "$scenario" --agents 1 --dds cyclone --domain "$domain" --out "$work/taken" \
+      --admit-timeout 2 >"$work/taken.log" 2>&1 || true
+    for pid in "${others[@]}"; do kill -TERM "$pid" 2>/dev/null || true; wait "$pid" 2>/dev/null || true; done
+    grep -q "participant indices 0..3 of domain $domain are all taken" "$work/taken.log" ||
+      { cat "$work/taken.log"; fail "a world behind four foreign participants did not say the agents cannot find it"; }
     ;;
   world-cut|agent-cut)
     bridge_lab

@@ -84,7 +84,14 @@ class Qos {
 class Context {
  public:
   Context(int domain_id, Role role, const Security& security) : domain_id_(domain_id) {
-    if (role == Role::kServer && open_server(security)) return;
+    if (role == Role::kServer && open_at_first_free(security, kServerIndices, kServerTries)) return;
+    if (role == Role::kWorld) {
+      if (open_at_first_free(security, 0, kServerIndices)) return;
+      spdlog::warn("Cyclone DDS: participant indices 0..{} of domain {} are all taken (by participants of other "
+                   "programs?): agents probe only those, so over unicast discovery they will not find this world; "
+                   "run it on another domain (docs/runtime.md#discovery-star)",
+                   kServerIndices - 1, domain_id);
+    }
     if (role == Role::kClient || security.enabled()) create_domain(role, security, -1);
     participant_ = dds_create_participant(static_cast<dds_domainid_t>(domain_id), nullptr, nullptr);
     if (participant_ < 0) {
@@ -103,14 +110,15 @@ class Context {
   int domain_id() const { return domain_id_; }
 
  private:
-  /// A server (monitor, tool): the first free participant index from kServerIndices up (Cyclone has no "first free
-  /// from N": each index is tried, quietly), so that any number of servers leave the indices the agents probe to the
-  /// world (docs/runtime.md#discovery-star). False when kServerTries indices are all taken (or the profile fails):
-  /// the caller then makes the participant as the profile says, with Cyclone's own messages.
-  bool open_server(const Security& security) {
+  /// The first free participant index of [first, first + count) (Cyclone has no "first free from N": each index is
+  /// tried, quietly): a server (monitor, tool) from kServerIndices up, so that any number of servers leave the indices
+  /// the agents probe to the world; the world within 0..kServerIndices-1, so that it never lands where agents do not
+  /// probe without saying so (docs/runtime.md#discovery-star). False when all are taken (or the profile fails): the
+  /// caller then makes the participant as the profile says, with Cyclone's own messages.
+  bool open_at_first_free(const Security& security, int first, int count) {
     const std::uint32_t mask = dds_get_log_mask();
     dds_set_log_mask(DDS_LC_FATAL);  // a taken index is expected, not an error to print
-    for (int index = kServerIndices; index < kServerIndices + kServerTries; ++index) {
+    for (int index = first; index < first + count; ++index) {
       try {
         create_domain(Role::kServer, security, index);
       } catch (const BusError&) {
