@@ -17,9 +17,6 @@ struct KnownMap {
   const CellMask& assumed;                   ///< 1 where no sensor read the surface (assumed ground, a bound)
   const std::vector<CellIndex>& trajectory;  ///< cells stood on, oldest first (world indices)
   bool scanned = false;                      ///< built from range scans (holes, shadows), not ground-truth tiles
-  /// The highest each cell can be, from free space the latest scan crossed [m] (+infinity: unbounded); null when the
-  /// map keeps no such bound (executive::MappingSystem::ceiling()).
-  const Heightmap* ceiling = nullptr;
 
   /// The world grid.
   const GridGeometry& geometry() const { return heights.geometry(); }

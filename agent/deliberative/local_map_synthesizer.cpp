@@ -79,7 +79,6 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
   for (int r = 0; r < w.rows; ++r)
     for (int c = 0; c < w.cols; ++c)
       if (assumed(r, c) != 0) local.gap(r, c) = 0.0;
-  add_bounded_gaps(map, local);
 
   local.robot = local.to_local(*map.geometry().cell_at(robot));
   // A scanned map may hold the robot's own cell not occupiable (a reading that changed under it, a face beside it);
@@ -123,40 +122,6 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
     }
   }
   return local;
-}
-
-void LocalMapSynthesizer::add_bounded_gaps(const KnownMap& map, LocalMap& local) const {
-  local.bounded = CellMask::Zero(local.rows(), local.cols());
-  if (map.ceiling == nullptr) return;
-  // Unread cells (unknown, or a height only assumed: ground under the body, a face's lower bound) the latest scan's
-  // free space bounds from above. Filling such a cell by its MARS height minus that bound never overshoots, whatever
-  // lies below (docs/runtime.md#mapping): a pit whose floor no ray reaches (a one-cell hole the camera sees only the
-  // far wall of) is filled from what the rays crossing it show, a step at a time.
-  const Heightmap ceiling = map.ceiling->window(local.offset, local.rows(), local.cols());
-  const auto assumed = map.assumed.block(local.offset.row, local.offset.col, local.rows(), local.cols());
-  const auto unread = [&](int r, int c) { return local.known(r, c) == 0 || assumed(r, c) != 0; };
-  bool any = false;
-  double lowest = std::numeric_limits<double>::infinity();
-  for (int r = 0; r < local.rows(); ++r)
-    for (int c = 0; c < local.cols(); ++c) {
-      if (!unread(r, c)) lowest = std::min(lowest, local.heights(r, c));
-      else if (std::isfinite(ceiling(r, c))) any = true;
-    }
-  if (!any || !std::isfinite(lowest)) return;
-  // The MARS height of what was read: a guess (assumed ground) or a lower bound must not lift a cell's own bound.
-  Heightmap read = local.heights;
-  for (int r = 0; r < local.rows(); ++r)
-    for (int c = 0; c < local.cols(); ++c)
-      if (unread(r, c)) read(r, c) = lowest;
-  const Heightmap read_gap = mars_.gap(read);
-  for (int r = 0; r < local.rows(); ++r)
-    for (int c = 0; c < local.cols(); ++c) {
-      if (!unread(r, c) || !std::isfinite(ceiling(r, c))) continue;
-      const double gap = read(r, c) + read_gap(r, c) - ceiling(r, c);
-      if (!(gap > 0.0)) continue;
-      local.gap(r, c) = gap;
-      local.bounded(r, c) = 1;
-    }
 }
 
 std::optional<CellIndex> LocalMapSynthesizer::local_origin(const LocalMap& local,

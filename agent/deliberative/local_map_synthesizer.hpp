@@ -33,9 +33,6 @@ struct LocalMap {
   Heightmap gap;                    ///< MARS gap P_kappa[h] - h of the window at the construction kappa [m]; 0 on
                                     ///< unknown cells
   CellMask blind;                   ///< 1 where the cell's ball holds an unknown cell: it is never occupiable
-  /// 1 where no sensor read the surface (unknown, or assumed) but the latest scan's free space bounds it below its
-  /// MARS height (KnownMap::ceiling): its gap is the least it can be, MARS height minus that bound [m]
-  CellMask bounded;
   CellMask passable;                ///< where a deposition path may run: known cells; on a scanned map known cells
                                     ///< that are not blind, when they reach the local goal
   CellMask occupiable;              ///< occupiable cells; never a blind one
@@ -99,9 +96,6 @@ class LocalMapSynthesizer {
   /// The local goal: the target's cell when it lies in the window, else the cell where the straight line from the
   /// robot to the target leaves the window (the rectangle of the window's cell centres). Second: goal_is_target.
   static std::pair<CellIndex, bool> local_goal(const LocalMap& local, Position robot, Position target);
-  /// The gap of the cells whose surface no sensor read, where the map's ceiling bounds them (LocalMap::bounded): the
-  /// MARS height of the window's read surfaces alone (the others at the lowest read height) minus the ceiling.
-  void add_bounded_gaps(const KnownMap& map, LocalMap& local) const;
 
   const NavigabilityParams& params() const { return navigability_.params(); }
   double sensing_range_m() const { return sensing_range_m_; }

@@ -30,13 +30,6 @@ std::vector<CellIndex> sorted_ball(double radius_cells) {
 
 bool positive_finite(double v) { return v > 0.0 && std::isfinite(v); }
 
-/// A cell whose gap the map knows: a known cell, or one whose surface no sensor read but free space bounds
-/// (LocalMap::bounded).
-bool may_fill(const deliberative::LocalMap& map, CellIndex cell) {
-  if (map.known(cell.row, cell.col) != 0) return true;
-  return map.bounded.rows() == map.rows() && map.bounded.cols() == map.cols() && map.bounded(cell.row, cell.col) != 0;
-}
-
 long long cells2(CellIndex a, CellIndex b) {
   const long long dr = a.row - b.row, dc = a.col - b.col;
   return dr * dr + dc * dc;
@@ -111,7 +104,7 @@ std::vector<DepositionCandidate> DepositionManager::candidates(const deliberativ
       std::uint8_t& s = seen[static_cast<std::size_t>(cell.row) * map.cols() + cell.col];
       if (s) continue;
       s = 1;
-      if (!may_fill(map, cell)) continue;
+      if (map.known(cell.row, cell.col) == 0) continue;
       // Whole layers, rounded down: never above the local MARS height (1e-9 absorbs rounding in gaps that are
       // exact multiples).
       int layers =
@@ -135,7 +128,7 @@ std::vector<DepositionCandidate> DepositionManager::candidates(const deliberativ
 
 bool DepositionManager::may_raise(const deliberative::LocalMap& map, CellIndex cell, Position robot,
                                   const Neighbourhood& neighbours) const {
-  if (!map.contains(cell) || !may_fill(map, cell)) return false;
+  if (!map.contains(cell) || map.known(cell.row, cell.col) == 0) return false;
   const Position centre = map.center(cell);
   if (distance(centre, robot) <= 0.5 * params_.navigability.delta_m + kUnderRobotMarginM) return false;
   if (params_.pad_radius_m > 0.0 && distance(centre, params_.pad_centre) <= params_.pad_radius_m) return false;

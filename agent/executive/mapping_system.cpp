@@ -34,9 +34,6 @@ constexpr double kMaxEdgeBand = 0.3;
 /// A hit this close to a cell edge lies on it, within the precision of a scan's float offsets [m]; a sensor whose
 /// noise is smaller places it there only when the ray struck a face standing on the edge (docs/runtime.md#mapping).
 constexpr double kOnEdgeM = 1e-5;
-/// Free space bounds a cell only where a ray crossed it this many range-noise spreads short of its hit: range noise
-/// may put a hit too far along its ray, under the surface (a Gaussian deviate beyond 6 sd: 2 in 10^9 rays) [1].
-constexpr double kCeilingNoise = 6.0;
 
 /// The cell whose face a hit struck, when the ray's horizontal path crosses a cell edge within within_m [m] of the
 /// hit (range noise moves a hit along its ray): the cell the ray enters at the crossing nearest to the hit; nullopt
@@ -193,10 +190,7 @@ struct MappingSystem::ScanBatch {
 };
 
 MappingSystem::MappingSystem(const GridGeometry& world, int tile_size, SensorSpec sensor)
-    : heights_(world, 0.0),
-      tile_size_(tile_size),
-      ceiling_(world, std::numeric_limits<double>::infinity()),
-      sensor_(std::move(sensor)) {
+    : heights_(world, 0.0), tile_size_(tile_size), sensor_(std::move(sensor)) {
   if (tile_size < 1) throw InvalidArgument(fmt::format("mapping system: tile size must be >= 1, got {}", tile_size));
   const std::string problem = sensor_problem(sensor_);
   if (!problem.empty()) throw InvalidArgument(fmt::format("mapping system: sensor {}", problem));
@@ -221,9 +215,6 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       registration_(other.registration_),
       built_(other.built_),
       face_floor_(other.face_floor_),
-      ceiling_(other.ceiling_),
-      ceiling_cells_(other.ceiling_cells_),
-      ceiling_range_m_(other.ceiling_range_m_),
       sensor_(other.sensor_),
       trajectory_(other.trajectory_),
       octree_(other.octree_ ? std::make_unique<Octree>(*other.octree_) : nullptr) {}
@@ -309,7 +300,6 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   }
   const double began_ms = thread_cpu_ms();
   const ScanBatch batch = bin_hits(points, origin);
-  bound_from_free_space(points, origin);
   // Rays carve free space up to each end voxel, which becomes more likely occupied (OctoMap's log-odds update).
   // Only leaves are ever read, so no inner node is kept (detail/voxel_occupancy.hpp).
   octree_->tree.insert(batch.cloud, tree_point(g, origin.x, origin.y, origin.z));
@@ -439,51 +429,10 @@ int MappingSystem::last_hit_scan(CellIndex cell) const {
   return hit_scan_[static_cast<std::size_t>(cell.row) * heights_.cols() + cell.col];
 }
 
-void MappingSystem::bound_from_free_space(const std::vector<ScanPoint>& points, Point3 origin) {
-  if (!(ceiling_range_m_ > 0.0)) return;
-  for (const CellIndex c : ceiling_cells_) ceiling_(c) = std::numeric_limits<double>::infinity();
-  ceiling_cells_.clear();
-  const GridGeometry& g = heights_.geometry();
-  const double cs = g.cell_size_m;
-  const double u0 = (origin.x - g.xll_m) / cs, v0 = (origin.y - g.yll_m) / cs;  // grid units, v northwards
-  for (const ScanPoint& p : points) {
-    const double dx = p.x_m, dy = p.y_m, dz = p.z_m;
-    const double range = std::sqrt(dx * dx + dy * dy + dz * dz), run = std::hypot(dx, dy);
-    if (!(run > 0.0)) continue;
-    // Range noise may put the hit too far along its ray, under the surface: trust the ray only short of that.
-    const double trusted = range - kCeilingNoise * sensor_.noise_sd_at(range);
-    const double t_end = std::min({trusted / range, ceiling_range_m_ / run, 1.0});
-    if (!(t_end > 0.0)) continue;
-    const auto hit_cell = g.cell_at({origin.x + dx, origin.y + dy});
-    // A 2D grid walk (Amanatides-Woo) over the columns the ray's horizontal projection crosses, t in [0, t_end]; the
-    // ray's lowest height over a column is at one of its ends there (z is linear in t).
-    const double du = dx / cs, dv = dy / cs;
-    int iu = static_cast<int>(std::floor(u0)), iv = static_cast<int>(std::floor(v0));
-    const int su = du > 0 ? 1 : -1, sv = dv > 0 ? 1 : -1;
-    const double inf = std::numeric_limits<double>::infinity();
-    double tu = du != 0.0 ? ((su > 0 ? iu + 1 - u0 : u0 - iu) / std::abs(du)) : inf;
-    double tv = dv != 0.0 ? ((sv > 0 ? iv + 1 - v0 : v0 - iv) / std::abs(dv)) : inf;
-    const double step_u = du != 0.0 ? 1.0 / std::abs(du) : inf, step_v = dv != 0.0 ? 1.0 / std::abs(dv) : inf;
-    double t0 = 0.0;
-    while (t0 < t_end) {
-      const double t1 = std::min({tu, tv, t_end});
-      const CellIndex cell{g.rows - 1 - iv, iu};
-      if (!heights_.contains(cell) || (hit_cell && cell == *hit_cell)) break;
-      double& ceiling = ceiling_(cell);
-      if (std::isinf(ceiling)) ceiling_cells_.push_back(cell);
-      ceiling = std::min(ceiling, origin.z + (dz < 0.0 ? t1 : t0) * dz);
-      t0 = t1;
-      if (tu < tv) iu += su, tu += step_u;
-      else iv += sv, tv += step_v;
-    }
-  }
-}
-
 void MappingSystem::record_built(CellIndex cell, double rise_m) {
   if (!heights_.contains(cell) || !std::isfinite(rise_m) || !(rise_m > 0.0)) return;
   const long long index = static_cast<long long>(cell.row) * heights_.cols() + cell.col;
-  // What lay under it is at most its ceiling; a cell whose surface no sensor read has no height to add to.
-  if (std::isfinite(ceiling_(cell))) ceiling_(cell) += rise_m;
+  // A cell whose surface no sensor read has no height to add to.
   const bool surface_read = known_(cell.row, cell.col) != 0 && (assumed_(cell.row, cell.col) == 0 ||
                                                                 face_floor_.count(index) > 0 || built_.count(index) > 0);
   if (!surface_read) return;

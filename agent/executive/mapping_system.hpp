@@ -63,17 +63,13 @@ class MappingSystem {
   /// centre) becomes known at `ground_z_m`, the height under the robot's centre (it stands there; a scan sees no nearer
   /// than its minimum range and the camera nothing behind it). A later scan's hits replace it. [m]
   void assume_ground(Position pose, double ground_z_m, double radius_m);
-  /// Free space bounds cells from above (docs/runtime.md#mapping): from now on each scan's rays, up to range_m [m]
-  /// from the sensor horizontally, give every cell they cross before their hit an upper bound, the ray's lowest
-  /// height over it (ceiling()). 0, the default: no bounds.
-  void set_ceiling_range(double range_m) { ceiling_range_m_ = range_m; }
   /// The robot's own construction: the world accepted its request to raise `cell` (world index, as the map registers
   /// it) by rise_m [m]. Terrain only ever rises (depositions add material), so the cell is at least its map height
   /// plus rise_m from now on, whatever a later scan reads there: a scan may not see the top of what the robot just
   /// built beside it (a column above the sensor, its faces left out as wall hits) and would otherwise keep the old
   /// height, and the robot would fill the same cell again without end. Ground-truth tiles are exact and replace it.
-  /// A cell without a surface reading (unknown, or known only as ground assumed under the body) gets no such floor (its
-  /// height is not known to add to), only its ceiling() rises by rise_m.
+  /// A cell without a surface reading (unknown, or known only as ground assumed under the body) gets no such floor: its
+  /// height is not known to add to.
   /// Off-grid cells and rises that are not finite and > 0 are ignored.
   void record_built(CellIndex cell, double rise_m);
   /// Appends the cell under `pose` [m] to the trajectory (consecutive repeats are kept once); throws
@@ -90,10 +86,6 @@ class MappingSystem {
   const CellMask& assumed() const { return assumed_; }
   /// Number of known cells.
   long long known_cells() const { return known_count_; }
-  /// The highest the terrain can be [m], per cell: the lowest height at which a ray of the latest scan crossed the
-  /// cell's column before its hit (short of it by 6 range-noise spreads: noise may put the hit too far), raised by what
-  /// the robot built there since; +infinity where that scan crossed nothing (set_ceiling_range()).
-  const Heightmap& ceiling() const { return ceiling_; }
   /// Scans integrated so far.
   int scans() const { return scans_; }
   /// True when one of the last `scans` scans hit the cell (its surface, not only rays through its column): what it
@@ -106,9 +98,7 @@ class MappingSystem {
   /// The world grid.
   const GridGeometry& geometry() const { return heights_.geometry(); }
   /// This map as the deliberative layer reads it (the local map synthesizer); valid while this map lives, unchanged.
-  deliberative::KnownMap known_map() const {
-    return {heights_, known_, assumed_, trajectory_, sensor_.casts_rays(), ceiling_range_m_ > 0.0 ? &ceiling_ : nullptr};
-  }
+  deliberative::KnownMap known_map() const { return {heights_, known_, assumed_, trajectory_, sensor_.casts_rays()}; }
   int tile_size() const { return tile_size_; }
   const SensorSpec& sensor() const { return sensor_; }
   /// What the last integrate_scan() cost [ms, CPU time of this thread]: inserting its hits into the octree (binning
@@ -129,7 +119,6 @@ class MappingSystem {
   ScanBatch bin_hits(const std::vector<ScanPoint>& points, Point3 origin);
   bool behind_edge(Point3 origin, Point3 hit, CellIndex cell, double spread_m) const;
   void rederive_heights(const ScanBatch& batch);
-  void bound_from_free_space(const std::vector<ScanPoint>& points, Point3 origin);  // ceiling()
 
   Heightmap heights_;
   CellMask known_;
@@ -141,9 +130,6 @@ class MappingSystem {
   CellIndex registration_{0, 0};
   std::unordered_map<long long, double> built_;  ///< record_built(): the least height of a cell (row-major index) [m]
   std::unordered_map<long long, double> face_floor_;  ///< the highest face hit of a cell (row-major index) [m]
-  Heightmap ceiling_;                     ///< ceiling(), +infinity where unbounded
-  std::vector<CellIndex> ceiling_cells_;  ///< the cells ceiling_ bounds
-  double ceiling_range_m_ = 0.0;          ///< set_ceiling_range() [m]
   SensorSpec sensor_;
   std::vector<CellIndex> trajectory_;
   std::unique_ptr<Octree> octree_;  // made at the first scan

@@ -115,8 +115,6 @@ void RampSteps::admit(const protocol::Admission& admission) {
               static_cast<int>(std::ceil((body.reach_m + body.navigability.delta_m) / body.max_step_m)) + 1,
               executive::make_depositor(context_.type)});
   goal_ = deliberative::make_goal_synthesizer(context_.type.goal_synthesizer, context_);
-  // Free-space bounds (MappingSystem::set_ceiling_range) stay off: filling unread cells by them built mounds above the
-  // world's bound with noisy sensors (docs/runtime.md#mapping, "bounded cells").
 }
 
 void RampSteps::set_registration(CellIndex offset) {
@@ -254,9 +252,7 @@ void RampSteps::count_gap_scans(const deliberative::LocalMap& local, bool scanne
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c) {
       const CellIndex g = local.to_global({r, c});
-      // A bounded cell (LocalMap::bounded) was read by no scan: its gap is current when this scan bounded it.
-      const bool bounded = local.bounded.size() == local.gap.size() && local.bounded(r, c) != 0;
-      if (!(local.gap(r, c) > margin) || !(bounded || current(g))) continue;
+      if (!(local.gap(r, c) > margin) || !current(g)) continue;
       GapStreak& streak = memory_.gap_streaks[static_cast<std::size_t>(g.row) * cols + g.col];
       streak.scans = streak.last_scan == map.scans() - 1 ? streak.scans + 1 : 1;
       streak.last_scan = map.scans();

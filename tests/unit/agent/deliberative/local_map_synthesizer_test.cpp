@@ -2,10 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <limits>
-#include <vector>
-
 #include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/iterators.hpp"
@@ -302,60 +298,4 @@ TEST(LocalMapSynthesizer, AScannedMapsGoalAndPathAvoidCellsItCannotJudge) {
 }
 
 }  // namespace
-// An unread cell (unknown, or a height only assumed) bounded from above by free space (KnownMap::ceiling) wants at
-// least its MARS height over the read cells minus that bound: checked against a brute-force cone maximum over the
-// read cells (and the lowest read height, which unread cells take); a bound at or above that height, or a read cell,
-// wants nothing from it. The window covers the whole grid.
-TEST(LocalMapSynthesizer, AnUnreadCellBoundedFromAboveWantsItsMarsHeightLessTheBound) {
-  Heightmap h(kWorld, 0.0);
-  for (int r = 0; r < kWorld.rows; ++r)
-    for (int c = 0; c < kWorld.cols; ++c) h(r, c) = c < 50 ? 0.2 + 0.01 * ((r * 7 + c * 3) % 5) : 1.5;
-  CellMask known = CellMask::Ones(kWorld.rows, kWorld.cols), assumed = CellMask::Zero(kWorld.rows, kWorld.cols);
-  Heightmap ceiling(kWorld, std::numeric_limits<double>::infinity());
-  const CellIndex pit{30, 49}, guessed{31, 49}, high{29, 49}, read{28, 49}, far{5, 5};
-  known(pit.row, pit.col) = 0;
-  assumed(guessed.row, guessed.col) = 1;
-  h(guessed) = 3.0;  // a guess far too high: it must not lift its own bound
-  ceiling(pit) = 0.3;
-  ceiling(guessed) = 0.7;
-  ceiling(high) = 2.0;  // above any MARS height here
-  ceiling(read) = 0.1;  // a read surface: its reading counts, not the bound
-  known(far.row, far.col) = 0;  // unknown and unbounded
-  const std::vector<CellIndex> trajectory{{30, 40}};
-  const KnownMap map{h, known, assumed, trajectory, true, &ceiling};
-  const double kappa = 0.3;
-  const LocalMap local = LocalMapSynthesizer(kBody, 8.0, kappa).synthesize(map, kRobot, {7.0, 2.95});
-  ASSERT_EQ(local.rows(), kWorld.rows);
-  ASSERT_EQ(local.cols(), kWorld.cols);
-  const auto unread = [&](CellIndex q) { return known(q.row, q.col) == 0 || assumed(q.row, q.col) != 0; };
-  double lowest = std::numeric_limits<double>::infinity();
-  for (int r = 0; r < kWorld.rows; ++r)
-    for (int c = 0; c < kWorld.cols; ++c)
-      if (!unread({r, c})) lowest = std::min(lowest, h(r, c));
-  const auto mars_of_read = [&](CellIndex p) {
-    double best = lowest;
-    for (int r = 0; r < kWorld.rows; ++r)
-      for (int c = 0; c < kWorld.cols; ++c)
-        if (!unread({r, c}))
-          best = std::max(best, h(r, c) - kappa * 0.1 * std::hypot(r - p.row, c - p.col));
-    return best;
-  };
-  for (const CellIndex p : {pit, guessed}) {
-    const double want = mars_of_read(p) - ceiling(p);
-    ASSERT_GT(want, 0.3) << p.row << ", " << p.col;
-    EXPECT_NEAR(local.gap(p.row, p.col), want, 1e-9) << p.row << ", " << p.col;
-    EXPECT_EQ(local.bounded(p.row, p.col), 1);
-  }
-  EXPECT_EQ(local.bounded(high.row, high.col), 0);
-  EXPECT_EQ(local.bounded(read.row, read.col), 0);
-  EXPECT_EQ(local.bounded(far.row, far.col), 0);
-  EXPECT_EQ(local.gap(far.row, far.col), 0.0);
-  // Without a ceiling nothing is bounded and unread cells want nothing.
-  const KnownMap plain{h, known, assumed, trajectory, true};
-  const LocalMap without = LocalMapSynthesizer(kBody, 8.0, kappa).synthesize(plain, kRobot, {7.0, 2.95});
-  EXPECT_EQ(without.bounded.cast<int>().sum(), 0);
-  EXPECT_EQ(without.gap(pit.row, pit.col), 0.0);
-  EXPECT_EQ(without.gap(guessed.row, guessed.col), 0.0);
-}
-
 }  // namespace marsala::agent::deliberative
