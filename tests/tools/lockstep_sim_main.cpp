@@ -180,13 +180,10 @@ RunResult run_one(marsala::scenario::Scenario s, const marsala::Heightmap& initi
   r.progress = world_server::progress(st);
   r.sha256 = runlog::terrain_sha256(st.terrain);
   if (st.completion == scenario::CompletionKind::kPayloadPath) {
-    r.band_width_m = world_server::construction_band_width_m(st);
-    r.outside_band_m3 = world_server::deposited_outside_band_m3(
-        initial, st.terrain,
-        world_server::construction_band(
-            world_server::band_route_cells(st, world_server::payload_path(st.terrain, st.payload_path)),
-            st.terrain.rows(), st.terrain.cols(),
-                                        st.terrain.cell_size_m(), r.band_width_m));
+    const world_server::BandReport band =
+        world_server::band_report(st, initial, world_server::payload_path(st.terrain, st.payload_path));
+    r.band_width_m = band.width_m;
+    r.outside_band_m3 = band.outside_m3;
   }
   fmt::print("{} agents {} seed {}: {} after {} steps, {:.3f} m3, outside band {:.3f} m3, progress {:.4f}, last "
              "change {}, rejected motions {}, sha256 {}\n",

@@ -64,11 +64,9 @@ FinalTerrainReport final_terrain_report(const WorldState& state, const RunInfo& 
                                       state.payload_path.navigability.delta_m);
   if (state.completion == scenario::CompletionKind::kPayloadPath && info.initial_terrain.rows() == state.terrain.rows() &&
       info.initial_terrain.cols() == state.terrain.cols()) {
-    report.band_width_m = construction_band_width_m(state);
-    report.outside_band_m3 = deposited_outside_band_m3(
-        info.initial_terrain, state.terrain,
-        construction_band(band_route_cells(state, report.route), state.terrain.rows(), state.terrain.cols(),
-                          state.terrain.cell_size_m(), report.band_width_m));
+    const BandReport band = band_report(state, info.initial_terrain, report.route);
+    report.band_width_m = band.width_m;
+    report.outside_band_m3 = band.outside_m3;
   }
   if (state.completion == scenario::CompletionKind::kLevelSite)
     report.site_fraction = site_level_fraction(state.terrain, state.site);

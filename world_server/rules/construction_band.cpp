@@ -44,4 +44,16 @@ double deposited_outside_band_m3(const Heightmap& initial, const Heightmap& fina
   return sum * initial.cell_size_m() * initial.cell_size_m();
 }
 
+BandReport band_report(const WorldState& state, const Heightmap& initial,
+                       const std::optional<PayloadRoute>& final_path) {
+  BandReport report;
+  report.width_m = construction_band_width_m(state);
+  const Heightmap& terrain = state.terrain;
+  report.outside_m3 = deposited_outside_band_m3(
+      initial, terrain,
+      construction_band(band_route_cells(state, final_path), terrain.rows(), terrain.cols(), terrain.cell_size_m(),
+                        report.width_m));
+  return report;
+}
+
 }  // namespace marsala::world_server

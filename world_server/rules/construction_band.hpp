@@ -30,4 +30,15 @@ CellMask construction_band(const std::vector<CellIndex>& route, int rows, int co
 /// Throws InvalidArgument when the terrains and the band differ in size.
 double deposited_outside_band_m3(const Heightmap& initial, const Heightmap& final_terrain, const CellMask& band);
 
+/// A payload_path run's band and what was raised outside it (summary.json's construction_band_width_m and
+/// deposited_outside_band_m3).
+struct BandReport {
+  double width_m = 0.0;     ///< construction_band_width_m() [m]
+  double outside_m3 = 0.0;  ///< deposited_outside_band_m3() over state.terrain [m^3]
+};
+/// The report of `state` (its terrain the final one) from `initial`, the band along band_route_cells(state,
+/// final_path). Throws InvalidArgument when the terrains differ in size.
+BandReport band_report(const WorldState& state, const Heightmap& initial,
+                       const std::optional<PayloadRoute>& final_path);
+
 }  // namespace marsala::world_server
