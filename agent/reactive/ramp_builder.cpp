@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -102,8 +101,7 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
         keeps_right_of_way_
             ? right_of_way_.lanes(3.0 * body.navigability.delta_m, 0.5 * body.navigability.delta_m + body.max_step_m)
             : std::vector<Lane>{};
-    const bool in_lane =
-        std::any_of(lanes.begin(), lanes.end(), [&](const Lane& lane) { return lane.contains(view.robot); });
+    const bool in_lane = in_any(lanes, view.robot);
     if (!in_lane) RampSteps::keep_out_of(local, view.robot, lanes);
     if (in_lane) {
       state_ = RampState::kGiveWay;

@@ -425,16 +425,13 @@ std::optional<executive::Motion> RampSteps::step_away(const deliberative::LocalM
 }
 
 bool RampSteps::keep_out_of(deliberative::LocalMap& local, Position robot, const std::vector<Lane>& lanes) {
-  const auto in_lane = [&](Position p) {
-    return std::any_of(lanes.begin(), lanes.end(), [&](const Lane& lane) { return lane.contains(p); });
-  };
   if (lanes.empty()) return false;
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c)
-      if (local.occupiable(r, c) != 0 && CellIndex{r, c} != local.robot && in_lane(local.center({r, c})))
+      if (local.occupiable(r, c) != 0 && CellIndex{r, c} != local.robot && in_any(lanes, local.center({r, c})))
         local.occupiable(r, c) = 0;
   local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
-  return in_lane(robot);
+  return in_any(lanes, robot);
 }
 
 std::optional<executive::Motion> RampSteps::leave_lanes(const deliberative::LocalMap& local, Position robot,
@@ -446,7 +443,7 @@ std::optional<executive::Motion> RampSteps::leave_lanes(const deliberative::Loca
   for (std::size_t i = 0; i < queue.size(); ++i) {
     const CellIndex at = queue[i];
     const Position p = local.center(at);
-    if (i > 0 && std::none_of(lanes.begin(), lanes.end(), [&](const Lane& lane) { return lane.contains(p); })) {
+    if (i > 0 && !in_any(lanes, p)) {
       const auto route = modules_->router.plan(local.gap, local.navigable, local.robot, at);
       return route.found ? advance(local, route.path, robot) : std::nullopt;
     }

@@ -89,6 +89,10 @@ void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours
   hold_left_ = 0;
 }
 
+bool in_any(const std::vector<Lane>& lanes, Position p) {
+  return std::any_of(lanes.begin(), lanes.end(), [&](const Lane& lane) { return lane.contains(p); });
+}
+
 bool Lane::contains(Position p) const {
   const double dx = to.x - from.x, dy = to.y - from.y, l2 = dx * dx + dy * dy;
   const double t = l2 > 0.0 ? std::clamp(((p.x - from.x) * dx + (p.y - from.y) * dy) / l2, 0.0, 1.0) : 0.0;

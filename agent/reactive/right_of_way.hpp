@@ -41,6 +41,9 @@ struct Lane {
   bool contains(Position p) const;
 };
 
+/// True when `p` [m] lies in one of `lanes`.
+bool in_any(const std::vector<Lane>& lanes, Position p);
+
 /// Who gives way to whom among robots standing still in contact; see the header.
 class RightOfWay {
  public:
