@@ -81,30 +81,22 @@ void VoxelOccupancy::update(Voxel& v, float change) {
 void VoxelOccupancy::insert(const octomap::Pointcloud& points, const octomap::point3d& origin) {
   ++scan_;
   hits_.clear();
+  ends_.clear();
   // computeDiscreteUpdate: each end voxel once, in the order first met, its centre the ray's end; the end voxels are
   // the occupied set (the key of a voxel's centre is the voxel).
-  std::vector<octomap::point3d> ends;
-  ends.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
     const octomap::OcTreeKey key = keys_.coordToKey(points[i]);
-    Voxel& v = voxel(key);
-    if (v.end_scan == scan_) continue;
-    v.end_scan = scan_;
-    ends.push_back(keys_.keyToCoord(key));
-  }
-  for (const octomap::point3d& end : ends) {
-    octomap::OcTreeKey key;
-    if (!keys_.coordToKeyChecked(end, key)) continue;
     Voxel& v = voxel(key);
     if (v.hit_scan == scan_) continue;
     v.hit_scan = scan_;
     hits_.push_back(key);
+    ends_.push_back(keys_.keyToCoord(key));
   }
   // computeUpdate: the voxels each ray crosses (its end excluded) are the free set, less the occupied ones. Each
   // voxel is updated once per scan, so the order of the updates does not matter (OctoMap walks its hash sets): a
   // crossed voxel is updated when first met, the occupied ones (all known by now) after.
   const float miss = keys_.getProbMissLog();
-  for (const octomap::point3d& end : ends) {
+  for (const octomap::point3d& end : ends_) {
     if (!keys_.computeRayKeys(origin, end, ray_)) continue;
     for (const octomap::OcTreeKey& key : ray_) {
       Voxel& v = voxel(key);

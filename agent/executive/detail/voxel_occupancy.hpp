@@ -37,8 +37,7 @@ class VoxelOccupancy {
   struct Voxel {
     float log_odds = std::numeric_limits<float>::quiet_NaN();  ///< NaN: no leaf yet
     std::uint32_t miss_scan = 0;  ///< the last scan that counted it crossed
-    std::uint32_t hit_scan = 0;   ///< the last scan that counted it occupied
-    std::uint32_t end_scan = 0;   ///< the last scan with a point in it
+    std::uint32_t hit_scan = 0;   ///< the last scan with a point in it: counted occupied
   };
   struct Column {
     int z0 = 0;  ///< key of voxels[0]
@@ -57,6 +56,7 @@ class VoxelOccupancy {
   std::uint32_t scan_ = 0;
   std::size_t leaves_ = 0;
   std::vector<octomap::OcTreeKey> hits_;  ///< this scan's end voxels (reused)
+  std::vector<octomap::point3d> ends_;    ///< and their centres, the rays' ends (reused)
 };
 
 }  // namespace marsala::agent::executive::detail
