@@ -25,32 +25,6 @@ struct NormalDeviate {
 /// first_hit(), knowing that no cell the ray can reach stands above ceiling_m [m]: a ray that does not descend and
 /// is above it can hit nothing more (a laser's upward rays end there instead of walking to their full range).
 std::optional<double> first_hit_below(const Heightmap& terrain, Point3 origin, Point3 d, double max_range_m,
-                                      double ceiling_m);
-
-/// The highest cell [m] within the square of half-side reach_m [m] around (x, y) (the cells a ray of that range can
-/// cross), -infinity when none is on the grid.
-double highest_within(const Heightmap& terrain, double x, double y, double reach_m) {
-  const GridGeometry& g = terrain.geometry();
-  const double cs = g.cell_size_m;
-  const auto col = [&](double at) { return static_cast<long long>(std::floor((at - g.xll_m) / cs)); };
-  const auto row = [&](double at) { return g.rows - 1 - static_cast<long long>(std::floor((at - g.yll_m) / cs)); };
-  const long long c0 = std::max(0LL, col(x - reach_m) - 1), c1 = std::min<long long>(g.cols - 1, col(x + reach_m) + 1);
-  const long long r0 = std::max(0LL, row(y + reach_m) - 1), r1 = std::min<long long>(g.rows - 1, row(y - reach_m) + 1);
-  double top = -kInf;
-  for (long long r = r0; r <= r1; ++r)
-    for (long long c = c0; c <= c1; ++c) top = std::max(top, terrain(static_cast<int>(r), static_cast<int>(c)));
-  return top;
-}
-
-}  // namespace
-
-std::optional<double> first_hit(const Heightmap& terrain, Point3 origin, Point3 d, double max_range_m) {
-  return first_hit_below(terrain, origin, d, max_range_m, kInf);
-}
-
-namespace {
-
-std::optional<double> first_hit_below(const Heightmap& terrain, Point3 origin, Point3 d, double max_range_m,
                                       double ceiling_m) {
   const GridGeometry& g = terrain.geometry();
   const double cs = g.cell_size_m;
@@ -92,7 +66,26 @@ std::optional<double> first_hit_below(const Heightmap& terrain, Point3 origin, P
   }
 }
 
+/// The highest cell [m] within the square of half-side reach_m [m] around (x, y) (the cells a ray of that range can
+/// cross), -infinity when none is on the grid.
+double highest_within(const Heightmap& terrain, double x, double y, double reach_m) {
+  const GridGeometry& g = terrain.geometry();
+  const double cs = g.cell_size_m;
+  const auto col = [&](double at) { return static_cast<long long>(std::floor((at - g.xll_m) / cs)); };
+  const auto row = [&](double at) { return g.rows - 1 - static_cast<long long>(std::floor((at - g.yll_m) / cs)); };
+  const long long c0 = std::max(0LL, col(x - reach_m) - 1), c1 = std::min<long long>(g.cols - 1, col(x + reach_m) + 1);
+  const long long r0 = std::max(0LL, row(y + reach_m) - 1), r1 = std::min<long long>(g.rows - 1, row(y - reach_m) + 1);
+  double top = -kInf;
+  for (long long r = r0; r <= r1; ++r)
+    for (long long c = c0; c <= c1; ++c) top = std::max(top, terrain(static_cast<int>(r), static_cast<int>(c)));
+  return top;
+}
+
 }  // namespace
+
+std::optional<double> first_hit(const Heightmap& terrain, Point3 origin, Point3 d, double max_range_m) {
+  return first_hit_below(terrain, origin, d, max_range_m, kInf);
+}
 
 Point3 sensor_origin(const Heightmap& terrain, double x_m, double y_m, const SensorSpec& sensor) {
   const std::optional<CellIndex> cell = terrain.cell_at({x_m, y_m});
