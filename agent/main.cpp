@@ -8,9 +8,7 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <csignal>
-#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <memory>
@@ -74,20 +72,12 @@ int main(int argc, char** argv) {
       ->type_name("FIELD=VALUE");
   marsala::cli::add_log_options(app, log_options);
   app.add_option("--admit-timeout", admit_timeout_s, "give up when not admitted within this [s]")
-      ->check(CLI::PositiveNumber);
+      ->check(marsala::cli::seconds_within(1e-3, 1e9));
   app.add_option("--world-timeout", world_timeout_s,
                  "give up when no frame comes for this long [s] (0: never); a silent world (paused, cut off,\n"
                  "restarted with --resume) is waited for until then, never given up on earlier")
       ->capture_default_str()
-      ->check(CLI::Validator(
-          [](std::string& text) {
-            char* end = nullptr;
-            const double v = std::strtod(text.c_str(), &end);
-            return !text.empty() && *end == '\0' && std::isfinite(v) && v >= 0.0 && v <= 1e9
-                       ? std::string()
-                       : fmt::format("must be a number of seconds from 0 to 1e9 (0: wait forever), not '{}'", text);
-          },
-          "S >= 0"));
+      ->check(marsala::cli::seconds_within(0.0, 1e9, " (0: wait forever)"));
   std::string dump_dir;
   app.add_option("--dump-map", dump_dir,
                  "when its admitted run ends, write the robot's map into DIR: agent-<id>-height.asc (NODATA: unknown)\n"

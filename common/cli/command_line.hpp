@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -67,6 +69,20 @@ inline CLI::Validator at_least_one() {
                    : fmt::format("must be a whole number of at least 1, not {}", text);
       },
       ">= 1");
+}
+
+/// A finite number of seconds in [lo, hi]; `meaning` is added to the message, e.g. " (0: wait forever)". CLI11's
+/// Range and PositiveNumber let "nan" through (every comparison with it is false).
+inline CLI::Validator seconds_within(double lo, double hi, const std::string& meaning = "") {
+  return CLI::Validator(
+      [lo, hi, meaning](std::string& text) {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        return !text.empty() && *end == '\0' && std::isfinite(v) && v >= lo && v <= hi
+                   ? std::string()
+                   : fmt::format("must be a number of seconds from {} to {}{}, not '{}'", lo, hi, meaning, text);
+      },
+      fmt::format("S in [{}, {}]", lo, hi));
 }
 
 /// Parses argv into `app`; returns nullopt when the program should go on, else the exit code to return now.

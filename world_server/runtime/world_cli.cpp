@@ -36,7 +36,7 @@ void add_timing_and_record_options(CLI::App& app, RuntimeOptions& options) {
   app.add_option("--silence-timeout", options.silence_timeout_s,
                  "how long a step is held while no live agent is heard at all (the world's host cut off, or the\n"
                  "whole team) before the drop rules apply [s]; 0: for ever (docs/runtime.md#silence)")
-      ->check(CLI::Range(0.0, 1e9))
+      ->check(cli::seconds_within(0.0, 1e9, " (0: for ever)"))
       ->capture_default_str();
   app.add_option("--snapshot-every", options.snapshot_every, "write snapshot.pb after every N steps (0: never)")
       ->check(CLI::Range(0ull, 1ull << 40))
