@@ -40,9 +40,11 @@ class TailPrinter {
 
   /// Prints a batch in step order: each status after the events of its step and earlier (the world
   /// publishes a step's events before its status; statuses are taken before events, so the events of a
-  /// taken status are in the batch). Stops at the final status and keeps the events after it; returns
-  /// whether a status of the followed run came.
+  /// taken status are in the batch). Events of a step whose status has not come yet wait for it: the take
+  /// of events can catch the next step's events before its status. Stops at the final status and keeps
+  /// the events after it; returns whether a status of the followed run came.
   bool print(const std::vector<protocol::WorldStatus>& statuses, const std::vector<protocol::WorldEvent>& events) {
+    pending_.insert(pending_.end(), events.begin(), events.end());
     bool got_status = false;
     std::size_t next_event = 0;
     for (const protocol::WorldStatus& status : statuses) {
@@ -52,15 +54,20 @@ class TailPrinter {
         final_ = status;
         break;
       }
-      while (next_event < events.size() && events[next_event].step <= status.step) print_event(events[next_event++]);
+      while (next_event < pending_.size() && pending_[next_event].step <= status.step) print_event(pending_[next_event++]);
+      if (!status_step_ || status.step > *status_step_) status_step_ = status.step;
       if (pacing_.take(status.step, Clock::now())) print_status(status);
     }
-    for (; next_event < events.size(); ++next_event) {
+    for (; next_event < pending_.size(); ++next_event) {
+      const protocol::WorldEvent& e = pending_[next_event];
       if (final_)
-        late_events_.push_back(events[next_event]);
+        late_events_.push_back(e);
+      else if (status_step_ && e.step <= *status_step_)
+        print_event(e);
       else
-        print_event(events[next_event]);
+        break;  // its step's status has not come yet
     }
+    pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(next_event));
     out_.flush();
     return got_status;
   }
@@ -93,6 +100,8 @@ class TailPrinter {
   }
 
   void print_stopped() {
+    for (const protocol::WorldEvent& e : pending_) print_event(e);
+    pending_.clear();
     if (last_)
       out_ << fmt::format("tail stopped after step {} of run {}\n", last_->step, printable(last_->run_id));
     else
@@ -142,6 +151,8 @@ class TailPrinter {
   std::optional<protocol::WorldStatus> final_;
   std::vector<std::uint32_t> header_ids_;
   std::vector<protocol::WorldEvent> late_events_;
+  std::vector<protocol::WorldEvent> pending_;  ///< events of steps whose status has not come yet
+  std::optional<std::uint64_t> status_step_;    ///< the highest step of a status taken so far
   std::set<std::string> ignored_runs_;
   LinePacing pacing_;  ///< which step lines are printed (--every, --interval); the final one always is
   bool run_over_printed_ = false;

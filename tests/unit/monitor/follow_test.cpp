@@ -146,6 +146,29 @@ TEST(Tail, PrintsEachStepAndItsEventsThenEndsWithTheRun) {
   EXPECT_NE(r.out.find("run r1 completed at step 2 (0.0 s) | live 2/2, at goal 2 |"), std::string::npos);
 }
 
+TEST(Tail, EventsOfAStepWaitForItsStatus) {
+  // The events of step 2 go out while the status of step 1 is still on its way: a take of events can
+  // hold the next step's events before its status. They print after the status of step 1.
+  FakeWorld world(66);
+  MonitorThread tail(66, tail_options(true));
+  ASSERT_TRUE(world.wait_for_monitor(1, 1));
+  const auto e1 = event(1, 2, protocol::EventKind::kDeposited, "1 cell");
+  const auto e2 = event(2, 1, protocol::EventKind::kAtGoal);
+  const auto over = event(2, 0, protocol::EventKind::kRunOver, "completed");
+  const auto s0 = status("r6", 0), s1 = status("r6", 1), s2 = final_status("r6", 2);
+  world.publish(s0);
+  world.publish(e1);
+  world.publish(e2);
+  std::this_thread::sleep_for(300ms);  // the monitor takes s0, e1 and e2 before s1 exists
+  world.publish(s1);
+  world.publish(s2);
+  world.publish(over);
+  const Result r = tail.join();
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, text({format_step_header(s0), format_step_line(s0), format_event(e1), format_step_line(s1),
+                         format_event(e2), format_event(over), format_step_line(s2), format_run_summary(s2)}));
+}
+
 TEST(Tail, ALateMonitorStartsAtTheLatestStatusAndSkipsEventsUnlessAsked) {
   FakeWorld world(62);
   world.publish(status("r2", 5));
