@@ -29,7 +29,11 @@ void RightOfWay::Loiter::update(Position p, double radius_m) {
 void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, double to_go_m,
                          double step_m, bool worked) {
   self_.update(self, loiter_m_);
-  if (at_goal || worked || to_go_m < best_to_go_m_ - step_m || no_progress_ < 0) {
+  // Frames spent holding or giving way are the protocol's, not tries: they neither count as no progress nor keep a
+  // best distance from before them (a robot that stepped away from its goal, or held, gets kStuckFrames frames to
+  // make way from where it stands before it holds again; else it held again at once, for ever).
+  const bool protocol_frame = hold_left_ > 0 || frames_left_ > 0;
+  if (at_goal || worked || protocol_frame || to_go_m < best_to_go_m_ - step_m || no_progress_ < 0) {
     best_to_go_m_ = to_go_m, no_progress_ = 0;
   } else {
     ++no_progress_;
