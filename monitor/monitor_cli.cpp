@@ -84,7 +84,7 @@ void define_tail(CLI::App& app, TailCommand& c, cli::DdsOptions& dds) {
   c.cmd->add_flag("--events", c.options.events, "also print one line per world event");
   c.timeout = c.cmd->add_option("--timeout", c.timeout_s,
                                 "exit 1 after this long without a world status [s] (default: wait forever)")
-                  ->check(CLI::Range(1e-3, 1e6));
+                  ->check(cli::seconds_within(1e-3, 1e6));
   c.cmd->add_option("--width", c.options.format.width, "longest line [columns]; 0 = no limit")
       ->check(CLI::Range(0, 10000))
       ->capture_default_str();
@@ -93,7 +93,7 @@ void define_tail(CLI::App& app, TailCommand& c, cli::DdsOptions& dds) {
       ->check(cli::at_least_one())
       ->type_name("N");
   c.cmd->add_option("--interval", c.interval_s, "print at most one step line every S seconds (and the last one)")
-      ->check(CLI::Range(1e-3, 86400.0))
+      ->check(cli::seconds_within(1e-3, 86400.0))
       ->type_name("S");
   c.cmd->footer(kTailLegend);
 }
@@ -122,10 +122,10 @@ void define_progress(CLI::App& app, ProgressCommand& c, cli::DdsOptions& dds) {
   cli::add_dds_options(*c.cmd, dds);
   c.cmd->add_option("--run-id", c.options.run_id, "follow this run only (default: the first run seen)");
   c.cmd->add_option("--interval", c.interval_s, "shortest time between two updates [s]")
-      ->check(CLI::Range(1e-3, 86400.0))
+      ->check(cli::seconds_within(1e-3, 86400.0))
       ->capture_default_str();
   c.timeout = c.cmd->add_option("--timeout", c.timeout_s, "exit 1 after this long without a world status [s]")
-                  ->check(CLI::Range(1e-3, 1e6));
+                  ->check(cli::seconds_within(1e-3, 1e6));
   auto* in_place_flag = c.cmd->add_flag("--in-place", c.in_place,
                                         "rewrite one line in place (the default when stdout is a terminal)");
   c.cmd->add_flag("--lines", c.lines, "print a new line at each update (the default otherwise)")->excludes(in_place_flag);
@@ -166,7 +166,7 @@ void define_status(CLI::App& app, StatusCommand& c, cli::DdsOptions& dds) {
   c.cmd = app.add_subcommand("status", "print the latest world status as a table, once");
   cli::add_dds_options(*c.cmd, dds);
   c.cmd->add_option("--timeout", c.timeout_s, "exit 1 when no world status arrives within this long [s]")
-      ->check(CLI::Range(1e-3, 1e6))
+      ->check(cli::seconds_within(1e-3, 1e6))
       ->capture_default_str();
 }
 
@@ -239,13 +239,13 @@ void define_serve(CLI::App& app, ServeCommand& c, cli::DdsOptions& dds) {
           ->type_name("DIR")
           ->excludes(run_dir);
   c.cmd->add_option("--speed", c.options.replay_steps_per_s, "replay pace [steps/s]")
-      ->check(CLI::Range(1e-3, 1e9))
+      ->check(cli::number_within(1e-3, 1e9, "a pace in steps/s"))
       ->needs(replay)
       ->capture_default_str();
   c.cmd
       ->add_option("--terrain-every", c.options.terrain_interval_s,
                    "shortest time between two terrain pictures [s]")
-      ->check(CLI::Range(0.0, 3600.0))
+      ->check(cli::seconds_within(0.0, 3600.0))
       ->capture_default_str();
   c.cmd->footer(kServeFooter);
 }
