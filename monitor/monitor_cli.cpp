@@ -34,11 +34,13 @@ constexpr int kExitError = 1;
 constexpr int kExitUsage = 2;
 
 constexpr const char* kTailLegend =
-    "Columns: step; live agents/all; mat = material on board of the live agents [m3]; dep = volume deposited\n"
+    "Columns: step; live agents/team slots; mat = material on board of the live agents [m3]; dep = volume deposited\n"
     "in the run [m3]; prog = the run's progress [%] (agents at the goal, share of the payload route's MARS gap\n"
     "filled, or level fraction of the site); then each agent's behaviour state in id order (* at its goal, --\n"
     "dropped, ? no state yet). Beyond what fits the width, live agents are counted per state. Event lines:\n"
-    "step > agent kind [volume] detail. The last line gives the progress in words.";
+    "step > agent kind [volume] detail. The last line gives the progress in words, and the team's slots missing.\n"
+    "Exit 0 the run ended (or Ctrl-C), 1 no status for --timeout, 2 a bad option, 3 the world is gone (no live\n"
+    "world status writer for --gone-after).";
 
 constexpr const char* kReplayFooter =
     "Rebuilds the terrain from DIR/run.log on DIR/terrain_initial.asc (its SHA-256 must match the log's header),\n"
@@ -75,6 +77,7 @@ struct TailCommand {
   double timeout_s = 0.0;
   CLI::Option* timeout = nullptr;
   double interval_s = 0.0;
+  double gone_after_s = 10.0;
 };
 
 void define_tail(CLI::App& app, TailCommand& c, cli::DdsOptions& dds) {
@@ -95,6 +98,11 @@ void define_tail(CLI::App& app, TailCommand& c, cli::DdsOptions& dds) {
   c.cmd->add_option("--interval", c.interval_s, "print at most one step line every S seconds (and the last one)")
       ->check(cli::seconds_within(1e-3, 86400.0))
       ->type_name("S");
+  c.cmd->add_option("--gone-after", c.gone_after_s,
+                    "once the run was seen, exit 3 when no world status writer has been alive for this long [s]; "
+                    "0 = never")
+      ->check(cli::seconds_within(0.0, 1e6, " (0: never)"))
+      ->capture_default_str();
   c.cmd->footer(kTailLegend);
 }
 
@@ -102,6 +110,7 @@ int run_tail_command(TailCommand& c, bus::Participant& participant, const StopSo
                      std::ostream& err) {
   if (c.timeout->count() > 0) c.options.timeout = std::chrono::duration<double>(c.timeout_s);
   c.options.interval = std::chrono::duration<double>(c.interval_s);
+  c.options.gone_after = std::chrono::duration<double>(c.gone_after_s);
   return run_tail(participant, c.options, stop, out, err);
 }
 
