@@ -14,6 +14,7 @@
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
 #include "marsala/world_server/records/output_lock.hpp"
+#include "marsala/world_server/records/run_key_file.hpp"
 #include "marsala/world_server/records/run_outputs.hpp"
 #include "marsala/world_server/runtime/scenario_check.hpp"
 #include "marsala/world_server/runtime/world_runtime.hpp"
@@ -81,7 +82,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       "Exit codes: 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled, 1 error, 2 usage or a\n"
       "scenario the world refuses at start (as --check).",
       "marsala-world"};
-  std::string scenario_path, check_path, resume_dir;
+  std::string scenario_path, check_path, resume_dir, run_key;
   cli::DdsOptions dds;
   RuntimeOptions options;
   bool quiet = false, check = false, json = false;
@@ -124,6 +125,10 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
           ->excludes(scenario_option)
           ->excludes(check_option);
   add_timing_and_record_options(app, options);
+  app.add_option("--run-key", run_key,
+                 "the run's key (64 hex digits; default: a new one, kept in OUT/run.key and read back by --resume):\n"
+                 "agents and monitors given it believe only this run's world (docs/runtime.md#who-wrote-it)")
+      ->type_name("FILE");
   app.add_flag("--replace", options.replace,
                "remove a previous run's files from --out before starting (without it such a folder is refused)")
       ->excludes(resume_option);
@@ -157,6 +162,12 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
         cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
         return kExitInvalidScenario;
       }
+    }
+    try {
+      start.options.run_key = settle_run_key(run_key, start.options.out_dir, !resume_dir.empty());
+    } catch (const InvalidArgument& e) {
+      cli::write_exit_error(err, fmt::format("marsala-world: error: {}{}", run_key.empty() ? "" : "--run-key ", e.what()));
+      return cli::kExitUsage;
     }
     const auto participant =
         bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kWorld,
