@@ -4,8 +4,9 @@
 // and gets samples it cannot read. Those must cost the reader bounded log and never its genuine samples.
 //
 // Usage: marsala-foreign-type DOMAIN TYPE PARTITION SECONDS
-//   e.g. marsala-foreign-type 7 ActionRequest 'ramp-d7/agent-1-*' 5. Prints how many samples it wrote and to how
-//   many matched readers; exits 0, or 2 on bad arguments or when DDS refuses the endpoint.
+//   e.g. marsala-foreign-type 7 ActionRequest 'ramp-d7/agent-1-*' 5. Prints "matched" once a reader matched (then
+//   floods for SECONDS) and how many samples it wrote; exits 0, 1 when no reader matched within 20 s, 2 on bad
+//   arguments or when DDS refuses the endpoint.
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -57,14 +58,17 @@ int run(int argc, char** argv) {
   qos.liveliness().announcement_period = eprosima::fastrtps::Duration_t(0, 250000000);
   dds::DataWriter* writer = topic && publisher ? publisher->create_datawriter(topic, qos) : nullptr;
   if (writer == nullptr) throw std::runtime_error("no writer for " + topic_name);
-  for (auto deadline = Clock::now() + std::chrono::seconds(10); Clock::now() < deadline;) {
-    dds::PublicationMatchedStatus matched;
+  dds::PublicationMatchedStatus matched;
+  for (auto deadline = Clock::now() + std::chrono::seconds(20); Clock::now() < deadline;) {
     writer->get_publication_matched_status(matched);
     if (matched.current_count > 0) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  dds::PublicationMatchedStatus matched;
-  writer->get_publication_matched_status(matched);
+  if (matched.current_count == 0) {
+    std::cout << "unmatched" << std::endl;
+    return 1;
+  }
+  std::cout << "matched" << std::endl;
   marsala::wire::ScanPoint sample;
   std::uint64_t written = 0;
   for (const auto end = Clock::now() + seconds; Clock::now() < end;) {

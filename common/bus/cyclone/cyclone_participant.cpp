@@ -15,6 +15,7 @@
 #include <unordered_map>
 
 #include "marsala/bus/cyclone/cyclone_convert.hpp"
+#include "marsala/bus/cyclone/cyclone_log.hpp"
 #include "marsala/bus/detail/backends.hpp"
 #include "marsala/bus/detail/participant_base.hpp"
 #include "marsala/bus/detail/reader_queue.hpp"
@@ -84,6 +85,7 @@ class Qos {
 class Context {
  public:
   Context(int domain_id, Role role, const Security& security) : domain_id_(domain_id) {
+    cyclone::bound_cyclone_log();  // a foreign type's flood must not flood the log (cyclone_log.hpp)
     if (role == Role::kServer && open_at_first_free(security, kServerIndices, kServerTries)) return;
     if (role == Role::kWorld) {
       if (open_at_first_free(security, 0, kServerIndices)) return;
