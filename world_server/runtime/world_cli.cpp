@@ -49,6 +49,26 @@ void add_timing_and_record_options(CLI::App& app, RuntimeOptions& options) {
       ->type_name("K");
 }
 
+/// The --run-key option (docs/runtime.md#who-wrote-it).
+void add_run_key_option(CLI::App& app, std::string& run_key) {
+  app.add_option("--run-key", run_key,
+                 "the run's key (64 hex digits; default: a new one, kept in OUT/run.key and read back by --resume):\n"
+                 "agents and monitors given it believe only this run's world (docs/runtime.md#who-wrote-it)")
+      ->type_name("FILE");
+}
+
+/// Exit code 2 (one line) when --run-key names no run key: refused before the folder is touched (settle_run_key()
+/// reads it again once the folder is the run's).
+std::optional<int> refuse_bad_run_key(const std::string& path, std::ostream& err) {
+  try {
+    if (!path.empty()) protocol::load_run_key(path);
+    return std::nullopt;
+  } catch (const InvalidArgument& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: --run-key {}", e.what()));
+    return cli::kExitUsage;
+  }
+}
+
 /// Locks the run's output folder into `lock` (docs/runtime.md#run-folders); the exit code when it cannot: 2 (one line
 /// naming the holder's pid) when another world holds it, 1 when the folder or its lock file cannot be made.
 std::optional<int> lock_folder(std::optional<OutputLock>& lock, const std::string& dir, std::ostream& err) {
@@ -125,10 +145,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
           ->excludes(scenario_option)
           ->excludes(check_option);
   add_timing_and_record_options(app, options);
-  app.add_option("--run-key", run_key,
-                 "the run's key (64 hex digits; default: a new one, kept in OUT/run.key and read back by --resume):\n"
-                 "agents and monitors given it believe only this run's world (docs/runtime.md#who-wrote-it)")
-      ->type_name("FILE");
+  add_run_key_option(app, run_key);
   app.add_flag("--replace", options.replace,
                "remove a previous run's files from --out before starting (without it such a folder is refused)")
       ->excludes(resume_option);
@@ -148,6 +165,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
     return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, dds.domain, json, out, err);
   if (quiet && app.get_option("--log-level")->count() == 0) log_options.level = "warn";
   const cli::LoggingScope logging("world", 0, log_options);
+  if (const auto code = refuse_bad_run_key(run_key, err)) return *code;
   // The folder is this process's from here to its exit, before --replace clears it or --resume reads it.
   std::optional<OutputLock> lock;
   if (const auto code = lock_folder(lock, resume_dir.empty() ? options.out_dir : resume_dir, err)) return *code;
@@ -163,12 +181,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
         return kExitInvalidScenario;
       }
     }
-    try {
-      start.options.run_key = settle_run_key(run_key, start.options.out_dir, !resume_dir.empty());
-    } catch (const InvalidArgument& e) {
-      cli::write_exit_error(err, fmt::format("marsala-world: error: {}{}", run_key.empty() ? "" : "--run-key ", e.what()));
-      return cli::kExitUsage;
-    }
+    start.options.run_key = settle_run_key(run_key, start.options.out_dir, !resume_dir.empty());
     const auto participant =
         bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kWorld,
                                bus::Security::of(dds.security, dds.identity, "world")});
