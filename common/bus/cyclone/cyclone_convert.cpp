@@ -294,6 +294,7 @@ marsala_wire_WorldStatus to_msg(const WorldStatus& in, Storage& storage) {
   out.world_id = in.world_id;
   out.admitting = in.admitting;
   out.progress_detail = borrow(in.progress_detail);
+  out.team_size = in.team_size;
   out.world_key = borrow(in.world_key);
   out.world_proof = borrow(in.world_proof);
   storage.agents.clear();
@@ -332,6 +333,7 @@ WorldStatus from_msg(const marsala_wire_WorldStatus& in) {
   out.world_id = in.world_id;
   out.admitting = in.admitting;
   out.progress_detail = copy(in.progress_detail);
+  out.team_size = in.team_size;
   out.world_key = copy(in.world_key);
   out.world_proof = copy(in.world_proof);
   out.agents.reserve(in.agents._length);

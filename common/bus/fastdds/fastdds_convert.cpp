@@ -265,6 +265,7 @@ wire::WorldStatus to_msg(const WorldStatus& in) {
   out.world_id(in.world_id);
   out.admitting(in.admitting);
   out.progress_detail(in.progress_detail);
+  out.team_size(in.team_size);
   out.world_key(in.world_key);
   out.world_proof(in.world_proof);
   out.agents().reserve(in.agents.size());
@@ -302,6 +303,7 @@ WorldStatus from_msg(const wire::WorldStatus& in) {
   out.world_id = in.world_id();
   out.admitting = in.admitting();
   out.progress_detail = in.progress_detail();
+  out.team_size = in.team_size();
   out.world_key = in.world_key();
   out.world_proof = in.world_proof();
   out.agents.reserve(in.agents().size());

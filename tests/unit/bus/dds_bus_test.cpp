@@ -169,6 +169,7 @@ void expect_same(const WorldStatus& a, const WorldStatus& b) {
   EXPECT_EQ(a.running, b.running);
   EXPECT_EQ(a.completed, b.completed);
   EXPECT_EQ(a.progress_detail, b.progress_detail);
+  EXPECT_EQ(a.team_size, b.team_size);
   EXPECT_EQ(a.world_key, b.world_key);
   EXPECT_EQ(a.world_proof, b.world_proof);
   ASSERT_EQ(a.agents.size(), b.agents.size());
@@ -315,6 +316,7 @@ WorldStatus filled_status(Filler& f) {
   s.running = false;
   s.completed = true;
   s.progress_detail = "12.31 of 21.30 m3 left " + kUtf8;
+  s.team_size = 120;
   s.world_key = "key " + std::to_string(f.u64());
   s.world_proof = std::string(128, 'f');
   for (int i = 0; i < 3; ++i) {
