@@ -84,6 +84,51 @@ std::optional<int> lock_folder(std::optional<OutputLock>& lock, const std::strin
   }
 }
 
+/// The run, once its folder is locked: the start (fresh or resumed), the run key, the participant, the lockstep and the
+/// last line; the exit code (docs/runtime.md#exit-codes), errors as one line.
+int run_in_folder(const std::string& scenario_path, const std::string& resume_dir, const std::string& run_key,
+                  const RuntimeOptions& options, const cli::DdsOptions& dds, const std::atomic<bool>& stop,
+                  std::ostream& out, std::ostream& err) {
+  try {
+    WorldStart start;
+    if (!resume_dir.empty()) {
+      start = prepare_resume(resume_dir, options, dds.domain);
+    } else {
+      try {
+        start = fresh_start(scenario_path, options, dds.domain);
+      } catch (const Error& e) {  // refused at start, as --check refuses it (docs/runtime.md#exit-codes)
+        cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+        return kExitInvalidScenario;
+      }
+    }
+    start.options.run_key = settle_run_key(run_key, start.options.out_dir, !resume_dir.empty());
+    const auto participant =
+        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kWorld,
+                               bus::Security::of(dds.security, dds.identity, "world")});
+    WorldRuntime runtime(std::move(start), *participant);
+    const RunResult result = runtime.run(stop);
+    out << fmt::format("run {}: {} after {} steps{}, {} agents{}, terrain sha256 {}\n", runtime.run_id(),
+                       to_string(result.end_reason), result.steps,
+                       result.resumed_at_step ? fmt::format(" (resumed at step {})", *result.resumed_at_step) : "",
+                       result.admitted,
+                       result.slots_missing > 0
+                           ? fmt::format(" ({} of {} slots missing at the end)", result.slots_missing, result.team)
+                           : "",
+                       result.terrain_sha256);
+    return exit_code(result.end_reason, result.slots_missing);
+  } catch (const Error& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return 1;
+  } catch (const std::bad_alloc&) {
+    cli::write_exit_error(err, "marsala-world: error: out of memory");
+    return 1;
+  } catch (const std::exception& e) {  // a library's own exception: still one line and exit 1, never an abort
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return 1;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& stop, std::ostream& out,
@@ -169,44 +214,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   // The folder is this process's from here to its exit, before --replace clears it or --resume reads it.
   std::optional<OutputLock> lock;
   if (const auto code = lock_folder(lock, resume_dir.empty() ? options.out_dir : resume_dir, err)) return *code;
-  try {
-    WorldStart start;
-    if (!resume_dir.empty()) {
-      start = prepare_resume(resume_dir, options, dds.domain);
-    } else {
-      try {
-        start = fresh_start(scenario_path, options, dds.domain);
-      } catch (const Error& e) {  // refused at start, as --check refuses it (docs/runtime.md#exit-codes)
-        cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
-        return kExitInvalidScenario;
-      }
-    }
-    start.options.run_key = settle_run_key(run_key, start.options.out_dir, !resume_dir.empty());
-    const auto participant =
-        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kWorld,
-                               bus::Security::of(dds.security, dds.identity, "world")});
-    WorldRuntime runtime(std::move(start), *participant);
-    const RunResult result = runtime.run(stop);
-    out << fmt::format("run {}: {} after {} steps{}, {} agents{}, terrain sha256 {}\n", runtime.run_id(),
-                       to_string(result.end_reason), result.steps,
-                       result.resumed_at_step ? fmt::format(" (resumed at step {})", *result.resumed_at_step) : "",
-                       result.admitted,
-                       result.slots_missing > 0
-                           ? fmt::format(" ({} of {} slots missing at the end)", result.slots_missing, result.team)
-                           : "",
-                       result.terrain_sha256);
-    return exit_code(result.end_reason, result.slots_missing);
-  } catch (const Error& e) {
-    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
-    return 1;
-  } catch (const std::bad_alloc&) {
-    cli::write_exit_error(err, "marsala-world: error: out of memory");
-    return 1;
-  } catch (const std::exception& e) {  // a library's own exception: still one line and exit 1, never an abort
-    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
-    return 1;
-  }
-  return 0;
+  return run_in_folder(scenario_path, resume_dir, run_key, options, dds, stop, out, err);
 }
 
 }  // namespace marsala::world_server
