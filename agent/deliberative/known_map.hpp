@@ -17,9 +17,6 @@ struct KnownMap {
   const CellMask& assumed;                   ///< 1 where no sensor read the surface (assumed ground, a bound)
   const std::vector<CellIndex>& trajectory;  ///< cells stood on, oldest first (world indices)
   bool scanned = false;                      ///< built from range scans (holes, shadows), not ground-truth tiles
-  /// Per known cell a height the terrain is above whatever its readings' noise [m] (the heights themselves for
-  /// tiles); a scanned map's MARS bound is taken over these, so noise never lifts it (docs/runtime.md#mapping).
-  const Heightmap& lower;
 
   /// The world grid.
   const GridGeometry& geometry() const { return heights.geometry(); }

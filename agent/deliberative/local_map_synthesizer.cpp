@@ -19,18 +19,6 @@ int clamp_int(double v, int lo, int hi) {
   return static_cast<int>(v);
 }
 
-/// Unknown cells take the lowest known height of `h`: they then never raise the MARS bound of a known cell.
-void fill_unknown_with_lowest(Heightmap& h, const CellMask& known) {
-  double lowest = std::numeric_limits<double>::infinity();
-  for (int r = 0; r < h.rows(); ++r)
-    for (int c = 0; c < h.cols(); ++c)
-      if (known(r, c) != 0) lowest = std::min(lowest, h(r, c));
-  if (!std::isfinite(lowest)) lowest = 0.0;
-  for (int r = 0; r < h.rows(); ++r)
-    for (int c = 0; c < h.cols(); ++c)
-      if (known(r, c) == 0) h(r, c) = lowest;
-}
-
 }  // namespace
 
 Window sensing_window(const GridGeometry& world, Position robot, double range_m) {
@@ -62,20 +50,20 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
   local.heights = map.heights.window(w.top_left, w.rows, w.cols);
   local.known = map.known.block(w.top_left.row, w.top_left.col, w.rows, w.cols);
 
+  // Unknown cells take the lowest known height: they then never raise the MARS bound of a known cell.
   const bool all_known = local.known.minCoeff() != 0;
-  if (!all_known) fill_unknown_with_lowest(local.heights, local.known);
-
-  if (map.scanned) {
-    // The MARS bound over readings less their noise (KnownMap::lower): over the readings themselves it is a maximum
-    // over many noisy cells, lifted by their noise, and a robot filling to it built above the world's bound. The gap
-    // is what lies between that bound and the cell's reading (none where the reading is above it).
-    Heightmap lower = map.lower.window(w.top_left, w.rows, w.cols);
-    if (!all_known) fill_unknown_with_lowest(lower, local.known);
-    const Heightmap bound = mars_.project(lower);
-    local.gap = Heightmap(bound.geometry(), (bound.heights() - local.heights.heights()).cwiseMax(0.0).eval());
-  } else {
-    local.gap = mars_.gap(local.heights);
+  if (!all_known) {
+    double lowest = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < w.rows; ++r)
+      for (int c = 0; c < w.cols; ++c)
+        if (local.known(r, c) != 0) lowest = std::min(lowest, local.heights(r, c));
+    if (!std::isfinite(lowest)) lowest = 0.0;
+    for (int r = 0; r < w.rows; ++r)
+      for (int c = 0; c < w.cols; ++c)
+        if (local.known(r, c) == 0) local.heights(r, c) = lowest;
   }
+
+  local.gap = mars_.gap(local.heights);
   local.occupiable = navigability_.occupiable(local.heights);
   // A ball that holds an unknown cell cannot be judged: treat its centre as not occupiable. No gap on unknown cells.
   local.blind = blind_cells(local.known, params().delta_m / (2.0 * local.geometry().cell_size_m));

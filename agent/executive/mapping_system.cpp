@@ -100,9 +100,7 @@ struct MappingSystem::Octree {
     octomap::key_type key_z = 0;
     double estimate_m = 0.0;  ///< surface height in this voxel, from the latest scan that hit it [m]
     bool has_estimate = false;
-    double estimate_sd_m = 0.0;  ///< the range-noise deviation of the hits the estimate came from [m]
-    double scan_sum_m = 0.0;     ///< this scan's hits [m]
-    double scan_sd_sum_m = 0.0;  ///< their range-noise deviations [m]
+    double scan_sum_m = 0.0;  ///< this scan's hits [m]
     int scan_count = 0;
     int hits_in_scan = 0;  ///< hits of the scan being integrated
   };
@@ -134,11 +132,9 @@ struct MappingSystem::Octree {
       for (VoxelHits& v : hits[index]) {
         if (v.scan_count == 0) continue;
         v.estimate_m = v.scan_sum_m / v.scan_count;
-        v.estimate_sd_m = v.scan_sd_sum_m / v.scan_count;
         v.has_estimate = true;
         v.hits_in_scan = v.scan_count;
         v.scan_sum_m = 0.0;
-        v.scan_sd_sum_m = 0.0;
         v.scan_count = 0;
       }
     }
@@ -183,7 +179,6 @@ struct MappingSystem::ScanBatch {
   struct Face {
     CellIndex cell;
     double z_m;
-    double sd_m;  ///< the hit's range-noise deviation [m]
   };
   octomap::Pointcloud cloud;
   std::vector<Face> faces;
@@ -195,7 +190,7 @@ struct MappingSystem::ScanBatch {
 };
 
 MappingSystem::MappingSystem(const GridGeometry& world, int tile_size, SensorSpec sensor)
-    : heights_(world, 0.0), lower_(world, 0.0), tile_size_(tile_size), sensor_(std::move(sensor)) {
+    : heights_(world, 0.0), tile_size_(tile_size), sensor_(std::move(sensor)) {
   if (tile_size < 1) throw InvalidArgument(fmt::format("mapping system: tile size must be >= 1, got {}", tile_size));
   const std::string problem = sensor_problem(sensor_);
   if (!problem.empty()) throw InvalidArgument(fmt::format("mapping system: sensor {}", problem));
@@ -211,7 +206,6 @@ MappingSystem::MappingSystem(MappingSystem&&) noexcept = default;
 MappingSystem& MappingSystem::operator=(MappingSystem&&) noexcept = default;
 MappingSystem::MappingSystem(const MappingSystem& other)
     : heights_(other.heights_),
-      lower_(other.lower_),
       known_(other.known_),
       assumed_(other.assumed_),
       known_count_(other.known_count_),
@@ -286,7 +280,6 @@ void MappingSystem::integrate_tile(const TerrainTile& tile) {
                 col = static_cast<int>(col0) + c + registration_.col;
       if (!heights_.contains({row, col})) continue;
       heights_(row, col) = tile.heights[static_cast<std::size_t>(r) * tile.cols + c];
-      lower_(row, col) = heights_(row, col);
       mark_known(row, col);
     }
 }
@@ -318,16 +311,14 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   // A face's hit bounds its cell from below for good (terrain only rises), as the robot's own construction does.
   for (const ScanBatch::Face& f : batch.faces) {
     const long long index = static_cast<long long>(f.cell.row) * g.cols + f.cell.col;
-    const double lower = f.z_m - kLowerBoundSpreads * f.sd_m;
-    Floor& least = face_floor_.try_emplace(index, Floor{f.z_m, lower}).first->second;
-    least = {std::max(least.z_m, f.z_m), std::max(least.lower_m, lower)};
+    double& least = face_floor_.try_emplace(index, f.z_m).first->second;
+    least = std::max(least, f.z_m);
     // A surface read at or above the face stays; else the cell is a bound, no surface: never a deposition target.
     const bool surface =
-        known_(f.cell.row, f.cell.col) != 0 && assumed_(f.cell.row, f.cell.col) == 0 && heights_(f.cell) >= least.z_m;
+        known_(f.cell.row, f.cell.col) != 0 && assumed_(f.cell.row, f.cell.col) == 0 && heights_(f.cell) >= least;
     if (!surface) {
       const auto built = built_.find(index);
-      heights_(f.cell) = built == built_.end() ? least.z_m : std::max(least.z_m, built->second.z_m);
-      lower_(f.cell) = built == built_.end() ? least.lower_m : std::max(least.lower_m, built->second.lower_m);
+      heights_(f.cell) = built == built_.end() ? least : std::max(least, built->second);
     }
     mark_known(f.cell.row, f.cell.col);
     assumed_(f.cell.row, f.cell.col) = surface ? 0 : 1;
@@ -363,7 +354,7 @@ MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& p
         const Position at{std::clamp(hit.x, in.x - 0.49 * cs, in.x + 0.49 * cs),
                           std::clamp(hit.y, in.y - 0.49 * cs, in.y + 0.49 * cs)};
         batch.cloud.push_back(tree_point(g, at.x, at.y, hit.z));
-        batch.faces.push_back({*face, hit.z, sensor_.noise_sd_at(range)});
+        batch.faces.push_back({*face, hit.z});
         continue;
       }
     }
@@ -382,7 +373,6 @@ MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& p
     batch.min_col = std::min(batch.min_col, cell->col);
     batch.max_col = std::max(batch.max_col, cell->col);
     voxel.scan_sum_m += hit.z;
-    voxel.scan_sd_sum_m += sensor_.noise_sd_at(range);
     ++voxel.scan_count;
   }
   return batch;
@@ -417,15 +407,12 @@ void MappingSystem::rederive_heights(const ScanBatch& batch) {
       if (!top) continue;  // every voxel it had was carved free since: keep what the map said
       const long long key_rc = static_cast<long long>(row) * g.cols + col;
       const auto built = built_.find(key_rc);
-      const double lower = top->estimate_m - kLowerBoundSpreads * top->estimate_sd_m;
-      heights_(row, col) = built == built_.end() ? top->estimate_m : std::max(top->estimate_m, built->second.z_m);
-      lower_(row, col) = built == built_.end() ? lower : std::max(lower, built->second.lower_m);
+      heights_(row, col) = built == built_.end() ? top->estimate_m : std::max(top->estimate_m, built->second);
       mark_known(row, col);
       // A face above the reading: the reading was the face's, not the cell's top (a bound, no surface).
       const auto face = face_floor_.find(key_rc);
-      if (face != face_floor_.end() && face->second.z_m > top->estimate_m) {
-        heights_(row, col) = std::max(heights_(row, col), face->second.z_m);
-        lower_(row, col) = std::max(lower_(row, col), face->second.lower_m);
+      if (face != face_floor_.end() && face->second > top->estimate_m) {
+        heights_(row, col) = std::max(heights_(row, col), face->second);
         assumed_(row, col) = 1;
       }
     }
@@ -449,11 +436,10 @@ void MappingSystem::record_built(CellIndex cell, double rise_m) {
   const bool surface_read = known_(cell.row, cell.col) != 0 && (assumed_(cell.row, cell.col) == 0 ||
                                                                 face_floor_.count(index) > 0 || built_.count(index) > 0);
   if (!surface_read) return;
-  const Floor floor{heights_(cell) + rise_m, lower_(cell) + rise_m};
-  Floor& built = built_.try_emplace(index, floor).first->second;
-  built = {std::max(built.z_m, floor.z_m), std::max(built.lower_m, floor.lower_m)};
-  heights_(cell) = std::max(heights_(cell), built.z_m);
-  lower_(cell) = std::max(lower_(cell), built.lower_m);
+  const double floor_m = heights_(cell) + rise_m;
+  double& built = built_.try_emplace(index, floor_m).first->second;
+  built = std::max(built, floor_m);
+  heights_(cell) = std::max(heights_(cell), built);
 }
 
 void MappingSystem::assume_ground(Position pose, double ground_z_m, double radius_m) {
@@ -466,8 +452,6 @@ void MappingSystem::assume_ground(Position pose, double ground_z_m, double radiu
   const GridGeometry& g = heights_.geometry();
   // The body's ball around the cell it stands on, with the project's tie tolerance (ARCHITECTURE.md, grid conventions).
   const double radius_cells = radius_m / g.cell_size_m;
-  // As far below the ground as the reading under the robot's centre may lie below its height.
-  const double lower_m = ground_z_m - (is_known(*centre) ? std::max(0.0, heights_(*centre) - lower_(*centre)) : 0.0);
   const int reach = static_cast<int>(std::ceil(radius_cells));
   for (int row = std::max(0, centre->row - reach); row <= std::min(g.rows - 1, centre->row + reach); ++row)
     for (int col = std::max(0, centre->col - reach); col <= std::min(g.cols - 1, centre->col + reach); ++col) {
@@ -475,7 +459,6 @@ void MappingSystem::assume_ground(Position pose, double ground_z_m, double radiu
       const double dr = row - centre->row, dc = col - centre->col;
       if (dr * dr + dc * dc > radius_cells * radius_cells + 1e-9) continue;
       heights_(row, col) = ground_z_m;
-      lower_(row, col) = lower_m;
       mark_known(row, col);
       assumed_(row, col) = 1;
     }

@@ -27,9 +27,6 @@ std::string tile_problem(const TerrainTile& tile, const GridGeometry& world, int
 /// its max range plus 6 noise standard deviations (and 1 m); otherwise the problem, naming the first bad point.
 std::string scan_problem(const std::vector<ScanPoint>& points, const SensorSpec& sensor);
 
-/// Range-noise deviations a reading's lower bound lies below it (MappingSystem::lower()) [1].
-constexpr double kLowerBoundSpreads = 3.0;
-
 /// The sensor origin the agent believes [m]: its believed position, the terrain height under it, plus the mount.
 inline Point3 believed_sensor_origin(Position pose, double ground_z_m, const SensorSpec& sensor) {
   return {pose.x, pose.y, ground_z_m + sensor.mount_height_m};
@@ -81,10 +78,6 @@ class MappingSystem {
 
   /// The map: known cells hold the sensed heights [m], unknown cells 0.
   const Heightmap& heights() const { return heights_; }
-  /// Per cell a height the terrain is above whatever the noise of its readings [m]: a scanned cell's reading less
-  /// kLowerBoundSpreads range-noise deviations at its hits' range (its face floors and built floors likewise); the
-  /// heights themselves for tiles. The MARS bound a scanning robot fills to is taken over these (docs/runtime.md#mapping).
-  const Heightmap& lower() const { return lower_; }
   /// 1 where the cell has been sensed at least once.
   const CellMask& known() const { return known_; }
   bool is_known(CellIndex cell) const { return heights_.contains(cell) && known_(cell.row, cell.col) != 0; }
@@ -105,9 +98,7 @@ class MappingSystem {
   /// The world grid.
   const GridGeometry& geometry() const { return heights_.geometry(); }
   /// This map as the deliberative layer reads it (the local map synthesizer); valid while this map lives, unchanged.
-  deliberative::KnownMap known_map() const {
-    return {heights_, known_, assumed_, trajectory_, sensor_.casts_rays(), lower_};
-  }
+  deliberative::KnownMap known_map() const { return {heights_, known_, assumed_, trajectory_, sensor_.casts_rays()}; }
   int tile_size() const { return tile_size_; }
   const SensorSpec& sensor() const { return sensor_; }
   /// What the last integrate_scan() cost [ms, CPU time of this thread]: inserting its hits into the octree (binning
@@ -129,13 +120,7 @@ class MappingSystem {
   bool behind_edge(Point3 origin, Point3 hit, CellIndex cell, double spread_m) const;
   void rederive_heights(const ScanBatch& batch);
 
-  /// A floor a cell keeps (terrain only rises): the height [m] and the same less the noise of what it came from [m].
-  struct Floor {
-    double z_m;
-    double lower_m;
-  };
   Heightmap heights_;
-  Heightmap lower_;  ///< lower(): heights no reading's noise lifts [m]
   CellMask known_;
   CellMask assumed_;
   long long known_count_ = 0;
@@ -143,8 +128,8 @@ class MappingSystem {
   std::vector<int> hit_scan_;  ///< per cell (row-major): the scan (1, 2, ...) that last hit it, 0 when none
   int tile_size_;
   CellIndex registration_{0, 0};
-  std::unordered_map<long long, Floor> built_;  ///< record_built(): the least height of a cell (row-major index)
-  std::unordered_map<long long, Floor> face_floor_;  ///< the highest face hit of a cell (row-major index)
+  std::unordered_map<long long, double> built_;  ///< record_built(): the least height of a cell (row-major index) [m]
+  std::unordered_map<long long, double> face_floor_;  ///< the highest face hit of a cell (row-major index) [m]
   SensorSpec sensor_;
   std::vector<CellIndex> trajectory_;
   std::unique_ptr<Octree> octree_;  // made at the first scan
