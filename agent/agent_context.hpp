@@ -26,9 +26,9 @@ struct AgentContext {
   double neighbour_keep_out_m = 0.0;
   std::uint64_t seed = 1;  ///< scenario seed; behaviours that randomise seed from seed + agent_id
   std::optional<GoalVectorMapSpec> goal_vector_map;  ///< the scenario's, for the "goal_vector_map" synthesizer
-  /// Ramp builders keep the right-of-way protocol (docs/runtime.md#right-of-way). Off by default: with it the shipped
-  /// hetero and site_rough runs stall; the liveness property test turns it on.
-  bool right_of_way = false;
+  /// Ramp builders keep the right-of-way protocol (docs/runtime.md#right-of-way); the scenario's `right_of_way: false`
+  /// turns it off.
+  bool right_of_way = true;
 };
 
 /// Keep-out around neighbours for a team whose largest body length is max_delta_m [m] and longest step

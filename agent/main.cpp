@@ -120,6 +120,7 @@ int main(int argc, char** argv) {
     config.neighbour_keep_out_m = agent::neighbour_keep_out_m(max_delta, max_step);
     config.seed = seed.value_or(s.seed);
     if (s.has_goal_vector_map) config.goal_vector_map = s.goal_vector_map;
+    config.right_of_way = s.right_of_way;
     config.admit_timeout = std::chrono::milliseconds(static_cast<long long>(admit_timeout_s * 1000.0));
     config.world_timeout = std::chrono::milliseconds(static_cast<long long>(world_timeout_s * 1000.0));
     config.world_key = world_key;

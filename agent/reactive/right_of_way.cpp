@@ -29,7 +29,11 @@ void RightOfWay::Loiter::update(Position p, double radius_m) {
 void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, double to_go_m,
                          double step_m, bool worked) {
   self_.update(self, loiter_m_);
-  if (at_goal || worked || to_go_m < best_to_go_m_ - step_m || no_progress_ < 0) {
+  // Frames spent holding or giving way are the protocol's, not tries: they neither count as no progress nor keep a
+  // best distance from before them (a robot that stepped away from its goal, or held, gets kStuckFrames frames to
+  // make way from where it stands before it holds again; else it held again at once, for ever).
+  const bool protocol_frame = hold_left_ > 0 || frames_left_ > 0;
+  if (at_goal || worked || protocol_frame || to_go_m < best_to_go_m_ - step_m || no_progress_ < 0) {
     best_to_go_m_ = to_go_m, no_progress_ = 0;
   } else {
     ++no_progress_;
@@ -47,7 +51,11 @@ void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours
       s.still = moved == 0.0 ? old->second.still + (frame_ - old->second.frame) : 0;
       s.heading = moved > 0.0 ? Position{dx / moved, dy / moved} : old->second.heading;
       s.loiter = old->second.loiter;
+      s.parked_at = old->second.parked_at;
+      s.left_parked = old->second.left_parked;
     }
+    if (s.still > kStillFrames + give_way_frames_) s.parked_at = s.at, s.left_parked = false;
+    if (s.parked_at && std::hypot(s.at.x - s.parked_at->x, s.at.y - s.parked_at->y) > loiter_m_) s.left_parked = true;
     s.loiter.update(n.position, loiter_m_);
     seen_[n.agent_id] = s;
   }
@@ -70,7 +78,11 @@ void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours
   for (const auto& [id, s] : seen_) {
     // Waits: holds still (at least kStillFrames and no longer than a hold: a robot parked at its goal waits for
     // nobody); to a robot at its goal, also one that has loitered that long (it tries and backs off in turn).
-    const bool holds = s.still >= kStillFrames && s.still <= kStillFrames + give_way_frames_;
+    // One that left where it stood still for longer than a hold and came back is parked there (back at its goal after
+    // giving way): standing still there again is not a hold.
+    const bool back_parked = s.left_parked && std::hypot(s.at.x - s.parked_at->x, s.at.y - s.parked_at->y) <=
+                                                  loiter_m_ / 3.0;
+    const bool holds = s.still >= kStillFrames && s.still <= kStillFrames + give_way_frames_ && !back_parked;
     const bool waits = holds || (at_goal && s.loiter.frames >= kStillFrames);
     if (s.frame != frame_ || !waits || (!at_goal && id > self_id_) || id == self_id_) continue;
     // At its goal a robot gives way to a robot once where it stands: one that waits there again after the episode

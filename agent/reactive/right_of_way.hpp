@@ -12,6 +12,7 @@
 //   - a robot that has loitered kStillFrames frames gives way (steps away for an episode) to a neighbour in contact
 //     that holds (has stood still kStillFrames to kStillFrames + an episode frames): to a lower id only, or, at its
 //     goal, to any id, also to one that loiters beside it, for three episodes and once per spot where it waits;
+//   - one that left a spot where it stood still longer than a hold and came back is parked there, not holding;
 //   - neighbours keep their record out of range (one parked all along does not seem to start holding again).
 
 #include <cstdint>
@@ -82,6 +83,8 @@ class RightOfWay {
     double radius_m = 0.0;
     Loiter loiter;
     long long frame = 0;  ///< the frame it was last seen in
+    std::optional<Position> parked_at;  ///< where it last stood still for longer than a hold
+    bool left_parked = false;           ///< it has been farther than loiter_m from parked_at since
   };
   std::uint32_t self_id_;
   double contact_m_;

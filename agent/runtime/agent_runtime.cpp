@@ -95,6 +95,7 @@ void AgentRuntime::make_behaviour() {
           : neighbour_keep_out_m(config_.type.body.navigability.delta_m, config_.type.body.max_step_m);
   context.seed = config_.seed;
   context.goal_vector_map = config_.goal_vector_map;
+  context.right_of_way = config_.right_of_way;
   behaviour_ = reactive::make_robot_behaviour(context);
 }
 

@@ -38,6 +38,7 @@ struct RuntimeConfig {
   double neighbour_keep_out_m = 0.0;                 ///< 0: delta/2 + max_step of this body [m]
   std::uint64_t seed = 1;                            ///< scenario seed
   std::optional<GoalVectorMapSpec> goal_vector_map;  ///< the scenario's, for the "goal_vector_map" synthesizer
+  bool right_of_way = true;                          ///< the scenario's: keep the right-of-way protocol
   std::chrono::milliseconds hello_period{200};       ///< between hellos until admitted
   std::chrono::milliseconds admit_timeout{60000};    ///< give up when not admitted by then
   std::chrono::milliseconds world_timeout{600000};   ///< give up when no frame comes for this long; 0: never

@@ -420,6 +420,7 @@ void read_run_settings(const proto::Scenario& p, Scenario& s, const Validator& c
   if (p.has_tile_size()) s.tile_size = p.tile_size();
   if (s.tile_size < 1 || s.tile_size > 4096) check.fail("tile_size", fmt::format("{} must be in 1..4096", s.tile_size));
   if (p.has_seed()) s.seed = p.seed();
+  if (p.has_right_of_way()) s.right_of_way = p.right_of_way();
 }
 
 Scenario to_scenario(const proto::Scenario& p, const std::string& source) {

@@ -30,10 +30,10 @@ namespace marsala::test {
 /// One run's world and agents, stepped in-process.
 class LockstepSim {
  public:
-  /// The run of `scenario` (its seed) on `terrain` with agents 1..agent_count, every one admitted; `right_of_way`:
-  /// the agents keep the right-of-way protocol (AgentContext::right_of_way).
+  /// The run of `scenario` (its seed) on `terrain` with agents 1..agent_count, every one admitted; the agents keep
+  /// the right-of-way protocol (AgentContext::right_of_way) when the scenario's right_of_way and `right_of_way` are.
   LockstepSim(const scenario::Scenario& scenario, Heightmap terrain, std::uint32_t agent_count,
-              bool right_of_way = false)
+              bool right_of_way = true)
       : state_(world_server::make_world_state(scenario, std::move(terrain), agent_count)) {
     double max_delta = 0.0, max_step = 0.0;
     for (const auto& a : state_.agents) {
@@ -47,7 +47,7 @@ class LockstepSim {
       context.type = a.type;
       context.neighbour_keep_out_m = agent::neighbour_keep_out_m(max_delta, max_step);
       context.seed = scenario.seed;
-      context.right_of_way = right_of_way;
+      context.right_of_way = right_of_way && scenario.right_of_way;
       if (scenario.has_goal_vector_map) context.goal_vector_map = scenario.goal_vector_map;
       protocol::AgentHello hello;
       hello.agent_id = a.id;
