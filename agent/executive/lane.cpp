@@ -22,6 +22,17 @@ std::optional<double> extent(const deliberative::LocalMap& local, const CellMask
   return std::nullopt;
 }
 
+/// The unit vector to the right of `path` at its cell i, its direction taken from path[i - k] to path[i + k] (k =
+/// kLaneDirectionSpan, clipped to the path); nullopt when those are the same cell.
+std::optional<Position> right_at(const deliberative::LocalMap& local, const std::vector<CellIndex>& path, int i) {
+  const int n = static_cast<int>(path.size());
+  const Position from = local.center(path[static_cast<std::size_t>(std::max(0, i - kLaneDirectionSpan))]);
+  const Position to = local.center(path[static_cast<std::size_t>(std::min(n - 1, i + kLaneDirectionSpan))]);
+  const double dx = to.x - from.x, dy = to.y - from.y, length = std::hypot(dx, dy);
+  if (!(length > 0.0)) return std::nullopt;
+  return Position{dy / length, -dx / length};  // right of (dx, dy): x east, y north
+}
+
 /// Per path cell: the unit vector to the right of the path there, and the offset from the cell of the point
 /// offset_m right of the corridor's centre across it (NaN where the path is not in a corridor of kMinCorridorCells
 /// path cells in a row), for path cells from `first` on.
@@ -38,11 +49,9 @@ Across across(const deliberative::LocalMap& local, const CellMask& corridor, con
   for (int i = first; i < n; ++i) {
     const std::size_t k = static_cast<std::size_t>(i);
     const CellIndex cell = path[k];
-    const Position from = local.center(path[static_cast<std::size_t>(std::max(0, i - kLaneDirectionSpan))]);
-    const Position to = local.center(path[static_cast<std::size_t>(std::min(n - 1, i + kLaneDirectionSpan))]);
-    const double dx = to.x - from.x, dy = to.y - from.y, length = std::hypot(dx, dy);
-    if (!(length > 0.0) || corridor(cell.row, cell.col) == 0) continue;
-    a.right[k] = {dy / length, -dx / length};  // right of (dx, dy): x east, y north
+    const auto right = right_at(local, path, i);
+    if (!right || corridor(cell.row, cell.col) == 0) continue;
+    a.right[k] = *right;
     const Position centre = local.center(cell);
     const auto to_right = extent(local, corridor, centre, a.right[k], corridor_width_m);
     const auto to_left = extent(local, corridor, centre, {-a.right[k].x, -a.right[k].y}, corridor_width_m);
@@ -96,21 +105,19 @@ std::vector<CellIndex> band_centre_path(const deliberative::LocalMap& local, con
   const Across a = across(local, corridor, path, 0.0, corridor_width_m, 0);
   std::vector<CellIndex> out;
   out.reserve(path.size());
-  double shift = 0.0;  // the offset to the centre line at the last path cell that had one [m]
+  double shift = 0.0;  // the shift towards the centre line at the last path cell in a corridor [m]
   bool seen = false;
   for (int i = 0; i < n; ++i) {
     const std::size_t k = static_cast<std::size_t>(i);
     const double w = a.wanted[k];
     if (!std::isnan(w)) shift = std::clamp(w, -max_shift_m, max_shift_m), seen = true;
     CellIndex cell = path[k];
-    // Past the corridor (the structure's end) the centre line goes on at the last offset, across the path's own
+    // Past the corridor (the structure's end) the centre line goes on at the last shift, across the path's own
     // direction there.
-    const Position from = local.center(path[static_cast<std::size_t>(std::max(0, i - kLaneDirectionSpan))]);
-    const Position to = local.center(path[static_cast<std::size_t>(std::min(n - 1, i + kLaneDirectionSpan))]);
-    const double dx = to.x - from.x, dy = to.y - from.y, length = std::hypot(dx, dy);
-    if (seen && shift != 0.0 && length > 0.0) {
+    const auto right = seen && shift != 0.0 ? right_at(local, path, i) : std::nullopt;
+    if (right) {
       const Position c = local.center(cell);
-      if (const auto moved = local.cell_at({c.x + shift * dy / length, c.y - shift * dx / length})) cell = *moved;
+      if (const auto moved = local.cell_at({c.x + shift * right->x, c.y + shift * right->y})) cell = *moved;
     }
     if (out.empty() || cell != out.back()) out.push_back(cell);
   }
