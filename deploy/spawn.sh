@@ -190,10 +190,10 @@ if [ -n "$progress_pid" ]; then
   kill -TERM "$progress_pid" 2>/dev/null || true
   wait "$progress_pid" 2>/dev/null || true
 fi
-# 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled: the run ended and wrote its outputs
-# (docs/runtime.md).
+# 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled, 7 completed short of slots: the run ended and
+# wrote its outputs (docs/runtime.md#exit-codes).
 case "$world_rc" in
-  0|3|4|5|6) ;;
+  0|3|4|5|6|7) ;;
   *)
     echo "spawn.sh: marsala-world exited with $world_rc; last lines of its log:" >&2
     tail -n 20 "$out/logs/world.log" >&2
@@ -211,5 +211,9 @@ if [ "$quiet" -eq 0 ]; then
     echo "spawn.sh: the run is over; see $out/summary.json and the pictures in $out"
   fi
 fi
-[ "$world_rc" -eq 0 ] || echo "spawn.sh: the run ended without completing; exit $world_rc" >&2
+if [ "$world_rc" -eq 7 ]; then
+  echo "spawn.sh: the run completed without some of its slots (summary.json slots_missing); exit 7" >&2
+elif [ "$world_rc" -ne 0 ]; then
+  echo "spawn.sh: the run ended without completing; exit $world_rc" >&2
+fi
 exit "$world_rc"

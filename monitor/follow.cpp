@@ -109,6 +109,18 @@ class TailPrinter {
     out_.flush();
   }
 
+  /// The end of a tail whose world is gone: what is pending, then one line saying so.
+  void print_world_gone(std::chrono::duration<double> after) {
+    for (const protocol::WorldEvent& e : pending_) print_event(e);
+    pending_.clear();
+    out_ << fmt::format("world gone: no live world status writer for {:g} s{}; tail ends\n", after.count(),
+                        last_seen());
+    out_.flush();
+  }
+
+  /// True once a status of the followed run came.
+  bool followed() const { return status_step_.has_value() || final_.has_value(); }
+
   std::string last_seen() const {
     if (!last_) return "";
     return fmt::format(" (last: step {} of run {})", last_->step, printable(last_->run_id));
@@ -175,6 +187,7 @@ int run_tail(bus::Participant& participant, const TailOptions& options, const St
   TailPrinter printer(options, out, err);
   WorldGate gate(err);  // only the run's own world speaks for it
   std::optional<Clock::time_point> deadline;
+  std::optional<Clock::time_point> gone_since;  ///< since when no status writer has been alive
   if (options.timeout) deadline = Clock::now() + to_clock(*options.timeout);
   for (;;) {
     // Statuses before events: every event published before a taken status is then taken too.
@@ -191,16 +204,35 @@ int run_tail(bus::Participant& participant, const TailOptions& options, const St
       return 0;
     }
     if (deadline && got_status) deadline = Clock::now() + to_clock(*options.timeout);
-    if (!deadline) {
-      signal->wait_for(std::chrono::hours(1));
-    } else if (Clock::now() < *deadline) {
-      signal->wait_until(*deadline);
-    } else {
+    // The world is gone once its status writer has not been alive for gone_after (docs/runtime.md#discovery-star):
+    // a world that died, was killed or stays paused or cut off, which would otherwise leave tail waiting for ever.
+    const Clock::time_point now = Clock::now();
+    if (got_status || statuses->alive_writers() > 0 || !printer.followed() || options.gone_after.count() <= 0)
+      gone_since.reset();
+    else if (!gone_since)
+      gone_since = now;
+    std::optional<Clock::time_point> wake = deadline;
+    if (gone_since) {
+      const Clock::time_point gone_at = *gone_since + to_clock(options.gone_after);
+      if (now >= gone_at) {
+        printer.print_world_gone(options.gone_after);
+        err << fmt::format("marsala-monitor: the world is gone: no live world status writer on {} for {:g} s{}",
+                           where(participant), options.gone_after.count(), printer.last_seen())
+            << std::endl;
+        return kExitWorldGone;
+      }
+      wake = wake ? std::min(*wake, gone_at) : gone_at;
+    }
+    if (deadline && now >= *deadline) {
       err << fmt::format("marsala-monitor: no world status on {} for {:g} s{}", where(participant),
                          options.timeout->count(), printer.last_seen())
           << std::endl;
       return 1;
     }
+    if (wake)
+      signal->wait_until(*wake);
+    else
+      signal->wait_for(std::chrono::hours(1));
   }
 
   // The run is over: the world may still be sending its last events (kRunOver comes last); wait briefly.

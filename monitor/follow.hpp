@@ -25,7 +25,13 @@ struct TailOptions {
   FormatOptions format;
   std::uint64_t every_steps = 0;            ///< a step line whenever the step crosses a multiple of this; 0 = all
   std::chrono::duration<double> interval{};  ///< at most a step line this often [s]; zero = no limit
+  /// Once a status of the run came: end (kExitWorldGone) when no status writer has been alive for this long [s]
+  /// (the world died, was killed, or is paused or cut off that long); zero = never.
+  std::chrono::duration<double> gone_after = std::chrono::seconds(10);
 };
+
+/// tail's exit code when the world of the run it follows is gone (TailOptions::gone_after).
+inline constexpr int kExitWorldGone = 3;
 
 /// Options of `status`.
 struct StatusOptions {
@@ -33,7 +39,9 @@ struct StatusOptions {
 };
 
 /// Prints one line per step (and per event) until the run ends (final summary, 0), `stop` is requested
-/// (0), or no status came for options.timeout (message on `err`, 1). Statuses of other runs are skipped.
+/// (0), no status came for options.timeout (message on `err`, 1), or the run's world is gone: no live status writer
+/// for options.gone_after (a last line on `out`, the reason on `err`, kExitWorldGone). Statuses of other runs are
+/// skipped.
 int run_tail(bus::Participant& participant, const TailOptions& options, const StopSource& stop, std::ostream& out,
              std::ostream& err);
 

@@ -19,6 +19,11 @@ std::string cut(const std::string& text, int width) {
   return text.substr(0, static_cast<std::size_t>(std::max(width, 0)));
 }
 
+/// The team's slots: the world's team size, or the agents it lists when it does not say [count].
+std::size_t team_size(const protocol::WorldStatus& status) {
+  return std::max<std::size_t>(status.team_size, status.agents.size());
+}
+
 std::size_t count_alive(const protocol::WorldStatus& status) {
   return static_cast<std::size_t>(
       std::count_if(status.agents.begin(), status.agents.end(), [](const auto& a) { return a.alive; }));
@@ -58,6 +63,22 @@ std::string run_outcome(const protocol::WorldStatus& status) {
 }
 
 const char* yes_no(bool value) { return value ? "yes" : "no"; }
+
+/// " | missing 2 of 3 slots: 2 dropped, 3 never admitted" for the slots of the team not in the run (dropped, or never
+/// admitted: ids up to the team size the world did not list); empty when none.
+std::string missing_slots(const protocol::WorldStatus& status) {
+  const std::size_t team = team_size(status);
+  std::vector<std::string> missing;
+  std::vector<bool> listed(team + 1, false);
+  for (const protocol::AgentStatus* a : agents_by_id(status)) {
+    if (a->agent_id <= team) listed[a->agent_id] = true;
+    if (!a->alive) missing.push_back(fmt::format("{} dropped", a->agent_id));
+  }
+  for (std::size_t id = 1; id <= team; ++id)
+    if (!listed[id]) missing.push_back(fmt::format("{} never admitted", id));
+  if (missing.empty()) return "";
+  return fmt::format(" | missing {} of {} slots: {}", missing.size(), team, fmt::join(missing, ", "));
+}
 
 }  // namespace
 
@@ -115,7 +136,7 @@ std::string format_step_line(const protocol::WorldStatus& status, const FormatOp
   double material_m3 = 0.0;
   for (const protocol::AgentStatus& a : status.agents)
     if (a.alive) material_m3 += a.material_m3;
-  const std::string live = fmt::format("{}/{}", count_alive(status), status.agents.size());
+  const std::string live = fmt::format("{}/{}", count_alive(status), team_size(status));
   std::string line = fmt::format("{:>6} {:>5} {:7.2f} {:8.3f} {:3.0f}% |", status.step, live, material_m3,
                                  status.deposited_volume_m3, 100.0 * status.progress);
   const int text_width = agent_column_text_width(status.agents.size(), options);
@@ -141,10 +162,11 @@ std::string format_run_summary(const protocol::WorldStatus& status) {
       status.progress_detail.empty()
           ? std::string()
           : fmt::format(" | progress {:.1f}%: {}", 100.0 * status.progress, printable(status.progress_detail));
-  return fmt::format("run {} {} at step {} ({:.1f} s) | live {}/{}, at goal {} | dep {:.3f} m3 | acc {} rej {} miss {}{}",
-                     printable(status.run_id), run_outcome(status), status.step, status.wall_seconds,
-                     count_alive(status), status.agents.size(), count_at_goal(status), status.deposited_volume_m3,
-                     accepted, rejected, missed, progress);
+  return fmt::format(
+      "run {} {} at step {} ({:.1f} s) | live {}/{}, at goal {}{} | dep {:.3f} m3 | acc {} rej {} miss {}{}",
+      printable(status.run_id), run_outcome(status), status.step, status.wall_seconds, count_alive(status),
+      team_size(status), count_at_goal(status), missing_slots(status),
+      status.deposited_volume_m3, accepted, rejected, missed, progress);
 }
 
 std::vector<std::string> format_waiting(const protocol::WorldStatus& status) {

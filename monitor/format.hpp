@@ -43,7 +43,8 @@ int agent_column_text_width(std::size_t agent_count, const FormatOptions& option
 std::string format_step_header(const protocol::WorldStatus& status, const FormatOptions& options = {});
 /// The tail view's line for one step.
 std::string format_step_line(const protocol::WorldStatus& status, const FormatOptions& options = {});
-/// The line tail prints last, once the run has ended: outcome, agents, volume and request counts.
+/// The line tail prints last, once the run has ended: outcome, agents, the team's slots not in the run (dropped or
+/// never admitted), volume and request counts.
 std::string format_run_summary(const protocol::WorldStatus& status);
 /// One line per world event: step, agent (or "world"), kind, volume when deposited, detail.
 std::string format_event(const protocol::WorldEvent& event, const FormatOptions& options = {});

@@ -34,11 +34,13 @@ constexpr int kExitError = 1;
 constexpr int kExitUsage = 2;
 
 constexpr const char* kTailLegend =
-    "Columns: step; live agents/all; mat = material on board of the live agents [m3]; dep = volume deposited\n"
+    "Columns: step; live agents/team slots; mat = material on board of the live agents [m3]; dep = volume deposited\n"
     "in the run [m3]; prog = the run's progress [%] (agents at the goal, share of the payload route's MARS gap\n"
     "filled, or level fraction of the site); then each agent's behaviour state in id order (* at its goal, --\n"
     "dropped, ? no state yet). Beyond what fits the width, live agents are counted per state. Event lines:\n"
-    "step > agent kind [volume] detail. The last line gives the progress in words.";
+    "step > agent kind [volume] detail. The last line gives the progress in words, and the team's slots missing.\n"
+    "Exit 0 the run ended (or Ctrl-C), 1 no status for --timeout, 2 a bad option, 3 the world is gone (no live\n"
+    "world status writer for --gone-after).";
 
 constexpr const char* kReplayFooter =
     "Rebuilds the terrain from DIR/run.log on DIR/terrain_initial.asc (its SHA-256 must match the log's header),\n"
@@ -75,6 +77,7 @@ struct TailCommand {
   double timeout_s = 0.0;
   CLI::Option* timeout = nullptr;
   double interval_s = 0.0;
+  double gone_after_s = 10.0;
 };
 
 void define_tail(CLI::App& app, TailCommand& c, cli::DdsOptions& dds) {
@@ -84,7 +87,7 @@ void define_tail(CLI::App& app, TailCommand& c, cli::DdsOptions& dds) {
   c.cmd->add_flag("--events", c.options.events, "also print one line per world event");
   c.timeout = c.cmd->add_option("--timeout", c.timeout_s,
                                 "exit 1 after this long without a world status [s] (default: wait forever)")
-                  ->check(CLI::Range(1e-3, 1e6));
+                  ->check(cli::seconds_within(1e-3, 1e6));
   c.cmd->add_option("--width", c.options.format.width, "longest line [columns]; 0 = no limit")
       ->check(CLI::Range(0, 10000))
       ->capture_default_str();
@@ -93,8 +96,13 @@ void define_tail(CLI::App& app, TailCommand& c, cli::DdsOptions& dds) {
       ->check(cli::at_least_one())
       ->type_name("N");
   c.cmd->add_option("--interval", c.interval_s, "print at most one step line every S seconds (and the last one)")
-      ->check(CLI::Range(1e-3, 86400.0))
+      ->check(cli::seconds_within(1e-3, 86400.0))
       ->type_name("S");
+  c.cmd->add_option("--gone-after", c.gone_after_s,
+                    "once the run was seen, exit 3 when no world status writer has been alive for this long [s]; "
+                    "0 = never")
+      ->check(cli::seconds_within(0.0, 1e6, " (0: never)"))
+      ->capture_default_str();
   c.cmd->footer(kTailLegend);
 }
 
@@ -102,6 +110,7 @@ int run_tail_command(TailCommand& c, bus::Participant& participant, const StopSo
                      std::ostream& err) {
   if (c.timeout->count() > 0) c.options.timeout = std::chrono::duration<double>(c.timeout_s);
   c.options.interval = std::chrono::duration<double>(c.interval_s);
+  c.options.gone_after = std::chrono::duration<double>(c.gone_after_s);
   return run_tail(participant, c.options, stop, out, err);
 }
 
@@ -122,10 +131,10 @@ void define_progress(CLI::App& app, ProgressCommand& c, cli::DdsOptions& dds) {
   cli::add_dds_options(*c.cmd, dds);
   c.cmd->add_option("--run-id", c.options.run_id, "follow this run only (default: the first run seen)");
   c.cmd->add_option("--interval", c.interval_s, "shortest time between two updates [s]")
-      ->check(CLI::Range(1e-3, 86400.0))
+      ->check(cli::seconds_within(1e-3, 86400.0))
       ->capture_default_str();
   c.timeout = c.cmd->add_option("--timeout", c.timeout_s, "exit 1 after this long without a world status [s]")
-                  ->check(CLI::Range(1e-3, 1e6));
+                  ->check(cli::seconds_within(1e-3, 1e6));
   auto* in_place_flag = c.cmd->add_flag("--in-place", c.in_place,
                                         "rewrite one line in place (the default when stdout is a terminal)");
   c.cmd->add_flag("--lines", c.lines, "print a new line at each update (the default otherwise)")->excludes(in_place_flag);
@@ -166,7 +175,7 @@ void define_status(CLI::App& app, StatusCommand& c, cli::DdsOptions& dds) {
   c.cmd = app.add_subcommand("status", "print the latest world status as a table, once");
   cli::add_dds_options(*c.cmd, dds);
   c.cmd->add_option("--timeout", c.timeout_s, "exit 1 when no world status arrives within this long [s]")
-      ->check(CLI::Range(1e-3, 1e6))
+      ->check(cli::seconds_within(1e-3, 1e6))
       ->capture_default_str();
 }
 
@@ -239,13 +248,13 @@ void define_serve(CLI::App& app, ServeCommand& c, cli::DdsOptions& dds) {
           ->type_name("DIR")
           ->excludes(run_dir);
   c.cmd->add_option("--speed", c.options.replay_steps_per_s, "replay pace [steps/s]")
-      ->check(CLI::Range(1e-3, 1e9))
+      ->check(cli::number_within(1e-3, 1e9, "a pace in steps/s"))
       ->needs(replay)
       ->capture_default_str();
   c.cmd
       ->add_option("--terrain-every", c.options.terrain_interval_s,
                    "shortest time between two terrain pictures [s]")
-      ->check(CLI::Range(0.0, 3600.0))
+      ->check(cli::seconds_within(0.0, 3600.0))
       ->capture_default_str();
   c.cmd->footer(kServeFooter);
 }

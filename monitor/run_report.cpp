@@ -76,6 +76,10 @@ std::string run_report(const std::string& dir) {
   if (s.completion() == "level_site") goal = fmt::format(", site {:.1f} % level", 100.0 * s.site_level_fraction());
   out += fmt::format("  agents {} ({} admitted, {} dropped), {:.3f} m3 deposited{}\n", s.agents(), s.admitted(),
                      s.dropped(), s.deposited_volume_m3(), goal);
+  if (s.slots_missing() > 0)
+    out += fmt::format("  short of {} of {} slots at the end (never admitted, or dropped and not back): agent{} {}\n",
+                       s.slots_missing(), s.agents(), s.missing_agents_size() == 1 ? "" : "s",
+                       fmt::join(s.missing_agents(), ", "));
   if (s.missed_deadlines() > 0 || s.rejected_requests() > 0)
     out += fmt::format("  {} missed deadlines, {} rejected requests (events.log says which)\n", s.missed_deadlines(),
                        s.rejected_requests());

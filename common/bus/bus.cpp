@@ -33,6 +33,14 @@ std::string WriterId::to_string() const {
 
 Vendor vendor_from_string(const std::string& name) { return enum_from_string(kVendorNames, name, "DDS vendor"); }
 
+int world_discovery_port(int domain_id, int k) {
+  // The RTPS port mapping (PB 7400, DG 250, PG 2, d1 10): a participant index i discovers on offset 10 + 2 i.
+  constexpr int kPortBase = 7400;
+  constexpr int kDomainGain = 250;
+  constexpr int kFirstWorldOffset = 2;
+  return kPortBase + kDomainGain * domain_id + kFirstWorldOffset + 2 * k;
+}
+
 void Signal::notify() {
   {
     std::lock_guard<std::mutex> lock(mutex_);

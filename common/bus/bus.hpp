@@ -160,15 +160,25 @@ class Participant {
 enum class Role {
   kServer,  ///< monitor, tools: takes the first free participant index from kServerIndices up, so that any number
             ///< of them leave indices 0..kServerIndices-1 to the world, and finds every participant on the domain
-            ///< (the profile's whole unicast probe range)
-  kClient,  ///< agent: finds only the participants at indices 0..kServerIndices-1 and the ones that find it; takes
-            ///< no index there (Cyclone: ParticipantIndex none; Fast DDS: ports from index kServerIndices up)
-  kWorld,   ///< the world: the lowest free participant index (below kServerIndices unless participants of other
-            ///< programs hold them all), and finds every participant on the domain
+            ///< (the profile's whole unicast probe range and the world's ports)
+  kClient,  ///< agent: finds only the participants at the world's ports and at indices 0..kServerIndices-1 and the
+            ///< ones that find it; takes no port there (Cyclone: ParticipantIndex none; Fast DDS: ports from index
+            ///< kServerIndices up)
+  kWorld,   ///< the world: discovery on the first free of its own ports (world_discovery_port()), which no
+            ///< participant with an automatic index can hold; finds every participant on the domain
 };
 
-/// Participant indices kept for the world: a client announces itself to these only.
+/// Participant indices kept for the world: a client announces itself to these (and to the world's ports) only.
 inline constexpr int kServerIndices = 4;
+
+/// The world's own discovery ports of a domain [count]: world_discovery_port(domain, 0..kWorldPorts-1).
+inline constexpr int kWorldPorts = 4;
+
+/// The world's discovery (metatraffic unicast) port number `k` of `domain` [UDP port]: 7400 + 250 domain + 2 + 2 k,
+/// k in 0..kWorldPorts-1, i.e. 7402, 7404, 7406, 7408 in domain 0. They lie between the domain's multicast ports
+/// (offsets 0, 1) and participant index 0 (offset 10 + 2 i) of the RTPS port mapping, where no participant with an
+/// automatic index of this domain ever binds (docs/runtime.md#discovery-star).
+int world_discovery_port(int domain_id, int k);
 
 /// DDS Security for a participant (docs/runtime.md#security): the folder deploy/security/make-identities.sh made
 /// and the identity to take from it. Empty dir: unsecured.

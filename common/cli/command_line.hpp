@@ -8,9 +8,11 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <optional>
 #include <ostream>
 #include <string>
+#include <utility>
 
 // CLI11 2.1's pair conversion trips a false -Wmaybe-uninitialized at -O2; keep our own warnings on.
 #pragma GCC diagnostic push
@@ -71,18 +73,43 @@ inline CLI::Validator at_least_one() {
       ">= 1");
 }
 
-/// A finite number of seconds in [lo, hi]; `meaning` is added to the message, e.g. " (0: wait forever)". CLI11's
-/// Range and PositiveNumber let "nan" through (every comparison with it is false).
-inline CLI::Validator seconds_within(double lo, double hi, const std::string& meaning = "") {
+/// A validator taking finite numbers for which `in_range` holds; anything else gets "must be <expected>, not '<text>'".
+/// CLI11's Range, PositiveNumber and NonNegativeNumber let "nan" through (every comparison with it is false), so every
+/// floating-point option uses one of the validators below.
+inline CLI::Validator finite_number(std::function<bool(double)> in_range, const std::string& expected,
+                                    const std::string& description) {
   return CLI::Validator(
-      [lo, hi, meaning](std::string& text) {
+      [in_range = std::move(in_range), expected](std::string& text) {
         char* end = nullptr;
         const double v = std::strtod(text.c_str(), &end);
-        return !text.empty() && *end == '\0' && std::isfinite(v) && v >= lo && v <= hi
+        return !text.empty() && *end == '\0' && std::isfinite(v) && in_range(v)
                    ? std::string()
-                   : fmt::format("must be a number of seconds from {} to {}{}, not '{}'", lo, hi, meaning, text);
+                   : fmt::format("must be {}, not '{}'", expected, text);
       },
-      fmt::format("S in [{}, {}]", lo, hi));
+      description);
+}
+
+/// A finite number in [lo, hi]; `what` names it (e.g. "a number of seconds") and `meaning` follows the range, e.g.
+/// " (0: wait forever)".
+inline CLI::Validator number_within(double lo, double hi, const std::string& what = "a number",
+                                    const std::string& meaning = "") {
+  return finite_number([lo, hi](double v) { return v >= lo && v <= hi; },
+                       fmt::format("{} from {} to {}{}", what, lo, hi, meaning), fmt::format("X in [{}, {}]", lo, hi));
+}
+
+/// A finite number of seconds in [lo, hi]; `meaning` is added to the message, e.g. " (0: wait forever)".
+inline CLI::Validator seconds_within(double lo, double hi, const std::string& meaning = "") {
+  return number_within(lo, hi, "a number of seconds", meaning);
+}
+
+/// A finite number above 0 (a length, a slope): CLI::PositiveNumber without "nan" and "inf".
+inline CLI::Validator positive_number() {
+  return finite_number([](double v) { return v > 0.0; }, "a finite number above 0", "X > 0");
+}
+
+/// A finite number of at least 0: CLI::NonNegativeNumber without "nan" and "inf".
+inline CLI::Validator non_negative_number() {
+  return finite_number([](double v) { return v >= 0.0; }, "a finite number of at least 0", "X >= 0");
 }
 
 /// Parses argv into `app`; returns nullopt when the program should go on, else the exit code to return now.

@@ -107,10 +107,10 @@ std::string methods_help() {
 /// Adds --kappa/--eps/--delta with range checks to a subcommand.
 void add_navigability_options(CLI::App& cmd, NavigabilityParams& params, bool required) {
   auto* kappa = cmd.add_option("--kappa", params.kappa, "maximum climbable slope, rise over run [m/m]")
-                    ->check(CLI::PositiveNumber);
+                    ->check(positive_number());
   auto* eps =
-      cmd.add_option("--eps", params.eps_m, "largest discontinuity per body length [m]")->check(CLI::NonNegativeNumber);
-  auto* delta = cmd.add_option("--delta", params.delta_m, "robot body length [m]")->check(CLI::PositiveNumber);
+      cmd.add_option("--eps", params.eps_m, "largest discontinuity per body length [m]")->check(non_negative_number());
+  auto* delta = cmd.add_option("--delta", params.delta_m, "robot body length [m]")->check(positive_number());
   if (required) {
     kappa->required();
     eps->required();
@@ -246,7 +246,7 @@ void define_generate(CLI::App& app, GenerateCommand& c) {
   c.cmd->add_option("--seed", c.spec.seed, "random seed")->capture_default_str();
   c.cmd->add_option("--rows", c.spec.rows, "rows")->required()->check(CLI::Range(1, 1 << 16));
   c.cmd->add_option("--cols", c.spec.cols, "columns")->required()->check(CLI::Range(1, 1 << 16));
-  c.cmd->add_option("--cell-size", c.spec.cell_size_m, "cell size [m]")->required()->check(CLI::PositiveNumber);
+  c.cmd->add_option("--cell-size", c.spec.cell_size_m, "cell size [m]")->required()->check(positive_number());
   c.cmd->add_option("--param", c.param_pairs, "method parameter KEY=VALUE (repeatable)");
   c.cmd->add_option("-o,--output", c.out_path, "output .asc")->required();
   c.cmd->footer(methods_help());
@@ -281,7 +281,7 @@ void define_import(CLI::App& app, ImportCommand& c) {
   c.cmd->add_option("--crop", c.preparation.crop, "crop X0 Y0 W H [m], in the imported local frame (lower-left = 0, 0)")
       ->expected(4);
   c.cmd->add_option("--cell-size", c.preparation.cell_size_m, "resample bilinearly to this cell size [m]")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   add_fill_nodata(*c.cmd, c.fill_nodata, "fill NODATA cells from their valid neighbours instead of failing");
   c.cmd->add_flag("--zero-base", c.preparation.zero_base, "shift heights so that the lowest cell is at 0 m");
 }
@@ -343,7 +343,7 @@ void define_mars(CLI::App& app, MarsCommand& c) {
   add_input(*c.cmd, c.in_path);
   c.cmd->add_option("--kappa", c.kappa, "maximum climbable slope, rise over run [m/m]")
       ->required()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   c.cmd->add_option("-o,--output", c.out_path, "output .asc")->required();
   c.cmd->add_flag("--gap", c.write_gap, "write the gap P_kappa[h] - h instead of P_kappa[h]");
   add_fill_nodata(*c.cmd, c.fill_nodata);
@@ -537,7 +537,7 @@ void define_route(CLI::App& app, RouteCommand& c) {
   c.cmd->add_option("--crop", c.preparation.crop, "crop X0 Y0 W H [m] in the input's frame (as a scenario's terrain.crop)")
       ->expected(4);
   c.cmd->add_option("--cell-size", c.preparation.cell_size_m, "resample bilinearly to this cell size [m]")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   c.cmd->add_flag("--zero-base", c.preparation.zero_base, "shift heights so that the lowest cell is at 0 m");
   add_fill_nodata(*c.cmd, c.fill_nodata);
   add_navigability_options(*c.cmd, c.payload, true);
@@ -547,23 +547,23 @@ void define_route(CLI::App& app, RouteCommand& c) {
   c.cmd->add_option("--pairs", c.pairs_path, "plan every route of FILE instead: one 'FROM_X FROM_Y TO_X TO_Y' a line")
       ->check(CLI::ExistingFile);
   c.cmd->add_option("--construction-kappa", c.build_kappa, "slope the builders build to [m/m] (default: --kappa)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   c.cmd->add_option("--width", c.band_width_m, "construction band width [m] (default: --delta)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   c.cmd
       ->add_option("--min-depth", c.min_depth_m,
                    "a route cell needs construction when its MARS gap is at least this [m], e.g. one cube layer")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   c.cmd
       ->add_option("--min-natural", c.min_natural_m,
                    "natural ground shorter than this does not separate two sites [m] (default: --delta)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   c.cmd
       ->add_option("--local-radius", c.local_radius_m,
                    "take each cell's MARS bound over the square of this half-side around it only, as a builder's local "
                    "map of its sensing range does [m]; 0: the whole terrain")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   c.cmd->add_flag("--json", c.json, "print JSON instead of text");
 }

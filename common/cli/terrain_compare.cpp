@@ -90,10 +90,10 @@ void define_compare(CLI::App& app, CompareCommand& c) {
       ->needs(scenario);
   for (CLI::Option* o :
        {c.cmd->add_option("--kappa", c.body.kappa, "body: maximum climbable slope, rise over run [m/m]")
-            ->check(CLI::PositiveNumber),
+            ->check(positive_number()),
         c.cmd->add_option("--eps", c.body.eps_m, "body: largest discontinuity per body length [m]")
-            ->check(CLI::NonNegativeNumber),
-        c.cmd->add_option("--delta", c.body.delta_m, "body: length [m]")->check(CLI::PositiveNumber)})
+            ->check(non_negative_number()),
+        c.cmd->add_option("--delta", c.body.delta_m, "body: length [m]")->check(positive_number())})
     o->capture_default_str()->excludes(scenario);
   c.cmd->add_flag("--json", c.json, "print one JSON object instead of text");
 }

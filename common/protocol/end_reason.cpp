@@ -24,6 +24,10 @@ int exit_code(EndReason reason) {
   return 1;
 }
 
+int exit_code(EndReason reason, std::uint32_t slots_missing) {
+  return reason == EndReason::kCompleted && slots_missing > 0 ? kExitCompletedShort : exit_code(reason);
+}
+
 std::string to_string(EndReason reason) { return enum_to_string(kEndReasonNames, reason); }
 
 EndReason end_reason_from_string(const std::string& name) {

@@ -2,6 +2,7 @@
 // Why a run ended (docs/runtime.md#end-reasons): the world decides it, run.log and summary.json name it, the monitor
 // reads it back.
 
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -20,6 +21,14 @@ enum class EndReason {
 /// 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled. 1 (an error) and 2 (usage, or a run refused at
 /// start) are not end reasons.
 int exit_code(EndReason reason);
+
+/// marsala-world's exit code when a run that completed was short of slots (docs/runtime.md#exit-codes): 7.
+inline constexpr int kExitCompletedShort = 7;
+
+/// marsala-world's exit code for a run that ended for `reason` with `slots_missing` slots of its team not in it at
+/// the end (never admitted, or dropped and not back) [count]: exit_code(reason), except kExitCompletedShort for a
+/// completed run short of any slot, so that a script sees the team did not complete it whole.
+int exit_code(EndReason reason, std::uint32_t slots_missing);
 
 /// "signal", "completed", "max_steps", "no_live_agents", "stalled".
 std::string to_string(EndReason reason);

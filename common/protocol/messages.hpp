@@ -115,6 +115,7 @@ struct WorldStatus {
   std::uint64_t world_id = 0;  ///< random per world process: tells two worlds on one domain apart
   bool admitting = false;      ///< the world is still admitting its agents (before its first step)
   std::string progress_detail;  ///< the progress in words, e.g. "12.31 of 21.30 m3 of MARS gap left on the route"
+  std::uint32_t team_size = 0;  ///< slots of the run's team (--agents), admitted or not [count]; 0 = not said
 };
 
 /// Kinds of world events, for the event stream and the monitor.

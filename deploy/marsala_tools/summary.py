@@ -71,8 +71,8 @@ def csv_word(text):
 
 
 # marsala-world's exit codes for a run that ended with its summary written (spawn.sh passes them on): completed,
-# max_steps, no_live_agents, stopped by a signal (spawn.sh's --timeout), stalled.
-ENDED_EXIT_CODES = (0, 3, 4, 5, 6)
+# max_steps, no_live_agents, stopped by a signal (spawn.sh's --timeout), stalled, completed short of slots.
+ENDED_EXIT_CODES = (0, 3, 4, 5, 6, 7)
 
 
 def run_summary(run_dir, exit_code):

@@ -21,7 +21,9 @@
 #                                                                    run loses nothing (same sha256 as unpaused)
 #   world-kill                                                       SIGKILL the world mid-run: every agent waits its
 #                                                                    --world-timeout (5 s) and exits 1 saying so
-#   monitor                                                          marsala-monitor tail follows a run to its end
+#   monitor                                                          marsala-monitor tail follows a run to its end; a
+#                                                                    run short of a slot exits 7 and says so; tail
+#                                                                    ends (exit 3) when the world is killed
 #   impostor                                                         a participant forging frames, a status and an
 #                                                                    event in the world's name changes nothing
 set -euo pipefail
@@ -111,7 +113,10 @@ case "$case_name" in
     "$bin/marsala-agent" --scenario "$scenario" --id 1 --dds cyclone --domain "$domain" >"$out/logs/agent-1.log" 2>&1 &
     agent=$!
     "$bin/marsala-rogue-agent" "$scenario" 2 cyclone "$domain" >"$out/logs/rogue.log" 2>&1 || true
-    wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
+    # The rogue left: the run completes short of its slot, exit 7 (docs/runtime.md#exit-codes).
+    rc=0
+    wait "$world" || rc=$?
+    [ "$rc" -eq 7 ] || { tail -30 "$out/logs/world.log"; fail "world exited $rc, expected 7 (completed without the rogue)"; }
     wait "$agent" || true
     s="$out/summary.json"
     [ "$(field completed "$s")" = "true" ] || { cat "$s"; tail -30 "$out/logs/world.log"; fail "honest agent did not complete"; }
@@ -139,9 +144,13 @@ case "$case_name" in
     for _ in $(seq 1 3000); do grep -q '"agent":2,"kind":"deposited"' "$out/events.log" 2>/dev/null && break; sleep 0.02; done
     grep -q '"agent":2,"kind":"deposited"' "$out/events.log" || fail "agent 2 never deposited (see $out/logs)"
     kill -KILL "${pids[1]}"
-    wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
+    rc=0
+    wait "$world" || rc=$?
+    [ "$rc" -eq 7 ] || { tail -30 "$out/logs/world.log"; fail "world exited $rc, expected 7 (completed without agent 2)"; }
     s="$out/summary.json"
     [ "$(field completed "$s")" = "true" ] || { cat "$s"; tail -30 "$out/logs/world.log"; fail "survivors did not complete"; }
+    [ "$(field slots_missing "$s")" = 1 ] && tr -d '\n ' <"$s" | grep -q '"missing_agents":\[2\]' ||
+      { cat "$s"; fail "summary.json does not name slot 2 missing"; }
     grep -q "lost liveliness" "$out/logs/world.log" || fail "world never noticed the killed agent via liveliness"
     # Agent 2's entry: it took part before it died, and it was dropped.
     entry2=$(tr -d '\n ' <"$s" | grep -o '{"agent_id":2,[^}]*}')
@@ -264,7 +273,10 @@ case "$case_name" in
     for _ in $(seq 1 150); do grep -q '"agent":3,"kind":"dropped"' "$out/events.log" 2>/dev/null && break; sleep 0.1; done
     grep -q '"agent":3,"kind":"dropped"' "$out/events.log" || { kill -CONT "${pids[2]}"; fail "agent 3 was not dropped while paused"; }
     kill -CONT "${pids[2]}"
-    wait "$world" || { tail -30 "$out/logs/world.log"; fail "world exited non-zero"; }
+    rc=0
+    wait "$world" || rc=$?
+    # 7: completed without agent 3 (the skip below); anything else but 0 is a failure.
+    [ "$rc" -eq 0 ] || [ "$rc" -eq 7 ] || { tail -30 "$out/logs/world.log"; fail "world exited $rc"; }
     s="$out/summary.json"
     for k in 0 1 2; do
       wait "${pids[$k]}" && continue
@@ -278,6 +290,7 @@ case "$case_name" in
       fail "agent $((k + 1)) exited non-zero (see $out/logs)"
     done
     expect_completed "$s" 3
+    [ "$rc" -eq 0 ] || fail "the world exited $rc, though agent 3 came back (slots_missing $(field slots_missing "$s"))"
     grep -q '"agent":3,"kind":"admitted","detail":"[^"]*(re-admitted, 1 of 3)' "$out/events.log" || fail "agent 3 was not re-admitted"
     [ "$(field readmissions "$s")" = "1" ] || fail "summary says $(field readmissions "$s") readmissions"
     echo "ok: agent 3 dropped while paused, re-admitted; run completed in $(field steps "$s") steps"
@@ -421,7 +434,43 @@ case "$case_name" in
     grep -q "completed at step $(field steps "$s")" "$work/tail.txt" || { cat "$work/tail.txt"; fail "no final line"; }
     lines=$(wc -l <"$work/tail.txt")
     [ "$lines" -ge 10 ] || { cat "$work/tail.txt"; fail "tail printed only $lines lines"; }
-    echo "ok: monitor followed the run ($lines lines) and saw it complete"
+    # Honest outcomes: three slots, agent 3 never started. The run completes short of it: exit 7, and summary.json
+    # and the monitor's last line say which slot is missing (docs/runtime.md#exit-codes).
+    "$bin/marsala-monitor" tail --dds cyclone --domain "$domain" --timeout 120 >"$work/short-tail.txt" 2>&1 &
+    monitor=$!
+    world_only=1 start_run "$work/short" --admit-timeout 3
+    pids=()
+    for id in 1 2; do
+      "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds cyclone --domain "$domain" >"$logs/agent-$id.log" 2>&1 &
+      pids+=($!)
+    done
+    rc=0
+    wait "$world" || rc=$?
+    [ "$rc" -eq 7 ] || { tail -20 "$logs/world.log"; fail "a run without agent 3 exited $rc, expected 7"; }
+    for p in "${pids[@]}"; do wait "$p" || fail "an agent exited non-zero (see $logs)"; done
+    wait "$monitor" || { cat "$work/short-tail.txt"; fail "monitor tail of the short run exited non-zero"; }
+    s="$out/summary.json"
+    [ "$(field completed "$s")" = true ] && [ "$(field slots_missing "$s")" = 1 ] && [ "$(field admitted "$s")" = 2 ] &&
+      tr -d '\n ' <"$s" | grep -q '"missing_agents":\[3\]' || { cat "$s"; fail "summary.json does not say slot 3 is missing"; }
+    grep -q "(1 of 3 slots missing at the end)" "$logs/world.log" || { tail -3 "$logs/world.log"; fail "the world's last line does not say it"; }
+    grep -q "completed at step .* | live 2/3, .* | missing 1 of 3 slots: 3 never admitted |" "$work/short-tail.txt" ||
+      { cat "$work/short-tail.txt"; fail "the monitor's last line does not name the missing slot"; }
+    # The world killed mid-run: tail ends with a line and exit 3 once no world status writer has been alive for
+    # --gone-after, instead of waiting for ever.
+    timeout 60 "$bin/marsala-monitor" tail --dds cyclone --domain "$domain" --gone-after 2 >"$work/gone-tail.txt" 2>&1 &
+    monitor=$!
+    start_run "$work/gone"
+    for _ in $(seq 1 3000); do grep -q '"kind":"deposited"' "$out/events.log" 2>/dev/null && break; sleep 0.02; done
+    kill -KILL "$world"
+    killed=$SECONDS
+    for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; wait "$p" 2>/dev/null || true; done
+    rc=0
+    wait "$monitor" || rc=$?
+    [ "$rc" -eq 3 ] || { cat "$work/gone-tail.txt"; fail "tail exited $rc after the world died, expected 3"; }
+    grep -q "^world gone: no live world status writer for 2 s (last: step [0-9]* of run" "$work/gone-tail.txt" ||
+      { cat "$work/gone-tail.txt"; fail "tail did not end with the world-gone line"; }
+    echo "ok: monitor followed the run ($lines lines) and saw it complete; a run short of slot 3 exited 7 saying so;" \
+      "tail ended $((SECONDS - killed)) s after the world was killed, exit 3"
     ;;
   impostor)
     # A Fast DDS participant speaks in the name of a Cyclone world: to every agent admitted, a "run over" frame, a

@@ -167,6 +167,9 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   }
   s.set_admitted(admitted);
   s.set_dropped(dropped);
+  const std::vector<std::uint32_t> missing = missing_slots(state);
+  s.set_slots_missing(static_cast<std::uint32_t>(missing.size()));
+  for (std::uint32_t id : missing) s.add_missing_agents(id);
   s.set_missed_deadlines(missed);
   s.set_rejected_requests(rejected);
   s.set_terrain_sha256(runlog::terrain_sha256(state.terrain));
@@ -220,6 +223,14 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
 }
 
 }  // namespace
+
+std::vector<std::uint32_t> missing_slots(const WorldState& state) {
+  std::vector<std::uint32_t> ids;
+  for (const AgentRecord& a : state.agents)
+    if (!a.alive) ids.push_back(a.id);  // alive: admitted and not dropped (world_state.hpp)
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
 
 std::string summary_json(const WorldState& state, const RunInfo& info) {
   return summary_text(state, info, final_terrain_report(state, info));

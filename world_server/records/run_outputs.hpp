@@ -63,6 +63,9 @@ struct RunInfo {
   Heightmap initial_terrain;
 };
 
+/// The ids of the slots of `state`'s team not in the run now (never admitted, or dropped and not back), in order.
+std::vector<std::uint32_t> missing_slots(const WorldState& state);
+
 /// summary.json's text: every field present (zeros included); steps = state.step; terrain_sha256 of state.terrain;
 /// payload_path: path_found and path_length_m of payload_path() on state.terrain; level_site: site_level_fraction()
 /// on state.terrain.

@@ -163,11 +163,15 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
                                bus::Security::of(dds.security, dds.identity, "world")});
     WorldRuntime runtime(std::move(start), *participant);
     const RunResult result = runtime.run(stop);
-    out << fmt::format("run {}: {} after {} steps{}, {} agents, terrain sha256 {}\n", runtime.run_id(),
+    out << fmt::format("run {}: {} after {} steps{}, {} agents{}, terrain sha256 {}\n", runtime.run_id(),
                        to_string(result.end_reason), result.steps,
                        result.resumed_at_step ? fmt::format(" (resumed at step {})", *result.resumed_at_step) : "",
-                       result.admitted, result.terrain_sha256);
-    return exit_code(result.end_reason);
+                       result.admitted,
+                       result.slots_missing > 0
+                           ? fmt::format(" ({} of {} slots missing at the end)", result.slots_missing, result.team)
+                           : "",
+                       result.terrain_sha256);
+    return exit_code(result.end_reason, result.slots_missing);
   } catch (const Error& e) {
     cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
     return 1;

@@ -62,6 +62,7 @@ protocol::WorldStatus world_status(const WorldState& state, bool running, bool c
   s.progress_detail = progress_detail(state);
   s.running = running;
   s.completed = completed;
+  s.team_size = static_cast<std::uint32_t>(state.agents.size());
   for (const AgentRecord& a : state.agents) {
     if (!a.admitted) continue;
     protocol::AgentStatus as;
@@ -598,6 +599,8 @@ struct WorldRuntime::Impl {
     info.connected = connected;
     recorder.finish(state, std::move(info), options.search_path);
     for (const AgentRecord& a : state.agents) result.admitted += a.admitted ? 1 : 0;
+    result.team = static_cast<std::uint32_t>(state.agents.size());
+    result.slots_missing = static_cast<std::uint32_t>(missing_slots(state).size());
     result.terrain_sha256 = runlog::terrain_sha256(state.terrain);
     if (resume) result.resumed_at_step = resume_step;
     spdlog::info("run over ({}): {} steps in {:.3f} s, {:.6f} m3 deposited, terrain sha256 {}", to_string(end_reason),

@@ -31,6 +31,8 @@ struct RunResult {
   std::uint64_t steps = 0;                                        ///< steps applied
   double wall_seconds = 0.0;                                      ///< from the first frame to the end [s]
   std::uint32_t admitted = 0;
+  std::uint32_t team = 0;           ///< slots of the team (--agents) [count]
+  std::uint32_t slots_missing = 0;  ///< slots not in the run at its end: never admitted, or dropped and not back
   std::string terrain_sha256;                    ///< of the final heights
   std::optional<std::uint64_t> resumed_at_step;  ///< set when this process continued a run from its log
 };

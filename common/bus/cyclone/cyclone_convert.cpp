@@ -290,6 +290,7 @@ marsala_wire_WorldStatus to_msg(const WorldStatus& in, Storage& storage) {
   out.world_id = in.world_id;
   out.admitting = in.admitting;
   out.progress_detail = borrow(in.progress_detail);
+  out.team_size = in.team_size;
   storage.agents.clear();
   for (const AgentStatus& a : in.agents) {
     marsala_wire_AgentStatus agent{};
@@ -326,6 +327,7 @@ WorldStatus from_msg(const marsala_wire_WorldStatus& in) {
   out.world_id = in.world_id;
   out.admitting = in.admitting;
   out.progress_detail = copy(in.progress_detail);
+  out.team_size = in.team_size;
   out.agents.reserve(in.agents._length);
   for (std::uint32_t i = 0; i < in.agents._length; ++i) {
     const marsala_wire_AgentStatus& a = in.agents._buffer[i];

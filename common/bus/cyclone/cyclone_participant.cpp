@@ -59,8 +59,16 @@ struct CycloneType<WorldEvent> {
   static const dds_topic_descriptor_t* descriptor() { return &marsala_wire_WorldEvent_desc; }
 };
 
-/// How many participant indices a server tries from kServerIndices up before it takes the profile's own choice.
+/// How many participant indices a server tries from kServerIndices up before it becomes a client.
 constexpr int kServerTries = 32;
+
+/// Our Cyclone participants count participant indices from the world's first port (docs/runtime.md#discovery-star):
+/// with the unicast offsets 2 (discovery) and 3 (data) instead of the RTPS mapping's 10 and 11, index j discovers on
+/// 7402 + 250 d + 2 j, so indices 0..kWorldPorts-1 are the world's ports (bus::world_discovery_port()) and index
+/// kWorldPorts + i is the mapping's index i. Every probe of "indices 0..n" thus reaches the world's ports first.
+constexpr const char* kWorldFirstPorts =
+    "<Discovery><Ports><UnicastMetaOffset>2</UnicastMetaOffset><UnicastDataOffset>3</UnicastDataOffset></Ports>"
+    "</Discovery>";
 
 std::string failure(const std::string& what, dds_return_t rc) {
   return fmt::format("Cyclone DDS: {} failed: {}", what, dds_strretcode(rc));
@@ -84,15 +92,17 @@ class Qos {
 class Context {
  public:
   Context(int domain_id, Role role, const Security& security) : domain_id_(domain_id) {
-    if (role == Role::kServer && open_at_first_free(security, kServerIndices, kServerTries)) return;
     if (role == Role::kWorld) {
-      if (open_at_first_free(security, 0, kServerIndices)) return;
-      spdlog::warn("Cyclone DDS: participant indices 0..{} of domain {} are all taken (by participants of other "
-                   "programs?): agents probe only those, so over unicast discovery they will not find this world; "
-                   "run it on another domain (docs/runtime.md#discovery-star)",
-                   kServerIndices - 1, domain_id);
+      if (open_at_first_free(security, 0, kWorldPorts + kServerIndices)) return;
+      spdlog::warn("Cyclone DDS: the world's ports {} and up and participant indices 0..{} of domain {} are all taken "
+                   "(by other worlds?): agents probe only those, so over unicast discovery they will not find this "
+                   "world; run it on another domain (docs/runtime.md#discovery-star)",
+                   world_discovery_port(domain_id, 0), kServerIndices - 1, domain_id);
     }
-    if (role == Role::kClient || security.enabled()) create_domain(role, security, -1);
+    if (role == Role::kServer && open_at_first_free(security, kWorldPorts + kServerIndices, kServerTries)) return;
+    // The world as the profile says (an automatic index above the probed ones); a server with no free index of its
+    // own as a client (an automatic index could take a world's port before the world starts).
+    create_domain(role == Role::kWorld ? Role::kWorld : Role::kClient, security, -1);
     participant_ = dds_create_participant(static_cast<dds_domainid_t>(domain_id), nullptr, nullptr);
     if (participant_ < 0) {
       if (domain_ > 0) dds_delete(domain_);
@@ -111,16 +121,16 @@ class Context {
 
  private:
   /// The first free participant index of [first, first + count) (Cyclone has no "first free from N": each index is
-  /// tried, quietly): a server (monitor, tool) from kServerIndices up, so that any number of servers leave the indices
-  /// the agents probe to the world; the world within 0..kServerIndices-1, so that it never lands where agents do not
-  /// probe without saying so (docs/runtime.md#discovery-star). False when all are taken (or the profile fails): the
-  /// caller then makes the participant as the profile says, with Cyclone's own messages.
+  /// tried, quietly): the world within its ports and the indices agents probe (kWorldFirstPorts), so that no
+  /// participant of another program, nor any number of monitors, keeps agents from finding it; a server (monitor,
+  /// tool) above those, so that it never takes them (docs/runtime.md#discovery-star). False when all are taken (or
+  /// the profile fails).
   bool open_at_first_free(const Security& security, int first, int count) {
     const std::uint32_t mask = dds_get_log_mask();
     dds_set_log_mask(DDS_LC_FATAL);  // a taken index is expected, not an error to print
     for (int index = first; index < first + count; ++index) {
       try {
-        create_domain(Role::kServer, security, index);
+        create_domain(Role::kServer, security, index);  // the world's settings are a server's
       } catch (const BusError&) {
         continue;
       }
@@ -133,21 +143,22 @@ class Context {
     return participant_ >= 0;
   }
 
-  /// The domain with this participant's settings on top of the profile (CYCLONEDDS_URI). A client: no participant
-  /// index, so no other participant's unicast probes reach it; probes of its own only to the servers' indices
-  /// 0..kServerIndices-1 (Cyclone probes the indices below MaxAutoParticipantIndex); its SPDP every second, so a
-  /// world that restarts finds its agents within a second (they announce; the world cannot probe them). A server
-  /// (monitor, tool): the index `fixed_index` (>= kServerIndices; -1: the profile's). Secured: the three DDS Security
-  /// plugins Debian ships with libddsc, with the identity's files.
+  /// The domain with this participant's settings on top of the profile (CYCLONEDDS_URI), its indices counted from
+  /// the world's first port (kWorldFirstPorts). A client: no participant index, so no other participant's unicast
+  /// probes reach it; probes of its own only to the world's ports and the indices 0..kServerIndices-1 (Cyclone probes
+  /// indices 0..MaxAutoParticipantIndex); its SPDP every second, so a world that restarts finds its agents within a
+  /// second (they announce; the world cannot probe them). The world or a server: the index `fixed_index` (-1: the
+  /// profile's). Secured: the three DDS Security plugins Debian ships with libddsc, with the identity's files.
   void create_domain(Role role, const Security& security, int fixed_index) {
     const char* uri = std::getenv("CYCLONEDDS_URI");
     std::string config = uri != nullptr && *uri != '\0' ? std::string(uri) : std::string();
     const auto add = [&config](const std::string& fragment) { config += (config.empty() ? "" : ",") + fragment; };
+    add(kWorldFirstPorts);
     if (role == Role::kClient)
       add(
           fmt::format("<Discovery><ParticipantIndex>none</ParticipantIndex><MaxAutoParticipantIndex>{}"
                       "</MaxAutoParticipantIndex><SPDPInterval>1s</SPDPInterval></Discovery>",
-                      kServerIndices));
+                      kWorldPorts + kServerIndices - 1));
     if (fixed_index >= 0)
       add(fmt::format("<Discovery><ParticipantIndex>{}</ParticipantIndex></Discovery>", fixed_index));
     if (security.enabled())

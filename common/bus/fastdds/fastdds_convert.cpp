@@ -261,6 +261,7 @@ wire::WorldStatus to_msg(const WorldStatus& in) {
   out.world_id(in.world_id);
   out.admitting(in.admitting);
   out.progress_detail(in.progress_detail);
+  out.team_size(in.team_size);
   out.agents().reserve(in.agents.size());
   for (const AgentStatus& a : in.agents) {
     wire::AgentStatus agent;
@@ -296,6 +297,7 @@ WorldStatus from_msg(const wire::WorldStatus& in) {
   out.world_id = in.world_id();
   out.admitting = in.admitting();
   out.progress_detail = in.progress_detail();
+  out.team_size = in.team_size();
   out.agents.reserve(in.agents().size());
   for (const wire::AgentStatus& a : in.agents()) {
     AgentStatus agent;

@@ -5,6 +5,8 @@
 // loopback like participants of different processes (intraprocess delivery off, see configure_library()).
 
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/common/Locator.h>
+#include <fastrtps/utils/IPLocator.h>
 #include <fastrtps/attributes/LibrarySettingsAttributes.h>
 #include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fmt/format.h>
@@ -26,6 +28,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "marsala/bus/detail/backends.hpp"
 #include "marsala/bus/detail/participant_base.hpp"
@@ -119,6 +122,8 @@ class Context {
     dds::DomainParticipantQos qos = factory->get_default_participant_qos();
     if (role == Role::kClient) make_client(qos);
     if (role == Role::kServer) leave_world_indices(qos);
+    if (role == Role::kWorld) discover_on_world_ports(qos, domain_id);
+    probe_world_ports(qos, domain_id);
     if (security.enabled()) secure(qos, security);
     participant_ = factory->create_participant(static_cast<dds::DomainId_t>(domain_id), qos);
     if (participant_ == nullptr)
@@ -163,6 +168,31 @@ class Context {
     // Fast DDS moves a busy port up one index at a time, 100 times by default: the 101st client of a host would get
     // no discovery port at all and be found by nobody (measured: agents 102..120 of a 120-agent run never admitted).
     qos.wire_protocol().builtin.mutation_tries = 1000;
+  }
+
+  /// The world's discovery on its own ports (bus::world_discovery_port(), docs/runtime.md#discovery-star): each
+  /// unicast discovery locator of the profile without a port takes the first world port; Fast DDS moves a taken port
+  /// up by the participant id gain (2), i.e. to the next world port, then to the indices 0, 1, ... that agents probe
+  /// too. A profile without unicast discovery locators (multicast discovery) is left as it is.
+  static void discover_on_world_ports(dds::DomainParticipantQos& qos, int domain_id) {
+    for (eprosima::fastrtps::rtps::Locator_t& locator : qos.wire_protocol().builtin.metatrafficUnicastLocatorList)
+      if (locator.port == 0) locator.port = static_cast<std::uint32_t>(world_discovery_port(domain_id, 0));
+  }
+
+  /// Every unicast initial peer of the profile without a port (probed at the profile's participant indices) is also
+  /// probed at the world's ports, wherever the world sits among them.
+  static void probe_world_ports(dds::DomainParticipantQos& qos, int domain_id) {
+    auto& peers = qos.wire_protocol().builtin.initialPeersList;
+    std::vector<eprosima::fastrtps::rtps::Locator_t> added;
+    for (const eprosima::fastrtps::rtps::Locator_t& peer : peers) {
+      if (peer.port != 0 || eprosima::fastrtps::rtps::IPLocator::isMulticast(peer)) continue;
+      for (int k = 0; k < kWorldPorts; ++k) {
+        eprosima::fastrtps::rtps::Locator_t world = peer;
+        world.port = static_cast<std::uint32_t>(world_discovery_port(domain_id, k));
+        added.push_back(world);
+      }
+    }
+    for (const auto& locator : added) peers.push_back(locator);
   }
 
   /// DDS Security with the builtin plugins Fast DDS is built with, the identity's files.

@@ -167,6 +167,7 @@ void expect_same(const WorldStatus& a, const WorldStatus& b) {
   EXPECT_EQ(a.running, b.running);
   EXPECT_EQ(a.completed, b.completed);
   EXPECT_EQ(a.progress_detail, b.progress_detail);
+  EXPECT_EQ(a.team_size, b.team_size);
   ASSERT_EQ(a.agents.size(), b.agents.size());
   for (std::size_t i = 0; i < a.agents.size(); ++i) {
     const AgentStatus& x = a.agents[i];
@@ -309,6 +310,7 @@ WorldStatus filled_status(Filler& f) {
   s.running = false;
   s.completed = true;
   s.progress_detail = "12.31 of 21.30 m3 left " + kUtf8;
+  s.team_size = 120;
   for (int i = 0; i < 3; ++i) {
     AgentStatus a;
     a.agent_id = f.u32();

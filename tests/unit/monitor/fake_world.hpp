@@ -14,8 +14,7 @@ namespace marsala::monitor::test_support {
 class FakeWorld {
  public:
   explicit FakeWorld(int domain_id) : participant_(bus::make_participant({bus::Vendor::kInProcess, domain_id})) {
-    status_ = participant_->create_writer<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
-    events_ = participant_->create_writer<protocol::WorldEvent>({"", nullptr, bus::Durability::kVolatile, 256});
+    join();
     status_probe_ = participant_->create_reader<protocol::WorldStatus>({"", probe_});
     event_probe_ = participant_->create_reader<protocol::WorldEvent>({"", probe_});
   }
@@ -29,6 +28,16 @@ class FakeWorld {
   }
   void publish(const protocol::WorldStatus& s) { status_->write(s); }
   void publish(const protocol::WorldEvent& e) { events_->write(e); }
+  /// The world's writers go, as when its process dies or stays paused: readers see no live status writer any more.
+  void leave() {
+    status_.reset();
+    events_.reset();
+  }
+  /// The world's writers (again, after leave(): a paused world that runs on).
+  void join() {
+    status_ = participant_->create_writer<protocol::WorldStatus>({"", nullptr, bus::Durability::kTransientLocal, 1});
+    events_ = participant_->create_writer<protocol::WorldEvent>({"", nullptr, bus::Durability::kVolatile, 256});
+  }
 
  private:
   std::unique_ptr<bus::Participant> participant_;

@@ -251,6 +251,57 @@ TEST(Tail, TimesOutWithoutAWorld) {
       << r.err;
 }
 
+TEST(Tail, EndsWithALineAndExit3WhenTheWorldIsGone) {
+  FakeWorld world(73);
+  TailOptions options = tail_options(false);  // the 10 s timeout is only a safety net here
+  options.gone_after = 300ms;
+  MonitorThread tail(73, options);
+  ASSERT_TRUE(world.wait_for_monitor(1, 0));
+  world.publish(status("r5", 3));
+  std::this_thread::sleep_for(500ms);  // longer than gone_after: a live writer keeps tail waiting
+  const auto left = Clock::now();
+  world.leave();  // its process dies: no final status will come
+  const Result r = tail.join();
+  EXPECT_GE(Clock::now() - left, 300ms);
+  EXPECT_LT(Clock::now() - left, 5s);
+  EXPECT_EQ(r.exit_code, kExitWorldGone);
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.out, text({format_step_header(status("r5", 3)), format_step_line(status("r5", 3)),
+                         "world gone: no live world status writer for 0.3 s (last: step 3 of run r5); tail ends"}));
+  EXPECT_NE(r.err.find("marsala-monitor: the world is gone: no live world status writer on domain 73 (inprocess) for "
+                       "0.3 s (last: step 3 of run r5)\n"),
+            std::string::npos)
+      << r.err;
+}
+
+TEST(Tail, AWorldBackWithinGoneAfterIsFollowedToTheEnd) {
+  FakeWorld world(74);
+  TailOptions options = tail_options(false);
+  options.gone_after = 3s;
+  MonitorThread tail(74, options);
+  ASSERT_TRUE(world.wait_for_monitor(1, 0));
+  world.publish(status("r6", 3));
+  world.leave();  // paused: back within gone_after
+  std::this_thread::sleep_for(300ms);
+  world.join();
+  world.publish(final_status("r6", 4));
+  const Result r = tail.join();
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, text({format_step_header(status("r6", 3)), format_step_line(status("r6", 3)),
+                         format_step_line(final_status("r6", 4)), format_run_summary(final_status("r6", 4))}));
+}
+
+TEST(Tail, ANeverSeenWorldIsNotGoneButTimesOut) {
+  TailOptions options;
+  options.timeout = 400ms;
+  options.gone_after = 100ms;  // no run seen yet: only the timeout ends it
+  MonitorThread tail(75, options);
+  const Result r = tail.join();
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.out, "");
+  EXPECT_NE(r.err.find("no world status on domain 75 (inprocess) for 0.4 s"), std::string::npos) << r.err;
+}
+
 TEST(Tail, EachStatusRestartsTheTimeout) {
   FakeWorld world(67);
   TailOptions options;

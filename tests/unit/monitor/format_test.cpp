@@ -38,6 +38,10 @@ TEST(Format, StepHeaderAndLineWithFewAgents) {
   EXPECT_EQ(format_step_header(s), "  step  live mat[m3]  dep[m3] prog | 1           2           3");
   // mat counts the live agents only (1.5 + 2.25); agent 2 at its goal, agent 3 dropped.
   EXPECT_EQ(format_step_line(s), "    42   2/3    3.75    0.125  33% | build       refill*     --");
+  // A team of four whose slot 4 was never admitted: live counts against the team.
+  protocol::WorldStatus four = s;
+  four.team_size = 4;
+  EXPECT_EQ(format_step_line(four), "    42   2/4    3.75    0.125  33% | build       refill*     --");
 }
 
 TEST(Format, TwelveAgentsFitOneHundredColumns) {
@@ -172,11 +176,29 @@ TEST(Format, RunSummary) {
   s.agents[1].rejected = 2;
   s.agents[2].accepted = 140;
   s.agents[2].missed = 3;
+  // Agent 3 was dropped: the line says the run was short of it.
   EXPECT_EQ(format_run_summary(s),
-            "run r7 completed at step 1234 (12.3 s) | live 2/3, at goal 1 | dep 1.250 m3 | acc 360 rej 2 miss 3");
+            "run r7 completed at step 1234 (12.3 s) | live 2/3, at goal 1 | missing 1 of 3 slots: 3 dropped | "
+            "dep 1.250 m3 | acc 360 rej 2 miss 3");
   s.completed = false;
   EXPECT_EQ(format_run_summary(s),
-            "run r7 stopped at step 1234 (12.3 s) | live 2/3, at goal 1 | dep 1.250 m3 | acc 360 rej 2 miss 3");
+            "run r7 stopped at step 1234 (12.3 s) | live 2/3, at goal 1 | missing 1 of 3 slots: 3 dropped | "
+            "dep 1.250 m3 | acc 360 rej 2 miss 3");
+}
+
+TEST(Format, RunSummaryNamesTheSlotsNeverAdmitted) {
+  protocol::WorldStatus s = three_agents();
+  s.running = false;
+  s.completed = true;
+  s.agents[2].alive = true;  // the three listed are all in the run
+  EXPECT_EQ(format_run_summary(s),
+            "run r7 completed at step 42 (0.0 s) | live 3/3, at goal 1 | dep 0.125 m3 | acc 0 rej 0 miss 0");
+  // A team of five: slots 4 and 5 never admitted (the world lists admitted agents only).
+  s.team_size = 5;
+  s.agents[0].alive = false;
+  EXPECT_EQ(format_run_summary(s),
+            "run r7 completed at step 42 (0.0 s) | live 2/5, at goal 0 | missing 3 of 5 slots: 2 dropped, "
+            "4 never admitted, 5 never admitted | dep 0.125 m3 | acc 0 rej 0 miss 0");
 }
 
 TEST(Format, StatusTable) {

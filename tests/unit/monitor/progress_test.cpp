@@ -248,6 +248,18 @@ TEST_F(RunReport, ACompletedPathRun) {
             "  everything else in " + d + ": events.log, logs/, run.log, summary.json\n");
 }
 
+TEST_F(RunReport, ACompletedRunShortOfSlotsNamesThem) {
+  write_summary(R"({"scenario": "ramp", "completed": true, "end_reason": "completed", "steps": 410,
+    "agents": 3, "admitted": 2, "dropped": 1, "completion": "agents_at_goal", "progress": 1,
+    "slots_missing": 2, "missing_agents": [2, 3]})");
+  const std::string report = run_report(dir_.string());
+  EXPECT_NE(report.find("\n  short of 2 of 3 slots at the end (never admitted, or dropped and not back): agents 2, 3\n"),
+            std::string::npos)
+      << report;
+  write_summary(R"({"scenario": "ramp", "completed": true, "agents": 3, "admitted": 3, "slots_missing": 0})");
+  EXPECT_EQ(run_report(dir_.string()).find("short of"), std::string::npos);
+}
+
 TEST_F(RunReport, SaysWhatLandedOutsideTheConstructionBand) {
   write_summary(R"({"scenario": "path_gale", "completed": true, "end_reason": "completed", "steps": 3500,
     "agents": 1, "admitted": 1, "deposited_volume_m3": 30.361, "completion": "payload_path", "path_found": true,

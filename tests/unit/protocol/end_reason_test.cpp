@@ -27,6 +27,21 @@ TEST(EndReason, ExitCodesSayHowTheRunEnded) {
   EXPECT_EQ(exit_code(EndReason::kStalled), 6);
 }
 
+TEST(EndReason, ACompletedRunShortOfSlotsHasAnExitCodeOfItsOwn) {
+  EXPECT_EQ(exit_code(EndReason::kCompleted, 0), 0);
+  EXPECT_EQ(exit_code(EndReason::kCompleted, 1), 7);
+  EXPECT_EQ(exit_code(EndReason::kCompleted, 2), 7);
+  // A run that did not complete says why, whatever slots it missed.
+  EXPECT_EQ(exit_code(EndReason::kMaxSteps, 1), 3);
+  EXPECT_EQ(exit_code(EndReason::kNoLiveAgents, 3), 4);
+  EXPECT_EQ(exit_code(EndReason::kSignal, 1), 5);
+  EXPECT_EQ(exit_code(EndReason::kStalled, 2), 6);
+  // 7 is none of the end reasons' own codes.
+  for (EndReason r : {EndReason::kSignal, EndReason::kCompleted, EndReason::kMaxSteps, EndReason::kNoLiveAgents,
+                      EndReason::kStalled})
+    EXPECT_NE(exit_code(r), kExitCompletedShort);
+}
+
 TEST(EndReason, AnUnknownNameListsTheValidOnes) {
   try {
     end_reason_from_string("finished");

@@ -9,6 +9,7 @@
 #include <png.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -110,6 +111,28 @@ TEST(RunSummary, SiteRunsReportTheLevelFractionOthersTheirKind) {
   EXPECT_TRUE(has(goal_json, "\"seed\": \"99\"")) << goal_json;
   EXPECT_EQ(json_number(goal_json, "start_jitter_m"), 0.25);
   EXPECT_EQ(json_number(goal_json, "completion_checks"), 0.0);
+}
+
+TEST(RunSummary, SaysWhichSlotsOfTheTeamWereNotInTheRunAtItsEnd) {
+  // Three slots: agent 2 never admitted, agent 3 admitted then dropped, agent 1 in the run to the end.
+  WorldState s = make_world_state(testing::small_scenario(), flat_terrain(), 3);
+  admit(s, testing::hello_for(s, 1, 1001));
+  admit(s, testing::hello_for(s, 3, 1003));
+  s.agents[2].alive = false;
+  s.agents[2].dropped = true;
+  EXPECT_EQ(missing_slots(s), (std::vector<std::uint32_t>{2, 3}));
+  const std::string json = summary_json(s, info_for("small", true));
+  EXPECT_EQ(json_number(json, "agents"), 3.0);
+  EXPECT_EQ(json_number(json, "admitted"), 2.0);
+  EXPECT_EQ(json_number(json, "slots_missing"), 2.0);
+  std::string compact = json;
+  compact.erase(std::remove_if(compact.begin(), compact.end(), [](char c) { return c == ' ' || c == '\n'; }),
+                compact.end());
+  EXPECT_TRUE(has(compact, "\"missing_agents\":[2,3]")) << json;
+  // The whole team in the run: nothing missing, and the field is still there (0).
+  const WorldState whole = admitted_state(testing::small_scenario(), flat_terrain(), 3);
+  EXPECT_TRUE(missing_slots(whole).empty());
+  EXPECT_EQ(json_number(summary_json(whole, info_for("small", true)), "slots_missing"), 0.0);
 }
 
 TEST(FinalPicture, PayloadRunsShowThePathEndsAgentsAndDepositors) {
