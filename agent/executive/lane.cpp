@@ -22,39 +22,59 @@ std::optional<double> extent(const deliberative::LocalMap& local, const CellMask
   return std::nullopt;
 }
 
+/// The unit vector to the right of `path` at its cell i, its direction taken from path[i - k] to path[i + k] (k =
+/// kLaneDirectionSpan, clipped to the path); nullopt when those are the same cell.
+std::optional<Position> right_at(const deliberative::LocalMap& local, const std::vector<CellIndex>& path, int i) {
+  const int n = static_cast<int>(path.size());
+  const Position from = local.center(path[static_cast<std::size_t>(std::max(0, i - kLaneDirectionSpan))]);
+  const Position to = local.center(path[static_cast<std::size_t>(std::min(n - 1, i + kLaneDirectionSpan))]);
+  const double dx = to.x - from.x, dy = to.y - from.y, length = std::hypot(dx, dy);
+  if (!(length > 0.0)) return std::nullopt;
+  return Position{dy / length, -dx / length};  // right of (dx, dy): x east, y north
+}
+
+/// Per path cell: the unit vector to the right of the path there, and the offset from the cell of the point
+/// offset_m right of the corridor's centre across it (NaN where the path is not in a corridor of kMinCorridorCells
+/// path cells in a row), for path cells from `first` on.
+struct Across {
+  std::vector<Position> right;
+  std::vector<double> wanted;
+};
+
+Across across(const deliberative::LocalMap& local, const CellMask& corridor, const std::vector<CellIndex>& path,
+              double offset_m, double corridor_width_m, int first) {
+  const int n = static_cast<int>(path.size());
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  Across a{std::vector<Position>(path.size(), Position{0.0, 0.0}), std::vector<double>(path.size(), none)};
+  for (int i = first; i < n; ++i) {
+    const std::size_t k = static_cast<std::size_t>(i);
+    const CellIndex cell = path[k];
+    const auto right = right_at(local, path, i);
+    if (!right || corridor(cell.row, cell.col) == 0) continue;
+    a.right[k] = *right;
+    const Position centre = local.center(cell);
+    const auto to_right = extent(local, corridor, centre, a.right[k], corridor_width_m);
+    const auto to_left = extent(local, corridor, centre, {-a.right[k].x, -a.right[k].y}, corridor_width_m);
+    if (to_right && to_left) a.wanted[k] = std::clamp(0.5 * (*to_right - *to_left) + offset_m, -*to_left, *to_right);
+  }
+  // A corridor is a stretch of at least kMinCorridorCells path cells: a narrow spot between obstacles is not a band.
+  for (int i = first; i < n;) {
+    int j = i;
+    while (j < n && !std::isnan(a.wanted[static_cast<std::size_t>(j)])) ++j;
+    if (j - i < kMinCorridorCells)
+      for (int k = i; k < j; ++k) a.wanted[static_cast<std::size_t>(k)] = none;
+    i = j + 1;
+  }
+  return a;
+}
+
 }  // namespace
 
 std::vector<CellIndex> lane_path(const deliberative::LocalMap& local, const CellMask& corridor,
                                  const std::vector<CellIndex>& path, double offset_m, double corridor_width_m) {
   if (!(offset_m > 0.0) || path.size() < 2) return path;
   const int n = static_cast<int>(path.size());
-  // Per path cell: the unit vector to the right of the path there, and the lane's offset from the cell (NaN where
-  // the path is not in a corridor).
-  const double none = std::numeric_limits<double>::quiet_NaN();
-  std::vector<Position> right(path.size(), Position{0.0, 0.0});
-  std::vector<double> wanted(path.size(), none);
-  for (int i = 1; i < n; ++i) {
-    const CellIndex cell = path[static_cast<std::size_t>(i)];
-    const Position a = local.center(path[static_cast<std::size_t>(std::max(0, i - kLaneDirectionSpan))]);
-    const Position b = local.center(path[static_cast<std::size_t>(std::min(n - 1, i + kLaneDirectionSpan))]);
-    const double dx = b.x - a.x, dy = b.y - a.y, length = std::hypot(dx, dy);
-    if (!(length > 0.0) || corridor(cell.row, cell.col) == 0) continue;
-    right[static_cast<std::size_t>(i)] = {dy / length, -dx / length};  // right of (dx, dy): x east, y north
-    const Position centre = local.center(cell);
-    const auto to_right = extent(local, corridor, centre, right[static_cast<std::size_t>(i)], corridor_width_m);
-    const Position left{-right[static_cast<std::size_t>(i)].x, -right[static_cast<std::size_t>(i)].y};
-    const auto to_left = extent(local, corridor, centre, left, corridor_width_m);
-    if (to_right && to_left)
-      wanted[static_cast<std::size_t>(i)] = std::clamp(0.5 * (*to_right - *to_left) + offset_m, -*to_left, *to_right);
-  }
-  // A corridor is a stretch of at least kMinCorridorCells path cells: a narrow spot between obstacles is not a band.
-  for (int i = 1; i < n;) {
-    int j = i;
-    while (j < n && !std::isnan(wanted[static_cast<std::size_t>(j)])) ++j;
-    if (j - i < kMinCorridorCells)
-      for (int k = i; k < j; ++k) wanted[static_cast<std::size_t>(k)] = none;
-    i = j + 1;
-  }
+  const auto [right, wanted] = across(local, corridor, path, offset_m, corridor_width_m, 1);
   // The offset changes by at most the distance between consecutive path cells (a lane is entered and left at 45
   // degrees at most), from 0 at the robot.
   std::vector<CellIndex> lane{path.front()};
@@ -75,6 +95,33 @@ std::vector<CellIndex> lane_path(const deliberative::LocalMap& local, const Cell
     if (cell != lane.back()) lane.push_back(cell);
   }
   return lane;
+}
+
+std::vector<CellIndex> band_centre_path(const deliberative::LocalMap& local, const CellMask& corridor,
+                                        const std::vector<CellIndex>& path, double corridor_width_m,
+                                        double max_shift_m) {
+  if (path.size() < 2 || !(max_shift_m > 0.0)) return path;
+  const int n = static_cast<int>(path.size());
+  const Across a = across(local, corridor, path, 0.0, corridor_width_m, 0);
+  std::vector<CellIndex> out;
+  out.reserve(path.size());
+  double shift = 0.0;  // the shift towards the centre line at the last path cell in a corridor [m]
+  bool seen = false;
+  for (int i = 0; i < n; ++i) {
+    const std::size_t k = static_cast<std::size_t>(i);
+    const double w = a.wanted[k];
+    if (!std::isnan(w)) shift = std::clamp(w, -max_shift_m, max_shift_m), seen = true;
+    CellIndex cell = path[k];
+    // Past the corridor (the structure's end) the centre line goes on at the last shift, across the path's own
+    // direction there.
+    const auto right = seen && shift != 0.0 ? right_at(local, path, i) : std::nullopt;
+    if (right) {
+      const Position c = local.center(cell);
+      if (const auto moved = local.cell_at({c.x + shift * right->x, c.y + shift * right->y})) cell = *moved;
+    }
+    if (out.empty() || cell != out.back()) out.push_back(cell);
+  }
+  return out;
 }
 
 }  // namespace marsala::agent::executive

@@ -40,4 +40,15 @@ inline constexpr int kMinCorridorCells = 2 * kLaneDirectionSpan + 1;
 std::vector<CellIndex> lane_path(const deliberative::LocalMap& local, const CellMask& corridor,
                                  const std::vector<CellIndex>& path, double offset_m, double corridor_width_m);
 
+/// `path` (local indices, path[0] where the robot will stand) moved towards the centre line of the corridor it runs
+/// in, for what is built along it (docs/runtime.md#the-construction-band): a path cell in a corridor (as lane_path()
+/// measures it with offset 0, path[0] included) is moved across the path towards the corridor's centre there, by
+/// its distance from it but at most max_shift_m [m], at once (no 45-degree entry); every later cell with no corridor
+/// across it (past the corridor's end) is moved by the last shift, across the path's direction there: the centre
+/// line carried on; cells before the first corridor cell stay. Consecutive repeats are merged. A path of one cell or
+/// max_shift_m <= 0: unchanged.
+std::vector<CellIndex> band_centre_path(const deliberative::LocalMap& local, const CellMask& corridor,
+                                        const std::vector<CellIndex>& path, double corridor_width_m,
+                                        double max_shift_m);
+
 }  // namespace marsala::agent::executive

@@ -56,6 +56,7 @@ PipelineParams pipeline_params(const Pipeline& pipeline, const RobotBody& body) 
 PathBuilder::PathBuilder(const AgentContext& context, PathBuilderOptions options)
     : steps_(context, std::move(options.planner)), pipeline_(pipeline_params(context.type.pipeline, context.type.body)) {
   steps_.set_lane(context.type.pipeline.lane_offset_m, construction_params(context.type).delta_m);
+  steps_.set_band_centre(true);
 }
 
 const executive::MappingSystem& PathBuilder::map() const {

@@ -301,6 +301,18 @@ std::vector<CellIndex> RampSteps::in_lane(const deliberative::LocalMap& local,
   return executive::lane_path(local, memory_.corridor, path, lane_offset_m_, corridor_width_m_);
 }
 
+std::vector<CellIndex> RampSteps::on_band_centre(const deliberative::LocalMap& local,
+                                                  const std::vector<CellIndex>& ahead) const {
+  if (!(corridor_width_m_ > 0.0) || memory_.corridor.rows() != local.rows() || memory_.corridor.cols() != local.cols())
+    return ahead;
+  // Only as far off the robot's path as keeps the body ball of every cell it drives on inside the footprint (what it
+  // drives on gets built): half the band less half a body, and less a cell's diagonal, since the shifted cells are
+  // rounded to cells and the footprint is a disc of cells with a ragged edge.
+  const double max_shift_m = 0.5 * (corridor_width_m_ - context_.type.body.navigability.delta_m) -
+                             std::sqrt(2.0) * local.geometry().cell_size_m;
+  return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m);
+}
+
 void RampSteps::move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) {
   trace.motion = motion;
   memory_.sent.motion = modules_->map.geometry().cell_at(motion.target);
@@ -313,8 +325,8 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
                         std::size_t from, BuildTrace& trace, protocol::ActionRequest& request) {
   // The path from where the robot will stand: the cells it leaves behind are its way back, not work.
   const auto& path = trace.plan.path;
-  const std::vector<CellIndex> ahead(path.begin() + static_cast<std::ptrdiff_t>(std::min(from, path.size())),
-                                     path.end());
+  std::vector<CellIndex> ahead(path.begin() + static_cast<std::ptrdiff_t>(std::min(from, path.size())), path.end());
+  if (band_centre_) ahead = on_band_centre(local, ahead);
   // Depositions are judged on the terrain alone (what stays occupiable and connected), not on where the other
   // robots stand this step: the masks before the neighbours were taken out.
   deliberative::LocalMap terrain_only = local;
@@ -500,7 +512,11 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
   trace.plan = modules_->router.plan(local.gap, local.navigable, local.robot, *goal);
   trace.planned = true;
   if (!trace.plan.found) return false;
-  if (const auto motion = advance(local, in_lane(local, trace.plan.path), robot)) {
+  // In its lane; when the lane gives no motion, along the route itself: near a corridor's edge the lane's first cell
+  // can lie two cells off, across a cell the robot cannot enter, and a robot that waits for it waits for ever.
+  auto motion = advance(local, in_lane(local, trace.plan.path), robot);
+  if (!motion) motion = advance(local, trace.plan.path, robot);
+  if (motion) {
     move(*motion, trace, request);
     if (distance(motion->target, base) <= radius) {
       request.refill = trace.refill = true;

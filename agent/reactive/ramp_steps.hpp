@@ -129,6 +129,11 @@ class RampSteps {
   /// Lanes for routes (executive/lane.hpp): offset_m to the right of a corridor's centre line, corridors up to
   /// corridor_width_m [m] each side of the path; offset 0 (the default): no lanes.
   void set_lane(double offset_m, double corridor_width_m);
+  /// One construction band for every front robot (docs/runtime.md#the-construction-band): when on, what the robot
+  /// fills follows its deposition path moved onto the centre line of the corridor it runs in (executive/lane.hpp
+  /// band_centre_path, on its own map without the other robots), not the path from where it stands; it still drives
+  /// its own path. Needs set_lane()'s corridor width; off by default.
+  void set_band_centre(bool on) { band_centre_ = on; }
   /// `path` moved into this robot's lane on the last look()'s map (unchanged without lanes).
   std::vector<CellIndex> in_lane(const deliberative::LocalMap& local, const std::vector<CellIndex>& path) const;
   /// Requests `motion` and records it.
@@ -214,6 +219,8 @@ class RampSteps {
   void keep_clear(const protocol::SensorFrame& frame, BuildView& view);  // the neighbours and the refused cells
   void deposit(const deliberative::LocalMap& local, const protocol::SensorFrame& frame, Position at, std::size_t from,
                BuildTrace& trace, protocol::ActionRequest& request);
+  // set_band_centre(): `ahead` (local indices, from where the robot will stand) on the corridor's centre line.
+  std::vector<CellIndex> on_band_centre(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const;
   std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
   void clear_pad_gap(deliberative::LocalMap& local) const;  // no work on the base station's pad
   /// A scanned map: counts, per cell of the window, the scans in a row that showed its gap (beyond the margin) on a
@@ -242,6 +249,7 @@ class RampSteps {
   Position sub_cell_error_{0.0, 0.0};  // set_sub_cell_error() [m]
   double lane_offset_m_ = 0.0;        // set_lane()
   double corridor_width_m_ = 0.0;
+  bool band_centre_ = false;  // set_band_centre()
   Memory memory_;
 };
 

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
+#include <random>
 
 #include "unit/agent/agent_test_support.hpp"
 
@@ -93,6 +96,98 @@ TEST(Lane, AnOccupiedLaneCellFallsBackToThePath) {
   const auto path = row_path(40, 5, 70);
   const auto lane = lane_path(map, corridor, path, 0.75, 3.0);
   EXPECT_EQ(lane, path);
+}
+
+// band_centre_path against a brute force: corridors drawn by hand on a 0.1 m grid (row-major, y north, so "right"
+// of an eastward path is the next row down the array), each column's run of corridor cells [lo, hi] wandering at
+// random; the centre of a column's run is row (lo + hi) / 2, found without sampling along a direction; a path cell
+// moves towards it by at most the shift allowed.
+struct HandCorridor {
+  std::vector<int> lo, hi;  // per column; lo > hi: the whole column is open ground
+  CellMask mask;
+};
+
+constexpr int kRows = 80, kCols = 80;  // kGrid
+
+HandCorridor random_corridor(std::mt19937& rng) {
+  HandCorridor h{std::vector<int>(kCols), std::vector<int>(kCols), CellMask::Zero(kRows, kCols)};
+  std::uniform_int_distribution<int> step(-1, 1), width(6, 24), open_at(0, 2 * kCols);
+  int lo = 40 - width(rng) / 2, hi = lo + width(rng);
+  const int open_from = open_at(rng);  // past this column (when on the grid) the corridor ends: open ground
+  for (int c = 0; c < kCols; ++c) {
+    lo = std::clamp(lo + step(rng), 30, 40);
+    hi = std::clamp(hi + step(rng), 41, 50);  // every edge within 1.5 m of the path (rows 36..44): found
+    h.lo[static_cast<std::size_t>(c)] = c < open_from ? lo : 1;
+    h.hi[static_cast<std::size_t>(c)] = c < open_from ? hi : 0;
+    for (int r = 0; r < kRows; ++r)
+      if (c >= open_from || (r >= lo && r <= hi)) h.mask(r, c) = 1;
+  }
+  return h;
+}
+
+TEST(Lane, BandCentrePathFollowsTheCorridorsCentreLikeABruteForce) {
+  const deliberative::LocalMap map = band_map({40, 0}, false);  // the grid; the corridor is the hand-made mask
+  const double cs = kGrid.cell_size_m, width_m = 1.6, max_shift_m = 0.55;
+  std::mt19937 rng(25);
+  int checked = 0, carried = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const HandCorridor h = random_corridor(rng);
+    const bool east = trial % 2 == 0;
+    const int row = 36 + trial % 9;
+    const auto path = east ? row_path(row, 0, kCols - 1) : row_path(row, kCols - 1, 0);
+    const auto moved = band_centre_path(map, h.mask, path, width_m, max_shift_m);
+    ASSERT_EQ(moved.size(), path.size()) << trial;  // straight along a row: one cell per column, none merged
+    // Brute force: the columns whose run holds the path's row and ends within width_m on both sides, in stretches of
+    // kMinCorridorCells columns; each such column's centre, unless farther off than max_shift_m.
+    std::vector<double> centre(kCols, std::nan(""));
+    for (int c = 0; c < kCols; ++c) {
+      const int lo = h.lo[static_cast<std::size_t>(c)], hi = h.hi[static_cast<std::size_t>(c)];
+      // Sampled every half cell, an edge is found within half a cell: keep away from the width's limit by a cell.
+      if (lo <= row && row <= hi && (row - lo + 1) * cs < width_m && (hi - row + 1) * cs < width_m)
+        centre[static_cast<std::size_t>(c)] = 0.5 * (lo + hi);
+    }
+    std::optional<double> last;  // the last shift [rows]
+    for (int i = 0; i < kCols; ++i) {
+      const int c = east ? i : kCols - 1 - i;
+      int run = 0;  // the stretch of corridor columns through c
+      for (int d = c; d >= 0 && !std::isnan(centre[static_cast<std::size_t>(d)]); --d) ++run;
+      for (int d = c + 1; d < kCols && !std::isnan(centre[static_cast<std::size_t>(d)]); ++d) ++run;
+      const double want = run >= kMinCorridorCells ? centre[static_cast<std::size_t>(c)] - row : std::nan("");
+      const auto& got = moved[static_cast<std::size_t>(i)];
+      EXPECT_EQ(got.col, c) << trial;
+      if (!std::isnan(want)) {  // towards the centre, at most max_shift_m
+        last = std::clamp(want, -max_shift_m / cs, max_shift_m / cs);
+        EXPECT_LE(std::abs(got.row - (row + *last)), 1.0) << "trial " << trial << " col " << c;
+        ++checked;
+      } else if (last) {  // no corridor here: the last shift carries on
+        EXPECT_LE(std::abs(got.row - (row + *last)), 1.0) << "trial " << trial << " col " << c << " carried";
+        ++carried;
+      } else {
+        EXPECT_EQ(got.row, row) << "trial " << trial << " col " << c << " before any corridor";
+      }
+    }
+  }
+  EXPECT_GT(checked, 3000);  // the brute force found centres and the carried line often enough to mean something
+  EXPECT_GT(carried, 300);
+}
+
+TEST(Lane, BandCentrePathMovesEveryPathInTheBandOntoItsCentreAtOnce) {
+  const deliberative::LocalMap map = band_map({47, 5});
+  // The corridor's centre is y = 4.0 m, between rows 39 and 40: every cell of a path anywhere in it, the first (the
+  // robot's) included, moves there at once, whichever side the path runs on and whichever way.
+  for (int row : {32, 40, 47})
+    for (const bool east : {true, false}) {
+      const auto centred =
+          band_centre_path(map, map.navigable, east ? row_path(row, 5, 70) : row_path(row, 70, 5), 3.0, 1.0);
+      ASSERT_FALSE(centred.empty());
+      for (const CellIndex& c : centred) EXPECT_TRUE(c.row == 39 || c.row == 40) << "from row " << row << ": " << c.row;
+    }
+  // A path farther from the centre than the shift allowed moves by that much: row 47 is 0.75 m off it, 0.5 m
+  // towards it is row 42.
+  for (const CellIndex& c : band_centre_path(map, map.navigable, row_path(47, 5, 70), 3.0, 0.5)) EXPECT_EQ(c.row, 42);
+  // On open ground there is no corridor: the path stays as it is.
+  const deliberative::LocalMap open = band_map({47, 5}, false);
+  EXPECT_EQ(band_centre_path(open, open.navigable, row_path(47, 5, 70), 3.0, 1.0), row_path(47, 5, 70));
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -435,6 +436,62 @@ TEST(RampSteps, AGapStaysCurrentUntilAnotherRobotComesNearIt) {
     }
     EXPECT_EQ(deposits, !neighbour) << (neighbour ? "with" : "without") << " a neighbour";
   }
+}
+
+}  // namespace
+}  // namespace marsala::agent::reactive
+
+namespace marsala::agent::reactive {
+namespace {
+
+// A built embankment 3 m wide and 0.3 m high along x (its centre line at y = 3 m) on flat ground: the MARS cones of
+// its top leave a gap in a strip beside each side (0.3 - kappa d > 0 within 0.6 m of it). A robot on top in the right
+// lane (0.75 m south of the centre, heading east) with a 3 m construction band and a deposition threshold large
+// enough to fill all it reaches in one step.
+constexpr double kEmbankmentCentreY = 3.0;
+
+Heightmap embankment_world() {
+  Heightmap h({60, 120, 0.0, 0.0, 0.1}, 0.0);
+  for (int r = 0; r < h.rows(); ++r)
+    for (int c = 0; c < h.cols(); ++c)
+      if (std::abs(h.cell_center({r, c}).y - kEmbankmentCentreY) < 1.5) h(r, c) = 0.3;
+  return h;
+}
+
+/// The depositions of one build step of the robot in the lane, with or without the band's centre line.
+std::vector<protocol::Deposition> lane_robot_depositions(bool band_centre) {
+  RobotBody body = test::husky();
+  body.max_deposit_m3 = 1.0;
+  AgentContext c = test::agent_context(3, body);
+  c.type.construction = NavigabilityParams{0.5, 3.0, 0.05};
+  RampSteps steps(c);
+  const Heightmap world = embankment_world();
+  steps.admit(test::admission_on(c, world.geometry(), {11.5, kEmbankmentCentreY}, {0.55, kEmbankmentCentreY}));
+  steps.set_lane(0.75, 3.0);
+  steps.set_band_centre(band_centre);
+  BuildTrace trace;
+  const protocol::SensorFrame f = test::full_frame(c, 0, {4.05, kEmbankmentCentreY - 0.75}, 1.0, world);
+  const BuildView view = steps.look(f, trace);
+  protocol::ActionRequest q = empty_request(c, f, "");
+  steps.build_step(view.local, f, trace, q);
+  return q.depositions;
+}
+
+TEST(RampSteps, WithTheBandCentreARobotInASideLaneFillsTheBandTheStructureShowsNotBesideIt) {
+  const Heightmap world = embankment_world();
+  // Beside the band: farther from the centre line than half the band and the half cell by which the centre line's
+  // cell (the rows next to y = 3 m are at 2.95 and 3.05 m) may lie off it.
+  const auto beside = [&](const protocol::Deposition& d) {
+    return std::abs(world.cell_center({d.row, d.col}).y - kEmbankmentCentreY) > 1.5 + 0.05 + 1e-9;
+  };
+  // Without it the footprint is centred on the robot's own path, 0.75 m off the centre, and fills the gap beside
+  // the embankment: the structure widens.
+  const auto own = lane_robot_depositions(false);
+  EXPECT_GT(std::count_if(own.begin(), own.end(), beside), 0);
+  // With it what the robot fills follows the embankment's centre line: nothing beside the band.
+  const auto centred = lane_robot_depositions(true);
+  EXPECT_FALSE(centred.empty());
+  EXPECT_EQ(std::count_if(centred.begin(), centred.end(), beside), 0);
 }
 
 }  // namespace
