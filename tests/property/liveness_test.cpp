@@ -125,6 +125,7 @@ std::optional<Case> random_case(std::uint64_t seed) {
   s.seed = seed;
   k.text = fmt::format("seed {}: {} robots", seed, robots);
   for (const auto& slot : s.slots) k.text += fmt::format(", {} {} -> {}", slot.id, slot.start, slot.target);
+  k.scenario.right_of_way = true;  // the scenario asks for it; team_completes() decides whether the team keeps it
   return k;
 }
 
