@@ -100,8 +100,7 @@ class TailPrinter {
   }
 
   void print_stopped() {
-    for (const protocol::WorldEvent& e : pending_) print_event(e);
-    pending_.clear();
+    print_pending();
     if (last_)
       out_ << fmt::format("tail stopped after step {} of run {}\n", last_->step, printable(last_->run_id));
     else
@@ -111,8 +110,7 @@ class TailPrinter {
 
   /// The end of a tail whose world is gone: what is pending, then one line saying so.
   void print_world_gone(std::chrono::duration<double> after) {
-    for (const protocol::WorldEvent& e : pending_) print_event(e);
-    pending_.clear();
+    print_pending();
     out_ << fmt::format("world gone: no live world status writer for {:g} s{}; tail ends\n", after.count(),
                         last_seen());
     out_.flush();
@@ -145,6 +143,12 @@ class TailPrinter {
     }
     out_ << format_step_line(status, options_.format) << '\n';
     last_ = status;
+  }
+
+  /// The events still waiting for their step's status, when no status will come.
+  void print_pending() {
+    for (const protocol::WorldEvent& e : pending_) print_event(e);
+    pending_.clear();
   }
 
   void print_event(const protocol::WorldEvent& event) {

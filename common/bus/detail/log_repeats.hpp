@@ -11,6 +11,8 @@
 #include <string>
 #include <string_view>
 
+#include "marsala/core/log_pacing.hpp"
+
 namespace marsala::bus::detail {
 
 /// The kind of log message `text`: each run of decimal digits replaced by '#'.
@@ -37,9 +39,7 @@ class RepeatedMessages {
     if (it == counts_.end()) it = counts_.size() < kMaxKinds ? counts_.emplace(kind, 0).first : counts_.find(kOthers);
     if (it == counts_.end()) it = counts_.emplace(kOthers, 0).first;
     const std::uint64_t n = ++it->second;
-    std::uint64_t power = 1;
-    while (power < n && power <= UINT64_MAX / 10) power *= 10;
-    return power == n ? n : 0;
+    return power_of_ten(n) ? n : 0;
   }
   /// Kinds remembered (at most kMaxKinds + 1).
   std::size_t kinds() const { return counts_.size(); }
