@@ -28,7 +28,7 @@ struct AgentContext {
   std::optional<GoalVectorMapSpec> goal_vector_map;  ///< the scenario's, for the "goal_vector_map" synthesizer
   /// Ramp builders keep the right-of-way protocol (docs/runtime.md#right-of-way); the agent sets it from the scenario's
   /// `right_of_way` (off by default).
-  bool right_of_way = true;
+  bool right_of_way = false;
 };
 
 /// Keep-out around neighbours for a team whose largest body length is max_delta_m [m] and longest step
