@@ -26,8 +26,8 @@
 #                 (repeatable; passed to marsala-world and every marsala-agent; summary.json lists them)
 #   --secure      DDS Security: a CA and an identity per process in OUT/security (deploy/security/make-identities.sh,
 #                 made anew each run), every process authenticated, access-controlled and encrypted (domain <= 230)
-# Exit codes: marsala-world's for a run that ended: 0 completed, 3 max_steps, 4 no_live_agents, 5 stopped by a
-#             signal, 6 stalled (no progress and no terrain change for the scenario's stall_steps: the account at the
+# Exit codes: marsala-world's for a run that ended: 0 completed, 7 completed short of slots, 3 max_steps,
+#             4 no_live_agents, 5 stopped by a signal, 6 stalled (no progress and no terrain change for the scenario's stall_steps: the account at the
 #             end says what each robot waited for) (the summary is written in every case); 1 the world failed or
 #             wrote no summary or the binaries are missing; 2 usage error or a run that `marsala-world --check` rejects (nothing started); 130 stopped.
 set -euo pipefail

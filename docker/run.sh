@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the MARSala image with podman and runs docker/docker-compose.yml: the world, AGENTS agents and a monitor,
 # inside a private network namespace (nothing leaves this machine), then prints the summary and exits with the
-# world's exit code (0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 1 error).
+# world's exit code (0 completed, 7 completed short of slots, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled,
+# 1 error).
 # Usage: docker/run.sh [--scenario NAME] [--agents N] [--dds cyclone|fastdds] [--domain D] [--out DIR] [--image TAG]
 #   --image  the image tag to build and run (default $MARSALA_IMAGE, else localhost/marsala:latest); give each checkout
 #            its own when several may run at once on one machine, so that none runs another's binaries

@@ -126,7 +126,6 @@ int run_in_folder(const std::string& scenario_path, const std::string& resume_di
     cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
     return 1;
   }
-  return 0;
 }
 
 }  // namespace
@@ -144,8 +143,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       "Every run also writes run.log (every accepted change, checksummed) and snapshot.pb; after a crash,\n"
       "marsala-world --resume DIR continues the run in DIR with its agents (docs/runtime.md#resume).\n"
       "A world holds its folder (DIR/world.lock) while it runs: a second world, --resume or --replace there exits 2.\n"
-      "Exit codes: 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled, 1 error, 2 usage or a\n"
-      "scenario the world refuses at start (as --check).",
+      "Exit codes: 0 completed, 7 completed with slots missing at the end, 3 max_steps, 4 no_live_agents,\n"
+      "5 signal, 6 stalled, 1 error, 2 usage or a scenario the world refuses at start (as --check).",
       "marsala-world"};
   std::string scenario_path, check_path, resume_dir, run_key;
   cli::DdsOptions dds;
