@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Runs a scenario as real processes: one marsala-world and N marsala-agent processes on a fresh DDS domain with the
-# loopback profile (or --profile lan|unicast), waits for the end, prints a short account of the run (summary.json holds everything), and
-# stops every child it started on exit or Ctrl-C. On a terminal it keeps one line up to date while the run goes:
-# step, progress, steps/s and the estimated time left (marsala-monitor progress).
+# loopback profile (or --profile lan|unicast, secured), waits for the end, prints a short account of the run
+# (summary.json holds everything), and stops every child it started on exit or Ctrl-C. On a terminal it keeps one
+# line up to date while the run goes: step, progress, steps/s and the estimated time left (marsala-monitor progress).
 #
 # Usage: deploy/spawn.sh --scenario FILE --agents N [--dds cyclone|fastdds] [--agent-dds cyclone|fastdds]
 #                        [--out DIR [--replace]] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N]
@@ -51,13 +51,18 @@ usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0";
 # The profile and security options, checked and settled: secure=1 for --secure and for lan/unicast without
 # --insecure; identities and world_address get their defaults. Exit 2 naming what is wrong.
 security_options() {
-  case "$profile" in lo|lan|unicast) ;; *) echo "spawn.sh: --profile must be lo, lan or unicast, got '$profile'" >&2; exit 2 ;; esac
+  case "$profile" in
+    lo|lan|unicast) ;;
+    *) echo "spawn.sh: --profile must be lo, lan or unicast, got '$profile'" >&2; exit 2 ;;
+  esac
   if [ "$secure" -eq 1 ] && [ "$insecure" -eq 1 ]; then
     echo "spawn.sh: --secure and --insecure contradict each other: give one" >&2; exit 2
   fi
   [ "$profile" != lo ] && [ "$insecure" -eq 0 ] && secure=1
   if [ "$secure" -eq 0 ] && [ -n "$identities" ]; then
-    echo "spawn.sh: --identities $identities is for secured runs, and this one is not (--insecure or --profile lo without --secure)" >&2; exit 2
+    echo "spawn.sh: --identities $identities is for secured runs, and this one is not" \
+      "(--insecure or --profile lo without --secure)" >&2
+    exit 2
   fi
   identities="${identities:-${MARSALA_IDENTITIES:-${HOME:-/root}/.marsala/identities}}"
   [[ "$identities" = /* ]] || identities="$PWD/$identities"
@@ -170,13 +175,17 @@ fi
 if [ "$secure" -eq 1 ]; then
   ids_line=$("$root/deploy/security/make-identities.sh" --out "$identities" --agents "$agents" --domain "$domain" \
     --reuse) || exit $?
-  case "$ids_line" in "identities: made"*) echo "spawn.sh: $ids_line" >&2 ;; *) [ "$quiet" -eq 1 ] || echo "spawn.sh: $ids_line" ;; esac
+  case "$ids_line" in
+    "identities: made"*) echo "spawn.sh: $ids_line" >&2 ;;  # a new secret on disk: said even with --quiet
+    *) [ "$quiet" -eq 1 ] || echo "spawn.sh: $ids_line" ;;
+  esac
 fi
 
 # A run never mixes its outputs with another's: the world refuses a folder holding a run; with --replace it removes
 # that run's files itself (marsala-world --replace knows the list), and the agents' old logs go here.
 [ "$replace" -eq 1 ] && [ -d "$out" ] && rm -rf -- "$out/logs" "$out/maps" "$out/dds"
-if [ "$profile" = unicast ]; then  # the profiles this run used, the world's address written in (Fast DDS reads no variables)
+# The unicast profiles this run used, the world's address written in (Fast DDS reads no variables).
+if [ "$profile" = unicast ]; then
   mkdir -p "$out/dds"
   for v in cyclone fastdds; do
     sed "s/\${MARSALA_WORLD_ADDRESS}/$world_address/g" "$root/deploy/dds/$v-unicast.xml" >"$out/dds/$v-unicast.xml"

@@ -42,7 +42,8 @@ done
   { echo "make-identities.sh: --agents N (N >= 1) is required, got '$agents'" >&2; exit 2; }
 [[ "$days" =~ ^[0-9]+$ ]] && [ "$days" -ge 1 ] || { echo "make-identities.sh: --days D (D >= 1), got '$days'" >&2; exit 2; }
 [ -z "$domain" ] || { [[ "$domain" =~ ^[0-9]+$ ]] && [ "$domain" -le 230 ]; } ||
-  { echo "make-identities.sh: --domain D must be 0..230 (Cyclone's access control reads no higher id), got '$domain'" >&2; exit 2; }
+  { echo "make-identities.sh: --domain D must be 0..230 (Cyclone's access control reads no higher id)," \
+      "got '$domain'" >&2; exit 2; }
 command -v openssl >/dev/null || { echo "make-identities.sh: openssl not found (apt-get install openssl)" >&2; exit 1; }
 wanted_domain="${domain:-0-230}"
 
@@ -60,7 +61,8 @@ if [ -e "$out" ] && [ -n "$(ls -A "$out" 2>/dev/null)" ]; then
   have_domain=$(manifest_field domain "$out") have_agents=$(manifest_field agents "$out")
   have_ca=$(manifest_field ca_sha256 "$out") valid_until=$(manifest_field valid_until "$out")
   if [ "$have_domain" != "$wanted_domain" ] && [ "$have_domain" != 0-230 ]; then  # a folder for every domain fits any
-    echo "make-identities.sh: $out was made for domain $have_domain, not $wanted_domain: give that domain or another folder" >&2
+    echo "make-identities.sh: $out was made for domain $have_domain, not $wanted_domain:" \
+      "give that domain or another folder" >&2
     exit 2
   fi
   if ! [[ "$have_agents" =~ ^[0-9]+$ ]] || [ "$have_agents" -lt "$agents" ]; then
@@ -86,7 +88,9 @@ work="$(mktemp -d "$parent/.identities.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 cd "$work"
 log="$work/openssl.log"
-ssl() { openssl "$@" >>openssl.log 2>&1 || { echo "make-identities.sh: openssl $1 failed: $(tail -1 "$log")" >&2; exit 1; }; }
+ssl() {
+  openssl "$@" >>openssl.log 2>&1 || { echo "make-identities.sh: openssl $1 failed: $(tail -1 "$log")" >&2; exit 1; }
+}
 
 ssl req -x509 -newkey rsa:2048 -nodes -days "$days" -keyout ca.key -out ca.pem -subj "/CN=marsala-ca"
 identity() {  # identity FILE_STEM COMMON_NAME

@@ -56,10 +56,12 @@ refused() {  # refused WORDS ARGS...: spawn.sh ARGS exits 2 with one line holdin
 refused "--secure and --insecure" --secure --insecure --domain "$domain"
 refused "--profile must be lo, lan or unicast" --profile wan --domain "$domain"
 refused "--identities $ids is for secured runs" --profile lan --insecure --identities "$ids" --domain "$domain"
-refused "$work/two was made for domain $domain, not $((domain + 1))" --profile lan --identities "$work/two" --domain $((domain + 1))
+refused "$work/two was made for domain $domain, not $((domain + 1))" --profile lan --identities "$work/two" \
+  --domain $((domain + 1))
 refused "$work/two was made for 2 agents, this run needs 3" --secure --identities "$work/two" --domain "$domain"
 [ ! -e "$ids" ] || fail "a refused run made $ids"
-echo "ok: spawn.sh refuses --secure with --insecure, an unknown profile, --identities unsecured, a folder of another domain or a smaller team (exit 2, one line, nothing written)"
+echo "ok: spawn.sh refuses --secure with --insecure, an unknown profile, --identities unsecured, a folder of another" \
+  "domain or a smaller team (exit 2, one line, nothing written)"
 
 # 1. Secured by default beyond loopback; the folder made on first use, then reused; the unsecured terrain.
 spawn unicast --profile unicast --world-address 127.0.0.1 --identities "$ids" --domain "$domain"
@@ -78,7 +80,8 @@ before=$(cd "$ids" && ls -l --time-style=+%s.%N && sha256sum ./*)
 spawn reused --secure --identities "$ids"  # no --domain: the folder's
 [ "$rc" = 0 ] || fail "the reusing run exited $rc: $(cat "$work/reused.err") (logs: $work/reused/logs)"
 [ "$(cd "$ids" && ls -l --time-style=+%s.%N && sha256sum ./*)" = "$before" ] || fail "the second run rewrote $ids"
-grep -q "secured (DDS Security) as world from $ids" "$work/reused/logs/world.log" || fail "the second run is not secured"
+grep -q "secured (DDS Security) as world from $ids" "$work/reused/logs/world.log" ||
+  fail "the second run is not secured"
 [ "$(jq -r .run_id "$work/reused/summary.json")" = "ramp-d$domain" ] ||
   fail "the second run did not take the folder's domain $domain ($(jq -r .run_id "$work/reused/summary.json"))"
 wait "$sim" || fail "marsala-lockstep-sim failed"
