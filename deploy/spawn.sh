@@ -59,6 +59,11 @@ security_options() {
     echo "spawn.sh: --secure and --insecure contradict each other: give one" >&2; exit 2
   fi
   [ "$profile" != lo ] && [ "$insecure" -eq 0 ] && secure=1
+  if [ "$secure" -eq 1 ] && [ "$agent_dds" != "$dds" ]; then
+    echo "spawn.sh: a secured team runs on one vendor (Cyclone 0.10.2 and Fast DDS 2.9.1 fail each other's" \
+      "handshake, docs/runtime.md#security): drop --agent-dds or give --insecure" >&2
+    exit 2
+  fi
   if [ "$secure" -eq 0 ] && [ -n "$identities" ]; then
     echo "spawn.sh: --identities $identities is for secured runs, and this one is not" \
       "(--insecure or --profile lo without --secure)" >&2

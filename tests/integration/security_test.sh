@@ -3,8 +3,9 @@
 # processes in a private network namespace (ctest runs it inside run_isolated.sh).
 #
 # Usage: security_test.sh VENDOR DOMAIN
-#   0. spawn.sh's bad inputs: --secure with --insecure, an unknown profile, --identities on an unsecured run, an
-#      identity folder made for another domain or a smaller team: one line naming it, exit 2, no run folder made;
+#   0. spawn.sh's bad inputs: --secure with --insecure, an unknown profile, a secured team of two vendors,
+#      --identities on an unsecured run, an identity folder made for another domain or a smaller team: one line
+#      naming it, exit 2, no run folder made;
 #   1. a 3-agent ramp run on the unicast profile (world at 127.0.0.1), no security flag, is secured by default (the
 #      identity folder made on first use, the world's and agents' logs say "secured") and completes on the terrain of
 #      the unsecured run (marsala-lockstep-sim, in-process); a second run, --secure on loopback, reuses the folder
@@ -55,13 +56,15 @@ refused() {  # refused WORDS ARGS...: spawn.sh ARGS exits 2 with one line holdin
 }
 refused "--secure and --insecure" --secure --insecure --domain "$domain"
 refused "--profile must be lo, lan or unicast" --profile wan --domain "$domain"
+other=$([ "$vendor" = cyclone ] && echo fastdds || echo cyclone)
+refused "a secured team runs on one vendor" --profile unicast --agent-dds "$other" --domain "$domain"
 refused "--identities $ids is for secured runs" --profile lan --insecure --identities "$ids" --domain "$domain"
 refused "$work/two was made for domain $domain, not $((domain + 1))" --profile lan --identities "$work/two" \
   --domain $((domain + 1))
 refused "$work/two was made for 2 agents, this run needs 3" --secure --identities "$work/two" --domain "$domain"
 [ ! -e "$ids" ] || fail "a refused run made $ids"
-echo "ok: spawn.sh refuses --secure with --insecure, an unknown profile, --identities unsecured, a folder of another" \
-  "domain or a smaller team (exit 2, one line, nothing written)"
+echo "ok: spawn.sh refuses --secure with --insecure, an unknown profile, a secured mixed team, --identities unsecured," \
+  "a folder of another domain or a smaller team (exit 2, one line, nothing written)"
 
 # 1. Secured by default beyond loopback; the folder made on first use, then reused; the unsecured terrain.
 spawn unicast --profile unicast --world-address 127.0.0.1 --identities "$ids" --domain "$domain"
