@@ -160,8 +160,8 @@ void check_security(const Security& security, int domain_id) {
   const std::filesystem::path key = std::filesystem::path(security.dir) / (security.identity + ".key");
   const std::filesystem::perms others = std::filesystem::perms::group_all | std::filesystem::perms::others_all;
   if ((std::filesystem::status(key).permissions() & others) != std::filesystem::perms::none)
-    throw InvalidArgument(fmt::format("DDS Security: private key {} is open to other users (chmod 600 it)",
-                                      key.string()));
+    throw InvalidArgument(
+        fmt::format("DDS Security: private key {} is open to other users (chmod 600 it)", key.string()));
   // A folder made for one domain (its manifest, make-identities.sh --domain) says so before DDS refuses it unexplained.
   const std::filesystem::path manifest = std::filesystem::path(security.dir) / "manifest";
   if (const std::optional<std::string> made_for = manifest_field(manifest, "domain");

@@ -69,7 +69,8 @@ TEST_F(ProfileTest, AGivenProfileMustBeOneOfThatVendor) {
 // The unicast profiles need the world's address: Cyclone reads MARSALA_WORLD_ADDRESS itself, Fast DDS 2.9 reads no
 // variable, so its template must be written out first (deploy/spawn.sh --profile unicast does).
 TEST_F(ProfileTest, AUnicastProfileWithoutTheWorldsAddressIsRefusedSayingWhatIsMissing) {
-  const std::string cyclone = source("deploy/dds/cyclone-unicast.xml"), fastdds = source("deploy/dds/fastdds-unicast.xml");
+  const std::string cyclone = source("deploy/dds/cyclone-unicast.xml");
+  const std::string fastdds = source("deploy/dds/fastdds-unicast.xml");
   const char* saved = std::getenv("MARSALA_WORLD_ADDRESS");
   const std::string kept = saved ? saved : "";
   ::unsetenv("MARSALA_WORLD_ADDRESS");
