@@ -82,7 +82,7 @@ security_options() {
     { echo "spawn.sh: --world-address must be a host name or an address, got '$world_address'" >&2; exit 2; }
 }
 # The domain the identity folder was made for (its manifest), or nothing (no folder yet, or made for every domain).
-identities_domain() { sed -n 's/^domain=\([0-9][0-9]*\)$/\1/p' "$identities/manifest" 2>/dev/null | head -1; }
+identities_domain() { sed -n 's/^domain=\([0-9][0-9]*\)$/\1/p' "$identities/manifest" 2>/dev/null | head -1 || true; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;

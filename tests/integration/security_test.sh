@@ -62,7 +62,11 @@ refused "--identities $ids is for secured runs" --profile lan --insecure --ident
 refused "$work/two was made for domain $domain, not $((domain + 1))" --profile lan --identities "$work/two" \
   --domain $((domain + 1))
 refused "$work/two was made for 2 agents, this run needs 3" --secure --identities "$work/two" --domain "$domain"
-[ ! -e "$ids" ] || fail "a refused run made $ids"
+# A run that marsala-world --check rejects (no --domain: the folder's, or a free one) makes no identities.
+spawn bad --secure --identities "$ids" --set no_such_field=1
+[ "$rc" = 2 ] && grep -q "marsala-world --check rejects the run" "$work/bad.err" ||
+  fail "a rejected scenario: exit $rc, expected 2: $(cat "$work/bad.err")"
+[ ! -e "$ids" ] && [ ! -e "$work/bad" ] || fail "a refused run made $ids or its run folder"
 echo "ok: spawn.sh refuses --secure with --insecure, an unknown profile, a secured mixed team, --identities unsecured," \
   "a folder of another domain or a smaller team (exit 2, one line, nothing written)"
 
