@@ -46,7 +46,7 @@ spawn() {  # spawn OUT ARGS...: spawn.sh's exit code in rc, its stderr in $work/
 
 # 0. Bad inputs: exit 2, one line naming what is wrong, nothing written.
 "$root/deploy/security/make-identities.sh" --out "$work/two" --agents 2 --domain "$domain" >/dev/null
-refused() {  # refused WORDS ARGS...: spawn.sh ARGS exits 2 with one line holding WORDS, and makes no run folder
+spawn_refused() {  # spawn_refused WORDS ARGS...: spawn.sh ARGS exits 2, one line holding WORDS, no run folder
   local words="$1"
   shift
   spawn bad "$@"
@@ -54,21 +54,21 @@ refused() {  # refused WORDS ARGS...: spawn.sh ARGS exits 2 with one line holdin
     fail "spawn.sh $*: exit $rc, expected 2 and one line with '$words': $(cat "$work/bad.err")"
   [ ! -e "$work/bad" ] || fail "spawn.sh $* wrote $work/bad"
 }
-refused "--secure and --insecure" --secure --insecure --domain "$domain"
-refused "--profile must be lo, lan or unicast" --profile wan --domain "$domain"
+spawn_refused "--secure and --insecure" --secure --insecure --domain "$domain"
+spawn_refused "--profile must be lo, lan or unicast" --profile wan --domain "$domain"
 other=$([ "$vendor" = cyclone ] && echo fastdds || echo cyclone)
-refused "a secured team runs on one vendor" --profile unicast --agent-dds "$other" --domain "$domain"
-refused "--identities $ids is for secured runs" --profile lan --insecure --identities "$ids" --domain "$domain"
-refused "$work/two was made for domain $domain, not $((domain + 1))" --profile lan --identities "$work/two" \
+spawn_refused "a secured team runs on one vendor" --profile unicast --agent-dds "$other" --domain "$domain"
+spawn_refused "--identities $ids is for secured runs" --profile lan --insecure --identities "$ids" --domain "$domain"
+spawn_refused "$work/two was made for domain $domain, not $((domain + 1))" --profile lan --identities "$work/two" \
   --domain $((domain + 1))
-refused "$work/two was made for 2 agents, this run needs 3" --secure --identities "$work/two" --domain "$domain"
+spawn_refused "$work/two was made for 2 agents, this run needs 3" --secure --identities "$work/two" --domain "$domain"
 # A run that marsala-world --check rejects (no --domain: the folder's, or a free one) makes no identities.
 spawn bad --secure --identities "$ids" --set no_such_field=1
 [ "$rc" = 2 ] && grep -q "marsala-world --check rejects the run" "$work/bad.err" ||
   fail "a rejected scenario: exit $rc, expected 2: $(cat "$work/bad.err")"
 [ ! -e "$ids" ] && [ ! -e "$work/bad" ] || fail "a refused run made $ids or its run folder"
-echo "ok: spawn.sh refuses --secure with --insecure, an unknown profile, a secured mixed team, --identities unsecured," \
-  "a folder of another domain or a smaller team (exit 2, one line, nothing written)"
+echo "ok: spawn.sh refuses --secure with --insecure, an unknown profile, a secured mixed team, --identities" \
+  "unsecured, a folder of another domain or a smaller team (exit 2, one line, nothing written)"
 
 # 1. Secured by default beyond loopback; the folder made on first use, then reused; the unsecured terrain.
 spawn unicast --profile unicast --world-address 127.0.0.1 --identities "$ids" --domain "$domain"
@@ -98,9 +98,10 @@ for run in unicast reused; do
   [ "$(field terrain_sha256 "$work/$run/summary.json")" = "$want" ] ||
     fail "the $run run ends on $(field terrain_sha256 "$work/$run/summary.json"), unsecured on $want"
 done
-echo "ok: the unicast run, secured by default, and a --secure run reusing its identities (CA ${ca:0:23}...) completed on" \
-  "the unsecured terrain ${want:0:8} (admitted in $(jq -r .admit_seconds "$work/unicast/summary.json") s; step median" \
-  "$(jq -r .step_wall_median_ms "$work/unicast/summary.json") ms)"
+admit=$(jq -r .admit_seconds "$work/unicast/summary.json")
+step=$(jq -r .step_wall_median_ms "$work/unicast/summary.json")
+echo "ok: the unicast run, secured by default, and a --secure run reusing its identities (CA ${ca:0:23}...)" \
+  "completed on the unsecured terrain ${want:0:8} (admitted in $admit s; step median $step ms)"
 
 # 2. The fence.
 sec="$ids"
