@@ -2,20 +2,25 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
 #include <cstdlib>
+#include <memory>
 #include <optional>
 #include <ostream>
+#include <thread>
 #include <utility>
 
 #include "marsala/bus/bus.hpp"
 #include "marsala/cli/command_line.hpp"
 #include "marsala/cli/logging.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/protocol/end_reason.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
 #include "marsala/world_server/records/output_lock.hpp"
 #include "marsala/world_server/records/run_key_file.hpp"
 #include "marsala/world_server/records/run_outputs.hpp"
+#include "marsala/world_server/runtime/metrics_server.hpp"
 #include "marsala/world_server/runtime/scenario_check.hpp"
 #include "marsala/world_server/runtime/world_runtime.hpp"
 
@@ -57,6 +62,48 @@ void add_run_key_option(CLI::App& app, std::string& run_key) {
       ->type_name("FILE");
 }
 
+/// The options of the metrics server (docs/runtime.md#metrics): --metrics-port, --metrics-address, --metrics-linger.
+void add_metrics_options(CLI::App& app, MetricsOptions& metrics) {
+  CLI::Option* port = app.add_option("--metrics-port", metrics.port,
+                                     "serve the run's metrics in the Prometheus text format on http://ADDRESS:P/metrics\n"
+                                     "(docs/runtime.md#metrics); a port that cannot be listened on exits 2 before anything is written")
+                          ->check(CLI::Range(1, 65535))
+                          ->type_name("P");
+  app.add_option("--metrics-address", metrics.address, "numeric address the metrics server listens on")
+      ->needs(port)
+      ->capture_default_str();
+  app.add_option("--metrics-linger", metrics.linger_s,
+                 "after the run's end, keep serving its last values this long, so that the last scrape sees them\n"
+                 "(not after a run stopped by a signal) [s]")
+      ->needs(port)
+      ->check(cli::seconds_within(0.0, 3600.0))
+      ->capture_default_str();
+}
+
+/// The metrics server when --metrics-port asks for one, bound before the run's folder is touched; exit code 2 (one
+/// line naming the port) when it cannot listen.
+std::optional<int> start_metrics(std::unique_ptr<MetricsServer>& server, const MetricsOptions& options,
+                                 std::ostream& err) {
+  if (options.port == 0) return std::nullopt;
+  try {
+    server = std::make_unique<MetricsServer>(options);
+    return std::nullopt;
+  } catch (const Error& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return cli::kExitUsage;
+  }
+}
+
+/// After a run that ended (not by a signal, not in an error), the metrics server keeps serving the last values for
+/// --metrics-linger seconds, or until `stop`.
+void linger_for_metrics(const MetricsServer* server, const MetricsOptions& options, int code,
+                        const std::atomic<bool>& stop) {
+  const int signalled = protocol::exit_code(protocol::EndReason::kSignal);
+  if (server == nullptr || code == 1 || code == cli::kExitUsage || code == signalled) return;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.linger_s);
+  while (!stop && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+}
+
 /// Exit code 2 (one line) when --run-key names no run key: refused before the folder is touched (settle_run_key()
 /// reads it again once the folder is the run's).
 std::optional<int> refuse_bad_run_key(const std::string& path, std::ostream& err) {
@@ -87,8 +134,8 @@ std::optional<int> lock_folder(std::optional<OutputLock>& lock, const std::strin
 /// The run, once its folder is locked: the start (fresh or resumed), the run key, the participant, the lockstep and the
 /// last line; the exit code (docs/runtime.md#exit-codes), errors as one line.
 int run_in_folder(const std::string& scenario_path, const std::string& resume_dir, const std::string& run_key,
-                  const RuntimeOptions& options, const cli::DdsOptions& dds, const std::atomic<bool>& stop,
-                  std::ostream& out, std::ostream& err) {
+                  const RuntimeOptions& options, const cli::DdsOptions& dds, MetricsServer* metrics,
+                  const std::atomic<bool>& stop, std::ostream& out, std::ostream& err) {
   try {
     WorldStart start;
     if (!resume_dir.empty()) {
@@ -106,6 +153,7 @@ int run_in_folder(const std::string& scenario_path, const std::string& resume_di
         bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kWorld,
                                bus::Security::of(dds.security, dds.identity, "world")});
     WorldRuntime runtime(std::move(start), *participant);
+    if (metrics != nullptr) runtime.serve_metrics(*metrics);
     const RunResult result = runtime.run(stop);
     out << fmt::format("run {}: {} after {} steps{}, {} agents{}, terrain sha256 {}\n", runtime.run_id(),
                        to_string(result.end_reason), result.steps,
@@ -190,6 +238,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
           ->excludes(check_option);
   add_timing_and_record_options(app, options);
   add_run_key_option(app, run_key);
+  MetricsOptions metrics_options;
+  add_metrics_options(app, metrics_options);
   app.add_flag("--replace", options.replace,
                "remove a previous run's files from --out before starting (without it such a folder is refused)")
       ->excludes(resume_option);
@@ -205,15 +255,24 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
 
   if (seed_option->count() > 0) options.seed = seed;
   if (const char* path = std::getenv("PATH")) options.search_path = path;
-  if (check)
+  if (check) {
+    // A metrics port the run could not listen on is refused by the check too (bound and let go at once).
+    std::unique_ptr<MetricsServer> metrics;
+    if (const auto code = start_metrics(metrics, metrics_options, err)) return *code;
+    metrics.reset();
     return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, dds.domain, json, out, err);
+  }
   if (quiet && app.get_option("--log-level")->count() == 0) log_options.level = "warn";
   const cli::LoggingScope logging("world", 0, log_options);
   if (const auto code = refuse_bad_run_key(run_key, err)) return *code;
+  std::unique_ptr<MetricsServer> metrics;
+  if (const auto code = start_metrics(metrics, metrics_options, err)) return *code;
   // The folder is this process's from here to its exit, before --replace clears it or --resume reads it.
   std::optional<OutputLock> lock;
   if (const auto code = lock_folder(lock, resume_dir.empty() ? options.out_dir : resume_dir, err)) return *code;
-  return run_in_folder(scenario_path, resume_dir, run_key, options, dds, stop, out, err);
+  const int code = run_in_folder(scenario_path, resume_dir, run_key, options, dds, metrics.get(), stop, out, err);
+  linger_for_metrics(metrics.get(), metrics_options, code, stop);
+  return code;
 }
 
 }  // namespace marsala::world_server

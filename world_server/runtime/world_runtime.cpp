@@ -26,6 +26,7 @@
 #include "marsala/world_server/rules/step.hpp"
 #include "marsala/world_server/runtime/admission_gate.hpp"
 #include "marsala/world_server/runtime/agent_links.hpp"
+#include "marsala/world_server/runtime/metrics_server.hpp"
 #include "marsala/world_server/runtime/request_collector.hpp"
 #include "marsala/world_server/runtime/team_silence.hpp"
 
@@ -197,6 +198,26 @@ struct WorldRuntime::Impl {
     s.run_id = options.run_id;
     s.scenario = scenario.name;
     write_logged(*status, s, "the world status");
+    publish_metrics();
+  }
+
+  /// The metrics snapshot of now to the metrics server, when there is one (docs/runtime.md#metrics).
+  void publish_metrics() {
+    if (metrics_server == nullptr) return;
+    std::vector<bool> connected(state.agents.size(), false);
+    for (const AgentRecord& a : state.agents) connected[a.id - 1] = links && links->has(a.id) && links->connected(a.id);
+    take_state(metrics, state, connected);
+    metrics.phase = ended ? RunPhase::kOver : run_started ? RunPhase::kRunning : RunPhase::kAdmitting;
+    metrics.end_reason = ended;
+    metrics_server->publish(std::make_shared<const MetricsSnapshot>(metrics));
+  }
+
+  /// A step's times and rejections into the metrics, when served.
+  void observe_step_metrics(const StepOutcome& outcome, Clock::duration step_took, Clock::duration world_part) {
+    if (metrics_server == nullptr) return;
+    metrics.step_seconds.observe(std::chrono::duration<double>(step_took).count());
+    metrics.step_world_seconds.observe(std::chrono::duration<double>(world_part).count());
+    for (std::size_t i = 0; i < kRejectionReasons; ++i) metrics.rejections_by_reason[i] += outcome.rejected_by_reason[i];
   }
 
   /// Refuses to go on beside another world on this domain (docs/runtime.md#one-world-per-domain): every world
@@ -502,6 +523,7 @@ struct WorldRuntime::Impl {
       const Clock::duration step_took = Clock::now() - step_start;
       step_ms.push_back(milliseconds(step_took));
       step_world_ms.push_back(milliseconds(step_took - collected.waited));
+      observe_step_metrics(outcome, step_took, step_took - collected.waited);
       publish_step(collected, outcome, start);
     }
   }
@@ -619,6 +641,7 @@ struct WorldRuntime::Impl {
     recorder.sync();
     for (std::uint32_t id : live) send_frame(id, true);
     emit(make_event(0, protocol::EventKind::kRunOver, to_string(end_reason)));
+    ended = end_reason;
     publish_status(false, result.completed, result.wall_seconds);
 
     RunInfo info = run_info(end_reason, result.wall_seconds, cpu_steps_ms);
@@ -662,6 +685,9 @@ struct WorldRuntime::Impl {
   std::vector<std::string> last_rejection;  ///< [id - 1]: the rejection reason last logged at info level
   std::vector<double> step_ms;              ///< wall time of each lockstep step [ms]
   std::vector<double> step_world_ms;        ///< the world's own part of each step: its wall time less its waits [ms]
+  MetricsServer* metrics_server = nullptr;  ///< where publish_metrics() goes; none: no metrics
+  MetricsSnapshot metrics;                  ///< the metrics, kept up to date while served
+  std::optional<protocol::EndReason> ended;  ///< set when the lockstep is over
 };
 
 WorldRuntime::WorldRuntime(const scenario::Scenario& scenario, Heightmap terrain, RuntimeOptions options,
@@ -676,6 +702,13 @@ WorldRuntime::WorldRuntime(WorldStart start, bus::Participant& participant)
 WorldRuntime::~WorldRuntime() = default;
 
 RunResult WorldRuntime::run(const std::atomic<bool>& stop) { return impl_->run(stop); }
+
+void WorldRuntime::serve_metrics(MetricsServer& server) {
+  impl_->metrics_server = &server;
+  impl_->metrics.run_id = impl_->options.run_id;
+  impl_->metrics.scenario = impl_->scenario.name;
+  impl_->metrics.dds = bus::to_string(impl_->participant.vendor());
+}
 
 const WorldState& WorldRuntime::state() const { return impl_->state; }
 

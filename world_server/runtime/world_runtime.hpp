@@ -24,6 +24,8 @@
 
 namespace marsala::world_server {
 
+class MetricsServer;
+
 /// How a run ended.
 struct RunResult {
   bool completed = false;
@@ -54,6 +56,10 @@ class WorldRuntime {
   /// its results are published. Throws Error when no agent is admitted within the admit timeout (or before `stop`),
   /// IoError when the outputs or the log cannot be written.
   RunResult run(const std::atomic<bool>& stop);
+
+  /// Publishes a metrics snapshot to `server` whenever WorldStatus goes out (while admitting, each step, at the end;
+  /// docs/runtime.md#metrics); `server` must outlive run().
+  void serve_metrics(MetricsServer& server);
 
   /// The world state (after run(): the final one).
   const WorldState& state() const;

@@ -1,6 +1,9 @@
 #include "marsala/world_server/runtime/world_cli.hpp"
 
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -52,6 +55,32 @@ TEST_F(WorldCliTest, UsageErrorsExitWith2) {
   EXPECT_EQ(run({"--resume", "somewhere", "--scenario", ok}), 2);  // a resume takes its scenario from the log
   EXPECT_EQ(run({"--help"}), 0);
   EXPECT_NE(out_.str().find("--admit-timeout"), std::string::npos);
+}
+
+// A metrics port that cannot be listened on is refused with one line naming it, exit 2, before the run's folder is
+// made; --check refuses it too (spawn.sh checks with the run's arguments before it starts anything).
+TEST_F(WorldCliTest, AMetricsPortInUseIsRefusedBeforeAnythingIsWritten) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof a;
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), length), 0);
+  ASSERT_EQ(::listen(fd, 1), 0);
+  ASSERT_EQ(::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &length), 0);
+  const std::string port = std::to_string(ntohs(a.sin_port));
+  const std::string scenario = write("small.pbtxt", testing::small_scenario_text());
+  const fs::path out = dir_ / "out";
+  EXPECT_EQ(run({"--scenario", scenario, "--out", out.string(), "--dds", "inprocess", "--metrics-port", port}), 2);
+  EXPECT_EQ(err_.str(), "marsala-world: error: --metrics-port " + port + ": cannot listen on 127.0.0.1 port " + port +
+                            ": the port is in use (another server listens there)\n");
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(run({"--check", scenario, "--metrics-port", port}), 2);
+  EXPECT_NE(err_.str().find("--metrics-port " + port), std::string::npos) << err_.str();
+  ::close(fd);
+  EXPECT_EQ(run({"--check", scenario, "--metrics-port", port}), 0) << err_.str();
+  EXPECT_EQ(run({"--scenario", scenario, "--metrics-port", "0"}), 2);
+  EXPECT_EQ(run({"--scenario", scenario, "--metrics-linger", "1"}), 2);  // needs --metrics-port
 }
 
 // --step-deadline overrides the scenario's, as the world's own start-up check reports it.

@@ -1,0 +1,18 @@
+#pragma once
+// The Prometheus text exposition format (version 0.0.4) of a metrics snapshot: the metric families of
+// docs/runtime.md#metrics, each with its HELP and TYPE lines. Pure: a string from a value.
+
+#include <string>
+
+#include "marsala/world_server/runtime/metrics_snapshot.hpp"
+
+namespace marsala::world_server {
+
+/// The content type of render_metrics()'s text, for an HTTP response.
+inline constexpr const char* kMetricsContentType = "text/plain; version=0.0.4; charset=utf-8";
+
+/// `snapshot` in the Prometheus text format: every family of docs/runtime.md#metrics, in that order, numbers in
+/// their shortest round-trip form, label values escaped; ends with a newline.
+std::string render_metrics(const MetricsSnapshot& snapshot);
+
+}  // namespace marsala::world_server
