@@ -22,6 +22,7 @@
 #include "marsala/world_server/records/run_outputs.hpp"
 #include "marsala/world_server/runtime/metrics_server.hpp"
 #include "marsala/world_server/runtime/scenario_check.hpp"
+#include "marsala/world_server/runtime/step_trace.hpp"
 #include "marsala/world_server/runtime/world_runtime.hpp"
 
 namespace marsala::world_server {
@@ -104,6 +105,19 @@ void linger_for_metrics(const MetricsServer* server, const MetricsOptions& optio
   while (!stop && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(20));
 }
 
+/// The step trace when --trace asks for one, its FILE.tmp opened before the run's folder is touched; exit code 2 (one
+/// line naming the file) when it cannot be written.
+std::optional<int> start_trace(std::unique_ptr<StepTrace>& trace, const std::string& path, std::ostream& err) {
+  if (path.empty()) return std::nullopt;
+  try {
+    trace = std::make_unique<StepTrace>(path, std::chrono::steady_clock::now());
+    return std::nullopt;
+  } catch (const Error& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return cli::kExitUsage;
+  }
+}
+
 /// Exit code 2 (one line) when --run-key names no run key: refused before the folder is touched (settle_run_key()
 /// reads it again once the folder is the run's).
 std::optional<int> refuse_bad_run_key(const std::string& path, std::ostream& err) {
@@ -135,7 +149,7 @@ std::optional<int> lock_folder(std::optional<OutputLock>& lock, const std::strin
 /// last line; the exit code (docs/runtime.md#exit-codes), errors as one line.
 int run_in_folder(const std::string& scenario_path, const std::string& resume_dir, const std::string& run_key,
                   const RuntimeOptions& options, const cli::DdsOptions& dds, MetricsServer* metrics,
-                  const std::atomic<bool>& stop, std::ostream& out, std::ostream& err) {
+                  StepTrace* trace, const std::atomic<bool>& stop, std::ostream& out, std::ostream& err) {
   try {
     WorldStart start;
     if (!resume_dir.empty()) {
@@ -154,6 +168,7 @@ int run_in_folder(const std::string& scenario_path, const std::string& resume_di
                                bus::Security::of(dds.security, dds.identity, "world")});
     WorldRuntime runtime(std::move(start), *participant);
     if (metrics != nullptr) runtime.serve_metrics(*metrics);
+    if (trace != nullptr) runtime.trace_steps(*trace);
     const RunResult result = runtime.run(stop);
     out << fmt::format("run {}: {} after {} steps{}, {} agents{}, terrain sha256 {}\n", runtime.run_id(),
                        to_string(result.end_reason), result.steps,
@@ -163,6 +178,7 @@ int run_in_folder(const std::string& scenario_path, const std::string& resume_di
                            ? fmt::format(" ({} of {} slots missing at the end)", result.slots_missing, result.team)
                            : "",
                        result.terrain_sha256);
+    if (trace != nullptr) trace->finish();
     return exit_code(result.end_reason, result.slots_missing);
   } catch (const Error& e) {
     cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
@@ -240,6 +256,11 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   add_run_key_option(app, run_key);
   MetricsOptions metrics_options;
   add_metrics_options(app, metrics_options);
+  std::string trace_path;
+  app.add_option("--trace", trace_path,
+                 "write the lockstep as a Chrome trace (trace-event JSON, for Perfetto) to FILE when the run is over:\n"
+                 "each step's frames, wait, application and record, each agent's wait (docs/runtime.md#step-traces)")
+      ->type_name("FILE");
   app.add_flag("--replace", options.replace,
                "remove a previous run's files from --out before starting (without it such a folder is refused)")
       ->excludes(resume_option);
@@ -267,10 +288,13 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   if (const auto code = refuse_bad_run_key(run_key, err)) return *code;
   std::unique_ptr<MetricsServer> metrics;
   if (const auto code = start_metrics(metrics, metrics_options, err)) return *code;
+  std::unique_ptr<StepTrace> trace;
+  if (const auto code = start_trace(trace, trace_path, err)) return *code;
   // The folder is this process's from here to its exit, before --replace clears it or --resume reads it.
   std::optional<OutputLock> lock;
   if (const auto code = lock_folder(lock, resume_dir.empty() ? options.out_dir : resume_dir, err)) return *code;
-  const int code = run_in_folder(scenario_path, resume_dir, run_key, options, dds, metrics.get(), stop, out, err);
+  const int code = run_in_folder(scenario_path, resume_dir, run_key, options, dds, metrics.get(), trace.get(), stop,
+                                 out, err);
   linger_for_metrics(metrics.get(), metrics_options, code, stop);
   return code;
 }

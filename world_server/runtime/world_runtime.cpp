@@ -28,6 +28,7 @@
 #include "marsala/world_server/runtime/agent_links.hpp"
 #include "marsala/world_server/runtime/metrics_server.hpp"
 #include "marsala/world_server/runtime/request_collector.hpp"
+#include "marsala/world_server/runtime/step_trace.hpp"
 #include "marsala/world_server/runtime/team_silence.hpp"
 
 namespace marsala::world_server {
@@ -513,19 +514,36 @@ struct WorldRuntime::Impl {
     for (;;) {
       recorder.frame(state, scenario.name, false);
       if (const auto end = end_before_step(stop)) return *end;
-      const Clock::time_point step_start = Clock::now();
+      StepTimes times;  // the phases' ends, for the step time and the trace
+      times.step = state.step;
+      times.start = Clock::now();
       send_frames();
-      const Collected collected = collector->collect(state, options.step_deadline_s, stop, duties);
+      times.frames_out = Clock::now();
+      Collected collected = collector->collect(state, options.step_deadline_s, stop, duties);
       if (stop) return protocol::EndReason::kSignal;  // the interrupted step is not applied
+      times.collected = Clock::now();
       const StepOutcome outcome = apply_step(state, collected.submissions);
+      times.applied = Clock::now();
       state.surplus_requests += collected.surplus;
       record_step(collected, outcome);
-      const Clock::duration step_took = Clock::now() - step_start;
+      times.recorded = Clock::now();
+      const Clock::duration step_took = times.recorded - times.start;
       step_ms.push_back(milliseconds(step_took));
       step_world_ms.push_back(milliseconds(step_took - collected.waited));
       observe_step_metrics(outcome, step_took, step_took - collected.waited);
       publish_step(collected, outcome, start);
+      trace_step(times, collected, outcome);
     }
+  }
+
+  /// A step's spans into the trace, when one is written (docs/runtime.md#step-traces).
+  void trace_step(StepTimes& times, Collected& collected, const StepOutcome& outcome) {
+    if (trace == nullptr) return;
+    times.published = Clock::now();
+    times.answers = std::move(collected.answered_at);
+    for (const protocol::WorldEvent& e : outcome.events)
+      if (e.kind == protocol::EventKind::kMissed) times.missed.push_back(e.agent_id);
+    trace->step(times);
   }
 
   // ---- the run
@@ -688,6 +706,7 @@ struct WorldRuntime::Impl {
   MetricsServer* metrics_server = nullptr;  ///< where publish_metrics() goes; none: no metrics
   MetricsSnapshot metrics;                  ///< the metrics, kept up to date while served
   std::optional<protocol::EndReason> ended;  ///< set when the lockstep is over
+  StepTrace* trace = nullptr;                ///< where trace_step() goes; none: no trace
 };
 
 WorldRuntime::WorldRuntime(const scenario::Scenario& scenario, Heightmap terrain, RuntimeOptions options,
@@ -702,6 +721,11 @@ WorldRuntime::WorldRuntime(WorldStart start, bus::Participant& participant)
 WorldRuntime::~WorldRuntime() = default;
 
 RunResult WorldRuntime::run(const std::atomic<bool>& stop) { return impl_->run(stop); }
+
+void WorldRuntime::trace_steps(StepTrace& trace) {
+  impl_->trace = &trace;
+  trace.name_tracks(static_cast<std::uint32_t>(impl_->state.agents.size()));
+}
 
 void WorldRuntime::serve_metrics(MetricsServer& server) {
   impl_->metrics_server = &server;

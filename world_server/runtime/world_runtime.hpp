@@ -25,6 +25,7 @@
 namespace marsala::world_server {
 
 class MetricsServer;
+class StepTrace;
 
 /// How a run ended.
 struct RunResult {
@@ -60,6 +61,9 @@ class WorldRuntime {
   /// Publishes a metrics snapshot to `server` whenever WorldStatus goes out (while admitting, each step, at the end;
   /// docs/runtime.md#metrics); `server` must outlive run().
   void serve_metrics(MetricsServer& server);
+
+  /// Appends every step's spans to `trace` (docs/runtime.md#step-traces); `trace` must outlive run().
+  void trace_steps(StepTrace& trace);
 
   /// The world state (after run(): the final one).
   const WorldState& state() const;
