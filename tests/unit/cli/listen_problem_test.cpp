@@ -1,27 +1,17 @@
 #include "marsala/cli/listen_problem.hpp"
 
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
+
+#include "support/busy_port.hpp"
 
 namespace marsala::cli {
 namespace {
 
 TEST(ListenProblem, APortSomeoneListensOnIsInUse) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t length = sizeof a;
-  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), length), 0);
-  ASSERT_EQ(::listen(fd, 1), 0);
-  ASSERT_EQ(::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &length), 0);
-  const int port = ntohs(a.sin_port);
-  EXPECT_EQ(listen_problem("127.0.0.1", port), "the port is in use (another server listens there)");
-  ::close(fd);
-  EXPECT_EQ(listen_problem("127.0.0.1", port), "unknown reason");  // free again: the try succeeds
+  testing::BusyPort busy;
+  EXPECT_EQ(listen_problem("127.0.0.1", busy.port()), "the port is in use (another server listens there)");
+  busy.release();
+  EXPECT_EQ(listen_problem("127.0.0.1", busy.port()), "unknown reason");  // free again: the try succeeds
 }
 
 TEST(ListenProblem, NamesWhatIsNotANumericAddress) {

@@ -10,34 +10,13 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/world_server/runtime/metrics_exposition.hpp"
+#include "support/busy_port.hpp"
 
 namespace marsala::world_server {
 namespace {
 
-/// A socket listening on a port of loopback the system chose; the port is in use while it lives.
-class Listener {
- public:
-  Listener() {
-    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t length = sizeof a;
-    if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), length) != 0 || ::listen(fd_, 1) != 0 ||
-        ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &length) != 0)
-      throw IoError("cannot listen on loopback");
-    port_ = ntohs(a.sin_port);
-  }
-  ~Listener() { ::close(fd_); }
-  int port() const { return port_; }
-
- private:
-  int fd_ = -1;
-  int port_ = 0;
-};
-
 /// A port of loopback that was free a moment ago.
-int free_port() { return Listener().port(); }
+int free_port() { return marsala::testing::BusyPort().port(); }
 
 /// The body of GET `path` from 127.0.0.1:`port` over HTTP/1.0 (headers dropped).
 std::string http_get(int port, const std::string& path) {
@@ -80,7 +59,7 @@ TEST(MetricsServer, ServesTheLatestSnapshotRendered) {
 }
 
 TEST(MetricsServer, APortInUseIsRefusedNamingIt) {
-  const Listener taken;
+  const marsala::testing::BusyPort taken;
   MetricsOptions o;
   o.port = taken.port();
   try {

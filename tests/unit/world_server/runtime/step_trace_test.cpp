@@ -7,11 +7,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <thread>
 #include <unistd.h>
 
 #include "marsala/core/error.hpp"
-#include "unit/world_server/fake_agent.hpp"
 #include "unit/world_server/world_cli_fixture.hpp"
 #include "unit/world_server/world_fixtures.hpp"
 
@@ -93,19 +91,8 @@ class StepTraceRun : public testing::WorldCliFixture {};
 TEST_F(StepTraceRun, TheTraceOfARunNestsAndMatchesTheSummary) {
   const std::string scenario = write("small.pbtxt", testing::small_scenario_text());
   const fs::path out = dir_ / "out", trace = dir_ / "trace.json";
-  int rc = -1;
-  std::thread world([&] {
-    rc = run({"--scenario", scenario, "--out", out.string(), "--max-steps", "12", "--trace", trace.string(), "--agents",
-              "1", "--dds", "inprocess", "--domain", "71", "--quiet"});
-  });
-  testing::FakeAgentConfig c;
-  c.domain = 71;
-  c.id = 1;
-  c.session = 5;
-  c.body = testing::small_scenario().robot_for(1).body;
-  testing::FakeAgent agent(c);
-  world.join();
-  agent.join();
+  const int rc = run_beside_walker(
+      71, {"--scenario", scenario, "--out", out.string(), "--max-steps", "12", "--trace", trace.string()});
   ASSERT_TRUE(rc == 0 || rc == 3) << rc << ": " << err_.str();  // the walker may reach the goal first
   const nlohmann::json summary = read_json(out / "summary.json");
   const auto steps = summary["steps"].get<std::size_t>();
