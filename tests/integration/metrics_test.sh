@@ -84,6 +84,10 @@ for expr, want in checks.items():
     print(f"{'ok' if ok else 'DIFFERS'}: {expr} = {got!r} (summary.json: {want!r})")
     if not ok:
         bad.append(expr)
+cpu_s = query(last("process_cpu_seconds_total"))
+print(f"ok: the world used {cpu_s:.2f} s of CPU by its last scrape")
+if not cpu_s > 0:
+    bad.append("no process_cpu_seconds_total")
 scrapes = query("count_over_time(marsala_steps_total[5m])")
 print(f"ok: {scrapes:.0f} scrapes of the run")
 if scrapes < 2:

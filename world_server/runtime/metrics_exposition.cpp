@@ -158,4 +158,14 @@ std::string render_metrics(const MetricsSnapshot& snapshot) {
   return x.take();
 }
 
+std::string render_process_metrics(const ProcessMetrics& process) {
+  Exposition x;
+  x.single("process_cpu_seconds_total", "counter", "Total user and system CPU time spent in seconds.",
+           process.cpu_seconds);
+  x.single("process_resident_memory_bytes", "gauge", "Resident memory size in bytes.", process.resident_memory_bytes);
+  x.single("process_start_time_seconds", "gauge", "Start time of the process since unix epoch in seconds.",
+           process.start_time_seconds);
+  return x.take();
+}
+
 }  // namespace marsala::world_server

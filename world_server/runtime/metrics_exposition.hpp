@@ -15,4 +15,15 @@ inline constexpr const char* kMetricsContentType = "text/plain; version=0.0.4; c
 /// their shortest round-trip form, label values escaped; ends with a newline.
 std::string render_metrics(const MetricsSnapshot& snapshot);
 
+/// The world process's own numbers, read when a scrape comes (not part of a step's snapshot).
+struct ProcessMetrics {
+  double cpu_seconds = 0.0;           ///< CPU time of every thread so far [s]
+  double resident_memory_bytes = 0.0;  ///< resident set size [bytes]
+  double start_time_seconds = 0.0;    ///< when the process started, since the Unix epoch [s]
+};
+
+/// The standard process families of Prometheus clients: process_cpu_seconds_total, process_resident_memory_bytes,
+/// process_start_time_seconds, in the text format.
+std::string render_process_metrics(const ProcessMetrics& process);
+
 }  // namespace marsala::world_server

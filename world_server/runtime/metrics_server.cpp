@@ -2,14 +2,17 @@
 
 #include <fmt/format.h>
 #include <httplib.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <mutex>
 #include <thread>
 #include <utility>
 
 #include "marsala/cli/listen_problem.hpp"
+#include "marsala/core/cpu_time.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/world_server/runtime/metrics_exposition.hpp"
 
@@ -21,6 +24,20 @@ constexpr std::size_t kHttpThreads = 2;
 /// A client that does not take its response within this long is cut off [s].
 constexpr time_t kSocketTimeoutS = 5;
 
+/// This process's CPU time and resident memory now, and `started` [s since the epoch].
+ProcessMetrics process_now(double started) {
+  ProcessMetrics p;
+  p.cpu_seconds = process_cpu_ms() / 1e3;
+  p.start_time_seconds = started;
+  long pages = 0, resident = 0;
+  if (std::FILE* statm = std::fopen("/proc/self/statm", "r")) {  // "size resident ..." in pages (proc(5))
+    if (std::fscanf(statm, "%ld %ld", &pages, &resident) == 2)
+      p.resident_memory_bytes = static_cast<double>(resident) * static_cast<double>(::sysconf(_SC_PAGESIZE));
+    std::fclose(statm);
+  }
+  return p;
+}
+
 }  // namespace
 
 struct MetricsServer::Impl {
@@ -30,6 +47,9 @@ struct MetricsServer::Impl {
   mutable std::mutex mutex;
   std::shared_ptr<const MetricsSnapshot> latest = std::make_shared<const MetricsSnapshot>();
   std::atomic<std::uint64_t> scrapes{0};
+  /// When the server started, since the epoch [s]: the process's start to within milliseconds (it starts before the
+  /// run's folder is touched).
+  double started_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 
   std::shared_ptr<const MetricsSnapshot> current() const {
     std::lock_guard<std::mutex> lock(mutex);
@@ -48,7 +68,8 @@ MetricsServer::MetricsServer(const MetricsOptions& options) : impl_(std::make_un
   impl.http.set_payload_max_length(1 << 12);
   impl.http.Get("/metrics", [&impl](const httplib::Request&, httplib::Response& res) {
     const std::shared_ptr<const MetricsSnapshot> snapshot = impl.current();
-    res.set_content(render_metrics(*snapshot), kMetricsContentType);
+    res.set_content(render_metrics(*snapshot) + render_process_metrics(process_now(impl.started_s)),
+                    kMetricsContentType);
     ++impl.scrapes;
   });
   impl.http.Get("/", [](const httplib::Request&, httplib::Response& res) {

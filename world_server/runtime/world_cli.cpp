@@ -207,6 +207,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       "Every run also writes run.log (every accepted change, checksummed) and snapshot.pb; after a crash,\n"
       "marsala-world --resume DIR continues the run in DIR with its agents (docs/runtime.md#resume).\n"
       "A world holds its folder (DIR/world.lock) while it runs: a second world, --resume or --replace there exits 2.\n"
+      "--metrics-port P serves the run's Prometheus metrics on http://127.0.0.1:P/metrics; --trace FILE writes the\n"
+      "lockstep as a Chrome trace for Perfetto (docs/runtime.md#metrics, #step-traces).\n"
       "Exit codes: 0 completed, 7 completed with slots missing at the end, 3 max_steps, 4 no_live_agents,\n"
       "5 signal, 6 stalled, 1 error, 2 usage or a scenario the world refuses at start (as --check).",
       "marsala-world"};

@@ -172,6 +172,19 @@ TEST(MetricsExposition, WritesNaNAndInfinitiesAsPrometheusReadsThem) {
   EXPECT_EQ(line_of(text, "marsala_deposited_volume_m3_total "), "marsala_deposited_volume_m3_total +Inf");
 }
 
+TEST(MetricsExposition, ProcessFamiliesAreThoseOfPrometheusClients) {
+  EXPECT_EQ(render_process_metrics({12.5, 4096.0, 1795828000.25}),
+            "# HELP process_cpu_seconds_total Total user and system CPU time spent in seconds.\n"
+            "# TYPE process_cpu_seconds_total counter\n"
+            "process_cpu_seconds_total 12.5\n"
+            "# HELP process_resident_memory_bytes Resident memory size in bytes.\n"
+            "# TYPE process_resident_memory_bytes gauge\n"
+            "process_resident_memory_bytes 4096\n"
+            "# HELP process_start_time_seconds Start time of the process since unix epoch in seconds.\n"
+            "# TYPE process_start_time_seconds gauge\n"
+            "process_start_time_seconds 1795828000.25\n");
+}
+
 // Prometheus's own checker (promtool, Debian's prometheus package) reads the text without a problem; skipped where
 // it is not installed.
 TEST(MetricsExposition, PromtoolFindsNoProblem) {
@@ -180,7 +193,7 @@ TEST(MetricsExposition, PromtoolFindsNoProblem) {
   s.scenario = "ramp";  // promtool flags nothing in label values; the escapes are checked above
   const std::filesystem::path file =
       std::filesystem::temp_directory_path() / ("marsala_metrics_" + std::to_string(::getpid()) + ".prom");
-  std::ofstream(file) << render_metrics(s);
+  std::ofstream(file) << render_metrics(s) << render_process_metrics({1.5, 1e6, 1795828000.0});
   const std::string command = "promtool check metrics < " + file.string() + " > " + file.string() + ".out 2>&1";
   const int rc = std::system(command.c_str());
   std::ifstream report(file.string() + ".out");

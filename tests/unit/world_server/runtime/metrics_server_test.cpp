@@ -43,7 +43,8 @@ TEST(MetricsServer, ServesTheLatestSnapshotRendered) {
   MetricsOptions o;
   o.port = free_port();
   MetricsServer server(o);
-  EXPECT_EQ(http_get(o.port, "/metrics"), render_metrics(MetricsSnapshot{}));  // before the first publish
+  const std::string empty = render_metrics(MetricsSnapshot{});
+  EXPECT_EQ(http_get(o.port, "/metrics").substr(0, empty.size()), empty);  // before the first publish
   auto s = std::make_shared<MetricsSnapshot>();
   s->run_id = "first";
   s->steps = 12;
@@ -52,7 +53,13 @@ TEST(MetricsServer, ServesTheLatestSnapshotRendered) {
   t->steps = 13;
   server.publish(t);
   const std::string text = http_get(o.port, "/metrics");
-  EXPECT_EQ(text, render_metrics(*t));
+  const std::string rendered = render_metrics(*t);
+  EXPECT_EQ(text.substr(0, rendered.size()), rendered);
+  // then this process's own numbers, read at the scrape
+  EXPECT_NE(text.find("\nprocess_cpu_seconds_total ", rendered.size() - 1), std::string::npos) << text;
+  const auto rss = text.find("\nprocess_resident_memory_bytes ");
+  ASSERT_NE(rss, std::string::npos);
+  EXPECT_GT(std::stod(text.substr(rss + 31)), 1e6);  // a test process holds more than a megabyte
   EXPECT_NE(text.find("\nmarsala_steps_total 13\n"), std::string::npos) << text;
   EXPECT_EQ(server.scrapes(), 2u);
   EXPECT_EQ(server.latest()->steps, 13u);
