@@ -27,8 +27,8 @@ struct AgentContext {
   std::uint64_t seed = 1;  ///< scenario seed; behaviours that randomise seed from seed + agent_id
   std::optional<GoalVectorMapSpec> goal_vector_map;  ///< the scenario's, for the "goal_vector_map" synthesizer
   /// Ramp builders keep the right-of-way protocol (docs/runtime.md#right-of-way); the agent sets it from the scenario's
-  /// `right_of_way` (off by default).
-  bool right_of_way = false;
+  /// `right_of_way` (on by default).
+  bool right_of_way = true;
 };
 
 /// Keep-out around neighbours for a team whose largest body length is max_delta_m [m] and longest step

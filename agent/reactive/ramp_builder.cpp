@@ -94,9 +94,14 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
     // target off the grid.
     const bool at_goal = local.goal == local.robot;
     const Position going = state_ == RampState::kReturnToBase ? steps_.context().assignment.base : view.target;
-    if (keeps_right_of_way_)
+    if (keeps_right_of_way_) {
+      // Where it goes moved (a goal vector map's next arrow, or the base): its progress is measured afresh.
+      const bool new_goal = going_ && std::hypot(going.x - going_->x, going.y - going_->y) > 0.5 * body.max_step_m;
+      going_ = going;
       right_of_way_.observe(view.robot, frame.neighbours, at_goal,
-                            std::hypot(going.x - view.robot.x, going.y - view.robot.y), 0.5 * body.max_step_m, worked_);
+                            std::hypot(going.x - view.robot.x, going.y - view.robot.y), 0.5 * body.max_step_m, worked_,
+                            new_goal);
+    }
     const std::vector<Lane> lanes =
         keeps_right_of_way_
             ? right_of_way_.lanes(3.0 * body.navigability.delta_m, 0.5 * body.navigability.delta_m + body.max_step_m)

@@ -104,6 +104,7 @@ class RampBuilder final : public Behaviour {
   RightOfWay right_of_way_;
   bool keeps_right_of_way_ = false;  // the context's right_of_way: else none of the protocol's steps are taken
   bool worked_ = false;  // the last request deposited or refilled: building is progress, not waiting
+  std::optional<Position> going_;  // where it went last frame (its target, or the base on the way back) [m]
   double return_below_m3_ = 0.0;  // less material than this (one cube) on board: back to the base [m^3]
   RampState state_ = RampState::kWaitAdmission;
   RampBuilderTrace trace_;

@@ -27,13 +27,14 @@ void RightOfWay::Loiter::update(Position p, double radius_m) {
 }
 
 void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, double to_go_m,
-                         double step_m, bool worked) {
+                         double step_m, bool worked, bool new_goal) {
   self_.update(self, loiter_m_);
   // Frames spent holding or giving way are the protocol's, not tries: they neither count as no progress nor keep a
   // best distance from before them (a robot that stepped away from its goal, or held, gets kStuckFrames frames to
   // make way from where it stands before it holds again; else it held again at once, for ever).
+  // A new goal starts its own count: the best distance to the old one says nothing of the way to it.
   const bool protocol_frame = hold_left_ > 0 || frames_left_ > 0;
-  if (at_goal || worked || protocol_frame || to_go_m < best_to_go_m_ - step_m || no_progress_ < 0) {
+  if (at_goal || worked || protocol_frame || new_goal || to_go_m < best_to_go_m_ - step_m || no_progress_ < 0) {
     best_to_go_m_ = to_go_m, no_progress_ = 0;
   } else {
     ++no_progress_;

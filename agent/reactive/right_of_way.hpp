@@ -55,9 +55,10 @@ class RightOfWay {
 
   /// One frame: where this robot stands and its neighbours (the frame's), at_goal when it is done, how far it still
   /// has to go to where it is going [m] (`step_m` [m]: what counts as progress), and `worked` when its last request
-  /// deposited or refilled (work in place is progress too: a builder is not waiting).
+  /// deposited or refilled (work in place is progress too: a builder is not waiting), and `new_goal` when where it
+  /// goes is not where it went last frame (its progress is then measured afresh: a goal vector map's next arrow).
   void observe(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, double to_go_m, double step_m,
-               bool worked = false);
+               bool worked = false, bool new_goal = false);
   /// True while the robot holds still (made no way with a neighbour in contact; see the header).
   bool holding() const { return hold_left_ > 0; }
   /// Where the robot it gives way to stood when the episode began [m], while an episode lasts; else nullopt.

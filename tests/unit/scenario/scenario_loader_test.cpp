@@ -428,8 +428,9 @@ TEST(ScenarioLoader, StallStepsDefaultsAndRange) {
   EXPECT_NE(invalid_override({"stall_steps=-1"}).find("stall_steps: -1 must be 0 (never)"), std::string::npos);
 }
 
-TEST(ScenarioLoader, RightOfWayOffUnlessTurnedOn) {
-  EXPECT_FALSE(parse_scenario(kMinimal, "t.pbtxt").right_of_way);
+TEST(ScenarioLoader, RightOfWayOnUnlessTurnedOff) {
+  EXPECT_TRUE(parse_scenario(kMinimal, "t.pbtxt").right_of_way);
+  EXPECT_FALSE(parse_scenario(std::string(kMinimal) + "right_of_way: false", "t.pbtxt").right_of_way);
   EXPECT_TRUE(parse_scenario(std::string(kMinimal) + "right_of_way: true", "t.pbtxt").right_of_way);
   EXPECT_TRUE(parse_scenario(kMinimal, "t.pbtxt", {"right_of_way=true"}).right_of_way);
   EXPECT_FALSE(

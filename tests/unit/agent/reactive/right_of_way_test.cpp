@@ -56,6 +56,26 @@ TEST(RightOfWay, ARobotThatMakesNoWayHoldsUnlessItBuilds) {
   EXPECT_EQ(idle_first, kStuckFrames - 1);
 }
 
+TEST(RightOfWay, ARobotWhoseGoalMovesOnMeasuresItsWayToEachGoalAfresh) {
+  RightOfWay fresh(2, 1.6, 0.9, 6), stale(2, 1.6, 0.9, 6);
+  int stale_first = -1;
+  for (int frame = 0; frame < 100; ++frame) {
+    // Both go back and forth along x within 0.8 m of robot 3 (in contact). Their goal is the head of the arrow
+    // they are on, 2 m ahead at the start of each 8-frame leg, so each leg ends 0.4 m nearer its own goal (progress),
+    // but never nearer than 1.6 m: measured against the best distance of the earlier legs that is no way made.
+    const int leg = frame / 8, in_leg = frame % 8;
+    const double dir = leg % 2 == 0 ? 1.0 : -1.0;
+    const double start = leg % 2 == 0 ? 0.0 : 0.4;
+    const Position self{start + dir * 0.05 * in_leg, 1.0};
+    const double to_go = 2.0 - 0.05 * in_leg;
+    fresh.observe(self, {at(3, 0.2, 1.5)}, false, to_go, 0.1, false, in_leg == 0);
+    stale.observe(self, {at(3, 0.2, 1.5)}, false, to_go, 0.1);
+    EXPECT_FALSE(fresh.holding()) << frame;
+    if (stale.holding() && stale_first < 0) stale_first = frame;
+  }
+  EXPECT_GE(stale_first, 0);  // the same robot without new goals holds: the test tells the two apart
+}
+
 TEST(RightOfWay, TwoRobotsParkedAtTheirGoalsSideBySideStayParked) {
   RightOfWay a(1, 1.6, 0.9, 6), b(2, 1.6, 0.9, 6);
   for (int frame = 0; frame < 300; ++frame) {
