@@ -68,6 +68,37 @@ Across across(const deliberative::LocalMap& local, const CellMask& corridor, con
   return a;
 }
 
+/// Per path cell: true when the cell is off `structure` but a structure cell lies across the path within
+/// corridor_width_m [m] on either side, for at least kMinCorridorCells path cells in a row (a path that runs beside
+/// the structure, not one that leaves its tip).
+std::vector<bool> beside(const deliberative::LocalMap& local, const CellMask& structure,
+                         const std::vector<CellIndex>& path, double corridor_width_m) {
+  const int n = static_cast<int>(path.size());
+  std::vector<bool> out(path.size(), false);
+  for (int i = 0; i < n; ++i) {
+    const CellIndex cell = path[static_cast<std::size_t>(i)];
+    const auto right = right_at(local, path, i);
+    if (!right || structure(cell.row, cell.col) != 0) continue;
+    const Position centre = local.center(cell);
+    // extent() through a cell off the structure reaches 0; it "ends" at once. Look for the first structure cell.
+    const double sample = 0.5 * local.geometry().cell_size_m;
+    for (const double side : {1.0, -1.0}) {
+      for (double t = sample; t <= corridor_width_m + 1e-9 && !out[static_cast<std::size_t>(i)]; t += sample) {
+        const auto at = local.cell_at({centre.x + side * t * right->x, centre.y + side * t * right->y});
+        if (at && structure(at->row, at->col) != 0) out[static_cast<std::size_t>(i)] = true;
+      }
+    }
+  }
+  for (int i = 0; i < n;) {
+    int j = i;
+    while (j < n && out[static_cast<std::size_t>(j)]) ++j;
+    if (j - i < kMinCorridorCells)
+      for (int k = i; k < j; ++k) out[static_cast<std::size_t>(k)] = false;
+    i = j + 1;
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<CellIndex> lane_path(const deliberative::LocalMap& local, const CellMask& corridor,
@@ -99,16 +130,26 @@ std::vector<CellIndex> lane_path(const deliberative::LocalMap& local, const Cell
 
 std::vector<CellIndex> band_centre_path(const deliberative::LocalMap& local, const CellMask& corridor,
                                         const std::vector<CellIndex>& path, double corridor_width_m,
-                                        double max_shift_m) {
+                                        double max_shift_m, const CellMask* structure) {
   if (path.size() < 2 || !(max_shift_m > 0.0)) return path;
   const int n = static_cast<int>(path.size());
-  const Across a = across(local, corridor, path, 0.0, corridor_width_m, 0);
+  Across a = across(local, corridor, path, 0.0, corridor_width_m, 0);
+  std::vector<bool> off(path.size(), false);
+  // Where the corridor gives no centre line (a shallow fill between occupiable ground), the strip of raised cells
+  // does; and a path that runs beside that strip is no part of it: nothing is built along it.
+  if (structure && structure->rows() == local.rows() && structure->cols() == local.cols()) {
+    const Across built = across(local, *structure, path, 0.0, corridor_width_m, 0);
+    for (std::size_t k = 0; k < path.size(); ++k)
+      if (std::isnan(a.wanted[k]) && !std::isnan(built.wanted[k])) a.wanted[k] = built.wanted[k];
+    off = beside(local, *structure, path, corridor_width_m);
+  }
   std::vector<CellIndex> out;
   out.reserve(path.size());
   double shift = 0.0;  // the shift towards the centre line at the last path cell in a corridor [m]
   bool seen = false;
   for (int i = 0; i < n; ++i) {
     const std::size_t k = static_cast<std::size_t>(i);
+    if (off[k]) continue;
     const double w = a.wanted[k];
     if (!std::isnan(w)) shift = std::clamp(w, -max_shift_m, max_shift_m), seen = true;
     CellIndex cell = path[k];

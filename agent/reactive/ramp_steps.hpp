@@ -37,6 +37,7 @@
 #include "marsala/agent/executive/body_clearance.hpp"
 #include "marsala/agent/executive/deposition_manager.hpp"
 #include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/agent/executive/raised_cells.hpp"
 #include "marsala/agent/executive/refused_cells.hpp"
 #include "marsala/agent/reactive/right_of_way.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
@@ -209,6 +210,7 @@ class RampSteps {
     CellMask corridor;                             ///< the last local map's navigable cells, neighbours not taken out
     CellMask terrain_occupiable;                   ///< and its occupiable cells
     std::vector<CellIndex> home;                   ///< the way home of this trip (world cells), empty: not planned
+    std::optional<executive::RaisedCells> raised;  ///< set_band_centre(): the structure seen built (first heights)
   };
 
   // look()'s steps, in order.
