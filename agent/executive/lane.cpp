@@ -68,11 +68,34 @@ Across across(const deliberative::LocalMap& local, const CellMask& corridor, con
   return a;
 }
 
-/// Per path cell: true when the cell is off `structure` but a structure cell lies across the path within
-/// corridor_width_m [m] on either side, for at least kMinCorridorCells path cells in a row (a path that runs beside
-/// the structure, not one that leaves its tip).
+/// Where the structure lies across a path cell off it, on one side: from the first structure cell, at most
+/// `limit` [m] away, to the end of the structure's run from there (up to twice the limit) [m].
+struct SideRun {
+  double from_m = 0.0;
+  double to_m = 0.0;
+};
+std::optional<SideRun> side_run(const deliberative::LocalMap& local, const CellMask& structure, Position from,
+                                Position unit, double limit) {
+  const double sample = 0.5 * local.geometry().cell_size_m;
+  const auto in_structure = [&](double t) {
+    const auto cell = local.cell_at({from.x + t * unit.x, from.y + t * unit.y});
+    return cell && structure(cell->row, cell->col) != 0;
+  };
+  double t = sample;
+  while (t <= limit + 1e-9 && !in_structure(t)) t += sample;
+  if (t > limit + 1e-9) return std::nullopt;
+  SideRun run{t, t};
+  while (run.to_m + sample <= 2.0 * limit + 1e-9 && in_structure(run.to_m + sample)) run.to_m += sample;
+  return run;
+}
+
+/// Per path cell: true when the path runs beside `structure` there: the cell is off it, and across the path on
+/// either side the structure begins within width_m [m] and its far edge lies more than width_m / 2 from the cell (a
+/// band width_m wide centred on the cell would not hold it: filling around the cell widens the structure, it does
+/// not complete it); for at least kMinCorridorCells path cells in a row (a path that runs beside the structure, not
+/// one that leaves its ragged tip).
 std::vector<bool> beside(const deliberative::LocalMap& local, const CellMask& structure,
-                         const std::vector<CellIndex>& path, double corridor_width_m) {
+                         const std::vector<CellIndex>& path, double width_m) {
   const int n = static_cast<int>(path.size());
   std::vector<bool> out(path.size(), false);
   for (int i = 0; i < n; ++i) {
@@ -80,14 +103,10 @@ std::vector<bool> beside(const deliberative::LocalMap& local, const CellMask& st
     const auto right = right_at(local, path, i);
     if (!right || structure(cell.row, cell.col) != 0) continue;
     const Position centre = local.center(cell);
-    // extent() through a cell off the structure reaches 0; it "ends" at once. Look for the first structure cell.
-    const double sample = 0.5 * local.geometry().cell_size_m;
-    for (const double side : {1.0, -1.0}) {
-      for (double t = sample; t <= corridor_width_m + 1e-9 && !out[static_cast<std::size_t>(i)]; t += sample) {
-        const auto at = local.cell_at({centre.x + side * t * right->x, centre.y + side * t * right->y});
-        if (at && structure(at->row, at->col) != 0) out[static_cast<std::size_t>(i)] = true;
-      }
-    }
+    const auto to_right = side_run(local, structure, centre, *right, width_m);
+    const auto to_left = side_run(local, structure, centre, {-right->x, -right->y}, width_m);
+    out[static_cast<std::size_t>(i)] =
+        (to_right && to_right->to_m > 0.5 * width_m) || (to_left && to_left->to_m > 0.5 * width_m);
   }
   for (int i = 0; i < n;) {
     int j = i;
@@ -133,16 +152,11 @@ std::vector<CellIndex> band_centre_path(const deliberative::LocalMap& local, con
                                         double max_shift_m, const CellMask* structure) {
   if (path.size() < 2 || !(max_shift_m > 0.0)) return path;
   const int n = static_cast<int>(path.size());
-  Across a = across(local, corridor, path, 0.0, corridor_width_m, 0);
+  const Across a = across(local, corridor, path, 0.0, corridor_width_m, 0);
+  // A path that runs beside the structure is no part of it: nothing is built along it.
   std::vector<bool> off(path.size(), false);
-  // Where the corridor gives no centre line (a shallow fill between occupiable ground), the strip of raised cells
-  // does; and a path that runs beside that strip is no part of it: nothing is built along it.
-  if (structure && structure->rows() == local.rows() && structure->cols() == local.cols()) {
-    const Across built = across(local, *structure, path, 0.0, corridor_width_m, 0);
-    for (std::size_t k = 0; k < path.size(); ++k)
-      if (std::isnan(a.wanted[k]) && !std::isnan(built.wanted[k])) a.wanted[k] = built.wanted[k];
+  if (structure && structure->rows() == local.rows() && structure->cols() == local.cols())
     off = beside(local, *structure, path, corridor_width_m);
-  }
   std::vector<CellIndex> out;
   out.reserve(path.size());
   double shift = 0.0;  // the shift towards the centre line at the last path cell in a corridor [m]

@@ -313,8 +313,9 @@ std::vector<CellIndex> RampSteps::on_band_centre(const deliberative::LocalMap& l
   const double max_shift_m = 0.5 * (corridor_width_m_ - context_.type.body.navigability.delta_m) -
                              std::sqrt(2.0) * local.geometry().cell_size_m;
   if (!memory_.raised) return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m);
-  // A shallow fill is no corridor: the strip of cells seen raised gives its centre line. A cell counts as raised by
-  // at least half a cube layer (the least a deposition adds), and beyond a scanned map's noise margin.
+  // Nothing is built along a path that runs beside the structure (the cells seen raised): the band is there already.
+  // A cell counts as raised by at least half a cube layer (the least a deposition adds), and beyond a scanned map's
+  // noise margin.
   const executive::DepositionParams& deposits = modules_->depositions.params();
   const CellMask built = memory_.raised->raised(local, std::max(deposits.gap_margin_m, 0.5 * deposits.cube_layer_m));
   return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m, &built);
