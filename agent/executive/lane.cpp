@@ -68,6 +68,56 @@ Across across(const deliberative::LocalMap& local, const CellMask& corridor, con
   return a;
 }
 
+/// Where the structure lies across a path cell off it, on one side: from the first structure cell, at most
+/// `limit` [m] away, to the end of the structure's run from there (up to twice the limit) [m].
+struct SideRun {
+  double from_m = 0.0;
+  double to_m = 0.0;
+};
+std::optional<SideRun> side_run(const deliberative::LocalMap& local, const CellMask& structure, Position from,
+                                Position unit, double limit) {
+  const double sample = 0.5 * local.geometry().cell_size_m;
+  const auto in_structure = [&](double t) {
+    const auto cell = local.cell_at({from.x + t * unit.x, from.y + t * unit.y});
+    return cell && structure(cell->row, cell->col) != 0;
+  };
+  double t = sample;
+  while (t <= limit + 1e-9 && !in_structure(t)) t += sample;
+  if (t > limit + 1e-9) return std::nullopt;
+  SideRun run{t, t};
+  while (run.to_m + sample <= 2.0 * limit + 1e-9 && in_structure(run.to_m + sample)) run.to_m += sample;
+  return run;
+}
+
+/// Per path cell: true when the path runs beside `structure` there: the cell is off it, and across the path on
+/// either side the structure begins within width_m [m] and its far edge lies more than width_m / 2 from the cell (a
+/// band width_m wide centred on the cell would not hold it: filling around the cell widens the structure, it does
+/// not complete it); for at least kMinCorridorCells path cells in a row (a path that runs beside the structure, not
+/// one that leaves its ragged tip).
+std::vector<bool> beside(const deliberative::LocalMap& local, const CellMask& structure,
+                         const std::vector<CellIndex>& path, double width_m) {
+  const int n = static_cast<int>(path.size());
+  std::vector<bool> out(path.size(), false);
+  for (int i = 0; i < n; ++i) {
+    const CellIndex cell = path[static_cast<std::size_t>(i)];
+    const auto right = right_at(local, path, i);
+    if (!right || structure(cell.row, cell.col) != 0) continue;
+    const Position centre = local.center(cell);
+    const auto to_right = side_run(local, structure, centre, *right, width_m);
+    const auto to_left = side_run(local, structure, centre, {-right->x, -right->y}, width_m);
+    out[static_cast<std::size_t>(i)] =
+        (to_right && to_right->to_m > 0.5 * width_m) || (to_left && to_left->to_m > 0.5 * width_m);
+  }
+  for (int i = 0; i < n;) {
+    int j = i;
+    while (j < n && out[static_cast<std::size_t>(j)]) ++j;
+    if (j - i < kMinCorridorCells)
+      for (int k = i; k < j; ++k) out[static_cast<std::size_t>(k)] = false;
+    i = j + 1;
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<CellIndex> lane_path(const deliberative::LocalMap& local, const CellMask& corridor,
@@ -99,16 +149,21 @@ std::vector<CellIndex> lane_path(const deliberative::LocalMap& local, const Cell
 
 std::vector<CellIndex> band_centre_path(const deliberative::LocalMap& local, const CellMask& corridor,
                                         const std::vector<CellIndex>& path, double corridor_width_m,
-                                        double max_shift_m) {
+                                        double max_shift_m, const CellMask* structure) {
   if (path.size() < 2 || !(max_shift_m > 0.0)) return path;
   const int n = static_cast<int>(path.size());
   const Across a = across(local, corridor, path, 0.0, corridor_width_m, 0);
+  // A path that runs beside the structure is no part of it: nothing is built along it.
+  std::vector<bool> off(path.size(), false);
+  if (structure && structure->rows() == local.rows() && structure->cols() == local.cols())
+    off = beside(local, *structure, path, corridor_width_m);
   std::vector<CellIndex> out;
   out.reserve(path.size());
   double shift = 0.0;  // the shift towards the centre line at the last path cell in a corridor [m]
   bool seen = false;
   for (int i = 0; i < n; ++i) {
     const std::size_t k = static_cast<std::size_t>(i);
+    if (off[k]) continue;
     const double w = a.wanted[k];
     if (!std::isnan(w)) shift = std::clamp(w, -max_shift_m, max_shift_m), seen = true;
     CellIndex cell = path[k];

@@ -46,9 +46,12 @@ std::vector<CellIndex> lane_path(const deliberative::LocalMap& local, const Cell
 /// its distance from it but at most max_shift_m [m], at once (no 45-degree entry); every later cell with no corridor
 /// across it (past the corridor's end) is moved by the last shift, across the path's direction there: the centre
 /// line carried on; cells before the first corridor cell stay. Consecutive repeats are merged. A path of one cell or
-/// max_shift_m <= 0: unchanged.
+/// max_shift_m <= 0: unchanged. `structure` (optional, the window's size: the cells seen raised,
+/// RaisedCells::raised()): path cells that run beside it are left out (nothing is built along them): off it, with
+/// structure across the path on either side that begins within corridor_width_m [m] and whose far edge lies more
+/// than half of that from the cell, for at least kMinCorridorCells path cells in a row.
 std::vector<CellIndex> band_centre_path(const deliberative::LocalMap& local, const CellMask& corridor,
                                         const std::vector<CellIndex>& path, double corridor_width_m,
-                                        double max_shift_m);
+                                        double max_shift_m, const CellMask* structure = nullptr);
 
 }  // namespace marsala::agent::executive

@@ -98,6 +98,7 @@ void RampSteps::admit(const protocol::Admission& admission) {
       context_.type.sensor.casts_rays() ? static_cast<std::size_t>(world.rows) * world.cols : 0;
   memory_.gap_streaks.assign(streak_cells, {});
   memory_.others_near.assign(streak_cells, 0);
+  if (band_centre_) memory_.raised.emplace(world.rows, world.cols);
   // A refused cell comes back once its ball reads differently: by more than the map's noise margin, at least half a
   // cube layer (the least another robot's deposit changes a cell).
   const double ball_cells = build.delta_m / (2.0 * world.cell_size_m);
@@ -128,6 +129,7 @@ BuildView RampSteps::look(const protocol::SensorFrame& frame, BuildTrace& trace)
   update_map(frame);
   learn_refusals(frame);
   BuildView view = synthesize_view(frame);
+  if (memory_.raised) memory_.raised->observe(view.local);  // before the neighbours leave the window's masks
   keep_clear(frame, view);
   trace.window_offset = view.local.offset;
   trace.local_goal = view.local.goal;
@@ -310,7 +312,13 @@ std::vector<CellIndex> RampSteps::on_band_centre(const deliberative::LocalMap& l
   // rounded to cells and the footprint is a disc of cells with a ragged edge.
   const double max_shift_m = 0.5 * (corridor_width_m_ - context_.type.body.navigability.delta_m) -
                              std::sqrt(2.0) * local.geometry().cell_size_m;
-  return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m);
+  if (!memory_.raised) return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m);
+  // Nothing is built along a path that runs beside the structure (the cells seen raised): the band is there already.
+  // A cell counts as raised by at least half a cube layer (the least a deposition adds), and beyond a scanned map's
+  // noise margin.
+  const executive::DepositionParams& deposits = modules_->depositions.params();
+  const CellMask built = memory_.raised->raised(local, std::max(deposits.gap_margin_m, 0.5 * deposits.cube_layer_m));
+  return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m, &built);
 }
 
 void RampSteps::move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) {

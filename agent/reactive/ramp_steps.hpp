@@ -37,6 +37,7 @@
 #include "marsala/agent/executive/body_clearance.hpp"
 #include "marsala/agent/executive/deposition_manager.hpp"
 #include "marsala/agent/executive/mapping_system.hpp"
+#include "marsala/agent/executive/raised_cells.hpp"
 #include "marsala/agent/executive/refused_cells.hpp"
 #include "marsala/agent/reactive/right_of_way.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
@@ -132,7 +133,8 @@ class RampSteps {
   /// One construction band for every front robot (docs/runtime.md#the-construction-band): when on, what the robot
   /// fills follows its deposition path moved onto the centre line of the corridor it runs in (executive/lane.hpp
   /// band_centre_path, on its own map without the other robots), not the path from where it stands; it still drives
-  /// its own path. Needs set_lane()'s corridor width; off by default.
+  /// its own path; and nothing along a stretch of it that runs beside the structure (the cells its map saw raised,
+  /// executive/raised_cells.hpp). Needs set_lane()'s corridor width; off by default; set before admit().
   void set_band_centre(bool on) { band_centre_ = on; }
   /// `path` moved into this robot's lane on the last look()'s map (unchanged without lanes).
   std::vector<CellIndex> in_lane(const deliberative::LocalMap& local, const std::vector<CellIndex>& path) const;
@@ -209,6 +211,7 @@ class RampSteps {
     CellMask corridor;                             ///< the last local map's navigable cells, neighbours not taken out
     CellMask terrain_occupiable;                   ///< and its occupiable cells
     std::vector<CellIndex> home;                   ///< the way home of this trip (world cells), empty: not planned
+    std::optional<executive::RaisedCells> raised;  ///< set_band_centre(): the structure seen built (first heights)
   };
 
   // look()'s steps, in order.

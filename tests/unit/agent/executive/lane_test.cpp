@@ -190,5 +190,47 @@ TEST(Lane, BandCentrePathMovesEveryPathInTheBandOntoItsCentreAtOnce) {
   EXPECT_EQ(band_centre_path(open, open.navigable, row_path(47, 5, 70), 3.0, 1.0), row_path(47, 5, 70));
 }
 
+// Open ground (no corridor of navigable cells) with a structure: rows `first`..`last` raised, from column 0 to column
+// `tip` (cells of 0.1 m: row r spans y in [7.9 - 0.1 r, 8.0 - 0.1 r)).
+CellMask raised_strip(int first, int last, int tip) {
+  CellMask m = CellMask::Zero(80, 80);
+  for (int r = first; r <= last; ++r)
+    for (int c = 0; c <= tip; ++c) m(r, c) = 1;
+  return m;
+}
+
+TEST(Lane, BandCentrePathBuildsNothingBesideTheStructureButGoesOnPastItsTip) {
+  const deliberative::LocalMap open = band_map({60, 5}, false);
+  const CellMask strip = raised_strip(25, 54, 40);  // 3 m across, as wide as the band
+  // Row 60 runs 0.6 m south of the strip's edge (row 54): beside it as far as column 40 (a column's cells across
+  // the path meet the strip there), past its tip from column 41 on, where the path is kept as it is.
+  EXPECT_EQ(band_centre_path(open, open.navigable, row_path(60, 5, 70), 3.0, 1.0, &strip), row_path(60, 41, 70));
+  // Row 75 is 2.05 m from the edge, within the 3 m looked across: beside too.
+  EXPECT_EQ(band_centre_path(open, open.navigable, row_path(75, 5, 70), 3.0, 1.0, &strip), row_path(75, 41, 70));
+  // A structure farther than 3 m across (rows 25..29, row 62 is 3.25 m from row 29) is not beside the path.
+  const CellMask far = raised_strip(25, 29, 40);
+  EXPECT_EQ(band_centre_path(open, open.navigable, row_path(62, 5, 70), 3.0, 1.0, &far), row_path(62, 5, 70));
+  // A narrow structure whose far edge lies within half the band (rows 50..54, 0.75 m at most from row 57) is one
+  // the band centred on the path still holds: kept (it is being built, not widened).
+  const CellMask narrow = raised_strip(50, 54, 40);
+  EXPECT_EQ(band_centre_path(open, open.navigable, row_path(57, 5, 70), 3.0, 1.0, &narrow), row_path(57, 5, 70));
+  // A notch in a structure narrower than the band (rows 28..37 and 43..51: both edges 1.2 m from row 40) is filled,
+  // not skipped.
+  CellMask notch = raised_strip(28, 51, 40);
+  for (int r = 38; r <= 42; ++r)
+    for (int c = 0; c <= 40; ++c) notch(r, c) = 0;
+  EXPECT_EQ(band_centre_path(open, open.navigable, row_path(40, 5, 70), 3.0, 1.0, &notch), row_path(40, 5, 70));
+  // A path along the structure, on it, keeps every cell (on open ground nothing moves it either).
+  EXPECT_EQ(band_centre_path(open, open.navigable, row_path(47, 5, 70), 3.0, 1.0, &strip), row_path(47, 5, 70));
+  // A path that leaves the structure across it keeps every cell.
+  std::vector<CellIndex> across;
+  for (int r = 47; r <= 79; ++r) across.push_back({r, 20});
+  EXPECT_EQ(band_centre_path(open, open.navigable, across, 3.0, 1.0, &strip), across);
+  // Without the structure (or with one of another size) the path stays.
+  const CellMask other = CellMask::Ones(10, 10);
+  EXPECT_EQ(band_centre_path(open, open.navigable, row_path(60, 5, 70), 3.0, 1.0), row_path(60, 5, 70));
+  EXPECT_EQ(band_centre_path(open, open.navigable, row_path(60, 5, 70), 3.0, 1.0, &other), row_path(60, 5, 70));
+}
+
 }  // namespace
 }  // namespace marsala::agent::executive
