@@ -20,6 +20,7 @@
 #include "marsala/agent/runtime/map_dump.hpp"
 #include "marsala/cli/command_line.hpp"
 #include "marsala/cli/logging.hpp"
+#include "marsala/protocol/world_proof.hpp"
 #include "marsala/scenario/scenario.hpp"
 
 namespace {
@@ -78,7 +79,11 @@ int main(int argc, char** argv) {
                  "restarted with --resume) is waited for until then, never given up on earlier")
       ->capture_default_str()
       ->check(marsala::cli::seconds_within(0.0, 1e9, " (0: wait forever)"));
-  std::string dump_dir;
+  std::string dump_dir, run_key;
+  app.add_option("--run-key", run_key,
+                 "the run's key (the world's OUT/run.key): believe only the world that proves it, never a stranger\n"
+                 "answering first (default: the first world that proves any key, pinned; docs/runtime.md#who-wrote-it)")
+      ->type_name("FILE");
   app.add_option("--dump-map", dump_dir,
                  "when its admitted run ends, write the robot's map into DIR: agent-<id>-height.asc (NODATA: unknown)\n"
                  "and agent-<id>-map.json; a DIR holding another run's maps is refused (exit 2)")
@@ -89,10 +94,13 @@ int main(int argc, char** argv) {
   const std::uint32_t id = id_text == "auto" ? 0u : static_cast<std::uint32_t>(std::stoul(id_text));
   marsala::cli::setup_logging("agent", id, log_options);
   std::shared_ptr<agent::runtime::MapDump> dump;
+  std::string world_key;
   try {
     if (!dump_dir.empty()) dump = std::make_shared<agent::runtime::MapDump>(dump_dir);
+    if (!run_key.empty()) world_key = protocol::world_key_of(protocol::load_run_key(run_key));
   } catch (const Error& e) {
-    marsala::cli::write_exit_error(std::cerr, fmt::format("marsala-agent: {}", e.what()));
+    marsala::cli::write_exit_error(std::cerr,
+                                   fmt::format("marsala-agent: {}{}", run_key.empty() ? "" : "--run-key ", e.what()));
     return marsala::cli::kExitUsage;
   }
   try {
@@ -114,6 +122,7 @@ int main(int argc, char** argv) {
     if (s.has_goal_vector_map) config.goal_vector_map = s.goal_vector_map;
     config.admit_timeout = std::chrono::milliseconds(static_cast<long long>(admit_timeout_s * 1000.0));
     config.world_timeout = std::chrono::milliseconds(static_cast<long long>(world_timeout_s * 1000.0));
+    config.world_key = world_key;
     if (dump) agent::runtime::dump_maps_into(dump, config);
 
     if (!dds.security.empty() && id == 0 && dds.identity.empty())

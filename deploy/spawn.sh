@@ -130,6 +130,12 @@ if [ "$check_rc" -ne 0 ]; then
 fi
 
 mkdir -p "$out/logs"
+# The run's key (docs/runtime.md#who-wrote-it): the world proves itself with it; the agents and monitors, given it,
+# believe no other participant speaking in the world's name. OUT/run.key, readable by its owner only; --resume reads
+# it back.
+(umask 077 && od -An -tx1 -N32 /dev/urandom | tr -d ' \n' >"$out/run.key")
+key_args=(--run-key "$out/run.key")
+export MARSALA_RUN_KEY="$out/run.key"
 pids=()
 cleanup() {
   trap - EXIT INT TERM
@@ -141,12 +147,12 @@ cleanup() {
 trap cleanup EXIT
 trap 'echo "spawn.sh: interrupted, stopping children" >&2; exit 130' INT TERM
 
-"$bin/marsala-world" "${world_args[@]}" >"$out/logs/world.log" 2>&1 &
+"$bin/marsala-world" "${world_args[@]}" "${key_args[@]}" >"$out/logs/world.log" 2>&1 &
 world_pid=$!
 pids+=("$world_pid")
 for id in $(seq 1 "$agents"); do
   "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds "$agent_dds" --domain "$domain" \
-    "${seed_args[@]}" "${set_args[@]}" "${sec_args[@]}" "${agent_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
+    "${seed_args[@]}" "${set_args[@]}" "${sec_args[@]}" "${agent_args[@]}" "${key_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
   pids+=("$!")
 done
 [ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain; logs in $out/logs"

@@ -252,8 +252,9 @@ int run_status(bus::Participant& participant, const StatusOptions& options, cons
   auto statuses =
       participant.create_reader<protocol::WorldStatus>({"", stop.signal(), bus::Durability::kTransientLocal, 1});
   const Clock::time_point deadline = Clock::now() + to_clock(options.timeout);
+  WorldGate gate(err);  // only a world that proves itself speaks for its run
   for (;;) {
-    const std::vector<protocol::WorldStatus> batch = statuses->take();
+    const std::vector<protocol::WorldStatus> batch = gate.statuses(statuses->take_received());
     if (!batch.empty()) {
       // The newest (the last of the highest step): a transient-local replay may arrive after a live sample.
       const protocol::WorldStatus* latest = &batch.front();

@@ -24,6 +24,7 @@
 #include "marsala/monitor/follow.hpp"
 #include "marsala/monitor/progress.hpp"
 #include "marsala/monitor/replay.hpp"
+#include "marsala/monitor/world_gate.hpp"
 #include "marsala/monitor/run_report.hpp"
 #include "marsala/monitor/serve.hpp"
 
@@ -302,6 +303,12 @@ int run_chosen(MonitorCommands& c, const StopSource& stop, std::ostream& out, st
       return 0;
     }
     if (*c.replay.cmd) return run_replay_command(c.replay, out, err);
+    try {
+      WorldGate::world_key_from_environment();  // a bad run key file is bad input: exit 2 before any traffic
+    } catch (const InvalidArgument& e) {
+      err << fmt::format("marsala-monitor: {}\n", e.what());
+      return cli::kExitUsage;
+    }
     const std::unique_ptr<bus::Participant> participant = join_domain(c.dds);
     if (*c.tail.cmd) return run_tail_command(c.tail, *participant, stop, out, err);
     if (*c.progress.cmd) return run_progress_command(c.progress, *participant, stop, out, err);

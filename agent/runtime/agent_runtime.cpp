@@ -14,6 +14,7 @@
 #include "marsala/core/error.hpp"
 #include "marsala/core/log_pacing.hpp"
 #include "marsala/core/statistics.hpp"
+#include "marsala/protocol/world_proof.hpp"
 
 namespace marsala::agent::runtime {
 namespace {
@@ -75,6 +76,7 @@ AgentRuntime::AgentRuntime(bus::Participant& participant, RuntimeConfig config)
         fmt::format("agent {}: the hello period and admit timeout must be positive, the world timeout not negative",
                     config_.agent_id));
   if (config_.session == 0) config_.session = random_session();
+  world_key_ = config_.world_key;
   // Made at once, so that an unknown behaviour fails before any traffic; an agent that asks for any slot (agent_id
   // 0) makes it again once its admission names the slot.
   make_behaviour();
@@ -136,6 +138,7 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
       const protocol::Admission& a = received.sample;
       const bool any_slot = config_.agent_id == 0;
       if (a.session != config_.session || (!any_slot && a.agent_id != config_.agent_id)) continue;  // not ours
+      if (!from_world(a, received.from, result)) continue;
       if (!a.accepted) {
         result.outcome = RunOutcome::kRefused;
         result.message = fmt::format("refused by the world: {}", a.reason);
@@ -152,6 +155,7 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
       }
       admission = a;
       world_ = received.from;
+      world_key_ = a.world_key;
       assignment_ = a.assignment;
       result.run_id = a.run_id;
       behaviour_->on_admission(a);
@@ -163,6 +167,19 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
   }
   result.outcome = RunOutcome::kStopped;
   result.message = "stopped before admission";
+  return false;
+}
+
+bool AgentRuntime::from_world(const protocol::Admission& a, const bus::WriterId& from, RunResult& result) const {
+  const char* problem = nullptr;
+  if (!world_key_.empty() && a.world_key != world_key_)
+    problem = "not signed with this run's key";
+  else if (!protocol::world_proven(a.world_key, a.world_proof, a.run_id, from.prefix))
+    problem = "its proof does not hold for that participant";
+  if (problem == nullptr) return true;
+  if (power_of_ten(++result.ignored_admissions))
+    spdlog::warn("agent {}: ignoring an admission ({}) from participant {} ({} so far): {}", config_.agent_id,
+                 a.accepted ? "accepted" : "refused", from.to_string(), result.ignored_admissions, problem);
   return false;
 }
 
@@ -234,10 +251,10 @@ class AgentRuntime::Lockstep {
     for (const bus::Received<protocol::Admission>& received : agent_.admissions_->take_received()) {
       const protocol::Admission& a = received.sample;
       if (a.agent_id != config.agent_id || a.session != config.session || !watch_.asked()) continue;
-      // Another participant answering: the world was restarted from its log (docs/runtime.md#resume), and frames now
-      // come from it; or a stranger, which only a stop of the world's frames lets in (asked), and only for this run.
+      // Another participant answering: the world was restarted from its log (docs/runtime.md#resume) and proves the
+      // run's key; frames now come from it. A stranger cannot prove it (docs/runtime.md#who-wrote-it).
       if (received.from != gate_.world()) {
-        if (!a.accepted || a.run_id != admission_.run_id) continue;
+        if (!a.accepted || a.run_id != admission_.run_id || !agent_.from_world(a, received.from, result_)) continue;
         spdlog::info("agent {}: the world of run '{}' answers from participant {} now (was {})", id(), a.run_id,
                      received.from.to_string(), gate_.world().to_string());
         gate_.set_world(received.from);
@@ -308,9 +325,9 @@ class AgentRuntime::Lockstep {
     result_.decision_cpu_median_ms = costs_.median_ms();
     result_.cpu_ms_per_step = costs_.process_ms_per(result_.requests);
     spdlog::info(
-        "agent {}: {} ({} requests, {} rejected, {} frames ignored; decision CPU median {:.3f} ms, "
-        "process CPU {:.3f} ms per step)",
-        id(), result_.message, result_.requests, result_.rejected, result_.ignored_frames,
+        "agent {}: {} ({} requests, {} rejected, {} frames ignored, {} admissions ignored; decision CPU median "
+        "{:.3f} ms, process CPU {:.3f} ms per step)",
+        id(), result_.message, result_.requests, result_.rejected, result_.ignored_frames, result_.ignored_admissions,
         result_.decision_cpu_median_ms, result_.cpu_ms_per_step);
   }
 

@@ -41,6 +41,9 @@ struct RuntimeConfig {
   std::chrono::milliseconds hello_period{200};       ///< between hellos until admitted
   std::chrono::milliseconds admit_timeout{60000};    ///< give up when not admitted by then
   std::chrono::milliseconds world_timeout{600000};   ///< give up when no frame comes for this long; 0: never
+  /// The run's public key (protocol::world_key_of() of --run-key): only a world that proves it is believed. Empty:
+  /// the key of the first world that proves itself is pinned (docs/runtime.md#who-wrote-it).
+  std::string world_key;
   std::function<void(std::uint32_t)> on_assigned;    ///< called with the slot an --id auto agent was given (logging)
   /// Called once admitted, with the run's id: a non-empty answer refuses the run on the agent's side (kOutputRefused,
   /// the answer as message; e.g. a --dump-map folder holding another run's maps).
@@ -67,6 +70,7 @@ struct RunResult {
   std::uint64_t last_answered = 0;   ///< step of the last new decision sent
   std::uint64_t repeated_past = 0;   ///< requests repeated for steps before last_answered (the world went back) [count]
   std::uint64_t ignored_frames = 0;  ///< frames not from the world it was admitted to, or inconsistent [count]
+  std::uint64_t ignored_admissions = 0;  ///< admissions of this agent not proven by the run's world [count]
   std::string final_state;           ///< the behaviour's state at the end
   double decision_cpu_median_ms = 0.0;  ///< median CPU time of the behaviour's decision of one step [ms]
   double cpu_ms_per_step = 0.0;  ///< the process's CPU time (all threads, DDS's too) from its first decision to the
@@ -96,6 +100,9 @@ class AgentRuntime {
 
  private:
   bool admit(const std::atomic<bool>& stop, RunResult& result, protocol::Admission& admission);
+  /// True when admission `a`, written by participant `from`, comes from the run's world: signed for `from` with the
+  /// run's key (config world_key, or the key pinned at admission); otherwise counted and logged (1st, 10th, ...).
+  bool from_world(const protocol::Admission& a, const bus::WriterId& from, RunResult& result) const;
   void end_admitted(const RunResult& result, bool failed) const;
   void make_behaviour();
   class Lockstep;  // the loop after admission, in agent_runtime.cpp
@@ -108,6 +115,7 @@ class AgentRuntime {
   std::unique_ptr<bus::Reader<protocol::Admission>> admissions_;
   bus::WriterId
       world_;  ///< the participant whose admission let this agent in (the lockstep's frame gate takes frames from it)
+  std::string world_key_;  ///< the run's public key: configured, or pinned from the admission that let it in
   Assignment assignment_;
   std::unique_ptr<reactive::Behaviour> behaviour_;
 };

@@ -41,6 +41,8 @@ struct Admission {
   std::string reason;     ///< why not, when rejected
   std::string run_id;     ///< names the run; the agent's endpoints use partition_for(run, id, session)
   Assignment assignment;  ///< when accepted: grid, tile size, start, target and base station
+  std::string world_key;    ///< the run's public key, 64 hex digits (world_proof.hpp)
+  std::string world_proof;  ///< the world's signature of (run, its participant), 128 hex digits (world_proof.hpp)
 };
 
 /// Outcome of an agent's previous request, reported in its next frame.
@@ -116,6 +118,8 @@ struct WorldStatus {
   bool admitting = false;      ///< the world is still admitting its agents (before its first step)
   std::string progress_detail;  ///< the progress in words, e.g. "12.31 of 21.30 m3 of MARS gap left on the route"
   std::uint32_t team_size = 0;  ///< slots of the run's team (--agents), admitted or not [count]; 0 = not said
+  std::string world_key;        ///< the run's public key, 64 hex digits (world_proof.hpp)
+  std::string world_proof;      ///< the world's signature of (run, its participant), 128 hex digits (world_proof.hpp)
 };
 
 /// Kinds of world events, for the event stream and the monitor.

@@ -1,9 +1,11 @@
 // The bus across processes: marsala-bus-probe processes of either vendor, per vendor pair. Frames travel bit for
 // bit and only within their partition; a SIGKILLed writer process is seen as not alive within a few seconds (and an
 // idle live one never is); two clients of the discovery star never find each other; an idle agent's participant
-// stays small. Run under run_isolated.sh (private network namespace) with the loopback configs in the environment
-// (CMakeLists.txt). Domains 160..163, 180..188.
+// stays small; a foreign type under a message's name costs a reader bounded log and no genuine frame. Run under
+// run_isolated.sh (private network namespace) with the loopback configs in the environment (CMakeLists.txt). Domains
+// 160..163, 180..193.
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <poll.h>
 #include <signal.h>
@@ -12,6 +14,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,13 +31,18 @@ using Clock = std::chrono::steady_clock;
 /// A child process whose stdout is read line by line.
 class Child {
  public:
-  explicit Child(const std::vector<std::string>& args) {
+  /// Runs `args`; its stderr goes to the file `stderr_path` when one is given.
+  explicit Child(const std::vector<std::string>& args, const std::string& stderr_path = "") {
     int fds[2];
     if (pipe(fds) != 0) throw std::runtime_error("pipe failed");
     pid_ = fork();
     if (pid_ < 0) throw std::runtime_error("fork failed");
     if (pid_ == 0) {
       dup2(fds[1], STDOUT_FILENO);
+      if (!stderr_path.empty()) {
+        const int err = open(stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (err >= 0) dup2(err, STDERR_FILENO);
+      }
       close(fds[0]);
       close(fds[1]);
       std::vector<char*> argv;
@@ -204,6 +212,35 @@ TEST_P(BusAcrossProcesses, ClientsFindTheServerButNotEachOther) {
       probe("write", GetParam().writer, domain,
             {"--role", "client", "--partition", "run-s/agent-1", "--count", "10", "--readers", "1"}),
       10, 3s);
+}
+
+// A foreign type under SensorFrame's name (another layout) floods the reader's partition while 20 genuine frames come
+// (docs/runtime.md#foreign-types): the reader gets all 20, bit for bit and nothing else, and its log (stderr) stays
+// within a few lines: Cyclone's line per undecodable sample is written at the 1st, 10th, 100th ... only.
+TEST_P(BusAcrossProcesses, AForeignTypeCostsBoundedLogAndNoGenuineFrame) {
+  const int domain = 190 + GetParam().index;
+  const std::string log = ::testing::TempDir() + "/foreign_reader_" + std::to_string(getpid()) + ".log";
+  Child reader(probe("read", GetParam().reader, domain,
+                     {"--partition", "run-f/agent-1", "--count", "20", "--tiles", "40", "--timeout-s", "40"}),
+               log);
+  ASSERT_TRUE(reader.expect_line("ready", 10s));
+  Child foreign({MARSALA_FOREIGN_TYPE, std::to_string(domain), "SensorFrame", "run-f/agent-1", "3"});
+  ASSERT_TRUE(foreign.expect_line("matched", 25s)) << foreign.last_line();
+  Child writer(probe("write", GetParam().writer, domain,
+                     {"--partition", "run-f/agent-1", "--count", "20", "--tiles", "40", "--readers", "1"}));
+  ASSERT_TRUE(writer.expect_line("matched", 20s)) << writer.last_line();
+  EXPECT_EQ(reader.wait_exit(40s), 0) << "reader: " << reader.last_line();
+  EXPECT_EQ(reader.last_line(), "received 20");
+  EXPECT_EQ(foreign.wait_exit(20s), 0) << foreign.last_line();
+  std::printf("%s; %s reader: ", foreign.last_line().c_str(), to_string(GetParam().reader).c_str());
+  writer.send(SIGTERM);
+  EXPECT_EQ(writer.wait_exit(10s), 0);
+  std::ifstream in(log);
+  int lines = 0;
+  for (std::string line; std::getline(in, line);) lines += line.empty() ? 0 : 1;
+  std::printf("%d log lines\n", lines);
+  EXPECT_LE(lines, 12) << "the reader's log grew under the foreign flood (" << log << ")";
+  std::remove(log.c_str());
 }
 
 INSTANTIATE_TEST_SUITE_P(Pairs, BusAcrossProcesses,

@@ -1,7 +1,8 @@
 // marsala-rogue-agent: a misbehaving agent process for integration tests. It gets admitted like a real agent,
-// then sends one bad request per step (spoofed id and session on another agent's partition, wrong step, NaN,
-// over-threshold deposition, out-of-reach deposition, a duplicate, absurd motion), then leaves. The world must
-// reject each with a reason, never crash, and let the other agents complete.
+// then sends one bad request per step (spoofed id on another agent's partition, wrong step, NaN, over-threshold
+// deposition, out-of-reach deposition, a duplicate, absurd motion, and agent 1's own session, read from its hello,
+// driving agent 1 west), then leaves. The world must reject each with a reason or ignore it (requests on agent 1's
+// session from this participant: docs/runtime.md#who-wrote-it), never crash, and let the other agents complete.
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -60,7 +61,11 @@ protocol::ActionRequest attack(int n, const protocol::ActionRequest& valid, cons
       what = "negative deposition";
       r.depositions.push_back({0, 0, -cell_m});
       break;
-    default: what = "duplicate request for the same step"; break;
+    case 7: what = "duplicate request for the same step"; break;
+    default:
+      what = "agent 1's session: a motion west on its partition";
+      spoof = true;
+      break;
   }
   return r;
 }
@@ -76,10 +81,12 @@ int run(int argc, char** argv) {
   const int domain = std::stoi(argv[4]);
   const RobotType& robot = sc.robot_for(id);
 
-  auto participant = bus::make_participant({vendor, domain});
+  // In the world's role: at an index agents probe, so that agent 1's hellos reach it (clients do not find each other).
+  auto participant = bus::make_participant({vendor, domain, {}, bus::Role::kWorld});
   auto signal = std::make_shared<bus::Signal>();
   auto hello_writer = participant->create_writer<protocol::AgentHello>();
   auto admissions = participant->create_reader<protocol::Admission>({"", signal});
+  auto others = participant->create_reader<protocol::AgentHello>({"", nullptr});  // agent 1's session, in clear
 
   protocol::AgentHello hello;
   hello.agent_id = id;
@@ -101,16 +108,22 @@ int run(int argc, char** argv) {
   auto frames = participant->create_reader<protocol::SensorFrame>({mine, signal});
   auto requests = participant->create_writer<protocol::ActionRequest>({mine, nullptr});
   auto victim =
-      // Agent 1's partition is named by its session, which the rogue does not know: a partition wildcard reaches it.
+      // Agent 1's partition is named by its session: a partition wildcard reaches it.
       participant->create_writer<protocol::ActionRequest>({admission.run_id + "/agent-1-*", nullptr});
+  std::uint64_t victim_session = 0;  // from agent 1's hellos, which it says before the lockstep starts
 
   int attacks_sent = 0;
-  constexpr int kAttacks = 8;
+  constexpr int kAttacks = 9;
   constexpr int kHonestSteps = 4;
   int honest_after = 0;
   const auto deadline = std::chrono::steady_clock::now() + 120s;
   while (std::chrono::steady_clock::now() < deadline) {
     signal->wait_for(100ms);
+    for (const protocol::AgentHello& h : others->take())
+      if (h.agent_id == 1 && h.session != victim_session) {
+        victim_session = h.session;
+        std::cout << "rogue: agent 1 says hello with session " << std::hex << victim_session << std::dec << std::endl;
+      }
     for (const auto& frame : frames->take()) {
       if (frame.run_over) return 0;
       if (attacks_sent > 0)
@@ -133,11 +146,19 @@ int run(int argc, char** argv) {
       }
       bool spoof = false;
       std::string what;
-      const protocol::ActionRequest bad =
+      protocol::ActionRequest bad =
           attack(attacks_sent, valid, frame, admission.assignment.world.cell_size_m, spoof, what);
+      if (attacks_sent == kAttacks - 1) {  // in agent 1's name, as agent 1 would: its id, session and step
+        if (victim_session == 0) throw Error("rogue: agent 1's hello was never heard");
+        bad.agent_id = 1;
+        bad.session = victim_session;
+        bad.move = true;
+        bad.target_x_m = frame.x_m - admission.assignment.world.cell_size_m;  // any valid-looking motion
+        bad.target_y_m = frame.y_m;
+      }
       std::cout << "rogue: step " << frame.step << " sending " << what << std::endl;
       (spoof ? victim : requests)->write(bad);
-      if (attacks_sent == kAttacks - 1) requests->write(bad);       // the duplicate goes out twice
+      if (attacks_sent == 7) requests->write(bad);                  // the duplicate goes out twice
       if (spoof || bad.step != frame.step) requests->write(valid);  // keep our own barrier slot filled
       ++attacks_sent;
     }

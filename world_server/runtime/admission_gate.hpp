@@ -3,6 +3,7 @@
 // with the clock passed in. Agents repeat their hello every 200 ms until answered; a flood of one-shot random sessions
 // never does. The gate remembers senders in bounded maps, so no flood can grow the world's memory.
 
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -13,20 +14,30 @@
 
 namespace marsala::world_server {
 
-/// Who says hello: an agent id and the session of its process.
+/// A participant's RTPS GUID prefix (bus::WriterId::prefix; this bus-free unit keeps the bytes).
+using WriterPrefix = std::array<std::uint8_t, 12>;
+
+/// Who says hello: an agent id, the session of its process and the participant that wrote it (a copy of another
+/// agent's hello, read on the default partition, is another sender: docs/runtime.md#who-wrote-it).
 struct SenderKey {
   std::uint32_t agent_id = 0;  ///< the hello's agent id (kAnySlot included)
   std::uint64_t session = 0;   ///< the hello's session: one per agent process
-  /// Ordered by agent id, then session.
+  WriterPrefix writer{};       ///< GUID prefix of the participant that wrote the hello (unknown: all zero)
+  /// Ordered by agent id, then session, then writer.
   bool operator<(const SenderKey& o) const {
-    return agent_id != o.agent_id ? agent_id < o.agent_id : session < o.session;
+    if (agent_id != o.agent_id) return agent_id < o.agent_id;
+    return session != o.session ? session < o.session : writer < o.writer;
   }
-  /// Same id and session.
-  bool operator==(const SenderKey& o) const { return agent_id == o.agent_id && session == o.session; }
+  /// Same id, session and writer.
+  bool operator==(const SenderKey& o) const {
+    return agent_id == o.agent_id && session == o.session && writer == o.writer;
+  }
 };
 
-/// The sender of `hello`.
-inline SenderKey sender_of(const protocol::AgentHello& hello) { return {hello.agent_id, hello.session}; }
+/// The sender of `hello`, written by the participant of GUID prefix `writer`.
+inline SenderKey sender_of(const protocol::AgentHello& hello, const WriterPrefix& writer = {}) {
+  return {hello.agent_id, hello.session, writer};
+}
 
 /// A session is admitted (first, re-admission, takeover) only on a hello repeated at least this long after its first.
 inline constexpr std::chrono::milliseconds kHelloConfirmation{100};

@@ -5,6 +5,8 @@
 #include <exception>
 #include <utility>
 
+#include "marsala/core/log_pacing.hpp"
+
 namespace marsala::world_server {
 
 template <typename T>
@@ -25,12 +27,13 @@ AgentLinks::AgentLinks(bus::Participant& participant, std::shared_ptr<bus::Signa
                        std::size_t slots)
     : participant_(participant), signal_(std::move(signal)), run_id_(std::move(run_id)), links_(slots) {}
 
-void AgentLinks::open(const AgentRecord& a) {
+void AgentLinks::open(const AgentRecord& a, const bus::WriterId& owner) {
   AgentLink& link = links_[a.id - 1];
   if (link.requests && link.session == a.session) return;
   const std::string partition = protocol::partition_for(run_id_, a.id, a.session);
   link = AgentLink{};
   link.session = a.session;
+  link.owner = owner;
   link.frames = participant_.create_writer<protocol::SensorFrame>({partition, nullptr, bus::Durability::kVolatile, 64});
   link.requests =
       participant_.create_reader<protocol::ActionRequest>({partition, signal_, bus::Durability::kVolatile, 64});
@@ -52,9 +55,39 @@ LivelinessVerdict AgentLinks::observe(std::uint32_t id, LivelinessWatch::Clock::
   return link.liveliness.observe(link.requests->alive_writers() >= 1, now);
 }
 
+bool AgentLinks::bind(std::uint32_t id, const bus::WriterId& from) {
+  AgentLink& link = links_[id - 1];
+  if (!link.owner.known()) {
+    link.owner = from;
+    spdlog::info("agent {}: session {:016x} belongs to participant {} from now on", id, link.session,
+                 from.to_string());
+    return true;
+  }
+  if (from == link.owner) return true;
+  count_foreign(id, from, "hellos");
+  return false;
+}
+
+void AgentLinks::count_foreign(std::uint32_t id, const bus::WriterId& from, const char* what) {
+  AgentLink& link = links_[id - 1];
+  if (power_of_ten(++link.foreign))
+    spdlog::warn("agent {}: ignoring {} of its session {:016x} from participant {} ({} so far): the session belongs "
+                 "to participant {}",
+                 id, what, link.session, from.to_string(), link.foreign, link.owner.to_string());
+}
+
 std::vector<protocol::ActionRequest> AgentLinks::take(std::uint32_t id) {
   AgentLink& link = links_[id - 1];
-  return link.requests ? link.requests->take() : std::vector<protocol::ActionRequest>{};
+  std::vector<protocol::ActionRequest> taken;
+  if (!link.requests) return taken;
+  for (bus::Received<protocol::ActionRequest>& r : link.requests->take_received()) {
+    if (link.owner.known() && r.from != link.owner) {
+      count_foreign(id, r.from, "requests");
+      continue;
+    }
+    taken.push_back(std::move(r.sample));
+  }
+  return taken;
 }
 
 void AgentLinks::send(std::uint32_t id, protocol::SensorFrame frame) {

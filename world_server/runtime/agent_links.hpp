@@ -1,7 +1,9 @@
 #pragma once
 // The world's links to its admitted agents: per slot, the endpoints of the admitted session on its partition
 // (protocol::partition_for(run_id, id, session)): a SensorFrame writer and an ActionRequest reader, the liveliness
-// of the agent's request writer (liveliness.hpp) and the frame of the current step, for resends.
+// of the agent's request writer (liveliness.hpp) and the frame of the current step, for resends. A session belongs to
+// the participant whose hello was admitted (its owner): requests on its partition from any other participant are
+// ignored and counted (docs/runtime.md#who-wrote-it); the session, readable by anyone, is worth nothing to them.
 
 #include <cstdint>
 #include <memory>
@@ -23,6 +25,8 @@ struct AgentLink {
   std::unique_ptr<bus::Reader<protocol::ActionRequest>> requests;
   LivelinessWatch liveliness;                  ///< of its request writer
   std::optional<protocol::SensorFrame> frame;  ///< the current step's frame, for resends
+  bus::WriterId owner;                         ///< the participant the session belongs to; unknown until bound
+  std::uint64_t foreign = 0;                   ///< requests from other participants ignored [count]
 };
 
 /// Writes a sample; a failing write is logged, never fatal: one agent's broken link must not stop the world.
@@ -35,9 +39,16 @@ class AgentLinks {
   /// `signal` wakes the world when a request arrives on any link.
   AgentLinks(bus::Participant& participant, std::shared_ptr<bus::Signal> signal, std::string run_id, std::size_t slots);
 
-  /// Opens the partition endpoints of `agent`'s admitted session, replacing another session's (a new link: its
-  /// liveliness starts unseen); nothing when they are open already.
-  void open(const AgentRecord& agent);
+  /// Opens the partition endpoints of `agent`'s admitted session, owned by participant `owner` (unknown: bound at
+  /// the session's next hello, bind()), replacing another session's (a new link: its liveliness starts unseen);
+  /// nothing when they are open already.
+  void open(const AgentRecord& agent, const bus::WriterId& owner = {});
+  /// Whether a hello of slot `id`'s admitted session written by `from` is its owner's: true when it is, or when the
+  /// link has no owner yet (a resumed world), which `from` then becomes; false (counted, logged at the 1st, 10th,
+  /// 100th ...) for another participant.
+  bool bind(std::uint32_t id, const bus::WriterId& from);
+  /// Requests and hellos of slot `id`'s session from participants other than its owner, ignored so far [count].
+  std::uint64_t foreign(std::uint32_t id) const { return links_[id - 1].foreign; }
   /// True when slot `id` has endpoints.
   bool has(std::uint32_t id) const { return static_cast<bool>(links_[id - 1].requests); }
   /// True when the request writer of slot `id`'s session is alive (false without endpoints).
@@ -50,7 +61,8 @@ class AgentLinks {
   LivelinessVerdict observe(std::uint32_t id, LivelinessWatch::Clock::time_point now);
   /// Forgets a running liveliness grace of slot `id` (it was just admitted again).
   void forgive(std::uint32_t id) { links_[id - 1].liveliness.forgive(); }
-  /// Takes the requests received on slot `id`'s partition (none without endpoints).
+  /// Takes the requests received on slot `id`'s partition from its session's owner (none without endpoints); the
+  /// others are counted as foreign.
   std::vector<protocol::ActionRequest> take(std::uint32_t id);
   /// Sends `frame` to slot `id` and keeps it for resend().
   void send(std::uint32_t id, protocol::SensorFrame frame);
@@ -61,6 +73,9 @@ class AgentLinks {
   bus::Participant& participant_;
   std::shared_ptr<bus::Signal> signal_;
   std::string run_id_;
+  /// Counts one sample of slot `id`'s session from `from`, not its owner, and logs the 1st, 10th, 100th ...
+  void count_foreign(std::uint32_t id, const bus::WriterId& from, const char* what);
+
   std::vector<AgentLink> links_;  ///< [id - 1]
 };
 

@@ -14,6 +14,7 @@
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
 #include "marsala/world_server/records/output_lock.hpp"
+#include "marsala/world_server/records/run_key_file.hpp"
 #include "marsala/world_server/records/run_outputs.hpp"
 #include "marsala/world_server/runtime/scenario_check.hpp"
 #include "marsala/world_server/runtime/world_runtime.hpp"
@@ -48,6 +49,26 @@ void add_timing_and_record_options(CLI::App& app, RuntimeOptions& options) {
       ->type_name("K");
 }
 
+/// The --run-key option (docs/runtime.md#who-wrote-it).
+void add_run_key_option(CLI::App& app, std::string& run_key) {
+  app.add_option("--run-key", run_key,
+                 "the run's key (64 hex digits; default: a new one, kept in OUT/run.key and read back by --resume):\n"
+                 "agents and monitors given it believe only this run's world (docs/runtime.md#who-wrote-it)")
+      ->type_name("FILE");
+}
+
+/// Exit code 2 (one line) when --run-key names no run key: refused before the folder is touched (settle_run_key()
+/// reads it again once the folder is the run's).
+std::optional<int> refuse_bad_run_key(const std::string& path, std::ostream& err) {
+  try {
+    if (!path.empty()) protocol::load_run_key(path);
+    return std::nullopt;
+  } catch (const InvalidArgument& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: --run-key {}", e.what()));
+    return cli::kExitUsage;
+  }
+}
+
 /// Locks the run's output folder into `lock` (docs/runtime.md#run-folders); the exit code when it cannot: 2 (one line
 /// naming the holder's pid) when another world holds it, 1 when the folder or its lock file cannot be made.
 std::optional<int> lock_folder(std::optional<OutputLock>& lock, const std::string& dir, std::ostream& err) {
@@ -61,6 +82,51 @@ std::optional<int> lock_folder(std::optional<OutputLock>& lock, const std::strin
     cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
     return 1;
   }
+}
+
+/// The run, once its folder is locked: the start (fresh or resumed), the run key, the participant, the lockstep and the
+/// last line; the exit code (docs/runtime.md#exit-codes), errors as one line.
+int run_in_folder(const std::string& scenario_path, const std::string& resume_dir, const std::string& run_key,
+                  const RuntimeOptions& options, const cli::DdsOptions& dds, const std::atomic<bool>& stop,
+                  std::ostream& out, std::ostream& err) {
+  try {
+    WorldStart start;
+    if (!resume_dir.empty()) {
+      start = prepare_resume(resume_dir, options, dds.domain);
+    } else {
+      try {
+        start = fresh_start(scenario_path, options, dds.domain);
+      } catch (const Error& e) {  // refused at start, as --check refuses it (docs/runtime.md#exit-codes)
+        cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+        return kExitInvalidScenario;
+      }
+    }
+    start.options.run_key = settle_run_key(run_key, start.options.out_dir, !resume_dir.empty());
+    const auto participant =
+        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kWorld,
+                               bus::Security::of(dds.security, dds.identity, "world")});
+    WorldRuntime runtime(std::move(start), *participant);
+    const RunResult result = runtime.run(stop);
+    out << fmt::format("run {}: {} after {} steps{}, {} agents{}, terrain sha256 {}\n", runtime.run_id(),
+                       to_string(result.end_reason), result.steps,
+                       result.resumed_at_step ? fmt::format(" (resumed at step {})", *result.resumed_at_step) : "",
+                       result.admitted,
+                       result.slots_missing > 0
+                           ? fmt::format(" ({} of {} slots missing at the end)", result.slots_missing, result.team)
+                           : "",
+                       result.terrain_sha256);
+    return exit_code(result.end_reason, result.slots_missing);
+  } catch (const Error& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return 1;
+  } catch (const std::bad_alloc&) {
+    cli::write_exit_error(err, "marsala-world: error: out of memory");
+    return 1;
+  } catch (const std::exception& e) {  // a library's own exception: still one line and exit 1, never an abort
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return 1;
+  }
+  return 0;
 }
 
 }  // namespace
@@ -81,7 +147,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       "Exit codes: 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled, 1 error, 2 usage or a\n"
       "scenario the world refuses at start (as --check).",
       "marsala-world"};
-  std::string scenario_path, check_path, resume_dir;
+  std::string scenario_path, check_path, resume_dir, run_key;
   cli::DdsOptions dds;
   RuntimeOptions options;
   bool quiet = false, check = false, json = false;
@@ -124,6 +190,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
           ->excludes(scenario_option)
           ->excludes(check_option);
   add_timing_and_record_options(app, options);
+  add_run_key_option(app, run_key);
   app.add_flag("--replace", options.replace,
                "remove a previous run's files from --out before starting (without it such a folder is refused)")
       ->excludes(resume_option);
@@ -143,46 +210,11 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
     return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, dds.domain, json, out, err);
   if (quiet && app.get_option("--log-level")->count() == 0) log_options.level = "warn";
   const cli::LoggingScope logging("world", 0, log_options);
+  if (const auto code = refuse_bad_run_key(run_key, err)) return *code;
   // The folder is this process's from here to its exit, before --replace clears it or --resume reads it.
   std::optional<OutputLock> lock;
   if (const auto code = lock_folder(lock, resume_dir.empty() ? options.out_dir : resume_dir, err)) return *code;
-  try {
-    WorldStart start;
-    if (!resume_dir.empty()) {
-      start = prepare_resume(resume_dir, options, dds.domain);
-    } else {
-      try {
-        start = fresh_start(scenario_path, options, dds.domain);
-      } catch (const Error& e) {  // refused at start, as --check refuses it (docs/runtime.md#exit-codes)
-        cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
-        return kExitInvalidScenario;
-      }
-    }
-    const auto participant =
-        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kWorld,
-                               bus::Security::of(dds.security, dds.identity, "world")});
-    WorldRuntime runtime(std::move(start), *participant);
-    const RunResult result = runtime.run(stop);
-    out << fmt::format("run {}: {} after {} steps{}, {} agents{}, terrain sha256 {}\n", runtime.run_id(),
-                       to_string(result.end_reason), result.steps,
-                       result.resumed_at_step ? fmt::format(" (resumed at step {})", *result.resumed_at_step) : "",
-                       result.admitted,
-                       result.slots_missing > 0
-                           ? fmt::format(" ({} of {} slots missing at the end)", result.slots_missing, result.team)
-                           : "",
-                       result.terrain_sha256);
-    return exit_code(result.end_reason, result.slots_missing);
-  } catch (const Error& e) {
-    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
-    return 1;
-  } catch (const std::bad_alloc&) {
-    cli::write_exit_error(err, "marsala-world: error: out of memory");
-    return 1;
-  } catch (const std::exception& e) {  // a library's own exception: still one line and exit 1, never an abort
-    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
-    return 1;
-  }
-  return 0;
+  return run_in_folder(scenario_path, resume_dir, run_key, options, dds, stop, out, err);
 }
 
 }  // namespace marsala::world_server

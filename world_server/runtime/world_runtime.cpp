@@ -15,6 +15,7 @@
 #include "marsala/core/format.hpp"
 #include "marsala/core/log_pacing.hpp"
 #include "marsala/core/statistics.hpp"
+#include "marsala/protocol/world_proof.hpp"
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/world_server/records/persistence.hpp"
 #include "marsala/world_server/records/run_outputs.hpp"
@@ -161,6 +162,11 @@ struct WorldRuntime::Impl {
     collector.emplace(*links, signal);
     std::random_device device;
     while (world_id == 0) world_id = (static_cast<std::uint64_t>(device()) << 32) ^ device();
+    // Who this world is, for agents and monitors (docs/runtime.md#who-wrote-it): the run key's public half and its
+    // signature of (run, this participant), once per process.
+    const protocol::RunKey key = options.run_key ? *options.run_key : protocol::make_run_key();
+    world_key = protocol::world_key_of(key);
+    world_proof = protocol::prove_world(key, options.run_id, participant.id().prefix);
   }
 
   void emit(const protocol::WorldEvent& e, const std::vector<Deposition>& cells = {}) {
@@ -185,6 +191,8 @@ struct WorldRuntime::Impl {
   void publish_status(bool running, bool completed, double wall_seconds) {
     protocol::WorldStatus s = world_status(state, running, completed, wall_seconds);
     s.world_id = world_id;
+    s.world_key = world_key;
+    s.world_proof = world_proof;
     s.admitting = running && !run_started;
     s.run_id = options.run_id;
     s.scenario = scenario.name;
@@ -213,11 +221,27 @@ struct WorldRuntime::Impl {
   /// True when the request writer of the slot's admitted session is alive.
   bool holder_connected(std::uint32_t id) const { return state.has_agent(id) && links->connected(id); }
 
+  /// False when `hello` names a slot's admitted session but `from` is not the participant that session belongs to
+  /// (a copy: ignored, counted, never answered; AgentLinks::bind()).
+  bool owned_session(const protocol::AgentHello& hello, const bus::WriterId& from) {
+    if (!state.has_agent(hello.agent_id) || !links->has(hello.agent_id)) return true;
+    const AgentRecord& a = state.agent(hello.agent_id);
+    return !a.admitted || a.session != hello.session || links->bind(hello.agent_id, from);
+  }
+
+  /// The answer to `hello`, with this world's proof.
+  protocol::Admission signed_admission(const protocol::AgentHello& hello, const AdmissionDecision& decision) const {
+    protocol::Admission a = admission_message(state, hello, decision, options.run_id);
+    a.world_key = world_key;
+    a.world_proof = world_proof;
+    return a;
+  }
+
   /// True when `hello` must wait for a live slot's connected session to go (AdmissionGate::takeover()).
-  bool waits_for_takeover(const protocol::AgentHello& hello, Clock::time_point now) {
+  bool waits_for_takeover(const protocol::AgentHello& hello, const SenderKey& sender, Clock::time_point now) {
     const bool held = state.has_agent(hello.agent_id) && state.agent(hello.agent_id).alive &&
                       state.agent(hello.agent_id).session != hello.session && holder_connected(hello.agent_id);
-    const TakeoverWait wait = gate.takeover(sender_of(hello), held, now);
+    const TakeoverWait wait = gate.takeover(sender, held, now);
     if (wait == TakeoverWait::kStarted)
       spdlog::info(
           "agent {}: session {:016x} says hello while session {:016x} is still connected; waiting up to {} s "
@@ -227,14 +251,15 @@ struct WorldRuntime::Impl {
     return wait != TakeoverWait::kNone;
   }
 
-  /// Carries out an accepted admission of a persistent sender: records it in run.log and opens its endpoints.
-  void carry_out(const protocol::AgentHello& slot, AdmissionKind kind) {
+  /// Carries out an accepted admission of a persistent sender, participant `from`: records it in run.log and opens
+  /// its endpoints, the session bound to `from`.
+  void carry_out(const protocol::AgentHello& slot, AdmissionKind kind, const bus::WriterId& from) {
     const std::uint64_t previous = state.agent(slot.agent_id).session;
     if (!admit(state, slot, kind)) return;
     recorder.record(admitted_record(state, slot.agent_id, kind));
     const AgentRecord& a = state.agent(slot.agent_id);
     if (kind != AdmissionKind::kFirst && a.session != previous) sensing->forget(slot.agent_id);
-    links->open(a);
+    links->open(a, from);
     links->forgive(slot.agent_id);
     std::string detail = a.name;
     if (kind == AdmissionKind::kReadmission)
@@ -257,20 +282,22 @@ struct WorldRuntime::Impl {
       next_admitting_status = now + kAdmittingStatusInterval;
     }
     gate.begin_round();
-    for (const protocol::AgentHello& hello : hellos->take()) {
-      if (waits_for_takeover(hello, now)) continue;
+    for (const bus::Received<protocol::AgentHello>& received : hellos->take_received()) {
+      const protocol::AgentHello& hello = received.sample;
+      const SenderKey sender = sender_of(hello, received.from.prefix);
+      if (!owned_session(hello, received.from) || waits_for_takeover(hello, sender, now)) continue;
       const AdmissionDecision decision = decide_admission(state, hello, run_started, holder_connected(hello.agent_id));
       if (decision.accepted && decision.kind != AdmissionKind::kRepeat) {
         const protocol::AgentHello slot = slot_hello(state, hello, decision);  // "any slot": the one assigned
-        if (!gate.persistent(sender_of(hello), now)) continue;                 // answered when it says hello again
-        carry_out(slot, decision.kind);
-      } else if (!decision.accepted && gate.report_refusal(sender_of(hello))) {
+        if (!gate.persistent(sender, now)) continue;                           // answered when it says hello again
+        carry_out(slot, decision.kind, received.from);
+      } else if (!decision.accepted && gate.report_refusal(sender)) {
         spdlog::warn("refused agent {}: {} ({} refusals so far)", hello.agent_id, decision.reason, gate.refusals());
         emit(make_event(hello.agent_id, protocol::EventKind::kRefused, decision.reason));
       }
       if (!decision.accepted && !gate.may_answer_refusal()) continue;
-      if (gate.may_answer(sender_of(hello), now))
-        write_logged(*admissions, admission_message(state, hello, decision, options.run_id), "an admission");
+      if (gate.may_answer(sender, now))
+        write_logged(*admissions, signed_admission(hello, decision), "an admission");
     }
   }
 
@@ -628,6 +655,7 @@ struct WorldRuntime::Impl {
   std::unique_ptr<bus::Writer<protocol::WorldEvent>> events;
   std::unique_ptr<bus::Reader<protocol::WorldStatus>> statuses;  ///< other worlds' status on this domain
   std::uint64_t world_id = 0;                                    ///< random, this process's
+  std::string world_key, world_proof;  ///< the run key's public half, its signature of (run, this participant)
   Clock::time_point next_admitting_status{};
   Clock::time_point next_hello_service{};
   bool run_started = false;

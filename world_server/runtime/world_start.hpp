@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "marsala/core/heightmap.hpp"
+#include "marsala/protocol/world_proof.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/world_server/rules/world_state.hpp"
 
@@ -31,6 +32,8 @@ struct RuntimeOptions {
   std::string scenario_text;           ///< the scenario file's text, recorded in run.log so that --resume needs no file
   std::vector<std::string> overrides;  ///< --set FIELD=VALUE applied to scenario_text (recorded in run.log too)
   bool replace = false;  ///< out_dir may hold another run's files: the caller clears them (clear_run_files())
+  /// The run key the world proves itself with (records/run_key_file.hpp); none: a random one, kept nowhere.
+  std::optional<protocol::RunKey> run_key;
 };
 
 /// Where a resumed run picks up (prepare_resume()).

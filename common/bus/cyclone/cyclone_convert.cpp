@@ -106,6 +106,8 @@ marsala_wire_Admission to_msg(const Admission& in, Storage&) {
   out.base_x_m = in.assignment.base.x;
   out.base_y_m = in.assignment.base.y;
   out.base_radius_m = in.assignment.base_radius_m;
+  out.world_key = borrow(in.world_key);
+  out.world_proof = borrow(in.world_proof);
   return out;
 }
 
@@ -129,6 +131,8 @@ Admission from_msg(const marsala_wire_Admission& in) {
   out.assignment.base.x = in.base_x_m;
   out.assignment.base.y = in.base_y_m;
   out.assignment.base_radius_m = in.base_radius_m;
+  out.world_key = copy(in.world_key);
+  out.world_proof = copy(in.world_proof);
   return out;
 }
 
@@ -291,6 +295,8 @@ marsala_wire_WorldStatus to_msg(const WorldStatus& in, Storage& storage) {
   out.admitting = in.admitting;
   out.progress_detail = borrow(in.progress_detail);
   out.team_size = in.team_size;
+  out.world_key = borrow(in.world_key);
+  out.world_proof = borrow(in.world_proof);
   storage.agents.clear();
   for (const AgentStatus& a : in.agents) {
     marsala_wire_AgentStatus agent{};
@@ -328,6 +334,8 @@ WorldStatus from_msg(const marsala_wire_WorldStatus& in) {
   out.admitting = in.admitting;
   out.progress_detail = copy(in.progress_detail);
   out.team_size = in.team_size;
+  out.world_key = copy(in.world_key);
+  out.world_proof = copy(in.world_proof);
   out.agents.reserve(in.agents._length);
   for (std::uint32_t i = 0; i < in.agents._length; ++i) {
     const marsala_wire_AgentStatus& a = in.agents._buffer[i];

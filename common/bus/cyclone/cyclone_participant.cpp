@@ -15,6 +15,7 @@
 #include <unordered_map>
 
 #include "marsala/bus/cyclone/cyclone_convert.hpp"
+#include "marsala/bus/cyclone/cyclone_log.hpp"
 #include "marsala/bus/detail/backends.hpp"
 #include "marsala/bus/detail/participant_base.hpp"
 #include "marsala/bus/detail/reader_queue.hpp"
@@ -92,6 +93,7 @@ class Qos {
 class Context {
  public:
   Context(int domain_id, Role role, const Security& security) : domain_id_(domain_id) {
+    cyclone::bound_cyclone_log();  // a foreign type's flood must not flood the log (cyclone_log.hpp)
     if (role == Role::kWorld) {
       if (open_at_first_free(security, 0, kWorldPorts + kServerIndices)) return;
       spdlog::warn("Cyclone DDS: the world's ports {} and up and participant indices 0..{} of domain {} are all taken "

@@ -84,6 +84,8 @@ wire::Admission to_msg(const Admission& in) {
   out.base_x_m(in.assignment.base.x);
   out.base_y_m(in.assignment.base.y);
   out.base_radius_m(in.assignment.base_radius_m);
+  out.world_key(in.world_key);
+  out.world_proof(in.world_proof);
   return out;
 }
 
@@ -107,6 +109,8 @@ Admission from_msg(const wire::Admission& in) {
   out.assignment.base.x = in.base_x_m();
   out.assignment.base.y = in.base_y_m();
   out.assignment.base_radius_m = in.base_radius_m();
+  out.world_key = in.world_key();
+  out.world_proof = in.world_proof();
   return out;
 }
 
@@ -262,6 +266,8 @@ wire::WorldStatus to_msg(const WorldStatus& in) {
   out.admitting(in.admitting);
   out.progress_detail(in.progress_detail);
   out.team_size(in.team_size);
+  out.world_key(in.world_key);
+  out.world_proof(in.world_proof);
   out.agents().reserve(in.agents.size());
   for (const AgentStatus& a : in.agents) {
     wire::AgentStatus agent;
@@ -298,6 +304,8 @@ WorldStatus from_msg(const wire::WorldStatus& in) {
   out.admitting = in.admitting();
   out.progress_detail = in.progress_detail();
   out.team_size = in.team_size();
+  out.world_key = in.world_key();
+  out.world_proof = in.world_proof();
   out.agents.reserve(in.agents().size());
   for (const wire::AgentStatus& a : in.agents()) {
     AgentStatus agent;

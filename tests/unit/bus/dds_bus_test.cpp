@@ -97,6 +97,8 @@ void expect_same(const Admission& a, const Admission& b) {
   EXPECT_SAME_DOUBLE(a.assignment.base.x, b.assignment.base.x);
   EXPECT_SAME_DOUBLE(a.assignment.base.y, b.assignment.base.y);
   EXPECT_SAME_DOUBLE(a.assignment.base_radius_m, b.assignment.base_radius_m);
+  EXPECT_EQ(a.world_key, b.world_key);
+  EXPECT_EQ(a.world_proof, b.world_proof);
 }
 
 void expect_same(const SensorFrame& a, const SensorFrame& b) {
@@ -168,6 +170,8 @@ void expect_same(const WorldStatus& a, const WorldStatus& b) {
   EXPECT_EQ(a.completed, b.completed);
   EXPECT_EQ(a.progress_detail, b.progress_detail);
   EXPECT_EQ(a.team_size, b.team_size);
+  EXPECT_EQ(a.world_key, b.world_key);
+  EXPECT_EQ(a.world_proof, b.world_proof);
   ASSERT_EQ(a.agents.size(), b.agents.size());
   for (std::size_t i = 0; i < a.agents.size(); ++i) {
     const AgentStatus& x = a.agents[i];
@@ -251,6 +255,8 @@ Admission filled_admission(Filler& f) {
   a.assignment.base.x = f.real();
   a.assignment.base.y = f.real();
   a.assignment.base_radius_m = f.real();
+  a.world_key = std::string(64, 'a') + kUtf8;
+  a.world_proof = "proof " + std::to_string(f.u64());
   return a;
 }
 
@@ -311,6 +317,8 @@ WorldStatus filled_status(Filler& f) {
   s.completed = true;
   s.progress_detail = "12.31 of 21.30 m3 left " + kUtf8;
   s.team_size = 120;
+  s.world_key = "key " + std::to_string(f.u64());
+  s.world_proof = std::string(128, 'f');
   for (int i = 0; i < 3; ++i) {
     AgentStatus a;
     a.agent_id = f.u32();

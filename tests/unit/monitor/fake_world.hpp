@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "marsala/bus/bus.hpp"
+#include "marsala/protocol/world_proof.hpp"
 
 namespace marsala::monitor::test_support {
 
@@ -26,7 +27,12 @@ class FakeWorld {
       if (!probe_->wait_until(deadline)) return false;
     return true;
   }
-  void publish(const protocol::WorldStatus& s) { status_->write(s); }
+  /// Publishes `s` with this world's proof (docs/runtime.md#who-wrote-it), as a world does.
+  void publish(protocol::WorldStatus s) {
+    s.world_key = protocol::world_key_of(key_);
+    s.world_proof = protocol::prove_world(key_, s.run_id, participant_->id().prefix);
+    status_->write(s);
+  }
   void publish(const protocol::WorldEvent& e) { events_->write(e); }
   /// The world's writers go, as when its process dies or stays paused: readers see no live status writer any more.
   void leave() {
@@ -41,6 +47,7 @@ class FakeWorld {
 
  private:
   std::unique_ptr<bus::Participant> participant_;
+  protocol::RunKey key_ = protocol::make_run_key();
   std::shared_ptr<bus::Signal> probe_ = std::make_shared<bus::Signal>();
   std::unique_ptr<bus::Writer<protocol::WorldStatus>> status_;
   std::unique_ptr<bus::Writer<protocol::WorldEvent>> events_;

@@ -14,6 +14,7 @@
 
 #include "marsala/agent/runtime/map_dump.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/protocol/world_proof.hpp"
 #include "marsala/terrain/asc_io.hpp"
 #include "unit/agent/agent_test_support.hpp"
 
@@ -32,6 +33,20 @@ RuntimeConfig config(std::uint32_t id, const std::string& behaviour = "idle") {
   c.admit_timeout = 5s;
   c.world_timeout = 5s;
   return c;
+}
+
+/// The run key of the scripted worlds.
+const protocol::RunKey& run_key() {
+  static const protocol::RunKey key = protocol::make_run_key();
+  return key;
+}
+
+/// `a` as participant `p` proves itself with `key`: the world's proof (protocol/world_proof.hpp).
+protocol::Admission signed_by(const bus::Participant& p, protocol::Admission a,
+                              const protocol::RunKey& key = run_key()) {
+  a.world_key = protocol::world_key_of(key);
+  a.world_proof = protocol::prove_world(key, a.run_id, p.id().prefix);
+  return a;
 }
 
 protocol::Admission admission_for(const protocol::AgentHello& hello, const Heightmap& h) {
@@ -78,7 +93,7 @@ struct ScriptedWorld {
     auto hellos = p.create_reader<protocol::AgentHello>({"", hello_signal});
     auto admissions = p.create_writer<protocol::Admission>();
     const protocol::AgentHello hello = wait_hello(*hellos, *hello_signal);
-    const protocol::Admission a = answer(hello);
+    const protocol::Admission a = signed_by(p, answer(hello));
     // The slot the admission names: `id`, or the one assigned to an "any slot" hello (id 0).
     const std::uint32_t slot = a.agent_id;
     const std::string partition = protocol::partition_for(a.run_id, slot, a.session);
@@ -422,7 +437,7 @@ TEST(AgentRuntime, AnySlotRefusalEndsTheRunWithTheWorldsReason) {
       no.agent_id = 0;
       no.session = hello.session;
       no.reason = "any slot: all 3 slots of this robot type are taken";
-      admissions->write(no);
+      admissions->write(signed_by(*world_participant, no));
       answered = true;
     }
   }
@@ -430,6 +445,48 @@ TEST(AgentRuntime, AnySlotRefusalEndsTheRunWithTheWorldsReason) {
   EXPECT_EQ(r.outcome, RunOutcome::kRefused);
   EXPECT_NE(r.message.find("all 3 slots of this robot type are taken"), std::string::npos) << r.message;
   EXPECT_EQ(agent.config().agent_id, 0u);
+}
+
+// A stranger answers first, in the world's name: a refusal, then an acceptance, signed with a key of its own, with the
+// world's proof copied from another participant, and unsigned. An agent given the run key believes none of them and
+// is admitted by the world that proves the key.
+TEST(AgentRuntime, BelievesOnlyTheWorldThatProvesTheRunKey) {
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, 110});
+  RuntimeConfig c = config(3);
+  c.world_key = protocol::world_key_of(run_key());
+  AgentRuntime agent(*participant, c);
+  std::atomic<bool> stop{false};
+  auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+  auto stranger = bus::make_participant({bus::Vendor::kInProcess, 110});
+  auto world_participant = bus::make_participant({bus::Vendor::kInProcess, 110});
+  auto signal = std::make_shared<bus::Signal>();
+  auto hellos = stranger->create_reader<protocol::AgentHello>({"", signal});
+  auto forged = stranger->create_writer<protocol::Admission>();
+  const Heightmap h({20, 40, 0.0, 0.0, 0.1}, 0.0);
+  bool done = false;
+  for (const auto deadline = Clock::now() + 5s; !done && Clock::now() < deadline;) {
+    signal->wait_for(20ms);
+    for (const auto& hello : hellos->take()) {
+      protocol::Admission no = admission_for(hello, h);
+      no.accepted = false;
+      no.reason = "this run is closed";
+      forged->write(signed_by(*stranger, no, protocol::make_run_key()));
+      protocol::Admission yes = admission_for(hello, h);
+      yes.run_id = "forged";
+      forged->write(signed_by(*stranger, yes, protocol::make_run_key()));
+      forged->write(signed_by(*world_participant, yes));  // the run key's proof, but made for another participant
+      forged->write(yes);                                 // no proof at all
+      done = true;
+    }
+  }
+  ASSERT_TRUE(done);
+  ScriptedWorld world{*world_participant, 3, 0, nullptr};
+  const auto requests = world.run([&](const protocol::AgentHello& hello) { return admission_for(hello, h); }, 2);
+  const RunResult r = running.get();
+  EXPECT_EQ(r.outcome, RunOutcome::kRunOver) << r.message;
+  EXPECT_EQ(r.run_id, "rt");
+  EXPECT_EQ(r.ignored_admissions, 4u);
+  EXPECT_EQ(requests.size(), 2u);
 }
 
 TEST(AgentRuntime, WorldSilenceAfterAdmissionTimesOut) {

@@ -27,6 +27,25 @@ TEST(AdmissionGate, ASessionIsConfirmedOnlyByAHelloRepeatedAtLeast100msAfterItsF
   EXPECT_FALSE(gate.persistent({2, 0xabd}, t0 + 300ms));
 }
 
+// A copy of an agent's hello (its id and session, read on the default partition) written by another participant is
+// another sender: the copy's repeats never confirm the agent's session, nor the agent's the copy's.
+TEST(AdmissionGate, ACopyOfAHelloFromAnotherParticipantIsAnotherSender) {
+  AdmissionGate gate;
+  WriterPrefix agent_writer{}, copier{};
+  agent_writer[11] = 1;
+  copier[11] = 2;
+  protocol::AgentHello hello;
+  hello.agent_id = 3;
+  hello.session = 0x77;
+  EXPECT_FALSE(gate.persistent(sender_of(hello, agent_writer), t0));
+  EXPECT_FALSE(gate.persistent(sender_of(hello, copier), t0 + 50ms));
+  EXPECT_FALSE(gate.persistent(sender_of(hello, copier), t0 + 120ms));  // 70 ms after its own first: not yet
+  EXPECT_TRUE(gate.persistent(sender_of(hello, agent_writer), t0 + 100ms));
+  EXPECT_FALSE(sender_of(hello, agent_writer) == sender_of(hello, copier));
+  EXPECT_TRUE(sender_of(hello, copier) < sender_of(hello, agent_writer) ||
+              sender_of(hello, agent_writer) < sender_of(hello, copier));
+}
+
 TEST(AdmissionGate, AHelloIsRememberedAcrossOneGenerationNotTwo) {
   AdmissionGate gate;
   const SenderKey agent{1, 7};
