@@ -203,6 +203,7 @@ BuildView RampSteps::synthesize_view(const protocol::SensorFrame& frame) {
   const Position robot{frame.x_m, frame.y_m};
   const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
   const Position target = goal.value_or(robot);  // nothing left to build towards: stay
+  memory_.target = target;
   BuildView view{modules_->synthesizer.synthesize(modules_->map.known_map(), robot, target), robot, target};
   clear_pad_gap(view.local);
   if (context_.type.sensor.casts_rays()) {
@@ -341,6 +342,13 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
   }
   trace.deposition = modules_->depositor->plan(modules_->depositions, terrain_only, ahead, at, frame.material_m3,
                                                neighbourhood(frame));
+  // A scanned map: where the path turned aside from the straight way to the target (its cells' balls hold cells no
+  // scan reached, a drop's shadow), the confirmed gap on that way is still work (docs/runtime.md#mapping).
+  if (context_.type.sensor.casts_rays() && !trace.deposition.any())
+    if (const auto stand = terrain_only.cell_at(at))
+      trace.deposition = modules_->depositor->plan(modules_->depositions, terrain_only,
+                                                   executive::line_cells(terrain_only, *stand, memory_.target), at,
+                                                   frame.material_m3, neighbourhood(frame));
   auto& deposits = trace.deposition.deposits;
   if (memory_.deposit_limit >= 0 && deposits.size() > static_cast<std::size_t>(memory_.deposit_limit)) {
     deposits.resize(static_cast<std::size_t>(memory_.deposit_limit));

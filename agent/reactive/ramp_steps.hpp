@@ -209,6 +209,7 @@ class RampSteps {
     CellMask corridor;                             ///< the last local map's navigable cells, neighbours not taken out
     CellMask terrain_occupiable;                   ///< and its occupiable cells
     std::vector<CellIndex> home;                   ///< the way home of this trip (world cells), empty: not planned
+    Position target;                               ///< this frame's target (synthesize_view()) [m]
   };
 
   // look()'s steps, in order.
