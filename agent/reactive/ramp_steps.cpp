@@ -174,6 +174,9 @@ void RampSteps::remember_result(const protocol::SensorFrame& frame) {
 }
 
 void RampSteps::learn_refusals(const protocol::SensorFrame& frame) {
+  // A motion refused for the terrain: the ground the map only assumed in the target's ball is what it guessed wrong.
+  if (memory_.refusal && memory_.refusal->terrain && memory_.refusal->motion)
+    modules_->map.forget_assumed_ground(memory_.refusal->cell, 0.5 * context_.type.body.navigability.delta_m);
   const executive::MappingSystem& map = modules_->map;
   memory_.refused->update(map.heights(), map.known(), frame.step);
   memory_.refused_depositions->update(map.heights(), map.known(), frame.step);
@@ -194,9 +197,11 @@ void RampSteps::update_map(const protocol::SensorFrame& frame) {
     const Position sensor_at{robot.x + sub_cell_error_.x, robot.y + sub_cell_error_.y};
     modules_->map.integrate_scan(frame.points, executive::believed_sensor_origin(sensor_at, frame.z_m, sensor));
   }
-  if (sensor.casts_rays())  // docs/runtime.md#mapping: the ground its body stands on and may step onto next
-    modules_->map.assume_ground(robot, frame.z_m,
-                                0.5 * context_.type.body.navigability.delta_m + context_.type.body.max_step_m);
+  if (sensor.casts_rays()) {  // docs/runtime.md#mapping: the ground its body stands on and may step onto next
+    const NavigabilityParams& body = context_.type.body.navigability;
+    const double radius_m = 0.5 * body.delta_m + context_.type.body.max_step_m;
+    modules_->map.assume_ground(robot, frame.z_m, radius_m, body.eps_m + body.kappa * radius_m);
+  }
 }
 
 BuildView RampSteps::synthesize_view(const protocol::SensorFrame& frame) {
