@@ -199,6 +199,7 @@ MappingSystem::MappingSystem(const GridGeometry& world, int tile_size, SensorSpe
                                       world.rows, world.cols, kOctreeHalfVoxels));
   known_ = CellMask::Zero(world.rows, world.cols);
   assumed_ = CellMask::Zero(world.rows, world.cols);
+  not_assumable_ = CellMask::Zero(world.rows, world.cols);
 }
 
 MappingSystem::~MappingSystem() = default;
@@ -208,6 +209,7 @@ MappingSystem::MappingSystem(const MappingSystem& other)
     : heights_(other.heights_),
       known_(other.known_),
       assumed_(other.assumed_),
+      not_assumable_(other.not_assumable_),
       known_count_(other.known_count_),
       scans_(other.scans_),
       hit_scan_(other.hit_scan_),
@@ -462,6 +464,7 @@ void MappingSystem::forget(CellIndex cell) {
   if (known_(cell.row, cell.col) != 0) --known_count_;
   known_(cell.row, cell.col) = 0;
   assumed_(cell.row, cell.col) = 0;
+  not_assumable_(cell.row, cell.col) = 1;
   heights_(cell) = 0.0;
 }
 
@@ -498,7 +501,7 @@ void MappingSystem::assume_ground(Position pose, double ground_z_m, double radiu
         continue;
       }
       // A ray went down past where this ground would be: the cell is lower than the robot stands (docs/runtime.md#mapping).
-      if (carved_below({row, col}, ground_z_m - below_m)) continue;
+      if (not_assumable_(row, col) != 0 || carved_below({row, col}, ground_z_m - below_m)) continue;
       heights_(row, col) = ground_z_m;
       mark_known(row, col);
       assumed_(row, col) = 1;

@@ -65,7 +65,8 @@ class MappingSystem {
   /// than its minimum range and the camera nothing behind it), unless a scan's ray crossed its column lower than
   /// below_m under that height and left it free: that cell lies lower (a drop's shadow, a pit) and stays unknown; and a
   /// cell of the disc known only as such assumed ground becomes unknown again once a ray went below_m under its
-  /// assumed height. A later scan's hits replace it. [m]
+  /// assumed height, and is never assumed again (nor a cell forget_assumed_ground() forgot). A later scan's hits
+  /// replace it. [m]
   void assume_ground(Position pose, double ground_z_m, double radius_m,
                      double below_m = std::numeric_limits<double>::infinity());
   /// The world refused a motion to `cell` (world index) as not occupiable: the cells within radius_m of it (centre to
@@ -135,6 +136,7 @@ class MappingSystem {
   Heightmap heights_;
   CellMask known_;
   CellMask assumed_;
+  CellMask not_assumable_;  ///< 1 where assumed ground was forgotten: no guess there again, only a reading
   long long known_count_ = 0;
   int scans_ = 0;
   std::vector<int> hit_scan_;  ///< per cell (row-major): the scan (1, 2, ...) that last hit it, 0 when none

@@ -323,7 +323,7 @@ TEST(MappingSystem, GroundARayWentBelowIsNotAssumed) {
 // went below cols 30 and 31 of row 30, and the next assume_ground() forgets them (unknown again, height 0); col 32 is
 // the hit's. A motion the world refused to (30, 33): the assumed cells within 0.1 m of it, (29, 33), (31, 33) and
 // (30, 34) (the robot's disc, 5 cells around (30, 29), ends there), are forgotten, (30, 33) itself too; (30, 32), read
-// by a scan, and the cells farther away, e.g. (29, 32), stay.
+// by a scan, and the cells farther away, e.g. (29, 32), stay. No forgotten cell is assumed again.
 TEST(MappingSystem, AssumedGroundARayWentBelowOrARefusalNamedIsForgotten) {
   const GridGeometry world{60, 60, 0.0, 0.0, 0.1};
   SensorSpec exact = sensor_defaults(SensorKind::kLaser);
@@ -347,6 +347,11 @@ TEST(MappingSystem, AssumedGroundARayWentBelowOrARefusalNamedIsForgotten) {
   EXPECT_TRUE(map.is_known({30, 32}));
   EXPECT_TRUE(map.is_known({29, 32}));
   EXPECT_EQ(map.known_cells(), 81 - 2 - 4);
+  // Forgotten cells are not guessed again: only a reading makes them known.
+  map.assume_ground({2.95, 2.95}, 1.0, 0.5, 0.1);
+  EXPECT_EQ(map.known_cells(), 81 - 2 - 4);
+  EXPECT_FALSE(map.is_known({30, 33}));
+  EXPECT_FALSE(map.is_known({30, 30}));
 }
 
 // Hand-made hits past the edge of a 0.3 m wall (cols 30-31) known from a first scan. A hit inside col 32 at the
