@@ -497,10 +497,12 @@ void MappingSystem::assume_ground(Position pose, double ground_z_m, double radiu
       const double dr = row - centre->row, dc = col - centre->col;
       if (dr * dr + dc * dc > radius_cells * radius_cells + 1e-9) continue;
       if (known_(row, col) != 0) {
-        if (was_assumed_ground({row, col}) && carved_below({row, col}, heights_(row, col) - below_m)) forget({row, col});
+        if (was_assumed_ground({row, col}) && carved_below({row, col}, heights_(row, col) - below_m))
+          forget({row, col});
         continue;
       }
-      // A ray went down past where this ground would be: the cell is lower than the robot stands (docs/runtime.md#mapping).
+      // A ray went down past where this ground would be: the cell lies lower than the robot stands
+      // (docs/runtime.md#mapping).
       if (not_assumable_(row, col) != 0 || carved_below({row, col}, ground_z_m - below_m)) continue;
       heights_(row, col) = ground_z_m;
       mark_known(row, col);

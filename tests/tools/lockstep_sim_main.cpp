@@ -301,8 +301,8 @@ int main(int argc, char** argv) {
   app.add_option("--stall-steps", o.stall_steps, "end after this many steps without a terrain change (0: never)");
   app.add_option("--set", overrides, "FIELD=VALUE");
   app.add_option("--write", o.write_dir,
-                 "write terrain_final.asc, built.asc (final - initial) and each agent's own map (agent-<id>-height.asc, "
-                 "-assumed.asc) into this folder");
+                 "write terrain_final.asc, built.asc (final - initial) and each agent's own map "
+                 "(agent-<id>-height.asc, -assumed.asc) into this folder");
   app.add_option("--show", show_steps, "print every robot after these steps");
   app.add_flag("--right-of-way,!--no-right-of-way", o.right_of_way,
                "ramp builders keep the right of way when the scenario asks for it (--set right_of_way=true; "

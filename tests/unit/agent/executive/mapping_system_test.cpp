@@ -288,17 +288,21 @@ TEST(MappingSystem, AssumedGroundFillsOnlyUnknownCellsUnderTheBody) {
   EXPECT_THROW(map.assume_ground({30.0, 3.0}, 0.7, 0.5), InvalidArgument);
 }
 
+// An empty map of a 6 x 6 m world at 0.1 m cells for a laser without range noise.
+MappingSystem exact_laser_map() {
+  SensorSpec exact = sensor_defaults(SensorKind::kLaser);
+  exact.noise_sd_m = 0.0;
+  exact.noise_sd_per_m2 = 0.0;
+  return MappingSystem(GridGeometry{60, 60, 0.0, 0.0, 0.1}, 16, exact);
+}
+
 // A robot at 1.0 m on the edge of a 1 m deep trench (cols 30-32 of row 30, 0.1 m cells): one noise-free laser ray
 // from its sensor (2.95, 2.95, 1.5) to the trench floor at the centre of col 32 (3.25, 2.95, 0.0) crosses col 30 from
 // 1.25 m down to 0.75 m and col 31 from 0.75 m to 0.25 m, both below 0.9 m (the ground less 0.1 m): those cells lie
 // lower than the robot stands and stay unknown. Col 32 is known from the hit; col 33, which the ray never reached, and
 // the trench cells of row 29, which no ray crossed, are assumed at 1.0 m, and so is everything without the check.
 TEST(MappingSystem, GroundARayWentBelowIsNotAssumed) {
-  const GridGeometry world{60, 60, 0.0, 0.0, 0.1};
-  SensorSpec exact = sensor_defaults(SensorKind::kLaser);
-  exact.noise_sd_m = 0.0;
-  exact.noise_sd_per_m2 = 0.0;
-  MappingSystem map(world, 16, exact);
+  MappingSystem map = exact_laser_map();
   map.integrate_scan({{0.3F, 0.0F, -1.5F}}, {2.95, 2.95, 1.5});
   ASSERT_TRUE(map.is_known({30, 32}));
   ASSERT_EQ(map.known_cells(), 1);
@@ -325,11 +329,7 @@ TEST(MappingSystem, GroundARayWentBelowIsNotAssumed) {
 // (30, 34) (the robot's disc, 5 cells around (30, 29), ends there), are forgotten, (30, 33) itself too; (30, 32), read
 // by a scan, and the cells farther away, e.g. (29, 32), stay. No forgotten cell is assumed again.
 TEST(MappingSystem, AssumedGroundARayWentBelowOrARefusalNamedIsForgotten) {
-  const GridGeometry world{60, 60, 0.0, 0.0, 0.1};
-  SensorSpec exact = sensor_defaults(SensorKind::kLaser);
-  exact.noise_sd_m = 0.0;
-  exact.noise_sd_per_m2 = 0.0;
-  MappingSystem map(world, 16, exact);
+  MappingSystem map = exact_laser_map();
   map.assume_ground({2.95, 2.95}, 1.0, 0.5, 0.1);
   ASSERT_EQ(map.known_cells(), 81);
   map.integrate_scan({{0.3F, 0.0F, -1.5F}}, {2.95, 2.95, 1.5});
