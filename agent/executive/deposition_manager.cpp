@@ -52,6 +52,19 @@ bool DepositionManager::in_territory(const deliberative::LocalMap& map, CellInde
   return true;
 }
 
+std::vector<CellIndex> line_cells(const deliberative::LocalMap& map, CellIndex from, Position to) {
+  const Position a = map.center(from);
+  const int samples = static_cast<int>(std::ceil(2.0 * distance(a, to) / map.geometry().cell_size_m));
+  std::vector<CellIndex> line{from};
+  for (int i = 1; i <= samples; ++i) {
+    const double t = static_cast<double>(i) / samples;
+    const auto cell = map.cell_at({a.x + t * (to.x - a.x), a.y + t * (to.y - a.y)});
+    if (!cell) break;
+    if (*cell != line.back()) line.push_back(*cell);
+  }
+  return line;
+}
+
 DepositionParams deposition_params(const RobotBody& body, double cell_size_m, double neighbour_keep_out_m,
                                    std::optional<double> footprint_m) {
   DepositionParams p;

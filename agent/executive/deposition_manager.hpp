@@ -76,6 +76,11 @@ struct DepositionPlan {
   int dropped_for_way_back = 0;         ///< candidates dropped to keep the way back [count]
 };
 
+/// The local cells the segment from the centre of local cell `from` to `to` [m] crosses, `from` first, each once, up
+/// to where it leaves the window (sampled every half cell). A deposition path for candidates() along the straight way
+/// to a target: where the planned path turns aside from it (docs/runtime.md#mapping), the band ahead is still work.
+std::vector<CellIndex> line_cells(const deliberative::LocalMap& map, CellIndex from, Position to);
+
 /// Chooses a step's depositions along a path.
 class DepositionManager {
  public:

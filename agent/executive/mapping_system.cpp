@@ -199,6 +199,7 @@ MappingSystem::MappingSystem(const GridGeometry& world, int tile_size, SensorSpe
                                       world.rows, world.cols, kOctreeHalfVoxels));
   known_ = CellMask::Zero(world.rows, world.cols);
   assumed_ = CellMask::Zero(world.rows, world.cols);
+  not_assumable_ = CellMask::Zero(world.rows, world.cols);
 }
 
 MappingSystem::~MappingSystem() = default;
@@ -208,6 +209,7 @@ MappingSystem::MappingSystem(const MappingSystem& other)
     : heights_(other.heights_),
       known_(other.known_),
       assumed_(other.assumed_),
+      not_assumable_(other.not_assumable_),
       known_count_(other.known_count_),
       scans_(other.scans_),
       hit_scan_(other.hit_scan_),
@@ -442,10 +444,47 @@ void MappingSystem::record_built(CellIndex cell, double rise_m) {
   heights_(cell) = std::max(heights_(cell), built);
 }
 
-void MappingSystem::assume_ground(Position pose, double ground_z_m, double radius_m) {
-  if (!std::isfinite(ground_z_m) || std::abs(ground_z_m) >= kMaxMagnitude || !(radius_m >= 0.0))
+bool MappingSystem::carved_below(CellIndex cell, double z_m) const {
+  if (!octree_ || !std::isfinite(z_m)) return false;
+  const GridGeometry& g = heights_.geometry();
+  const Position centre = g.cell_center(cell);
+  octomap::OcTreeKey key;
+  if (!octree_->tree.key_of(tree_point(g, centre.x, centre.y, z_m), key)) return false;
+  // The voxel holding z_m reaches above it: only the voxels under it lie wholly below z_m.
+  return key[2] > 0 && octree_->tree.free_at_or_below(key, static_cast<octomap::key_type>(key[2] - 1));
+}
+
+bool MappingSystem::was_assumed_ground(CellIndex cell) const {
+  const std::size_t index = static_cast<std::size_t>(cell.row) * heights_.cols() + cell.col;
+  return assumed_(cell.row, cell.col) != 0 && face_floor_.count(static_cast<long long>(index)) == 0 &&
+         (hit_scan_.empty() || hit_scan_[index] == 0);
+}
+
+void MappingSystem::forget(CellIndex cell) {
+  if (known_(cell.row, cell.col) != 0) --known_count_;
+  known_(cell.row, cell.col) = 0;
+  assumed_(cell.row, cell.col) = 0;
+  not_assumable_(cell.row, cell.col) = 1;
+  heights_(cell) = 0.0;
+}
+
+void MappingSystem::forget_assumed_ground(CellIndex cell, double radius_m) {
+  if (!heights_.contains(cell) || !(radius_m >= 0.0) || !std::isfinite(radius_m)) return;
+  const GridGeometry& g = heights_.geometry();
+  const double radius_cells = radius_m / g.cell_size_m;
+  const int reach = static_cast<int>(std::ceil(radius_cells));
+  for (int row = std::max(0, cell.row - reach); row <= std::min(g.rows - 1, cell.row + reach); ++row)
+    for (int col = std::max(0, cell.col - reach); col <= std::min(g.cols - 1, cell.col + reach); ++col) {
+      const double dr = row - cell.row, dc = col - cell.col;
+      if (dr * dr + dc * dc <= radius_cells * radius_cells + 1e-9 && was_assumed_ground({row, col})) forget({row, col});
+    }
+}
+
+void MappingSystem::assume_ground(Position pose, double ground_z_m, double radius_m, double below_m) {
+  if (!std::isfinite(ground_z_m) || std::abs(ground_z_m) >= kMaxMagnitude || !(radius_m >= 0.0) || !(below_m >= 0.0))
     throw InvalidArgument(
-        fmt::format("mapping system: ground {} m within {} m is not a finite height and radius", ground_z_m, radius_m));
+        fmt::format("mapping system: ground {} m within {} m, {} m below it, is not a finite height, radius and depth",
+                    ground_z_m, radius_m, below_m));
   const std::optional<CellIndex> centre =
       std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;
   if (!centre) throw InvalidArgument(fmt::format("mapping system: pose {} is off the grid", pose));
@@ -455,9 +494,16 @@ void MappingSystem::assume_ground(Position pose, double ground_z_m, double radiu
   const int reach = static_cast<int>(std::ceil(radius_cells));
   for (int row = std::max(0, centre->row - reach); row <= std::min(g.rows - 1, centre->row + reach); ++row)
     for (int col = std::max(0, centre->col - reach); col <= std::min(g.cols - 1, centre->col + reach); ++col) {
-      if (known_(row, col) != 0) continue;
       const double dr = row - centre->row, dc = col - centre->col;
       if (dr * dr + dc * dc > radius_cells * radius_cells + 1e-9) continue;
+      if (known_(row, col) != 0) {
+        if (was_assumed_ground({row, col}) && carved_below({row, col}, heights_(row, col) - below_m))
+          forget({row, col});
+        continue;
+      }
+      // A ray went down past where this ground would be: the cell lies lower than the robot stands
+      // (docs/runtime.md#mapping).
+      if (not_assumable_(row, col) != 0 || carved_below({row, col}, ground_z_m - below_m)) continue;
       heights_(row, col) = ground_z_m;
       mark_known(row, col);
       assumed_(row, col) = 1;

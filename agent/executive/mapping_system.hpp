@@ -5,6 +5,7 @@
 // heightmap of the deliberative layer is derived (OctoMap -> GridMap, docs/runtime.md#mapping). The agent never sees
 // the global terrain: a cell it has not sensed stays unknown. OctoMap stays inside mapping_system.cpp.
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -61,8 +62,17 @@ class MappingSystem {
   void integrate_scan(const std::vector<ScanPoint>& points, Point3 sensor_origin);
   /// The ground under the robot's body: every still unknown cell within radius_m of the cell under `pose` (centre to
   /// centre) becomes known at `ground_z_m`, the height under the robot's centre (it stands there; a scan sees no nearer
-  /// than its minimum range and the camera nothing behind it). A later scan's hits replace it. [m]
-  void assume_ground(Position pose, double ground_z_m, double radius_m);
+  /// than its minimum range and the camera nothing behind it), unless a scan's ray crossed its column lower than
+  /// below_m under that height and left it free: that cell lies lower (a drop's shadow, a pit) and stays unknown; and a
+  /// cell of the disc known only as such assumed ground becomes unknown again once a ray went below_m under its
+  /// assumed height, and is never assumed again (nor a cell forget_assumed_ground() forgot). A later scan's hits
+  /// replace it. [m]
+  void assume_ground(Position pose, double ground_z_m, double radius_m,
+                     double below_m = std::numeric_limits<double>::infinity());
+  /// The world refused a motion to `cell` (world index) as not occupiable: the cells within radius_m of it (centre to
+  /// centre) known only as assumed ground (never hit by a scan, no face bound) are what the map guessed there, so they
+  /// become unknown again (docs/runtime.md#refused-requests). Off-grid cells are ignored. [m]
+  void forget_assumed_ground(CellIndex cell, double radius_m);
   /// The robot's own construction: the world accepted its request to raise `cell` (world index, as the map registers
   /// it) by rise_m [m]. Terrain only ever rises (depositions add material), so the cell is at least its map height
   /// plus rise_m from now on, whatever a later scan reads there: a scan may not see the top of what the robot just
@@ -118,11 +128,15 @@ class MappingSystem {
   // integrate_scan()'s steps: bin the hits a scan can place, judge a hit in an edge's shadow, re-derive the heights.
   ScanBatch bin_hits(const std::vector<ScanPoint>& points, Point3 origin);
   bool behind_edge(Point3 origin, Point3 hit, CellIndex cell, double spread_m) const;
+  bool carved_below(CellIndex cell, double z_m) const;  // a scan's ray left a voxel of its column free under z_m
+  bool was_assumed_ground(CellIndex cell) const;        // known only from assume_ground(): never hit, no face
+  void forget(CellIndex cell);                           // unknown again
   void rederive_heights(const ScanBatch& batch);
 
   Heightmap heights_;
   CellMask known_;
   CellMask assumed_;
+  CellMask not_assumable_;  ///< 1 where assumed ground was forgotten: no guess there again, only a reading
   long long known_count_ = 0;
   int scans_ = 0;
   std::vector<int> hit_scan_;  ///< per cell (row-major): the scan (1, 2, ...) that last hit it, 0 when none

@@ -176,6 +176,9 @@ void RampSteps::remember_result(const protocol::SensorFrame& frame) {
 }
 
 void RampSteps::learn_refusals(const protocol::SensorFrame& frame) {
+  // A motion refused for the terrain: the ground the map only assumed in the target's ball is what it guessed wrong.
+  if (memory_.refusal && memory_.refusal->terrain && memory_.refusal->motion)
+    modules_->map.forget_assumed_ground(memory_.refusal->cell, 0.5 * context_.type.body.navigability.delta_m);
   const executive::MappingSystem& map = modules_->map;
   memory_.refused->update(map.heights(), map.known(), frame.step);
   memory_.refused_depositions->update(map.heights(), map.known(), frame.step);
@@ -196,15 +199,18 @@ void RampSteps::update_map(const protocol::SensorFrame& frame) {
     const Position sensor_at{robot.x + sub_cell_error_.x, robot.y + sub_cell_error_.y};
     modules_->map.integrate_scan(frame.points, executive::believed_sensor_origin(sensor_at, frame.z_m, sensor));
   }
-  if (sensor.casts_rays())  // docs/runtime.md#mapping: the ground its body stands on and may step onto next
-    modules_->map.assume_ground(robot, frame.z_m,
-                                0.5 * context_.type.body.navigability.delta_m + context_.type.body.max_step_m);
+  if (sensor.casts_rays()) {  // docs/runtime.md#mapping: the ground its body stands on and may step onto next
+    const NavigabilityParams& body = context_.type.body.navigability;
+    const double radius_m = 0.5 * body.delta_m + context_.type.body.max_step_m;
+    modules_->map.assume_ground(robot, frame.z_m, radius_m, body.eps_m + body.kappa * radius_m);
+  }
 }
 
 BuildView RampSteps::synthesize_view(const protocol::SensorFrame& frame) {
   const Position robot{frame.x_m, frame.y_m};
   const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
   const Position target = goal.value_or(robot);  // nothing left to build towards: stay
+  memory_.target = target;
   BuildView view{modules_->synthesizer.synthesize(modules_->map.known_map(), robot, target), robot, target};
   clear_pad_gap(view.local);
   if (context_.type.sensor.casts_rays()) {
@@ -349,6 +355,13 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
   }
   trace.deposition = modules_->depositor->plan(modules_->depositions, terrain_only, ahead, at, frame.material_m3,
                                                neighbourhood(frame));
+  // A scanned map: where the path turned aside from the straight way to the target (its cells' balls hold cells no
+  // scan reached, a drop's shadow), the confirmed gap on that way is still work (docs/runtime.md#mapping).
+  if (context_.type.sensor.casts_rays() && !trace.deposition.any())
+    if (const auto stand = terrain_only.cell_at(at))
+      trace.deposition = modules_->depositor->plan(modules_->depositions, terrain_only,
+                                                   executive::line_cells(terrain_only, *stand, memory_.target), at,
+                                                   frame.material_m3, neighbourhood(frame));
   auto& deposits = trace.deposition.deposits;
   if (memory_.deposit_limit >= 0 && deposits.size() > static_cast<std::size_t>(memory_.deposit_limit)) {
     deposits.resize(static_cast<std::size_t>(memory_.deposit_limit));

@@ -212,6 +212,7 @@ class RampSteps {
     CellMask terrain_occupiable;                   ///< and its occupiable cells
     std::vector<CellIndex> home;                   ///< the way home of this trip (world cells), empty: not planned
     std::optional<executive::RaisedCells> raised;  ///< set_band_centre(): the structure seen built (first heights)
+    Position target;                               ///< this frame's target (synthesize_view()) [m]
   };
 
   // look()'s steps, in order.

@@ -3,13 +3,22 @@
 # ramp.pbtxt, 3 robots with the default RGB-D camera (robot_type.sensor.name=rgbd), seed 1, over DDS for 600 steps
 # (twice the ground-truth run's 298). They do not complete the ramp yet (the issue is open: the table of
 # docs/runtime.md#mapping); the test holds what they do: they build (at least 8 m^3, the in-process run deposits
-# 9.09 m^3 by step 600), never more than 1.25 times the ground-truth run's 12.04 m^3, no cell above the MARS bound of
+# 10.31 m^3 by step 600), never more than 1.25 times the ground-truth run's 12.04 m^3, no cell above the MARS bound of
 # the initial terrain (kappa 0.3), and under 1 % of their requests refused. When they complete, the run must stop
-# there (exit 0, end_reason completed).
-# Usage: scanning_builders_test.sh DOMAIN
+# there (exit 0, end_reason completed). Case rgbd_exact: the same cameras without range noise (noise_sd_m and
+# noise_sd_per_m2 0) must complete the ramp (in-process: 326 steps, 13.04 m^3, docs/runtime.md#mapping) within 2x the
+# ground-truth run's steps (596) and 1.25x its volume, with the other checks above.
+# Usage: scanning_builders_test.sh DOMAIN [rgbd|rgbd_exact]
 set -euo pipefail
-case_name=rgbd
 domain="$1"
+case_name="${2:-rgbd}"
+sensor=(--set robot_type.sensor.name=rgbd)
+min_m3=8.0
+case "$case_name" in
+  rgbd) ;;
+  rgbd_exact) sensor+=(--set robot_type.sensor.noise_sd_m=0 --set robot_type.sensor.noise_sd_per_m2=0) min_m3=0 ;;
+  *) echo "scanning_builders_test.sh: unknown case '$case_name' (rgbd, rgbd_exact)" >&2; exit 2 ;;
+esac
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 . "$here/lib.sh"
 test_workspace scanning_builders
@@ -18,17 +27,19 @@ steps=600
 
 rc=0
 "$root/deploy/spawn.sh" --scenario "$root/deploy/scenarios/ramp.pbtxt" --agents 3 --seed 1 --domain "$domain" \
-  --out "$out" --quiet --timeout 600 --max-steps "$steps" --set robot_type.sensor.name=rgbd >"$work/spawn.log" 2>&1 ||
+  --out "$out" --quiet --timeout 600 --max-steps "$steps" "${sensor[@]}" >"$work/spawn.log" 2>&1 ||
   rc=$?
 summary="$out/summary.json"
 [ -f "$summary" ] || { cat "$work/spawn.log"; fail "spawn.sh exit $rc and no summary.json"; }
 end=$(field end_reason "$summary")
-case "$rc:$end" in
-  0:completed | 3:max_steps) ;;
+case "$case_name:$rc:$end" in
+  rgbd:0:completed | rgbd:3:max_steps | rgbd_exact:0:completed) ;;
   *) cat "$work/spawn.log"; fail "spawn.sh exit $rc, end_reason $end" ;;
 esac
-jq -e '.deposited_volume_m3 >= 8.0 and .deposited_volume_m3 <= 1.25 * 12.04' "$summary" >/dev/null ||
-  fail "deposited $(jq .deposited_volume_m3 "$summary") m^3, expected 8 to 15.05 m^3"
+[ "$case_name" != rgbd_exact ] || [ "$(jq .steps "$summary")" -le $((2 * 298)) ] ||
+  fail "completed after $(jq .steps "$summary") steps, more than twice the ground-truth run's 298"
+jq -e --argjson lo "$min_m3" '.deposited_volume_m3 >= $lo and .deposited_volume_m3 <= 1.25 * 12.04' "$summary" \
+  >/dev/null || fail "deposited $(jq .deposited_volume_m3 "$summary") m^3, expected $min_m3 to 15.05 m^3"
 run_steps=$(jq .steps "$summary")
 jq -e --argjson n "$run_steps" '(.rejected_requests | tonumber) * 100 < 3 * $n' "$summary" >/dev/null ||
   fail "$(jq .rejected_requests "$summary") of $((3 * run_steps)) requests refused, 1 % or more"
@@ -38,5 +49,5 @@ above=$(paste <(awk 'NR > 6' "$out/terrain_final.asc" | tr -s ' ' '\n' | grep -v
   <(awk 'NR > 6' "$work/bound.asc" | tr -s ' ' '\n' | grep -v '^$') |
   awk '$1 > $2 + 1e-6 { n++ } END { print n + 0 }')
 [ "$above" = 0 ] || fail "$above cells above the MARS bound of the initial terrain"
-echo "ramp, 3 rgbd builders: $end after $run_steps steps, $(jq .deposited_volume_m3 "$summary") m^3," \
+echo "ramp, 3 $case_name builders: $end after $run_steps steps, $(jq .deposited_volume_m3 "$summary") m^3," \
   "$(jq -r .rejected_requests "$summary") refused"

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
@@ -20,6 +21,7 @@
 #include "lockstep_sim.hpp"
 #include "marsala/agent/reactive/path_builder.hpp"
 #include "marsala/cli/command_line.hpp"
+#include "marsala/core/mars_processor.hpp"
 #include "marsala/core/navigability_processor.hpp"
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
@@ -140,6 +142,54 @@ struct RunResult {
   std::string sha256;
 };
 
+/// Requests the world refused and what a run built above the MARS bound (docs/runtime.md#deposit-bound): the bound
+/// of the initial terrain at the smallest construction kappa of the run's robots.
+struct Refusals {
+  std::uint64_t requests = 0;  // requests applied [count]
+  std::uint64_t refused = 0;   // of them rejected by a rule [count]
+
+  /// Counts the last step's requests and those the world rejected.
+  void count(const LockstepSim& sim) {
+    for (const auto& q : sim.last_requests()) {
+      ++requests;
+      if (sim.state().agent(q.agent_id).last_result == marsala::protocol::ActionResult::kRejected) ++refused;
+    }
+  }
+
+  /// "refused requests R of N, cells above the MARS bound C (up to H m)", the bound of `initial` with tolerance 1e-9 m.
+  std::string describe(const LockstepSim& sim, const marsala::Heightmap& initial) const {
+    double kappa = 1e300;
+    for (const auto& a : sim.state().agents) kappa = std::min(kappa, marsala::construction_params(a.type).kappa);
+    const marsala::Heightmap bound = marsala::MarsProcessor(kappa).project(initial);
+    const auto& terrain = sim.state().terrain;
+    int above = 0;
+    double most = 0.0;
+    for (int r = 0; r < terrain.rows(); ++r)
+      for (int c = 0; c < terrain.cols(); ++c)
+        if (terrain(r, c) > bound(r, c) + 1e-9) ++above, most = std::max(most, terrain(r, c) - bound(r, c));
+    return fmt::format("refused requests {} of {} ({:.2f} %), cells above the MARS bound {} (up to {:.3f} m)", refused,
+                       requests, requests > 0 ? 100.0 * refused / requests : 0.0, above, most);
+  }
+};
+
+/// Each agent's own map into `dir` (docs/runtime.md#seeing-the-map): agent-<id>-height.asc, its heights, NODATA where
+/// it knows nothing, and agent-<id>-assumed.asc, 1 where the height is no surface a sensor read, 0 elsewhere.
+void write_agent_maps(const LockstepSim& sim, const std::string& dir) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& a : sim.state().agents) {
+    const auto map = sim.behaviour(a.id).known_map();
+    if (!map) continue;
+    marsala::Heightmap heights = map->heights, assumed = map->heights;
+    for (int r = 0; r < heights.rows(); ++r)
+      for (int c = 0; c < heights.cols(); ++c) {
+        if (map->known(r, c) == 0) heights(r, c) = nan;
+        assumed(r, c) = map->known(r, c) == 0 ? nan : map->assumed(r, c) != 0 ? 1.0 : 0.0;
+      }
+    marsala::terrain::write_asc(heights, fmt::format("{}/agent-{}-height.asc", dir, a.id));
+    marsala::terrain::write_asc(assumed, fmt::format("{}/agent-{}-assumed.asc", dir, a.id));
+  }
+}
+
 /// What to run and print.
 struct RunOptions {
   std::uint64_t max_steps = 0;    // 0: the scenario's
@@ -158,6 +208,7 @@ RunResult run_one(marsala::scenario::Scenario s, const marsala::Heightmap& initi
   const std::uint64_t max_steps = o.max_steps > 0 ? o.max_steps : s.max_steps;
   LockstepSim sim(s, initial, agents, o.right_of_way);
   std::uint64_t last_change = 0;
+  Refusals refusals;
   RunResult r;
   r.agents = agents, r.seed = seed, r.end = "max_steps";
   while (sim.state().step < max_steps) {
@@ -166,6 +217,7 @@ RunResult run_one(marsala::scenario::Scenario s, const marsala::Heightmap& initi
       break;
     }
     const auto outcome = sim.step();
+    refusals.count(sim);
     if (!outcome.changed_tiles.empty()) last_change = sim.state().step;
     if (o.shown.count(sim.state().step) > 0) show(sim);
     if (o.stall_steps > 0 && sim.state().step - last_change >= o.stall_steps) {
@@ -189,6 +241,7 @@ RunResult run_one(marsala::scenario::Scenario s, const marsala::Heightmap& initi
              "change {}, rejected motions {}, sha256 {}\n",
              s.name, agents, seed, r.end, st.step, st.deposited_volume_m3, r.outside_band_m3, r.progress, last_change,
              st.rejected_motions, r.sha256);
+  fmt::print("  {}\n", refusals.describe(sim, initial));
   std::fflush(stdout);
   if (!o.write_dir.empty()) {
     terrain::write_asc(st.terrain, o.write_dir + "/terrain_final.asc");
@@ -196,6 +249,7 @@ RunResult run_one(marsala::scenario::Scenario s, const marsala::Heightmap& initi
     for (int row = 0; row < built.rows(); ++row)
       for (int c = 0; c < built.cols(); ++c) built(row, c) -= initial(row, c);
     terrain::write_asc(built, o.write_dir + "/built.asc");
+    write_agent_maps(sim, o.write_dir);
   }
   return r;
 }
@@ -246,7 +300,9 @@ int main(int argc, char** argv) {
   app.add_option("--max-steps", o.max_steps, "step limit (default: the scenario's)");
   app.add_option("--stall-steps", o.stall_steps, "end after this many steps without a terrain change (0: never)");
   app.add_option("--set", overrides, "FIELD=VALUE");
-  app.add_option("--write", o.write_dir, "write terrain_final.asc and built.asc (final - initial) into this folder");
+  app.add_option("--write", o.write_dir,
+                 "write terrain_final.asc, built.asc (final - initial) and each agent's own map "
+                 "(agent-<id>-height.asc, -assumed.asc) into this folder");
   app.add_option("--show", show_steps, "print every robot after these steps");
   app.add_flag("--right-of-way,!--no-right-of-way", o.right_of_way,
                "ramp builders keep the right of way unless the scenario turns it off (right_of_way: false; "

@@ -1,5 +1,6 @@
 #include "marsala/agent/executive/detail/voxel_occupancy.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace marsala::agent::executive::detail {
@@ -111,6 +112,18 @@ void VoxelOccupancy::insert(const octomap::Pointcloud& points, const octomap::po
 bool VoxelOccupancy::occupied(const octomap::OcTreeKey& key) const {
   const Voxel* v = find(key);
   return v && v->log_odds >= keys_.getOccupancyThresLog();
+}
+
+bool VoxelOccupancy::free_at_or_below(const octomap::OcTreeKey& key, octomap::key_type max_z) const {
+  const long long index = column_index(key);
+  if (index < 0) return false;  // beyond the grid's columns: no cell's
+  const Column& column = columns_[static_cast<std::size_t>(index)];
+  const int last = std::min(static_cast<int>(max_z) - column.z0, static_cast<int>(column.voxels.size()) - 1);
+  for (int at = 0; at <= last; ++at) {
+    const float odds = column.voxels[static_cast<std::size_t>(at)].log_odds;
+    if (!std::isnan(odds) && odds < keys_.getOccupancyThresLog()) return true;
+  }
+  return false;
 }
 
 bool VoxelOccupancy::log_odds(const octomap::OcTreeKey& key, float& value) const {

@@ -28,6 +28,9 @@ class VoxelOccupancy {
   bool occupied(const octomap::OcTreeKey& key) const;
   /// The leaf's log-odds, or false when no leaf `key` exists.
   bool log_odds(const octomap::OcTreeKey& key, float& value) const;
+  /// True when a ray crossed a voxel of the column of `key` (its x and y) at or below z key `max_z` and left it free
+  /// (log-odds under the occupancy threshold): the surface there lies lower than that voxel's top.
+  bool free_at_or_below(const octomap::OcTreeKey& key, octomap::key_type max_z) const;
   /// Leaves made so far (OcTree::getNumLeafNodes of the tree this replaces: it is never pruned).
   std::size_t leaves() const { return leaves_; }
   /// The key of a point [m, tree frame]; false when it lies outside the tree (OcTree::coordToKeyChecked).

@@ -231,6 +231,39 @@ TEST(DepositionManager, NeverBuildsOnTheBasePad) {
   EXPECT_TRUE(on_pad);
 }
 
+// The straight way to a target, cell by cell: hand-derived on the 0.1 m grid. From (0, 0) to the centre of (2, 4)
+// the half-cell samples lie at (row, col) offsets (2i/9, 4i/9), i = 1..9, rounded to cells.
+TEST(DepositionManager, TheLineToATargetCrossesItsCellsUpToTheWindowsEdge) {
+  const LocalMap map = make_map(Heightmap(kGrid, 0.0), Heightmap(kGrid, 0.0), params().navigability, {10, 10}, {});
+  const std::vector<CellIndex> diagonal{{0, 0}, {0, 1}, {1, 1}, {1, 2}, {1, 3}, {2, 3}, {2, 4}};
+  EXPECT_EQ(line_cells(map, {0, 0}, kGrid.cell_center({2, 4})), diagonal);
+  // A target beyond the window's east edge: the row up to the last column.
+  const Position east{kGrid.cell_center({10, 30}).x + 5.0, kGrid.cell_center({10, 30}).y};
+  EXPECT_EQ(line_cells(map, {10, 10}, east), row_path(10, 10, 30));
+  EXPECT_EQ(line_cells(map, {10, 10}, kGrid.cell_center({10, 10})), (std::vector<CellIndex>{{10, 10}}));
+}
+
+// docs/runtime.md#mapping: a path that turned aside (east) leaves the gap on the straight way to the target (south)
+// out of its footprint; the line to the target holds it. Robot at (10, 10), footprint 0.4 m (2 cells each side of a
+// path cell): the gap cells (14, 10) and (15, 10), 0.4 and 0.5 m away, in reach, are candidates only along the line,
+// nearest first, 5 layers each.
+TEST(DepositionManager, AGapOnTheLineToTheTargetOffThePathIsACandidateAlongThatLine) {
+  Heightmap gap(kGrid, 0.0);
+  gap(14, 10) = 5.0 * kQ;
+  gap(15, 10) = 5.0 * kQ;
+  const LocalMap map = make_map(Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, {{10, 0}});
+  const DepositionManager dm(params());
+  const Position robot = kGrid.cell_center({10, 10});
+  EXPECT_TRUE(dm.candidates(map, row_path(10, 10, 25), robot, 10.0, {1, robot, {}}).empty());
+  const Position south{robot.x, kGrid.cell_center({20, 10}).y - 3.0};
+  const auto c = dm.candidates(map, line_cells(map, {10, 10}, south), robot, 10.0, {1, robot, {}});
+  ASSERT_EQ(c.size(), 2u);
+  EXPECT_EQ(c[0].cell, (CellIndex{14, 10}));
+  EXPECT_EQ(c[1].cell, (CellIndex{15, 10}));
+  EXPECT_EQ(c[0].layers, 5);
+  EXPECT_EQ(c[1].layers, 5);
+}
+
 TEST(DepositionManager, RejectsInvalidLimits) {
   DepositionParams p = params();
   p.reach_m = 0.0;

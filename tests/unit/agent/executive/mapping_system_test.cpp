@@ -288,6 +288,72 @@ TEST(MappingSystem, AssumedGroundFillsOnlyUnknownCellsUnderTheBody) {
   EXPECT_THROW(map.assume_ground({30.0, 3.0}, 0.7, 0.5), InvalidArgument);
 }
 
+// An empty map of a 6 x 6 m world at 0.1 m cells for a laser without range noise.
+MappingSystem exact_laser_map() {
+  SensorSpec exact = sensor_defaults(SensorKind::kLaser);
+  exact.noise_sd_m = 0.0;
+  exact.noise_sd_per_m2 = 0.0;
+  return MappingSystem(GridGeometry{60, 60, 0.0, 0.0, 0.1}, 16, exact);
+}
+
+// A robot at 1.0 m on the edge of a 1 m deep trench (cols 30-32 of row 30, 0.1 m cells): one noise-free laser ray
+// from its sensor (2.95, 2.95, 1.5) to the trench floor at the centre of col 32 (3.25, 2.95, 0.0) crosses col 30 from
+// 1.25 m down to 0.75 m and col 31 from 0.75 m to 0.25 m, both below 0.9 m (the ground less 0.1 m): those cells lie
+// lower than the robot stands and stay unknown. Col 32 is known from the hit; col 33, which the ray never reached, and
+// the trench cells of row 29, which no ray crossed, are assumed at 1.0 m, and so is everything without the check.
+TEST(MappingSystem, GroundARayWentBelowIsNotAssumed) {
+  MappingSystem map = exact_laser_map();
+  map.integrate_scan({{0.3F, 0.0F, -1.5F}}, {2.95, 2.95, 1.5});
+  ASSERT_TRUE(map.is_known({30, 32}));
+  ASSERT_EQ(map.known_cells(), 1);
+  MappingSystem unchecked = map;
+  map.assume_ground({2.95, 2.95}, 1.0, 0.5, 0.1);
+  EXPECT_FALSE(map.is_known({30, 30}));
+  EXPECT_FALSE(map.is_known({30, 31}));
+  EXPECT_FALSE(map.assumed()(30, 32));
+  for (const CellIndex c : {CellIndex{30, 29}, CellIndex{30, 33}, CellIndex{29, 30}, CellIndex{29, 31}}) {
+    EXPECT_TRUE(map.is_known(c)) << c.row << ", " << c.col;
+    EXPECT_TRUE(map.assumed()(c.row, c.col) != 0) << c.row << ", " << c.col;
+    EXPECT_EQ(map.heights()(c), 1.0);
+  }
+  unchecked.assume_ground({2.95, 2.95}, 1.0, 0.5);
+  EXPECT_TRUE(unchecked.is_known({30, 30}));
+  EXPECT_TRUE(unchecked.is_known({30, 31}));
+  EXPECT_EQ(unchecked.known_cells(), map.known_cells() + 2);
+  EXPECT_THROW(map.assume_ground({2.95, 2.95}, 1.0, 0.5, std::nan("")), InvalidArgument);
+}
+
+// Ground assumed before any ray came (the trench of the test above, the robot at 1.0 m): the same ray, scanned later,
+// went below cols 30 and 31 of row 30, and the next assume_ground() forgets them (unknown again, height 0); col 32 is
+// the hit's. A motion the world refused to (30, 33): the assumed cells within 0.1 m of it, (29, 33), (31, 33) and
+// (30, 34) (the robot's disc, 5 cells around (30, 29), ends there), are forgotten, (30, 33) itself too; (30, 32), read
+// by a scan, and the cells farther away, e.g. (29, 32), stay. No forgotten cell is assumed again.
+TEST(MappingSystem, AssumedGroundARayWentBelowOrARefusalNamedIsForgotten) {
+  MappingSystem map = exact_laser_map();
+  map.assume_ground({2.95, 2.95}, 1.0, 0.5, 0.1);
+  ASSERT_EQ(map.known_cells(), 81);
+  map.integrate_scan({{0.3F, 0.0F, -1.5F}}, {2.95, 2.95, 1.5});
+  ASSERT_TRUE(map.is_known({30, 30}));  // still assumed: nothing looks at it until the robot assumes again
+  map.assume_ground({2.95, 2.95}, 1.0, 0.5, 0.1);
+  EXPECT_FALSE(map.is_known({30, 30}));
+  EXPECT_FALSE(map.is_known({30, 31}));
+  EXPECT_EQ(map.heights()(30, 30), 0.0);
+  EXPECT_TRUE(map.is_known({30, 32}));
+  EXPECT_FALSE(map.assumed()(30, 32));
+  EXPECT_EQ(map.known_cells(), 81 - 2);
+  map.forget_assumed_ground({30, 33}, 0.1);
+  for (const CellIndex c : {CellIndex{30, 33}, CellIndex{29, 33}, CellIndex{31, 33}, CellIndex{30, 34}})
+    EXPECT_FALSE(map.is_known(c)) << c.row << ", " << c.col;
+  EXPECT_TRUE(map.is_known({30, 32}));
+  EXPECT_TRUE(map.is_known({29, 32}));
+  EXPECT_EQ(map.known_cells(), 81 - 2 - 4);
+  // Forgotten cells are not guessed again: only a reading makes them known.
+  map.assume_ground({2.95, 2.95}, 1.0, 0.5, 0.1);
+  EXPECT_EQ(map.known_cells(), 81 - 2 - 4);
+  EXPECT_FALSE(map.is_known({30, 33}));
+  EXPECT_FALSE(map.is_known({30, 30}));
+}
+
 // Hand-made hits past the edge of a 0.3 m wall (cols 30-31) known from a first scan. A hit inside col 32 at the
 // wall's height, from a ray that came over the wall's top (it crossed into col 32 at 0.3 m, within noise of the
 // top), is the edge's hit pushed over by noise: left out, col 32 stays unknown. The same point from a ray that came
