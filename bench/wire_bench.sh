@@ -5,7 +5,8 @@
 # medians over the runs:
 #   steps        steps reached (all of them unless the run timed out, --timeout S per run, default 150)
 #   wall s       the run's wall time, spawn to summary [s]
-#   bytes/step   bytes sent on lo (every process, DDS discovery and heartbeats included) per step reached
+#   bytes/step   bytes sent on lo (every process, DDS discovery and heartbeats included) per step reached (all of them
+#                when no step was)
 #   /agent       the same per agent
 #   pkts/step    packets sent on lo per step
 #   x clean      bytes/step against the same vendor unthrottled
@@ -25,7 +26,7 @@ while [ $# -gt 0 ]; do
     --runs) runs="$2"; shift 2 ;;
     --steps) steps="$2"; shift 2 ;;
     --timeout) timeout="$2"; shift 2 ;;
-    -h|--help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "wire_bench.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -59,9 +60,9 @@ for dds in $vendors; do
       b1=$(lo 10) p1=$(lo 11) t1=$(date +%s.%N)
       s=$(jq -r '.steps // 0' "$out/summary.json" 2>/dev/null || echo 0)
       sha=$(jq -r '.terrain_sha256 // "none"' "$out/summary.json" 2>/dev/null || echo none)
-      [ "$s" -ge 1 ] || s=1
+      per=$((s > 0 ? s : 1))
       drops=$(tc -s qdisc show dev lo | grep -o 'dropped [0-9]*' | head -1 | cut -d' ' -f2)
-      echo "$s $(echo "$t1 - $t0" | bc) $(((b1 - b0) / s)) $(((p1 - p0) / s)) ${drops:-0} $sha" >>"$work/rows"
+      echo "$s $(echo "$t1 - $t0" | bc) $(((b1 - b0) / per)) $(((p1 - p0) / per)) ${drops:-0} $sha" >>"$work/rows"
       [ "$rate" = none ] || { tc qdisc del dev lo root; tc qdisc add dev lo root tbf rate "$rate" burst 32kbit latency 400ms; }
     done
     col() { awk -v c="$1" '{ print $c }' "$work/rows" | median; }
