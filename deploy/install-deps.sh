@@ -3,13 +3,16 @@
 # otherwise runs `apt-get update` once and installs what is missing.
 # --containers: also podman, runc, podman-compose and mmdebstrap, for docker/run.sh and the container test.
 # --browser: also chromium, for the live view's browser test (tests/integration/live_view_test.sh; skipped without).
+# --prometheus: also prometheus (the server and promtool), for the metrics test (tests/integration/metrics_test.sh,
+#   the exposition's promtool check; skipped without). Debian's package enables a prometheus service on :9090.
 set -euo pipefail
-containers=0 browser=0
+containers=0 browser=0 prometheus=0
 for arg in "$@"; do
   case "$arg" in
     --containers) containers=1 ;;
     --browser) browser=1 ;;
-    *) echo "install-deps: unknown option '$arg' (known: --containers, --browser)" >&2; exit 2 ;;
+    --prometheus) prometheus=1 ;;
+    *) echo "install-deps: unknown option '$arg' (known: --containers, --browser, --prometheus)" >&2; exit 2 ;;
   esac
 done
 
@@ -38,6 +41,7 @@ packages=(
 
 [ "$containers" -eq 1 ] && packages+=(podman runc podman-compose mmdebstrap)
 [ "$browser" -eq 1 ] && packages+=(chromium)
+[ "$prometheus" -eq 1 ] && packages+=(prometheus)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -6,7 +6,8 @@
 #
 # Usage: deploy/spawn.sh --scenario FILE --agents N [--dds cyclone|fastdds] [--agent-dds cyclone|fastdds]
 #                        [--out DIR [--replace]] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N]
-#                        [--quiet] [--secure] [--frames-every K] [--dump-maps] [--set FIELD=VALUE ...]
+#                        [--quiet] [--secure] [--frames-every K] [--dump-maps] [--metrics-port P] [--trace FILE]
+#                        [--set FIELD=VALUE ...]
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
 #                 folder that holds another run's files, unless --replace removes them (and logs/, maps/) first, and
 #                 a folder a live (or paused) world holds, --replace or not (exit 2 naming its pid)
@@ -21,6 +22,10 @@
 #                 agent-<id>-height.asc (NODATA where it knows nothing) and agent-<id>-map.json; see how good it is
 #                 with `marsala-terrain compare OUT/maps/agent-<id>-height.asc OUT/terrain_final.asc` (--replace
 #                 removes the previous run's maps; an agent refuses maps of another run, exit 2)
+#   --metrics-port the world serves its metrics on http://127.0.0.1:P/metrics (Prometheus text format,
+#                 docs/runtime.md#metrics); a port in use exits 2 before anything starts
+#   --trace       marsala-world writes the lockstep as a Chrome trace (trace-event JSON, for Perfetto) to FILE at the
+#                 end (docs/runtime.md#step-traces)
 #   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
 #   --set         change a field of the scenario for this run, e.g. --set robot_type.body.sensing_range_m=5
 #                 (repeatable; passed to marsala-world and every marsala-agent; summary.json lists them)
@@ -35,7 +40,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
 scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0 frames_every=""
-replace=0 secure=0 dump_maps=0 set_args=()
+replace=0 secure=0 dump_maps=0 set_args=() observe_args=()
 usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; }  # the whole header comment
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -48,6 +53,8 @@ while [ $# -gt 0 ]; do
     --monitor) monitor=1; shift ;;
     --max-steps) max_steps="$2"; shift 2 ;;
     --frames-every) frames_every="$2"; shift 2 ;;
+    --metrics-port) observe_args+=(--metrics-port "$2"); shift 2 ;;
+    --trace) observe_args+=(--trace "$2"); shift 2 ;;
     --timeout) timeout_s="$2"; shift 2 ;;
     --seed) seed="$2"; shift 2 ;;
     --set) set_args+=(--set "$2"); shift 2 ;;
@@ -118,7 +125,7 @@ seed_args=()
 [ -n "$seed" ] && seed_args=(--seed "$seed")
 agent_args=()
 [ "$dump_maps" -eq 1 ] && agent_args=(--dump-map "$out/maps")
-world_args+=("${seed_args[@]}" "${set_args[@]}")
+world_args+=("${seed_args[@]}" "${set_args[@]}" "${observe_args[@]}")
 
 # The world's own start-up checks with the run's arguments (scenario, terrain, completion, slots, --agents), before
 # any process starts: a bad scenario fails here with the check's message (marsala-world --check, no DDS).

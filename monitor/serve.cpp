@@ -1,23 +1,18 @@
 #include "marsala/monitor/serve.hpp"
 
-#include <arpa/inet.h>
 #include <fmt/format.h>
 #include <httplib.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
 #include <condition_variable>
-#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <mutex>
 #include <ostream>
 #include <thread>
 
+#include "marsala/cli/listen_problem.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/monitor/live_model.hpp"
 #include "marsala/monitor/replay.hpp"
@@ -47,36 +42,6 @@ constexpr auto kFollowPoll = 100ms;
 constexpr auto kRetryPoll = 500ms;
 /// Records applied between two looks at the clock (a picture or the stop may be due) in a long backlog.
 constexpr int kRecordsPerBatch = 5000;
-
-/// Why binding `address`:`port` fails, found by trying it (httplib only says that it failed).
-std::string bind_problem(const std::string& address, int port) {
-  sockaddr_storage storage{};
-  socklen_t length = 0;
-  int family = AF_INET;
-  auto* v4 = reinterpret_cast<sockaddr_in*>(&storage);
-  auto* v6 = reinterpret_cast<sockaddr_in6*>(&storage);
-  if (::inet_pton(AF_INET, address.c_str(), &v4->sin_addr) == 1) {
-    v4->sin_family = AF_INET;
-    v4->sin_port = htons(static_cast<std::uint16_t>(port));
-    length = sizeof(sockaddr_in);
-  } else if (::inet_pton(AF_INET6, address.c_str(), &v6->sin6_addr) == 1) {
-    family = AF_INET6;
-    v6->sin6_family = AF_INET6;
-    v6->sin6_port = htons(static_cast<std::uint16_t>(port));
-    length = sizeof(sockaddr_in6);
-  } else {
-    return "not a numeric IPv4 or IPv6 address";
-  }
-  const int fd = ::socket(family, SOCK_STREAM, 0);
-  if (fd < 0) return std::strerror(errno);
-  const int yes = 1;
-  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-  std::string problem;
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&storage), length) != 0 || ::listen(fd, 1) != 0)
-    problem = errno == EADDRINUSE ? "the port is in use (another server listens there)" : std::strerror(errno);
-  ::close(fd);
-  return problem.empty() ? "unknown reason" : problem;
-}
 
 const char* content_type(const std::string& name) {
   if (name.size() >= 5 && name.compare(name.size() - 5, 5, ".html") == 0) return "text/html; charset=utf-8";
@@ -393,7 +358,7 @@ LiveServer::LiveServer(ServeOptions options) : impl_(std::make_unique<Impl>(std:
   impl.http.set_payload_max_length(1 << 16);
   if (!impl.http.bind_to_port(o.bind_address, o.port))
     throw ListenError(
-        fmt::format("cannot listen on {} port {}: {}", o.bind_address, o.port, bind_problem(o.bind_address, o.port)));
+        fmt::format("cannot listen on {} port {}: {}", o.bind_address, o.port, cli::listen_problem(o.bind_address, o.port)));
 }
 
 LiveServer::~LiveServer() = default;

@@ -24,6 +24,12 @@ protocol::WorldEvent event(std::uint64_t step, std::uint32_t agent, protocol::Ev
   return e;
 }
 
+/// Counts one rejected request of the step, of `reason`.
+void count_rejection(StepOutcome& out, RejectionReason reason) {
+  ++out.rejected;
+  ++out.rejected_by_reason[static_cast<std::size_t>(reason)];
+}
+
 /// Applies the requests that arrived on one live agent's partition.
 void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submission>& submissions,
                  const std::vector<std::size_t>& mine, std::vector<CellIndex>& changed_cells, StepOutcome& out,
@@ -42,7 +48,7 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
         ++state.agent(r->agent_id).rejected;
       else
         ++state.unattributed_rejections;
-      ++out.rejected;
+      count_rejection(out, RejectionReason::kIdentity);
       out.events.push_back(event(step, known ? r->agent_id : 0, protocol::EventKind::kRejected,
                                  fmt::format("request claiming agent {} session {} on agent {}'s partition "
                                              "rejected: not its admitted identity",
@@ -62,7 +68,7 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
           r->step > step ? fmt::format("request for future step {} rejected", r->step)
                          : fmt::format("duplicate request for step {} rejected; the first stands", step);
       ++agent.rejected;
-      ++out.rejected;
+      count_rejection(out, r->step > step ? RejectionReason::kFutureStep : RejectionReason::kDuplicate);
       out.events.push_back(event(step, agent.id, protocol::EventKind::kRejected, reason));
       continue;
     }
@@ -86,7 +92,7 @@ void apply_agent(WorldState& state, AgentRecord& agent, const std::vector<Submis
       agent.last_result = protocol::ActionResult::kRejected;
       agent.last_reason = verdict.reason;
       ++agent.rejected;
-      ++out.rejected;
+      count_rejection(out, rejection_reason_of_rule(verdict.rule));
       if (verdict.rule == 2) ++state.rejected_motions;
       out.events.push_back(event(step, agent.id, protocol::EventKind::kRejected, verdict.reason));
     }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "marsala/protocol/messages.hpp"
+#include "marsala/world_server/rules/rejection_reason.hpp"
 #include "marsala/world_server/rules/world_state.hpp"
 
 namespace marsala::world_server {
@@ -37,6 +38,7 @@ struct StepOutcome {
   std::vector<std::vector<Deposition>> raised_cells;  ///< [i]: the cells accepted submission i raised, in order
   std::uint32_t accepted = 0;                ///< requests accepted
   std::uint32_t rejected = 0;                ///< requests rejected (including duplicates and future steps)
+  RejectionCounts rejected_by_reason{};      ///< the rejected requests by reason; they add up to `rejected`
   std::uint32_t missed = 0;                  ///< live agents without a request for this step
   bool completion_checked = false;           ///< the payload/site check was evaluated in this step
   bool completed = false;                    ///< is_completed() after the step

@@ -11,7 +11,9 @@ void RequestCollector::read_partitions(const WorldState& state, RequestSelection
     if (!a.alive) continue;  // a dropped agent's requests are read only to be discarded
     for (protocol::ActionRequest& r : received) {
       const bool answers = r.step == state.step && carries_identity_of(a, r);
-      if (selection.take(a.id, answers) != RequestTake::kSurplus) into.submissions.push_back({a.id, std::move(r)});
+      const RequestTake take = selection.take(a.id, answers);
+      if (take == RequestTake::kAnswer) into.answered_at.emplace_back(a.id, Clock::now());
+      if (take != RequestTake::kSurplus) into.submissions.push_back({a.id, std::move(r)});
     }
   }
 }

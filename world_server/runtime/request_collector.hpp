@@ -51,6 +51,8 @@ struct Collected {
   std::vector<Submission> submissions;           ///< in the order read, partition by partition
   std::uint32_t surplus = 0;                     ///< requests beyond a partition's limit, never applied
   std::chrono::steady_clock::duration waited{};  ///< time spent waiting for requests
+  /// Each agent whose answer was taken, when it was read (for the step trace, step_trace.hpp).
+  std::vector<std::pair<std::uint32_t, std::chrono::steady_clock::time_point>> answered_at;
 };
 
 /// Collects the requests of each step from the agents' links.

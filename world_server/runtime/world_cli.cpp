@@ -2,21 +2,27 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
 #include <cstdlib>
+#include <memory>
 #include <optional>
 #include <ostream>
+#include <thread>
 #include <utility>
 
 #include "marsala/bus/bus.hpp"
 #include "marsala/cli/command_line.hpp"
 #include "marsala/cli/logging.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/protocol/end_reason.hpp"
 #include "marsala/scenario/scenario.hpp"
 #include "marsala/scenario/terrain_builder.hpp"
 #include "marsala/world_server/records/output_lock.hpp"
 #include "marsala/world_server/records/run_key_file.hpp"
 #include "marsala/world_server/records/run_outputs.hpp"
+#include "marsala/world_server/runtime/metrics_server.hpp"
 #include "marsala/world_server/runtime/scenario_check.hpp"
+#include "marsala/world_server/runtime/step_trace.hpp"
 #include "marsala/world_server/runtime/world_runtime.hpp"
 
 namespace marsala::world_server {
@@ -57,6 +63,61 @@ void add_run_key_option(CLI::App& app, std::string& run_key) {
       ->type_name("FILE");
 }
 
+/// The options of the metrics server (docs/runtime.md#metrics): --metrics-port, --metrics-address, --metrics-linger.
+void add_metrics_options(CLI::App& app, MetricsOptions& metrics) {
+  CLI::Option* port = app.add_option("--metrics-port", metrics.port,
+                                     "serve the run's metrics in the Prometheus text format on http://ADDRESS:P/metrics\n"
+                                     "(docs/runtime.md#metrics); a port that cannot be listened on exits 2 before anything is written")
+                          ->check(CLI::Range(1, 65535))
+                          ->type_name("P");
+  app.add_option("--metrics-address", metrics.address, "numeric address the metrics server listens on")
+      ->needs(port)
+      ->capture_default_str();
+  app.add_option("--metrics-linger", metrics.linger_s,
+                 "after the run's end, keep serving its last values this long, so that the last scrape sees them\n"
+                 "(not after a run stopped by a signal) [s]")
+      ->needs(port)
+      ->check(cli::seconds_within(0.0, 3600.0))
+      ->capture_default_str();
+}
+
+/// The metrics server when --metrics-port asks for one, bound before the run's folder is touched; exit code 2 (one
+/// line naming the port) when it cannot listen.
+std::optional<int> start_metrics(std::unique_ptr<MetricsServer>& server, const MetricsOptions& options,
+                                 std::ostream& err) {
+  if (options.port == 0) return std::nullopt;
+  try {
+    server = std::make_unique<MetricsServer>(options);
+    return std::nullopt;
+  } catch (const Error& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return cli::kExitUsage;
+  }
+}
+
+/// After a run that ended (not by a signal, not in an error), the metrics server keeps serving the last values for
+/// --metrics-linger seconds, or until `stop`.
+void linger_for_metrics(const MetricsServer* server, const MetricsOptions& options, int code,
+                        const std::atomic<bool>& stop) {
+  const int signalled = protocol::exit_code(protocol::EndReason::kSignal);
+  if (server == nullptr || code == 1 || code == cli::kExitUsage || code == signalled) return;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.linger_s);
+  while (!stop && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+}
+
+/// The step trace when --trace asks for one, its FILE.tmp opened before the run's folder is touched; exit code 2 (one
+/// line naming the file) when it cannot be written.
+std::optional<int> start_trace(std::unique_ptr<StepTrace>& trace, const std::string& path, std::ostream& err) {
+  if (path.empty()) return std::nullopt;
+  try {
+    trace = std::make_unique<StepTrace>(path, std::chrono::steady_clock::now());
+    return std::nullopt;
+  } catch (const Error& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return cli::kExitUsage;
+  }
+}
+
 /// Exit code 2 (one line) when --run-key names no run key: refused before the folder is touched (settle_run_key()
 /// reads it again once the folder is the run's).
 std::optional<int> refuse_bad_run_key(const std::string& path, std::ostream& err) {
@@ -87,8 +148,8 @@ std::optional<int> lock_folder(std::optional<OutputLock>& lock, const std::strin
 /// The run, once its folder is locked: the start (fresh or resumed), the run key, the participant, the lockstep and the
 /// last line; the exit code (docs/runtime.md#exit-codes), errors as one line.
 int run_in_folder(const std::string& scenario_path, const std::string& resume_dir, const std::string& run_key,
-                  const RuntimeOptions& options, const cli::DdsOptions& dds, const std::atomic<bool>& stop,
-                  std::ostream& out, std::ostream& err) {
+                  const RuntimeOptions& options, const cli::DdsOptions& dds, MetricsServer* metrics,
+                  StepTrace* trace, const std::atomic<bool>& stop, std::ostream& out, std::ostream& err) {
   try {
     WorldStart start;
     if (!resume_dir.empty()) {
@@ -106,6 +167,8 @@ int run_in_folder(const std::string& scenario_path, const std::string& resume_di
         bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kWorld,
                                bus::Security::of(dds.security, dds.identity, "world")});
     WorldRuntime runtime(std::move(start), *participant);
+    if (metrics != nullptr) runtime.serve_metrics(*metrics);
+    if (trace != nullptr) runtime.trace_steps(*trace);
     const RunResult result = runtime.run(stop);
     out << fmt::format("run {}: {} after {} steps{}, {} agents{}, terrain sha256 {}\n", runtime.run_id(),
                        to_string(result.end_reason), result.steps,
@@ -115,6 +178,7 @@ int run_in_folder(const std::string& scenario_path, const std::string& resume_di
                            ? fmt::format(" ({} of {} slots missing at the end)", result.slots_missing, result.team)
                            : "",
                        result.terrain_sha256);
+    if (trace != nullptr) trace->finish();
     return exit_code(result.end_reason, result.slots_missing);
   } catch (const Error& e) {
     cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
@@ -143,6 +207,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       "Every run also writes run.log (every accepted change, checksummed) and snapshot.pb; after a crash,\n"
       "marsala-world --resume DIR continues the run in DIR with its agents (docs/runtime.md#resume).\n"
       "A world holds its folder (DIR/world.lock) while it runs: a second world, --resume or --replace there exits 2.\n"
+      "--metrics-port P serves the run's Prometheus metrics on http://127.0.0.1:P/metrics; --trace FILE writes the\n"
+      "lockstep as a Chrome trace for Perfetto (docs/runtime.md#metrics, #step-traces).\n"
       "Exit codes: 0 completed, 7 completed with slots missing at the end, 3 max_steps, 4 no_live_agents,\n"
       "5 signal, 6 stalled, 1 error, 2 usage or a scenario the world refuses at start (as --check).",
       "marsala-world"};
@@ -190,6 +256,13 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
           ->excludes(check_option);
   add_timing_and_record_options(app, options);
   add_run_key_option(app, run_key);
+  MetricsOptions metrics_options;
+  add_metrics_options(app, metrics_options);
+  std::string trace_path;
+  app.add_option("--trace", trace_path,
+                 "write the lockstep as a Chrome trace (trace-event JSON, for Perfetto) to FILE when the run is over:\n"
+                 "each step's frames, wait, application and record, each agent's wait (docs/runtime.md#step-traces)")
+      ->type_name("FILE");
   app.add_flag("--replace", options.replace,
                "remove a previous run's files from --out before starting (without it such a folder is refused)")
       ->excludes(resume_option);
@@ -205,15 +278,27 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
 
   if (seed_option->count() > 0) options.seed = seed;
   if (const char* path = std::getenv("PATH")) options.search_path = path;
-  if (check)
+  if (check) {
+    // A metrics port the run could not listen on is refused by the check too (bound and let go at once).
+    std::unique_ptr<MetricsServer> metrics;
+    if (const auto code = start_metrics(metrics, metrics_options, err)) return *code;
+    metrics.reset();
     return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, dds.domain, json, out, err);
+  }
   if (quiet && app.get_option("--log-level")->count() == 0) log_options.level = "warn";
   const cli::LoggingScope logging("world", 0, log_options);
   if (const auto code = refuse_bad_run_key(run_key, err)) return *code;
+  std::unique_ptr<MetricsServer> metrics;
+  if (const auto code = start_metrics(metrics, metrics_options, err)) return *code;
+  std::unique_ptr<StepTrace> trace;
+  if (const auto code = start_trace(trace, trace_path, err)) return *code;
   // The folder is this process's from here to its exit, before --replace clears it or --resume reads it.
   std::optional<OutputLock> lock;
   if (const auto code = lock_folder(lock, resume_dir.empty() ? options.out_dir : resume_dir, err)) return *code;
-  return run_in_folder(scenario_path, resume_dir, run_key, options, dds, stop, out, err);
+  const int code = run_in_folder(scenario_path, resume_dir, run_key, options, dds, metrics.get(), trace.get(), stop,
+                                 out, err);
+  linger_for_metrics(metrics.get(), metrics_options, code, stop);
+  return code;
 }
 
 }  // namespace marsala::world_server

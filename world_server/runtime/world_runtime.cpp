@@ -26,7 +26,9 @@
 #include "marsala/world_server/rules/step.hpp"
 #include "marsala/world_server/runtime/admission_gate.hpp"
 #include "marsala/world_server/runtime/agent_links.hpp"
+#include "marsala/world_server/runtime/metrics_server.hpp"
 #include "marsala/world_server/runtime/request_collector.hpp"
+#include "marsala/world_server/runtime/step_trace.hpp"
 #include "marsala/world_server/runtime/team_silence.hpp"
 
 namespace marsala::world_server {
@@ -197,6 +199,26 @@ struct WorldRuntime::Impl {
     s.run_id = options.run_id;
     s.scenario = scenario.name;
     write_logged(*status, s, "the world status");
+    publish_metrics();
+  }
+
+  /// The metrics snapshot of now to the metrics server, when there is one (docs/runtime.md#metrics).
+  void publish_metrics() {
+    if (metrics_server == nullptr) return;
+    std::vector<bool> connected(state.agents.size(), false);
+    for (const AgentRecord& a : state.agents) connected[a.id - 1] = links && links->has(a.id) && links->connected(a.id);
+    take_state(metrics, state, connected);
+    metrics.phase = ended ? RunPhase::kOver : run_started ? RunPhase::kRunning : RunPhase::kAdmitting;
+    metrics.end_reason = ended;
+    metrics_server->publish(std::make_shared<const MetricsSnapshot>(metrics));
+  }
+
+  /// A step's times and rejections into the metrics, when served.
+  void observe_step_metrics(const StepOutcome& outcome, Clock::duration step_took, Clock::duration world_part) {
+    if (metrics_server == nullptr) return;
+    metrics.step_seconds.observe(std::chrono::duration<double>(step_took).count());
+    metrics.step_world_seconds.observe(std::chrono::duration<double>(world_part).count());
+    for (std::size_t i = 0; i < kRejectionReasons; ++i) metrics.rejections_by_reason[i] += outcome.rejected_by_reason[i];
   }
 
   /// Refuses to go on beside another world on this domain (docs/runtime.md#one-world-per-domain): every world
@@ -492,18 +514,36 @@ struct WorldRuntime::Impl {
     for (;;) {
       recorder.frame(state, scenario.name, false);
       if (const auto end = end_before_step(stop)) return *end;
-      const Clock::time_point step_start = Clock::now();
+      StepTimes times;  // the phases' ends, for the step time and the trace
+      times.step = state.step;
+      times.start = Clock::now();
       send_frames();
-      const Collected collected = collector->collect(state, options.step_deadline_s, stop, duties);
+      times.frames_out = Clock::now();
+      Collected collected = collector->collect(state, options.step_deadline_s, stop, duties);
       if (stop) return protocol::EndReason::kSignal;  // the interrupted step is not applied
+      times.collected = Clock::now();
       const StepOutcome outcome = apply_step(state, collected.submissions);
+      times.applied = Clock::now();
       state.surplus_requests += collected.surplus;
       record_step(collected, outcome);
-      const Clock::duration step_took = Clock::now() - step_start;
+      times.recorded = Clock::now();
+      const Clock::duration step_took = times.recorded - times.start;
       step_ms.push_back(milliseconds(step_took));
       step_world_ms.push_back(milliseconds(step_took - collected.waited));
+      observe_step_metrics(outcome, step_took, step_took - collected.waited);
       publish_step(collected, outcome, start);
+      trace_step(times, collected, outcome);
     }
+  }
+
+  /// A step's spans into the trace, when one is written (docs/runtime.md#step-traces).
+  void trace_step(StepTimes& times, Collected& collected, const StepOutcome& outcome) {
+    if (trace == nullptr) return;
+    times.published = Clock::now();
+    times.answers = std::move(collected.answered_at);
+    for (const protocol::WorldEvent& e : outcome.events)
+      if (e.kind == protocol::EventKind::kMissed) times.missed.push_back(e.agent_id);
+    trace->step(times);
   }
 
   // ---- the run
@@ -619,6 +659,7 @@ struct WorldRuntime::Impl {
     recorder.sync();
     for (std::uint32_t id : live) send_frame(id, true);
     emit(make_event(0, protocol::EventKind::kRunOver, to_string(end_reason)));
+    ended = end_reason;
     publish_status(false, result.completed, result.wall_seconds);
 
     RunInfo info = run_info(end_reason, result.wall_seconds, cpu_steps_ms);
@@ -662,6 +703,10 @@ struct WorldRuntime::Impl {
   std::vector<std::string> last_rejection;  ///< [id - 1]: the rejection reason last logged at info level
   std::vector<double> step_ms;              ///< wall time of each lockstep step [ms]
   std::vector<double> step_world_ms;        ///< the world's own part of each step: its wall time less its waits [ms]
+  MetricsServer* metrics_server = nullptr;  ///< where publish_metrics() goes; none: no metrics
+  MetricsSnapshot metrics;                  ///< the metrics, kept up to date while served
+  std::optional<protocol::EndReason> ended;  ///< set when the lockstep is over
+  StepTrace* trace = nullptr;                ///< where trace_step() goes; none: no trace
 };
 
 WorldRuntime::WorldRuntime(const scenario::Scenario& scenario, Heightmap terrain, RuntimeOptions options,
@@ -676,6 +721,18 @@ WorldRuntime::WorldRuntime(WorldStart start, bus::Participant& participant)
 WorldRuntime::~WorldRuntime() = default;
 
 RunResult WorldRuntime::run(const std::atomic<bool>& stop) { return impl_->run(stop); }
+
+void WorldRuntime::trace_steps(StepTrace& trace) {
+  impl_->trace = &trace;
+  trace.name_tracks(static_cast<std::uint32_t>(impl_->state.agents.size()));
+}
+
+void WorldRuntime::serve_metrics(MetricsServer& server) {
+  impl_->metrics_server = &server;
+  impl_->metrics.run_id = impl_->options.run_id;
+  impl_->metrics.scenario = impl_->scenario.name;
+  impl_->metrics.dds = bus::to_string(impl_->participant.vendor());
+}
 
 const WorldState& WorldRuntime::state() const { return impl_->state; }
 

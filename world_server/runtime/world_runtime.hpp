@@ -24,6 +24,9 @@
 
 namespace marsala::world_server {
 
+class MetricsServer;
+class StepTrace;
+
 /// How a run ended.
 struct RunResult {
   bool completed = false;
@@ -54,6 +57,13 @@ class WorldRuntime {
   /// its results are published. Throws Error when no agent is admitted within the admit timeout (or before `stop`),
   /// IoError when the outputs or the log cannot be written.
   RunResult run(const std::atomic<bool>& stop);
+
+  /// Publishes a metrics snapshot to `server` whenever WorldStatus goes out (while admitting, each step, at the end;
+  /// docs/runtime.md#metrics); `server` must outlive run().
+  void serve_metrics(MetricsServer& server);
+
+  /// Appends every step's spans to `trace` (docs/runtime.md#step-traces); `trace` must outlive run().
+  void trace_steps(StepTrace& trace);
 
   /// The world state (after run(): the final one).
   const WorldState& state() const;

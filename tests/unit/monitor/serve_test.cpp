@@ -16,6 +16,7 @@
 #include "marsala/monitor/live_model.hpp"
 #include "marsala/monitor/monitor_cli.hpp"
 #include "marsala/monitor/serve.hpp"
+#include "support/busy_port.hpp"
 
 namespace marsala::monitor {
 namespace {
@@ -162,29 +163,6 @@ Result run_cli(std::vector<std::string> args) {
   return r;
 }
 
-/// A socket listening on a free loopback port, for "port in use".
-class BusyPort {
- public:
-  BusyPort() {
-    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    a.sin_port = 0;
-    socklen_t length = sizeof a;
-    if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 || ::listen(fd_, 1) != 0 ||
-        ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &length) != 0)
-      ADD_FAILURE() << "cannot make a listening socket";
-    port_ = ntohs(a.sin_port);
-  }
-  ~BusyPort() { ::close(fd_); }
-  int port() const { return port_; }
-
- private:
-  int fd_ = -1;
-  int port_ = 0;
-};
-
 TEST(Serve, UsageErrorsExitTwoNamingWhat) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{"serve", "--port", "0"}, "--port"},
@@ -204,7 +182,7 @@ TEST(Serve, UsageErrorsExitTwoNamingWhat) {
 }
 
 TEST(Serve, APortInUseExitsTwoNamingIt) {
-  BusyPort busy;
+  marsala::testing::BusyPort busy;
   const std::string port = std::to_string(busy.port());
   const Result r = run_cli({"serve", "--port", port, "--dds", "inprocess"});
   EXPECT_EQ(r.exit_code, 2);

@@ -1,5 +1,6 @@
 #pragma once
-// A test fixture that runs marsala-world's command line in process, as main() does, in a fresh folder per test.
+// A test fixture that runs marsala-world's command line in process, as main() does, in a fresh folder per test, alone
+// or beside a walking fake agent.
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -9,9 +10,12 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "marsala/world_server/runtime/world_cli.hpp"
+#include "unit/world_server/fake_agent.hpp"
+#include "unit/world_server/world_fixtures.hpp"
 
 namespace marsala::world_server::testing {
 
@@ -31,6 +35,22 @@ class WorldCliFixture : public ::testing::Test {
     const std::filesystem::path p = dir_ / name;
     std::ofstream(p) << text;
     return p.string();
+  }
+  /// Runs marsala-world with `args` on the in-process bus of `domain` beside one walking fake agent in slot 1 of the
+  /// small scenario (--agents 1 --quiet added); returns the world's exit code.
+  int run_beside_walker(int domain, std::vector<std::string> args) {
+    args.insert(args.end(), {"--agents", "1", "--dds", "inprocess", "--domain", std::to_string(domain), "--quiet"});
+    int rc = -1;
+    std::thread world([&] { rc = run(args); });
+    FakeAgentConfig c;
+    c.domain = domain;
+    c.id = 1;
+    c.session = 5;
+    c.body = small_scenario().robot_for(1).body;
+    FakeAgent agent(c);
+    world.join();
+    agent.join();
+    return rc;
   }
   /// marsala-world with `args`; out_ and err_ hold what it printed.
   int run(std::vector<std::string> args) {

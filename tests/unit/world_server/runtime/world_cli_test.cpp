@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "support/busy_port.hpp"
 #include "unit/world_server/fake_agent.hpp"
 #include "unit/world_server/world_cli_fixture.hpp"
 #include "unit/world_server/world_fixtures.hpp"
@@ -19,26 +20,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// The command-line fixture with a walking fake agent beside the world.
-class WorldCliTest : public testing::WorldCliFixture {
- protected:
-  /// Runs marsala-world with `args` on the in-process bus of `domain` beside one walking fake agent in slot 1 of the
-  /// small scenario (--agents 1 --quiet added); returns the world's exit code.
-  int run_beside_walker(int domain, std::vector<std::string> args) {
-    args.insert(args.end(), {"--agents", "1", "--dds", "inprocess", "--domain", std::to_string(domain), "--quiet"});
-    int rc = -1;
-    std::thread world([&] { rc = run(args); });
-    testing::FakeAgentConfig c;
-    c.domain = domain;
-    c.id = 1;
-    c.session = 5;
-    c.body = testing::small_scenario().robot_for(1).body;
-    testing::FakeAgent agent(c);
-    world.join();
-    agent.join();
-    return rc;
-  }
-};
+/// The command-line fixture.
+class WorldCliTest : public testing::WorldCliFixture {};
 
 TEST_F(WorldCliTest, UsageErrorsExitWith2) {
   EXPECT_EQ(run({}), 2);
@@ -52,6 +35,25 @@ TEST_F(WorldCliTest, UsageErrorsExitWith2) {
   EXPECT_EQ(run({"--resume", "somewhere", "--scenario", ok}), 2);  // a resume takes its scenario from the log
   EXPECT_EQ(run({"--help"}), 0);
   EXPECT_NE(out_.str().find("--admit-timeout"), std::string::npos);
+}
+
+// A metrics port that cannot be listened on is refused with one line naming it, exit 2, before the run's folder is
+// made; --check refuses it too (spawn.sh checks with the run's arguments before it starts anything).
+TEST_F(WorldCliTest, AMetricsPortInUseIsRefusedBeforeAnythingIsWritten) {
+  marsala::testing::BusyPort busy;
+  const std::string port = std::to_string(busy.port());
+  const std::string scenario = write("small.pbtxt", testing::small_scenario_text());
+  const fs::path out = dir_ / "out";
+  EXPECT_EQ(run({"--scenario", scenario, "--out", out.string(), "--dds", "inprocess", "--metrics-port", port}), 2);
+  EXPECT_EQ(err_.str(), "marsala-world: error: --metrics-port " + port + ": cannot listen on 127.0.0.1 port " + port +
+                            ": the port is in use (another server listens there)\n");
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(run({"--check", scenario, "--metrics-port", port}), 2);
+  EXPECT_NE(err_.str().find("--metrics-port " + port), std::string::npos) << err_.str();
+  busy.release();
+  EXPECT_EQ(run({"--check", scenario, "--metrics-port", port}), 0) << err_.str();
+  EXPECT_EQ(run({"--scenario", scenario, "--metrics-port", "0"}), 2);
+  EXPECT_EQ(run({"--scenario", scenario, "--metrics-linger", "1"}), 2);  // needs --metrics-port
 }
 
 // --step-deadline overrides the scenario's, as the world's own start-up check reports it.
