@@ -21,8 +21,8 @@ inline constexpr std::uint32_t kRepairDecaySteps = 16;
 
 /// What an agent's frame writer says about the copies written so far, at one look.
 struct CopyState {
-  int readers = 0;            ///< readers matched now [count]
-  bool acknowledged = true;   ///< every matched reader acknowledged every copy (nothing left to deliver)
+  int readers = 0;           ///< readers matched now [count]
+  bool acknowledged = true;  ///< every matched reader acknowledged every copy (nothing left to deliver)
 };
 
 /// True when a copy is still on its way: a matched reader has not acknowledged it (DDS is delivering it).
@@ -55,11 +55,11 @@ class ResendPolicy {
 
  private:
   std::chrono::milliseconds interval_ = kFirstRepairInterval;
-  Clock::time_point last_copy_{};     // when the latest copy was written
-  int readers_at_last_copy_ = 0;      // fewest readers matched since it was written
-  bool repaired_ = false;             // this step's repair was written
-  std::uint32_t resends_ = 0;         // copies this step besides the first
-  std::uint32_t quiet_steps_ = 0;     // steps in a row without a repair
+  Clock::time_point last_copy_{};  // when the latest copy was written
+  int readers_at_last_copy_ = 0;   // fewest readers matched since it was written
+  bool repaired_ = false;          // this step's repair was written
+  std::uint32_t resends_ = 0;      // copies this step besides the first
+  std::uint32_t quiet_steps_ = 0;  // steps in a row without a repair
 };
 
 }  // namespace marsala::world_server
