@@ -22,6 +22,9 @@ work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-security.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 export MARSALA_BUILD_DIR="$build"
 
+# One identity folder for every run (every domain, the largest team): spawn.sh reuses it.
+largest=$(printf '%s\n' $teams | sort -n | tail -1)
+"$root/deploy/security/make-identities.sh" --out "$work/identities" --agents "$largest" >/dev/null
 printf '%-8s %6s %-9s %8s %9s %9s\n' vendor agents mode "admit s" "step med" "step p90"
 domain=60
 for dds in $vendors; do
@@ -30,7 +33,7 @@ for dds in $vendors; do
       out="$work/$dds-$n-$mode"
       domain=$((domain + 1))
       flags=()
-      [ "$mode" = secured ] && flags=(--secure)
+      [ "$mode" = secured ] && flags=(--secure --identities "$work/identities")
       rc=0
       "$root/deploy/spawn.sh" --scenario "$root/deploy/scenarios/crowd_120.pbtxt" --agents "$n" --dds "$dds" \
         --domain "$domain" --out "$out" --max-steps "$steps" --quiet --timeout 600 "${flags[@]}" \

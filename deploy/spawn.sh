@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Runs a scenario as real processes: one marsala-world and N marsala-agent processes on a fresh DDS domain with the
-# loopback configuration, waits for the end, prints a short account of the run (summary.json holds everything), and
-# stops every child it started on exit or Ctrl-C. On a terminal it keeps one line up to date while the run goes:
-# step, progress, steps/s and the estimated time left (marsala-monitor progress).
+# loopback profile (or --profile lan|unicast, secured), waits for the end, prints a short account of the run
+# (summary.json holds everything), and stops every child it started on exit or Ctrl-C. On a terminal it keeps one
+# line up to date while the run goes: step, progress, steps/s and the estimated time left (marsala-monitor progress).
 #
 # Usage: deploy/spawn.sh --scenario FILE --agents N [--dds cyclone|fastdds] [--agent-dds cyclone|fastdds]
 #                        [--out DIR [--replace]] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N]
-#                        [--quiet] [--secure] [--frames-every K] [--dump-maps] [--metrics-port P] [--trace FILE]
+#                        [--quiet] [--profile lo|lan|unicast [--world-address A]] [--secure | --insecure]
+#                        [--identities DIR] [--frames-every K] [--dump-maps] [--metrics-port P] [--trace FILE]
 #                        [--set FIELD=VALUE ...]
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
 #                 folder that holds another run's files, unless --replace removes them (and logs/, maps/) first, and
@@ -29,8 +30,18 @@
 #   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
 #   --set         change a field of the scenario for this run, e.g. --set robot_type.body.sensing_range_m=5
 #                 (repeatable; passed to marsala-world and every marsala-agent; summary.json lists them)
-#   --secure      DDS Security: a CA and an identity per process in OUT/security (deploy/security/make-identities.sh,
-#                 made anew each run), every process authenticated, access-controlled and encrypted (domain <= 230)
+#   --profile     where DDS traffic goes (deploy/dds/<vendor>-<profile>.xml): lo (default: this host's loopback only,
+#                 unsecured unless --secure), lan (a subnet, multicast discovery) or unicast (no multicast: every
+#                 process finds the world at --world-address, default this host's first address, else 127.0.0.1;
+#                 the profiles used are written to OUT/dds/); lan and unicast run secured unless --insecure
+#   --secure      DDS Security (also on lo): every process authenticated, access-controlled and encrypted (domain
+#                 <= 230), with the identities of --identities
+#   --insecure    no DDS Security on a lan or unicast profile: anyone on the network can read and write the run
+#   --identities  the identity folder of secured runs (default $MARSALA_IDENTITIES, else ~/.marsala/identities: it
+#                 outlives run folders and is what you copy to the other hosts): made on first use by
+#                 deploy/security/make-identities.sh for the run's domain and team (one line says where), reused
+#                 afterwards; without --domain a secured run takes the folder's domain. A folder made for another
+#                 domain or a smaller team is refused (exit 2, nothing written)
 # Exit codes: marsala-world's for a run that ended: 0 completed, 7 completed short of slots, 3 max_steps,
 #             4 no_live_agents, 5 stopped by a signal, 6 stalled (no progress and no terrain change for the scenario's stall_steps: the account at the
 #             end says what each robot waited for) (the summary is written in every case); 1 the world failed or
@@ -40,8 +51,43 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
 scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0 frames_every=""
-replace=0 secure=0 dump_maps=0 set_args=() observe_args=()
+replace=0 secure=0 insecure=0 dump_maps=0 set_args=() observe_args=() profile=lo world_address="" identities=""
 usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; }  # the whole header comment
+# The profile and security options, checked and settled: secure=1 for --secure and for lan/unicast without
+# --insecure; identities and world_address get their defaults. Exit 2 naming what is wrong.
+security_options() {
+  case "$profile" in
+    lo|lan|unicast) ;;
+    *) echo "spawn.sh: --profile must be lo, lan or unicast, got '$profile'" >&2; exit 2 ;;
+  esac
+  if [ "$secure" -eq 1 ] && [ "$insecure" -eq 1 ]; then
+    echo "spawn.sh: --secure and --insecure contradict each other: give one" >&2; exit 2
+  fi
+  [ "$profile" != lo ] && [ "$insecure" -eq 0 ] && secure=1
+  if [ "$secure" -eq 1 ] && [ "$agent_dds" != "$dds" ]; then
+    echo "spawn.sh: a secured team runs on one vendor (Cyclone 0.10.2 and Fast DDS 2.9.1 fail each other's" \
+      "handshake, docs/runtime.md#security): drop --agent-dds or give --insecure" >&2
+    exit 2
+  fi
+  if [ "$secure" -eq 0 ] && [ -n "$identities" ]; then
+    echo "spawn.sh: --identities $identities is for secured runs, and this one is not" \
+      "(--insecure or --profile lo without --secure)" >&2
+    exit 2
+  fi
+  identities="${identities:-${MARSALA_IDENTITIES:-${HOME:-/root}/.marsala/identities}}"
+  [[ "$identities" = /* ]] || identities="$PWD/$identities"
+  if [ -n "$world_address" ] && [ "$profile" != unicast ]; then
+    echo "spawn.sh: --world-address is for --profile unicast, not '$profile'" >&2; exit 2
+  fi
+  if [ "$profile" = unicast ] && [ -z "$world_address" ]; then
+    world_address=$(hostname -I 2>/dev/null | awk '{ print $1 }')
+    world_address="${world_address:-127.0.0.1}"
+  fi
+  [[ "$world_address" =~ ^[A-Za-z0-9.:-]*$ ]] ||
+    { echo "spawn.sh: --world-address must be a host name or an address, got '$world_address'" >&2; exit 2; }
+}
+# The domain the identity folder was made for (its manifest), or nothing (no folder yet, or made for every domain).
+identities_domain() { sed -n 's/^domain=\([0-9][0-9]*\)$/\1/p' "$identities/manifest" 2>/dev/null | head -1 || true; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -61,6 +107,10 @@ while [ $# -gt 0 ]; do
     --quiet) quiet=1; shift ;;
     --replace) replace=1; shift ;;
     --secure) secure=1; shift ;;
+    --insecure) insecure=1; shift ;;
+    --profile) profile="$2"; shift 2 ;;
+    --world-address) world_address="$2"; shift 2 ;;
+    --identities) identities="$2"; shift 2 ;;
     --dump-maps) dump_maps=1; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "spawn.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
@@ -76,18 +126,22 @@ done
   { echo "spawn.sh: --seed N needs a non-negative integer, got '$seed'" >&2; exit 2; }
 agent_dds="${agent_dds:-$dds}"
 [ -n "$out" ] || { out="$root/out/$(basename "${scenario%.*}")-$agents"; replace=1; }
+security_options
 for b in marsala-world marsala-agent; do
   [ -x "$bin/$b" ] || { echo "spawn.sh: $bin/$b not built (run deploy/build.sh)" >&2; exit 1; }
 done
 
-# Loopback only: DDS traffic never leaves this host's lo interface.
-export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
-export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-lo.xml"
+# The profile: loopback by default, DDS traffic never leaves this host's lo interface. The unicast ones get the
+# world's address (Cyclone reads it from the environment; Fast DDS's copy is written at the start, below).
+export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-$profile.xml"
+export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-$profile.xml"
+[ "$profile" = unicast ] && export MARSALA_WORLD_ADDRESS="$world_address"
 
 # Without --domain: a random one (not derived from the PID, whose values repeat) on which no world answers
 # `marsala-monitor status` within 1 s (a world publishes its status from its start, while it admits). Two runs
 # started at the same moment may still pick one domain: the world itself then refuses to share it (the later one, or
 # the one still admitting, exits 1 naming the other; docs/runtime.md#one-world-per-domain).
+[ -z "$domain" ] && [ "$secure" -eq 1 ] && domain=$(identities_domain)
 if [ -z "$domain" ]; then
   for _ in 1 2 3 4 5; do
     domain=$(( (RANDOM % 200) + 20 ))
@@ -103,17 +157,10 @@ if [ -e "$out/world.lock" ] && ! flock -n "$out/world.lock" true 2>/dev/null; th
   echo "spawn.sh: output folder '$out' is in use by marsala-world pid $(head -c 20 "$out/world.lock" | tr -dc 0-9): a run goes on there, or is paused; wait for its end, stop it, or give another --out" >&2
   exit 2
 fi
-# A run never mixes its outputs with another's: the world refuses a folder holding a run; with --replace it removes
-# that run's files itself (marsala-world --replace knows the list), and the agents' old logs go here.
-[ "$replace" -eq 1 ] && [ -d "$out" ] && rm -rf -- "$out/logs" "$out/maps"
-
-# Secured: identities made anew for this run's processes (docs/runtime.md#security).
 sec_args=()
 if [ "$secure" -eq 1 ]; then
-  [ "$domain" -le 230 ] || { echo "spawn.sh: --secure needs a domain <= 230, got $domain" >&2; exit 2; }
-  rm -rf -- "$out/security"
-  "$root/deploy/security/make-identities.sh" --out "$out/security" --agents "$agents" >/dev/null
-  sec_args=(--security "$out/security")
+  [ "$domain" -le 230 ] || { echo "spawn.sh: a secured run needs a domain <= 230, got $domain" >&2; exit 2; }
+  sec_args=(--security "$identities")
 fi
 
 world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$domain" --out "$out" "${sec_args[@]}")
@@ -134,6 +181,28 @@ check_rc=0
 if [ "$check_rc" -ne 0 ]; then
   echo "spawn.sh: marsala-world --check rejects the run (exit $check_rc); nothing started" >&2
   exit "$check_rc"
+fi
+# Secured: the identity folder, made on first use or reused when it fits this domain and team (exit 2 otherwise,
+# before anything of the run is written; docs/runtime.md#security).
+if [ "$secure" -eq 1 ]; then
+  ids_line=$("$root/deploy/security/make-identities.sh" --out "$identities" --agents "$agents" --domain "$domain" \
+    --reuse) || exit $?
+  case "$ids_line" in
+    "identities: made"*) echo "spawn.sh: $ids_line" >&2 ;;  # a new secret on disk: said even with --quiet
+    *) [ "$quiet" -eq 1 ] || echo "spawn.sh: $ids_line" ;;
+  esac
+fi
+
+# A run never mixes its outputs with another's: the world refuses a folder holding a run; with --replace it removes
+# that run's files itself (marsala-world --replace knows the list), and the agents' old logs go here.
+[ "$replace" -eq 1 ] && [ -d "$out" ] && rm -rf -- "$out/logs" "$out/maps" "$out/dds"
+# The unicast profiles this run used, the world's address written in (Fast DDS reads no variables).
+if [ "$profile" = unicast ]; then
+  mkdir -p "$out/dds"
+  for v in cyclone fastdds; do
+    sed "s/\${MARSALA_WORLD_ADDRESS}/$world_address/g" "$root/deploy/dds/$v-unicast.xml" >"$out/dds/$v-unicast.xml"
+  done
+  export FASTRTPS_DEFAULT_PROFILES_FILE="$out/dds/fastdds-unicast.xml"
 fi
 
 mkdir -p "$out/logs"
@@ -162,7 +231,7 @@ for id in $(seq 1 "$agents"); do
     "${seed_args[@]}" "${set_args[@]}" "${sec_args[@]}" "${agent_args[@]}" "${key_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
   pids+=("$!")
 done
-[ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain; logs in $out/logs"
+[ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain, profile $profile, $([ "$secure" -eq 1 ] && echo "secured with $identities" || echo unsecured); logs in $out/logs"
 
 progress_pid=""
 if [ "$monitor" -eq 1 ] && [ -x "$bin/marsala-monitor" ]; then

@@ -4,6 +4,10 @@
 # world's exit code (0 completed, 7 completed short of slots, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled,
 # 1 error).
 # Usage: docker/run.sh [--scenario NAME] [--agents N] [--dds cyclone|fastdds] [--domain D] [--out DIR] [--image TAG]
+#                      [--identities DIR | --insecure]
+#   --identities  the identity folders of secured runs (default OUT/identities, kept between runs: made on first use
+#                 in DIR/domain-D by the world's container, reused afterwards; docs/runtime.md#security)
+#   --insecure    no DDS Security (the containers' network is this run's alone inside the namespace)
 #   --image  the image tag to build and run (default $MARSALA_IMAGE, else localhost/marsala:latest); give each checkout
 #            its own when several may run at once on one machine, so that none runs another's binaries
 # Needs podman, runc, podman-compose and, without an image registry, mmdebstrap for the base image
@@ -11,6 +15,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 scenario=ramp agents=3 dds=cyclone domain=0 out="$root/out/containers" image="${MARSALA_IMAGE:-localhost/marsala:latest}"
+identities="" insecure=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -19,10 +24,16 @@ while [ $# -gt 0 ]; do
     --domain) domain="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --image) image="$2"; shift 2 ;;
-    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
+    --identities) identities="$2"; shift 2 ;;
+    --insecure) insecure=1; shift ;;
+    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
     *) echo "run.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
+if [ "$insecure" -eq 1 ] && [ -n "$identities" ]; then
+  echo "run.sh: --identities is for secured runs, and --insecure asks for none: give one" >&2; exit 2
+fi
+identities="${identities:-$out/identities}"
 for tool in podman podman-compose; do
   command -v "$tool" >/dev/null || { echo "run.sh: $tool is not installed (deploy/install-deps.sh --containers)" >&2; exit 1; }
 done
@@ -44,8 +55,10 @@ echo "run.sh: building $image"
 podman build --pull=never -q -t "$image" -f "$root/docker/Dockerfile" "$root" >/dev/null
 echo "run.sh: image built in $((SECONDS - t1)) s ($(podman image ls --format '{{.Size}}' "$image" | head -1))"
 
-mkdir -p "$out"
+mkdir -p "$out" "$identities"
 chmod 777 "$out"  # the containers' user (uid 1000) writes there
+# The identity folders: the containers' user makes them (0700 inside); rootful podman maps it to uid 1000 here.
+chown 1000:1000 "$identities" 2>/dev/null || chmod 777 "$identities"
 rm -rf "$out/run"
 # One project per run: its containers and network are its own, and removed at the end (podman-compose 1.0.3's `down`
 # leaves the network, whose /24 of podman's pool would otherwise stay taken).
@@ -54,6 +67,7 @@ compose="$root/docker/docker-compose.yml"
 t2=$SECONDS
 rc=0
 SCENARIO="$scenario" AGENTS="$agents" DDS="$dds" DOMAIN="$domain" OUT="$out" MARSALA_IMAGE="$image" \
+  IDENTITIES="$identities" INSECURE="$insecure" \
   unshare -n sh -c '
     ip link set lo up
     podman-compose -p "$1" -f "$2" up -d >"$3/compose.log" 2>&1 || { cat "$3/compose.log" >&2; exit 1; }

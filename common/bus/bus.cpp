@@ -3,6 +3,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <optional>
 #include <vector>
 
 #include <fmt/format.h>
@@ -73,6 +75,23 @@ std::filesystem::path executable_dir() {
   return ec ? std::filesystem::path() : self.parent_path();
 }
 
+/// Throws InvalidArgument when the profile at `path` (deploy/dds/*-unicast.xml) still needs the world's address:
+/// Cyclone expands ${MARSALA_WORLD_ADDRESS} itself but it is not set; Fast DDS 2.9 expands nothing.
+void check_world_address(Vendor vendor, const std::string& path) {
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const char* address = std::getenv("MARSALA_WORLD_ADDRESS");
+  if (vendor == Vendor::kCyclone && text.find("\"${MARSALA_WORLD_ADDRESS}\"") != std::string::npos &&
+      (address == nullptr || *address == '\0'))
+    throw InvalidArgument(fmt::format(
+        "DDS profile '{}' needs MARSALA_WORLD_ADDRESS, the world host's address (docs/runtime.md#dds-profiles)", path));
+  if (vendor == Vendor::kFastDds && text.find(">${MARSALA_WORLD_ADDRESS}<") != std::string::npos)
+    throw InvalidArgument(fmt::format(
+        "DDS profile '{}' is a template: write the world host's address in place of ${{MARSALA_WORLD_ADDRESS}} (Fast "
+        "DDS 2.9 expands no variables; docs/runtime.md#dds-profiles)",
+        path));
+}
+
 /// Throws InvalidArgument unless `path` is a readable profile document of `vendor`.
 void check_profile(Vendor vendor, const std::string& path) {
   std::ifstream in(path);
@@ -90,6 +109,7 @@ void check_profile(Vendor vendor, const std::string& path) {
     throw InvalidArgument(
         fmt::format("DDS profile '{}' is not a Fast DDS profile (no <dds> or <profiles> element){}", path,
                     cyclone ? ": it is a Cyclone DDS one; use --dds cyclone or a fastdds-*.xml" : ""));
+  check_world_address(vendor, path);
 }
 
 }  // namespace
@@ -113,7 +133,18 @@ std::string resolve_profile(Vendor vendor, const std::string& given) {
   return {};
 }
 
-void check_security(const Security& security) {
+namespace {
+/// The value of `name=` in the identity folder's manifest, or nullopt when the folder has no manifest or no such line.
+std::optional<std::string> manifest_field(const std::filesystem::path& manifest, const std::string& name) {
+  std::ifstream in(manifest);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind(name + "=", 0) == 0) return line.substr(name.size() + 1);
+  return std::nullopt;
+}
+}  // namespace
+
+void check_security(const Security& security, int domain_id) {
   if (!security.enabled()) return;
   if (security.identity.empty())
     throw InvalidArgument(fmt::format("DDS Security: no identity given for {}", security.dir));
@@ -125,12 +156,24 @@ void check_security(const Security& security) {
       throw InvalidArgument(fmt::format(
           "DDS Security: {} not found (make the folder with deploy/security/make-identities.sh)", file.string()));
   }
+  // A private key others can read is no secret any more: refused, as ssh refuses one.
+  const std::filesystem::path key = std::filesystem::path(security.dir) / (security.identity + ".key");
+  const std::filesystem::perms others = std::filesystem::perms::group_all | std::filesystem::perms::others_all;
+  if ((std::filesystem::status(key).permissions() & others) != std::filesystem::perms::none)
+    throw InvalidArgument(
+        fmt::format("DDS Security: private key {} is open to other users (chmod 600 it)", key.string()));
+  // A folder made for one domain (its manifest, make-identities.sh --domain) says so before DDS refuses it unexplained.
+  const std::filesystem::path manifest = std::filesystem::path(security.dir) / "manifest";
+  if (const std::optional<std::string> made_for = manifest_field(manifest, "domain");
+      made_for && *made_for != "0-230" && *made_for != std::to_string(domain_id))
+    throw InvalidArgument(fmt::format("DDS Security: {} was made for domain {}, not domain {} ({})", security.dir,
+                                      *made_for, domain_id, manifest.string()));
 }
 
 std::unique_ptr<Participant> make_participant(const BusConfig& config) {
   if (config.vendor == Vendor::kInProcess && config.security.enabled())
     throw InvalidArgument("DDS Security needs a DDS vendor (cyclone or fastdds), not inprocess");
-  check_security(config.security);
+  check_security(config.security, config.domain_id);
   if (config.domain_id < 0 || config.domain_id > 232)
     throw InvalidArgument(fmt::format("DDS domain id must be in 0..232, got {}", config.domain_id));
   if (const std::string profile = resolve_profile(config.vendor, config.profile); !profile.empty()) {

@@ -197,8 +197,9 @@ struct Security {
   }
 };
 
-/// The files of `security`, checked: throws InvalidArgument naming the first one missing.
-void check_security(const Security& security);
+/// The files of `security`, checked for a participant of `domain_id` (0..232): throws InvalidArgument naming the first
+/// one missing, a private key open to other users, or a folder whose manifest names another domain.
+void check_security(const Security& security, int domain_id);
 
 /// How to make a participant.
 struct BusConfig {

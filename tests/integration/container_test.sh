@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Real containers: docker/run.sh builds the image with podman and runs docker/docker-compose.yml (the world, three
-# `--id auto` agents and a monitor, each container a host of its own on the compose network, LAN profiles) inside a
-# private network namespace; the run must end on the terrain_sha256 of the same run on loopback.
+# agents and a monitor, each container a host of its own on the compose network, LAN profiles) inside a private
+# network namespace, secured by default: the world's container makes the identities in the identity folder and says
+# so, every process runs with DDS Security, the agents claim slots 1..3; the run must end on the terrain_sha256 of the
+# same run on loopback.
 # Exits 77 (skipped) where podman cannot run containers.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -34,10 +36,17 @@ summary="$work/containers/run/summary.json"
 grep -q '"completed": *true' "$summary" || fail "the containers' run did not complete"
 sha=$(grep -o '"terrain_sha256": *"[0-9a-f]*"' "$summary" | cut -d'"' -f4)
 [ "$sha" = "$reference" ] || fail "containers ended on $sha, loopback on $reference"
-# Three auto agents took the three slots, each under its slot's name.
+# Three agents took the three slots, each under its slot's name.
 for id in 1 2 3; do
   grep -q "admitted agent $id: husky-$id\$" "$work/containers/world.log" ||
-    fail "the world's log names no auto admission of slot $id as husky-$id"
+    fail "the world's log names no admission of slot $id as husky-$id"
 done
-echo "ok: world, 3 --id auto agents and a monitor in containers completed in $((SECONDS - start)) s (image build" \
+# Secured by default: the identities made on first use in the identity folder, one line saying where.
+grep -q "^marsala-entrypoint: identities: made /identities/domain-7 for domain 7, 3 agents" "$work/containers/world.log" ||
+  fail "the world's container did not say where it made the identities"
+[ -f "$work/containers/identities/domain-7/manifest" ] || fail "no identities in run.sh's identity folder"
+grep -q "secured (DDS Security) as world" "$work/containers/world.log" || fail "the world did not run secured"
+grep -l "secured (DDS Security) as agent-" "$work/containers/"agent*.log | wc -l | grep -qx 3 ||
+  fail "not every agent ran secured"
+echo "ok: world, 3 agents and a monitor in containers, secured, completed in $((SECONDS - start)) s (image build" \
   "included) on the loopback terrain $sha; image $image $(podman image ls --format '{{.Size}}' "$image" | head -1)"

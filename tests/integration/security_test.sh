@@ -3,7 +3,13 @@
 # processes in a private network namespace (ctest runs it inside run_isolated.sh).
 #
 # Usage: security_test.sh VENDOR DOMAIN
-#   1. a secured 3-agent ramp run (spawn.sh --secure) completes on the unsecured run's terrain_sha256;
+#   0. spawn.sh's bad inputs: --secure with --insecure, an unknown profile, a secured team of two vendors,
+#      --identities on an unsecured run, an identity folder made for another domain or a smaller team: one line
+#      naming it, exit 2, no run folder made;
+#   1. a 3-agent ramp run on the unicast profile (world at 127.0.0.1), no security flag, is secured by default (the
+#      identity folder made on first use, the world's and agents' logs say "secured") and completes on the terrain of
+#      the unsecured run (marsala-lockstep-sim, in-process); a second run, --secure on loopback, reuses the folder
+#      (same CA fingerprint, no file rewritten) and ends there too;
 #   2. the fence, with marsala-bus-probe processes on one partition of agent 1 (run/agent-1-5eed):
 #      - the world's frames reach agent 1's secured reader;
 #      - a participant without identity receives none of them, and its own frames never reach agent 1;
@@ -27,23 +33,78 @@ fail() { echo "FAIL (security $vendor): $*" >&2; exit 1; }
 . "$root/tests/integration/lib.sh"  # field
 command -v openssl >/dev/null || { echo "SKIP: openssl not installed"; exit 77; }
 
-# 1. A secured run ends where the unsecured one does.
-run() {  # run OUT [--secure]
-  "$root/deploy/spawn.sh" --scenario "$root/deploy/scenarios/ramp.pbtxt" --agents 3 --dds "$vendor" \
-    --domain "$domain" --out "$work/$1" --quiet --timeout 300 "${@:2}" >&2 || fail "spawn.sh $* failed (logs: $work/$1/logs)"
+scenario="$root/deploy/scenarios/ramp.pbtxt"
+ids="$work/identities"
+# The unsecured run's terrain, in-process, while the secured runs go.
+"$build/bin/marsala-lockstep-sim" --scenario "$scenario" --agents 3 --seeds 1 --csv "$work/sim.csv" >/dev/null 2>&1 &
+sim=$!
+spawn() {  # spawn OUT ARGS...: spawn.sh's exit code in rc, its stderr in $work/OUT.err
+  rc=0
+  "$root/deploy/spawn.sh" --scenario "$scenario" --agents 3 --dds "$vendor" --out "$work/$1" --timeout 300 \
+    "${@:2}" >/dev/null 2>"$work/$1.err" || rc=$?
 }
-run plain
-run secured --secure
-[ "$(field completed "$work/secured/summary.json")" = true ] || fail "the secured run did not complete"
-sha_plain=$(field terrain_sha256 "$work/plain/summary.json")
-sha_secured=$(field terrain_sha256 "$work/secured/summary.json")
-[ "$sha_secured" = "$sha_plain" ] || fail "secured run ends on $sha_secured, unsecured on $sha_plain"
-echo "ok: secured ramp run completed on ${sha_secured:0:8} (admitted in $(jq -r .admit_seconds "$work/secured/summary.json") s," \
-  "unsecured $(jq -r .admit_seconds "$work/plain/summary.json") s; step median" \
-  "$(jq -r .step_wall_median_ms "$work/secured/summary.json") ms against $(jq -r .step_wall_median_ms "$work/plain/summary.json") ms)"
+
+# 0. Bad inputs: exit 2, one line naming what is wrong, nothing written.
+"$root/deploy/security/make-identities.sh" --out "$work/two" --agents 2 --domain "$domain" >/dev/null
+spawn_refused() {  # spawn_refused WORDS ARGS...: spawn.sh ARGS exits 2, one line holding WORDS, no run folder
+  local words="$1"
+  shift
+  spawn bad "$@"
+  [ "$rc" = 2 ] && [ "$(wc -l <"$work/bad.err")" = 1 ] && grep -qF -- "$words" "$work/bad.err" ||
+    fail "spawn.sh $*: exit $rc, expected 2 and one line with '$words': $(cat "$work/bad.err")"
+  [ ! -e "$work/bad" ] || fail "spawn.sh $* wrote $work/bad"
+}
+spawn_refused "--secure and --insecure" --secure --insecure --domain "$domain"
+spawn_refused "--profile must be lo, lan or unicast" --profile wan --domain "$domain"
+other=$([ "$vendor" = cyclone ] && echo fastdds || echo cyclone)
+spawn_refused "a secured team runs on one vendor" --profile unicast --agent-dds "$other" --domain "$domain"
+spawn_refused "--identities $ids is for secured runs" --profile lan --insecure --identities "$ids" --domain "$domain"
+spawn_refused "$work/two was made for domain $domain, not $((domain + 1))" --profile lan --identities "$work/two" \
+  --domain $((domain + 1))
+spawn_refused "$work/two was made for 2 agents, this run needs 3" --secure --identities "$work/two" --domain "$domain"
+# A run that marsala-world --check rejects (no --domain: the folder's, or a free one) makes no identities.
+spawn bad --secure --identities "$ids" --set no_such_field=1
+[ "$rc" = 2 ] && grep -q "marsala-world --check rejects the run" "$work/bad.err" ||
+  fail "a rejected scenario: exit $rc, expected 2: $(cat "$work/bad.err")"
+[ ! -e "$ids" ] && [ ! -e "$work/bad" ] || fail "a refused run made $ids or its run folder"
+echo "ok: spawn.sh refuses --secure with --insecure, an unknown profile, a secured mixed team, --identities" \
+  "unsecured, a folder of another domain or a smaller team (exit 2, one line, nothing written)"
+
+# 1. Secured by default beyond loopback; the folder made on first use, then reused; the unsecured terrain.
+spawn unicast --profile unicast --world-address 127.0.0.1 --identities "$ids" --domain "$domain"
+[ "$rc" = 0 ] || fail "the unicast run exited $rc: $(cat "$work/unicast.err") (logs: $work/unicast/logs)"
+grep -qx "spawn.sh: identities: made $ids for domain $domain, 3 agents (CA sha256 .*)" "$work/unicast.err" ||
+  fail "spawn.sh did not say where it made the identities: $(cat "$work/unicast.err")"
+for log in world agent-1 agent-3; do
+  grep -q "secured (DDS Security) as ${log} from $ids" "$work/unicast/logs/$log.log" ||
+    fail "the unicast run's $log.log does not say it is secured"
+done
+grep -q "<address>127.0.0.1</address>" "$work/unicast/dds/fastdds-unicast.xml" || fail "no world address in OUT/dds"
+[ "$(stat -c %a "$ids/world.key")" = 600 ] || fail "world.key is $(stat -c %a "$ids/world.key"), not 600"
+ca=$(openssl x509 -noout -fingerprint -sha256 -in "$ids/ca.pem" | sed 's/^.*=//')
+grep -qx "ca_sha256=$ca" "$ids/manifest" || fail "the manifest does not name the CA's fingerprint $ca"
+before=$(cd "$ids" && ls -l --time-style=+%s.%N && sha256sum ./*)
+spawn reused --secure --identities "$ids"  # no --domain: the folder's
+[ "$rc" = 0 ] || fail "the reusing run exited $rc: $(cat "$work/reused.err") (logs: $work/reused/logs)"
+[ "$(cd "$ids" && ls -l --time-style=+%s.%N && sha256sum ./*)" = "$before" ] || fail "the second run rewrote $ids"
+grep -q "secured (DDS Security) as world from $ids" "$work/reused/logs/world.log" ||
+  fail "the second run is not secured"
+[ "$(jq -r .run_id "$work/reused/summary.json")" = "ramp-d$domain" ] ||
+  fail "the second run did not take the folder's domain $domain ($(jq -r .run_id "$work/reused/summary.json"))"
+wait "$sim" || fail "marsala-lockstep-sim failed"
+want=$(tail -1 "$work/sim.csv" | awk -F, '{print $NF}')
+for run in unicast reused; do
+  [ "$(field completed "$work/$run/summary.json")" = true ] || fail "the $run run did not complete"
+  [ "$(field terrain_sha256 "$work/$run/summary.json")" = "$want" ] ||
+    fail "the $run run ends on $(field terrain_sha256 "$work/$run/summary.json"), unsecured on $want"
+done
+admit=$(jq -r .admit_seconds "$work/unicast/summary.json")
+step=$(jq -r .step_wall_median_ms "$work/unicast/summary.json")
+echo "ok: the unicast run, secured by default, and a --secure run reusing its identities (CA ${ca:0:23}...)" \
+  "completed on the unsecured terrain ${want:0:8} (admitted in $admit s; step median $step ms)"
 
 # 2. The fence.
-sec="$work/secured/security"
+sec="$ids"
 part="run/agent-1-5eed"
 as() {  # as IDENTITY: the probe's security arguments ("none": unsecured)
   [ "$1" = none ] || echo "--security $sec --identity $1"

@@ -391,9 +391,10 @@ class CycloneParticipant final : public ParticipantBase<CycloneParticipant> {
  public:
   explicit CycloneParticipant(const BusConfig& config)
       : context_(std::make_shared<Context>(config.domain_id, config.role, config.security)) {
-    if (config.security.enabled())
-      spdlog::debug("bus: Cyclone DDS participant in domain {}, secured as {}", config.domain_id,
-                    config.security.identity);
+    if (config.security.enabled())  // said in the world's and agents' logs (a monitor's stdout stays its output)
+      spdlog::log(config.role == Role::kServer ? spdlog::level::debug : spdlog::level::info,
+                  "bus: Cyclone DDS participant in domain {}, secured (DDS Security) as {} from {}", config.domain_id,
+                  config.security.identity, config.security.dir);
     else
       spdlog::debug("bus: Cyclone DDS participant in domain {}", config.domain_id);
   }

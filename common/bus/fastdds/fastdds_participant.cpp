@@ -326,6 +326,7 @@ class FastDdsReader final : public Reader<T> {
       throw BusError(fmt::format("Fast DDS: creating a subscriber for {} failed", TopicName<T>::value));
     dds::DataReaderQos qos = subscriber_->get_default_datareader_qos();
     set_common_qos(qos, options);  // RELIABLE set explicitly: Fast DDS 2.9 readers default to BEST_EFFORT
+    keep_all_up_to_depth(qos, options);
     qos.durability().kind = options.durability == Durability::kTransientLocal ? dds::TRANSIENT_LOCAL_DURABILITY_QOS
                                                                               : dds::VOLATILE_DURABILITY_QOS;
     // A Fast DDS reader tracks writer liveliness (liveliness_changed, alive_count) only with a finite lease of its
@@ -345,6 +346,18 @@ class FastDdsReader final : public Reader<T> {
   }
 
   std::vector<Received<T>> take_received() override { return listener_.queue.take(); }
+
+  /// A stream reader (depth > 1) keeps all its samples, up to the depth: Fast DDS stores a sample undecoded until it
+  /// is taken, so under a flood (a foreign type's samples, or any writer faster than the reader takes) a keep-last
+  /// history pushes out genuine samples not yet taken, acknowledged and lost for good; a full keep-all history refuses
+  /// the newcomer instead, and its reliable writer resends it (docs/runtime.md#foreign-types). A depth-1 reader
+  /// (a latest status) keeps the last.
+  static void keep_all_up_to_depth(dds::DataReaderQos& qos, const EndpointOptions& options) {
+    if (options.depth <= 1) return;
+    qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+    qos.resource_limits().max_samples = options.depth;
+    qos.resource_limits().max_samples_per_instance = options.depth;
+  }
 
   // Matched writers not (yet) found dead: Fast DDS counts a writer alive only once its first liveliness assertion
   // arrives (up to 0.8 s after the match for a Cyclone writer), Cyclone from the match on; this counts like Cyclone.
@@ -414,9 +427,10 @@ class FastDdsParticipant final : public ParticipantBase<FastDdsParticipant> {
  public:
   explicit FastDdsParticipant(const BusConfig& config)
       : context_(std::make_shared<Context>(config.domain_id, config.role, config.security)) {
-    if (config.security.enabled())
-      spdlog::debug("bus: Fast DDS participant in domain {}, secured as {}", config.domain_id,
-                    config.security.identity);
+    if (config.security.enabled())  // said in the world's and agents' logs (a monitor's stdout stays its output)
+      spdlog::log(config.role == Role::kServer ? spdlog::level::debug : spdlog::level::info,
+                  "bus: Fast DDS participant in domain {}, secured (DDS Security) as {} from {}", config.domain_id,
+                  config.security.identity, config.security.dir);
     else
       spdlog::debug("bus: Fast DDS participant in domain {}", config.domain_id);
   }

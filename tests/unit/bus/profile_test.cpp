@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "marsala/bus/bus.hpp"
@@ -63,6 +64,38 @@ TEST_F(ProfileTest, AGivenProfileMustBeOneOfThatVendor) {
   EXPECT_THROW(resolve_profile(Vendor::kCyclone, (dir_ / "missing.xml").string()), InvalidArgument);
   EXPECT_THROW(resolve_profile(Vendor::kFastDds, write("junk.xml", "ncols 3\n")), InvalidArgument);
   EXPECT_EQ(resolve_profile(Vendor::kInProcess, "anything"), "");
+}
+
+// The unicast profiles need the world's address: Cyclone reads MARSALA_WORLD_ADDRESS itself, Fast DDS 2.9 reads no
+// variable, so its template must be written out first (deploy/spawn.sh --profile unicast does).
+TEST_F(ProfileTest, AUnicastProfileWithoutTheWorldsAddressIsRefusedSayingWhatIsMissing) {
+  const std::string cyclone = source("deploy/dds/cyclone-unicast.xml");
+  const std::string fastdds = source("deploy/dds/fastdds-unicast.xml");
+  const char* saved = std::getenv("MARSALA_WORLD_ADDRESS");
+  const std::string kept = saved ? saved : "";
+  ::unsetenv("MARSALA_WORLD_ADDRESS");
+  const auto refusal = [](Vendor v, const std::string& path) -> std::string {
+    try {
+      resolve_profile(v, path);
+      return "";
+    } catch (const InvalidArgument& e) {
+      return e.what();
+    }
+  };
+  EXPECT_NE(refusal(Vendor::kCyclone, cyclone).find("needs MARSALA_WORLD_ADDRESS"), std::string::npos);
+  EXPECT_NE(refusal(Vendor::kFastDds, fastdds).find("is a template"), std::string::npos);
+  ::setenv("MARSALA_WORLD_ADDRESS", "10.0.0.5", 1);
+  EXPECT_EQ(refusal(Vendor::kCyclone, cyclone), "");
+  EXPECT_NE(refusal(Vendor::kFastDds, fastdds).find("is a template"), std::string::npos);  // the variable is no help
+  std::ifstream in(fastdds);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (std::size_t at; (at = text.find("${MARSALA_WORLD_ADDRESS}")) != std::string::npos;)
+    text.replace(at, std::string("${MARSALA_WORLD_ADDRESS}").size(), "10.0.0.5");
+  EXPECT_EQ(refusal(Vendor::kFastDds, write("fastdds-unicast-10.0.0.5.xml", text)), "");
+  if (saved)
+    ::setenv("MARSALA_WORLD_ADDRESS", kept.c_str(), 1);
+  else
+    ::unsetenv("MARSALA_WORLD_ADDRESS");
 }
 
 // Without a given profile: the vendor's own variable applies when set, else the shipped loopback profile.
