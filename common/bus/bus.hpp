@@ -77,6 +77,9 @@ class Writer {
   virtual void write(const T& sample) = 0;
   /// Readers currently matched [count].
   virtual int matched_readers() const = 0;
+  /// True when every matched reader has acknowledged every sample written so far (nothing left to deliver; also
+  /// with no reader); a backend that cannot tell says true.
+  virtual bool acknowledged() const { return true; }
 };
 
 /// The participant that wrote a sample: its RTPS GUID prefix, which every vendor sees alike (a Fast DDS reader and

@@ -94,13 +94,23 @@ void AgentLinks::send(std::uint32_t id, protocol::SensorFrame frame) {
   AgentLink& link = links_[id - 1];
   link.frame = std::move(frame);
   write_logged(*link.frames, *link.frame, "a sensor frame");
+  link.resends.first_copy(ResendPolicy::Clock::now(), link.frames->matched_readers());
 }
 
-bool AgentLinks::resend(std::uint32_t id, std::uint64_t step) {
+bool AgentLinks::resend(std::uint32_t id, std::uint64_t step, ResendPolicy::Clock::time_point now) {
   AgentLink& link = links_[id - 1];
   if (!link.frame || link.frame->step != step) return false;
+  const int readers = link.frames->matched_readers();
+  const Resend what = link.resends.look(now, {readers, readers < 1 || link.frames->acknowledged()});
+  if (what == Resend::kNone) return true;
   write_logged(*link.frames, *link.frame, "a sensor frame");
+  link.resends.copied(what, now, readers);
   return true;
+}
+
+bool AgentLinks::in_flight(std::uint32_t id) const {
+  const AgentLink& link = links_[id - 1];
+  return link.frames && link.frames->matched_readers() >= 1 && !link.frames->acknowledged();
 }
 
 }  // namespace marsala::world_server

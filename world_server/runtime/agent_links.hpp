@@ -1,7 +1,8 @@
 #pragma once
 // The world's links to its admitted agents: per slot, the endpoints of the admitted session on its partition
 // (protocol::partition_for(run_id, id, session)): a SensorFrame writer and an ActionRequest reader, the liveliness
-// of the agent's request writer (liveliness.hpp) and the frame of the current step, for resends. A session belongs to
+// of the agent's request writer (liveliness.hpp) and the frame of the current step with its resend rule
+// (resend_policy.hpp). A session belongs to
 // the participant whose hello was admitted (its owner): requests on its partition from any other participant are
 // ignored and counted (docs/runtime.md#who-wrote-it); the session, readable by anyone, is worth nothing to them.
 
@@ -15,6 +16,7 @@
 #include "marsala/protocol/messages.hpp"
 #include "marsala/world_server/rules/world_state.hpp"
 #include "marsala/world_server/runtime/liveliness.hpp"
+#include "marsala/world_server/runtime/resend_policy.hpp"
 
 namespace marsala::world_server {
 
@@ -25,6 +27,7 @@ struct AgentLink {
   std::unique_ptr<bus::Reader<protocol::ActionRequest>> requests;
   LivelinessWatch liveliness;                  ///< of its request writer
   std::optional<protocol::SensorFrame> frame;  ///< the current step's frame, for resends
+  ResendPolicy resends;                        ///< when its frame is written again
   bus::WriterId owner;                         ///< the participant the session belongs to; unknown until bound
   std::uint64_t foreign = 0;                   ///< requests from other participants ignored [count]
 };
@@ -66,8 +69,13 @@ class AgentLinks {
   std::vector<protocol::ActionRequest> take(std::uint32_t id);
   /// Sends `frame` to slot `id` and keeps it for resend().
   void send(std::uint32_t id, protocol::SensorFrame frame);
-  /// Sends slot `id` its kept frame again when it is of `step`; false when it has none of that step.
-  bool resend(std::uint32_t id, std::uint64_t step);
+  /// Sends slot `id` its kept frame again at `now` when the resend rule says so (resend_policy.hpp); false when it
+  /// has no frame of `step`.
+  bool resend(std::uint32_t id, std::uint64_t step, ResendPolicy::Clock::time_point now);
+  /// True when a copy of slot `id`'s frames is on its way: a matched reader has not acknowledged it yet.
+  bool in_flight(std::uint32_t id) const;
+  /// Copies of slot `id`'s current frame written besides the first [count].
+  std::uint32_t resends(std::uint32_t id) const { return links_[id - 1].resends.resends(); }
 
  private:
   bus::Participant& participant_;

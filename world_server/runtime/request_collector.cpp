@@ -18,12 +18,27 @@ void RequestCollector::read_partitions(const WorldState& state, RequestSelection
   }
 }
 
+bool RequestCollector::look(const WorldState& state, const RequestSelection& selection, const CollectDuties& duties,
+                            Clock::time_point now) {
+  bool delivering = false;
+  for (std::uint32_t id : state.live_ids()) {
+    if (selection.answered(id)) continue;
+    if (!links_.resend(id, state.step, now))
+      duties.send_frame(id);  // admitted during this step (re-admission, takeover): its first frame of it
+    else if (links_.in_flight(id))
+      delivering = true;
+  }
+  return delivering;
+}
+
 Collected RequestCollector::collect(const WorldState& state, double deadline_s, const std::atomic<bool>& stop,
                                     const CollectDuties& duties) {
   Clock::time_point deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(deadline_s));
   Clock::time_point last_wake = Clock::now();
-  Clock::time_point next_resend = Clock::now() + kResendInterval;
+  Clock::time_point next_look = last_wake;
+  Clock::duration stretched{};  // deadline added for frames in flight
+  bool delivering = false;      // at the latest look, a frame of an agent that has not answered was in flight
   RequestSelection selection(state.agents.size());
   Collected collected;
   for (;;) {
@@ -35,19 +50,22 @@ Collected RequestCollector::collect(const WorldState& state, double deadline_s, 
       next_liveliness_check_ = now + kLivelinessPoll;
     }
     // A wait lasts at most kPollInterval: a longer gap is time this process did not run, in which no agent could be
-    // heard; a held step waits for its team without a deadline. Neither is charged to the agents.
-    if (now - last_wake >= kWorldPause || (duties.held && duties.held())) deadline += now - last_wake;
-    last_wake = now;
-    const std::vector<std::uint32_t> live = state.live_ids();
-    if (selection.all_answered(live)) break;
-    if (stop || now >= deadline) break;
-    if (now >= next_resend) {
-      for (std::uint32_t id : live)
-        if (!selection.answered(id) && !links_.resend(id, state.step))
-          duties.send_frame(id);  // admitted during this step (re-admission, takeover): its first frame of it
-      next_resend = now + kResendInterval;
+    // heard; a held step waits for its team without a deadline; a frame still in flight on a slow link has not
+    // reached its agent. None of these is charged to the agents.
+    if (now - last_wake >= kWorldPause || (duties.held && duties.held())) {
+      deadline += now - last_wake;
+    } else if (delivering && stretched < kMaxDeliveryStretch) {
+      deadline += now - last_wake;
+      stretched += now - last_wake;
     }
-    signal_->wait_until(std::min({deadline, next_resend, now + Clock::duration(kPollInterval)}));
+    last_wake = now;
+    if (selection.all_answered(state.live_ids())) break;
+    if (stop || now >= deadline) break;
+    if (now >= next_look) {
+      delivering = look(state, selection, duties, now);
+      next_look = now + kResendLook;
+    }
+    signal_->wait_until(std::min({deadline, next_look, now + Clock::duration(kPollInterval)}));
     collected.waited += Clock::now() - now;
   }
   collected.surplus = selection.surplus();

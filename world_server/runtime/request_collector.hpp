@@ -1,8 +1,9 @@
 #pragma once
 // The request collector: one step's wait for the live agents' requests (docs/runtime.md#lockstep). It reads every
 // partition, selects with RequestSelection (the owner's answer always, others up to kMaxRequestsPerPartition, the
-// rest surplus), resends the step's frame to an agent that has not answered after kResendInterval, and returns when
-// every live agent has answered, the step deadline passes or the run is stopped.
+// rest surplus), looks every kResendLook at the agents that have not answered (their frame written again when the
+// resend rule says so, resend_policy.hpp; the deadline stopped while a frame is still being delivered), and returns
+// when every live agent has answered, the step deadline passes or the run is stopped.
 
 #include <atomic>
 #include <chrono>
@@ -20,9 +21,12 @@
 
 namespace marsala::world_server {
 
-/// A live agent that has not answered its frame after this long gets the same frame again (its reader may have
-/// matched late, e.g. after a resume); an agent that receives a frame twice repeats its request, which is ignored.
-inline constexpr std::chrono::milliseconds kResendInterval{500};
+/// How often the agents that have not answered are looked at: resends (resend_policy.hpp; an agent that receives a
+/// frame twice repeats its request, which is ignored) and frames still in flight.
+inline constexpr std::chrono::milliseconds kResendLook{100};
+/// At most this much of one step's wait is not counted against its deadline because a frame was still in flight
+/// (a slow link delivering it) [ms]; beyond it the deadline runs as usual.
+inline constexpr std::chrono::milliseconds kMaxDeliveryStretch{120000};
 /// Between liveliness checks while a step waits. The world wakes once per arriving request; checking every agent's
 /// writer at each wake-up cost N^2 status queries per step (14,400 at 120 agents: 18 ms of the world's CPU per step
 /// with Fast DDS), against a grace of seconds.
@@ -61,7 +65,8 @@ class RequestCollector {
       : links_(links), signal_(std::move(signal)) {}
 
   /// The requests of state.step's live agents until all answered, `deadline_s` passes, or `stop`; the time the
-  /// world's process did not run (kWorldPause) and the time the step is held are not counted. Requests of a dropped
+  /// world's process did not run (kWorldPause), the time the step is held and the time a frame of an agent that has
+  /// not answered is in flight (up to kMaxDeliveryStretch) are not counted. Requests of a dropped
   /// agent's partition are read and discarded.
   Collected collect(const WorldState& state, double deadline_s, const std::atomic<bool>& stop,
                     const CollectDuties& duties);
@@ -69,6 +74,10 @@ class RequestCollector {
  private:
   /// Reads every partition once into `into`.
   void read_partitions(const WorldState& state, RequestSelection& selection, Collected& into);
+  /// Looks at the live agents that have not answered at `now`: resends, first frames; true when a frame of one of
+  /// them is in flight.
+  bool look(const WorldState& state, const RequestSelection& selection, const CollectDuties& duties,
+            Clock::time_point now);
 
   AgentLinks& links_;
   std::shared_ptr<bus::Signal> signal_;

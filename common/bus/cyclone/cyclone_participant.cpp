@@ -255,6 +255,8 @@ class CycloneWriter final : public Writer<T> {
     return static_cast<int>(status.current_count);
   }
 
+  bool acknowledged() const override { return dds_wait_for_acks(writer_, 0) == DDS_RETCODE_OK; }
+
  private:
   static std::string label(const EndpointOptions& options) {
     return fmt::format("{} in partition '{}'", TopicName<T>::value, options.partition);

@@ -296,6 +296,11 @@ class FastDdsWriter final : public Writer<T> {
     return status.current_count;
   }
 
+  bool acknowledged() const override {
+    return writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0, 0)) ==
+           eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK;
+  }
+
  private:
   static std::string label(const EndpointOptions& options) {
     return fmt::format("{} in partition '{}'", TopicName<T>::value, options.partition);

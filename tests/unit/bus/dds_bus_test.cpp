@@ -3,7 +3,7 @@
 // status replays to late readers, writer liveliness shows up in alive_writers().
 //
 // Loopback only: CYCLONEDDS_URI / FASTRTPS_DEFAULT_PROFILES_FILE point at deploy/dds/*-lo.xml (set here from
-// MARSALA_SOURCE_DIR when the environment does not set them). Each test uses its own domain id (150..172).
+// MARSALA_SOURCE_DIR when the environment does not set them). Each test uses its own domain id (150..177).
 
 #include <gtest/gtest.h>
 
@@ -665,6 +665,39 @@ TEST_P(DdsBus, SamplesNameTheParticipantThatWroteThem) {
   }));
   // Across vendors too: the writer's participant, by the GUID prefix both vendors put on the wire.
   for (const Received<SensorFrame>& r : got) EXPECT_EQ(r.from, r.sample.step < 100 ? a : b) << r.sample.step;
+}
+
+// The world's resend rule (docs/runtime.md#resends) asks whether a frame is still in flight: acknowledged() is true
+// with no reader, false right after a large write to another vendor's or Fast DDS's reader (about 1.6 MB, some 1,200
+// fragments of 1.3 kB: no reader can have acknowledged them by the time write() returns) and true once the reader has
+// it.
+TEST_P(DdsBus, AcknowledgedOnlyOnceTheReaderHasEverySample) {
+  make_participants(6);
+  auto alone = writer_side_->create_writer<SensorFrame>({"run-a/agent-2", nullptr});
+  alone->write(SensorFrame{});
+  EXPECT_TRUE(alone->acknowledged()) << "no reader: nothing left to deliver";
+  auto signal = std::make_shared<Signal>();
+  auto reader = reader_side_->create_reader<SensorFrame>({"run-a/agent-1", signal});
+  auto writer = writer_side_->create_writer<SensorFrame>({"run-a/agent-1", nullptr});
+  ASSERT_TRUE(wait_matched(*writer, 1));
+  ASSERT_TRUE(wait_for(*signal, [&] { return reader->alive_writers() >= 1; }));
+  SensorFrame frame;
+  frame.step = 7;
+  frame.tiles.assign(50, TerrainTile{0, 0, 64, 64, std::vector<double>(64 * 64, 1.5)});
+  writer->write(frame);
+  // Two Cyclone participants of one process share one domain instance, which delivers to its own readers before
+  // write() returns: nothing is on a wire there. Across processes (the world and its agents) it is.
+  const bool local = GetParam().writer == Vendor::kCyclone && GetParam().reader == Vendor::kCyclone;
+  if (!local) EXPECT_FALSE(writer->acknowledged()) << "1.6 MB acknowledged as soon as written";
+  std::vector<SensorFrame> got;
+  ASSERT_TRUE(wait_for(*signal, [&] {
+    for (auto& f : reader->take()) got.push_back(std::move(f));
+    return !got.empty();
+  }));
+  EXPECT_EQ(got[0].tiles.size(), 50u);
+  const auto deadline = Clock::now() + kTimeout;
+  while (!writer->acknowledged() && Clock::now() < deadline) std::this_thread::sleep_for(5ms);
+  EXPECT_TRUE(writer->acknowledged()) << "never acknowledged after the reader took it";
 }
 
 INSTANTIATE_TEST_SUITE_P(Pairs, DdsBus,

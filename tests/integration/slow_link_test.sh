@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# A slow link does not collapse (issue 30 deliverable 4, docs/runtime.md#resends): ramp 3 on Cyclone, its first
+# STEPS steps over loopback limited to 1 Mbit/s with MTU 1500 (tc tbf; netem is not in every kernel), end on the
+# terrain of the same steps unthrottled, run first in the same test, with no missed deadline, no drop, and at most
+# 3 times the unthrottled run's bytes on the wire. Before the resend rule every agent was dropped by step 4 there.
+#
+# Usage: slow_link_test.sh STEPS DOMAIN, inside run_isolated.sh (tc changes this namespace's lo only); 77 = skipped
+# where tbf cannot be set up.
+set -euo pipefail
+case_name="slow-link"
+steps="$1"
+domain="$2"
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+. "$here/lib.sh"  # field, test_workspace
+test_workspace slow_link
+scenario="$root/deploy/scenarios/ramp.pbtxt"
+
+# lo_bytes: bytes sent on this namespace's lo so far (/proc/net/dev is per namespace; /sys may show the host's).
+lo_bytes() { awk '/^ *lo:/ { print $10 }' /proc/net/dev; }
+# run NAME: ramp 3 for $steps steps into $work/NAME; prints the bytes it sent on lo.
+run() {
+  local before
+  before=$(lo_bytes)
+  MARSALA_BUILD_DIR="$(dirname "$bin")" "$root/deploy/spawn.sh" --scenario "$scenario" --agents 3 --domain "$domain" \
+    --dds cyclone --max-steps "$steps" --out "$work/$1" --quiet --timeout 240 >/dev/null 2>"$work/$1.err" || true
+  [ -f "$work/$1/summary.json" ] || { cat "$work/$1.err"; fail "$1: no summary.json"; }
+  echo $(($(lo_bytes) - before))
+}
+
+ip link set lo mtu 1500 || { echo "SKIP: cannot set lo's MTU"; exit 77; }
+clean_bytes=$(run clean)
+sha=$(field terrain_sha256 "$work/clean/summary.json")
+[ "$(field steps "$work/clean/summary.json")" = "$steps" ] || fail "the unthrottled run did not reach step $steps"
+
+tc qdisc add dev lo root tbf rate 1mbit burst 32kbit latency 400ms 2>/dev/null || { echo "SKIP: no tbf qdisc here"; exit 77; }
+start=$(date +%s)
+slow_bytes=$(run slow)
+seconds=$(($(date +%s) - start))
+summary="$work/slow/summary.json"
+[ "$(field steps "$summary")" = "$steps" ] && [ "$(field end_reason "$summary")" = "max_steps" ] ||
+  { cat "$summary"; tail -5 "$work/slow/logs/world.log"; fail "at 1 Mbit/s the run ended before step $steps"; }
+[ "$(field terrain_sha256 "$summary")" = "$sha" ] ||
+  fail "at 1 Mbit/s the terrain after $steps steps is $(field terrain_sha256 "$summary"), unthrottled $sha"
+[ "$(field missed_deadlines "$summary")" = 0 ] && ! grep -q '"kind":"dropped"' "$work/slow/events.log" ||
+  { grep '"kind":"\(missed\|dropped\)"' "$work/slow/events.log" | head; fail "missed deadlines or drops at 1 Mbit/s"; }
+[ "$slow_bytes" -le $((3 * clean_bytes)) ] ||
+  fail "at 1 Mbit/s $slow_bytes bytes on the wire, more than 3 times the unthrottled $clean_bytes"
+echo "ok: $steps steps at 1 Mbit/s in $seconds s on the unthrottled terrain $sha; bytes on lo $slow_bytes" \
+  "(unthrottled $clean_bytes); tbf dropped $(tc -s qdisc show dev lo | grep -o 'dropped [0-9]*' | cut -d' ' -f2) packets"
