@@ -74,6 +74,9 @@ class AgentLinks {
   bool resend(std::uint32_t id, std::uint64_t step, ResendPolicy::Clock::time_point now);
   /// True when a copy of slot `id`'s frames is on its way: a matched reader has not acknowledged it yet.
   bool in_flight(std::uint32_t id) const;
+  /// Slot `id`'s agent said hello again (ResendPolicy::asked()): its unanswered frame is written once more at the
+  /// next look unless a copy is in flight.
+  void asked(std::uint32_t id) { links_[id - 1].resends.asked(); }
   /// Copies of slot `id`'s current frame written besides the first [count].
   std::uint32_t resends(std::uint32_t id) const { return links_[id - 1].resends.resends(); }
 

@@ -15,6 +15,7 @@ void ResendPolicy::first_copy(Clock::time_point now, int readers) {
   last_copy_ = now;
   readers_at_last_copy_ = readers;
   repaired_ = false;
+  asked_ = false;
   resends_ = 0;
 }
 
@@ -23,6 +24,7 @@ Resend ResendPolicy::look(Clock::time_point now, const CopyState& copy) {
   // Nobody to write to, or DDS still delivering a copy: another copy would only queue behind it.
   if (copy.readers < 1 || in_flight(copy)) return Resend::kNone;
   if (copy.readers > readers_at_last_copy_) return Resend::kLateReader;
+  if (asked_) return Resend::kAsked;
   if (!repaired_ && now - last_copy_ >= interval_) return Resend::kRepair;
   return Resend::kNone;
 }
@@ -35,6 +37,7 @@ void ResendPolicy::copied(Resend what, Clock::time_point now, int readers) {
   }
   last_copy_ = now;
   readers_at_last_copy_ = readers;
+  asked_ = false;
   ++resends_;
 }
 

@@ -33,6 +33,7 @@ enum class Resend {
   kNone,        ///< nothing: answered, a copy in flight, no reader, or not due
   kLateReader,  ///< a reader matched since the last copy was written: it has none, write one now
   kRepair,      ///< the copy was delivered, no answer within the interval: write it once more (once per step)
+  kAsked,       ///< the agent said hello again since the last copy: it holds no frame it takes, write one now
 };
 
 /// The resend rule of one agent link: per step, from the frame's first copy to the step's end.
@@ -45,7 +46,11 @@ class ResendPolicy {
   /// What to do at `now` about the step's frame, not answered yet, given its writer's `copy` state; a reader that
   /// left since the last copy is forgotten, so one that matches again counts as late.
   Resend look(Clock::time_point now, const CopyState& copy);
-  /// Records that `what` (kLateReader or kRepair) was written at `now` to `readers` matched readers.
+  /// The agent said hello again while its frame is unanswered (it asks whether the world still counts it in, having
+  /// taken no frame for a while, e.g. one written before it trusted this world): a negative acknowledgement, so the
+  /// next look writes one copy unless one is in flight (the agent asks only after 2 s without a frame).
+  void asked() { asked_ = true; }
+  /// Records that `what` (kLateReader, kRepair or kAsked) was written at `now` to `readers` matched readers.
   void copied(Resend what, Clock::time_point now, int readers);
   /// The current repair interval [ms]: kFirstRepairInterval, doubled after each repair, halved after
   /// kRepairDecaySteps steps without one.
@@ -58,6 +63,7 @@ class ResendPolicy {
   Clock::time_point last_copy_{};  // when the latest copy was written
   int readers_at_last_copy_ = 0;   // fewest readers matched since it was written
   bool repaired_ = false;          // this step's repair was written
+  bool asked_ = false;             // the agent asked since the latest copy
   std::uint32_t resends_ = 0;      // copies this step besides the first
   std::uint32_t quiet_steps_ = 0;  // steps in a row without a repair
 };

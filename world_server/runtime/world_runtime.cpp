@@ -309,6 +309,11 @@ struct WorldRuntime::Impl {
       const SenderKey sender = sender_of(hello, received.from.prefix);
       if (!owned_session(hello, received.from) || waits_for_takeover(hello, sender, now)) continue;
       const AdmissionDecision decision = decide_admission(state, hello, run_started, holder_connected(hello.agent_id));
+      // A live agent asking again holds no frame it takes: a negative acknowledgement (docs/runtime.md#resends).
+      if (decision.accepted && decision.kind == AdmissionKind::kRepeat && run_started) {
+        const std::uint32_t id = slot_hello(state, hello, decision).agent_id;  // "any slot": the one it holds
+        if (state.has_agent(id) && links->has(id)) links->asked(id);
+      }
       if (decision.accepted && decision.kind != AdmissionKind::kRepeat) {
         const protocol::AgentHello slot = slot_hello(state, hello, decision);  // "any slot": the one assigned
         if (!gate.persistent(sender, now)) continue;                           // answered when it says hello again

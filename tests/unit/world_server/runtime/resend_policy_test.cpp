@@ -73,6 +73,26 @@ TEST(ResendPolicy, SixteenQuietStepsHalveTheInterval) {
   EXPECT_EQ(policy.interval(), kFirstRepairInterval);
 }
 
+// An agent that took the step's copies while it did not trust this world yet (a resumed world answers from a new
+// participant) asks again after its repair: each ask is one copy at the next look, never one while a copy is in flight,
+// and the ask is spent by the copy.
+TEST(ResendPolicy, AnAgentThatAsksAgainGetsOneCopyPerAsk) {
+  ResendPolicy policy;
+  policy.first_copy(t0, 1);
+  EXPECT_EQ(policy.look(t0 + 500ms, kDelivered), Resend::kRepair);
+  policy.copied(Resend::kRepair, t0 + 500ms, 1);
+  EXPECT_EQ(policy.look(t0 + 2000ms, kDelivered), Resend::kNone);  // the step's one repair is spent
+  policy.asked();
+  EXPECT_EQ(policy.look(t0 + 2100ms, kInFlight), Resend::kNone);  // a copy on its way answers the ask
+  EXPECT_EQ(policy.look(t0 + 2200ms, kDelivered), Resend::kAsked);
+  policy.copied(Resend::kAsked, t0 + 2200ms, 1);
+  EXPECT_EQ(policy.look(t0 + 2300ms, kDelivered), Resend::kNone);
+  EXPECT_EQ(policy.interval(), 1000ms);  // an ask is no repair: the back-off stays where the repair left it
+  policy.asked();
+  EXPECT_EQ(policy.look(t0 + 4300ms, kDelivered), Resend::kAsked);
+  EXPECT_EQ(policy.resends(), 2u);  // the repair and the first ask's copy
+}
+
 TEST(ResendPolicy, AReaderMatchedAfterTheCopyGetsOneAtOnce) {
   ResendPolicy policy;
   policy.first_copy(t0, 0);  // written before the agent's reader matched: nobody got it
