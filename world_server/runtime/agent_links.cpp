@@ -97,20 +97,28 @@ void AgentLinks::send(std::uint32_t id, protocol::SensorFrame frame) {
   link.resends.first_copy(ResendPolicy::Clock::now(), link.frames->matched_readers());
 }
 
+namespace {
+
+// What `link`'s frame writer says about the copies written so far (no writer: nobody to deliver to).
+CopyState copy_state(const AgentLink& link) {
+  if (!link.frames) return {0, true};
+  const int readers = link.frames->matched_readers();
+  return {readers, readers < 1 || link.frames->acknowledged()};
+}
+
+}  // namespace
+
 bool AgentLinks::resend(std::uint32_t id, std::uint64_t step, ResendPolicy::Clock::time_point now) {
   AgentLink& link = links_[id - 1];
   if (!link.frame || link.frame->step != step) return false;
-  const int readers = link.frames->matched_readers();
-  const Resend what = link.resends.look(now, {readers, readers < 1 || link.frames->acknowledged()});
+  const CopyState copy = copy_state(link);
+  const Resend what = link.resends.look(now, copy);
   if (what == Resend::kNone) return true;
   write_logged(*link.frames, *link.frame, "a sensor frame");
-  link.resends.copied(what, now, readers);
+  link.resends.copied(what, now, copy.readers);
   return true;
 }
 
-bool AgentLinks::in_flight(std::uint32_t id) const {
-  const AgentLink& link = links_[id - 1];
-  return link.frames && link.frames->matched_readers() >= 1 && !link.frames->acknowledged();
-}
+bool AgentLinks::in_flight(std::uint32_t id) const { return world_server::in_flight(copy_state(links_[id - 1])); }
 
 }  // namespace marsala::world_server
