@@ -43,11 +43,15 @@ class FakeAgent {
   void join() {
     if (thread_.joinable()) thread_.join();
   }
-  /// Frames received so far (copy; safe while running).
+  /// Frames taken so far, one per step as a real agent takes them (copy; safe while running). A copy of the frame
+  /// just taken (the world writes one again to a reader that matched after the first: docs/runtime.md#resends) is
+  /// answered again but not listed; copies() counts those.
   std::vector<protocol::SensorFrame> frames() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return frames_;
   }
+  /// Copies of an already taken frame received so far [count].
+  int copies() const { return copies_; }
   bool admitted() const { return admitted_; }
   /// The refusal reason, when refused (read after join()).
   const std::string& refusal() const { return refusal_; }
@@ -90,7 +94,10 @@ class FakeAgent {
       for (const protocol::SensorFrame& f : frames->take()) {
         {
           std::lock_guard<std::mutex> lock(mutex_);
-          frames_.push_back(f);
+          if (!frames_.empty() && frames_.back().step == f.step && frames_.back().run_over == f.run_over)
+            ++copies_;
+          else
+            frames_.push_back(f);
         }
         if (f.run_over) return;
         if (config_.mode == FakeMode::kSilent) continue;
@@ -129,6 +136,7 @@ class FakeAgent {
   FakeAgentConfig config_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> admitted_{false};
+  std::atomic<int> copies_{0};
   std::string refusal_;
   mutable std::mutex mutex_;
   std::vector<protocol::SensorFrame> frames_;
