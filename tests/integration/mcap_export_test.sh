@@ -4,7 +4,8 @@
 # reads the export of a ramp run of 3 agents (run inside run_isolated.sh's namespace) with mcap_check.js: both of its
 # readers, every message against its embedded schema, the counts, the first and last terrains against the run's .asc
 # files, the last poses against summary.json. Then the bad inputs: an existing target, a missing folder, a log that
-# fails its checksums: exit 2, one line naming it, nothing written. 77 = skipped without node/npm or when npm cannot
+# fails its checksums: exit 2, one line naming it, nothing written. The same run's summary.json carries the material
+# score, which marsala-monitor summary prints. 77 = skipped without node/npm or when npm cannot
 # install the reader (no network).
 # Usage: mcap_export_test.sh DOMAIN
 set -euo pipefail
@@ -26,6 +27,21 @@ monitor="$bin/marsala-monitor"
 sh "$here/run_isolated.sh" "$root/deploy/spawn.sh" --scenario "$root/deploy/scenarios/ramp.pbtxt" --agents 3 \
   --dds cyclone --domain "$domain" --out "$work/run" --timeout 120 --quiet >"$work/spawn.log" 2>&1 ||
   { tail -20 "$work/spawn.log"; fail "spawn.sh ramp 3"; }
+
+# The material score of the real run (docs/runtime.md#material-score): deposited is the run's volume, the ratio is
+# deposited / needed, nothing off the ramps, and the need is the three wedges: 1.5 m high, 1.5 / kappa = 5 m long, the
+# 1 m band 11 cells (1.1 m) wide, 3 x 1.5 x 5 / 2 x 1.1 = 12.375 m^3 as a continuous wedge (within 3 %: the cells).
+python3 - "$work/run/summary.json" <<'PY' || fail "summary.json's material block"
+import json, sys
+s = json.load(open(sys.argv[1]))
+m = s["material"]
+assert m["deposited_m3"] == s["deposited_volume_m3"], m
+assert abs(m["ratio"] - m["deposited_m3"] / m["needed_m3"]) <= 1e-12, m
+assert abs(m["needed_m3"] - 12.375) <= 0.03 * 12.375, m
+assert m.get("off_band_m3", 0) <= 1e-9, m
+print(f"ok: material {m['deposited_m3']:.3f} of {m['needed_m3']:.3f} m3 needed, ratio {m['ratio']:.3f}")
+PY
+"$monitor" summary "$work/run" | grep -q '^  material .* of .* m3 needed: ratio ' || fail "monitor summary: no material line"
 
 started=$(date +%s.%N)
 "$monitor" export "$work/run" --mcap "$work/run.mcap" --every 50 >"$work/export.log" || fail "export: $(cat "$work/export.log")"

@@ -11,7 +11,8 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 sweep="$root/deploy/sweep.sh"
 scenario="$root/deploy/scenarios/ramp.pbtxt"
 header="team_size,seed,completed,completion_steps,wall_seconds,deposited_m3,path_length_m,idle_steps,"
-header+="idle_fraction,end_reason,sites,site_spans_m"
+header+="idle_fraction,end_reason,sites,site_spans_m,material_deposited_m3,material_needed_m3,material_ratio,"
+header+="material_off_band_m3"
 
 work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-it-sweep.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
