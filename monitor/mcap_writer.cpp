@@ -2,26 +2,13 @@
 
 #include <fmt/format.h>
 
-#include <array>
-
 #include "marsala/core/error.hpp"
+#include "marsala/runlog/crc32c.hpp"
 
 namespace marsala::monitor {
 namespace {
 
-constexpr std::uint32_t kPolynomial = 0xEDB88320u;
-
-constexpr std::array<std::uint32_t, 256> make_table() {
-  std::array<std::uint32_t, 256> table{};
-  for (std::uint32_t i = 0; i < 256; ++i) {
-    std::uint32_t c = i;
-    for (int k = 0; k < 8; ++k) c = (c & 1u) ? (c >> 1) ^ kPolynomial : c >> 1;
-    table[i] = c;
-  }
-  return table;
-}
-
-constexpr std::array<std::uint32_t, 256> kTable = make_table();
+using runlog::crc32_iso;
 
 constexpr char kMagic[] = "\x89MCAP0\r\n";
 constexpr std::size_t kMagicBytes = 8;
@@ -64,13 +51,6 @@ std::string record(Op op, const std::string& content) {
 }
 
 }  // namespace
-
-std::uint32_t crc32_iso(const void* data, std::size_t size, std::uint32_t crc) {
-  const auto* bytes = static_cast<const std::uint8_t*>(data);
-  crc = ~crc;
-  for (std::size_t i = 0; i < size; ++i) crc = kTable[(crc ^ bytes[i]) & 0xFFu] ^ (crc >> 8);
-  return ~crc;
-}
 
 McapWriter::McapWriter(std::ostream& out, const std::string& library, std::uint64_t chunk_bytes)
     : out_(out), chunk_bytes_(chunk_bytes) {

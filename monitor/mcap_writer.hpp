@@ -3,7 +3,8 @@
 // in uncompressed Chunks each followed by its MessageIndex records, DataEnd with the data section's CRC-32, then a
 // Summary section (Schema and Channel records again, Statistics, ChunkIndex records) with its SummaryOffset records,
 // the Footer and the closing magic, so that indexed readers seek and stream readers read straight through. No
-// compression, no attachments, no metadata. Writes to an ostream only: the caller opens, names and renames the file.
+// compression, no attachments, no metadata; checksums by runlog::crc32_iso. Writes to an ostream only: the caller
+// opens, names and renames the file.
 
 #include <cstdint>
 #include <map>
@@ -12,10 +13,6 @@
 #include <vector>
 
 namespace marsala::monitor {
-
-/// CRC-32 (ISO-HDLC, reflected polynomial 0xEDB88320, the zlib one MCAP uses) of `size` bytes, continuing from `crc`
-/// (0 to start). crc32_iso("123456789") == 0xCBF43926.
-std::uint32_t crc32_iso(const void* data, std::size_t size, std::uint32_t crc = 0);
 
 /// What an MCAP file holds, as its Statistics record says.
 struct McapStatistics {
