@@ -669,7 +669,7 @@ TEST_P(DdsBus, SamplesNameTheParticipantThatWroteThem) {
 
 // The world's resend rule (docs/runtime.md#resends) asks whether a frame is still in flight: acknowledged() is true
 // with no reader and true once the reader has a large frame (about 1.6 MB, some 1,200 fragments of 1.3 kB).
-TEST_P(DdsBus, AcknowledgedOnlyOnceTheReaderHasEverySample) {
+TEST_P(DdsBus, AcknowledgedWithoutReadersAndOnceTheReaderHasEverySample) {
   make_participants(6);
   auto alone = writer_side_->create_writer<SensorFrame>({"run-a/agent-2", nullptr});
   alone->write(SensorFrame{});
