@@ -217,6 +217,7 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       registration_(other.registration_),
       built_(other.built_),
       face_floor_(other.face_floor_),
+      face_scan_(other.face_scan_),
       sensor_(other.sensor_),
       trajectory_(other.trajectory_),
       octree_(other.octree_ ? std::make_unique<Octree>(*other.octree_) : nullptr) {}
@@ -314,11 +315,13 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   for (const ScanBatch::Face& f : batch.faces) {
     const long long index = static_cast<long long>(f.cell.row) * g.cols + f.cell.col;
     double& least = face_floor_.try_emplace(index, f.z_m).first->second;
+    if (f.z_m > least || face_scan_.count(index) == 0) face_scan_[index] = scans_;
     least = std::max(least, f.z_m);
-    // A surface read at or above the face stays; else the cell is a bound, no surface: never a deposition target.
-    const bool surface =
-        known_(f.cell.row, f.cell.col) != 0 && assumed_(f.cell.row, f.cell.col) == 0 && heights_(f.cell) >= least;
-    if (!surface) {
+    // A surface read at or above the face stays, and so does one read in an earlier scan only: the cell rose since
+    // (terrain only rises), its top at least the face. Else the cell is a bound, no surface: never a deposition target.
+    const bool read = known_(f.cell.row, f.cell.col) != 0 && assumed_(f.cell.row, f.cell.col) == 0;
+    const bool surface = read && (heights_(f.cell) >= least || rose_since_read(f.cell));
+    if (!surface || heights_(f.cell) < least) {
       const auto built = built_.find(index);
       heights_(f.cell) = built == built_.end() ? least : std::max(least, built->second);
     }
@@ -413,7 +416,9 @@ void MappingSystem::rederive_heights(const ScanBatch& batch) {
       mark_known(row, col);
       // A face above the reading: the reading was the face's, not the cell's top (a bound, no surface).
       const auto face = face_floor_.find(key_rc);
-      if (face != face_floor_.end() && face->second > top->estimate_m) {
+      if (face != face_floor_.end() && face->second > top->estimate_m && rose_since_read({row, col})) {
+        heights_(row, col) = std::max(heights_(row, col), face->second);  // a stale reading: the face's bound is a top
+      } else if (face != face_floor_.end() && face->second > top->estimate_m) {
         heights_(row, col) = std::max(heights_(row, col), face->second);
         assumed_(row, col) = 1;
       }
@@ -442,6 +447,13 @@ void MappingSystem::record_built(CellIndex cell, double rise_m) {
   double& built = built_.try_emplace(index, floor_m).first->second;
   built = std::max(built, floor_m);
   heights_(cell) = std::max(heights_(cell), built);
+}
+
+bool MappingSystem::rose_since_read(CellIndex cell) const {
+  const long long index = static_cast<long long>(cell.row) * heights_.cols() + cell.col;
+  const auto face = face_scan_.find(index);
+  const int read = last_hit_scan(cell);
+  return face != face_scan_.end() && read > 0 && read < face->second;
 }
 
 bool MappingSystem::carved_below(CellIndex cell, double z_m) const {

@@ -133,6 +133,7 @@ class MappingSystem {
   bool behind_edge(Point3 origin, Point3 hit, CellIndex cell, double spread_m) const;
   bool carved_below(CellIndex cell, double z_m) const;  // a scan's ray left a voxel of its column free under z_m
   bool was_assumed_ground(CellIndex cell) const;        // known only from assume_ground(): never hit, no face
+  bool rose_since_read(CellIndex cell) const;  // its surface was last read before a scan that raised its face floor
   void forget(CellIndex cell);                           // unknown again
   // forget_assumed_ground()'s edge: the guessed cells connected to `seeds` outside every ball the robot stood in.
   void forget_along_edge(const std::vector<CellIndex>& seeds, double radius_cells);
@@ -149,6 +150,7 @@ class MappingSystem {
   CellIndex registration_{0, 0};
   std::unordered_map<long long, double> built_;  ///< record_built(): the least height of a cell (row-major index) [m]
   std::unordered_map<long long, double> face_floor_;  ///< the highest face hit of a cell (row-major index) [m]
+  std::unordered_map<long long, int> face_scan_;  ///< the scan that set face_floor_ (1, 2, ...)
   SensorSpec sensor_;
   std::vector<CellIndex> trajectory_;
   std::unique_ptr<Octree> octree_;  // made at the first scan

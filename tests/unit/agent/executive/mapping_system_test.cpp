@@ -392,6 +392,31 @@ TEST(MappingSystem, ARefusalForgetsTheWholeGuessedEdgeOnItsSideOfThePath) {
   EXPECT_EQ(pathless.known_cells(), 81 - 49);  // the ball lies in the disc (1 cell off its centre, 4 in radius)
 }
 
+// A noise-free laser at (3.55, 2.95, 0.5) m reads cell (30, 40) (x 4.0-4.1 m) at 0 m in its first scan (a ray down to
+// its centre). Then robots build there out of its view, and a second scan's rising ray strikes the cell's west face
+// (the edge x = 4.0 m) at 0.6 m: the cell rose since it was read (terrain only rises), so its top is at least 0.6 m, a
+// surface (a deposition target). The same face hit on a map that never read the cell is a bound (no surface), and so
+// is one that comes in the same scan as a reading below it.
+TEST(MappingSystem, AFaceAboveAnOlderReadingIsTheSurfaceTheCellRoseTo) {
+  const Point3 origin{3.55, 2.95, 0.5};
+  const ScanPoint down{0.5F, 0.0F, -0.5F}, face{0.45F, 0.0F, 0.1F};
+  MappingSystem rose = exact_laser_map();
+  rose.integrate_scan({down}, origin);
+  ASSERT_TRUE(rose.is_known({30, 40}));
+  ASSERT_NEAR(rose.heights()(30, 40), 0.0, 1e-6);
+  rose.integrate_scan({face}, origin);
+  EXPECT_NEAR(rose.heights()(30, 40), 0.6, 1e-6);
+  EXPECT_EQ(rose.assumed()(30, 40), 0);
+  MappingSystem unread = exact_laser_map();
+  unread.integrate_scan({face}, origin);
+  EXPECT_NEAR(unread.heights()(30, 40), 0.6, 1e-6);
+  EXPECT_NE(unread.assumed()(30, 40), 0);
+  MappingSystem same_scan = exact_laser_map();
+  same_scan.integrate_scan({down, face}, origin);
+  EXPECT_NEAR(same_scan.heights()(30, 40), 0.6, 1e-6);
+  EXPECT_NE(same_scan.assumed()(30, 40), 0);
+}
+
 // Hand-made hits past the edge of a 0.3 m wall (cols 30-31) known from a first scan. A hit inside col 32 at the
 // wall's height, from a ray that came over the wall's top (it crossed into col 32 at 0.3 m, within noise of the
 // top), is the edge's hit pushed over by noise: left out, col 32 stays unknown. The same point from a ray that came
