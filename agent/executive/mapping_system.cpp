@@ -217,6 +217,7 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       registration_(other.registration_),
       built_(other.built_),
       face_floor_(other.face_floor_),
+      face_scan_(other.face_scan_),
       sensor_(other.sensor_),
       trajectory_(other.trajectory_),
       octree_(other.octree_ ? std::make_unique<Octree>(*other.octree_) : nullptr) {}
@@ -314,11 +315,13 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   for (const ScanBatch::Face& f : batch.faces) {
     const long long index = static_cast<long long>(f.cell.row) * g.cols + f.cell.col;
     double& least = face_floor_.try_emplace(index, f.z_m).first->second;
+    if (f.z_m > least || face_scan_.count(index) == 0) face_scan_[index] = scans_;
     least = std::max(least, f.z_m);
-    // A surface read at or above the face stays; else the cell is a bound, no surface: never a deposition target.
-    const bool surface =
-        known_(f.cell.row, f.cell.col) != 0 && assumed_(f.cell.row, f.cell.col) == 0 && heights_(f.cell) >= least;
-    if (!surface) {
+    // A surface read at or above the face stays, and so does one read in an earlier scan only: the cell rose since
+    // (terrain only rises), its top at least the face. Else the cell is a bound, no surface: never a deposition target.
+    const bool read = known_(f.cell.row, f.cell.col) != 0 && assumed_(f.cell.row, f.cell.col) == 0;
+    const bool surface = read && (heights_(f.cell) >= least || rose_since_read(f.cell));
+    if (!surface || heights_(f.cell) < least) {
       const auto built = built_.find(index);
       heights_(f.cell) = built == built_.end() ? least : std::max(least, built->second);
     }
@@ -413,7 +416,9 @@ void MappingSystem::rederive_heights(const ScanBatch& batch) {
       mark_known(row, col);
       // A face above the reading: the reading was the face's, not the cell's top (a bound, no surface).
       const auto face = face_floor_.find(key_rc);
-      if (face != face_floor_.end() && face->second > top->estimate_m) {
+      if (face != face_floor_.end() && face->second > top->estimate_m && rose_since_read({row, col})) {
+        heights_(row, col) = std::max(heights_(row, col), face->second);  // a stale reading: the face's bound is a top
+      } else if (face != face_floor_.end() && face->second > top->estimate_m) {
         heights_(row, col) = std::max(heights_(row, col), face->second);
         assumed_(row, col) = 1;
       }
@@ -442,6 +447,13 @@ void MappingSystem::record_built(CellIndex cell, double rise_m) {
   double& built = built_.try_emplace(index, floor_m).first->second;
   built = std::max(built, floor_m);
   heights_(cell) = std::max(heights_(cell), built);
+}
+
+bool MappingSystem::rose_since_read(CellIndex cell) const {
+  const long long index = static_cast<long long>(cell.row) * heights_.cols() + cell.col;
+  const auto face = face_scan_.find(index);
+  const int read = last_hit_scan(cell);
+  return face != face_scan_.end() && read > 0 && read < face->second;
 }
 
 bool MappingSystem::carved_below(CellIndex cell, double z_m) const {
@@ -473,11 +485,60 @@ void MappingSystem::forget_assumed_ground(CellIndex cell, double radius_m) {
   const GridGeometry& g = heights_.geometry();
   const double radius_cells = radius_m / g.cell_size_m;
   const int reach = static_cast<int>(std::ceil(radius_cells));
+  std::vector<CellIndex> guessed;
   for (int row = std::max(0, cell.row - reach); row <= std::min(g.rows - 1, cell.row + reach); ++row)
     for (int col = std::max(0, cell.col - reach); col <= std::min(g.cols - 1, cell.col + reach); ++col) {
       const double dr = row - cell.row, dc = col - cell.col;
-      if (dr * dr + dc * dc <= radius_cells * radius_cells + 1e-9 && was_assumed_ground({row, col})) forget({row, col});
+      if (dr * dr + dc * dc <= radius_cells * radius_cells + 1e-9 && was_assumed_ground({row, col}))
+        guessed.push_back({row, col});
     }
+  forget_along_edge(guessed, radius_cells);
+  for (const CellIndex c : guessed) forget(c);
+}
+
+void MappingSystem::forget_along_edge(const std::vector<CellIndex>& seeds, double radius_cells) {
+  if (trajectory_.empty()) return;  // no body stood anywhere: nothing says which side the wrong guess lies on
+  // The nearest cell the robot stood on [cells^2] and the offset from it [cells].
+  struct Side {
+    double distance2;
+    int dr, dc;
+  };
+  const auto side_of = [this](CellIndex c) {
+    Side best{std::numeric_limits<double>::infinity(), 0, 0};
+    for (const CellIndex t : trajectory_) {
+      const int dr = c.row - t.row, dc = c.col - t.col;
+      const double d2 = static_cast<double>(dr) * dr + static_cast<double>(dc) * dc;
+      if (d2 < best.distance2) best = {d2, dr, dc};
+    }
+    return best;
+  };
+  const double vouched2 = radius_cells * radius_cells + 1e-9;  // in the body's ball where it stood: the world's check
+  const GridGeometry& g = heights_.geometry();
+  CellMask seen(g.rows, g.cols);
+  seen.setZero();
+  // From each guessed cell of the refused ball that no ball the robot stood in covered, along the connected guessed
+  // cells no such ball covered either, on the same side of the robot's path (docs/runtime.md#mapping).
+  std::vector<std::pair<CellIndex, Side>> open;
+  for (const CellIndex s : seeds) {
+    const Side side = side_of(s);
+    if (side.distance2 > vouched2 && seen(s.row, s.col) == 0) open.push_back({s, side}), seen(s.row, s.col) = 1;
+  }
+  std::vector<CellIndex> edge;
+  while (!open.empty()) {
+    const auto [c, seed] = open.back();
+    open.pop_back();
+    edge.push_back(c);
+    for (int dr = -1; dr <= 1; ++dr)
+      for (int dc = -1; dc <= 1; ++dc) {
+        const CellIndex n{c.row + dr, c.col + dc};
+        if (!heights_.contains(n) || seen(n.row, n.col) != 0 || !was_assumed_ground(n)) continue;
+        const Side side = side_of(n);
+        if (side.distance2 <= vouched2 || side.dr * seed.dr + side.dc * seed.dc <= 0) continue;
+        seen(n.row, n.col) = 1;
+        open.push_back({n, seed});
+      }
+  }
+  for (const CellIndex c : edge) forget(c);
 }
 
 void MappingSystem::assume_ground(Position pose, double ground_z_m, double radius_m, double below_m) {

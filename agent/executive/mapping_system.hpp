@@ -71,7 +71,10 @@ class MappingSystem {
                      double below_m = std::numeric_limits<double>::infinity());
   /// The world refused a motion to `cell` (world index) as not occupiable: the cells within radius_m of it (centre to
   /// centre) known only as assumed ground (never hit by a scan, no face bound) are what the map guessed there, so they
-  /// become unknown again (docs/runtime.md#refused-requests). Off-grid cells are ignored. [m]
+  /// become unknown again (docs/runtime.md#refused-requests); and so do the cells known only as assumed ground that are
+  /// 8-connected to those of them outside every ball of radius_m around a cell the robot stood on (trajectory()),
+  /// through such cells on the same side of its path (offset from the nearest cell stood on, dot product > 0): the
+  /// whole edge it guessed wrong along its path, not one ball of it. Off-grid cells are ignored. [m]
   void forget_assumed_ground(CellIndex cell, double radius_m);
   /// The robot's own construction: the world accepted its request to raise `cell` (world index, as the map registers
   /// it) by rise_m [m]. Terrain only ever rises (depositions add material), so the cell is at least its map height
@@ -130,7 +133,10 @@ class MappingSystem {
   bool behind_edge(Point3 origin, Point3 hit, CellIndex cell, double spread_m) const;
   bool carved_below(CellIndex cell, double z_m) const;  // a scan's ray left a voxel of its column free under z_m
   bool was_assumed_ground(CellIndex cell) const;        // known only from assume_ground(): never hit, no face
+  bool rose_since_read(CellIndex cell) const;  // its surface was last read before a scan that raised its face floor
   void forget(CellIndex cell);                           // unknown again
+  // forget_assumed_ground()'s edge: the guessed cells connected to `seeds` outside every ball the robot stood in.
+  void forget_along_edge(const std::vector<CellIndex>& seeds, double radius_cells);
   void rederive_heights(const ScanBatch& batch);
 
   Heightmap heights_;
@@ -144,6 +150,7 @@ class MappingSystem {
   CellIndex registration_{0, 0};
   std::unordered_map<long long, double> built_;  ///< record_built(): the least height of a cell (row-major index) [m]
   std::unordered_map<long long, double> face_floor_;  ///< the highest face hit of a cell (row-major index) [m]
+  std::unordered_map<long long, int> face_scan_;  ///< the scan that set face_floor_ (1, 2, ...)
   SensorSpec sensor_;
   std::vector<CellIndex> trajectory_;
   std::unique_ptr<Octree> octree_;  // made at the first scan

@@ -354,6 +354,69 @@ TEST(MappingSystem, AssumedGroundARayWentBelowOrARefusalNamedIsForgotten) {
   EXPECT_FALSE(map.is_known({30, 30}));
 }
 
+// A camera robot drove east along row 15 of a 3 x 3 m world (cols 5 to 15, 0.1 m cells), assuming the ground 0.5 m
+// around it at 1.0 m (no scan came): a band of rows 10 to 20. Its body's ball is 0.4 m, so the world vouched for the
+// cells within 4 cells of the path; the outer ring (4 to 5 cells from the path) is a guess on both sides. A motion to
+// (14, 10) refused for the terrain: its ball is forgotten, and so is the whole guessed ring north of the path, its end
+// caps too, down to the path's row (a distance of 4 or less from a cell stood on, or the path's side, stops it); the
+// south ring and the rest of the band stay.
+TEST(MappingSystem, ARefusalForgetsTheWholeGuessedEdgeOnItsSideOfThePath) {
+  const GridGeometry world{30, 30, 0.0, 0.0, 0.1};
+  MappingSystem map(world, 16, sensor_defaults(SensorKind::kRgbd));
+  for (int col = 5; col <= 15; ++col) {
+    const Position at = world.cell_center({15, col});
+    map.record_pose(at);
+    map.assume_ground(at, 1.0, 0.5);
+  }
+  const MappingSystem before = map;
+  map.forget_assumed_ground({14, 10}, 0.4);
+  const auto path_distance2 = [](int row, int col) {  // to the nearest cell of the path [cells^2]
+    const int dc = std::max({0, 5 - col, col - 15});
+    return (row - 15) * (row - 15) + dc * dc;
+  };
+  int forgotten = 0;
+  for (int row = 0; row < 30; ++row)
+    for (int col = 0; col < 30; ++col) {
+      if (!before.is_known({row, col})) continue;
+      const bool in_ball = (row - 14) * (row - 14) + (col - 10) * (col - 10) <= 16;
+      const bool north_ring = row < 15 && path_distance2(row, col) > 16;
+      EXPECT_EQ(map.is_known({row, col}), !(in_ball || north_ring)) << row << ", " << col;
+      forgotten += in_ball || north_ring ? 1 : 0;
+    }
+  EXPECT_EQ(map.known_cells(), before.known_cells() - forgotten);
+  EXPECT_GT(forgotten, 49 + 11);  // the ball and more than the ring's straight part
+  // Without a path (nothing stood on) only the ball is forgotten.
+  MappingSystem pathless(world, 16, sensor_defaults(SensorKind::kRgbd));
+  pathless.assume_ground(world.cell_center({15, 10}), 1.0, 0.5);
+  pathless.forget_assumed_ground({14, 10}, 0.4);
+  EXPECT_EQ(pathless.known_cells(), 81 - 49);  // the ball lies in the disc (1 cell off its centre, 4 in radius)
+}
+
+// A noise-free laser at (3.55, 2.95, 0.5) m reads cell (30, 40) (x 4.0-4.1 m) at 0 m in its first scan (a ray down to
+// its centre). Then robots build there out of its view, and a second scan's rising ray strikes the cell's west face
+// (the edge x = 4.0 m) at 0.6 m: the cell rose since it was read (terrain only rises), so its top is at least 0.6 m, a
+// surface (a deposition target). The same face hit on a map that never read the cell is a bound (no surface), and so
+// is one that comes in the same scan as a reading below it.
+TEST(MappingSystem, AFaceAboveAnOlderReadingIsTheSurfaceTheCellRoseTo) {
+  const Point3 origin{3.55, 2.95, 0.5};
+  const ScanPoint down{0.5F, 0.0F, -0.5F}, face{0.45F, 0.0F, 0.1F};
+  MappingSystem rose = exact_laser_map();
+  rose.integrate_scan({down}, origin);
+  ASSERT_TRUE(rose.is_known({30, 40}));
+  ASSERT_NEAR(rose.heights()(30, 40), 0.0, 1e-6);
+  rose.integrate_scan({face}, origin);
+  EXPECT_NEAR(rose.heights()(30, 40), 0.6, 1e-6);
+  EXPECT_EQ(rose.assumed()(30, 40), 0);
+  MappingSystem unread = exact_laser_map();
+  unread.integrate_scan({face}, origin);
+  EXPECT_NEAR(unread.heights()(30, 40), 0.6, 1e-6);
+  EXPECT_NE(unread.assumed()(30, 40), 0);
+  MappingSystem same_scan = exact_laser_map();
+  same_scan.integrate_scan({down, face}, origin);
+  EXPECT_NEAR(same_scan.heights()(30, 40), 0.6, 1e-6);
+  EXPECT_NE(same_scan.assumed()(30, 40), 0);
+}
+
 // Hand-made hits past the edge of a 0.3 m wall (cols 30-31) known from a first scan. A hit inside col 32 at the
 // wall's height, from a ray that came over the wall's top (it crossed into col 32 at 0.3 m, within noise of the
 // top), is the edge's hit pushed over by noise: left out, col 32 stays unknown. The same point from a ray that came
