@@ -118,6 +118,9 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
       waiting_for_ = right_of_way_text("giving way", close_by());
     } else if (at_goal) {
       state_ = RampState::kAtGoal;
+    } else if (right_of_way_.standing_aside()) {
+      state_ = RampState::kGiveWay;  // stands aside: nothing requested
+      waiting_for_ = right_of_way_text("standing aside until the robot given way to has passed", close_by());
     } else if (right_of_way_.holding()) {
       state_ = RampState::kGiveWay;  // holds still: nothing requested
       waiting_for_ = right_of_way_text(fmt::format("holding still, no way for {} steps", kStuckFrames), close_by());

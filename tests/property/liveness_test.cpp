@@ -145,11 +145,26 @@ long long env_number(const char* name, long long fallback) {
   return v != nullptr ? std::atoll(v) : fallback;
 }
 
+/// Prints the field of `k`, northmost row first: '#' a wall, 'a'.. a robot's start, 'A'.. its target, '.' ground.
+void print_field(const Case& k) {
+  std::vector<std::string> rows(kRows, std::string(kCols, '.'));
+  for (int r = 0; r < kRows; ++r)
+    for (int c = 0; c < kCols; ++c)
+      if (k.terrain({r, c}) > 0.0) rows[r][c] = '#';
+  for (const auto& slot : k.scenario.slots) {
+    const CellIndex s = *k.terrain.cell_at(slot.start), t = *k.terrain.cell_at(slot.target);
+    rows[s.row][s.col] = static_cast<char>('a' + slot.id - 1);
+    rows[t.row][t.col] = static_cast<char>('A' + slot.id - 1);
+  }
+  for (const std::string& row : rows) fmt::print("{}\n", row);
+}
+
 /// Runs the whole team of `k` for at most `steps`, keeping the right of way when `right_of_way`; with `every` > 0
 /// prints every robot each `every` steps (to look inside one case: MARSALA_LIVENESS_SEED, MARSALA_LIVENESS_EVERY).
 /// True when every robot ends on its target.
 bool team_completes(const Case& k, std::uint64_t steps, bool right_of_way, long long every) {
   LockstepSim sim(k.scenario, k.terrain, static_cast<std::uint32_t>(k.scenario.slots.size()), right_of_way);
+  if (every > 0) print_field(k);
   while (sim.state().step < steps && !world_server::is_completed(sim.state())) {
     sim.step();
     if (every <= 0 || sim.state().step % static_cast<std::uint64_t>(every) != 0) continue;
