@@ -15,6 +15,14 @@ constexpr double kContactTieM = 1e-6;
 
 }  // namespace
 
+double give_way_contact_m(const RobotBody& body) {
+  return 2.0 * body.navigability.delta_m + 2.0 * body.max_step_m;
+}
+
+int give_way_frames(const RobotBody& body) {
+  return static_cast<int>(std::ceil(2.0 * body.navigability.delta_m / body.max_step_m));
+}
+
 RightOfWay::RightOfWay(std::uint32_t self_id, double contact_m, double loiter_m, int give_way_frames)
     : self_id_(self_id), contact_m_(contact_m + kContactTieM), loiter_m_(loiter_m), give_way_frames_(give_way_frames) {
   if (!(contact_m > 0.0) || !std::isfinite(contact_m) || !(loiter_m > 0.0) || !std::isfinite(loiter_m) ||
@@ -117,6 +125,13 @@ void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours
   frames_left_ = (at_goal ? 3 : 1) * give_way_frames_;
   self_ = Loiter{};
   hold_left_ = 0;
+}
+
+void RightOfWay::observe_towards(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, Position going,
+                                 double step_m, bool worked) {
+  const bool new_goal = going_ && std::hypot(going.x - going_->x, going.y - going_->y) > step_m;
+  going_ = going;
+  observe(self, neighbours, at_goal, std::hypot(going.x - self.x, going.y - self.y), step_m, worked, new_goal);
 }
 
 bool RightOfWay::stand_aside(Position self) {
