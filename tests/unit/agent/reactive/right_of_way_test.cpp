@@ -57,7 +57,8 @@ TEST(RightOfWay, ARobotAtItsGoalGivesWayEveryTimeAWaitingRobotHolds) {
 TEST(RightOfWay, AfterGivingWayFromItsGoalARobotStandsAsideWhileTheOtherDrivesPast) {
   RightOfWay parked(1, 1.6, 0.9, 6);
   // Robot 2 holds beside it until the parked robot gives way.
-  for (int frame = 0; frame < 100 && !parked.giving_way(); ++frame) parked.observe({2.7, 1.7}, {at(2, 2.1, 2.3)}, true, 0.0, 0.1);
+  for (int frame = 0; frame < 100 && !parked.giving_way(); ++frame)
+    parked.observe({2.7, 1.7}, {at(2, 2.1, 2.3)}, true, 0.0, 0.1);
   ASSERT_TRUE(parked.giving_way());
   // The episode lasts three episodes of frames (it stays where it is here); robot 2 ends its hold after 5 of them
   // and drives on, 0.03 m a frame, in contact.
