@@ -116,9 +116,10 @@ protocol::ActionRequest PathBuilder::decide(const protocol::SensorFrame& frame) 
   }
   trace_.after = state_;
   worked_ = !request.depositions.empty() || !request.deposits.empty() || request.refill;
-  if (trace_.role && (*trace_.role == PipelineRole::kHold || *trace_.role == PipelineRole::kFollow) &&
-      !request.move && state_ != PathState::kYield)
-    worked_ = true;  // waits for its front neighbour, as the pipeline says
+  // Only a robot on its way back can be in a knot: on the way out the pipeline's own order (follow, hold, back off,
+  // the front robot's retreat) makes no way towards the target by design.
+  const bool returning = state_ == PathState::kReturnToBase || (resume_ && *resume_ == PathState::kReturnToBase);
+  if (!returning) worked_ = true;
   request.state = to_string(state_);
   request.waiting_for = waiting_for_;
   return request;
@@ -134,7 +135,7 @@ bool PathBuilder::right_of_way_step(BuildView& view, const protocol::SensorFrame
                              : view.target;
   right_of_way_.observe_towards(view.robot, frame.neighbours, false, going, 0.5 * body.max_step_m, worked_);
   const auto what =
-      steps_.right_of_way_step(right_of_way_, view.local, view.robot, false, close_by(frame), trace_, request);
+      steps_.right_of_way_step(right_of_way_, view.local, view.robot, false, close_by(frame), trace_, request, false);
   if (!what) {
     if (resume_) state_ = *resume_, resume_.reset();
     return false;

@@ -12,10 +12,11 @@
 //   any but kReturnToBase --material below one deposition threshold (not enough for a deposition task), or the
 //                    robot on the local goal's cell (the path is there: go back, refill, come again) -> kReturnToBase
 //   kReturnToBase  --retrace the trajectory through navigable cells; at the base: refill--------------> kAdvance
-//   any            --right of way (right_of_way.hpp, when the robot keeps it): leaving a lower id's lane, giving
-//                    way, or holding still after no way towards the target (or the base) in contact ---> kYield,
-//                    then back to the state it interrupted. A follower waiting for its front neighbour (kHold, or
-//                    kFollow without a motion) works as the pipeline says: it never holds for it.
+//   any            --right of way (right_of_way.hpp, when the robot keeps it; no lanes: the pipeline has its own):
+//                    giving way to a lower id that holds, or, on the way back, holding still after no way towards
+//                    the base with a robot in contact ------------------------------------------------> kYield,
+//                    then back to the state it interrupted. On the way out a robot never holds: the pipeline's own
+//                    order (follow, hold, back off, the front robot's retreat) makes no way by design.
 //   not kActive, and a returning neighbour within the separation that has not passed the robot yet (it is nearer the
 //                    target): step aside, off the line from it to the base (the front robot builds on;
 //                    returning robots go round it) ---------------------------------------------------> kYield
@@ -139,7 +140,7 @@ class PathBuilder final : public Behaviour {
   ReturnProgress return_progress_;  // how long the return to the base has come no nearer
   RightOfWay right_of_way_;
   bool keeps_right_of_way_ = false;  // the context's right_of_way: else none of the protocol's steps are taken
-  // The last request deposited, refilled or waited for its front neighbour as the pipeline says: work, not a knot.
+  // The last request deposited or refilled, or the robot is on its way out (the pipeline's order): no knot.
   bool worked_ = false;
   std::optional<PathState> resume_;  // the state a protocol frame interrupted
 };

@@ -495,10 +495,12 @@ std::optional<executive::Motion> RampSteps::leave_lanes(const deliberative::Loca
 
 std::optional<std::string> RampSteps::right_of_way_step(const RightOfWay& protocol, deliberative::LocalMap& local,
                                                         Position robot, bool at_goal, const std::string& close_by,
-                                                        BuildTrace& trace, protocol::ActionRequest& request) {
+                                                        BuildTrace& trace, protocol::ActionRequest& request,
+                                                        bool keep_lanes) {
   const RobotBody& body = context_.type.body;
   const std::vector<Lane> lanes =
-      protocol.lanes(3.0 * body.navigability.delta_m, 0.5 * body.navigability.delta_m + body.max_step_m);
+      keep_lanes ? protocol.lanes(3.0 * body.navigability.delta_m, 0.5 * body.navigability.delta_m + body.max_step_m)
+                 : std::vector<Lane>{};
   const bool in_lane = in_any(lanes, robot);
   if (!in_lane) keep_out_of(local, robot, lanes);
   std::string what;

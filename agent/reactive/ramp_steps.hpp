@@ -163,9 +163,11 @@ class RampSteps {
   /// from the robot it gives way to, nothing more when `at_goal` (the behaviour's own), standing aside or holding
   /// (nothing requested). Returns what the robot waits for ("right of way: ...", then "; robots <close_by> close by"
   /// unless empty) when the protocol took the frame; nullopt when the behaviour's own step goes on.
+  /// Without `lanes` no lane is kept (a pipeline's robots all drive one corridor, in lanes of their own).
   std::optional<std::string> right_of_way_step(const RightOfWay& protocol, deliberative::LocalMap& local,
                                                Position robot, bool at_goal, const std::string& close_by,
-                                               BuildTrace& trace, protocol::ActionRequest& request);
+                                               BuildTrace& trace, protocol::ActionRequest& request,
+                                               bool lanes = true);
 
   /// Advance, build or start retreating (see the header); nullopt, with nothing requested, when no deposition path
   /// leads through known cells (the behaviour's state stays: wait for the map to grow).

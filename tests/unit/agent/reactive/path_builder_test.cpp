@@ -180,12 +180,12 @@ TEST(PathBuilder, HoldsWithinTheSeparationAndFollowsAgainOnceTheFrontMovesOn) {
   EXPECT_TRUE(q.move);
 }
 
-TEST(PathBuilder, AFollowerWaitingForItsFrontNeighbourNeverHoldsForTheRightOfWay) {
+TEST(PathBuilder, OnItsWayOutARobotNeverHoldsForTheRightOfWay) {
   const AgentContext c = context();  // keeps the right of way (the default)
   PathBuilder pb(c);
   pb.on_admission(admission(c, kTarget));
   // 1.85 m behind robot 5 (in contact) for kPatienceSteps frames (then it steps aside on its own): it makes no way,
-  // but it waits as the pipeline says; without that rule it would hold after kStuckFrames of them.
+  // but it waits as the pipeline says; were it on its way back it would hold after kStuckFrames of them (below).
   static_assert(kStuckFrames < kPatienceSteps);
   for (std::uint64_t step = 0; step < kPatienceSteps; ++step) {
     const protocol::ActionRequest q = pb.decide(frame(c, step, kAtFoot, 1.0, {test::neighbour_at(5, 6.9, 3.05)}));
