@@ -1,6 +1,7 @@
 // Liveness of solid robots (docs/runtime.md#right-of-way): many short randomized runs, in-process (the world's rules
 // and the real behaviours, tests/support/lockstep_sim.hpp), 2-6 robots on fields cut by walls into corridors about
-// one and a half bodies wide, random starts and targets on open ground. Every run must end with every robot on its
+// one and a half bodies wide (every third case a wall across the field with doors one body wide, where robots meet
+// head on), random starts and targets on open ground. Every run must end with every robot on its
 // target: a knot of robots that wait for each other never dissolves by luck, only by the protocol.
 
 #include <gtest/gtest.h>
