@@ -26,7 +26,7 @@ struct AgentContext {
   double neighbour_keep_out_m = 0.0;
   std::uint64_t seed = 1;  ///< scenario seed; behaviours that randomise seed from seed + agent_id
   std::optional<GoalVectorMapSpec> goal_vector_map;  ///< the scenario's, for the "goal_vector_map" synthesizer
-  /// Ramp builders keep the right-of-way protocol (docs/runtime.md#right-of-way); the agent sets it from the scenario's
+  /// Builders keep the right-of-way protocol (docs/runtime.md#right-of-way); the agent sets it from the scenario's
   /// `right_of_way` (on by default).
   bool right_of_way = true;
 };

@@ -54,7 +54,11 @@ PipelineParams pipeline_params(const Pipeline& pipeline, const RobotBody& body) 
 }
 
 PathBuilder::PathBuilder(const AgentContext& context, PathBuilderOptions options)
-    : steps_(context, std::move(options.planner)), pipeline_(pipeline_params(context.type.pipeline, context.type.body)) {
+    : steps_(context, std::move(options.planner)),
+      pipeline_(pipeline_params(context.type.pipeline, context.type.body)),
+      right_of_way_(context.agent_id, give_way_contact_m(context.type.body),
+                    1.5 * context.type.body.navigability.delta_m, give_way_frames(context.type.body)),
+      keeps_right_of_way_(context.right_of_way) {
   steps_.set_lane(context.type.pipeline.lane_offset_m, construction_params(context.type).delta_m);
   steps_.set_band_centre(true);
 }
@@ -82,7 +86,7 @@ protocol::ActionRequest PathBuilder::decide(const protocol::SensorFrame& frame) 
   if (frame.run_over || state_ == PathState::kDone) {
     state_ = PathState::kDone;
   } else {
-    const BuildView view = steps_.look(frame, trace_);
+    BuildView view = steps_.look(frame, trace_);
     const Position here{frame.x_m, frame.y_m};
     still_steps_ = last_position_ && last_position_->x == here.x && last_position_->y == here.y ? still_steps_ + 1 : 0;
     last_position_ = here;
@@ -91,9 +95,14 @@ protocol::ActionRequest PathBuilder::decide(const protocol::SensorFrame& frame) 
     // back to the base, to come again.
     const bool at_goal = view.local.goal == view.local.robot;
     pipeline_.observe(frame.neighbours, view.target);
-    if (state_ != PathState::kReturnToBase && (frame.material_m3 < return_below_m3_ - 1e-12 || at_goal))
+    if (right_of_way_step(view, frame, request)) {
+      // the protocol's frame
+    } else if (state_ != PathState::kReturnToBase && (frame.material_m3 < return_below_m3_ - 1e-12 || at_goal)) {
       state_ = PathState::kReturnToBase;
-    if (state_ == PathState::kReturnToBase) {
+    }
+    if (state_ == PathState::kYield && resume_) {
+      // the protocol's frame: nothing more
+    } else if (state_ == PathState::kReturnToBase) {
       const double to_base_m = distance(here, steps_.context().assignment.base);
       const int no_nearer = return_progress_.observe(to_base_m);
       if (steps_.return_step(view.local, frame, trace_, request)) {
@@ -106,9 +115,35 @@ protocol::ActionRequest PathBuilder::decide(const protocol::SensorFrame& frame) 
     }
   }
   trace_.after = state_;
+  worked_ = !request.depositions.empty() || !request.deposits.empty() || request.refill;
+  // Only a robot on its way back can be in a knot: on the way out the pipeline's own order (follow, hold, back off,
+  // the front robot's retreat) makes no way towards the target by design.
+  const bool returning = state_ == PathState::kReturnToBase || (resume_ && *resume_ == PathState::kReturnToBase);
+  if (!returning) worked_ = true;
   request.state = to_string(state_);
   request.waiting_for = waiting_for_;
   return request;
+}
+
+bool PathBuilder::right_of_way_step(BuildView& view, const protocol::SensorFrame& frame,
+                                    protocol::ActionRequest& request) {
+  if (!keeps_right_of_way_) return false;
+  const RobotBody& body = steps_.context().type.body;
+  // Where it goes: the target, or the base on the way back. A path builder never parks at a goal.
+  const Position going = state_ == PathState::kReturnToBase || (resume_ && *resume_ == PathState::kReturnToBase)
+                             ? steps_.context().assignment.base
+                             : view.target;
+  right_of_way_.observe_towards(view.robot, frame.neighbours, false, going, 0.5 * body.max_step_m, worked_);
+  const auto what =
+      steps_.right_of_way_step(right_of_way_, view.local, view.robot, false, close_by(frame), trace_, request, false);
+  if (!what) {
+    if (resume_) state_ = *resume_, resume_.reset();
+    return false;
+  }
+  if (!resume_) resume_ = state_;
+  state_ = PathState::kYield;
+  waiting_for_ = *what;
+  return true;
 }
 
 std::string PathBuilder::close_by(const protocol::SensorFrame& frame) const {

@@ -12,6 +12,11 @@
 //   any but kReturnToBase --material below one deposition threshold (not enough for a deposition task), or the
 //                    robot on the local goal's cell (the path is there: go back, refill, come again) -> kReturnToBase
 //   kReturnToBase  --retrace the trajectory through navigable cells; at the base: refill--------------> kAdvance
+//   any            --right of way (right_of_way.hpp, when the robot keeps it; no lanes: the pipeline has its own):
+//                    giving way to a lower id that holds, or, on the way back, holding still after no way towards
+//                    the base with a robot in contact ------------------------------------------------> kYield,
+//                    then back to the state it interrupted. On the way out a robot never holds: the pipeline's own
+//                    order (follow, hold, back off, the front robot's retreat) makes no way by design.
 //   not kActive, and a returning neighbour within the separation that has not passed the robot yet (it is nearer the
 //                    target): step aside, off the line from it to the base (the front robot builds on;
 //                    returning robots go round it) ---------------------------------------------------> kYield
@@ -42,6 +47,7 @@
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/agent/reactive/pipeline.hpp"
 #include "marsala/agent/reactive/ramp_steps.hpp"
+#include "marsala/agent/reactive/right_of_way.hpp"
 #include "marsala/agent/reactive/waiting_for.hpp"
 #include "marsala/core/navigable_path_planner.hpp"
 
@@ -120,6 +126,8 @@ class PathBuilder final : public Behaviour {
   std::optional<Neighbour> oncoming(const BuildView& view, const protocol::SensorFrame& frame) const;
   void yield_step(const BuildView& view, Position from, protocol::ActionRequest& request);
   std::string close_by(const protocol::SensorFrame& frame) const;  // robots_close_by() within a body length
+  // The right of way's frame (right_of_way.hpp), when it takes this one: true, the request filled, the state kYield.
+  bool right_of_way_step(BuildView& view, const protocol::SensorFrame& frame, protocol::ActionRequest& request);
 
   RampSteps steps_;
   PipelineTracker pipeline_;
@@ -130,6 +138,11 @@ class PathBuilder final : public Behaviour {
   PathBuilderTrace trace_;
   std::string waiting_for_;         // what the last decision waits for (waiting_for.hpp), set where its state is chosen
   ReturnProgress return_progress_;  // how long the return to the base has come no nearer
+  RightOfWay right_of_way_;
+  bool keeps_right_of_way_ = false;  // the context's right_of_way: else none of the protocol's steps are taken
+  // The last request deposited or refilled, or the robot is on its way out (the pipeline's order): no knot.
+  bool worked_ = false;
+  std::optional<PathState> resume_;  // the state a protocol frame interrupted
 };
 
 }  // namespace marsala::agent::reactive

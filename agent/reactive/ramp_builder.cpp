@@ -30,21 +30,7 @@ RampState state_of(BuildPhase phase) {
   return RampState::kAdvance;
 }
 
-/// What a robot keeping the right of way waits for: "right of way: <what>", and the robots close by when any are.
-std::string right_of_way_text(const std::string& what, const std::string& close_by) {
-  return close_by.empty() ? fmt::format("right of way: {}", what)
-                          : fmt::format("right of way: {}; robots {} close by", what, close_by);
-}
-
 }  // namespace
-
-double give_way_contact_m(const RobotBody& body) {
-  return 2.0 * body.navigability.delta_m + 2.0 * body.max_step_m;
-}
-
-int give_way_frames(const RobotBody& body) {
-  return static_cast<int>(std::ceil(2.0 * body.navigability.delta_m / body.max_step_m));
-}
 
 std::string to_string(RampState state) { return enum_to_string(kRampStateNames, state); }
 
@@ -94,33 +80,17 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
     // target off the grid.
     const bool at_goal = local.goal == local.robot;
     const Position going = state_ == RampState::kReturnToBase ? steps_.context().assignment.base : view.target;
-    if (keeps_right_of_way_) {
-      // Where it goes moved (a goal vector map's next arrow, or the base): its progress is measured afresh.
-      const bool new_goal = going_ && std::hypot(going.x - going_->x, going.y - going_->y) > 0.5 * body.max_step_m;
-      going_ = going;
-      right_of_way_.observe(view.robot, frame.neighbours, at_goal,
-                            std::hypot(going.x - view.robot.x, going.y - view.robot.y), 0.5 * body.max_step_m, worked_,
-                            new_goal);
-    }
-    const std::vector<Lane> lanes =
+    if (keeps_right_of_way_)
+      right_of_way_.observe_towards(view.robot, frame.neighbours, at_goal, going, 0.5 * body.max_step_m, worked_);
+    const auto protocol_frame =
         keeps_right_of_way_
-            ? right_of_way_.lanes(3.0 * body.navigability.delta_m, 0.5 * body.navigability.delta_m + body.max_step_m)
-            : std::vector<Lane>{};
-    const bool in_lane = in_any(lanes, view.robot);
-    if (!in_lane) RampSteps::keep_out_of(local, view.robot, lanes);
-    if (in_lane) {
+            ? steps_.right_of_way_step(right_of_way_, local, view.robot, at_goal, close_by(), trace_, request)
+            : std::nullopt;
+    if (protocol_frame) {
       state_ = RampState::kGiveWay;
-      if (const auto out = steps_.leave_lanes(local, view.robot, lanes)) steps_.move(*out, trace_, request);
-      waiting_for_ = right_of_way_text("leaving a lower id's lane", close_by());
-    } else if (const auto from = right_of_way_.giving_way()) {
-      state_ = RampState::kGiveWay;
-      if (const auto motion = steps_.step_away(local, view.robot, *from)) steps_.move(*motion, trace_, request);
-      waiting_for_ = right_of_way_text("giving way", close_by());
+      waiting_for_ = *protocol_frame;
     } else if (at_goal) {
       state_ = RampState::kAtGoal;
-    } else if (right_of_way_.holding()) {
-      state_ = RampState::kGiveWay;  // holds still: nothing requested
-      waiting_for_ = right_of_way_text(fmt::format("holding still, no way for {} steps", kStuckFrames), close_by());
     } else {
       if (state_ == RampState::kGiveWay) state_ = RampState::kAdvance;
       if (state_ == RampState::kAtGoal) state_ = RampState::kAdvance;

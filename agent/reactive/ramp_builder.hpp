@@ -57,11 +57,6 @@ enum class RampState : std::uint8_t {
 };
 /// "wait_admission", "survey", "advance", "build", "retreat", "return_to_base", "at_goal", "done", "give_way".
 std::string to_string(RampState state);
-/// Robots of this body whose centres lie nearer than this are in contact (right_of_way.hpp): their bodies, a step
-/// each and a body of slack (a robot that tries and backs off in turn is not always at its nearest) [m].
-double give_way_contact_m(const RobotBody& body);
-/// Frames of one giving-way episode: two body lengths of steps.
-int give_way_frames(const RobotBody& body);
 /// The inverse of to_string; throws InvalidArgument listing the valid names.
 RampState ramp_state_from_string(const std::string& name);
 
@@ -104,7 +99,6 @@ class RampBuilder final : public Behaviour {
   RightOfWay right_of_way_;
   bool keeps_right_of_way_ = false;  // the context's right_of_way: else none of the protocol's steps are taken
   bool worked_ = false;  // the last request deposited or refilled: building is progress, not waiting
-  std::optional<Position> going_;  // where it went last frame (its target, or the base on the way back) [m]
   double return_below_m3_ = 0.0;  // less material than this (one cube) on board: back to the base [m^3]
   RampState state_ = RampState::kWaitAdmission;
   RampBuilderTrace trace_;

@@ -1,5 +1,7 @@
 #include "marsala/agent/reactive/ramp_steps.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -489,6 +491,36 @@ std::optional<executive::Motion> RampSteps::leave_lanes(const deliberative::Loca
       }
   }
   return std::nullopt;
+}
+
+std::optional<std::string> RampSteps::right_of_way_step(const RightOfWay& protocol, deliberative::LocalMap& local,
+                                                        Position robot, bool at_goal, const std::string& close_by,
+                                                        BuildTrace& trace, protocol::ActionRequest& request,
+                                                        bool keep_lanes) {
+  const RobotBody& body = context_.type.body;
+  const std::vector<Lane> lanes =
+      keep_lanes ? protocol.lanes(3.0 * body.navigability.delta_m, 0.5 * body.navigability.delta_m + body.max_step_m)
+                 : std::vector<Lane>{};
+  const bool in_lane = in_any(lanes, robot);
+  if (!in_lane) keep_out_of(local, robot, lanes);
+  std::string what;
+  if (in_lane) {
+    if (const auto out = leave_lanes(local, robot, lanes)) move(*out, trace, request);
+    what = "leaving a lower id's lane";
+  } else if (const auto from = protocol.giving_way()) {
+    if (const auto motion = step_away(local, robot, *from)) move(*motion, trace, request);
+    what = "giving way";
+  } else if (at_goal) {
+    return std::nullopt;
+  } else if (protocol.standing_aside()) {
+    what = "standing aside until the robot given way to has passed";
+  } else if (protocol.holding()) {
+    what = fmt::format("holding still, no way for {} steps", kStuckFrames);
+  } else {
+    return std::nullopt;
+  }
+  return close_by.empty() ? fmt::format("right of way: {}", what)
+                          : fmt::format("right of way: {}; robots {} close by", what, close_by);
 }
 
 std::optional<CellIndex> RampSteps::farthest_navigable_from_goal(const deliberative::LocalMap& local) {

@@ -158,6 +158,17 @@ class RampSteps {
   std::optional<executive::Motion> leave_lanes(const deliberative::LocalMap& local, Position robot,
                                                const std::vector<Lane>& lanes) const;
 
+  /// One frame of the right of way (right_of_way.hpp) for a robot at `robot` [m] that keeps it: `local` loses the lanes
+  /// of the robots with the right of way (keep_out_of); then, in this order, a step out of such a lane, a step away
+  /// from the robot it gives way to, nothing more when `at_goal` (the behaviour's own), standing aside or holding
+  /// (nothing requested). Returns what the robot waits for ("right of way: ...", then "; robots <close_by> close by"
+  /// unless empty) when the protocol took the frame; nullopt when the behaviour's own step goes on.
+  /// Without `lanes` no lane is kept (a pipeline's robots all drive one corridor, in lanes of their own).
+  std::optional<std::string> right_of_way_step(const RightOfWay& protocol, deliberative::LocalMap& local,
+                                               Position robot, bool at_goal, const std::string& close_by,
+                                               BuildTrace& trace, protocol::ActionRequest& request,
+                                               bool lanes = true);
+
   /// Advance, build or start retreating (see the header); nullopt, with nothing requested, when no deposition path
   /// leads through known cells (the behaviour's state stays: wait for the map to grow).
   std::optional<BuildPhase> build_step(const deliberative::LocalMap& local, const protocol::SensorFrame& frame,

@@ -8,9 +8,23 @@
 #include "marsala/core/error.hpp"
 
 namespace marsala::agent::reactive {
+namespace {
+
+// Positions carry rounding of a few 1e-10 m (sums of steps): robots exactly contact_m apart are in contact.
+constexpr double kContactTieM = 1e-6;
+
+}  // namespace
+
+double give_way_contact_m(const RobotBody& body) {
+  return 2.0 * body.navigability.delta_m + 2.0 * body.max_step_m;
+}
+
+int give_way_frames(const RobotBody& body) {
+  return static_cast<int>(std::ceil(2.0 * body.navigability.delta_m / body.max_step_m));
+}
 
 RightOfWay::RightOfWay(std::uint32_t self_id, double contact_m, double loiter_m, int give_way_frames)
-    : self_id_(self_id), contact_m_(contact_m), loiter_m_(loiter_m), give_way_frames_(give_way_frames) {
+    : self_id_(self_id), contact_m_(contact_m + kContactTieM), loiter_m_(loiter_m), give_way_frames_(give_way_frames) {
   if (!(contact_m > 0.0) || !std::isfinite(contact_m) || !(loiter_m > 0.0) || !std::isfinite(loiter_m) ||
       give_way_frames < 1)
     throw InvalidArgument(fmt::format(
@@ -29,11 +43,12 @@ void RightOfWay::Loiter::update(Position p, double radius_m) {
 void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, double to_go_m,
                          double step_m, bool worked, bool new_goal) {
   self_.update(self, loiter_m_);
+  if (at_goal) displaced_ = false;
   // Frames spent holding or giving way are the protocol's, not tries: they neither count as no progress nor keep a
   // best distance from before them (a robot that stepped away from its goal, or held, gets kStuckFrames frames to
   // make way from where it stands before it holds again; else it held again at once, for ever).
   // A new goal starts its own count: the best distance to the old one says nothing of the way to it.
-  const bool protocol_frame = hold_left_ > 0 || frames_left_ > 0;
+  const bool protocol_frame = hold_left_ > 0 || frames_left_ > 0 || aside_left_ > 0;
   if (at_goal || worked || protocol_frame || new_goal || to_go_m < best_to_go_m_ - step_m || no_progress_ < 0) {
     best_to_go_m_ = to_go_m, no_progress_ = 0;
   } else {
@@ -67,8 +82,14 @@ void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours
     hold_left_ = kStillFrames + give_way_frames_;
     no_progress_ = 0, best_to_go_m_ = to_go_m;
   }
+  if (stand_aside(self)) return;
+  // Off its goal only to give way: it keeps the lowest priority until it is back (see lanes() and below); it still
+  // holds when it makes no way back (above), so that a robot parked on its way gives way to it.
+  at_goal = at_goal || displaced_;
   if (frames_left_ > 0 && --frames_left_ > 0) return;
+  if (from_ && given_at_goal_) aside_left_ = kAsideEpisodes * give_way_frames_;  // the episode ends: stay aside
   from_.reset();
+  if (stand_aside(self)) return;
   if (self_.frames < kStillFrames) return;
   // In contact: this robot has loitered long enough, the other holds still (it has stood still at least kStillFrames
   // and no longer than a hold: a robot parked at its goal waits for nobody), near enough. The lowest id goes first; a
@@ -86,20 +107,43 @@ void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours
     const bool holds = s.still >= kStillFrames && s.still <= kStillFrames + give_way_frames_ && !back_parked;
     const bool waits = holds || (at_goal && s.loiter.frames >= kStillFrames);
     if (s.frame != frame_ || !waits || (!at_goal && id > self_id_) || id == self_id_) continue;
-    // At its goal a robot gives way to a robot once where it stands: one that waits there again after the episode
-    // waits for something else (it is parked at its own goal, or this robot is not what blocks it).
+    // At its goal a robot gives way to one that loiters beside it once where it loiters: one that loiters there
+    // again after the episode waits for something else (it is parked at its own goal, or this robot is not what
+    // blocks it). One that holds is given way to every time it holds: a hold is the signal of a robot that tried and
+    // made no way (parked robots never hold), and where it holds again it has still not got past.
     const auto given = given_to_.find(id);
-    if (at_goal && given != given_to_.end() && std::hypot(s.at.x - given->second.x, s.at.y - given->second.y) <=
-                                                   loiter_m_ / 3.0)
+    if (at_goal && !holds && given != given_to_.end() &&
+        std::hypot(s.at.x - given->second.x, s.at.y - given->second.y) <= loiter_m_ / 3.0)
       continue;
     const double d = std::hypot(s.at.x - self.x, s.at.y - self.y);
     if (d <= nearest) nearest = d, from_ = s.at, to_id = id;
   }
   if (!from_) return;
   if (at_goal) given_to_[to_id] = *from_;
+  given_at_goal_ = at_goal, giving_to_ = to_id;
+  displaced_ = displaced_ || at_goal;
   frames_left_ = (at_goal ? 3 : 1) * give_way_frames_;
   self_ = Loiter{};
   hold_left_ = 0;
+}
+
+void RightOfWay::observe_towards(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, Position going,
+                                 double step_m, bool worked) {
+  const bool new_goal = going_ && std::hypot(going.x - going_->x, going.y - going_->y) > step_m;
+  going_ = going;
+  observe(self, neighbours, at_goal, std::hypot(going.x - self.x, going.y - self.y), step_m, worked, new_goal);
+}
+
+bool RightOfWay::stand_aside(Position self) {
+  if (aside_left_ == 0) return false;
+  // The robot it gave way to still drives in contact: it has not got past yet; coming back now cuts its way again.
+  const auto other = seen_.find(giving_to_);
+  const bool passing = other != seen_.end() && other->second.frame == frame_ &&
+                       other->second.still < kMovingFrames &&
+                       std::hypot(other->second.at.x - self.x, other->second.at.y - self.y) <=
+                           contact_m_ + loiter_m_;
+  aside_left_ = passing ? aside_left_ - 1 : 0;
+  return aside_left_ > 0;
 }
 
 bool in_any(const std::vector<Lane>& lanes, Position p) {
@@ -115,7 +159,7 @@ bool Lane::contains(Position p) const {
 std::vector<Lane> RightOfWay::lanes(double length_m, double clearance_m) const {
   std::vector<Lane> out;
   for (const auto& [id, s] : seen_) {
-    if (s.frame != frame_ || id >= self_id_ || s.still >= kMovingFrames || (s.heading.x == 0.0 && s.heading.y == 0.0)) continue;
+    if (s.frame != frame_ || (id >= self_id_ && !displaced_) || s.still >= kMovingFrames || (s.heading.x == 0.0 && s.heading.y == 0.0)) continue;
     out.push_back({s.at, {s.at.x + length_m * s.heading.x, s.at.y + length_m * s.heading.y}, s.radius_m + clearance_m});
   }
   return out;

@@ -20,6 +20,7 @@
 #include <optional>
 #include <vector>
 
+#include "marsala/core/robot_body.hpp"
 #include "marsala/core/types.hpp"
 
 namespace marsala::agent::reactive {
@@ -31,6 +32,15 @@ inline constexpr int kStillFrames = 16;
 inline constexpr int kStuckFrames = 24;
 /// A neighbour that moved within this many frames is on its way: its lane ahead is reserved [frames].
 inline constexpr int kMovingFrames = 3;
+/// After giving way from its goal, a robot stands aside while the robot it gave way to still drives in contact, for
+/// at most this many episodes [episodes].
+inline constexpr int kAsideEpisodes = 4;
+
+/// Robots of this body whose centres lie nearer than this are in contact: their bodies, a step each and a body of
+/// slack (a robot that tries and backs off in turn is not always at its nearest) [m].
+double give_way_contact_m(const RobotBody& body);
+/// Frames of one giving-way episode: two body lengths of steps.
+int give_way_frames(const RobotBody& body);
 
 /// The way ahead of a moving robot with the right of way: the capsule of `radius_m` around the segment from `from`
 /// to `to` [m]. A robot of a higher id keeps out of it, and leaves it when it stands in it.
@@ -59,8 +69,16 @@ class RightOfWay {
   /// goes is not where it went last frame (its progress is then measured afresh: a goal vector map's next arrow).
   void observe(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, double to_go_m, double step_m,
                bool worked = false, bool new_goal = false);
+  /// observe() with where the robot goes, `going` [m]: how far it has to go is its distance from there, and its
+  /// progress is measured afresh when that moved by more than step_m since the last frame (a goal vector map's next
+  /// arrow, the base on the way back).
+  void observe_towards(Position self, const std::vector<Neighbour>& neighbours, bool at_goal, Position going,
+                       double step_m, bool worked);
   /// True while the robot holds still (made no way with a neighbour in contact; see the header).
   bool holding() const { return hold_left_ > 0; }
+  /// True while the robot stands aside after giving way from its goal (the robot it gave way to still drives in
+  /// contact: it has not got past yet).
+  bool standing_aside() const { return aside_left_ > 0; }
   /// Where the robot it gives way to stood when the episode began [m], while an episode lasts; else nullopt.
   std::optional<Position> giving_way() const { return frames_left_ > 0 ? from_ : std::nullopt; }
   /// Frames this robot has loitered [frames].
@@ -100,6 +118,12 @@ class RightOfWay {
   double best_to_go_m_ = 0.0;
   int no_progress_ = 0;
   int hold_left_ = 0;
+  bool given_at_goal_ = false;  // the episode under way was given from the robot's goal
+  std::uint32_t giving_to_ = 0;  // the robot the last episode gave way to
+  int aside_left_ = 0;           // frames it may still stand aside
+  std::optional<Position> going_;  // where the robot went last frame (observe_towards())
+  bool displaced_ = false;       // it gave way from its goal and is not back on it: the lowest priority still
+  bool stand_aside(Position self);  // one frame of standing aside at `self` [m]; true while it lasts
 };
 
 }  // namespace marsala::agent::reactive

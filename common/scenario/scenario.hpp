@@ -103,7 +103,7 @@ struct Scenario {
   /// The run ends "stalled" after this many steps without a rise of its progress or a change of its terrain; 0: never
   /// (docs/runtime.md#stall) [steps].
   std::uint64_t stall_steps = kDefaultStallSteps;
-  /// Ramp builders keep the right-of-way protocol (docs/runtime.md#right-of-way); on by default, false turns it off.
+  /// Builders keep the right-of-way protocol (docs/runtime.md#right-of-way); on by default, false turns it off.
   bool right_of_way = true;
   double step_deadline_s = 10.0;
   std::int32_t tile_size = 16;

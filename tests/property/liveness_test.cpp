@@ -1,6 +1,7 @@
 // Liveness of solid robots (docs/runtime.md#right-of-way): many short randomized runs, in-process (the world's rules
 // and the real behaviours, tests/support/lockstep_sim.hpp), 2-6 robots on fields cut by walls into corridors about
-// one and a half bodies wide, random starts and targets on open ground. Every run must end with every robot on its
+// one and a half bodies wide (every third case a wall across the field with doors one body wide, where robots meet
+// head on), random starts and targets on open ground. Every run must end with every robot on its
 // target: a knot of robots that wait for each other never dissolves by luck, only by the protocol.
 
 #include <gtest/gtest.h>
@@ -53,6 +54,25 @@ Heightmap field(std::mt19937& rng, int walls) {
   return h;
 }
 
+/// A field cut in two by a wall across it from border to border (north-south or east-west), with 1-2 doors 1.2-1.6 m
+/// wide (two bodies cannot pass in one: robots crossing each way meet head on in a door), and 0-2 random walls.
+Heightmap door_field(std::mt19937& rng) {
+  Heightmap h = field(rng, std::uniform_int_distribution<int>(0, 2)(rng));
+  const bool across_rows = std::uniform_int_distribution<int>(0, 1)(rng) == 0;  // a north-south wall
+  const int length = across_rows ? kRows : kCols, at = across_rows ? std::uniform_int_distribution<int>(15, 35)(rng)
+                                                                  : std::uniform_int_distribution<int>(10, 20)(rng);
+  std::vector<bool> open(static_cast<std::size_t>(length), false);
+  const int doors = std::uniform_int_distribution<int>(1, 2)(rng);
+  for (int d = 0; d < doors; ++d) {
+    const int width = std::uniform_int_distribution<int>(6, 8)(rng);
+    const int from = std::uniform_int_distribution<int>(2, length - 2 - width)(rng);
+    for (int k = from; k < from + width; ++k) open[static_cast<std::size_t>(k)] = true;
+  }
+  for (int k = 0; k < length; ++k)
+    if (!open[static_cast<std::size_t>(k)]) h(across_rows ? CellIndex{k, at} : CellIndex{at, k}) = 0.25;
+  return h;
+}
+
 struct Case {
   scenario::Scenario scenario;
   Heightmap terrain;
@@ -87,7 +107,9 @@ bool well_formed(const Heightmap& terrain, const RobotBody& body, const std::vec
 /// well formed.
 std::optional<Case> random_case(std::uint64_t seed) {
   std::mt19937 rng(static_cast<std::uint32_t>(seed));
-  Case k{{}, field(rng, std::uniform_int_distribution<int>(2, 5)(rng)), ""};
+  // Every third seed a field with a wall across and doors, else one of random walls.
+  const bool doors = seed % 3 == 0;
+  Case k{{}, doors ? door_field(rng) : field(rng, std::uniform_int_distribution<int>(2, 5)(rng)), ""};
   const RobotType type = mover();
   NavigabilityParams wide = type.body.navigability;
   wide.delta_m = 2.0 * kDelta;  // open ground: a ball twice the body's is level
@@ -123,7 +145,7 @@ std::optional<Case> random_case(std::uint64_t seed) {
   s.base = {{0.3, 0.3}, 0.2};
   s.tile_size = 16;
   s.seed = seed;
-  k.text = fmt::format("seed {}: {} robots", seed, robots);
+  k.text = fmt::format("seed {}: {} robots{}", seed, robots, doors ? " (a wall across with doors)" : "");
   for (const auto& slot : s.slots) k.text += fmt::format(", {} {} -> {}", slot.id, slot.start, slot.target);
   k.scenario.right_of_way = true;  // the scenario asks for it; team_completes() decides whether the team keeps it
   return k;
@@ -145,11 +167,26 @@ long long env_number(const char* name, long long fallback) {
   return v != nullptr ? std::atoll(v) : fallback;
 }
 
+/// Prints the field of `k`, northmost row first: '#' a wall, 'a'.. a robot's start, 'A'.. its target, '.' ground.
+void print_field(const Case& k) {
+  std::vector<std::string> rows(kRows, std::string(kCols, '.'));
+  for (int r = 0; r < kRows; ++r)
+    for (int c = 0; c < kCols; ++c)
+      if (k.terrain({r, c}) > 0.0) rows[r][c] = '#';
+  for (const auto& slot : k.scenario.slots) {
+    const CellIndex s = *k.terrain.cell_at(slot.start), t = *k.terrain.cell_at(slot.target);
+    rows[s.row][s.col] = static_cast<char>('a' + slot.id - 1);
+    rows[t.row][t.col] = static_cast<char>('A' + slot.id - 1);
+  }
+  for (const std::string& row : rows) fmt::print("{}\n", row);
+}
+
 /// Runs the whole team of `k` for at most `steps`, keeping the right of way when `right_of_way`; with `every` > 0
 /// prints every robot each `every` steps (to look inside one case: MARSALA_LIVENESS_SEED, MARSALA_LIVENESS_EVERY).
 /// True when every robot ends on its target.
 bool team_completes(const Case& k, std::uint64_t steps, bool right_of_way, long long every) {
   LockstepSim sim(k.scenario, k.terrain, static_cast<std::uint32_t>(k.scenario.slots.size()), right_of_way);
+  if (every > 0) print_field(k);
   while (sim.state().step < steps && !world_server::is_completed(sim.state())) {
     sim.step();
     if (every <= 0 || sim.state().step % static_cast<std::uint64_t>(every) != 0) continue;

@@ -198,7 +198,7 @@ struct RunOptions {
   std::uint64_t stall_steps = 0;  // 0: never
   std::set<std::uint64_t> shown;
   std::string write_dir;
-  bool right_of_way = true;  // ramp builders keep the right of way unless the scenario turns it off (right_of_way: false)
+  bool right_of_way = true;  // builders keep the right of way unless the scenario turns it off (right_of_way: false)
 };
 
 RunResult run_one(marsala::scenario::Scenario s, const marsala::Heightmap& initial, std::uint32_t agents,
@@ -312,7 +312,7 @@ int main(int argc, char** argv) {
                  "(agent-<id>-height.asc, -assumed.asc) into this folder");
   app.add_option("--show", show_steps, "print every robot after these steps");
   app.add_flag("--right-of-way,!--no-right-of-way", o.right_of_way,
-               "ramp builders keep the right of way unless the scenario turns it off (right_of_way: false; "
+               "builders keep the right of way unless the scenario turns it off (right_of_way: false; "
                "docs/runtime.md#right-of-way; the default); --no-right-of-way turns it off whatever the scenario says");
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-lockstep-sim", std::cout, std::cerr))
     return *code;

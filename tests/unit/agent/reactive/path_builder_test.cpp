@@ -180,6 +180,43 @@ TEST(PathBuilder, HoldsWithinTheSeparationAndFollowsAgainOnceTheFrontMovesOn) {
   EXPECT_TRUE(q.move);
 }
 
+TEST(PathBuilder, OnItsWayOutARobotNeverHoldsForTheRightOfWay) {
+  const AgentContext c = context();  // keeps the right of way (the default)
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, kTarget));
+  // 1.85 m behind robot 5 (in contact) for kPatienceSteps frames (then it steps aside on its own): it makes no way,
+  // but it waits as the pipeline says; were it on its way back it would hold after kStuckFrames of them (below).
+  static_assert(kStuckFrames < kPatienceSteps);
+  for (std::uint64_t step = 0; step < kPatienceSteps; ++step) {
+    const protocol::ActionRequest q = pb.decide(frame(c, step, kAtFoot, 1.0, {test::neighbour_at(5, 6.9, 3.05)}));
+    EXPECT_EQ(q.waiting_for.find("right of way"), std::string::npos) << step << ": " << q.waiting_for;
+  }
+}
+
+TEST(PathBuilder, OnItsWayBackARobotThatMakesNoWayBesideAnotherHolds) {
+  for (const bool keeps : {true, false}) {
+    AgentContext c = context();
+    c.right_of_way = keeps;
+    PathBuilder pb(c);
+    pb.on_admission(admission(c, kTarget));
+    // Out of material at the platform's foot, robot 5 1.5 m nearer the base; the frames keep it where it is (its
+    // motions come to nothing): after kStuckFrames frames without way towards the base it holds still.
+    int first_hold = -1;
+    for (int step = 0; step < 40 && first_hold < 0; ++step) {
+      const protocol::ActionRequest q = pb.decide(frame(c, static_cast<std::uint64_t>(step), kAtFoot, 0.0,
+                                                      {test::neighbour_at(5, kAtFoot.x - 1.5, 3.05)}));
+      if (pb.state() == PathState::kYield) {
+        first_hold = step;
+        EXPECT_FALSE(q.move);
+        EXPECT_NE(q.waiting_for.find("right of way: holding still"), std::string::npos) << q.waiting_for;
+      }
+    }
+    // Frame 0 still heads for the target (it turns back after the protocol's look), frame 1 for the base: its way
+    // is measured afresh there, and kStuckFrames frames without way end with frame kStuckFrames + 1.
+    EXPECT_EQ(first_hold, keeps ? kStuckFrames + 1 : -1) << keeps;
+  }
+}
+
 TEST(PathBuilder, BacksOffAwayFromAFrontNeighbourTooNear) {
   const AgentContext c = context();
   PathBuilder pb(c);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 namespace marsala::agent::reactive {
@@ -27,6 +28,71 @@ TEST(RightOfWay, ARobotAtItsGoalGivesWayOnceToOneThatWaitsBesideIt) {
   // after it, it waits for something else.
   EXPECT_EQ(first, 100 + kStillFrames);
   EXPECT_EQ(episodes, 1);
+}
+
+// Robot 2 beside a robot parked at its goal at (2.7, 1.7): it holds (stands still kStillFrames + an episode = 22
+// frames) at (2.1, 2.3), tries for 10 frames (0.2 m back and forth) and holds there again, four times.
+Neighbour holder_at(int frame) {
+  const int cycle = frame % 32;
+  return cycle < 22 ? at(2, 2.1, 2.3) : at(2, 2.1 - (cycle < 27 ? 0.04 * (cycle - 21) : 0.04 * (32 - cycle)), 2.3);
+}
+
+TEST(RightOfWay, ARobotAtItsGoalGivesWayEveryTimeAWaitingRobotHolds) {
+  RightOfWay parked(1, 1.6, 0.9, 6);
+  int episodes = 0;
+  bool was_giving = false;
+  for (int frame = 0; frame < 4 * 32; ++frame) {
+    // Parked: on its goal, except while it gives way (it does not move here: the episode counts all the same).
+    parked.observe({2.7, 1.7}, {holder_at(frame)}, !parked.giving_way() && !parked.standing_aside(), 0.0, 0.1);
+    const bool giving = parked.giving_way().has_value();
+    if (giving && !was_giving) ++episodes;
+    was_giving = giving;
+  }
+  // Each hold is seen from its kStillFrames-th frame to its last: one episode per hold after the first, whose
+  // first frames the parked robot spends loitering (it has to have stood still kStillFrames itself). An episode from
+  // the goal lasts three episodes (18 frames) plus its standing aside, within one 32-frame cycle.
+  EXPECT_GE(episodes, 3);
+}
+
+TEST(RightOfWay, AfterGivingWayFromItsGoalARobotStandsAsideWhileTheOtherDrivesPast) {
+  RightOfWay parked(1, 1.6, 0.9, 6);
+  // Robot 2 holds beside it until the parked robot gives way.
+  for (int frame = 0; frame < 100 && !parked.giving_way(); ++frame)
+    parked.observe({2.7, 1.7}, {at(2, 2.1, 2.3)}, true, 0.0, 0.1);
+  ASSERT_TRUE(parked.giving_way());
+  // The episode lasts three episodes of frames (it stays where it is here); robot 2 ends its hold after 5 of them
+  // and drives on, 0.03 m a frame, in contact.
+  const auto other = [](int k) { return at(2, 2.1 + 0.03 * std::max(0, k - 5), 2.3); };
+  int k = 0;
+  for (; k < 3 * 6; ++k) parked.observe({3.5, 1.0}, {other(k)}, false, 1.0, 0.1);
+  EXPECT_FALSE(parked.giving_way());
+  // After the episode the robot stands aside while robot 2 still drives (it does not cut back in) ...
+  int aside = 0;
+  for (; k < 30; ++k) {
+    parked.observe({3.5, 1.0}, {other(k)}, false, 1.0, 0.1);
+    aside += parked.standing_aside() ? 1 : 0;
+  }
+  EXPECT_EQ(aside, 30 - 3 * 6);
+  // ... until robot 2 stands still (one last motion, then kMovingFrames frames).
+  for (int still = 0; still <= kMovingFrames; ++still) parked.observe({3.5, 1.0}, {other(30)}, false, 1.0, 0.1);
+  EXPECT_FALSE(parked.standing_aside());
+}
+
+TEST(RightOfWay, ARobotOffItsGoalToGiveWayKeepsOutOfEveryLaneUntilItIsBack) {
+  RightOfWay parked(1, 1.6, 0.9, 6);
+  for (int frame = 0; frame < 100 && !parked.giving_way(); ++frame)
+    parked.observe({2.7, 1.7}, {at(2, 2.1, 2.3)}, true, 0.0, 0.1);
+  ASSERT_TRUE(parked.giving_way());
+  // Robot 2 (a higher id) drives on: off its goal, robot 1 keeps out of robot 2's lane ...
+  parked.observe({3.5, 1.0}, {at(2, 2.2, 2.3)}, false, 1.0, 0.1);
+  EXPECT_EQ(parked.lanes(3.0, 0.5).size(), 1u);
+  // ... and once back on its goal it has the lowest priority there anyway: no lanes of higher ids.
+  RightOfWay fresh(1, 1.6, 0.9, 6);
+  fresh.observe({3.5, 1.0}, {at(2, 2.1, 2.3)}, false, 1.0, 0.1);
+  fresh.observe({3.5, 1.0}, {at(2, 2.2, 2.3)}, false, 1.0, 0.1);
+  EXPECT_TRUE(fresh.lanes(3.0, 0.5).empty());  // a robot that never gave way from its goal: lower ids' lanes only
+  parked.observe({2.7, 1.7}, {at(2, 2.3, 2.3)}, true, 0.0, 0.1);
+  EXPECT_TRUE(parked.lanes(3.0, 0.5).empty());
 }
 
 TEST(RightOfWay, ARobotParkedOutOfRangeForAWhileDoesNotHoldAgainWhenSeenAgain) {
