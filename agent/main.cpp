@@ -132,7 +132,7 @@ int main(int argc, char** argv) {
           "assigned");
     const auto participant =
         bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kClient,
-                               bus::Security::of(dds.security, dds.identity, fmt::format("agent-{}", id))});
+                               bus::Security::of(dds.security, dds.identity, fmt::format("agent-{}", id)), dds.peers});
     agent::runtime::AgentRuntime agent(*participant, config);
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
@@ -146,7 +146,12 @@ int main(int argc, char** argv) {
       spdlog::info("agent {}: {}", id, result.message);
       return 0;
     }
-    marsala::cli::write_exit_error(std::cerr, fmt::format("marsala-agent: agent {}: {}", id, result.message));
+    // Discovery by unicast reaches only the hosts listed: say which were tried (docs/runtime.md#peers).
+    const std::string tried = result.outcome == agent::runtime::RunOutcome::kAdmitTimeout && !dds.peers.empty()
+                                  ? fmt::format("; no world answered at --peers {} on domain {} ({})",
+                                                fmt::join(dds.peers, ","), dds.domain, dds.vendor)
+                                  : "";
+    marsala::cli::write_exit_error(std::cerr, fmt::format("marsala-agent: agent {}: {}{}", id, result.message, tried));
     return 1;
   } catch (const std::exception& e) {
     marsala::cli::write_exit_error(std::cerr, fmt::format("marsala-agent: {}", e.what()));

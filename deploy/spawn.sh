@@ -6,7 +6,7 @@
 #
 # Usage: deploy/spawn.sh --scenario FILE --agents N [--dds cyclone|fastdds] [--agent-dds cyclone|fastdds]
 #                        [--out DIR [--replace]] [--domain D] [--monitor] [--max-steps N] [--timeout S] [--seed N]
-#                        [--quiet] [--profile lo|lan|unicast [--world-address A]] [--secure | --insecure]
+#                        [--quiet] [--profile lo|lan|unicast] [--peers ADDR[,ADDR...]] [--secure | --insecure]
 #                        [--identities DIR] [--frames-every K] [--dump-maps] [--metrics-port P] [--trace FILE]
 #                        [--set FIELD=VALUE ...]
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
@@ -32,8 +32,11 @@
 #                 (repeatable; passed to marsala-world and every marsala-agent; summary.json lists them)
 #   --profile     where DDS traffic goes (deploy/dds/<vendor>-<profile>.xml): lo (default: this host's loopback only,
 #                 unsecured unless --secure), lan (a subnet, multicast discovery) or unicast (no multicast: every
-#                 process finds the world at --world-address, default this host's first address, else 127.0.0.1;
-#                 the profiles used are written to OUT/dds/); lan and unicast run secured unless --insecure
+#                 process finds the world at --peers); lan and unicast run secured unless --insecure
+#   --peers       unicast discovery at these hosts, given as --peers to the world, every agent and the monitor
+#                 (docs/runtime.md#peers): the world's address is enough; implies --profile unicast; default with
+#                 --profile unicast: $MARSALA_PEERS, else this host's first address, else 127.0.0.1
+#                 (--world-address A: the same as --peers A)
 #   --secure      DDS Security (also on lo): every process authenticated, access-controlled and encrypted (domain
 #                 <= 230), with the identities of --identities
 #   --insecure    no DDS Security on a lan or unicast profile: anyone on the network can read and write the run
@@ -51,11 +54,14 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
 scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0 frames_every=""
-replace=0 secure=0 insecure=0 dump_maps=0 set_args=() observe_args=() profile=lo world_address="" identities=""
+replace=0 secure=0 insecure=0 dump_maps=0 set_args=() observe_args=() profile="" peers="" identities=""
 usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; }  # the whole header comment
 # The profile and security options, checked and settled: secure=1 for --secure and for lan/unicast without
-# --insecure; identities and world_address get their defaults. Exit 2 naming what is wrong.
+# --insecure; identities and peers get their defaults (--peers implies --profile unicast). Exit 2 naming what is wrong.
 security_options() {
+  peers="${peers:-${MARSALA_PEERS:-}}"
+  [ -n "$peers" ] && [ -z "$profile" ] && profile=unicast
+  profile="${profile:-lo}"
   case "$profile" in
     lo|lan|unicast) ;;
     *) echo "spawn.sh: --profile must be lo, lan or unicast, got '$profile'" >&2; exit 2 ;;
@@ -76,15 +82,13 @@ security_options() {
   fi
   identities="${identities:-${MARSALA_IDENTITIES:-${HOME:-/root}/.marsala/identities}}"
   [[ "$identities" = /* ]] || identities="$PWD/$identities"
-  if [ -n "$world_address" ] && [ "$profile" != unicast ]; then
-    echo "spawn.sh: --world-address is for --profile unicast, not '$profile'" >&2; exit 2
+  if [ -n "$peers" ] && [ "$profile" != unicast ]; then
+    echo "spawn.sh: --peers is for --profile unicast (discovery without multicast), not '$profile'" >&2; exit 2
   fi
-  if [ "$profile" = unicast ] && [ -z "$world_address" ]; then
-    world_address=$(hostname -I 2>/dev/null | awk '{ print $1 }')
-    world_address="${world_address:-127.0.0.1}"
+  if [ "$profile" = unicast ] && [ -z "$peers" ]; then
+    peers=$(hostname -I 2>/dev/null | awk '{ print $1 }')
+    peers="${peers:-127.0.0.1}"
   fi
-  [[ "$world_address" =~ ^[A-Za-z0-9.:-]*$ ]] ||
-    { echo "spawn.sh: --world-address must be a host name or an address, got '$world_address'" >&2; exit 2; }
 }
 # The domain the identity folder was made for (its manifest), or nothing (no folder yet, or made for every domain).
 identities_domain() { sed -n 's/^domain=\([0-9][0-9]*\)$/\1/p' "$identities/manifest" 2>/dev/null | head -1 || true; }
@@ -109,7 +113,9 @@ while [ $# -gt 0 ]; do
     --secure) secure=1; shift ;;
     --insecure) insecure=1; shift ;;
     --profile) profile="$2"; shift 2 ;;
-    --world-address) world_address="$2"; shift 2 ;;
+    --peers|--world-address)
+      [ -z "$peers" ] || { echo "spawn.sh: give the peers once (--peers ADDR[,ADDR...])" >&2; exit 2; }
+      peers="$2"; shift 2 ;;
     --identities) identities="$2"; shift 2 ;;
     --dump-maps) dump_maps=1; shift ;;
     -h|--help) usage; exit 0 ;;
@@ -131,11 +137,11 @@ for b in marsala-world marsala-agent; do
   [ -x "$bin/$b" ] || { echo "spawn.sh: $bin/$b not built (run deploy/build.sh)" >&2; exit 1; }
 done
 
-# The profile: loopback by default, DDS traffic never leaves this host's lo interface. The unicast ones get the
-# world's address (Cyclone reads it from the environment; Fast DDS's copy is written at the start, below).
+# The profile: loopback by default, DDS traffic never leaves this host's lo interface. The unicast one gets the peers
+# from the command line of every process (--peers, through MARSALA_PEERS: the binaries check it, exit 2 when malformed).
 export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-$profile.xml"
 export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-$profile.xml"
-[ "$profile" = unicast ] && export MARSALA_WORLD_ADDRESS="$world_address"
+if [ -n "$peers" ]; then export MARSALA_PEERS="$peers"; else unset MARSALA_PEERS; fi
 
 # Without --domain: a random one (not derived from the PID, whose values repeat) on which no world answers
 # `marsala-monitor status` within 1 s (a world publishes its status from its start, while it admits). Two runs
@@ -196,14 +202,6 @@ fi
 # A run never mixes its outputs with another's: the world refuses a folder holding a run; with --replace it removes
 # that run's files itself (marsala-world --replace knows the list), and the agents' old logs go here.
 [ "$replace" -eq 1 ] && [ -d "$out" ] && rm -rf -- "$out/logs" "$out/maps" "$out/dds"
-# The unicast profiles this run used, the world's address written in (Fast DDS reads no variables).
-if [ "$profile" = unicast ]; then
-  mkdir -p "$out/dds"
-  for v in cyclone fastdds; do
-    sed "s/\${MARSALA_WORLD_ADDRESS}/$world_address/g" "$root/deploy/dds/$v-unicast.xml" >"$out/dds/$v-unicast.xml"
-  done
-  export FASTRTPS_DEFAULT_PROFILES_FILE="$out/dds/fastdds-unicast.xml"
-fi
 
 mkdir -p "$out/logs"
 # The run's key (docs/runtime.md#who-wrote-it): the world proves itself with it; the agents and monitors, given it,
@@ -231,7 +229,7 @@ for id in $(seq 1 "$agents"); do
     "${seed_args[@]}" "${set_args[@]}" "${sec_args[@]}" "${agent_args[@]}" "${key_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
   pids+=("$!")
 done
-[ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain, profile $profile, $([ "$secure" -eq 1 ] && echo "secured with $identities" || echo unsecured); logs in $out/logs"
+[ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain, profile $profile$([ -n "$peers" ] && echo " (peers $peers)"), $([ "$secure" -eq 1 ] && echo "secured with $identities" || echo unsecured); logs in $out/logs"
 
 progress_pid=""
 if [ "$monitor" -eq 1 ] && [ -x "$bin/marsala-monitor" ]; then

@@ -6,12 +6,14 @@
 #   world    makes the identity folder on first use, or reuses it (make-identities.sh --reuse: a folder for fewer
 #            agents exits 2 naming it), and says where in one line; then runs marsala-world --agents $MARSALA_AGENTS
 #   agent    waits for the folder (up to $MARSALA_IDENTITIES_WAIT s, default 120), claims the first free slot K of
-#            1..$MARSALA_AGENTS (a lock held for the agent's life: a restarted container takes a slot freed by a dead
-#            one) and runs marsala-agent --id K with identity agent-K; unsecured: marsala-agent --id auto
+#            $MARSALA_SLOTS (A-B, default all: 1-$MARSALA_AGENTS; each host of a run over several hosts its own range: the
+#            claims are this host's) (a lock held for the agent's life: a restarted container takes a slot freed by a
+#            dead one) and runs marsala-agent --id K with identity agent-K; unsecured: marsala-agent --id auto
 #   monitor  waits for the folder, then runs marsala-monitor with identity monitor
 # Environment: MARSALA_DOMAIN (the folder is $MARSALA_IDENTITIES_ROOT/domain-<D>, the root default /identities, a
 # volume), MARSALA_AGENTS (the team size), MARSALA_INSECURE (1: no DDS Security; anyone on the network can read and
-# write the run), and the programs' own MARSALA_DDS, MARSALA_DDS_CONFIG.
+# write the run), and the programs' own MARSALA_DDS, MARSALA_DDS_CONFIG and MARSALA_PEERS (unicast discovery at
+# those hosts, no multicast: docker/docker-compose.agents.yml sets the world's address; docs/runtime.md#peers).
 set -euo pipefail
 role="${1:-}"
 [ $# -gt 0 ] && shift
@@ -22,6 +24,15 @@ agents="${MARSALA_AGENTS:-3}"
 domain="${MARSALA_DOMAIN:-0}"
 [[ "$agents" =~ ^[0-9]+$ ]] && [ "$agents" -ge 1 ] ||
   { echo "marsala-entrypoint: MARSALA_AGENTS must be a whole number >= 1, got '$agents'" >&2; exit 2; }
+slots="${MARSALA_SLOTS:-all}"
+[ "$slots" = all ] && slots="1-$agents"
+[[ "$slots" =~ ^([0-9]+)-([0-9]+)$ ]] && [ "${BASH_REMATCH[1]}" -ge 1 ] &&
+  [ "${BASH_REMATCH[1]}" -le "${BASH_REMATCH[2]}" ] && [ "${BASH_REMATCH[2]}" -le "$agents" ] ||
+  { echo "marsala-entrypoint: MARSALA_SLOTS must be A-B with 1 <= A <= B <= MARSALA_AGENTS ($agents), got '$slots'" >&2
+    exit 2; }
+first_slot="${BASH_REMATCH[1]}" last_slot="${BASH_REMATCH[2]}"
+[ -n "${MARSALA_PEERS:-}" ] &&
+  echo "marsala-entrypoint: $role discovers by unicast only, at $MARSALA_PEERS (MARSALA_PEERS)" >&2
 case "${MARSALA_INSECURE:-0}" in
   1|true|yes)
     echo "marsala-entrypoint: $role runs without DDS Security (MARSALA_INSECURE): anyone on the network can read" \
@@ -57,10 +68,10 @@ done
 # An agent: the first slot no living agent holds. flock exits 75 when the slot is taken (-E), else with the agent's
 # own code, which ends the loop.
 mkdir -p "$root/claims-domain-$domain"
-for k in $(seq 1 "$agents"); do
+for k in $(seq "$first_slot" "$last_slot"); do
   rc=0
   flock -n -E 75 "$root/claims-domain-$domain/agent-$k.lock" marsala-agent --id "$k" "$@" || rc=$?
   [ "$rc" -eq 75 ] || exit "$rc"
 done
-echo "marsala-entrypoint: all $agents agent slots of domain $domain are taken (MARSALA_AGENTS)" >&2
+echo "marsala-entrypoint: agent slots $slots of domain $domain are all taken on this host (MARSALA_SLOTS)" >&2
 exit 1

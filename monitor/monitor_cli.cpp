@@ -70,7 +70,7 @@ int terminal_columns() {
 /// Joins the DDS domain of the command line, read only.
 std::unique_ptr<bus::Participant> join_domain(const cli::DdsOptions& dds) {
   return bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,
-                                bus::Security::of(dds.security, dds.identity, "monitor")});
+                                bus::Security::of(dds.security, dds.identity, "monitor"), dds.peers});
 }
 
 /// The tail subcommand: its options (define_tail binds them) and its CLI11 subcommand.

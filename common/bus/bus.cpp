@@ -8,8 +8,11 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
 
 #include "marsala/bus/detail/backends.hpp"
+#include "marsala/bus/peers.hpp"
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 
@@ -75,20 +78,23 @@ std::filesystem::path executable_dir() {
   return ec ? std::filesystem::path() : self.parent_path();
 }
 
-/// Throws InvalidArgument when the profile at `path` (deploy/dds/*-unicast.xml) still needs the world's address:
-/// Cyclone expands ${MARSALA_WORLD_ADDRESS} itself but it is not set; Fast DDS 2.9 expands nothing.
+/// Throws InvalidArgument when the profile at `path` (an older copy of deploy/dds/*-unicast.xml) still needs the
+/// world's address: Cyclone expands ${MARSALA_WORLD_ADDRESS} itself but it is not set; Fast DDS 2.9 expands nothing.
+/// The shipped profiles take the address from --peers instead (docs/runtime.md#peers).
 void check_world_address(Vendor vendor, const std::string& path) {
   std::ifstream in(path);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const char* address = std::getenv("MARSALA_WORLD_ADDRESS");
   if (vendor == Vendor::kCyclone && text.find("\"${MARSALA_WORLD_ADDRESS}\"") != std::string::npos &&
       (address == nullptr || *address == '\0'))
-    throw InvalidArgument(fmt::format(
-        "DDS profile '{}' needs MARSALA_WORLD_ADDRESS, the world host's address (docs/runtime.md#dds-profiles)", path));
+    throw InvalidArgument(
+        fmt::format("DDS profile '{}' needs MARSALA_WORLD_ADDRESS, the world host's address; or drop its peer and "
+                    "give --peers ADDR (docs/runtime.md#peers)",
+                    path));
   if (vendor == Vendor::kFastDds && text.find(">${MARSALA_WORLD_ADDRESS}<") != std::string::npos)
     throw InvalidArgument(fmt::format(
-        "DDS profile '{}' is a template: write the world host's address in place of ${{MARSALA_WORLD_ADDRESS}} (Fast "
-        "DDS 2.9 expands no variables; docs/runtime.md#dds-profiles)",
+        "DDS profile '{}' is a template: Fast DDS 2.9 expands no variables; drop its initial peer and give --peers "
+        "ADDR (docs/runtime.md#peers)",
         path));
 }
 
@@ -114,14 +120,15 @@ void check_profile(Vendor vendor, const std::string& path) {
 
 }  // namespace
 
-std::string resolve_profile(Vendor vendor, const std::string& given) {
+std::string resolve_profile(Vendor vendor, const std::string& given, bool unicast) {
   if (vendor == Vendor::kInProcess) return {};
   if (!given.empty()) {
     check_profile(vendor, given);
     return std::filesystem::absolute(given).string();
   }
   if (const char* set = std::getenv(profile_variable(vendor)); set != nullptr && *set != '\0') return {};
-  const std::string name = std::string(vendor == Vendor::kCyclone ? "cyclone" : "fastdds") + "-lo.xml";
+  const std::string name =
+      std::string(vendor == Vendor::kCyclone ? "cyclone" : "fastdds") + (unicast ? "-unicast.xml" : "-lo.xml");
   std::vector<std::filesystem::path> candidates;
   if (const std::filesystem::path exe = executable_dir(); !exe.empty())
     candidates.push_back(exe.parent_path() / "share" / "marsala" / "dds" / name);
@@ -176,16 +183,26 @@ std::unique_ptr<Participant> make_participant(const BusConfig& config) {
   check_security(config.security, config.domain_id);
   if (config.domain_id < 0 || config.domain_id > 232)
     throw InvalidArgument(fmt::format("DDS domain id must be in 0..232, got {}", config.domain_id));
-  if (const std::string profile = resolve_profile(config.vendor, config.profile); !profile.empty()) {
+  // The vendors are given addresses: a name is resolved once, here, and one that does not resolve is refused by name.
+  BusConfig resolved = config;
+  resolved.peers = resolve_peers(config.peers);
+  if (const std::string profile = resolve_profile(config.vendor, config.profile, !config.peers.empty());
+      !profile.empty()) {
     const std::string value = config.vendor == Vendor::kCyclone ? "file://" + profile : profile;
     ::setenv(profile_variable(config.vendor), value.c_str(), 1);
   }
+  std::unique_ptr<Participant> participant;
   switch (config.vendor) {
     case Vendor::kInProcess: return detail::make_inprocess_participant(config.domain_id);
-    case Vendor::kCyclone: return detail::make_cyclone_participant(config);
-    case Vendor::kFastDds: return detail::make_fastdds_participant(config);
+    case Vendor::kCyclone: participant = detail::make_cyclone_participant(resolved); break;
+    case Vendor::kFastDds: participant = detail::make_fastdds_participant(resolved); break;
   }
-  throw InvalidArgument("unknown DDS vendor");
+  if (!participant) throw InvalidArgument("unknown DDS vendor");
+  if (!resolved.peers.empty())  // said in the world's and agents' logs (a monitor's stdout stays its output)
+    spdlog::log(config.role == Role::kServer ? spdlog::level::debug : spdlog::level::info,
+                "bus: {} participant in domain {} discovers by unicast only, at {} (--peers; no multicast)",
+                to_string(config.vendor), config.domain_id, fmt::join(resolved.peers, ", "));
+  return participant;
 }
 
 }  // namespace marsala::bus

@@ -204,14 +204,23 @@ void check_security(const Security& security, int domain_id);
 /// How to make a participant.
 struct BusConfig {
   BusConfig() = default;
-  BusConfig(Vendor v, int domain, std::string profile_file = {}, Role r = Role::kServer, Security sec = {})
-      : vendor(v), domain_id(domain), profile(std::move(profile_file)), role(r), security(std::move(sec)) {}
+  BusConfig(Vendor v, int domain, std::string profile_file = {}, Role r = Role::kServer, Security sec = {},
+            std::vector<std::string> peer_hosts = {})
+      : vendor(v),
+        domain_id(domain),
+        profile(std::move(profile_file)),
+        role(r),
+        security(std::move(sec)),
+        peers(std::move(peer_hosts)) {}
 
   Vendor vendor = Vendor::kCyclone;
   int domain_id = 0;    ///< 0..232
   std::string profile;  ///< a profile file of the vendor; empty: resolve_profile()'s default
   Role role = Role::kServer;
   Security security;  ///< DDS Security; off when its dir is empty
+  /// Hosts to discover by unicast, IPv4 addresses or names (--peers, docs/runtime.md#peers): multicast off, each probed
+  /// at the world's ports and the profile's participant indices. Empty: discovery as the profile says.
+  std::vector<std::string> peers;
 };
 
 /// The profile file a participant of `vendor` uses (docs/runtime.md#dds-profiles): `given` when not empty (it must
@@ -219,9 +228,10 @@ struct BusConfig {
 /// InvalidArgument naming it); else empty when the vendor's own variable (CYCLONEDDS_URI,
 /// FASTRTPS_DEFAULT_PROFILES_FILE) is set, which then applies; else the shipped loopback profile
 /// (deploy/dds/<vendor>-lo.xml: share/marsala/dds beside the executable's folder, or the source tree it was built
-/// from), so that processes started alone on one machine find each other; empty when none is found. Always empty
-/// for kInProcess.
-std::string resolve_profile(Vendor vendor, const std::string& given);
+/// from), so that processes started alone on one machine find each other, or with `unicast` (peers given) the
+/// shipped unicast one (deploy/dds/<vendor>-unicast.xml: every interface, no multicast); empty when none is found.
+/// Always empty for kInProcess.
+std::string resolve_profile(Vendor vendor, const std::string& given, bool unicast = false);
 
 /// Creates a participant of the chosen vendor with the profile resolve_profile() gives (set into the vendor's
 /// variable before the vendor reads it); throws BusError naming vendor and domain on failure, InvalidArgument for a

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <functional>
@@ -13,6 +14,7 @@
 #include <ostream>
 #include <string>
 #include <utility>
+#include <vector>
 
 // CLI11 2.1's pair conversion trips a false -Wmaybe-uninitialized at -O2; keep our own warnings on.
 #pragma GCC diagnostic push
@@ -34,10 +36,48 @@ struct DdsOptions {
   std::string profile;             ///< a profile file of the vendor; empty: bus::resolve_profile()'s default
   std::string security;            ///< DDS Security folder (deploy/security/make-identities.sh); empty: unsecured
   std::string identity;            ///< the identity in it; empty: the program's own (world, monitor, agent-<id>)
+  std::vector<std::string> peers;  ///< hosts to discover by unicast, no multicast (--peers); empty: the profile's way
 };
 
-/// Adds --dds, --domain and --dds-config to `app`, each also read from the environment (MARSALA_DDS,
-/// MARSALA_DOMAIN, MARSALA_DDS_CONFIG) when the flag is not given: flags win (docs/runtime.md#dds-profiles).
+/// True when `text` is a dotted-quad IPv4 address (four decimal numbers 0..255) or a host name (labels of letters,
+/// digits and '-', none starting or ending with '-', at most 63 characters each and 253 in all, not all digits).
+inline bool is_peer_address(const std::string& text) {
+  if (text.empty() || text.size() > 253 || text.front() == '.' || text.back() == '.') return false;
+  std::vector<std::string> labels(1);
+  for (const char c : text) {
+    if (c == '.')
+      labels.emplace_back();
+    else if (std::isalnum(static_cast<unsigned char>(c)) || c == '-')
+      labels.back() += c;
+    else
+      return false;
+  }
+  bool numeric = true;
+  for (const std::string& label : labels) {
+    if (label.empty() || label.size() > 63 || label.front() == '-' || label.back() == '-') return false;
+    numeric = numeric && label.find_first_not_of("0123456789") == std::string::npos;
+  }
+  if (!numeric) return true;
+  if (labels.size() != 4) return false;
+  for (const std::string& label : labels)
+    if (label.size() > 3 || std::stoi(label) > 255 || (label.size() > 1 && label.front() == '0')) return false;
+  return true;
+}
+
+/// Every element of --peers: an IPv4 address or a host name (is_peer_address()), else "'<text>' is not ...".
+inline CLI::Validator peer_address() {
+  return CLI::Validator(
+      [](std::string& text) {
+        return is_peer_address(text)
+                   ? std::string()
+                   : fmt::format("'{}' is not an IPv4 address or a host name (ADDR[,ADDR...], no port)", text);
+      },
+      "ADDR");
+}
+
+/// Adds --dds, --domain, --dds-config, --security, --identity and --peers to `app`, each also read from the
+/// environment (MARSALA_DDS, MARSALA_DOMAIN, MARSALA_DDS_CONFIG, MARSALA_SECURITY, MARSALA_IDENTITY, MARSALA_PEERS)
+/// when the flag is not given: flags win (docs/runtime.md#dds-profiles).
 inline void add_dds_options(CLI::App& app, DdsOptions& options) {
   app.add_option("--dds", options.vendor, "DDS vendor: cyclone, fastdds (inprocess: tests only)")
       ->check(CLI::IsMember({"cyclone", "fastdds", "inprocess"}))
@@ -59,6 +99,14 @@ inline void add_dds_options(CLI::App& app, DdsOptions& options) {
          "--identity", options.identity,
          "with --security: the identity to use (file stem in the folder; default: world, monitor or agent-<id>)")
       ->envname("MARSALA_IDENTITY");
+  app.add_option("--peers", options.peers,
+                 "discover by unicast only, no multicast: the hosts to probe, IPv4 addresses or names; the world's\n"
+                 "address is enough for agents and monitors (default profile: deploy/dds/<vendor>-unicast.xml, every\n"
+                 "interface; docs/runtime.md#peers)")
+      ->delimiter(',')
+      ->type_name("ADDR[,ADDR...]")
+      ->check(peer_address())
+      ->envname("MARSALA_PEERS");
 }
 
 /// A whole number >= 1, e.g. a "every K steps" (CLI11's PositiveNumber explains a 0 with a range of 300 digits).

@@ -3,7 +3,8 @@
 # agents and a monitor, each container a host of its own on the compose network, LAN profiles) inside a private
 # network namespace, secured by default: the world's container makes the identities in the identity folder and says
 # so, every process runs with DDS Security, the agents claim slots 1..3; the run must end on the terrain_sha256 of the
-# same run on loopback.
+# same run on loopback. Then the same image on two namespace hosts without multicast, world and agents joined by
+# address (container_hosts.sh, about 30 s more).
 # Exits 77 (skipped) where podman cannot run containers.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -50,3 +51,7 @@ grep -l "secured (DDS Security) as agent-" "$work/containers/"agent*.log | wc -l
   fail "not every agent ran secured"
 echo "ok: world, 3 agents and a monitor in containers, secured, completed in $((SECONDS - start)) s (image build" \
   "included) on the loopback terrain $sha; image $image $(podman image ls --format '{{.Size}}' "$image" | head -1)"
+
+# The same image on two hosts without multicast (docker/docker-compose.agents.yml's layout, --peers): no new build.
+bash "$root/tests/integration/container_hosts.sh" "$image" "$work/hosts" "$reference" ||
+  fail "containers on two hosts without multicast (logs: $work/hosts)"

@@ -40,6 +40,30 @@ bridge_hosts() {
     ip -n "h$i" route add 224.0.0.0/4 dev eth0
   done
 }
+# no_multicast COUNT, after bridge_hosts PREFIX COUNT: multicast off on every interface (each host's lo and eth0, the
+# bridge, its ports, this namespace's lo), and on each host an nftables table `nomc` that counts and drops every
+# packet to or from 224.0.0.0/4 (the routes bridge_hosts made stay, so a process that tries multicast is caught
+# here, not by a missing route). multicast_drops HOST prints that host's count, out and in: "OUT IN".
+no_multicast() {
+  ip link set lo multicast off
+  ip link set br0 multicast off
+  local i
+  for i in $(seq 1 "$1"); do
+    ip link set "port$i" multicast off
+    ip -n "h$i" link set lo multicast off
+    ip -n "h$i" link set eth0 multicast off
+    ip netns exec "h$i" nft -f - <<'NFT' || { echo "SKIP: no nftables here (apt-get install nftables)"; exit 77; }
+table inet nomc {
+  chain out { type filter hook output priority 0; ip daddr 224.0.0.0/4 counter drop; }
+  chain in { type filter hook input priority 0; ip daddr 224.0.0.0/4 counter drop; }
+}
+NFT
+  done
+}
+multicast_drops() {
+  ip netns exec "$1" nft list table inet nomc | grep -o 'counter packets [0-9]*' | grep -o '[0-9]*$' | tr '\n' ' ' |
+    sed 's/ $//'
+}
 # expect_tool_usage_error TOOL WORK PATTERN ARGS...: TOOL --out WORK/bad ARGS exits 2 with PATTERN on stderr and
 # writes nothing (fail MESSAGE must be defined)
 expect_tool_usage_error() {

@@ -3,10 +3,10 @@
 # processes in a private network namespace (ctest runs it inside run_isolated.sh).
 #
 # Usage: security_test.sh VENDOR DOMAIN
-#   0. spawn.sh's bad inputs: --secure with --insecure, an unknown profile, a secured team of two vendors,
-#      --identities on an unsecured run, an identity folder made for another domain or a smaller team: one line
-#      naming it, exit 2, no run folder made;
-#   1. a 3-agent ramp run on the unicast profile (world at 127.0.0.1), no security flag, is secured by default (the
+#   0. spawn.sh's bad inputs: --secure with --insecure, an unknown profile, --peers on a multicast profile, a secured
+#      team of two vendors, --identities on an unsecured run, an identity folder made for another domain or a smaller
+#      team: one line naming it, exit 2, no run folder made;
+#   1. a 3-agent ramp run on the unicast profile (--peers 127.0.0.1), no security flag, is secured by default (the
 #      identity folder made on first use, the world's and agents' logs say "secured") and completes on the terrain of
 #      the unsecured run (marsala-lockstep-sim, in-process); a second run, --secure on loopback, reuses the folder
 #      (same CA fingerprint, no file rewritten) and ends there too;
@@ -58,6 +58,7 @@ spawn_refused "--secure and --insecure" --secure --insecure --domain "$domain"
 spawn_refused "--profile must be lo, lan or unicast" --profile wan --domain "$domain"
 other=$([ "$vendor" = cyclone ] && echo fastdds || echo cyclone)
 spawn_refused "a secured team runs on one vendor" --profile unicast --agent-dds "$other" --domain "$domain"
+spawn_refused "--peers is for --profile unicast" --peers 127.0.0.1 --profile lan --domain "$domain"
 spawn_refused "--identities $ids is for secured runs" --profile lan --insecure --identities "$ids" --domain "$domain"
 spawn_refused "$work/two was made for domain $domain, not $((domain + 1))" --profile lan --identities "$work/two" \
   --domain $((domain + 1))
@@ -71,7 +72,7 @@ echo "ok: spawn.sh refuses --secure with --insecure, an unknown profile, a secur
   "unsecured, a folder of another domain or a smaller team (exit 2, one line, nothing written)"
 
 # 1. Secured by default beyond loopback; the folder made on first use, then reused; the unsecured terrain.
-spawn unicast --profile unicast --world-address 127.0.0.1 --identities "$ids" --domain "$domain"
+spawn unicast --peers 127.0.0.1 --identities "$ids" --domain "$domain"  # --peers: the unicast profile
 [ "$rc" = 0 ] || fail "the unicast run exited $rc: $(cat "$work/unicast.err") (logs: $work/unicast/logs)"
 grep -qx "spawn.sh: identities: made $ids for domain $domain, 3 agents (CA sha256 .*)" "$work/unicast.err" ||
   fail "spawn.sh did not say where it made the identities: $(cat "$work/unicast.err")"
@@ -79,7 +80,7 @@ for log in world agent-1 agent-3; do
   grep -q "secured (DDS Security) as ${log} from $ids" "$work/unicast/logs/$log.log" ||
     fail "the unicast run's $log.log does not say it is secured"
 done
-grep -q "<address>127.0.0.1</address>" "$work/unicast/dds/fastdds-unicast.xml" || fail "no world address in OUT/dds"
+grep -q "discovers by unicast only, at 127.0.0.1" "$work/unicast/logs/world.log" || fail "the world does not say its peers"
 [ "$(stat -c %a "$ids/world.key")" = 600 ] || fail "world.key is $(stat -c %a "$ids/world.key"), not 600"
 ca=$(openssl x509 -noout -fingerprint -sha256 -in "$ids/ca.pem" | sed 's/^.*=//')
 grep -qx "ca_sha256=$ca" "$ids/manifest" || fail "the manifest does not name the CA's fingerprint $ca"

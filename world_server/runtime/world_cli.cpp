@@ -165,7 +165,7 @@ int run_in_folder(const std::string& scenario_path, const std::string& resume_di
     start.options.run_key = settle_run_key(run_key, start.options.out_dir, !resume_dir.empty());
     const auto participant =
         bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kWorld,
-                               bus::Security::of(dds.security, dds.identity, "world")});
+                               bus::Security::of(dds.security, dds.identity, "world"), dds.peers});
     WorldRuntime runtime(std::move(start), *participant);
     if (metrics != nullptr) runtime.serve_metrics(*metrics);
     if (trace != nullptr) runtime.trace_steps(*trace);

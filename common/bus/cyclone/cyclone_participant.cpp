@@ -13,6 +13,7 @@
 #include <mutex>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "marsala/bus/cyclone/cyclone_convert.hpp"
 #include "marsala/bus/cyclone/cyclone_log.hpp"
@@ -92,7 +93,8 @@ class Qos {
 /// participant outlives its endpoints whatever order the caller destroys them in.
 class Context {
  public:
-  Context(int domain_id, Role role, const Security& security) : domain_id_(domain_id) {
+  Context(int domain_id, Role role, const Security& security, const std::vector<std::string>& peers)
+      : domain_id_(domain_id), peers_(peers_fragment(peers)) {
     cyclone::bound_cyclone_log();  // a foreign type's flood must not flood the log (cyclone_log.hpp)
     if (role == Role::kWorld) {
       if (open_at_first_free(security, 0, kWorldPorts + kServerIndices)) return;
@@ -156,6 +158,7 @@ class Context {
     std::string config = uri != nullptr && *uri != '\0' ? std::string(uri) : std::string();
     const auto add = [&config](const std::string& fragment) { config += (config.empty() ? "" : ",") + fragment; };
     add(kWorldFirstPorts);
+    if (!peers_.empty()) add(peers_);
     if (role == Role::kClient)
       add(
           fmt::format("<Discovery><ParticipantIndex>none</ParticipantIndex><MaxAutoParticipantIndex>{}"
@@ -196,7 +199,20 @@ class Context {
   }
 
  private:
+  /// Discovery by unicast at `peers` (IPv4 addresses, bus::resolve_peers()) and never by multicast, whatever the
+  /// profile says (docs/runtime.md#peers); empty when there are none. Each peer is probed at the world's ports and the
+  /// participant indices the role probes (kWorldFirstPorts).
+  static std::string peers_fragment(const std::vector<std::string>& peers) {
+    if (peers.empty()) return {};
+    std::string listed;
+    for (const std::string& peer : peers) listed += fmt::format(R"(<Peer address="{}"/>)", peer);
+    return fmt::format("<General><AllowMulticast>false</AllowMulticast></General><Discovery><Peers>{}</Peers>"
+                       "</Discovery>",
+                       listed);
+  }
+
   int domain_id_;
+  std::string peers_;        ///< peers_fragment(): added to every domain this participant tries
   dds_entity_t domain_ = 0;  ///< a client's own domain entity; 0 when the participant uses the default one
   dds_entity_t participant_ = -1;
   std::mutex mutex_;
@@ -390,7 +406,7 @@ class CycloneParticipant final : public ParticipantBase<CycloneParticipant> {
 
  public:
   explicit CycloneParticipant(const BusConfig& config)
-      : context_(std::make_shared<Context>(config.domain_id, config.role, config.security)) {
+      : context_(std::make_shared<Context>(config.domain_id, config.role, config.security, config.peers)) {
     if (config.security.enabled())  // said in the world's and agents' logs (a monitor's stdout stays its output)
       spdlog::log(config.role == Role::kServer ? spdlog::level::debug : spdlog::level::info,
                   "bus: Cyclone DDS participant in domain {}, secured (DDS Security) as {} from {}", config.domain_id,

@@ -119,10 +119,12 @@ void configure_library() {
 /// participant outlives its endpoints whatever order the caller destroys them in.
 class Context {
  public:
-  Context(int domain_id, Role role, const Security& security) : domain_id_(domain_id) {
+  Context(int domain_id, Role role, const Security& security, const std::vector<std::string>& peers)
+      : domain_id_(domain_id) {
     configure_library();
     auto* factory = dds::DomainParticipantFactory::get_instance();
     dds::DomainParticipantQos qos = factory->get_default_participant_qos();
+    if (!peers.empty()) discover_at_peers(qos, peers);
     if (role == Role::kClient) make_client(qos);
     if (role == Role::kServer) leave_world_indices(qos);
     if (role == Role::kWorld) discover_on_world_ports(qos, domain_id);
@@ -150,6 +152,27 @@ class Context {
   int domain_id() const { return domain_id_; }
 
  private:
+  /// Discovery by unicast at `peers` (IPv4 addresses, bus::resolve_peers()) and never by multicast, whatever the
+  /// profile says (docs/runtime.md#peers): no multicast discovery locator, a unicast one on every interface when the
+  /// profile has none (which also keeps Fast DDS from adding 239.255.0.1), and each peer an initial peer without a
+  /// port, i.e. probed at the profile's participant indices and (probe_world_ports()) at the world's ports.
+  static void discover_at_peers(dds::DomainParticipantQos& qos, const std::vector<std::string>& peers) {
+    using eprosima::fastrtps::rtps::Locator_t;
+    auto& builtin = qos.wire_protocol().builtin;
+    builtin.metatrafficMulticastLocatorList.clear();
+    if (builtin.metatrafficUnicastLocatorList.empty()) {
+      Locator_t any;  // 0.0.0.0, no port: every interface, the port of the participant's index
+      any.kind = LOCATOR_KIND_UDPv4;
+      builtin.metatrafficUnicastLocatorList.push_back(any);
+    }
+    for (const std::string& peer : peers) {
+      Locator_t locator;
+      locator.kind = LOCATOR_KIND_UDPv4;
+      eprosima::fastrtps::rtps::IPLocator::setIPv4(locator, peer);
+      builtin.initialPeersList.push_back(locator);
+    }
+  }
+
   /// A client's participant (the profile's, with the client's discovery on top): its ports start at participant
   /// index kServerIndices (the next free one from there), so no server index is taken and no other client's probes
   /// reach it; its initial peers are probed at the servers' indices 0..kServerIndices-1 only.
@@ -452,7 +475,7 @@ class FastDdsParticipant final : public ParticipantBase<FastDdsParticipant> {
 
  public:
   explicit FastDdsParticipant(const BusConfig& config)
-      : context_(std::make_shared<Context>(config.domain_id, config.role, config.security)) {
+      : context_(std::make_shared<Context>(config.domain_id, config.role, config.security, config.peers)) {
     if (config.security.enabled())  // said in the world's and agents' logs (a monitor's stdout stays its output)
       spdlog::log(config.role == Role::kServer ? spdlog::level::debug : spdlog::level::info,
                   "bus: Fast DDS participant in domain {}, secured (DDS Security) as {} from {}", config.domain_id,

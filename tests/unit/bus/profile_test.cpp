@@ -66,11 +66,16 @@ TEST_F(ProfileTest, AGivenProfileMustBeOneOfThatVendor) {
   EXPECT_EQ(resolve_profile(Vendor::kInProcess, "anything"), "");
 }
 
-// The unicast profiles need the world's address: Cyclone reads MARSALA_WORLD_ADDRESS itself, Fast DDS 2.9 reads no
-// variable, so its template must be written out first (deploy/spawn.sh --profile unicast does).
-TEST_F(ProfileTest, AUnicastProfileWithoutTheWorldsAddressIsRefusedSayingWhatIsMissing) {
-  const std::string cyclone = source("deploy/dds/cyclone-unicast.xml");
-  const std::string fastdds = source("deploy/dds/fastdds-unicast.xml");
+// An older unicast profile holding the world's address as a variable: Cyclone reads MARSALA_WORLD_ADDRESS itself,
+// Fast DDS 2.9 reads no variable; each refusal says to give --peers instead (the shipped ones hold no address).
+TEST_F(ProfileTest, AProfileStillHoldingTheWorldsAddressVariableIsRefusedPointingToPeers) {
+  const std::string cyclone = write("cyclone-old.xml",
+                                    "<CycloneDDS><Domain><Discovery><Peers><Peer address=\"${MARSALA_WORLD_ADDRESS}\"/>"
+                                    "</Peers></Discovery></Domain></CycloneDDS>\n");
+  const std::string fastdds = write("fastdds-old.xml",
+                                    "<dds><profiles><participant><rtps><builtin><initialPeersList><locator><udpv4>"
+                                    "<address>${MARSALA_WORLD_ADDRESS}</address></udpv4></locator></initialPeersList>"
+                                    "</builtin></rtps></participant></profiles></dds>\n");
   const char* saved = std::getenv("MARSALA_WORLD_ADDRESS");
   const std::string kept = saved ? saved : "";
   ::unsetenv("MARSALA_WORLD_ADDRESS");
@@ -83,19 +88,31 @@ TEST_F(ProfileTest, AUnicastProfileWithoutTheWorldsAddressIsRefusedSayingWhatIsM
     }
   };
   EXPECT_NE(refusal(Vendor::kCyclone, cyclone).find("needs MARSALA_WORLD_ADDRESS"), std::string::npos);
+  EXPECT_NE(refusal(Vendor::kCyclone, cyclone).find("--peers"), std::string::npos);
   EXPECT_NE(refusal(Vendor::kFastDds, fastdds).find("is a template"), std::string::npos);
+  EXPECT_NE(refusal(Vendor::kFastDds, fastdds).find("--peers"), std::string::npos);
   ::setenv("MARSALA_WORLD_ADDRESS", "10.0.0.5", 1);
   EXPECT_EQ(refusal(Vendor::kCyclone, cyclone), "");
   EXPECT_NE(refusal(Vendor::kFastDds, fastdds).find("is a template"), std::string::npos);  // the variable is no help
-  std::ifstream in(fastdds);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  for (std::size_t at; (at = text.find("${MARSALA_WORLD_ADDRESS}")) != std::string::npos;)
-    text.replace(at, std::string("${MARSALA_WORLD_ADDRESS}").size(), "10.0.0.5");
-  EXPECT_EQ(refusal(Vendor::kFastDds, write("fastdds-unicast-10.0.0.5.xml", text)), "");
+  for (const char* shipped : {"deploy/dds/cyclone-unicast.xml", "deploy/dds/fastdds-unicast.xml"})
+    EXPECT_EQ(refusal(std::string(shipped).find("cyclone") != std::string::npos ? Vendor::kCyclone : Vendor::kFastDds,
+                      source(shipped)),
+              "")
+        << shipped;
   if (saved)
     ::setenv("MARSALA_WORLD_ADDRESS", kept.c_str(), 1);
   else
     ::unsetenv("MARSALA_WORLD_ADDRESS");
+}
+
+// With peers (and no profile given nor set): the shipped unicast profile, every interface and no multicast.
+TEST_F(ProfileTest, WithPeersTheDefaultIsTheShippedUnicastProfile) {
+  EXPECT_EQ(fs::path(resolve_profile(Vendor::kCyclone, "", true)).filename(), "cyclone-unicast.xml");
+  EXPECT_EQ(fs::path(resolve_profile(Vendor::kFastDds, "", true)).filename(), "fastdds-unicast.xml");
+  const std::string lan = source("deploy/dds/cyclone-lan.xml");
+  EXPECT_EQ(resolve_profile(Vendor::kCyclone, lan, true), fs::absolute(lan).string());  // a given one still wins
+  ::setenv("FASTRTPS_DEFAULT_PROFILES_FILE", "/somewhere/else.xml", 1);
+  EXPECT_EQ(resolve_profile(Vendor::kFastDds, "", true), "");  // and so does the vendor's variable
 }
 
 // Without a given profile: the vendor's own variable applies when set, else the shipped loopback profile.
