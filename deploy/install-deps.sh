@@ -5,14 +5,17 @@
 # --browser: also chromium, for the live view's browser test (tests/integration/live_view_test.sh; skipped without).
 # --prometheus: also prometheus (the server and promtool), for the metrics test (tests/integration/metrics_test.sh,
 #   the exposition's promtool check; skipped without). Debian's package enables a prometheus service on :9090.
+# --npm: also nodejs and npm, for the MCAP export's test (tests/integration/mcap_export_test.sh reads the file with
+#   npm's @mcap/core; skipped without).
 set -euo pipefail
-containers=0 browser=0 prometheus=0
+containers=0 browser=0 prometheus=0 npm=0
 for arg in "$@"; do
   case "$arg" in
     --containers) containers=1 ;;
     --browser) browser=1 ;;
     --prometheus) prometheus=1 ;;
-    *) echo "install-deps: unknown option '$arg' (known: --containers, --browser, --prometheus)" >&2; exit 2 ;;
+    --npm) npm=1 ;;
+    *) echo "install-deps: unknown option '$arg' (known: --containers, --browser, --prometheus, --npm)" >&2; exit 2 ;;
   esac
 done
 
@@ -42,6 +45,8 @@ packages=(
 [ "$containers" -eq 1 ] && packages+=(podman runc podman-compose mmdebstrap)
 [ "$browser" -eq 1 ] && packages+=(chromium)
 [ "$prometheus" -eq 1 ] && packages+=(prometheus)
+# Only when the commands are missing: a node installed another way (one that bundles npm) stays as it is.
+if [ "$npm" -eq 1 ] && ! { command -v node && command -v npm; } >/dev/null; then packages+=(nodejs npm); fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -4,7 +4,7 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # The container test runs real containers with podman; the live view's test drives a headless chromium; the metrics
 # test scrapes the world with Debian's prometheus.
-"$root/deploy/install-deps.sh" --containers --browser --prometheus
+"$root/deploy/install-deps.sh" --containers --browser --prometheus --npm
 "$root/deploy/build.sh"
 cd "${MARSALA_BUILD_DIR:-$root/build}"
 ctest --output-on-failure -j"$(nproc)" --timeout 600

@@ -1,5 +1,5 @@
-// marsala-monitor: tail a running system (tail, status), replay a run's log (replay). Reads only; Ctrl-C ends it
-// cleanly.
+// marsala-monitor: tail a running system (tail, status), replay a run's log (replay), export it as MCAP (export).
+// Reads only; Ctrl-C ends it cleanly.
 #include <fmt/format.h>
 
 #include <exception>

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <iostream>
@@ -22,6 +23,7 @@
 #include "marsala/bus/bus.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/monitor/follow.hpp"
+#include "marsala/monitor/mcap_export.hpp"
 #include "marsala/monitor/progress.hpp"
 #include "marsala/monitor/replay.hpp"
 #include "marsala/monitor/world_gate.hpp"
@@ -225,6 +227,51 @@ int run_replay_command(ReplayCommand& c, std::ostream& out, std::ostream& err) {
   return 0;
 }
 
+constexpr const char* kExportFooter =
+    "Writes the run folder DIR as one MCAP file for Foxglove or Lichtblick (docs/runtime.md#mcap-export): /terrain\n"
+    "(foxglove.Grid, heights as float32 \"height\") at the start, every K steps and at the end; /robots\n"
+    "(foxglove.SceneUpdate: pose, heading, state, material of each robot) at the start and after every step; /events\n"
+    "(foxglove.Log) from events.log. JSON encoding with JSON Schemas; chunked, indexed, uncompressed. The log is\n"
+    "replayed with every check of replay; a damaged log is refused. Exit 0 ok, 2 bad input (FILE exists, no run\n"
+    "folder, a log that fails its checksums), 1 another error; nothing is left under FILE unless it succeeded.";
+
+/// The export subcommand: its options (define_export binds them) and its CLI11 subcommand.
+struct ExportCommand {
+  CLI::App* cmd = nullptr;
+  std::string dir;
+  std::string mcap;
+  McapExportOptions options;
+  double step_ms = 100.0;
+};
+
+void define_export(CLI::App& app, ExportCommand& c) {
+  c.cmd = app.add_subcommand("export", "write a finished run's folder as an MCAP file (Foxglove, Lichtblick)");
+  c.cmd->add_option("DIR", c.dir, "the run's output folder (run.log, terrain_initial.asc, events.log)")->required();
+  c.cmd->add_option("--mcap", c.mcap, "the MCAP file to write; must not exist")->required()->type_name("FILE");
+  c.cmd->add_option("--every", c.options.terrain_every, "a terrain every K steps (and at the start and end)")
+      ->check(cli::at_least_one())
+      ->type_name("K")
+      ->capture_default_str();
+  c.cmd->add_option("--step-ms", c.step_ms, "the time of one step in the file [ms]")
+      ->check(cli::number_within(1e-3, 3.6e6, "a step time in ms"))
+      ->capture_default_str();
+  c.cmd->footer(kExportFooter);
+}
+
+/// Bad input (a missing folder, an existing target, a damaged or inconsistent log) exits 2.
+int run_export_command(ExportCommand& c, std::ostream& out, std::ostream& err) {
+  c.options.step_ns = static_cast<std::uint64_t>(std::llround(c.step_ms * 1e6));
+  try {
+    out << format_export_report(export_mcap(c.dir, c.mcap, c.options));
+    return 0;
+  } catch (const InvalidArgument& e) {
+    err << fmt::format("marsala-monitor: export: {}\n", e.what());
+  } catch (const ParseError& e) {
+    err << fmt::format("marsala-monitor: export: {}\n", e.what());
+  }
+  return kExitUsage;
+}
+
 /// The serve subcommand: its options (define_serve binds them) and its CLI11 subcommand.
 struct ServeCommand {
   CLI::App* cmd = nullptr;
@@ -293,6 +340,7 @@ struct MonitorCommands {
   StatusCommand status;
   ReplayCommand replay;
   ServeCommand serve;
+  ExportCommand export_;
 };
 
 /// Runs the chosen subcommand other than serve; errors become one line on `err` and exit code 1.
@@ -303,6 +351,7 @@ int run_chosen(MonitorCommands& c, const StopSource& stop, std::ostream& out, st
       return 0;
     }
     if (*c.replay.cmd) return run_replay_command(c.replay, out, err);
+    if (*c.export_.cmd) return run_export_command(c.export_, out, err);
     try {
       WorldGate::world_key_from_environment();  // a bad run key file is bad input: exit 2 before any traffic
     } catch (const InvalidArgument& e) {
@@ -342,6 +391,7 @@ int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::o
   define_status(app, commands.status, commands.dds);
   define_replay(app, commands.replay);
   define_serve(app, commands.serve, commands.dds);
+  define_export(app, commands.export_);
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-monitor", out, usage_err)) return *code;
 
   // The monitor's diagnostics are lines on a stream; in json each becomes one log record (common/cli/logging.hpp).

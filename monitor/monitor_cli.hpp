@@ -7,7 +7,7 @@
 
 namespace marsala::monitor {
 
-/// Runs marsala-monitor with argv (subcommands tail, status, replay, serve); returns the exit code (0 ok, 1 error, 2 usage).
+/// Runs marsala-monitor with argv (subcommands tail, progress, summary, status, replay, serve, export); returns the exit code (0 ok, 1 error, 2 usage).
 /// `stop` ends a running tail or status (main.cpp wires it to SIGINT/SIGTERM). Errors go to `err` as
 /// "marsala-monitor: <reason>".
 int run_monitor_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err, const StopSource& stop);

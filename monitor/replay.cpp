@@ -72,6 +72,22 @@ ReplayedAgent& TerrainReplayer::agent(std::uint32_t id) {
   return a;
 }
 
+void TerrainReplayer::admit(const proto::AgentAdmitted& admitted) {
+  ReplayedAgent& a = agent(admitted.agent_id());
+  a.name = admitted.name();
+  a.admitted = true;
+  a.dropped = false;
+  const auto start = starts_.find(admitted.agent_id());
+  if (start == starts_.end()) return;
+  // The world (re-)admits an agent at its start, facing its target, full (docs/runtime.md#heading, #admission).
+  a.material_m3 = start->second.capacity_m3;
+  if (!start->second.start) return;
+  a.position = start->second.start;
+  const double dx = start->second.target.x - a.position->x;
+  const double dy = start->second.target.y - a.position->y;
+  a.heading_rad = dx == 0.0 && dy == 0.0 ? 0.0 : std::atan2(dy, dx);
+}
+
 void TerrainReplayer::apply(const proto::LogRecord& record, std::uint64_t offset) {
   const std::string where = fmt::format("{} record at byte {}", record_kind(record), offset);
   if (run_end_)
@@ -79,13 +95,7 @@ void TerrainReplayer::apply(const proto::LogRecord& record, std::uint64_t offset
                      fmt::format("{}: a record after the run's end (RunEnd after {} steps)", where, run_end_->steps()));
   switch (record.record_case()) {
     case proto::LogRecord::kHeader: throw ParseError(log_name_, 0, fmt::format("{}: a second header", where));
-    case proto::LogRecord::kAdmitted: {
-      ReplayedAgent& a = agent(record.admitted().agent_id());
-      a.name = record.admitted().name();
-      a.admitted = true;
-      a.dropped = false;
-      return;
-    }
+    case proto::LogRecord::kAdmitted: admit(record.admitted()); return;
     case proto::LogRecord::kDropped: agent(record.dropped().agent_id()).dropped = true; return;
     case proto::LogRecord::kResumed: ++resumptions_; return;
     case proto::LogRecord::kStep: apply_step(record.step(), where); return;
@@ -129,7 +139,12 @@ void TerrainReplayer::apply_step(const proto::StepRecord& step, const std::strin
     ReplayedAgent& me = agent(r.agent_id());
     ++me.accepted;
     me.state = r.state();
-    if (r.move()) me.position = Position{r.target_x_m(), r.target_y_m()};
+    if (r.move()) {
+      const Position to{r.target_x_m(), r.target_y_m()};
+      if (me.position && (to.x != me.position->x || to.y != me.position->y))
+        me.heading_rad = std::atan2(to.y - me.position->y, to.x - me.position->x);
+      me.position = to;
+    }
     double volume_m3 = 0.0;
     // A layer depositor's depositions say their cells; a cube or cone depositor's deposits were shaped by the world,
     // which logged the cells it raised.
@@ -146,6 +161,11 @@ void TerrainReplayer::apply_step(const proto::StepRecord& step, const std::strin
     }
     me.deposited_m3 += volume_m3;
     deposited_volume_m3_ += volume_m3;
+    const auto start = starts_.find(r.agent_id());
+    if (start != starts_.end() && !std::isnan(me.material_m3)) {
+      me.material_m3 = std::max(0.0, me.material_m3 - volume_m3);
+      if (r.refill()) me.material_m3 = start->second.capacity_m3;
+    }
   }
   const double logged = step.deposited_volume_m3();
   const double tolerance =

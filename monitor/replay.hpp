@@ -13,6 +13,7 @@
 // and writes the frames.
 
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -35,6 +36,20 @@ struct ReplayedAgent {
   std::uint64_t rejected = 0;        ///< requests the world rejected
   double deposited_m3 = 0.0;         ///< volume of its accepted depositions [m^3]
   std::string state;                 ///< the behaviour state of its latest logged request (accepted or not)
+  /// [rad from east, counter-clockwise] (docs/runtime.md#heading): towards its target from its start at admission
+  /// (with a known start), then along its latest accepted motion of non-zero length; NaN while unknown.
+  double heading_rad = std::numeric_limits<double>::quiet_NaN();
+  /// On board [m^3] (docs/runtime.md#applying-requests): its capacity at admission, less each accepted deposition,
+  /// full again on a refill; NaN without its start (TerrainReplayer::set_start).
+  double material_m3 = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// What the log does not say of a slot and a replay can take from the run's scenario: where it starts, where it
+/// heads, what it carries.
+struct SlotStart {
+  std::optional<Position> start;  ///< [m]; empty when the world moved the starts (start jitter)
+  Position target;                ///< its slot's target [m]
+  double capacity_m3 = 0.0;       ///< its robot type's material capacity [m^3]
 };
 
 /// Throws ParseError naming `terrain_name` when `terrain` is not the initial terrain `header` describes: rows, cols,
@@ -47,6 +62,9 @@ class TerrainReplayer {
   /// Starts from `initial_terrain` (check_initial_terrain() is the caller's business); `log_name` names the log in
   /// messages.
   TerrainReplayer(const proto::LogHeader& header, Heightmap initial_terrain, std::string log_name);
+
+  /// Gives slot `id` its start: each admission of it puts it there (when known), facing its target, full.
+  void set_start(std::uint32_t id, const SlotStart& start) { starts_[id] = start; }
 
   /// Applies the record found at byte `offset` of the log. Throws ParseError("<log>: <record> at byte N: ...") for a
   /// second header, a step out of order (a gap or a repeat), an accepted deposition off the grid or of a non-finite
@@ -76,6 +94,7 @@ class TerrainReplayer {
  private:
   void apply_step(const proto::StepRecord& step, const std::string& where);
   ReplayedAgent& agent(std::uint32_t id);
+  void admit(const proto::AgentAdmitted& admitted);
 
   proto::LogHeader header_;
   Heightmap terrain_;
@@ -84,6 +103,7 @@ class TerrainReplayer {
   std::uint64_t steps_ = 0;
   double deposited_volume_m3_ = 0.0;
   std::map<std::uint32_t, ReplayedAgent> agents_;
+  std::map<std::uint32_t, SlotStart> starts_;
   std::uint64_t requests_ = 0;
   std::uint64_t accepted_requests_ = 0;
   std::uint32_t resumptions_ = 0;

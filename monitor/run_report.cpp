@@ -76,6 +76,11 @@ std::string run_report(const std::string& dir) {
   if (s.completion() == "level_site") goal = fmt::format(", site {:.1f} % level", 100.0 * s.site_level_fraction());
   out += fmt::format("  agents {} ({} admitted, {} dropped), {:.3f} m3 deposited{}\n", s.agents(), s.admitted(),
                      s.dropped(), s.deposited_volume_m3(), goal);
+  if (s.has_material())
+    out += fmt::format("  material {:.3f} of {:.3f} m3 needed: ratio {:.3f} (1 = the exact MARS need), {:.3f} m3 off "
+                       "the band\n",
+                       s.material().deposited_m3(), s.material().needed_m3(), s.material().ratio(),
+                       s.material().off_band_m3());
   if (s.slots_missing() > 0)
     out += fmt::format("  short of {} of {} slots at the end (never admitted, or dropped and not back): agent{} {}\n",
                        s.slots_missing(), s.agents(), s.missing_agents_size() == 1 ? "" : "s",

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <random>
 #include <vector>
@@ -28,14 +29,18 @@ constexpr std::chrono::milliseconds kStopPoll{100};
 /// of the cores while it ran), and the process's CPU time, every thread's (DDS's too), from the first decision on.
 class DecisionCosts {
  public:
-  /// Runs `decide` and records its cost.
+  /// Runs `decide`, records its cost and tells it in the request (decision_us, decision_cpu_us: the step trace).
   template <typename Decide>
-  auto measure(Decide decide) {
+  protocol::ActionRequest measure(Decide decide) {
     if (!process_at_first_ms_) process_at_first_ms_ = process_cpu_ms();
+    const Clock::time_point wall = Clock::now();
     const double began = thread_cpu_ms();
-    auto decision = decide();
-    decision_ms_.push_back(thread_cpu_ms() - began);
-    return decision;
+    protocol::ActionRequest request = decide();
+    const double cpu_ms = thread_cpu_ms() - began;
+    decision_ms_.push_back(cpu_ms);
+    request.decision_us = to_us(std::chrono::duration<double, std::milli>(Clock::now() - wall).count());
+    request.decision_cpu_us = to_us(cpu_ms);
+    return request;
   }
   /// The median decision [ms]; 0 before the first.
   double median_ms() const { return median(decision_ms_); }
@@ -46,6 +51,10 @@ class DecisionCosts {
   }
 
  private:
+  static std::uint32_t to_us(double ms) {
+    return static_cast<std::uint32_t>(std::clamp(std::lround(ms * 1000.0), 0L, 4294967295L));
+  }
+
   std::vector<double> decision_ms_;            // [ms]
   std::optional<double> process_at_first_ms_;  // [ms]
 };

@@ -83,6 +83,10 @@ struct ActionRequest {
   /// What keeps the robot from going on, in a few words ("front neighbour 7 at 1.4 m (hold)"); empty when nothing
   /// does. For people (the world's stall account); the world keeps a bounded, printable copy.
   std::string waiting_for;
+  /// How long the decision behind this request took, wall clock and the deciding thread's CPU [us] (0: not said).
+  /// For the step trace only: never part of the request's meaning, so same_request() and the run log ignore them.
+  std::uint32_t decision_us = 0;
+  std::uint32_t decision_cpu_us = 0;  ///< [us]
 };
 
 /// One agent as the world sees it, for status and the monitor.

@@ -21,6 +21,7 @@ class Summary:
     end_reason: str              # completed, max_steps, no_live_agents, signal, stalled
     completion: str              # the scenario's completion kind: payload_path, level_site, ...
     sites: list                  # [(from_m, to_m)] the construction sites along the payload's final path [m]
+    material: tuple = (0.0, 0.0, 0.0, 0.0)  # summary.json's material: deposited, needed [m^3], ratio, off band [m^3]
 
     @property
     def idle_fraction(self):
@@ -52,6 +53,9 @@ def read_summary(path):
         doc = json.load(f)
     if not isinstance(doc, dict):
         raise ValueError("not an object")
+    material = doc.get("material") or {}
+    if not isinstance(material, dict):
+        raise ValueError("material is not an object")
     sites = doc.get("construction_sites") or []
     if not isinstance(sites, list) or not all(isinstance(s, dict) for s in sites):
         raise ValueError("construction_sites is not a list of objects")
@@ -62,7 +66,9 @@ def read_summary(path):
                    site_level_fraction=_number(doc, "site_level_fraction", float),
                    rejected_requests=_number(doc, "rejected_requests", int), end_reason=_text(doc, "end_reason"),
                    completion=_text(doc, "completion"),
-                   sites=[(_number(s, "from_m", float), _number(s, "to_m", float)) for s in sites])
+                   sites=[(_number(s, "from_m", float), _number(s, "to_m", float)) for s in sites],
+                   material=tuple(_number(material, k, float)
+                                  for k in ("deposited_m3", "needed_m3", "ratio", "off_band_m3")))
 
 
 def csv_word(text):

@@ -23,12 +23,15 @@ A re-run into the same OUT runs only the (team, seed) pairs missing from sweep.c
 CSV columns: team_size,seed,completed,completion_steps,wall_seconds,deposited_m3,path_length_m,idle_steps,
              idle_fraction,end_reason,sites,site_spans_m (idle_fraction = idle_steps / completion_steps; sites: the
              construction sites along the payload's final path, site_spans_m their FROM-TO [m] along it, joined
-             by ';': summary.json's construction_sites).
+             by ';': summary.json's construction_sites), material_deposited_m3,material_needed_m3,material_ratio,
+             material_off_band_m3 (summary.json's material: the deposited volume against the task's exact MARS gap,
+             docs/runtime.md#material-score; 0 from a build that does not write it).
 Exit codes: 0 ok, 1 a run failed (no summary) or the binaries are missing, 2 usage error (or a scenario that
             marsala-world --check rejects), 130 interrupted."""
 
 COLUMNS = ("team_size", "seed", "completed", "completion_steps", "wall_seconds", "deposited_m3", "path_length_m",
-           "idle_steps", "idle_fraction", "end_reason", "sites", "site_spans_m")
+           "idle_steps", "idle_fraction", "end_reason", "sites", "site_spans_m", "material_deposited_m3",
+           "material_needed_m3", "material_ratio", "material_off_band_m3")
 STATS_COLUMNS = ("team_size", "runs", "completed", "steps_mean", "steps_min", "steps_max", "wall_mean", "wall_min",
                  "wall_max", "idle_mean", "idle_min", "idle_max")
 MAX_TEAM = 999999
@@ -88,7 +91,8 @@ def csv_row(team, seed, s, end_reason):
     """The CSV row of a run of `team` robots with `seed` that ended with Summary s."""
     spans = ";".join(f"{a:.1f}-{b:.1f}" for a, b in s.sites)
     return [team, seed, "true" if s.completed else "false", s.steps, s.wall_seconds, s.deposited_m3, s.path_length_m,
-            s.idle_steps, f"{s.idle_fraction:.6f}", end_reason, len(s.sites), spans]
+            s.idle_steps, f"{s.idle_fraction:.6f}", end_reason, len(s.sites), spans,
+            *(f"{v:.6f}" for v in s.material)]
 
 
 def number(text):

@@ -40,7 +40,7 @@ done
 
 started=$(date +%s.%N)
 "$root/deploy/spawn.sh" --scenario "$root/deploy/scenarios/ramp.pbtxt" --agents 3 --dds cyclone --domain "$domain" \
-  --out "$work/run" --timeout 120 --quiet --metrics-port "$metrics_port" ||
+  --out "$work/run" --timeout 120 --quiet --metrics-port "$metrics_port" --trace "$work/trace.json" ||
   { tail -20 "$work/run/logs/world.log"; fail "spawn.sh --metrics-port $metrics_port"; }
 took=$(python3 -c "import time; print(round(time.time() - $started, 1))")
 
@@ -97,6 +97,30 @@ if summary["steps"] < 100 or summary["end_reason"] != "completed":
 sys.exit(f"differ: {bad}" if bad else 0)
 PY
 echo "ok: the run took ${took} s with Prometheus scraping it"
+
+# The same run's step trace: each agent's track holds its own decision (reported in its requests) inside its answer,
+# with its CPU time, on most steps (a step whose answer the world read in under the agent's own decision time still
+# nests: the span is cut to the answer).
+python3 - "$work/trace.json" "$work/run/summary.json" <<'PY' || fail "the agents' decisions are not in the trace"
+import json, sys
+events = [e for e in json.load(open(sys.argv[1]))["traceEvents"] if e["ph"] == "X"]
+summary = json.load(open(sys.argv[2]))
+answers = {(e["tid"], e["args"]["step"]): e for e in events if e["name"] == "answer"}
+decides = [e for e in events if e["name"] == "decide"]
+bad = []
+for d in decides:
+    a = answers.get((d["tid"], d["args"]["step"]))
+    if a is None or d["ts"] < a["ts"] - 0.001 or d["ts"] + d["dur"] > a["ts"] + a["dur"] + 0.002:
+        bad.append(f"decide of agent {d['tid']} at step {d['args']['step']} outside its answer")
+    if "cpu_us" not in d["args"]:
+        bad.append(f"decide of agent {d['tid']} at step {d['args']['step']} without cpu_us")
+for agent in (1, 2, 3):
+    mine = [d for d in decides if d["tid"] == agent]
+    print(f"ok: agent {agent}: {len(mine)} decisions traced of {summary['steps']} steps")
+    if len(mine) < 0.9 * summary["steps"]:
+        bad.append(f"agent {agent}: {len(mine)} decisions traced over {summary['steps']} steps")
+sys.exit(f"{bad[:5]}" if bad else 0)
+PY
 
 # A port in use (Prometheus's): one line naming it, exit 2, no folder; spawn.sh stops at its check, nothing started.
 rc=0

@@ -11,7 +11,8 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 sweep="$root/deploy/sweep.sh"
 scenario="$root/deploy/scenarios/ramp.pbtxt"
 header="team_size,seed,completed,completion_steps,wall_seconds,deposited_m3,path_length_m,idle_steps,"
-header+="idle_fraction,end_reason,sites,site_spans_m"
+header+="idle_fraction,end_reason,sites,site_spans_m,material_deposited_m3,material_needed_m3,material_ratio,"
+header+="material_off_band_m3"
 
 work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-it-sweep.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
@@ -96,8 +97,9 @@ for team in 1 2; do
   awk -v v="$(csv_field "$csv" "$team" 1 6)" -v w="$(field deposited_volume_m3 "$s")" 'BEGIN { exit !(v == w) }' ||
     fail "team $team: CSV volume differs from the summary"
   awk -F, -v t="$team" 'NR > 1 && $1 == t {
-        ok = NF == 12 && $4 > 0 && $5 > 0 && $5 < 300 && $6 > 0 && $8 >= 0 && $8 <= $4 && $9 >= 0 && $9 <= 1 &&
-             ($9 - $8 / $4) ^ 2 < 1e-10 && $11 == 0 && $12 == ""  # a ramp run has no construction sites
+        ok = NF == 16 && $4 > 0 && $5 > 0 && $5 < 300 && $6 > 0 && $8 >= 0 && $8 <= $4 && $9 >= 0 && $9 <= 1 &&
+             ($9 - $8 / $4) ^ 2 < 1e-10 && $11 == 0 && $12 == "" &&  # a ramp run has no construction sites
+             ($13 - $6) ^ 2 < 1e-10 && $14 > 0 && ($15 - $13 / $14) ^ 2 < 1e-8 && $16 >= 0  # the material score
         exit !ok }' "$csv" || { cat "$csv"; fail "implausible row for team $team"; }
   grep -Eq "team +$team, seed 1: completed in $steps steps" "$work/sweep1.txt" ||
     { cat "$work/sweep1.txt"; fail "no run line for team $team"; }
@@ -142,7 +144,7 @@ wait "$sweep_pid" || rc=$?
 [ "$rc" -eq 130 ] || { cat "$work/sweep4.txt"; fail "a stopped sweep exited $rc, expected 130"; }
 grep -q "the same command resumes" "$work/sweep4.txt" || { cat "$work/sweep4.txt"; fail "no resume hint"; }
 [ "$(head -n 1 "$csv")" = "$header" ] || fail "the header is gone after the stop"
-awk -F, 'NR > 1 && NF != 12 { bad = 1 } END { exit bad }' "$csv" || { cat "$csv"; fail "a partial row after the stop"; }
+awk -F, 'NR > 1 && NF != 16 { bad = 1 } END { exit bad }' "$csv" || { cat "$csv"; fail "a partial row after the stop"; }
 [ "$(wc -l <"$csv")" -eq 3 ] || { cat "$csv"; fail "rows lost or added by the stop"; }
 ls "$out"/sweep.csv.tmp.* >/dev/null 2>&1 && fail "a temporary CSV was left behind"
 # The run was stopped, not waited for: its world ended early (on the signal) or wrote no summary at all.

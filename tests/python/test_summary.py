@@ -9,7 +9,8 @@ from marsala_tools import summary
 FULL = {"completed": True, "end_reason": "completed", "steps": 200, "wall_seconds": 12.5, "deposited_volume_m3": 3.25,
         "path_length_m": 40.0, "idle_steps": 50, "site_level_fraction": 0.0, "rejected_requests": 7,
         "completion": "payload_path",
-        "construction_sites": [{"from_m": 1.04, "to_m": 2.5, "volume_m3": 1}, {"from_m": 10, "to_m": 12.25}]}
+        "construction_sites": [{"from_m": 1.04, "to_m": 2.5, "volume_m3": 1}, {"from_m": 10, "to_m": 12.25}],
+        "material": {"deposited_m3": 3.25, "needed_m3": 2.5, "ratio": 1.3, "off_band_m3": 0.5}}
 
 
 def write(tmp_path, doc):
@@ -24,11 +25,13 @@ def test_every_field(tmp_path):
     assert (s.idle_steps, s.rejected_requests, s.end_reason, s.completion) == (50, 7, "completed", "payload_path")
     assert s.sites == [(1.04, 2.5), (10.0, 12.25)]
     assert s.idle_fraction == 0.25
+    assert s.material == (3.25, 2.5, 1.3, 0.5)
 
 
 def test_missing_fields_read_as_zero_or_none(tmp_path):
     s = summary.read_summary(write(tmp_path, {"steps": 0}))
     assert (s.completed, s.steps, s.idle_steps, s.end_reason, s.sites) == (False, 0, 0, "", [])
+    assert s.material == (0.0, 0.0, 0.0, 0.0)
     assert s.idle_fraction == 0.0
 
 
@@ -37,7 +40,8 @@ def test_protobuf_json_strings_for_special_doubles(tmp_path):
     assert s.wall_seconds != s.wall_seconds and s.steps == 12
 
 
-@pytest.mark.parametrize("doc", [[], {"end_reason": 3}, {"steps": "many"}, {"construction_sites": [1]}])
+@pytest.mark.parametrize("doc", [[], {"end_reason": 3}, {"steps": "many"}, {"construction_sites": [1]},
+                                 {"material": 3}, {"material": {"ratio": "x"}}])
 def test_not_a_summary(tmp_path, doc):
     with pytest.raises(ValueError):
         summary.read_summary(write(tmp_path, doc))

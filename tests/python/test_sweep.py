@@ -9,7 +9,9 @@ import pytest
 from marsala_tools import common, runner, sweep
 
 HEADER = ("team_size,seed,completed,completion_steps,wall_seconds,deposited_m3,path_length_m,idle_steps,"
-          "idle_fraction,end_reason,sites,site_spans_m")
+          "idle_fraction,end_reason,sites,site_spans_m,material_deposited_m3,material_needed_m3,material_ratio,"
+          "material_off_band_m3")
+NO_MATERIAL = "0.000000,0.000000,0.000000,0.000000"  # a summary without its material block
 
 
 @pytest.fixture
@@ -87,23 +89,27 @@ def finish(s, team, seed, doc, code=0, log=""):
     s.finish_run(job, code)
 
 
-def run_doc(steps, idle, completed=True, reason="completed", sites=()):
-    return {"completed": completed, "end_reason": reason, "steps": steps, "wall_seconds": 2.5,
-            "deposited_volume_m3": 4.25, "path_length_m": 31.5, "idle_steps": idle,
-            "construction_sites": [{"from_m": a, "to_m": b} for a, b in sites]}
+def run_doc(steps, idle, completed=True, reason="completed", sites=(), material=None):
+    doc = {"completed": completed, "end_reason": reason, "steps": steps, "wall_seconds": 2.5,
+           "deposited_volume_m3": 4.25, "path_length_m": 31.5, "idle_steps": idle,
+           "construction_sites": [{"from_m": a, "to_m": b} for a, b in sites]}
+    if material:
+        doc["material"] = dict(zip(("deposited_m3", "needed_m3", "ratio", "off_band_m3"), material))
+    return doc
 
 
 def test_csv_rows_from_summaries(tmp_path, scenario, capsys):
     s = opened(tmp_path, scenario)
-    finish(s, 10, 1, run_doc(200, 50, sites=[(0.04, 2.46), (10.0, 12.25)]))
+    finish(s, 10, 1, run_doc(200, 50, sites=[(0.04, 2.46), (10.0, 12.25)], material=(4.25, 3.4, 1.25, 0.125)))
     finish(s, 9, 2, run_doc(4000, 1000, completed=False, reason="max_steps"))
     finish(s, 9, 1, run_doc(300, 0), code=5, log="spawn.sh: no end after 1800 s\n")
     finish(s, 3, 1, None, code=1, log="boom\n")
     lines = (tmp_path / "out" / "sweep.csv").read_text().splitlines()
     assert lines == [HEADER,  # sorted by team and seed as numbers (10 after 9)
-                     "9,1,true,300,2.5,4.25,31.5,0,0.000000,timeout,0,",
-                     "9,2,false,4000,2.5,4.25,31.5,1000,0.250000,max_steps,0,",
-                     "10,1,true,200,2.5,4.25,31.5,50,0.250000,completed,2,0.0-2.5;10.0-12.2"]
+                     "9,1,true,300,2.5,4.25,31.5,0,0.000000,timeout,0,," + NO_MATERIAL,
+                     "9,2,false,4000,2.5,4.25,31.5,1000,0.250000,max_steps,0,," + NO_MATERIAL,
+                     "10,1,true,200,2.5,4.25,31.5,50,0.250000,completed,2,0.0-2.5;10.0-12.2,"
+                     "4.250000,3.400000,1.250000,0.125000"]
     assert s.failed == 1
     out = capsys.readouterr().out
     assert "  team  10, seed 1: completed in 200 steps, 2.50 s wall, 4.250 m^3 deposited, idle 25.0%" in out
@@ -112,7 +118,7 @@ def test_csv_rows_from_summaries(tmp_path, scenario, capsys):
     # A run again replaces its row; the folder keeps no temporary file.
     finish(s, 9, 2, run_doc(100, 10))
     assert (tmp_path / "out" / "sweep.csv").read_text().splitlines()[2] == \
-        "9,2,true,100,2.5,4.25,31.5,10,0.100000,completed,0,"
+        "9,2,true,100,2.5,4.25,31.5,10,0.100000,completed,0,," + NO_MATERIAL
     assert not [n for n in os.listdir(tmp_path / "out") if ".tmp." in n]
 
 

@@ -27,6 +27,7 @@
 #include "marsala/scenario/terrain_builder.hpp"
 #include "marsala/terrain/asc_io.hpp"
 #include "marsala/world_server/rules/construction_band.hpp"
+#include "marsala/world_server/rules/material_score.hpp"
 
 namespace {
 
@@ -140,6 +141,7 @@ struct RunResult {
   double band_width_m = 0.0;
   double progress = 0.0;
   std::string sha256;
+  marsala::world_server::MaterialScore material;  // docs/runtime.md#material-score
 };
 
 /// Requests the world refused and what a run built above the MARS bound (docs/runtime.md#deposit-bound): the bound
@@ -237,11 +239,14 @@ RunResult run_one(marsala::scenario::Scenario s, const marsala::Heightmap& initi
     r.band_width_m = band.width_m;
     r.outside_band_m3 = band.outside_m3;
   }
+  r.material = world_server::material_score(st, initial, r.outside_band_m3);
   fmt::print("{} agents {} seed {}: {} after {} steps, {:.3f} m3, outside band {:.3f} m3, progress {:.4f}, last "
              "change {}, rejected motions {}, sha256 {}\n",
              s.name, agents, seed, r.end, st.step, st.deposited_volume_m3, r.outside_band_m3, r.progress, last_change,
              st.rejected_motions, r.sha256);
   fmt::print("  {}\n", refusals.describe(sim, initial));
+  fmt::print("  material: {:.3f} of {:.3f} m3 needed (ratio {:.3f}), {:.3f} m3 off the band\n", r.material.deposited_m3,
+             r.material.needed_m3, r.material.ratio, r.material.off_band_m3);
   std::fflush(stdout);
   if (!o.write_dir.empty()) {
     terrain::write_asc(st.terrain, o.write_dir + "/terrain_final.asc");
@@ -255,8 +260,9 @@ RunResult run_one(marsala::scenario::Scenario s, const marsala::Heightmap& initi
 }
 
 std::string csv_row(const std::string& scenario, const RunResult& r) {
-  return fmt::format("{},{},{},{},{},{:.3f},{:.3f},{:.1f},{:.4f},{}\n", scenario, r.agents, r.seed, r.end, r.steps,
-                     r.volume_m3, r.outside_band_m3, r.band_width_m, r.progress, r.sha256);
+  return fmt::format("{},{},{},{},{},{:.3f},{:.3f},{:.1f},{:.4f},{},{:.3f},{:.3f},{:.4f},{:.3f}\n", scenario, r.agents,
+                     r.seed, r.end, r.steps, r.volume_m3, r.outside_band_m3, r.band_width_m, r.progress, r.sha256,
+                     r.material.deposited_m3, r.material.needed_m3, r.material.ratio, r.material.off_band_m3);
 }
 
 /// Per team size: runs, completed, mean / min / max of steps, volume and volume outside the band.
@@ -296,7 +302,8 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", seeds_text, "run seeds, e.g. 1-5 (instead of --seed)");
   app.add_option("--csv", csv_file,
                  "write one row per run: scenario,agents,seed,end_reason,steps,volume_m3,outside_band_m3,"
-                 "band_width_m,progress,terrain_sha256 (FILE.partial while the sweep runs)");
+                 "band_width_m,progress,terrain_sha256,material_deposited_m3,material_needed_m3,material_ratio,"
+                 "material_off_band_m3 (FILE.partial while the sweep runs)");
   app.add_option("--max-steps", o.max_steps, "step limit (default: the scenario's)");
   app.add_option("--stall-steps", o.stall_steps, "end after this many steps without a terrain change (0: never)");
   app.add_option("--set", overrides, "FIELD=VALUE");
@@ -326,7 +333,8 @@ int main(int argc, char** argv) {
     if (!csv_file.empty()) {
       csv.open(csv_file + ".partial");
       if (!csv) throw IoError(fmt::format("--csv {}: cannot be written", csv_file));
-      csv << "scenario,agents,seed,end_reason,steps,volume_m3,outside_band_m3,band_width_m,progress,terrain_sha256\n";
+      csv << "scenario,agents,seed,end_reason,steps,volume_m3,outside_band_m3,band_width_m,progress,terrain_sha256,"
+             "material_deposited_m3,material_needed_m3,material_ratio,material_off_band_m3\n";
     }
     for (const std::uint64_t n : teams)
       for (const std::uint64_t sd : seeds) {

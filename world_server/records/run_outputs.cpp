@@ -24,6 +24,7 @@
 #include "marsala/terrain/asc_io.hpp"
 #include "marsala/world_server/rules/arbiter.hpp"
 #include "marsala/world_server/rules/construction_band.hpp"
+#include "marsala/world_server/rules/material_score.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -52,6 +53,7 @@ struct FinalTerrainReport {
   double site_fraction = 0.0;              ///< level_site only
   double band_width_m = 0.0;               ///< payload_path with the initial terrain known: the construction band
   double outside_band_m3 = 0.0;            ///< and the volume raised outside it (construction_band.hpp)
+  std::optional<MaterialScore> material;   ///< with the initial terrain known (material_score.hpp)
 };
 
 FinalTerrainReport final_terrain_report(const WorldState& state, const RunInfo& info) {
@@ -70,6 +72,8 @@ FinalTerrainReport final_terrain_report(const WorldState& state, const RunInfo& 
   }
   if (state.completion == scenario::CompletionKind::kLevelSite)
     report.site_fraction = site_level_fraction(state.terrain, state.site);
+  if (info.initial_terrain.geometry() == state.terrain.geometry())
+    report.material = material_score(state, info.initial_terrain, report.outside_band_m3);
   return report;
 }
 
@@ -195,6 +199,13 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_site_level_fraction(report.site_fraction);
   s.set_construction_band_width_m(report.band_width_m);
   s.set_deposited_outside_band_m3(report.outside_band_m3);
+  if (report.material) {
+    proto::MaterialScore* m = s.mutable_material();
+    m->set_deposited_m3(report.material->deposited_m3);
+    m->set_needed_m3(report.material->needed_m3);
+    m->set_ratio(report.material->ratio);
+    m->set_off_band_m3(report.material->off_band_m3);
+  }
   for (const ConstructionSite& site : report.sites) {
     proto::ConstructionSite* p = s.add_construction_sites();
     p->set_from_m(site.from_m);

@@ -36,8 +36,8 @@ void RunRecorder::open(const scenario::Scenario& scenario, const LogStart& start
   const bool resumed = setup_.resume_good_bytes.has_value();
   const std::string& dir = setup_.out_dir;
   // make_world_state() keeps the terrain as given: the state's terrain is still the initial one, unless resumed.
-  if (scenario.has_goal_vector_map || state.completion == scenario::CompletionKind::kPayloadPath)
-    initial_terrain_ = resumed ? terrain::read_asc(path_in(dir, "terrain_initial.asc")) : state.terrain;
+  // Kept for every kind: the material score (material_score.hpp) needs it at the end.
+  initial_terrain_ = resumed ? terrain::read_asc(path_in(dir, "terrain_initial.asc")) : state.terrain;
   if (!resumed) write_initial_outputs(dir, state.terrain);
   event_log_.emplace(path_in(dir, "events.log"), resumed);
   if (setup_.frames_every > 0) {

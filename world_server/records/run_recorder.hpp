@@ -67,7 +67,7 @@ class RunRecorder {
   std::optional<EventLog> event_log_;
   std::optional<render::FrameWriter> frames_;
   std::optional<CellRect> frame_window_;  ///< the frames' close-up; none = the whole terrain
-  Heightmap initial_terrain_;             ///< for goal_vector_map.png and payload_path's construction sites
+  Heightmap initial_terrain_;             ///< for goal_vector_map.png, payload_path's construction sites, the material score
 };
 
 }  // namespace marsala::world_server

@@ -12,7 +12,8 @@ void RequestCollector::read_partitions(const WorldState& state, RequestSelection
     for (protocol::ActionRequest& r : received) {
       const bool answers = r.step == state.step && carries_identity_of(a, r);
       const RequestTake take = selection.take(a.id, answers);
-      if (take == RequestTake::kAnswer) into.answered_at.emplace_back(a.id, Clock::now());
+      if (take == RequestTake::kAnswer)
+        into.answered_at.push_back({a.id, Clock::now(), r.decision_us, r.decision_cpu_us});
       if (take != RequestTake::kSurplus) into.submissions.push_back({a.id, std::move(r)});
     }
   }

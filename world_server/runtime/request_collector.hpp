@@ -18,6 +18,7 @@
 #include "marsala/world_server/rules/world_state.hpp"
 #include "marsala/world_server/runtime/agent_links.hpp"
 #include "marsala/world_server/runtime/request_selection.hpp"
+#include "marsala/world_server/runtime/step_trace.hpp"
 
 namespace marsala::world_server {
 
@@ -51,8 +52,8 @@ struct Collected {
   std::vector<Submission> submissions;           ///< in the order read, partition by partition
   std::uint32_t surplus = 0;                     ///< requests beyond a partition's limit, never applied
   std::chrono::steady_clock::duration waited{};  ///< time spent waiting for requests
-  /// Each agent whose answer was taken, when it was read (for the step trace, step_trace.hpp).
-  std::vector<std::pair<std::uint32_t, std::chrono::steady_clock::time_point>> answered_at;
+  /// Each agent whose answer was taken, when it was read and its reported decision time (the step trace).
+  std::vector<AgentAnswer> answered_at;
 };
 
 /// Collects the requests of each step from the agents' links.

@@ -20,10 +20,11 @@ double us_between(StepTimes::Clock::time_point from, StepTimes::Clock::time_poin
 
 std::string trace_event_json(const TraceSpan& span) {
   // Names are the fixed words of step_spans(): nothing to escape.
+  const std::string cpu = span.cpu_us >= 0.0 ? fmt::format(R"(,"cpu_us":{:.0f})", span.cpu_us) : std::string();
   return fmt::format(
-      R"({{"name":"{}","cat":"{}","ph":"X","ts":{:.3f},"dur":{:.3f},"pid":1,"tid":{},"args":{{"step":{}}}}})",
+      R"({{"name":"{}","cat":"{}","ph":"X","ts":{:.3f},"dur":{:.3f},"pid":1,"tid":{},"args":{{"step":{}{}}}}})",
       span.name, span.track == kWorldTrack ? "world" : "agent", span.start_us, span.duration_us, span.track,
-      span.step);
+      span.step, cpu);
 }
 
 std::vector<TraceSpan> step_spans(const StepTimes& t, StepTimes::Clock::time_point origin) {
@@ -38,7 +39,15 @@ std::vector<TraceSpan> step_spans(const StepTimes& t, StepTimes::Clock::time_poi
   add(kWorldTrack, "apply", t.collected, t.applied);
   add(kWorldTrack, "record", t.applied, t.recorded);
   add(kWorldTrack, "status", t.recorded, t.published);
-  for (const auto& [id, at] : t.answers) add(id, "answer", t.frames_out, std::max(at, t.frames_out));
+  for (const AgentAnswer& a : t.answers) {
+    const StepTimes::Clock::time_point read = std::max(a.read, t.frames_out);
+    add(a.agent, "answer", t.frames_out, read);
+    if (a.decision_us == 0) continue;
+    const double answer_us = spans.back().duration_us;
+    const double decide_us = std::min(static_cast<double>(a.decision_us), answer_us);
+    spans.push_back({a.agent, "decide", spans.back().start_us + answer_us - decide_us, decide_us, t.step,
+                     static_cast<double>(a.decision_cpu_us)});
+  }
   for (std::uint32_t id : t.missed) add(id, "missed", t.frames_out, t.collected);
   return spans;
 }

@@ -26,11 +26,20 @@ struct TraceSpan {
   double start_us = 0.0;              ///< from the trace's origin [us]
   double duration_us = 0.0;           ///< [us]
   std::uint64_t step = 0;             ///< the step it belongs to
+  double cpu_us = -1.0;               ///< a decision's CPU time, in the event's args when >= 0 [us]
 };
 
 /// `span` as one JSON object of the trace-event format: {"name","cat","ph":"X","ts","dur","pid","tid","args":{"step"}},
 /// times with nanosecond digits.
 std::string trace_event_json(const TraceSpan& span);
+
+/// One agent's answer to a step: when the world read it, and the decision time the agent reported in it.
+struct AgentAnswer {
+  std::uint32_t agent = 0;                     ///< its id
+  std::chrono::steady_clock::time_point read;  ///< when the world read the request
+  std::uint32_t decision_us = 0;               ///< the agent's decision, wall clock (0: not said) [us]
+  std::uint32_t decision_cpu_us = 0;           ///< the same, the deciding thread's CPU time [us]
+};
 
 /// The times of one step's phases, read from the world's clock as it ran (steady_clock).
 struct StepTimes {
@@ -42,13 +51,15 @@ struct StepTimes {
   Clock::time_point applied;    ///< apply_step done
   Clock::time_point recorded;   ///< run.log (and snapshot) written: the end of the step's time in summary.json
   Clock::time_point published;  ///< notes, events and WorldStatus out
-  std::vector<std::pair<std::uint32_t, Clock::time_point>> answers;  ///< each agent that answered, when it was read
-  std::vector<std::uint32_t> missed;                                 ///< the live agents that did not answer
+  std::vector<AgentAnswer> answers;   ///< each agent that answered, when it was read
+  std::vector<std::uint32_t> missed;  ///< the live agents that did not answer
 };
 
 /// The spans of one step: on the world's track "step" (start to recorded) and its phases "frames", "collect",
 /// "apply", "record" that tile it, then "status" (recorded to published); on each agent's track "answer" (frames out
-/// to its answer) or "missed" (frames out to the end of the wait). Times from `origin` [us].
+/// to its answer) or "missed" (frames out to the end of the wait). Inside an "answer", "decide": the decision the
+/// agent reported, ending where the answer was read (the agents share no clock with the world, so it is placed as
+/// late as it can have been; no longer than the answer, with its CPU time in args). Times from `origin` [us].
 std::vector<TraceSpan> step_spans(const StepTimes& times, StepTimes::Clock::time_point origin);
 
 /// A trace being written.

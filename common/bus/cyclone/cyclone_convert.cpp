@@ -247,6 +247,8 @@ marsala_wire_ActionRequest to_msg(const ActionRequest& in, Storage& storage) {
   out.refill = in.refill;
   out.state = borrow(in.state);
   out.waiting_for = borrow(in.waiting_for);
+  out.decision_us = in.decision_us;
+  out.decision_cpu_us = in.decision_cpu_us;
   return out;
 }
 
@@ -278,6 +280,8 @@ ActionRequest from_msg(const marsala_wire_ActionRequest& in) {
   out.refill = in.refill;
   out.state = copy(in.state);
   out.waiting_for = copy(in.waiting_for);
+  out.decision_us = in.decision_us;
+  out.decision_cpu_us = in.decision_cpu_us;
   return out;
 }
 

@@ -220,6 +220,8 @@ wire::ActionRequest to_msg(const ActionRequest& in) {
   out.refill(in.refill);
   out.state(in.state);
   out.waiting_for(in.waiting_for);
+  out.decision_us(in.decision_us);
+  out.decision_cpu_us(in.decision_cpu_us);
   return out;
 }
 
@@ -249,6 +251,8 @@ ActionRequest from_msg(const wire::ActionRequest& in) {
   out.refill = in.refill();
   out.state = in.state();
   out.waiting_for = in.waiting_for();
+  out.decision_us = in.decision_us();
+  out.decision_cpu_us = in.decision_cpu_us();
   return out;
 }
 

@@ -269,6 +269,19 @@ TEST_F(RunReport, SaysWhatLandedOutsideTheConstructionBand) {
       << run_report(dir_.string());
 }
 
+TEST_F(RunReport, PrintsTheMaterialScore) {
+  write_summary(R"({"scenario": "ramp", "completed": true, "end_reason": "completed", "steps": 298, "agents": 3,
+    "admitted": 3, "deposited_volume_m3": 12.0, "completion": "agents_at_goal", "progress": 1,
+    "material": {"deposited_m3": 12.0, "needed_m3": 10.0, "ratio": 1.2, "off_band_m3": 0.5}})");
+  EXPECT_NE(run_report(dir_.string())
+                .find("\n  material 12.000 of 10.000 m3 needed: ratio 1.200 (1 = the exact MARS need), 0.500 m3 off "
+                      "the band\n"),
+            std::string::npos)
+      << run_report(dir_.string());
+  write_summary(R"({"scenario": "ramp", "completed": true, "agents": 3, "admitted": 3})");  // an older summary
+  EXPECT_EQ(run_report(dir_.string()).find("material"), std::string::npos);
+}
+
 TEST_F(RunReport, SaysWhereTheTimeLapseIs) {
   write_summary(R"({"scenario": "ramp", "completed": true, "end_reason": "completed", "steps": 275,
     "wall_seconds": 2.0, "agents": 3, "admitted": 3, "completion": "agents_at_goal", "progress": 1})");

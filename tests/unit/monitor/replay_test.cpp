@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -270,6 +271,69 @@ TEST(TerrainReplayer, KeepsDepositorsAndPositionsOfAcceptedRequestsOnly) {
   r.mutable_step()->mutable_requests(0)->mutable_depositions(0)->set_row(2);
   r.mutable_step()->set_deposited_volume_m3(0.5);
   EXPECT_THROW(replayer.apply(r, 200), ParseError);
+}
+
+TEST(TerrainReplayer, GivesAStartedSlotItsHeadingAndMaterialAsTheWorldApplies) {
+  // docs/runtime.md#heading and #applying-requests: admitted at its start facing its target, full; a motion of
+  // non-zero length turns it, one to where it stands does not; a deposition takes its volume off, a refill fills it.
+  proto::LogHeader header;
+  header.set_agents(1);
+  header.set_rows(2);
+  header.set_cols(2);
+  header.set_cell_size_m(1.0);
+  TerrainReplayer replayer(header, Heightmap(GridGeometry{2, 2, 0.0, 0.0, 1.0}), "run.log");
+  replayer.set_start(1, SlotStart{Position{0.5, 0.5}, Position{0.5, 1.5}, 2.0});
+  proto::LogRecord admitted;
+  admitted.mutable_admitted()->set_agent_id(1);
+  replayer.apply(admitted, 10);
+  const ReplayedAgent& a = replayer.agents().at(1);
+  ASSERT_TRUE(a.position);
+  EXPECT_EQ(a.position->x, 0.5);
+  EXPECT_DOUBLE_EQ(a.heading_rad, std::acos(0.0));  // north, towards its target
+  EXPECT_EQ(a.material_m3, 2.0);
+  double volume = 0.0;
+  const auto step = [&](std::uint64_t k, double x, double y, double height_m, bool refill) {
+    proto::LogRecord r;
+    r.mutable_step()->set_step(k);
+    proto::LoggedRequest& q = *r.mutable_step()->add_requests();
+    q.set_agent_id(1);
+    q.set_channel_id(1);
+    q.set_accepted(true);
+    q.set_move(true);
+    q.set_target_x_m(x);
+    q.set_target_y_m(y);
+    q.set_refill(refill);
+    if (height_m > 0.0) {
+      proto::LoggedDeposition& d = *q.add_depositions();
+      d.set_row(0);
+      d.set_col(0);
+      d.set_height_m(height_m);
+    }
+    volume += height_m;
+    r.mutable_step()->set_deposited_volume_m3(volume);
+    replayer.apply(r, 20 + k);
+  };
+  step(0, 1.5, 0.5, 0.5, false);  // east, 0.5 m^3 off
+  EXPECT_DOUBLE_EQ(a.heading_rad, 0.0);
+  EXPECT_DOUBLE_EQ(a.material_m3, 1.5);
+  step(1, 1.5, 0.5, 2.0, false);  // standing still: the heading stays; never below 0
+  EXPECT_DOUBLE_EQ(a.heading_rad, 0.0);
+  EXPECT_EQ(a.material_m3, 0.0);
+  step(2, 0.5, 0.5, 0.0, true);  // west, full again
+  EXPECT_DOUBLE_EQ(a.heading_rad, std::atan2(0.0, -1.0));
+  EXPECT_EQ(a.material_m3, 2.0);
+}
+
+TEST(TerrainReplayer, WithoutAStartHeadingAndMaterialStayUnknown) {
+  proto::LogHeader header;
+  header.set_agents(1);
+  TerrainReplayer replayer(header, Heightmap(GridGeometry{2, 2, 0.0, 0.0, 1.0}), "run.log");
+  proto::LogRecord admitted;
+  admitted.mutable_admitted()->set_agent_id(1);
+  replayer.apply(admitted, 10);
+  EXPECT_TRUE(std::isnan(replayer.agents().at(1).heading_rad));
+  EXPECT_TRUE(std::isnan(replayer.agents().at(1).material_m3));
+  EXPECT_FALSE(replayer.agents().at(1).position);
 }
 
 TEST_F(ReplayTest, ToStepGivesTheTerrainTheWorldAwaitedThatStepOn) {

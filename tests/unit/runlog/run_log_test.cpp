@@ -30,6 +30,16 @@ TEST(Crc32c, KnownVectors) {
   EXPECT_EQ(crc32c(digits.data() + 4, 5, crc32c(digits.data(), 4)), 0xE3069283u);
 }
 
+// Check values of the ISO-HDLC CRC-32 (MCAP's): the catalogue's "123456789", and zlib.crc32 of 32 zeros and ones.
+TEST(Crc32Iso, KnownVectors) {
+  const std::string digits = "123456789";
+  EXPECT_EQ(crc32_iso(digits.data(), digits.size()), 0xCBF43926u);
+  const std::vector<unsigned char> zeros(32, 0x00), ones(32, 0xFF);
+  EXPECT_EQ(crc32_iso(zeros.data(), zeros.size()), 0x190A55ADu);
+  EXPECT_EQ(crc32_iso(ones.data(), ones.size()), 0xFF6CAB0Bu);
+  EXPECT_EQ(crc32_iso(digits.data() + 4, 5, crc32_iso(digits.data(), 4)), 0xCBF43926u);
+}
+
 class RunLogTest : public ::testing::Test {
  protected:
   void SetUp() override {

@@ -58,6 +58,34 @@ TEST(StepTrace, APhasesTileItsStepAndEachAgentWaitsFromTheFrames) {
   EXPECT_EQ(got, expected);
 }
 
+// An agent's reported decision lies inside its answer and ends where the answer was read; one longer than the answer
+// (its clock is not the world's) is cut to it; an agent that reports none gets no "decide".
+TEST(StepTrace, AnAgentsDecisionEndsWhereItsAnswerWasRead) {
+  const Clock::time_point origin{};
+  StepTimes t;
+  t.step = 9;
+  t.start = origin;
+  t.frames_out = t.start + microseconds(10);
+  t.collected = t.applied = t.recorded = t.published = t.frames_out + microseconds(60);
+  t.answers = {{1, t.frames_out + microseconds(30), 12, 9},
+               {2, t.frames_out + microseconds(40), 500, 480},
+               {3, t.frames_out + microseconds(50), 0, 0}};
+  std::map<std::pair<std::uint32_t, std::string>, std::pair<double, double>> got;
+  std::map<std::uint32_t, double> cpu;
+  for (const TraceSpan& s : step_spans(t, origin)) {
+    if (s.track == kWorldTrack) continue;
+    got[{s.track, s.name}] = {s.start_us, s.duration_us};
+    if (s.name == "decide") cpu[s.track] = s.cpu_us;
+  }
+  const std::map<std::pair<std::uint32_t, std::string>, std::pair<double, double>> expected{
+      {{1, "answer"}, {10, 30}}, {{1, "decide"}, {28, 12}}, {{2, "answer"}, {10, 40}},
+      {{2, "decide"}, {10, 40}}, {{3, "answer"}, {10, 50}}};
+  EXPECT_EQ(got, expected);
+  EXPECT_EQ(cpu, (std::map<std::uint32_t, double>{{1, 9.0}, {2, 480.0}}));
+  EXPECT_EQ(trace_event_json({1, "decide", 28, 12, 9, 9.0}),
+            R"({"name":"decide","cat":"agent","ph":"X","ts":28.000,"dur":12.000,"pid":1,"tid":1,"args":{"step":9,"cpu_us":9}})");
+}
+
 TEST(StepTrace, WritesTheFileOnlyWhenFinished) {
   const fs::path dir = fs::temp_directory_path() / ("marsala_trace_" + std::to_string(::getpid()));
   fs::create_directories(dir);
