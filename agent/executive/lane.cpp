@@ -179,21 +179,4 @@ std::vector<CellIndex> band_centre_path(const deliberative::LocalMap& local, con
   return out;
 }
 
-bool structure_beyond_reach(const deliberative::LocalMap& local, const CellMask& structure,
-                            const std::vector<CellIndex>& path, Position at, double reach_m) {
-  if (structure.rows() != local.rows() || structure.cols() != local.cols()) return false;
-  return std::any_of(path.begin(), path.end(), [&](CellIndex c) {
-    const Position p = local.center(c);
-    return local.contains(c) && structure(c.row, c.col) != 0 && std::hypot(p.x - at.x, p.y - at.y) > reach_m;
-  });
-}
-
-std::vector<CellIndex> from_unfinished(const deliberative::LocalMap& local, const std::vector<CellIndex>& path,
-                                       double tolerance_m) {
-  const auto first = std::find_if(path.begin(), path.end(), [&](CellIndex c) {
-    return local.contains(c) && local.known(c.row, c.col) != 0 && local.gap(c.row, c.col) > tolerance_m;
-  });
-  return {first, path.end()};
-}
-
 }  // namespace marsala::agent::executive

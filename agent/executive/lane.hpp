@@ -54,18 +54,4 @@ std::vector<CellIndex> band_centre_path(const deliberative::LocalMap& local, con
                                         const std::vector<CellIndex>& path, double corridor_width_m,
                                         double max_shift_m, const CellMask* structure = nullptr);
 
-/// The part of a footprint path (local indices, path[0] where the robot will stand) that a robot driving on along it
-/// fills: from its first unfinished cell on, a path cell whose own MARS gap in `local` exceeds tolerance_m [m]; empty
-/// when none is (docs/runtime.md#the-construction-band, "one front"). The way up to that cell is finished: what is
-/// left beside it is the band of a structure someone else built along another line, not this robot's work; the
-/// front is where the way itself is unfinished.
-/// True when `structure` (the window's size: the cells seen raised) holds a cell of `path` (local indices) farther
-/// than reach_m [m] from `at` [m]: the structure goes on past what a robot standing at `at` can fill, so the front of
-/// the construction is farther along than this robot (docs/runtime.md#the-construction-band, "one front").
-bool structure_beyond_reach(const deliberative::LocalMap& local, const CellMask& structure,
-                            const std::vector<CellIndex>& path, Position at, double reach_m);
-
-std::vector<CellIndex> from_unfinished(const deliberative::LocalMap& local, const std::vector<CellIndex>& path,
-                                       double tolerance_m);
-
 }  // namespace marsala::agent::executive

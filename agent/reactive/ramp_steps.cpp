@@ -353,15 +353,6 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
     const CellIndex p = terrain_only.to_local(g);
     if (terrain_only.contains(p)) terrain_only.gap(p.row, p.col) = 0.0;
   }
-  // One front (docs/runtime.md#the-construction-band): a robot that drives on along a structure that goes on past
-  // its reach fills only from where the way itself is unfinished.
-  if (band_centre_ && from > 0 && memory_.raised) {
-    const executive::DepositionParams& params = modules_->depositions.params();
-    const double tolerance_m = std::max(params.gap_margin_m, 0.5 * params.cube_layer_m);
-    if (executive::structure_beyond_reach(local, memory_.raised->raised(local, tolerance_m), ahead, at,
-                                          context_.type.body.reach_m))
-      ahead = executive::from_unfinished(terrain_only, ahead, tolerance_m);
-  }
   trace.deposition = modules_->depositor->plan(modules_->depositions, terrain_only, ahead, at, frame.material_m3,
                                                neighbourhood(frame));
   // A scanned map: where the path turned aside from the straight way to the target (its cells' balls hold cells no

@@ -134,9 +134,7 @@ class RampSteps {
   /// fills follows its deposition path moved onto the centre line of the corridor it runs in (executive/lane.hpp
   /// band_centre_path, on its own map without the other robots), not the path from where it stands; it still drives
   /// its own path; and nothing along a stretch of it that runs beside the structure (the cells its map saw raised,
-  /// executive/raised_cells.hpp); and, while it drives on along a structure that goes on past its reach, only from
-  /// where the way itself is unfinished (one front: executive::structure_beyond_reach, from_unfinished). Needs
-  /// set_lane()'s corridor width; off by default; set before admit().
+  /// executive/raised_cells.hpp). Needs set_lane()'s corridor width; off by default; set before admit().
   void set_band_centre(bool on) { band_centre_ = on; }
   /// `path` moved into this robot's lane on the last look()'s map (unchanged without lanes).
   std::vector<CellIndex> in_lane(const deliberative::LocalMap& local, const std::vector<CellIndex>& path) const;

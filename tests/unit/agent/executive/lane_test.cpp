@@ -232,47 +232,5 @@ TEST(Lane, BandCentrePathBuildsNothingBesideTheStructureButGoesOnPastItsTip) {
   EXPECT_EQ(band_centre_path(open, open.navigable, row_path(60, 5, 70), 3.0, 1.0, &other), row_path(60, 5, 70));
 }
 
-TEST(Lane, FromUnfinishedStartsWhereTheWayItselfHasAGap) {
-  // A way along row 40 whose cells up to column 29 are finished (no gap of their own) while the cells beside them,
-  // rows 45..54 (the edge of a structure built along another line), still have one; from column 30 on the way
-  // itself is unfinished: a gap above the tolerance on every other cell.
-  Heightmap gap(kGrid, 0.0);
-  for (int c = 0; c < 80; ++c)
-    for (int r = 45; r <= 54; ++r) gap(r, c) = 0.2;
-  for (int c = 30; c < 80; c += 2) gap(40, c) = 0.05;
-  gap(40, 12) = 0.004;  // below the tolerance: finished
-  deliberative::LocalMap map = test::make_local_map(Heightmap(kGrid, 0.0), gap, kBody, {40, 5}, std::nullopt);
-  const std::vector<CellIndex> way = row_path(40, 5, 70);
-  EXPECT_EQ(from_unfinished(map, way, 0.008), row_path(40, 30, 70));
-  // The first unfinished cell counts from wherever it is, the robot's own cell included.
-  EXPECT_EQ(from_unfinished(map, row_path(40, 30, 5), 0.008), row_path(40, 30, 5));
-  // A finished way: nothing (what is left beside it is not this robot's work); an unknown cell never counts.
-  EXPECT_TRUE(from_unfinished(map, row_path(40, 5, 29), 0.008).empty());
-  map.known(40, 30) = 0;
-  EXPECT_EQ(from_unfinished(map, way, 0.008), row_path(40, 32, 70));
-  // A lower tolerance takes the small gap at column 12 as unfinished.
-  EXPECT_EQ(from_unfinished(map, way, 0.001), row_path(40, 12, 70));
-}
-
-TEST(Lane, StructureBeyondReachIsAStructureCellOfThePathFartherThanTheReach) {
-  const deliberative::LocalMap open = band_map({40, 5}, false);
-  const CellMask strip = raised_strip(25, 54, 40);  // its tip at column 40 (x 4.05 m)
-  const std::vector<CellIndex> way = row_path(40, 5, 70);
-  // Distances from the centre of the cell the robot stands on: the tip 3.5 m away, past a 2 m reach.
-  const Position at = open.center({40, 5});
-  EXPECT_TRUE(structure_beyond_reach(open, strip, way, at, 2.0));
-  // On the way from column 25 the tip is 1.5 m away: within the reach, the robot is at the front.
-  const std::vector<CellIndex> rest = row_path(40, 25, 70);
-  EXPECT_FALSE(structure_beyond_reach(open, strip, rest, open.center({40, 25}), 2.0));
-  // Exactly at the reach is within it; a hair less reach puts the tip beyond.
-  const double tip_m = open.center({40, 40}).x - open.center({40, 25}).x;
-  EXPECT_FALSE(structure_beyond_reach(open, strip, rest, open.center({40, 25}), tip_m));
-  EXPECT_TRUE(structure_beyond_reach(open, strip, rest, open.center({40, 25}), tip_m - 1e-6));
-  // A structure beside the path but not on it, none at all, or a mask of another size: not beyond.
-  EXPECT_FALSE(structure_beyond_reach(open, raised_strip(50, 54, 79), way, at, 2.0));
-  EXPECT_FALSE(structure_beyond_reach(open, CellMask::Zero(80, 80), way, at, 2.0));
-  EXPECT_FALSE(structure_beyond_reach(open, CellMask::Ones(10, 10), way, at, 2.0));
-}
-
 }  // namespace
 }  // namespace marsala::agent::executive
