@@ -3,6 +3,10 @@
 field() {
   grep -o "\"$1\": *[^,}]*" "$2" | head -1 | sed 's/^[^:]*: *//; s/"//g'
 }
+# csv_last CSV NAME: the column NAME (by the header's names) of the last row of CSV
+csv_last() {
+  awk -F, -v name="$2" 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == name) col = i } END { if (col) print $col }' "$1"
+}
 # is_png FILE: true when FILE starts with the PNG signature
 is_png() { [ "$(head -c 8 "$1" | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ]; }
 # test_workspace NAME, in a script that has set case_name and here (its folder): sets root, bin (MARSALA_BUILD_DIR's

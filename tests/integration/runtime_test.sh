@@ -38,7 +38,7 @@ work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-it-$case_name.XXXXXX")"
 trap '[ -n "${MARSALA_KEEP_WORK:-}" ] || rm -rf "$work"' EXIT  # MARSALA_KEEP_WORK=1 keeps the logs
 
 fail() { echo "FAIL ($case_name): $*" >&2; exit 1; }
-. "$root/tests/integration/lib.sh"  # field, is_png
+. "$root/tests/integration/lib.sh"  # field, is_png, csv_last
 run_spawn() {  # run_spawn OUT_NAME AGENTS DDS [AGENT_DDS]
   local out="$work/$1"
   "$root/deploy/spawn.sh" --scenario "$scenario" --agents "$2" --dds "$3" --agent-dds "${4:-$3}" \
@@ -524,7 +524,7 @@ case "$case_name" in
     expect_completed "$s" 3
     steps=$(field steps "$s")
     wait "$sim" || fail "marsala-lockstep-sim failed"
-    want=$(tail -1 "$work/sim.csv" | awk -F, '{print $NF}')  # its terrain_sha256
+    want=$(csv_last "$work/sim.csv" terrain_sha256)
     [ "$(field terrain_sha256 "$s")" = "$want" ] || fail "terrain $(field terrain_sha256 "$s") is not the unperturbed $want"
     grep -q "forged [1-9][0-9]* admissions" "$work/impostor.log" || { cat "$work/impostor.log"; fail "no admission forged"; }
     grep -q "([1-9][0-9]* run-over frames)" "$work/impostor.log" || { cat "$work/impostor.log"; fail "no frame forged"; }

@@ -30,7 +30,7 @@ cleanup() {
 }
 trap cleanup EXIT
 fail() { echo "FAIL (security $vendor): $*" >&2; exit 1; }
-. "$root/tests/integration/lib.sh"  # field
+. "$root/tests/integration/lib.sh"  # field, csv_last
 command -v openssl >/dev/null || { echo "SKIP: openssl not installed"; exit 77; }
 
 scenario="$root/deploy/scenarios/ramp.pbtxt"
@@ -92,7 +92,7 @@ grep -q "secured (DDS Security) as world from $ids" "$work/reused/logs/world.log
 [ "$(jq -r .run_id "$work/reused/summary.json")" = "ramp-d$domain" ] ||
   fail "the second run did not take the folder's domain $domain ($(jq -r .run_id "$work/reused/summary.json"))"
 wait "$sim" || fail "marsala-lockstep-sim failed"
-want=$(tail -1 "$work/sim.csv" | awk -F, '{print $NF}')
+want=$(csv_last "$work/sim.csv" terrain_sha256)
 for run in unicast reused; do
   [ "$(field completed "$work/$run/summary.json")" = true ] || fail "the $run run did not complete"
   [ "$(field terrain_sha256 "$work/$run/summary.json")" = "$want" ] ||

@@ -38,9 +38,6 @@ inline constexpr std::chrono::milliseconds kWriterLease{1000};
 inline constexpr std::chrono::milliseconds kReaderLease{1500};
 /// How often a Fast DDS participant asserts its automatic writers (Cyclone derives it: 80 % of the lease).
 inline constexpr std::chrono::milliseconds kLivelinessAnnouncement{250};
-/// Heartbeat period of reliable Fast DDS writers: the delay before a lost sample is repaired (Cyclone adapts its own
-/// from 100 ms).
-inline constexpr std::chrono::milliseconds kHeartbeatPeriod{100};
 /// How long a reliable write may block when the writer's resend buffer is full.
 inline constexpr std::chrono::milliseconds kMaxBlocking{1000};
 

@@ -1,0 +1,36 @@
+#pragma once
+// Reliability timing of the Fast DDS endpoints (docs/runtime.md#lossy-links): how fast a lost sample is repaired.
+// The shipped profiles set it in their default <data_writer> / <data_reader>; a profile that leaves Fast DDS's
+// defaults gets the same values from here.
+
+#include <chrono>
+#include <string>
+
+namespace eprosima::fastrtps::rtps {
+struct WriterTimes;
+struct ReaderTimes;
+}  // namespace eprosima::fastrtps::rtps
+
+namespace marsala::bus::fastdds {
+
+/// Heartbeat period of a reliable writer whose profile leaves Fast DDS's default (3 s) [ms].
+inline constexpr std::chrono::milliseconds kRepairHeartbeat{5};
+
+/// A writer's timing: the profile's when it sets a heartbeat period, else kRepairHeartbeat and repairs at once.
+void fast_repair(eprosima::fastrtps::rtps::WriterTimes& times);
+/// A reader's timing: the profile's when it sets a heartbeat response delay, else answers heartbeats at once.
+void fast_repair(eprosima::fastrtps::rtps::ReaderTimes& times);
+
+/// The reliability timing endpoints get [ns].
+struct RepairTiming {
+  long long heartbeat_period_ns = 0;          ///< writer: period of heartbeats while a reader lacks samples [ns]
+  long long nack_response_delay_ns = 0;       ///< writer: wait before repairing what a reader asked for [ns]
+  long long heartbeat_response_delay_ns = 0;  ///< reader: wait before answering a heartbeat [ns]
+  bool from_profile = false;  ///< the profile set both the writer's and the reader's timing (fast_repair left them)
+};
+
+/// The timing endpoints get under the Fast DDS profile file `path` (its default data writer and reader, as Fast DDS
+/// parses them, then fast_repair). Throws InvalidArgument naming the file when Fast DDS cannot load it.
+RepairTiming repair_timing_of_profile(const std::string& path);
+
+}  // namespace marsala::bus::fastdds
