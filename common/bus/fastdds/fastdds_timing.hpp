@@ -14,7 +14,7 @@ struct ReaderTimes;
 namespace marsala::bus::fastdds {
 
 /// Heartbeat period of a reliable writer whose profile leaves Fast DDS's default (3 s) [ms].
-inline constexpr std::chrono::milliseconds kRepairHeartbeat{5};
+inline constexpr std::chrono::milliseconds kRepairHeartbeat{50};
 
 /// A writer's timing: the profile's when it sets a heartbeat period, else kRepairHeartbeat and repairs at once.
 void fast_repair(eprosima::fastrtps::rtps::WriterTimes& times);
