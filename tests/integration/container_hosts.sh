@@ -46,10 +46,17 @@ for n in world agent1 agent2 agent3; do podman logs "$project-$n" >"$work/$n.log
 [ "$rc" = 0 ] || { tail -5 "$work/world.log"; fail "the world exited $rc"; }
 sha=$(field terrain_sha256 "$work/out/run/summary.json")
 [ "$sha" = "$reference" ] || fail "ended on $sha across hosts, on $reference on loopback"
+# The slot each container ran secured under: h1's two containers take slots 1 and 2 in whichever order their claims
+# land (under one flock), h2's takes 3, its host's only slot.
+slot() { grep -o "secured (DDS Security) as agent-[0-9]* from /identities/domain-7" "$work/agent$1.log" |
+  head -1 | sed 's/.*agent-\([0-9]*\) .*/\1/'; }
+slots_h1="$(printf '%s\n' "$(slot 1)" "$(slot 2)" | sort -n | tr '\n' ' ')"
+[ "$slots_h1" = "1 2 " ] ||
+  fail "h1's agents did not run secured under slots 1 and 2 (MARSALA_SLOTS=1-2): got '$slots_h1'; $(tail -2 "$work/agent1.log")"
+[ "$(slot 3)" = 3 ] ||
+  fail "h2's agent did not run secured under slot 3 (MARSALA_SLOTS=3-3): $(tail -2 "$work/agent3.log")"
 for n in 1 2 3; do
-  grep -q "secured (DDS Security) as agent-$n from /identities/domain-7" "$work/agent$n.log" ||
-    fail "agent $n did not run secured under its slot (MARSALA_SLOTS): $(tail -2 "$work/agent$n.log")"
-  grep -q "discovers by unicast only, at 10.77.0.1" "$work/agent$n.log" || fail "agent $n does not say its peers"
+  grep -q "discovers by unicast only, at 10.77.0.1" "$work/agent$n.log" || fail "agent container $n does not say its peers"
 done
 for h in h1 h2; do
   [ "$(multicast_drops "$h")" = "0 0" ] || fail "$h sent or received multicast: $(multicast_drops "$h")"
