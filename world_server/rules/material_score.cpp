@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <map>
 #include <optional>
+#include <utility>
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/mars_processor.hpp"
@@ -51,23 +52,32 @@ MaterialNeed site_need(const WorldState& state, const Heightmap& initial) {
 MaterialNeed goal_need(const WorldState& state, const Heightmap& initial) {
   MaterialNeed need = empty_need(initial);
   const double cs = initial.cell_size_m();
-  std::map<double, Heightmap> bounds;  // per kappa: one MARS computation for the whole team
+  // Per kappa, one MARS bound and its gap over the initial terrain for the whole team.
+  struct Bound {
+    Heightmap height, gap;
+  };
+  std::map<double, Bound> bounds;
   const CellMask everywhere = CellMask::Ones(initial.rows(), initial.cols());
   for (const AgentRecord& a : state.agents) {
     const std::optional<CellIndex> from = initial.cell_at(a.start);
     const std::optional<CellIndex> to = initial.cell_at(a.target);
     if (!from || !to) continue;
     const NavigabilityParams body = construction_params(a.type);
-    auto bound = bounds.find(body.kappa);
-    if (bound == bounds.end()) bound = bounds.emplace(body.kappa, MarsProcessor(body.kappa).project(initial)).first;
-    const Heightmap gap(initial.geometry(), (bound->second.heights() - initial.heights()).cwiseMax(0.0));
-    const PlannerResult plan = NavigablePathPlanner(default_planner_params(body.delta_m, cs)).plan(gap, everywhere, *from, *to);
+    auto it = bounds.find(body.kappa);
+    if (it == bounds.end()) {
+      Heightmap height = MarsProcessor(body.kappa).project(initial);
+      Heightmap gap(initial.geometry(), (height.heights() - initial.heights()).cwiseMax(0.0));
+      it = bounds.emplace(body.kappa, Bound{std::move(height), std::move(gap)}).first;
+    }
+    const Bound& bound = it->second;
+    const PlannerResult plan =
+        NavigablePathPlanner(default_planner_params(body.delta_m, cs)).plan(bound.gap, everywhere, *from, *to);
     if (!plan.found) continue;
     const CellMask band = construction_band(plan.path, initial.rows(), initial.cols(), cs, body.delta_m);
     for (int r = 0; r < initial.rows(); ++r)
       for (int c = 0; c < initial.cols(); ++c) {
         if (band(r, c) == 0) continue;
-        need.ceiling(r, c) = need.band(r, c) != 0 ? std::max(need.ceiling(r, c), bound->second(r, c)) : bound->second(r, c);
+        need.ceiling(r, c) = need.band(r, c) != 0 ? std::max(need.ceiling(r, c), bound.height(r, c)) : bound.height(r, c);
         need.band(r, c) = 1;
       }
   }
