@@ -120,7 +120,7 @@ void configure_library() {
 class Context {
  public:
   Context(int domain_id, Role role, const Security& security, const std::vector<std::string>& peers)
-      : domain_id_(domain_id) {
+      : domain_id_(domain_id), serves_team_(role != Role::kClient) {
     configure_library();
     auto* factory = dds::DomainParticipantFactory::get_instance();
     dds::DomainParticipantQos qos = factory->get_default_participant_qos();
@@ -150,6 +150,8 @@ class Context {
 
   dds::DomainParticipant* participant() const { return participant_; }
   int domain_id() const { return domain_id_; }
+  /// True unless an agent's (Role::kClient): this process's writers serve the team, not one world.
+  bool serves_team() const { return serves_team_; }
 
  private:
   /// Discovery by unicast at `peers` (IPv4 addresses, bus::resolve_peers()) and never by multicast, whatever the
@@ -279,6 +281,7 @@ class Context {
  private:
   using ReturnCode_t = eprosima::fastrtps::types::ReturnCode_t;
   int domain_id_;
+  bool serves_team_;
   dds::DomainParticipant* participant_ = nullptr;
   std::mutex mutex_;
   std::map<std::string, dds::Topic*> topics_;
@@ -318,6 +321,7 @@ class FastDdsWriter final : public Writer<T> {
     qos.liveliness().lease_duration = duration(kWriterLease);
     qos.liveliness().announcement_period = duration(kLivelinessAnnouncement);
     fastdds::fast_repair(qos.reliable_writer_qos().times);  // docs/runtime.md#lossy-links
+    fastdds::follow_team(qos.reliable_writer_qos().times, context_->serves_team());
     // Readers filter what they receive themselves (the decode filter): the writer does not decode each sample again
     // per reader for them.
     qos.writer_resource_limits().reader_filters_allocation.maximum = 0;

@@ -7,6 +7,9 @@
 #include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cstdint>
+
 #include "marsala/core/error.hpp"
 
 namespace marsala::bus::fastdds {
@@ -30,6 +33,18 @@ void fast_repair(eprosima::fastrtps::rtps::ReaderTimes& times) {
   times.heartbeatResponseDelay = Duration_t(0, 0);
 }
 
+long long team_heartbeat_ns(long long period_ns, bool serves_team) {
+  if (serves_team) return period_ns;
+  const long long shortest = std::chrono::duration_cast<std::chrono::nanoseconds>(kShortestHeartbeat).count();
+  return std::min(period_ns, std::max(shortest, period_ns / kOneReaderHeartbeatDivisor));
+}
+
+void follow_team(eprosima::fastrtps::rtps::WriterTimes& times, bool serves_team) {
+  const long long ns = team_heartbeat_ns(nanoseconds(times.heartbeatPeriod), serves_team);
+  times.heartbeatPeriod = Duration_t(static_cast<std::int32_t>(ns / 1000000000LL),
+                                     static_cast<std::uint32_t>(ns % 1000000000LL));
+}
+
 RepairTiming repair_timing_of_profile(const std::string& path) {
   using eprosima::fastrtps::xmlparser::XMLP_ret;
   using eprosima::fastrtps::xmlparser::XMLProfileManager;
@@ -43,7 +58,8 @@ RepairTiming repair_timing_of_profile(const std::string& path) {
   const eprosima::fastrtps::rtps::ReaderTimes reader_profile = reader.times;
   fast_repair(writer.times);
   fast_repair(reader.times);
-  return {nanoseconds(writer.times.heartbeatPeriod), nanoseconds(writer.times.nackResponseDelay),
+  const long long period = nanoseconds(writer.times.heartbeatPeriod);
+  return {period, team_heartbeat_ns(period, false), nanoseconds(writer.times.nackResponseDelay),
           nanoseconds(reader.times.heartbeatResponseDelay),
           writer.times == writer_profile && reader.times == reader_profile};
 }
