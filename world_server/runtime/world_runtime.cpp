@@ -665,6 +665,7 @@ struct WorldRuntime::Impl {
     info.step_world_median_ms = median(step_world_ms);
     info.step_world_p90_ms = percentile(step_world_ms, 0.9);
     info.world_cpu_ms_per_step = step_ms.empty() ? 0.0 : cpu_ms / static_cast<double>(step_ms.size());
+    if (fork) info.fork = fork->origin();
     return info;
   }
 
