@@ -562,6 +562,8 @@ case "$case_name" in
     [ "$rc" -eq 3 ] || fail "the parent exited $rc, not 3 (max_steps)"
     parent_sha=$(field terrain_sha256 "$work/parent/summary.json")
     at_k=$("$bin/marsala-world" --check --fork "$work/parent" --at 100 | sed 's/.* //')
+    [ "$("$bin/marsala-monitor" replay "$work/parent" --to-step 100 | tail -1)" = "terrain_sha256 $at_k" ] ||
+      fail "the world's digest of the parent at step 100 ($at_k) is not the monitor's replay's"
     [ "$(forked same --at 100)" = 3 ] || { cat "$work/same.out"; fail "the unchanged fork did not end at max_steps"; }
     [ "$(field terrain_sha256 "$work/same/summary.json")" = "$parent_sha" ] ||
       fail "the unchanged fork ended on $(field terrain_sha256 "$work/same/summary.json"), the parent on $parent_sha"
@@ -570,8 +572,8 @@ case "$case_name" in
     [ "$(forked fewer --at 100 --agents 2)" = 3 ] || { cat "$work/fewer.out"; fail "the fork with 2 agents failed"; }
     fewer_sha=$(field terrain_sha256 "$work/fewer/summary.json")
     [ "$fewer_sha" != "$parent_sha" ] || fail "the fork with 2 agents did not diverge from its parent"
-    # The fork's own run.log, replayed to K, has the parent's terrain there; then agent 3 leaves.
-    fewer_k=$("$bin/marsala-world" --check --fork "$work/fewer" --at 100 | sed 's/.* //')
+    # The fork's own run.log, replayed to K by the monitor, has the parent's terrain there; then agent 3 leaves.
+    fewer_k=$("$bin/marsala-monitor" replay "$work/fewer" --to-step 100 | tail -1 | sed 's/.* //')
     [ "$fewer_k" = "$at_k" ] || fail "the fork with 2 agents had $fewer_k at step 100, the parent $at_k"
     grep -q '"step":100,"agent":3,"kind":"dropped","detail":"not in the fork' "$work/fewer/events.log" ||
       fail "agent 3 did not leave the fork at step 100"
