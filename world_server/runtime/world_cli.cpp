@@ -9,6 +9,7 @@
 #include <ostream>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "marsala/bus/bus.hpp"
 #include "marsala/cli/command_line.hpp"
@@ -152,6 +153,22 @@ struct ForkRequest {
   std::uint64_t at = 0;  ///< K [steps]
 };
 
+/// The --fork DIR and --at K options (docs/runtime.md#fork), excluding `others`; returns --fork.
+CLI::Option* add_fork_options(CLI::App& app, ForkRequest& fork, const std::vector<CLI::Option*>& others) {
+  CLI::Option* fork_option =
+      app.add_option("--fork", fork.dir,
+                     "start a new run (in --out) from the run in DIR: its first K steps (--at) replayed with fresh\n"
+                     "agents, each request checked against DIR/run.log (exit 8 naming the agent and step when one\n"
+                     "differs), then live with --agents (fewer), --max-steps, --step-deadline (docs/runtime.md#fork)")
+          ->type_name("DIR");
+  for (CLI::Option* other : others) fork_option->excludes(other);
+  app.add_option("--at", fork.at, "with --fork: the step K the fork goes live at (0 .. the parent's steps)")
+      ->needs(fork_option)
+      ->check(CLI::Range(0ull, 1ull << 40))
+      ->type_name("K");
+  return fork_option;
+}
+
 /// marsala-world --check --fork DIR --at K: whether the fork can be made (prepare_fork() without a folder); 0 and one
 /// line saying what it replays when it can, 2 and the reason when not.
 int check_fork(const ForkRequest& fork, RuntimeOptions options, int domain, std::ostream& out, std::ostream& err) {
@@ -293,18 +310,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
           ->excludes(scenario_option)
           ->excludes(check_option);
   ForkRequest fork;
-  CLI::Option* fork_option =
-      app.add_option("--fork", fork.dir,
-                     "start a new run (in --out) from the run in DIR: its first K steps (--at) replayed with fresh\n"
-                     "agents, each request checked against DIR/run.log (exit 8 naming the agent and step when one\n"
-                     "differs), then live with --agents (fewer), --max-steps, --step-deadline (docs/runtime.md#fork)")
-          ->excludes(scenario_option)
-          ->excludes(resume_option)
-          ->type_name("DIR");
-  app.add_option("--at", fork.at, "with --fork: the step K the fork goes live at (0 .. the parent's steps)")
-      ->needs(fork_option)
-      ->check(CLI::Range(0ull, 1ull << 40))
-      ->type_name("K");
+  CLI::Option* fork_option = add_fork_options(app, fork, {scenario_option, resume_option});
   add_timing_and_record_options(app, options);
   add_run_key_option(app, run_key);
   MetricsOptions metrics_options;
