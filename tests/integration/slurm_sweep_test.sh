@@ -107,3 +107,23 @@ done
 [ "$nodes" -eq 2 ] || fail "the tasks ran on $nodes node(s), not on both"
 [ -z "$(squeue -h)" ] || fail "tasks are left in the queue"
 echo "ok: 2 runs as one array job on $nodes node(s): the CSV and every terrain_sha256 equal the local sweep's"
+
+# --- 5. a failed task: one task cancelled while it runs; the other's row is kept, the failed run is named, exit 1 ---
+"$sweep" "${matrix[@]}" --max-steps 150 --out "$work/cut" --slurm >"$work/cut.txt" 2>&1 &
+cut_pid=$!
+job=""
+for _ in $(seq 1 300); do
+  job=$(squeue -h -t R -o '%i' 2>/dev/null | grep '_1$' || true)
+  [ -n "$job" ] && break
+  sleep 0.05
+done
+[ -n "$job" ] || { kill "$cut_pid"; fail "task 1 of the array job never ran"; }
+scancel "$job"
+rc=0
+wait "$cut_pid" || rc=$?
+[ "$rc" -eq 1 ] || { cat "$work/cut.txt"; fail "a sweep with a cancelled task exited $rc, expected 1"; }
+grep -q "team 3, seed 1: FAILED" "$work/cut.txt" && grep -q "1 run(s) failed" "$work/cut.txt" ||
+  { cat "$work/cut.txt"; fail "the failed run is not named"; }
+[ "$(cut -d, -f1,2 "$work/cut/sweep.csv" | tail -n +2)" = "1,1" ] || { cat "$work/cut/sweep.csv"; fail "rows kept"; }
+[ -z "$(squeue -h)" ] || fail "tasks are left in the queue after the failure"
+echo "ok: a cancelled task: exit 1, the failed run named, the other run's row kept"
