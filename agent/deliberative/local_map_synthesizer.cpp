@@ -63,8 +63,7 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
         if (local.known(r, c) == 0) local.heights(r, c) = lowest;
   }
 
-  local.gap = mars_.gap(local.heights);
-  local.occupiable = navigability_.occupiable(local.heights);
+  gap_and_occupiable(local);
   // A ball that holds an unknown cell cannot be judged: treat its centre as not occupiable. No gap on unknown cells.
   local.blind = blind_cells(local.known, params().delta_m / (2.0 * local.geometry().cell_size_m));
   for (int r = 0; r < w.rows; ++r)
@@ -122,6 +121,20 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
     }
   }
   return local;
+}
+
+void LocalMapSynthesizer::gap_and_occupiable(LocalMap& local) const {
+  const double* first = local.heights.data();
+  const double* last = first + static_cast<std::ptrdiff_t>(local.rows()) * local.cols();
+  if (memo_.offset == local.offset && memo_.rows == local.rows() && memo_.cols == local.cols() &&
+      std::equal(first, last, memo_.heights.begin(), memo_.heights.end())) {
+    local.gap = memo_.gap;
+    local.occupiable = memo_.occupiable;
+    return;
+  }
+  local.gap = mars_.gap(local.heights);
+  local.occupiable = navigability_.occupiable(local.heights);
+  memo_ = Memo{local.offset, local.rows(), local.cols(), std::vector<double>(first, last), local.gap, local.occupiable};
 }
 
 std::optional<CellIndex> LocalMapSynthesizer::local_origin(const LocalMap& local,

@@ -27,8 +27,6 @@ constexpr EnumName<BuildPhase> kBuildPhaseNames[] = {
 /// Kept inside the world's base radius so a refill is never rejected on a tie [m].
 constexpr double kBaseMarginM = 1e-6;
 
-double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
-
 executive::Neighbourhood neighbourhood(const protocol::SensorFrame& frame) {
   return {frame.agent_id, {frame.x_m, frame.y_m}, frame.neighbours};
 }

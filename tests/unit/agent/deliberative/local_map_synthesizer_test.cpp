@@ -75,6 +75,32 @@ TEST(LocalMapSynthesizer, WindowGapAndNavigabilityMatchReferences) {
   EXPECT_GT(local.navigable.cast<int>().sum(), 300);
 }
 
+// One synthesizer asked again and again, as a robot's is each step: the same window, a window whose heights changed
+// by one deposit, a window moved by one cell. Each answer is the brute-force reference of its own window, never the
+// answer kept from the window before.
+TEST(LocalMapSynthesizer, AWindowAskedAgainGivesItsOwnGapAfterADepositOrAMove) {
+  const LocalMapSynthesizer synthesizer(kBody, 1.0);
+  const Position target{4.55, 2.95};
+  const auto check = [&](const Heightmap& terrain, Position robot, const char* what) {
+    SCOPED_TRACE(what);
+    executive::MappingSystem map = test::full_map(terrain);
+    map.record_pose(robot);
+    const LocalMap local = synthesizer.synthesize(map.known_map(), robot, target);
+    const Heightmap window = terrain.window(local.offset, local.rows(), local.cols());
+    const Heightmap p = testing::mars_brute_force(window, kBody.kappa);
+    for (int r = 0; r < local.rows(); ++r)
+      for (int c = 0; c < local.cols(); ++c) ASSERT_NEAR(local.gap(r, c), p(r, c) - window(r, c), 1e-9);
+    EXPECT_TRUE(local.occupiable == testing::occupiable_brute_force(window, kBody));
+  };
+  Heightmap h = bumpy_terrain();
+  check(h, kRobot, "first");
+  check(h, kRobot, "the same window again");
+  h(31, 41) += 0.3;  // a deposit beside the robot: the window holds the same cells, one of them higher
+  check(h, kRobot, "after a deposit");
+  check(h, {4.15, 2.95}, "moved one cell east");
+  check(bumpy_terrain(), {4.15, 2.95}, "the deposit gone, same place");
+}
+
 TEST(LocalMapSynthesizer, OccupiableIsTheWorldsSingleCellAnswer) {
   // A ramp at exactly slope kappa with a step of exactly eps halfway, beside the bumps and the block: the pairs across
   // the step are ties (|dh| = eps + kappa |r - q|). The agent judges each cell of its window as the world judges one
