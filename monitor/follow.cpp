@@ -18,11 +18,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// Reader history: a slow terminal must not make tail skip steps; the world keeps only the latest (depth 1).
-constexpr std::int32_t kStatusDepth = 64;
+/// Reader history of the events topic: a slow terminal must not make tail miss events [samples].
 constexpr std::int32_t kEventDepth = 256;
-
-Clock::duration to_clock(std::chrono::duration<double> d) { return std::chrono::duration_cast<Clock::duration>(d); }
 
 std::string where(const bus::Participant& participant) {
   return fmt::format("domain {} ({})", participant.domain_id(), bus::to_string(participant.vendor()));

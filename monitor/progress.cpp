@@ -15,12 +15,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// Reader history, as tail's: statuses come once per step.
-constexpr std::int32_t kStatusDepth = 64;
 /// Samples closer than this in the world's wall time add nothing to the rates [s].
 constexpr double kSampleSpacingS = 0.1;
-
-Clock::duration to_clock(std::chrono::duration<double> d) { return std::chrono::duration_cast<Clock::duration>(d); }
 
 }  // namespace
 

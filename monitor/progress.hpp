@@ -21,6 +21,15 @@
 
 namespace marsala::monitor {
 
+/// Reader history of the world's status topic, for tail and progress: statuses come once per step and a slow terminal
+/// must not make them skip steps (the world keeps only the latest, depth 1) [samples].
+inline constexpr std::int32_t kStatusDepth = 64;
+
+/// A duration in seconds as a steady clock's duration.
+inline std::chrono::steady_clock::duration to_clock(std::chrono::duration<double> d) {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(d);
+}
+
 /// Which step lines tail prints: all of them by default; with every_steps N, the first status and then one whenever
 /// the step crosses a multiple of N; with an interval S, at most one every S seconds (monitor clock); with both, a
 /// line when both allow it.

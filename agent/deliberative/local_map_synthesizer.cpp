@@ -19,6 +19,23 @@ int clamp_int(double v, int lo, int hi) {
   return static_cast<int>(v);
 }
 
+// How far a cell the map holds as no surface may be raised [m]: a bound (faces seen from below, the floor never read)
+// whose four neighbours all hold a surface or bound at least as high is a pit, raised at most to its lowest rim;
+// anything else (assumed ground, a bound beside lower ground: a wall's foot or side) is no deposition target, 0
+// (docs/runtime.md#mapping, pits).
+double pit_rim_gap(const KnownMap& map, CellIndex cell) {
+  if (map.bound(cell.row, cell.col) == 0) return 0.0;
+  const double floor_m = map.heights(cell);
+  double rim_m = std::numeric_limits<double>::infinity();
+  for (const CellIndex step : {CellIndex{-1, 0}, CellIndex{1, 0}, CellIndex{0, -1}, CellIndex{0, 1}}) {
+    const CellIndex n{cell.row + step.row, cell.col + step.col};
+    if (!map.heights.contains(n) || map.known(n.row, n.col) == 0) return 0.0;
+    if (map.assumed(n.row, n.col) != 0 && map.bound(n.row, n.col) == 0) return 0.0;  // a guess is no rim
+    rim_m = std::min(rim_m, map.heights(n));
+  }
+  return std::max(0.0, rim_m - floor_m);
+}
+
 }  // namespace
 
 Window sensing_window(const GridGeometry& world, Position robot, double range_m) {
@@ -63,8 +80,7 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
         if (local.known(r, c) == 0) local.heights(r, c) = lowest;
   }
 
-  local.gap = mars_.gap(local.heights);
-  local.occupiable = navigability_.occupiable(local.heights);
+  gap_and_occupiable(local);
   // A ball that holds an unknown cell cannot be judged: treat its centre as not occupiable. No gap on unknown cells.
   local.blind = blind_cells(local.known, params().delta_m / (2.0 * local.geometry().cell_size_m));
   for (int r = 0; r < w.rows; ++r)
@@ -74,11 +90,11 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
     }
 
   // Ground the map only assumes (under and around the robot's body: KnownMap::assumed) is no deposition
-  // target: building on it would never show in the map.
+  // target: building on it would never show in the map. A bound in a pit is filled up to its rim (pit_rim_gap).
   const auto assumed = map.assumed.block(w.top_left.row, w.top_left.col, w.rows, w.cols);
   for (int r = 0; r < w.rows; ++r)
     for (int c = 0; c < w.cols; ++c)
-      if (assumed(r, c) != 0) local.gap(r, c) = 0.0;
+      if (assumed(r, c) != 0) local.gap(r, c) = std::min(local.gap(r, c), pit_rim_gap(map, local.to_global({r, c})));
 
   local.robot = local.to_local(*map.geometry().cell_at(robot));
   // A scanned map may hold the robot's own cell not occupiable (a reading that changed under it, a face beside it);
@@ -122,6 +138,20 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
     }
   }
   return local;
+}
+
+void LocalMapSynthesizer::gap_and_occupiable(LocalMap& local) const {
+  const double* first = local.heights.data();
+  const double* last = first + static_cast<std::ptrdiff_t>(local.rows()) * local.cols();
+  if (memo_.offset == local.offset && memo_.rows == local.rows() && memo_.cols == local.cols() &&
+      std::equal(first, last, memo_.heights.begin(), memo_.heights.end())) {
+    local.gap = memo_.gap;
+    local.occupiable = memo_.occupiable;
+    return;
+  }
+  local.gap = mars_.gap(local.heights);
+  local.occupiable = navigability_.occupiable(local.heights);
+  memo_ = Memo{local.offset, local.rows(), local.cols(), std::vector<double>(first, last), local.gap, local.occupiable};
 }
 
 std::optional<CellIndex> LocalMapSynthesizer::local_origin(const LocalMap& local,

@@ -11,8 +11,6 @@
 namespace marsala::agent::executive {
 namespace {
 
-double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
-
 /// Below this a robot counts as standing on its cell's centre [m].
 constexpr double kCentredM = 1e-9;
 

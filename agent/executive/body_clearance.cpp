@@ -8,8 +8,6 @@
 namespace marsala::agent::executive {
 namespace {
 
-double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
-
 /// Navigable again after cells were taken out: occupiable and 8-connected to the robot's cell, as the synthesizer
 /// makes it.
 void renavigate(deliberative::LocalMap& local) {

@@ -17,8 +17,6 @@ namespace {
 /// Margin kept inside the world's strict "more than delta/2 from every robot" rule [m].
 constexpr double kUnderRobotMarginM = 1e-6;
 
-double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
-
 /// Ball offsets nearest first (then row-major), so each path cell's footprint is visited from its centre outwards.
 std::vector<CellIndex> sorted_ball(double radius_cells) {
   std::vector<CellIndex> ball = disc_offsets(radius_cells);

@@ -10,8 +10,6 @@
 namespace marsala::agent::executive {
 namespace {
 
-double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
-
 /// One deposit and the cells it is predicted to raise (local indices).
 struct Placed {
   Deposit deposit;

@@ -24,8 +24,6 @@ constexpr EnumName<PathState> kPathStateNames[] = {{PathState::kWaitAdmission, "
                                                    {PathState::kDone, "done"},
                                                    {PathState::kYield, "yield"}};
 
-double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
-
 PathState state_of(BuildPhase phase) {
   switch (phase) {
     case BuildPhase::kAdvance: return PathState::kAdvance;

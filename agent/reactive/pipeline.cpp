@@ -16,7 +16,6 @@ constexpr EnumName<PipelineRole> kPipelineRoleNames[] = {{PipelineRole::kActive,
                                                          {PipelineRole::kHold, "hold"},
                                                          {PipelineRole::kBackOff, "back_off"}};
 
-double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
 Position where(const Neighbour& n) { return n.position; }
 
 }  // namespace

@@ -21,7 +21,7 @@ constexpr EnumName<RampState> kRampStateNames[] = {{RampState::kWaitAdmission, "
                                                    {RampState::kDone, "done"},
                                                    {RampState::kGiveWay, "give_way"}};
 
-RampState state_of(BuildPhase phase) {
+RampState ramp_state_of(BuildPhase phase) {
   switch (phase) {
     case BuildPhase::kAdvance: return RampState::kAdvance;
     case BuildPhase::kBuild: return RampState::kBuild;
@@ -106,9 +106,9 @@ protocol::ActionRequest RampBuilder::decide(const protocol::SensorFrame& frame) 
         }
         waiting_for_ = return_waiting_text(trace_, request, close_by(), no_nearer, to_base_m);
       } else if (state_ == RampState::kRetreat) {
-        state_ = state_of(steps_.retreat_step(local, frame, trace_, request));
+        state_ = ramp_state_of(steps_.retreat_step(local, frame, trace_, request));
       } else if (const auto phase = steps_.build_step(local, frame, trace_, request)) {
-        state_ = state_of(*phase);
+        state_ = ramp_state_of(*phase);
       } else {
         waiting_for_ = build_waiting_text(close_by());
       }

@@ -9,8 +9,6 @@
 namespace marsala::agent::reactive {
 namespace {
 
-double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
-
 std::string with_robots(std::string text, const std::string& close_by) {
   return close_by.empty() ? text : fmt::format("{}: robots {} close by", text, close_by);
 }

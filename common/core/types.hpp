@@ -1,6 +1,7 @@
 #pragma once
 // Vocabulary types shared by every layer, in the paper's language.
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -36,6 +37,9 @@ struct Position {
   friend bool operator==(Position a, Position b) { return a.x == b.x && a.y == b.y; }
   friend bool operator!=(Position a, Position b) { return !(a == b); }
 };
+
+/// The planar (Euclidean) distance between two positions [m].
+inline double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
 /// An axis-aligned rectangle of the world frame [m]: [x0, x1] x [y0, y1] (x0 <= x1 and y0 <= y1 once validated).
 struct Rect {

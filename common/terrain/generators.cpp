@@ -20,7 +20,7 @@ namespace {
 
 using ParamValues = std::map<std::string, double>;
 
-constexpr long long kMaxCells = 1LL << 28;
+constexpr long long kMaxGeneratedCells = 1LL << 28;
 constexpr double kMaxLength = 1e7;  // [m]
 constexpr double kMaxHeight = 1e4;  // [m]
 constexpr double kEdgeTol = 1e-9;   // [m], platform edges: west/south inclusive, east/north exclusive
@@ -139,9 +139,9 @@ void check_spec(const std::string& method, const GeneratorSpec& spec) {
   if (spec.rows <= 0 || spec.cols <= 0)
     throw InvalidArgument(
         fmt::format("terrain generator '{}': grid size must be positive, got {} x {}", method, spec.rows, spec.cols));
-  if (static_cast<long long>(spec.rows) * spec.cols > kMaxCells)
+  if (static_cast<long long>(spec.rows) * spec.cols > kMaxGeneratedCells)
     throw InvalidArgument(fmt::format("terrain generator '{}': grid of {} x {} cells exceeds the limit of {} cells",
-                                      method, spec.rows, spec.cols, kMaxCells));
+                                      method, spec.rows, spec.cols, kMaxGeneratedCells));
   if (!(spec.cell_size_m > 0.0 && spec.cell_size_m <= kMaxLength))
     throw InvalidArgument(fmt::format("terrain generator '{}': cell size must be in (0, {}] m, got {}", method,
                                       kMaxLength, spec.cell_size_m));

@@ -31,7 +31,7 @@ constexpr uint32_t kModelPixelScaleTag = 33550;
 constexpr uint32_t kModelTransformationTag = 34264;
 constexpr uint32_t kGdalNodataTag = 42113;
 // Guard against absurd sizes in a damaged header before allocating [cells].
-constexpr long long kMaxCells = 1LL << 31;
+constexpr long long kMaxHeaderCells = 1LL << 31;
 
 enum class SampleKind { kFloat32, kFloat64, kInt16, kUInt16, kInt32 };
 
@@ -145,7 +145,7 @@ class GeoTiffReader {
     if (width == 0 || height == 0) fail(fmt::format("empty raster: {} x {}", width, height));
     if (width > static_cast<uint32_t>(std::numeric_limits<int>::max()) ||
         height > static_cast<uint32_t>(std::numeric_limits<int>::max()) ||
-        static_cast<long long>(width) * height > kMaxCells)
+        static_cast<long long>(width) * height > kMaxHeaderCells)
       fail(fmt::format("raster too large: {} x {}", width, height));
     width_ = width;
     height_ = height;

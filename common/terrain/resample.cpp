@@ -14,7 +14,7 @@ namespace {
 
 // Tolerance of floor(width / cs' + 1e-9): 0.6 / 0.2 is 2.9999999999999996 and must give 3 cells.
 constexpr double kCountTolerance = 1e-9;
-constexpr double kMaxCells = 2147483648.0;  // 2^31
+constexpr double kMaxResampledCells = 2147483648.0;  // 2^31
 
 // Kept cell range [first, last] along one axis: centres first + (i + 0.5) * cs (as
 // GridGeometry::cell_center computes them) inside [lo, hi). Returns false when none.
@@ -86,7 +86,7 @@ Heightmap resample_bilinear(const Heightmap& map, double cell_size_m) {
   if (cols_real < 1.0 || rows_real < 1.0)
     throw InvalidArgument(fmt::format("resample_bilinear: a cell of {} m does not fit in the {} x {} m extent",
                                       cell_size_m, g.cols * g.cell_size_m, g.rows * g.cell_size_m));
-  if (cols_real * rows_real > kMaxCells)
+  if (cols_real * rows_real > kMaxResampledCells)
     throw InvalidArgument(
         fmt::format("resample_bilinear: a cell of {} m would give {} x {} cells", cell_size_m, cols_real, rows_real));
   GridGeometry out_geometry = g;

@@ -2,7 +2,7 @@
 # Several hosts on one machine: three network namespaces (h1, h2, h3) joined by a bridge, addresses 10.77.0.1-3/24
 # that exist only inside this test's private namespaces. The world runs on h1, five agents of path_generated on h2
 # and h3, every process with the LAN profile of its vendor (deploy/dds/*-lan.xml: interface chosen automatically,
-# multicast discovery). Each team must end on the loopback run's terrain_sha256 after the same 2,000 steps (of the
+# multicast discovery). Each team must end on the loopback run's terrain_sha256 after the same 600 steps (of the
 # 5,550 the run needs: every step already goes through all hosts, and CI's time is counted).
 # Usage: multihost_test.sh CASE DOMAIN     CASE: cyclone | fastdds | mixed (world on Cyclone, agents on both)
 # Exits 77 (skipped) where network or mount namespaces, veth pairs or bridges cannot be made.
@@ -12,7 +12,7 @@ domain="$2"
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 scenario="$root/deploy/scenarios/path_generated.pbtxt"
-steps_cap=2000
+steps_cap=600
 fail() { echo "FAIL (multihost $case_name): $*" >&2; exit 1; }
 
 # Private network and mount namespaces of our own: the bridge and /run/netns exist only there.

@@ -12,8 +12,6 @@
 namespace marsala::world_server {
 namespace {
 
-double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
-
 /// True when bodies of delta_a and delta_b [m] centred at a and b overlap (bodies_overlap(): touching is allowed).
 bool overlap(Position a, double delta_a, Position b, double delta_b) {
   return distance(a, b) < 0.5 * (delta_a + delta_b) - 1e-9;

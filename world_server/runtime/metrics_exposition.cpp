@@ -9,7 +9,7 @@ namespace marsala::world_server {
 namespace {
 
 /// A sample value as the text format writes it: shortest round-trip decimals, NaN, +Inf, -Inf.
-std::string number(double v) {
+std::string sample_value(double v) {
   if (std::isnan(v)) return "NaN";
   if (std::isinf(v)) return v > 0 ? "+Inf" : "-Inf";
   return fmt::format("{}", v);
@@ -34,7 +34,7 @@ class Exposition {
   void sample(const std::string& name, const std::string& labels, const std::string& value) {
     text_ += labels.empty() ? fmt::format("{} {}\n", name, value) : fmt::format("{}{{{}}} {}\n", name, labels, value);
   }
-  void sample(const std::string& name, double value) { sample(name, "", number(value)); }
+  void sample(const std::string& name, double value) { sample(name, "", sample_value(value)); }
   void sample(const std::string& name, std::uint64_t value) { sample(name, "", fmt::format("{}", value)); }
   /// One family with one sample.
   template <typename T>
@@ -47,7 +47,7 @@ class Exposition {
     std::uint64_t cumulative = 0;
     for (std::size_t i = 0; i < h.bucket_counts().size(); ++i) {
       cumulative += h.bucket_counts()[i];
-      const std::string le = i < h.upper_bounds_s().size() ? number(h.upper_bounds_s()[i]) : "+Inf";
+      const std::string le = i < h.upper_bounds_s().size() ? sample_value(h.upper_bounds_s()[i]) : "+Inf";
       sample(fmt::format("{}_bucket", name), fmt::format("le=\"{}\"", le), fmt::format("{}", cumulative));
     }
     sample(fmt::format("{}_sum", name), h.sum_s());
@@ -142,9 +142,9 @@ void agent_families(Exposition& x, const MetricsSnapshot& s) {
   x.per_agent("marsala_agent_deadline_misses_total", "counter", "The agent's missed deadlines.", s,
               [](const AgentMetrics& a) { return fmt::format("{}", a.missed); });
   x.per_agent("marsala_agent_deposited_volume_m3_total", "counter", "Material the agent deposited [m^3].", s,
-              [](const AgentMetrics& a) { return number(a.deposited_m3); });
+              [](const AgentMetrics& a) { return sample_value(a.deposited_m3); });
   x.per_agent("marsala_agent_material_m3", "gauge", "Material on board the agent [m^3].", s,
-              [](const AgentMetrics& a) { return number(a.material_m3); });
+              [](const AgentMetrics& a) { return sample_value(a.material_m3); });
 }
 
 }  // namespace

@@ -21,7 +21,9 @@ TEST(LogRepeats, EachKindIsWrittenAtItsFirstTenthHundredthMessage) {
   std::vector<std::uint64_t> written;
   for (int i = 1; i <= 1000; ++i) {
     if (const std::uint64_t n = repeats.count("flood")) written.push_back(n);
-    if (i == 5) EXPECT_EQ(repeats.count("other"), 1u);  // another kind keeps its own count
+    if (i == 5) {
+      EXPECT_EQ(repeats.count("other"), 1u);  // another kind keeps its own count
+    }
   }
   EXPECT_EQ(written, (std::vector<std::uint64_t>{1, 10, 100, 1000}));
 }

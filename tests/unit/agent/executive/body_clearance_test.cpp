@@ -14,8 +14,6 @@ namespace {
 const GridGeometry kGrid{40, 40, 0.0, 0.0, 0.1};  // 4 x 4 m
 const NavigabilityParams kNav{0.3, 0.4, 0.05};     // a small ball: every cell of the flat map is occupiable
 
-double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
-
 TEST(BodyClearance, DiscsAreBothRadiiPlusAStepForALowerId) {
   const std::vector<Neighbour> seen = {{2, 1.0, 1.0, 0.0, 0.5}, {7, 3.0, 1.0, 0.0, 0.75}};
   const auto discs = body_clearances(seen, 5, 0.5, 0.25);

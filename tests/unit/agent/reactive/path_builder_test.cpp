@@ -39,8 +39,6 @@ protocol::SensorFrame frame(const AgentContext& c, std::uint64_t step, Position 
   return f;
 }
 
-double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
-
 // The target lies on the platform, due east of the robots; a robot at x = 5.05 m has the gap at the platform's foot
 // (x > 4 m at kappa 0.5) within its 1.5 m reach.
 constexpr Position kTarget{8.55, 3.05};

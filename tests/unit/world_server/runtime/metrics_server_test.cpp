@@ -43,7 +43,7 @@ TEST(MetricsServer, ServesTheLatestSnapshotRendered) {
   MetricsOptions o;
   o.port = free_port();
   MetricsServer server(o);
-  const std::string empty = render_metrics(MetricsSnapshot{});
+  const std::string empty = render_metrics(MetricsSnapshot());
   EXPECT_EQ(http_get(o.port, "/metrics").substr(0, empty.size()), empty);  // before the first publish
   auto s = std::make_shared<MetricsSnapshot>();
   s->run_id = "first";
