@@ -42,7 +42,7 @@ if [ "$mode" = scenario ]; then
 fi
 
 "$root/deploy/install-deps.sh"
-"$root/deploy/build.sh"
+"$root/deploy/build.sh" --programs  # the tests and benchmarks are deploy/test.sh's
 
 if [ "$mode" = scenario ]; then
   name="$(basename "$file" .pbtxt)"

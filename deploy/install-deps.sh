@@ -7,15 +7,19 @@
 #   the exposition's promtool check; skipped without). Debian's package enables a prometheus service on :9090.
 # --npm: also nodejs and npm, for the MCAP export's test (tests/integration/mcap_export_test.sh reads the file with
 #   npm's @mcap/core; skipped without).
+# --slurm: also slurm-wlm and munge, for sweeps on Slurm (deploy/sweep.sh --slurm) and their test
+#   (tests/integration/slurm_sweep_test.sh starts a private two-node cluster; skipped without).
 set -euo pipefail
-containers=0 browser=0 prometheus=0 npm=0
+containers=0 browser=0 prometheus=0 npm=0 slurm=0
 for arg in "$@"; do
   case "$arg" in
     --containers) containers=1 ;;
     --browser) browser=1 ;;
     --prometheus) prometheus=1 ;;
     --npm) npm=1 ;;
-    *) echo "install-deps: unknown option '$arg' (known: --containers, --browser, --prometheus, --npm)" >&2; exit 2 ;;
+    --slurm) slurm=1 ;;
+    *) echo "install-deps: unknown option '$arg' (known: --containers, --browser, --prometheus, --npm, --slurm)" >&2
+       exit 2 ;;
   esac
 done
 
@@ -45,6 +49,7 @@ packages=(
 [ "$containers" -eq 1 ] && packages+=(podman runc podman-compose mmdebstrap)
 [ "$browser" -eq 1 ] && packages+=(chromium)
 [ "$prometheus" -eq 1 ] && packages+=(prometheus)
+[ "$slurm" -eq 1 ] && packages+=(slurm-wlm munge)
 # Only when the commands are missing: a node installed another way (one that bundles npm) stays as it is.
 if [ "$npm" -eq 1 ] && ! { command -v node && command -v npm; } >/dev/null; then packages+=(nodejs npm); fi
 

@@ -9,6 +9,7 @@
 #                        [--quiet] [--profile lo|lan|unicast] [--peers ADDR[,ADDR...]] [--secure | --insecure]
 #                        [--identities DIR] [--frames-every K] [--dump-maps] [--metrics-port P] [--trace FILE]
 #                        [--set FIELD=VALUE ...]
+#        deploy/spawn.sh --fork DIR --at K --out NEW [--agents M] [--max-steps N] [--scenario FILE] [options above]
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
 #                 folder that holds another run's files, unless --replace removes them (and logs/, maps/) first, and
 #                 a folder a live (or paused) world holds, --replace or not (exit 2 naming its pid)
@@ -30,6 +31,12 @@
 #   --seed        run seed, passed as --seed N to marsala-world and every marsala-agent (default: the scenario's)
 #   --set         change a field of the scenario for this run, e.g. --set robot_type.body.sensing_range_m=5
 #                 (repeatable; passed to marsala-world and every marsala-agent; summary.json lists them)
+#   --fork        a new run (--out NEW) from the finished run in DIR (docs/runtime.md#fork): the parent's team starts
+#                 afresh with its scenario (DIR/summary.json's scenario_file, or --scenario), seed and --set; the world
+#                 replays the parent's first K steps (--at K), checking each request against DIR/run.log (exit 8
+#                 naming the agent and the step when one differs), then goes on live: --agents M (fewer than the
+#                 parent's: the others leave at K), --max-steps. --set and --seed may not change (exit 2, nothing
+#                 written); NEW's run.log header and events.log say where the run came from
 #   --profile     where DDS traffic goes (deploy/dds/<vendor>-<profile>.xml): lo (default: this host's loopback only,
 #                 unsecured unless --secure), lan (a subnet, multicast discovery) or unicast (no multicast: every
 #                 process finds the world at --peers); lan and unicast run secured unless --insecure
@@ -48,13 +55,15 @@
 # Exit codes: marsala-world's for a run that ended: 0 completed, 7 completed short of slots, 3 max_steps,
 #             4 no_live_agents, 5 stopped by a signal, 6 stalled (no progress and no terrain change for the scenario's stall_steps: the account at the
 #             end says what each robot waited for) (the summary is written in every case); 1 the world failed or
-#             wrote no summary or the binaries are missing; 2 usage error or a run that `marsala-world --check` rejects (nothing started); 130 stopped.
+#             wrote no summary or the binaries are missing; 8 a fork whose request differed from its parent's before K;
+#             2 usage error or a run that `marsala-world --check` rejects (nothing started); 130 stopped.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
 scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0 frames_every=""
 replace=0 secure=0 insecure=0 dump_maps=0 set_args=() observe_args=() profile="" peers="" identities=""
+fork="" fork_at=""
 usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; }  # the whole header comment
 # The profile and security options, checked and settled: secure=1 for --secure and for lan/unicast without
 # --insecure; identities and peers get their defaults (--peers implies --profile unicast). Exit 2 naming what is wrong.
@@ -92,6 +101,31 @@ security_options() {
 }
 # The domain the identity folder was made for (its manifest), or nothing (no folder yet, or made for every domain).
 identities_domain() { sed -n 's/^domain=\([0-9][0-9]*\)$/\1/p' "$identities/manifest" 2>/dev/null | head -1 || true; }
+# A fork's parent (--fork DIR --at K): its team, scenario file, seed and --set from DIR/summary.json, for the agents;
+# the world takes them from DIR/run.log and checks the rest. Exit 2 naming what is wrong, nothing written.
+fork_options() {
+  [ -z "$seed" ] && [ ${#set_args[@]} -eq 0 ] ||
+    { echo "spawn.sh: --set and --seed may not change at a fork (the parent's apply); --agents, --max-steps may" >&2
+      exit 2; }
+  [[ "$fork_at" =~ ^[0-9]+$ ]] || { echo "spawn.sh: --fork needs --at K (K >= 0), got '$fork_at'" >&2; exit 2; }
+  [ -f "$fork/summary.json" ] && [ -f "$fork/run.log" ] ||
+    { echo "spawn.sh: --fork $fork: not a finished run folder (no summary.json and run.log)" >&2; exit 2; }
+  local parent
+  parent=$(python3 -c 'import json, sys
+d = json.load(open(sys.argv[1]))
+print(d["agents"], d["seed"], d["scenario_file"])
+for o in d.get("overrides", []): print(o)' "$fork/summary.json") ||
+    { echo "spawn.sh: --fork $fork: summary.json cannot be read" >&2; exit 2; }
+  fork_agents="$agents"
+  read -r agents seed parent_scenario <<<"$(head -1 <<<"$parent")"
+  while IFS= read -r o; do [ -n "$o" ] && set_args+=(--set "$o"); done < <(tail -n +2 <<<"$parent")
+  if [ -z "$scenario" ]; then
+    scenario="$parent_scenario"
+    [[ "$scenario" = /* ]] || [ -f "$scenario" ] || scenario="$root/$scenario"
+  fi
+  [ -z "$out" ] && { echo "spawn.sh: --fork needs --out NEW (the fork's own folder)" >&2; exit 2; }
+  return 0
+}
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -118,10 +152,18 @@ while [ $# -gt 0 ]; do
       peers="$2"; shift 2 ;;
     --identities) identities="$2"; shift 2 ;;
     --dump-maps) dump_maps=1; shift ;;
+    --fork) fork="$2"; shift 2 ;;
+    --at) fork_at="$2"; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "spawn.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
+fork_agents=""
+if [ -n "$fork" ]; then
+  fork_options  # sets scenario, agents, seed and set_args from the parent; fork_agents from --agents
+elif [ -n "$fork_at" ]; then
+  echo "spawn.sh: --at K is for --fork DIR" >&2; exit 2
+fi
 [ -n "$scenario" ] || { echo "spawn.sh: --scenario FILE is required (try --help)" >&2; exit 2; }
 [ -f "$scenario" ] || { echo "spawn.sh: scenario file '$scenario' not found" >&2; exit 2; }
 [[ "$agents" =~ ^[0-9]+$ ]] && [ "$agents" -ge 1 ] || { echo "spawn.sh: --agents N (N >= 1) is required" >&2; exit 2; }
@@ -169,7 +211,9 @@ if [ "$secure" -eq 1 ]; then
   sec_args=(--security "$identities")
 fi
 
-world_args=(--scenario "$scenario" --agents "$agents" --dds "$dds" --domain "$domain" --out "$out" "${sec_args[@]}")
+world_args=(--scenario "$scenario" --agents "$agents")
+[ -n "$fork" ] && world_args=(--fork "$fork" --at "$fork_at" ${fork_agents:+--agents "$fork_agents"})
+world_args+=(--dds "$dds" --domain "$domain" --out "$out" "${sec_args[@]}")
 [ "$replace" -eq 1 ] && world_args+=(--replace)
 [ -n "$max_steps" ] && world_args+=(--max-steps "$max_steps")
 [ -n "$frames_every" ] && world_args+=(--frames-every "$frames_every")  # the world checks K (exit 2 when bad)
@@ -178,7 +222,8 @@ seed_args=()
 [ -n "$seed" ] && seed_args=(--seed "$seed")
 agent_args=()
 [ "$dump_maps" -eq 1 ] && agent_args=(--dump-map "$out/maps")
-world_args+=("${seed_args[@]}" "${set_args[@]}" "${observe_args[@]}")
+[ -z "$fork" ] && world_args+=("${seed_args[@]}" "${set_args[@]}")  # a fork's world takes them from the parent's log
+world_args+=("${observe_args[@]}")
 
 # The world's own start-up checks with the run's arguments (scenario, terrain, completion, slots, --agents), before
 # any process starts: a bad scenario fails here with the check's message (marsala-world --check, no DDS).
@@ -273,7 +318,7 @@ fi
 # 0 completed, 3 max_steps, 4 no_live_agents, 5 signal, 6 stalled, 7 completed short of slots: the run ended and
 # wrote its outputs (docs/runtime.md#exit-codes).
 case "$world_rc" in
-  0|3|4|5|6|7) ;;
+  0|3|4|5|6|7) ;;  # 8: a fork's request differed from its parent's before K (the world's log says which)
   *)
     echo "spawn.sh: marsala-world exited with $world_rc; last lines of its log:" >&2
     tail -n 20 "$out/logs/world.log" >&2

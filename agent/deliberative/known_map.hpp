@@ -15,6 +15,7 @@ struct KnownMap {
   const Heightmap& heights;                  ///< the world grid: known cells hold the sensed heights [m], unknown 0
   const CellMask& known;                     ///< 1 where the cell has been sensed at least once
   const CellMask& assumed;                   ///< 1 where no sensor read the surface (assumed ground, a bound)
+  const CellMask& bound;                     ///< 1 where `assumed` is a lower bound from faces (not assumed ground)
   const std::vector<CellIndex>& trajectory;  ///< cells stood on, oldest first (world indices)
   bool scanned = false;                      ///< built from range scans (holes, shadows), not ground-truth tiles
 

@@ -19,6 +19,23 @@ int clamp_int(double v, int lo, int hi) {
   return static_cast<int>(v);
 }
 
+// How far a cell the map holds as no surface may be raised [m]: a bound (faces seen from below, the floor never read)
+// whose four neighbours all hold a surface or bound at least as high is a pit, raised at most to its lowest rim;
+// anything else (assumed ground, a bound beside lower ground: a wall's foot or side) is no deposition target, 0
+// (docs/runtime.md#mapping, pits).
+double pit_rim_gap(const KnownMap& map, CellIndex cell) {
+  if (map.bound(cell.row, cell.col) == 0) return 0.0;
+  const double floor_m = map.heights(cell);
+  double rim_m = std::numeric_limits<double>::infinity();
+  for (const CellIndex step : {CellIndex{-1, 0}, CellIndex{1, 0}, CellIndex{0, -1}, CellIndex{0, 1}}) {
+    const CellIndex n{cell.row + step.row, cell.col + step.col};
+    if (!map.heights.contains(n) || map.known(n.row, n.col) == 0) return 0.0;
+    if (map.assumed(n.row, n.col) != 0 && map.bound(n.row, n.col) == 0) return 0.0;  // a guess is no rim
+    rim_m = std::min(rim_m, map.heights(n));
+  }
+  return std::max(0.0, rim_m - floor_m);
+}
+
 }  // namespace
 
 Window sensing_window(const GridGeometry& world, Position robot, double range_m) {
@@ -73,11 +90,11 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
     }
 
   // Ground the map only assumes (under and around the robot's body: KnownMap::assumed) is no deposition
-  // target: building on it would never show in the map.
+  // target: building on it would never show in the map. A bound in a pit is filled up to its rim (pit_rim_gap).
   const auto assumed = map.assumed.block(w.top_left.row, w.top_left.col, w.rows, w.cols);
   for (int r = 0; r < w.rows; ++r)
     for (int c = 0; c < w.cols; ++c)
-      if (assumed(r, c) != 0) local.gap(r, c) = 0.0;
+      if (assumed(r, c) != 0) local.gap(r, c) = std::min(local.gap(r, c), pit_rim_gap(map, local.to_global({r, c})));
 
   local.robot = local.to_local(*map.geometry().cell_at(robot));
   // A scanned map may hold the robot's own cell not occupiable (a reading that changed under it, a face beside it);

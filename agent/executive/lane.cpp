@@ -5,6 +5,8 @@
 #include <limits>
 #include <optional>
 
+#include "marsala/core/mars_processor.hpp"
+
 namespace marsala::agent::executive {
 namespace {
 
@@ -177,6 +179,36 @@ std::vector<CellIndex> band_centre_path(const deliberative::LocalMap& local, con
     if (out.empty() || cell != out.back()) out.push_back(cell);
   }
   return out;
+}
+
+CellMask band_mask(const deliberative::LocalMap& local, const std::vector<std::vector<CellIndex>>& paths,
+                   double half_width_m) {
+  CellMask out = CellMask::Zero(local.rows(), local.cols());
+  const double radius = half_width_m / local.geometry().cell_size_m;  // [cells]
+  const int reach = static_cast<int>(std::floor(radius));
+  for (const auto& path : paths)
+    for (const CellIndex p : path)
+      for (int dr = -reach; dr <= reach; ++dr)
+        for (int dc = -reach; dc <= reach; ++dc) {
+          const CellIndex q{p.row + dr, p.col + dc};
+          if (dr * dr + dc * dc <= radius * radius + 1e-9 && local.contains(q)) out(q.row, q.col) = 1;
+        }
+  return out;
+}
+
+Heightmap band_fill_gap(const deliberative::LocalMap& local, const CellMask& band, double kappa) {
+  // The lowest height of the window is no source: every cone from it lies under every cell.
+  Heightmap sources = local.heights;
+  const double low = local.heights.heights().minCoeff();
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c)
+      if (band(r, c) == 0) sources(r, c) = low;
+  const Heightmap target = MarsProcessor(kappa).project(sources);
+  Heightmap gap = local.gap;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c)
+      gap(r, c) = std::min(gap(r, c), std::max(0.0, target(r, c) - local.heights(r, c)));
+  return gap;
 }
 
 }  // namespace marsala::agent::executive

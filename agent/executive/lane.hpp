@@ -54,4 +54,16 @@ std::vector<CellIndex> band_centre_path(const deliberative::LocalMap& local, con
                                         const std::vector<CellIndex>& path, double corridor_width_m,
                                         double max_shift_m, const CellMask* structure = nullptr);
 
+/// 1 on the window's cells whose centre lies within half_width_m [m] of the centre of a cell of one of `paths`
+/// (local indices; cells off the window count too): the band a robot fills along its ways; the window's size.
+CellMask band_mask(const deliberative::LocalMap& local, const std::vector<std::vector<CellIndex>>& paths,
+                   double half_width_m);
+
+/// What is left to fill in a band (docs/runtime.md#the-construction-band): the MARS gap at `kappa` [m/m] of the
+/// band's own surface, max(0, P_kappa[h_band] - h) [m], where h_band is the window's heights on the cells of `band`
+/// (1: in it; the window's size) and the window's lowest height elsewhere; never above local.gap. Terrain and
+/// structure beside the band, natural or built, neither raise the band's target nor are filled from it by more
+/// than the band's own slopes ask.
+Heightmap band_fill_gap(const deliberative::LocalMap& local, const CellMask& band, double kappa);
+
 }  // namespace marsala::agent::executive

@@ -168,7 +168,7 @@ struct MappingSystem::Octree {
     return top ? top : top_any;
   }
 
-  detail::VoxelOccupancy tree;  ///< the octree's leaves (OctoMap's updates, held per grid column)
+  detail::VoxelOccupancy tree;               ///< the octree's leaves (OctoMap's updates, held per grid column)
   std::vector<std::vector<VoxelHits>> hits;  ///< per cell (row-major)
 };
 
@@ -199,6 +199,7 @@ MappingSystem::MappingSystem(const GridGeometry& world, int tile_size, SensorSpe
                                       world.rows, world.cols, kOctreeHalfVoxels));
   known_ = CellMask::Zero(world.rows, world.cols);
   assumed_ = CellMask::Zero(world.rows, world.cols);
+  bound_ = CellMask::Zero(world.rows, world.cols);
   not_assumable_ = CellMask::Zero(world.rows, world.cols);
 }
 
@@ -209,6 +210,7 @@ MappingSystem::MappingSystem(const MappingSystem& other)
     : heights_(other.heights_),
       known_(other.known_),
       assumed_(other.assumed_),
+      bound_(other.bound_),
       not_assumable_(other.not_assumable_),
       known_count_(other.known_count_),
       scans_(other.scans_),
@@ -218,6 +220,7 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       built_(other.built_),
       face_floor_(other.face_floor_),
       face_scan_(other.face_scan_),
+      face_hit_scan_(other.face_hit_scan_),
       sensor_(other.sensor_),
       trajectory_(other.trajectory_),
       octree_(other.octree_ ? std::make_unique<Octree>(*other.octree_) : nullptr) {}
@@ -266,6 +269,7 @@ std::string scan_problem(const std::vector<ScanPoint>& points, const SensorSpec&
 
 void MappingSystem::mark_known(int row, int col) {
   assumed_(row, col) = 0;
+  bound_(row, col) = 0;
   if (known_(row, col) == 0) {
     known_(row, col) = 1;
     ++known_count_;
@@ -316,6 +320,7 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
     const long long index = static_cast<long long>(f.cell.row) * g.cols + f.cell.col;
     double& least = face_floor_.try_emplace(index, f.z_m).first->second;
     if (f.z_m > least || face_scan_.count(index) == 0) face_scan_[index] = scans_;
+    face_hit_scan_[index] = scans_;
     least = std::max(least, f.z_m);
     // A surface read at or above the face stays, and so does one read in an earlier scan only: the cell rose since
     // (terrain only rises), its top at least the face. Else the cell is a bound, no surface: never a deposition target.
@@ -327,6 +332,7 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
     }
     mark_known(f.cell.row, f.cell.col);
     assumed_(f.cell.row, f.cell.col) = surface ? 0 : 1;
+    bound_(f.cell.row, f.cell.col) = surface ? 0 : 1;
   }
   last_scan_cost_ = {inserted_ms - began_ms, thread_cpu_ms() - inserted_ms};
 }
@@ -421,14 +427,19 @@ void MappingSystem::rederive_heights(const ScanBatch& batch) {
       } else if (face != face_floor_.end() && face->second > top->estimate_m) {
         heights_(row, col) = std::max(heights_(row, col), face->second);
         assumed_(row, col) = 1;
+        bound_(row, col) = 1;
       }
     }
 }
 
 bool MappingSystem::hit_within(CellIndex cell, int scans) const {
   if (hit_scan_.empty() || !heights_.contains(cell)) return false;
-  const int last = hit_scan_[static_cast<std::size_t>(cell.row) * heights_.cols() + cell.col];
-  return last > 0 && scans_ - last < scans;
+  const std::size_t index = static_cast<std::size_t>(cell.row) * heights_.cols() + cell.col;
+  if (hit_scan_[index] > 0 && scans_ - hit_scan_[index] < scans) return true;
+  // A bound's surface is never hit; its faces are what a scan reads of it (docs/runtime.md#mapping, pits).
+  if (bound_(cell.row, cell.col) == 0) return false;
+  const auto face = face_hit_scan_.find(static_cast<long long>(index));
+  return face != face_hit_scan_.end() && scans_ - face->second < scans;
 }
 
 int MappingSystem::last_hit_scan(CellIndex cell) const {
@@ -440,8 +451,9 @@ void MappingSystem::record_built(CellIndex cell, double rise_m) {
   if (!heights_.contains(cell) || !std::isfinite(rise_m) || !(rise_m > 0.0)) return;
   const long long index = static_cast<long long>(cell.row) * heights_.cols() + cell.col;
   // A cell whose surface no sensor read has no height to add to.
-  const bool surface_read = known_(cell.row, cell.col) != 0 && (assumed_(cell.row, cell.col) == 0 ||
-                                                                face_floor_.count(index) > 0 || built_.count(index) > 0);
+  const bool surface_read =
+      known_(cell.row, cell.col) != 0 &&
+      (assumed_(cell.row, cell.col) == 0 || face_floor_.count(index) > 0 || built_.count(index) > 0);
   if (!surface_read) return;
   const double floor_m = heights_(cell) + rise_m;
   double& built = built_.try_emplace(index, floor_m).first->second;
@@ -476,6 +488,7 @@ void MappingSystem::forget(CellIndex cell) {
   if (known_(cell.row, cell.col) != 0) --known_count_;
   known_(cell.row, cell.col) = 0;
   assumed_(cell.row, cell.col) = 0;
+  bound_(cell.row, cell.col) = 0;
   not_assumable_(cell.row, cell.col) = 1;
   heights_(cell) = 0.0;
 }

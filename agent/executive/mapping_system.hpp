@@ -97,12 +97,15 @@ class MappingSystem {
   /// 1 where the cell's height is no surface a sensor read (never a deposition target): ground assume_ground() put
   /// under the body, or a lower bound from a face seen from below (its top above every ray that reached it).
   const CellMask& assumed() const { return assumed_; }
+  /// 1 where the cell's height is a lower bound from faces seen from below, no surface read (a subset of assumed()).
+  const CellMask& bound() const { return bound_; }
   /// Number of known cells.
   long long known_cells() const { return known_count_; }
   /// Scans integrated so far.
   int scans() const { return scans_; }
-  /// True when one of the last `scans` scans hit the cell (its surface, not only rays through its column): what it
-  /// says there is current. Others may have built there since an older scan (docs/runtime.md#mapping).
+  /// True when one of the last `scans` scans hit the cell (its surface, or a face of a bound(): not only rays through
+  /// its column): what it says there is current. Others may have built there since an older scan
+  /// (docs/runtime.md#mapping).
   bool hit_within(CellIndex cell, int scans) const;
   /// The scan (1, 2, ...) that last hit the cell's surface, 0 when none did or the cell is off the grid.
   int last_hit_scan(CellIndex cell) const;
@@ -111,7 +114,9 @@ class MappingSystem {
   /// The world grid.
   const GridGeometry& geometry() const { return heights_.geometry(); }
   /// This map as the deliberative layer reads it (the local map synthesizer); valid while this map lives, unchanged.
-  deliberative::KnownMap known_map() const { return {heights_, known_, assumed_, trajectory_, sensor_.casts_rays()}; }
+  deliberative::KnownMap known_map() const {
+    return {heights_, known_, assumed_, bound_, trajectory_, sensor_.casts_rays()};
+  }
   int tile_size() const { return tile_size_; }
   const SensorSpec& sensor() const { return sensor_; }
   /// What the last integrate_scan() cost [ms, CPU time of this thread]: inserting its hits into the octree (binning
@@ -134,7 +139,7 @@ class MappingSystem {
   bool carved_below(CellIndex cell, double z_m) const;  // a scan's ray left a voxel of its column free under z_m
   bool was_assumed_ground(CellIndex cell) const;        // known only from assume_ground(): never hit, no face
   bool rose_since_read(CellIndex cell) const;  // its surface was last read before a scan that raised its face floor
-  void forget(CellIndex cell);                           // unknown again
+  void forget(CellIndex cell);                 // unknown again
   // forget_assumed_ground()'s edge: the guessed cells connected to `seeds` outside every ball the robot stood in.
   void forget_along_edge(const std::vector<CellIndex>& seeds, double radius_cells);
   void rederive_heights(const ScanBatch& batch);
@@ -142,6 +147,7 @@ class MappingSystem {
   Heightmap heights_;
   CellMask known_;
   CellMask assumed_;
+  CellMask bound_;          ///< 1 where assumed_ is a face's lower bound, not ground assumed under the body
   CellMask not_assumable_;  ///< 1 where assumed ground was forgotten: no guess there again, only a reading
   long long known_count_ = 0;
   int scans_ = 0;
@@ -150,7 +156,8 @@ class MappingSystem {
   CellIndex registration_{0, 0};
   std::unordered_map<long long, double> built_;  ///< record_built(): the least height of a cell (row-major index) [m]
   std::unordered_map<long long, double> face_floor_;  ///< the highest face hit of a cell (row-major index) [m]
-  std::unordered_map<long long, int> face_scan_;  ///< the scan that set face_floor_ (1, 2, ...)
+  std::unordered_map<long long, int> face_scan_;      ///< the scan that set face_floor_ (1, 2, ...)
+  std::unordered_map<long long, int> face_hit_scan_;  ///< the last scan with a face hit on the cell (1, 2, ...)
   SensorSpec sensor_;
   std::vector<CellIndex> trajectory_;
   std::unique_ptr<Octree> octree_;  // made at the first scan

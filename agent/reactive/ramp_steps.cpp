@@ -327,6 +327,14 @@ std::vector<CellIndex> RampSteps::on_band_centre(const deliberative::LocalMap& l
   return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m, &built);
 }
 
+Heightmap RampSteps::band_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const {
+  if (!(corridor_width_m_ > 0.0)) return local.gap;
+  // What is left to fill is judged against the band's own slope: the terrain and structure beside it (other fronts'
+  // strips, high ground along the way) neither raise its target nor widen it.
+  const CellMask band = executive::band_mask(local, {ahead}, 0.5 * corridor_width_m_);
+  return executive::band_fill_gap(local, band, construction_params(context_.type).kappa);
+}
+
 void RampSteps::move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) {
   trace.motion = motion;
   memory_.sent.motion = modules_->map.geometry().cell_at(motion.target);
@@ -349,6 +357,7 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
     terrain_only.navigable = memory_.corridor;
   }
   if (context_.type.sensor.casts_rays()) clear_unconfirmed_gap(terrain_only);
+  if (band_centre_) terrain_only.gap = band_gap(terrain_only, ahead);
   for (const CellIndex g : memory_.refused_depositions->cells()) {
     const CellIndex p = terrain_only.to_local(g);
     if (terrain_only.contains(p)) terrain_only.gap(p.row, p.col) = 0.0;

@@ -133,8 +133,10 @@ class RampSteps {
   /// One construction band for every front robot (docs/runtime.md#the-construction-band): when on, what the robot
   /// fills follows its deposition path moved onto the centre line of the corridor it runs in (executive/lane.hpp
   /// band_centre_path, on its own map without the other robots), not the path from where it stands; it still drives
-  /// its own path; and nothing along a stretch of it that runs beside the structure (the cells its map saw raised,
-  /// executive/raised_cells.hpp). Needs set_lane()'s corridor width; off by default; set before admit().
+  /// its own path; nothing along a stretch of it that runs beside the structure (the cells its map saw raised,
+  /// executive/raised_cells.hpp); and what is left to fill is the band's own MARS gap (executive::band_fill_gap: the
+  /// terrain beside the band raises nothing in it). Needs set_lane()'s corridor width; off by default; set before
+  /// admit().
   void set_band_centre(bool on) { band_centre_ = on; }
   /// `path` moved into this robot's lane on the last look()'s map (unchanged without lanes).
   std::vector<CellIndex> in_lane(const deliberative::LocalMap& local, const std::vector<CellIndex>& path) const;
@@ -236,6 +238,8 @@ class RampSteps {
                BuildTrace& trace, protocol::ActionRequest& request);
   // set_band_centre(): `ahead` (local indices, from where the robot will stand) on the corridor's centre line.
   std::vector<CellIndex> on_band_centre(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const;
+  // set_band_centre(): the window's gap against the band along `ahead` alone (executive::band_fill_gap).
+  Heightmap band_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const;
   std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
   void clear_pad_gap(deliberative::LocalMap& local) const;  // no work on the base station's pad
   /// A scanned map: counts, per cell of the window, the scans in a row that showed its gap (beyond the margin) on a

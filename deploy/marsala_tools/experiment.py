@@ -6,7 +6,7 @@ import os
 import shutil
 import subprocess
 
-from . import common, runner, stats, summary, tables
+from . import common, runner, slurm, stats, summary, tables
 from .common import UsageError, say, warn
 
 PROG = "experiment"
@@ -61,6 +61,7 @@ def build_parser():
     p.add_argument("--no-plot", dest="plot", action="store_false", help="skip OUT/experiment.png (it needs gnuplot)")
     p.add_argument("--dump-maps", action="store_true",
                    help="every agent writes its final map into the run's maps/ (spawn.sh --dump-maps)")
+    slurm.add_arguments(p)
     return p
 
 
@@ -71,6 +72,7 @@ def parse_arguments(argv):
         raise UsageError(f"scenario file '{args.scenario}' not found")
     args.scenario = os.path.abspath(args.scenario)
     args.label = args.label or args.vary
+    slurm.check(args)
     return args
 
 
@@ -231,7 +233,8 @@ class Experiment:
         jobs = [self.job(v, s, agents) for v in a.values for s in range(1, a.seeds + 1)]
         self.total = len(jobs)
         try:
-            runner.Runner(spawn, a.jobs, self.finish_run).run(jobs)
+            slurm.make_runner(a, spawn, a.jobs, self.finish_run, os.path.abspath(a.out),
+                              "marsala-experiment").run(jobs)
         except runner.Interrupted:
             if self.results:
                 self.write_outputs()

@@ -7,7 +7,7 @@ import os
 import shutil
 import subprocess
 
-from . import common, runner, stats, summary, tables
+from . import common, runner, slurm, stats, summary, tables
 from .common import ROOT, UsageError, say, warn
 
 PROG = "sweep"
@@ -64,6 +64,7 @@ def build_parser():
                    help="runs at a time (default 1; more share the cores, so wall times grow)")
     p.add_argument("--force", action="store_true", help="re-run the requested runs and replace their rows")
     p.add_argument("--no-plot", dest="plot", action="store_false", help="skip OUT/sweep.png")
+    slurm.add_arguments(p)
     return p
 
 
@@ -76,6 +77,7 @@ def parse_arguments(argv):
     if not os.path.isfile(args.scenario):
         raise UsageError(f"scenario file '{args.scenario}' not found")
     args.scenario = os.path.abspath(args.scenario)
+    slurm.check(args)
     return args
 
 
@@ -227,9 +229,10 @@ class Sweep:
         say(f"{PROG}: {os.path.basename(a.scenario)} ({self.slots} slots), teams {' '.join(map(str, a.teams))}, "
             f"seeds {' '.join(map(str, a.seeds))}, {a.dds}; {len(todo)} of {len(a.teams) * len(a.seeds)} runs to do; "
             f"CSV {self.csv}")
-        if a.jobs != 1:
+        if a.jobs != 1 and not a.slurm:
             warn(PROG, f"{a.jobs} runs at a time share the cores: wall times are not comparable to --jobs 1")
-        runner.Runner(self.spawn, a.jobs, self.finish_run).run(self.job(t, s) for t, s in todo)
+        slurm.make_runner(a, self.spawn, a.jobs, self.finish_run, self.out, "marsala-sweep").run(
+            self.job(t, s) for t, s in todo)
 
     def report(self):
         """sweep_stats.csv, the table and the plot, over every row of the CSV."""

@@ -27,6 +27,11 @@
 #   impostor                                                         a participant forging admissions, frames, statuses
 #                                                                    and events in the world's name, also during a
 #                                                                    4 s pause of the world, changes nothing
+#   fork                                                             spawn.sh --fork of a 160-step run at K = 100:
+#                                                                    unchanged, it ends on the parent's terrain; with
+#                                                                    --agents 2 it has the parent's terrain at K, then
+#                                                                    diverges; agents of another scenario: exit 8;
+#                                                                    bad input: exit 2, nothing written
 set -euo pipefail
 case_name="$1"
 domain="$2"
@@ -542,6 +547,55 @@ case "$case_name" in
       fail "the monitor did not say what it ignored"
     echo "ok: forged admissions, frames, statuses and events ignored through a 4 s pause; the run completed at" \
       "step $steps on the unperturbed terrain $want"
+    ;;
+  fork)
+    # docs/runtime.md#fork. The parent stops at max_steps 160 (exit 3) to keep the case short.
+    forked() {  # forked NAME ARGS...: spawn.sh --fork of the parent into $work/NAME; prints its exit code
+      local rc=0
+      "$root/deploy/spawn.sh" --fork "$work/parent" --domain "$domain" --out "$work/$1" --quiet --timeout 120 \
+        "${@:2}" >"$work/$1.out" 2>&1 || rc=$?
+      echo "$rc"
+    }
+    rc=0
+    "$root/deploy/spawn.sh" --scenario "$scenario" --agents 3 --domain "$domain" --out "$work/parent" --max-steps 160 \
+      --quiet --timeout 120 || rc=$?
+    [ "$rc" -eq 3 ] || fail "the parent exited $rc, not 3 (max_steps)"
+    parent_sha=$(field terrain_sha256 "$work/parent/summary.json")
+    at_k=$("$bin/marsala-world" --check --fork "$work/parent" --at 100 | sed 's/.* //')
+    [ "$("$bin/marsala-monitor" replay "$work/parent" --to-step 100 | tail -1)" = "terrain_sha256 $at_k" ] ||
+      fail "the world's digest of the parent at step 100 ($at_k) is not the monitor's replay's"
+    [ "$(forked same --at 100)" = 3 ] || { cat "$work/same.out"; fail "the unchanged fork did not end at max_steps"; }
+    [ "$(field terrain_sha256 "$work/same/summary.json")" = "$parent_sha" ] ||
+      fail "the unchanged fork ended on $(field terrain_sha256 "$work/same/summary.json"), the parent on $parent_sha"
+    [ "$(field at_step "$work/same/summary.json")" = 100 ] || fail "summary.json does not say the fork's K"
+    [ "$(field parent_sha256_at_step "$work/same/summary.json")" = "$at_k" ] || fail "summary.json's parent digest"
+    [ "$(forked fewer --at 100 --agents 2)" = 3 ] || { cat "$work/fewer.out"; fail "the fork with 2 agents failed"; }
+    fewer_sha=$(field terrain_sha256 "$work/fewer/summary.json")
+    [ "$fewer_sha" != "$parent_sha" ] || fail "the fork with 2 agents did not diverge from its parent"
+    # The fork's own run.log, replayed to K by the monitor, has the parent's terrain there; then agent 3 leaves.
+    fewer_k=$("$bin/marsala-monitor" replay "$work/fewer" --to-step 100 | tail -1 | sed 's/.* //')
+    [ "$fewer_k" = "$at_k" ] || fail "the fork with 2 agents had $fewer_k at step 100, the parent $at_k"
+    grep -q '"step":100,"agent":3,"kind":"dropped","detail":"not in the fork' "$work/fewer/events.log" ||
+      fail "agent 3 did not leave the fork at step 100"
+    "$bin/marsala-monitor" replay "$work/fewer" | tail -1 | grep -q "terrain_sha256 $fewer_sha" ||
+      fail "a replay of the fork's run.log does not end on its terrain"
+    # Agents of another construction slope make other requests: the fork stops at the first, exit 8 naming it.
+    sed 's/^  }$/  }\n  construction { kappa: 0.25 }/' "$scenario" >"$work/other.pbtxt"
+    [ "$(forked other --at 100 --scenario "$work/other.pbtxt")" = 8 ] || { cat "$work/other.out"; fail "no exit 8"; }
+    grep -q "error: fork of .* at step 100: agent [1-3] at step [0-9]*: its request differs" "$work/other.out" ||
+      { cat "$work/other.out"; fail "the mismatch was not named"; }
+    # Bad input: one line, exit 2, nothing written.
+    for bad in "--at 161" "--at -1" "--at 100 --agents 4" "--at 100 --set max_steps=5" "--at 100 --seed 2"; do
+      # shellcheck disable=SC2086
+      [ "$(forked bad $bad)" = 2 ] || { cat "$work/bad.out"; fail "--fork $bad did not exit 2"; }
+      [ ! -e "$work/bad" ] || fail "--fork $bad wrote $work/bad"
+      [ "$(wc -l <"$work/bad.out")" -le 2 ] || { cat "$work/bad.out"; fail "--fork $bad said more than a line"; }
+    done
+    rc=0
+    "$root/deploy/spawn.sh" --fork "$work/none" --at 1 --out "$work/bad" --quiet >/dev/null 2>&1 || rc=$?
+    [ "$rc" -eq 2 ] && [ ! -e "$work/bad" ] || fail "a fork of no run exited $rc"
+    echo "ok: fork at 100 unchanged ends on the parent's $parent_sha; with 2 agents it has the parent's $at_k at" \
+      "step 100 and ends on $fewer_sha; other agents exit 8: $(grep -o 'agent [1-3] at step [0-9]*' "$work/other.out")"
     ;;
   *) echo "unknown case '$case_name'" >&2; exit 2 ;;
 esac

@@ -114,6 +114,13 @@ proto::LogHeader log_header(const scenario::Scenario& scenario, const LogStart& 
   h.set_cols(initial.cols());
   h.set_cell_size_m(initial.cell_size_m());
   h.set_initial_terrain_sha256(runlog::terrain_sha256(initial));
+  if (start.fork != nullptr) {
+    h.set_fork_parent(start.fork->parent_dir);
+    h.set_fork_parent_run_id(start.fork->parent_run_id);
+    h.set_fork_step(start.fork->at_step);
+    h.set_fork_parent_sha256(start.fork->parent_sha256_at_step);
+    h.set_fork_agents(start.fork->agents);
+  }
   return h;
 }
 
@@ -154,6 +161,8 @@ proto::LogRecord step_record(const std::vector<Submission>& submissions, const S
   r->set_surplus_requests(surplus);
   return record;
 }
+
+Submission logged_submission(const proto::LoggedRequest& request) { return submission(request); }
 
 proto::Snapshot make_snapshot(const WorldState& state, const std::string& run_id, std::uint64_t log_offset) {
   proto::Snapshot s;

@@ -12,6 +12,7 @@
 #include "marsala/core/heightmap.hpp"
 #include "marsala/runlog/run_log.hpp"
 #include "marsala/scenario/scenario.hpp"
+#include "marsala/world_server/records/fork_replay.hpp"
 #include "marsala/world_server/rules/admission.hpp"
 #include "marsala/world_server/rules/step.hpp"
 #include "marsala/world_server/rules/world_state.hpp"
@@ -29,6 +30,7 @@ struct LogStart {
   std::uint32_t agents = 0;
   std::uint64_t max_steps = 0;
   double step_deadline_s = 0.0;
+  const ForkOrigin* fork = nullptr;  ///< where a fork comes from (none: no fork)
 };
 
 /// The header record of a run of `scenario` (its name, file and seed) from `initial` terrain.
@@ -42,6 +44,9 @@ proto::LogRecord dropped_record(const WorldState& state, std::uint32_t id, const
 /// deposited volume after it. `surplus` counts requests that were not submitted (beyond the per-partition limit).
 proto::LogRecord step_record(const std::vector<Submission>& submissions, const StepOutcome& outcome,
                              const WorldState& after, std::uint32_t surplus = 0);
+
+/// The submission a logged request records (what apply_record() gives apply_step()).
+Submission logged_submission(const proto::LoggedRequest& request);
 
 /// The state after a step, with the byte offset of run.log just after that step's record.
 proto::Snapshot make_snapshot(const WorldState& state, const std::string& run_id, std::uint64_t log_offset);

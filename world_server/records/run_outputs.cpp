@@ -128,6 +128,15 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   s.set_scenario(info.scenario);
   s.set_scenario_file(info.scenario_file);
   for (const std::string& o : info.overrides) s.add_overrides(o);
+  if (info.fork) {
+    proto::ForkOrigin* f = s.mutable_fork();
+    f->set_parent(info.fork->parent_dir);
+    f->set_parent_run_id(info.fork->parent_run_id);
+    f->set_at_step(info.fork->at_step);
+    f->set_parent_sha256_at_step(info.fork->parent_sha256_at_step);
+    f->set_parent_agents(info.fork->parent_agents);
+    f->set_agents(info.fork->agents);
+  }
   s.set_run_id(info.run_id);
   s.set_seed(info.seed);
   s.set_dds(info.dds);

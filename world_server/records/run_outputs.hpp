@@ -61,6 +61,7 @@ struct RunInfo {
   /// The terrain before the run (goal_vector_map.png, payload_path's construction sites); empty = unknown (the
   /// final one is drawn, no sites are reported).
   Heightmap initial_terrain;
+  std::optional<ForkOrigin> fork;  ///< where a fork came from (none: no fork)
 };
 
 /// The ids of the slots of `state`'s team not in the run now (never admitted, or dropped and not back), in order.

@@ -13,7 +13,7 @@
 namespace marsala::world_server {
 namespace {
 
-std::string path_in(const std::string& dir, const std::string& name) {
+std::string file_in(const std::string& dir, const std::string& name) {
   return (std::filesystem::path(dir) / name).string();
 }
 
@@ -37,19 +37,19 @@ void RunRecorder::open(const scenario::Scenario& scenario, const LogStart& start
   const std::string& dir = setup_.out_dir;
   // make_world_state() keeps the terrain as given: the state's terrain is still the initial one, unless resumed.
   // Kept for every kind: the material score (material_score.hpp) needs it at the end.
-  initial_terrain_ = resumed ? terrain::read_asc(path_in(dir, "terrain_initial.asc")) : state.terrain;
+  initial_terrain_ = resumed ? terrain::read_asc(file_in(dir, "terrain_initial.asc")) : state.terrain;
   if (!resumed) write_initial_outputs(dir, state.terrain);
-  event_log_.emplace(path_in(dir, "events.log"), resumed);
+  event_log_.emplace(file_in(dir, "events.log"), resumed);
   if (setup_.frames_every > 0) {
     // A resumed run goes on adding frames to its folder; a fresh one never mixes its frames with another's.
-    const std::string frames_dir = path_in(dir, "frames");
+    const std::string frames_dir = file_in(dir, "frames");
     if (!resumed) render::check_fresh_frames_dir(frames_dir, "another run's time-lapse");
     frames_.emplace(frames_dir, setup_.frames_every);
     // One window for every frame, so that the time-lapse does not jump: the close-up of the base and the payload
     // ends or the site (and what was built before a resume), as final_zoom.png frames them.
     frame_window_ = zoom_window(state, std::nullopt);
   }
-  const std::string log_path = path_in(dir, kRunLogFile);
+  const std::string log_path = file_in(dir, kRunLogFile);
   if (resumed)
     run_log_ = runlog::RunLogWriter::continue_at(log_path, *setup_.resume_good_bytes);
   else
@@ -67,7 +67,7 @@ void RunRecorder::note(std::uint64_t step, const std::string& text) {
 void RunRecorder::after_step(const WorldState& state) {
   if (setup_.snapshot_every == 0 || state.step % setup_.snapshot_every != 0) return;
   run_log_->sync();
-  write_snapshot(path_in(setup_.out_dir, kSnapshotFile), make_snapshot(state, setup_.run_id, run_log_->bytes()));
+  write_snapshot(file_in(setup_.out_dir, kSnapshotFile), make_snapshot(state, setup_.run_id, run_log_->bytes()));
 }
 
 void RunRecorder::frame(const WorldState& state, const std::string& scenario_name, bool last) {

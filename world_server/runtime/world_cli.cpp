@@ -9,6 +9,7 @@
 #include <ostream>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "marsala/bus/bus.hpp"
 #include "marsala/cli/command_line.hpp"
@@ -20,6 +21,7 @@
 #include "marsala/world_server/records/output_lock.hpp"
 #include "marsala/world_server/records/run_key_file.hpp"
 #include "marsala/world_server/records/run_outputs.hpp"
+#include "marsala/world_server/runtime/fork_start.hpp"
 #include "marsala/world_server/runtime/metrics_server.hpp"
 #include "marsala/world_server/runtime/scenario_check.hpp"
 #include "marsala/world_server/runtime/step_trace.hpp"
@@ -145,15 +147,64 @@ std::optional<int> lock_folder(std::optional<OutputLock>& lock, const std::strin
   }
 }
 
+/// marsala-world --fork DIR --at K (docs/runtime.md#fork); dir empty: no fork.
+struct ForkRequest {
+  std::string dir;
+  std::uint64_t at = 0;  ///< K [steps]
+};
+
+/// The --fork DIR and --at K options (docs/runtime.md#fork), excluding `others`; returns --fork.
+CLI::Option* add_fork_options(CLI::App& app, ForkRequest& fork, const std::vector<CLI::Option*>& others) {
+  CLI::Option* fork_option =
+      app.add_option("--fork", fork.dir,
+                     "start a new run (in --out) from the run in DIR: its first K steps (--at) replayed with fresh\n"
+                     "agents, each request checked against DIR/run.log (exit 8 naming the agent and step when one\n"
+                     "differs), then live with --agents (fewer), --max-steps, --step-deadline (docs/runtime.md#fork)")
+          ->type_name("DIR");
+  for (CLI::Option* other : others) fork_option->excludes(other);
+  app.add_option("--at", fork.at, "with --fork: the step K the fork goes live at (0 .. the parent's steps)")
+      ->needs(fork_option)
+      ->check(CLI::Range(0ull, 1ull << 40))
+      ->type_name("K");
+  return fork_option;
+}
+
+/// marsala-world --check --fork DIR --at K: whether the fork can be made (prepare_fork() without a folder); 0 and one
+/// line saying what it replays when it can, 2 and the reason when not.
+int check_fork(const ForkRequest& fork, RuntimeOptions options, int domain, std::ostream& out, std::ostream& err) {
+  options.out_dir.clear();
+  options.replace = false;
+  try {
+    const WorldStart start = prepare_fork(fork.dir, fork.at, std::move(options), domain);
+    const ForkOrigin& o = start.fork->origin();
+    out << fmt::format(
+        "fork of {} (run '{}', {} agents): its first {} steps replayed, live from step {} with {} agents; the "
+        "parent's terrain sha256 there {}\n",
+        o.parent_dir, o.parent_run_id, o.parent_agents, o.at_step, o.at_step, o.agents, o.parent_sha256_at_step);
+    return 0;
+  } catch (const Error& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return cli::kExitUsage;
+  }
+}
+
 /// The run, once its folder is locked: the start (fresh or resumed), the run key, the participant, the lockstep and the
 /// last line; the exit code (docs/runtime.md#exit-codes), errors as one line.
-int run_in_folder(const std::string& scenario_path, const std::string& resume_dir, const std::string& run_key,
-                  const RuntimeOptions& options, const cli::DdsOptions& dds, MetricsServer* metrics,
-                  StepTrace* trace, const std::atomic<bool>& stop, std::ostream& out, std::ostream& err) {
+int run_in_folder(const std::string& scenario_path, const std::string& resume_dir, const ForkRequest& fork,
+                  const std::string& run_key, const RuntimeOptions& options, const cli::DdsOptions& dds,
+                  MetricsServer* metrics, StepTrace* trace, const std::atomic<bool>& stop, std::ostream& out,
+                  std::ostream& err) {
   try {
     WorldStart start;
     if (!resume_dir.empty()) {
       start = prepare_resume(resume_dir, options, dds.domain);
+    } else if (!fork.dir.empty()) {
+      try {
+        start = prepare_fork(fork.dir, fork.at, options, dds.domain);
+      } catch (const Error& e) {  // no fork to make: nothing written (docs/runtime.md#fork)
+        cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+        return cli::kExitUsage;
+      }
     } else {
       try {
         start = fresh_start(scenario_path, options, dds.domain);
@@ -180,6 +231,9 @@ int run_in_folder(const std::string& scenario_path, const std::string& resume_di
                        result.terrain_sha256);
     if (trace != nullptr) trace->finish();
     return exit_code(result.end_reason, result.slots_missing);
+  } catch (const ForkMismatch& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return kExitForkMismatch;
   } catch (const Error& e) {
     cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
     return 1;
@@ -210,7 +264,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
       "--metrics-port P serves the run's Prometheus metrics on http://127.0.0.1:P/metrics; --trace FILE writes the\n"
       "lockstep as a Chrome trace for Perfetto (docs/runtime.md#metrics, #step-traces).\n"
       "Exit codes: 0 completed, 7 completed with slots missing at the end, 3 max_steps, 4 no_live_agents,\n"
-      "5 signal, 6 stalled, 1 error, 2 usage or a scenario the world refuses at start (as --check).",
+      "5 signal, 6 stalled, 8 a fork's request differed from its parent's before K, 1 error, 2 usage or a scenario\n"
+      "the world refuses at start (as --check).",
       "marsala-world"};
   std::string scenario_path, check_path, resume_dir, run_key;
   cli::DdsOptions dds;
@@ -254,6 +309,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
              "state come from DIR/run.log (and snapshot.pb); the agents that were running reconnect")
           ->excludes(scenario_option)
           ->excludes(check_option);
+  ForkRequest fork;
+  CLI::Option* fork_option = add_fork_options(app, fork, {scenario_option, resume_option});
   add_timing_and_record_options(app, options);
   add_run_key_option(app, run_key);
   MetricsOptions metrics_options;
@@ -271,8 +328,9 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   cli::add_log_options(app, log_options);
   app.callback([&] {
     // --scenario is required of a run; a check takes its file either way; a resume reads it from the log.
-    if (scenario_option->count() == 0 && check_path.empty() && resume_option->count() == 0)
-      throw CLI::RequiredError(check ? "SCENARIO (or --scenario)" : "--scenario (or --resume DIR)");
+    if (scenario_option->count() == 0 && check_path.empty() && resume_option->count() == 0 && fork_option->count() == 0)
+      throw CLI::RequiredError(check ? "SCENARIO (or --scenario)" : "--scenario (or --resume DIR, --fork DIR)");
+    if (fork_option->count() > 0 && app.get_option("--at")->count() == 0) throw CLI::RequiredError("--at K");
   });
   if (const auto code = cli::parse_command_line(app, argc, argv, "marsala-world", out, err)) return *code;
 
@@ -283,6 +341,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
     std::unique_ptr<MetricsServer> metrics;
     if (const auto code = start_metrics(metrics, metrics_options, err)) return *code;
     metrics.reset();
+    if (!fork.dir.empty()) return check_fork(fork, options, dds.domain, out, err);
     return run_scenario_check(check_path.empty() ? scenario_path : check_path, options, dds.domain, json, out, err);
   }
   if (quiet && app.get_option("--log-level")->count() == 0) log_options.level = "warn";
@@ -295,8 +354,8 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   // The folder is this process's from here to its exit, before --replace clears it or --resume reads it.
   std::optional<OutputLock> lock;
   if (const auto code = lock_folder(lock, resume_dir.empty() ? options.out_dir : resume_dir, err)) return *code;
-  const int code = run_in_folder(scenario_path, resume_dir, run_key, options, dds, metrics.get(), trace.get(), stop,
-                                 out, err);
+  const int code =
+      run_in_folder(scenario_path, resume_dir, fork, run_key, options, dds, metrics.get(), trace.get(), stop, out, err);
   linger_for_metrics(metrics.get(), metrics_options, code, stop);
   return code;
 }

@@ -144,6 +144,7 @@ struct WorldRuntime::Impl {
         participant(p),
         state(std::move(start.state)),
         resume(std::move(start.resume)),
+        fork(std::move(start.fork)),
         resume_step(state.step),
         recorder(recorder_setup(options, resume)),
         silence(std::chrono::milliseconds(static_cast<long long>(options.silence_timeout_s * 1000.0))) {
@@ -517,6 +518,7 @@ struct WorldRuntime::Impl {
     const CollectDuties duties{[this] { service_hellos(); }, [this] { check_liveliness(); },
                                [this](std::uint32_t id) { send_frame(id, false); }, [this] { return silence.held(); }};
     for (;;) {
+      if (fork && state.step == fork->origin().at_step && !fork_live) go_live();
       recorder.frame(state, scenario.name, false);
       if (const auto end = end_before_step(stop)) return *end;
       StepTimes times;  // the phases' ends, for the step time and the trace
@@ -526,6 +528,7 @@ struct WorldRuntime::Impl {
       times.frames_out = Clock::now();
       Collected collected = collector->collect(state, options.step_deadline_s, stop, duties);
       if (stop) return protocol::EndReason::kSignal;  // the interrupted step is not applied
+      if (fork && fork->replaying(state.step)) replay_fork_step(collected);
       times.collected = Clock::now();
       const StepOutcome outcome = apply_step(state, collected.submissions);
       times.applied = Clock::now();
@@ -538,6 +541,34 @@ struct WorldRuntime::Impl {
       observe_step_metrics(outcome, step_took, step_took - collected.waited);
       publish_step(collected, outcome, start);
       trace_step(times, collected, outcome);
+    }
+  }
+
+  /// A fork's step before K (docs/runtime.md#fork): the live requests must be the parent's, and the recorded ones
+  /// are applied. Throws ForkMismatch naming the agent and the step.
+  void replay_fork_step(Collected& collected) {
+    if (const std::string problem = fork->mismatch(state.step, collected.submissions); !problem.empty())
+      throw ForkMismatch(fmt::format("fork of {} at step {}: {}", fork->origin().parent_dir, fork->origin().at_step,
+                                     problem));
+    collected.submissions = fork->recorded(state.step, state);
+  }
+
+  /// A fork at step K: checks the terrain against the parent's at K, then lets the slots above the fork's team leave.
+  void go_live() {
+    fork_live = true;
+    const ForkOrigin& o = fork->origin();
+    const std::string sha = runlog::terrain_sha256(state.terrain);
+    if (sha != o.parent_sha256_at_step)
+      throw ForkMismatch(fmt::format("fork of {}: the terrain at step {} is {}, the parent's was {}", o.parent_dir,
+                                     o.at_step, sha, o.parent_sha256_at_step));
+    note(fmt::format("fork of {} (run '{}') live from step {} with {} of {} agents: terrain sha256 {} as the parent's",
+                     o.parent_dir, o.parent_run_id, o.at_step, o.agents, o.parent_agents, sha));
+    for (std::uint32_t id = o.agents + 1; id <= o.parent_agents; ++id) {
+      if (!state.has_agent(id) || !state.agent(id).alive) continue;
+      const std::string reason = fmt::format("not in the fork's team of {}", o.agents);
+      recorder.record(dropped_record(state, id, reason));
+      emit(drop_agent(state, id, reason));
+      send_frame(id, true);
     }
   }
 
@@ -572,6 +603,7 @@ struct WorldRuntime::Impl {
     log_start.agents = static_cast<std::uint32_t>(state.agents.size());
     log_start.max_steps = options.max_steps;
     log_start.step_deadline_s = options.step_deadline_s;
+    if (fork) log_start.fork = &fork->origin();
     recorder.open(scenario, log_start, state);
     if (resume) {
       proto::LogRecord r;
@@ -633,6 +665,7 @@ struct WorldRuntime::Impl {
     info.step_world_median_ms = median(step_world_ms);
     info.step_world_p90_ms = percentile(step_world_ms, 0.9);
     info.world_cpu_ms_per_step = step_ms.empty() ? 0.0 : cpu_ms / static_cast<double>(step_ms.size());
+    if (fork) info.fork = fork->origin();
     return info;
   }
 
@@ -688,6 +721,8 @@ struct WorldRuntime::Impl {
   WorldState state;
   std::optional<ResumeInfo> resume;
   std::uint64_t resume_step = 0;  ///< the step a resumed run continued at
+  std::optional<ForkReplay> fork;  ///< a fork's replay of its parent's first K steps (docs/runtime.md#fork)
+  bool fork_live = false;          ///< the fork has reached K
   RunRecorder recorder;           ///< run.log, snapshots, events.log, frames, final outputs
   TeamSilence silence;            ///< whether the step is held for a silent team
   std::optional<SensingService> sensing;

@@ -33,7 +33,7 @@ void check_run_id(const std::string& run_id) {
 }
 
 WorldStart prepare_world_start(const scenario::Scenario& s, Heightmap terrain, RuntimeOptions options, int domain_id) {
-  WorldStart start{s, std::move(options), {}, std::nullopt};
+  WorldStart start{s, std::move(options), {}, std::nullopt, std::nullopt};
   RuntimeOptions& o = start.options;
   if (o.seed) start.scenario.seed = *o.seed;
   const std::uint32_t agents = o.agents == 0 ? static_cast<std::uint32_t>(s.slots.size()) : o.agents;

@@ -11,6 +11,7 @@
 #include "marsala/core/heightmap.hpp"
 #include "marsala/protocol/world_proof.hpp"
 #include "marsala/scenario/scenario.hpp"
+#include "marsala/world_server/records/fork_replay.hpp"
 #include "marsala/world_server/rules/world_state.hpp"
 
 namespace marsala::world_server {
@@ -59,6 +60,7 @@ struct WorldStart {
   RuntimeOptions options;            ///< resolved: agents, run id, max_steps and step deadline filled in and checked
   WorldState state;                  ///< the initial state (make_world_state(): start jitter, completion check set up)
   std::optional<ResumeInfo> resume;  ///< set by prepare_resume(): `state` is the rebuilt one
+  std::optional<ForkReplay> fork;    ///< set by prepare_fork(): replay the parent's first K steps (fork_start.hpp)
 };
 
 /// Everything the world checks and decides at start before it admits agents, on the run's terrain: applies the seed

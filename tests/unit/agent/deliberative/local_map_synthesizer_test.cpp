@@ -267,11 +267,47 @@ TEST(LocalMapSynthesizer, AScannedMapKeepsTheRobotsWayOutOfItsOwnCell) {
   ASSERT_FALSE(cell_occupiable(h, {30, 40}, kBody));
   const LocalMapSynthesizer synthesizer(kBody, 2.5);
   for (const bool scanned : {true, false}) {
-    const LocalMap local = synthesizer.synthesize({h, known, assumed, trajectory, scanned}, kRobot, {7.0, 2.95});
+    const LocalMap local =
+        synthesizer.synthesize({h, known, assumed, assumed, trajectory, scanned}, kRobot, {7.0, 2.95});
     EXPECT_EQ(local.occupiable(local.robot.row, local.robot.col), scanned ? 1 : 0);
     const CellIndex west{local.robot.row, local.robot.col - 3};  // occupiable ground beside the robot's ball
     ASSERT_EQ(local.occupiable(west.row, west.col), 1);
     EXPECT_EQ(local.navigable(west.row, west.col), scanned ? 1 : 0);
+  }
+}
+
+// A one-cell pit whose floor no scan read (its height a bound from faces) is raised, but never above its lowest rim; a
+// bound beside lower ground (a wall's foot) and ground only assumed are no targets (docs/runtime.md#mapping, pits).
+TEST(LocalMapSynthesizer, ABoundInAPitIsFilledUpToItsLowestRim) {
+  const CellMask known = CellMask::Ones(kWorld.rows, kWorld.cols);
+  const std::vector<CellIndex> trajectory{{30, 40}};
+  const LocalMapSynthesizer synthesizer(kBody, 2.5);  // kappa 0.5: a cell may lie 0.05 m under its 1 m neighbours
+  const CellIndex pit{30, 45}, wall{30, 50}, guess{25, 45};
+  struct Case {
+    double west_rim_m;  // the pit's west neighbour; its other three stand at 1 m like the ground around
+    double wall_foot_m;
+    double expected_pit_gap_m;
+  };
+  // Hand-derived: the pit's MARS height is 1 - 0.5 x 0.1 = 0.95 m over its 1 m neighbours, a gap of 0.45 m over its
+  // 0.5 m bound; a 0.6 m rim caps it at 0.1 m. The wall's foot (bound 0.5 m beside a 0 m cell) and the assumed ground
+  // (0.5 m among 1 m cells, gap 0.45 m over its reading) get none.
+  for (const Case& k : {Case{1.0, 0.0, 0.45}, Case{0.6, 0.0, 0.1}}) {
+    Heightmap h(kWorld, 1.0);
+    CellMask assumed = CellMask::Zero(kWorld.rows, kWorld.cols), bound = assumed;
+    h(pit) = 0.5, h(pit.row, pit.col - 1) = k.west_rim_m;
+    h(wall) = 0.5, h(wall.row, wall.col + 1) = k.wall_foot_m;
+    h(guess) = 0.5;
+    for (const CellIndex c : {pit, wall}) assumed(c.row, c.col) = bound(c.row, c.col) = 1;
+    assumed(guess.row, guess.col) = 1;
+    const LocalMap local = synthesizer.synthesize({h, known, assumed, bound, trajectory, true}, kRobot, {7.0, 2.95});
+    const auto gap = [&](CellIndex c) { return local.gap(c.row - local.offset.row, c.col - local.offset.col); };
+    EXPECT_NEAR(gap(pit), k.expected_pit_gap_m, 1e-9);
+    EXPECT_EQ(gap(wall), 0.0);
+    EXPECT_EQ(gap(guess), 0.0);
+    // The same cells as surfaces read: their full MARS gaps (0.45 m each), as before the rule.
+    const CellMask none = CellMask::Zero(kWorld.rows, kWorld.cols);
+    const LocalMap read = synthesizer.synthesize({h, known, none, none, trajectory, true}, kRobot, {7.0, 2.95});
+    EXPECT_NEAR(read.gap(guess.row - read.offset.row, guess.col - read.offset.col), 0.45, 1e-9);
   }
 }
 
@@ -286,7 +322,7 @@ TEST(LocalMapSynthesizer, AScannedMapsGoalAndPathAvoidCellsItCannotJudge) {
     for (int c = 25; c < 80; ++c)
       if (!(r == 31 && c == 64)) map.assume_ground(kWorld.cell_center({r, c}), 0.0, 0.0);
   map.record_pose(kRobot);
-  const LocalMapSynthesizer synthesizer(kBody, 2.5);                         // ball radius 2 cells; window cols 15..65
+  const LocalMapSynthesizer synthesizer(kBody, 2.5);  // ball radius 2 cells; window cols 15..65
   const LocalMap local =
       synthesizer.synthesize(map.known_map(), kRobot, {7.05, 2.95});  // the target (30, 70), off the window
   const CellIndex exit = local.to_local({30, 65});

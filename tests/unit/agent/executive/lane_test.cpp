@@ -7,6 +7,7 @@
 #include <optional>
 #include <random>
 
+#include "marsala/core/mars_processor.hpp"
 #include "unit/agent/agent_test_support.hpp"
 
 namespace marsala::agent::executive {
@@ -230,6 +231,48 @@ TEST(Lane, BandCentrePathBuildsNothingBesideTheStructureButGoesOnPastItsTip) {
   const CellMask other = CellMask::Ones(10, 10);
   EXPECT_EQ(band_centre_path(open, open.navigable, row_path(60, 5, 70), 3.0, 1.0), row_path(60, 5, 70));
   EXPECT_EQ(band_centre_path(open, open.navigable, row_path(60, 5, 70), 3.0, 1.0, &other), row_path(60, 5, 70));
+}
+
+TEST(BandFill, TheBandIsTheCellsWithinHalfTheWidthOfItsPaths) {
+  const deliberative::LocalMap map = band_map({40, 5}, false);
+  // 0.2 m = 2 cells around (40, 40): the 13 cells with dr^2 + dc^2 <= 4; around (0, 79) the part inside the window.
+  const CellMask band = band_mask(map, {{{40, 40}}, {{0, 79}}}, 0.2);
+  long long count = 0;
+  for (int r = 0; r < 80; ++r)
+    for (int c = 0; c < 80; ++c) {
+      const bool near_a = (r - 40) * (r - 40) + (c - 40) * (c - 40) <= 4;
+      const bool near_b = r * r + (c - 79) * (c - 79) <= 4;
+      EXPECT_EQ(band(r, c), near_a || near_b ? 1 : 0) << r << ", " << c;
+      count += band(r, c);
+    }
+  EXPECT_EQ(count, 13 + 6);
+}
+
+TEST(BandFill, WhatIsLeftToFillIsTheBandsOwnMarsGap) {
+  // 12 x 14 cells of 0.25 m: a band on rows 0..5; beside it a 1 m strip on row 9 (another front's, or high ground)
+  // and a 0.4 m top at (3, 2) inside it.
+  const GridGeometry g{12, 14, 0.0, 0.0, 0.25};
+  const double kappa = 0.2;
+  Heightmap h(g, 0.1);
+  for (int c = 0; c < 14; ++c) h(9, c) = 1.0;
+  h(3, 2) = 0.4;
+  h(11, 13) = 0.0;  // the window's lowest cell
+  const deliberative::LocalMap map =
+      test::make_local_map(h, MarsProcessor(kappa).gap(h), kBody, {3, 3}, std::nullopt);
+  CellMask band = CellMask::Zero(12, 14);
+  band.topRows(6).setOnes();
+  const Heightmap gap = band_fill_gap(map, band, kappa);
+  // Brute force: cones of slope kappa from the band's cells only (the others are no sources).
+  for (int r = 0; r < 12; ++r)
+    for (int c = 0; c < 14; ++c) {
+      double top = h(r, c);
+      for (int qr = 0; qr < 6; ++qr)
+        for (int qc = 0; qc < 14; ++qc) top = std::max(top, h(qr, qc) - kappa * 0.25 * std::hypot(qr - r, qc - c));
+      EXPECT_NEAR(gap(r, c), top - h(r, c), 1e-9) << r << ", " << c;
+    }
+  // The strip beside the band would have asked for 1 - 0.2 x 0.75 - 0.1 m at the band's edge (row 6 is 3 cells away).
+  EXPECT_NEAR(map.gap(6, 10), 0.75, 1e-9);
+  EXPECT_LT(gap(6, 10), 0.01);
 }
 
 }  // namespace

@@ -510,6 +510,22 @@ TEST(MappingSystem, AFaceSeenFromBelowIsABoundNotASurface) {
   EXPECT_GT(bounds, 3);
   ASSERT_TRUE(map.is_known({29, 36}));
   EXPECT_FALSE(map.assumed()(29, 36));
+  // Those bounds are faces' (bound()), and a face hit is a bound's reading: current while a recent scan hit a face
+  // (hit_within), no longer once scans miss it.
+  int current = 0;
+  for (int r = 20; r <= 40; ++r) {
+    if (!map.is_known({r, 40})) continue;
+    EXPECT_TRUE(map.bound()(r, 40)) << r;
+    current += map.hit_within({r, 40}, 1) ? 1 : 0;
+  }
+  EXPECT_GT(current, 0);
+  EXPECT_FALSE(map.bound()(29, 36));
+  for (int k = 0; k < 3; ++k) map.integrate_scan({}, {2.95, 3.05, 0.5});
+  for (int r = 20; r <= 40; ++r) EXPECT_FALSE(map.hit_within({r, 40}, 3)) << r;
+  // Ground assumed under the body is no face's bound.
+  map.assume_ground({1.05, 5.05}, 0.0, 0.3);
+  ASSERT_TRUE(map.assumed()(9, 10));
+  EXPECT_FALSE(map.bound()(9, 10));
 }
 
 // hit_within(cell, n): one of the last n scans hit the cell's surface.

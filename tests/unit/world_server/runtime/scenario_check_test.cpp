@@ -267,7 +267,7 @@ TEST_F(ScenarioCheckTest, UsageErrorsExitWith2) {
   EXPECT_NE(err_.str().find("--json requires --check"), std::string::npos) << err_.str();
   EXPECT_EQ(run({"--check", "--scenario", ramp, ramp}), 2);
   EXPECT_EQ(run({}), 2);
-  EXPECT_NE(err_.str().find("--scenario (or --resume DIR) is required"), std::string::npos) << err_.str();
+  EXPECT_NE(err_.str().find("--scenario (or --resume DIR, --fork DIR) is required"), std::string::npos) << err_.str();
 }
 
 TEST_F(ScenarioCheckTest, EveryShippedScenarioPasses) {

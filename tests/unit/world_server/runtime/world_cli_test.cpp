@@ -25,7 +25,7 @@ class WorldCliTest : public testing::WorldCliFixture {};
 
 TEST_F(WorldCliTest, UsageErrorsExitWith2) {
   EXPECT_EQ(run({}), 2);
-  EXPECT_NE(err_.str().find("--scenario (or --resume DIR) is required"), std::string::npos) << err_.str();
+  EXPECT_NE(err_.str().find("--scenario (or --resume DIR, --fork DIR) is required"), std::string::npos) << err_.str();
   const std::string ok = write("ok.pbtxt", testing::small_scenario_text());
   EXPECT_EQ(run({"--scenario", ok, "--frobnicate"}), 2);
   EXPECT_EQ(run({"--scenario", ok, "--agents", "0"}), 2);

@@ -1,0 +1,59 @@
+#include "marsala/world_server/runtime/fork_start.hpp"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <utility>
+#include <vector>
+
+#include "marsala/core/error.hpp"
+#include "marsala/runlog/run_log.hpp"
+#include "marsala/runlog/sha256.hpp"
+#include "marsala/scenario/terrain_builder.hpp"
+#include "marsala/world_server/records/persistence.hpp"
+#include "marsala/world_server/records/run_outputs.hpp"
+
+namespace marsala::world_server {
+
+WorldStart prepare_fork(const std::string& dir, std::uint64_t at, RuntimeOptions options, int domain_id) {
+  namespace fs = std::filesystem;
+  const std::string log_path = (fs::path(dir) / kRunLogFile).string();
+  if (!fs::is_regular_file(log_path))
+    throw InvalidArgument(fmt::format("--fork {}: no {} there: not a run folder", dir, kRunLogFile));
+  if (!options.overrides.empty() || options.seed)
+    throw InvalidArgument(fmt::format(
+        "--fork {}: --set and --seed may not change at a fork (the agents replay the parent's scenario and seed from "
+        "step 0); --agents (fewer), --max-steps and --step-deadline may",
+        dir));
+  std::error_code ec;
+  if (!options.out_dir.empty() && fs::exists(options.out_dir) && fs::equivalent(options.out_dir, dir, ec))
+    throw InvalidArgument(fmt::format("--fork {}: --out must be another folder than the parent's", dir));
+  const proto::LogHeader h = runlog::RunLogReader(log_path).header();
+  if (h.scenario_text().empty())
+    throw InvalidArgument(fmt::format("--fork {}: run.log's header holds no scenario text", dir));
+  const std::vector<std::string> overrides(h.overrides().begin(), h.overrides().end());
+  const scenario::Scenario scenario = scenario::parse_scenario(h.scenario_text(), h.scenario_file(), overrides);
+  Heightmap terrain = scenario::build_terrain(scenario);
+  if (runlog::terrain_sha256(terrain) != h.initial_terrain_sha256())
+    throw InvalidArgument(fmt::format("--fork {}: the header's scenario builds another terrain than the run's", dir));
+  const std::uint32_t fork_agents = options.agents;
+  options.agents = h.agents();
+  options.seed = h.seed();
+  if (options.max_steps == 0) options.max_steps = h.max_steps();
+  if (options.step_deadline_s == 0.0) options.step_deadline_s = h.step_deadline_s();
+  options.scenario_text = h.scenario_text();
+  options.overrides = overrides;
+  const std::string out_dir = options.out_dir;
+  options.out_dir.clear();  // checked below, once the fork is known to be possible
+  WorldStart start = prepare_world_start(scenario, std::move(terrain), std::move(options), domain_id);
+  start.fork.emplace(read_fork(dir, at, fork_agents, start.state));
+  start.options.out_dir = out_dir;
+  if (out_dir.empty()) return start;  // a check: no folder
+  if (start.options.replace)
+    clear_run_files(out_dir);
+  else
+    check_fresh_output_dir(out_dir);
+  return start;
+}
+
+}  // namespace marsala::world_server
