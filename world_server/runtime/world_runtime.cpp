@@ -144,8 +144,8 @@ struct WorldRuntime::Impl {
         participant(p),
         state(std::move(start.state)),
         resume(std::move(start.resume)),
-        fork(std::move(start.fork)),
         resume_step(state.step),
+        fork(std::move(start.fork)),
         recorder(recorder_setup(options, resume)),
         silence(std::chrono::milliseconds(static_cast<long long>(options.silence_timeout_s * 1000.0))) {
     sensing.emplace(state);
