@@ -2,11 +2,18 @@
 // Hand-made worlds for the world server's unit tests: a small scenario in text, states with admitted agents, and
 // requests with their envelope filled in.
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <string>
+
+#include <gtest/gtest.h>
 
 #include "marsala/core/heightmap.hpp"
 #include "marsala/protocol/messages.hpp"
 #include "marsala/scenario/scenario.hpp"
+#include "marsala/runlog/run_log.hpp"
+#include "marsala/world_server/records/persistence.hpp"
 #include "marsala/world_server/rules/admission.hpp"
 #include "marsala/world_server/rules/initial_state.hpp"
 #include "marsala/world_server/rules/world_state.hpp"
@@ -112,5 +119,41 @@ inline protocol::ActionRequest move_to(const WorldState& state, std::uint32_t id
 
 /// Cube layer of the test robot on 0.1 m cells [m].
 inline constexpr double kLayer = 0.05 * 0.05 * 0.05 / (0.1 * 0.1);
+
+/// A test with a folder of its own under the temporary directory (made empty before it, removed after it) and the
+/// small scenario that completes on a level site: the fixture of the tests that record a run and read it back.
+class RecordedRunTest : public ::testing::Test {
+ protected:
+  /// prefix: the start of the folder's name (the process id and the test's name follow).
+  explicit RecordedRunTest(std::string prefix) : prefix_(std::move(prefix)) {}
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           (prefix_ + std::to_string(::getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+    scenario_ = scenario::parse_scenario(small_scenario_text_completing(site_block(4, 1.0)), "small.pbtxt");
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  std::string log_path() const { return (dir_ / kRunLogFile).string(); }
+  /// Opens run.log for `state` (run id small-d1, 3 agents) and admits agents 1..3 into both, as a run starts.
+  runlog::RunLogWriter start_log(WorldState& state) const {
+    LogStart start;
+    start.run_id = "small-d1";
+    start.agents = 3;
+    runlog::RunLogWriter log = runlog::RunLogWriter::create(log_path(), log_header(scenario_, start, state.terrain));
+    for (std::uint32_t id = 1; id <= 3; ++id) {
+      admit(state, hello_for(state, id, 100 + id), AdmissionKind::kFirst);
+      log.append(admitted_record(state, id, AdmissionKind::kFirst));
+    }
+    return log;
+  }
+
+  scenario::Scenario scenario_;
+  std::filesystem::path dir_;
+
+ private:
+  std::string prefix_;
+};
 
 }  // namespace marsala::world_server::testing

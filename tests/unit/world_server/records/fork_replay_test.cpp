@@ -26,19 +26,11 @@ using testing::small_scenario_text_completing;
 
 /// A parent run recorded as the runtime records it, with requests that depend only on the state and a seeded random
 /// stream, so that a "fresh team" (new sessions, same seed) makes the same requests again, as deterministic agents do.
-class ForkReplayTest : public ::testing::Test {
+class ForkReplayTest : public testing::RecordedRunTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("marsala_fork_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    scenario_ = scenario::parse_scenario(small_scenario_text_completing(site_block(4, 1.0)), "small.pbtxt");
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  ForkReplayTest() : RecordedRunTest("marsala_fork_") {}
 
   WorldState initial() const { return make_world_state(scenario_, flat_terrain(), 3); }
-  std::string log_path() const { return (dir_ / kRunLogFile).string(); }
 
   /// Every live agent's requests of this step: deposits near the robot, sometimes a move.
   static std::vector<Submission> requests(const WorldState& state, std::mt19937_64& random) {
@@ -73,14 +65,7 @@ class ForkReplayTest : public ::testing::Test {
   /// after each step in sha_after_[k] (k steps applied).
   void record(int steps, int drop_at = 0) {
     WorldState state = initial();
-    LogStart start;
-    start.run_id = "small-d1";
-    start.agents = 3;
-    runlog::RunLogWriter log = runlog::RunLogWriter::create(log_path(), log_header(scenario_, start, state.terrain));
-    for (std::uint32_t id = 1; id <= 3; ++id) {
-      admit(state, hello_for(state, id, 100 + id), AdmissionKind::kFirst);
-      log.append(admitted_record(state, id, AdmissionKind::kFirst));
-    }
+    runlog::RunLogWriter log = start_log(state);
     std::mt19937_64 random(7);
     sha_after_.push_back(runlog::terrain_sha256(state.terrain));
     for (int k = 0; k < steps; ++k) {
@@ -95,8 +80,6 @@ class ForkReplayTest : public ::testing::Test {
     }
   }
 
-  scenario::Scenario scenario_;
-  fs::path dir_;
   std::vector<std::string> sha_after_;
 };
 

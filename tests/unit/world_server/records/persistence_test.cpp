@@ -25,31 +25,16 @@ using testing::small_scenario_text_completing;
 
 /// A run recorded step by step the way the runtime records it: admissions, a drop, a re-admission, random steps with
 /// accepted and rejected requests, on a level-site scenario so that the completion check's cache is exercised.
-class PersistenceTest : public ::testing::Test {
+class PersistenceTest : public testing::RecordedRunTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("marsala_persistence_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    scenario_ = scenario::parse_scenario(small_scenario_text_completing(site_block(4, 1.0)), "small.pbtxt");
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  PersistenceTest() : RecordedRunTest("marsala_persistence_") {}
 
   WorldState initial() const { return make_world_state(scenario_, terrain_, 3); }
-  std::string log_path() const { return (dir_ / kRunLogFile).string(); }
 
   /// Runs `steps` steps, writing run.log (and snapshot.pb after step `snapshot_after`, when > 0). Returns the state.
   WorldState record(int steps, int snapshot_after = 0) {
     WorldState state = initial();
-    LogStart start;
-    start.run_id = "small-d1";
-    start.agents = 3;
-    runlog::RunLogWriter log = runlog::RunLogWriter::create(log_path(), log_header(scenario_, start, state.terrain));
-    for (std::uint32_t id = 1; id <= 3; ++id) {
-      admit(state, hello_for(state, id, 100 + id), AdmissionKind::kFirst);
-      log.append(admitted_record(state, id, AdmissionKind::kFirst));
-    }
+    runlog::RunLogWriter log = start_log(state);
     std::mt19937_64 random(7);
     std::uniform_real_distribution<double> offset(-0.6, 0.6);
     for (int k = 0; k < steps; ++k) {
@@ -95,9 +80,7 @@ class PersistenceTest : public ::testing::Test {
     return make_snapshot(state, "small-d1", 0).SerializeAsString();
   }
 
-  scenario::Scenario scenario_;
   Heightmap terrain_ = flat_terrain();
-  fs::path dir_;
 };
 
 TEST_F(PersistenceTest, TheHeaderKeepsTheOverridesSoThatAResumeAppliesThemAgain) {
