@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 
+#include "marsala/core/iterators.hpp"
 #include "marsala/core/mars_processor.hpp"
 
 namespace marsala::agent::executive {
@@ -184,15 +185,13 @@ std::vector<CellIndex> band_centre_path(const deliberative::LocalMap& local, con
 CellMask band_mask(const deliberative::LocalMap& local, const std::vector<std::vector<CellIndex>>& paths,
                    double half_width_m) {
   CellMask out = CellMask::Zero(local.rows(), local.cols());
-  const double radius = half_width_m / local.geometry().cell_size_m;  // [cells]
-  const int reach = static_cast<int>(std::floor(radius));
+  const std::vector<CellIndex> disc = disc_offsets(half_width_m / local.geometry().cell_size_m);
   for (const auto& path : paths)
     for (const CellIndex p : path)
-      for (int dr = -reach; dr <= reach; ++dr)
-        for (int dc = -reach; dc <= reach; ++dc) {
-          const CellIndex q{p.row + dr, p.col + dc};
-          if (dr * dr + dc * dc <= radius * radius + 1e-9 && local.contains(q)) out(q.row, q.col) = 1;
-        }
+      for (const CellIndex d : disc) {
+        const CellIndex q{p.row + d.row, p.col + d.col};
+        if (local.contains(q)) out(q.row, q.col) = 1;
+      }
   return out;
 }
 

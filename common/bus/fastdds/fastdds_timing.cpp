@@ -18,13 +18,15 @@ namespace {
 using eprosima::fastrtps::Duration_t;
 
 long long nanoseconds(const Duration_t& d) { return static_cast<long long>(d.seconds) * 1000000000LL + d.nanosec; }
+Duration_t duration_of(long long ns) {
+  return Duration_t(static_cast<std::int32_t>(ns / 1000000000LL), static_cast<std::uint32_t>(ns % 1000000000LL));
+}
 
 }  // namespace
 
 void fast_repair(eprosima::fastrtps::rtps::WriterTimes& times) {
   if (times.heartbeatPeriod != eprosima::fastrtps::rtps::WriterTimes().heartbeatPeriod) return;
-  times.heartbeatPeriod = Duration_t(0, static_cast<std::uint32_t>(
-                                            std::chrono::duration_cast<std::chrono::nanoseconds>(kRepairHeartbeat).count()));
+  times.heartbeatPeriod = duration_of(std::chrono::duration_cast<std::chrono::nanoseconds>(kRepairHeartbeat).count());
   times.nackResponseDelay = Duration_t(0, 0);
 }
 
@@ -41,8 +43,7 @@ long long team_heartbeat_ns(long long period_ns, bool serves_team) {
 
 void follow_team(eprosima::fastrtps::rtps::WriterTimes& times, bool serves_team) {
   const long long ns = team_heartbeat_ns(nanoseconds(times.heartbeatPeriod), serves_team);
-  times.heartbeatPeriod = Duration_t(static_cast<std::int32_t>(ns / 1000000000LL),
-                                     static_cast<std::uint32_t>(ns % 1000000000LL));
+  times.heartbeatPeriod = duration_of(ns);
 }
 
 RepairTiming repair_timing_of_profile(const std::string& path) {
