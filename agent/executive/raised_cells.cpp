@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <limits>
 
+#include "marsala/agent/executive/lane.hpp"
 #include "marsala/core/error.hpp"
-#include "marsala/core/mars_processor.hpp"
 
 namespace marsala::agent::executive {
 
@@ -50,12 +50,7 @@ Heightmap first_seen_gap(const deliberative::LocalMap& local, const RaisedCells&
       const double seen = raised.first_height_m(local.to_global({r, c}));
       if (!std::isnan(seen)) first(r, c) = seen;
     }
-  const Heightmap bound = MarsProcessor(kappa).project(first);
-  Heightmap gap = local.gap;
-  for (int r = 0; r < local.rows(); ++r)
-    for (int c = 0; c < local.cols(); ++c)
-      gap(r, c) = std::min(gap(r, c), std::max(0.0, bound(r, c) - local.heights(r, c)));
-  return gap;
+  return gap_below_bound_of(local, first, kappa);
 }
 
 }  // namespace marsala::agent::executive

@@ -558,10 +558,19 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
   const Position base = context_.assignment.base;
   const double radius = context_.assignment.base_radius_m - kBaseMarginM;
   if (distance(robot, base) <= radius) {
-    request.refill = trace.refill = true;
-    memory_.home.clear();
+    refilled(trace, request);
     return true;
   }
+  // A robot that has got no nearer the base for as many steps as it takes to cross its window twice takes the way
+  // home over its own map and keeps it for the rest of the trip: the nearest cell of a window that moves with the
+  // robot can lie one way from here and the other way from the next cell, and a robot that follows it oscillates.
+  const double to_base_m = distance(robot, base);
+  if (to_base_m < memory_.return_nearest_m - 1e-9)
+    memory_.return_nearest_m = to_base_m, memory_.return_no_nearer = 0;
+  else
+    ++memory_.return_no_nearer;
+  const RobotBody& body = context_.type.body;
+  const bool patience_out = memory_.return_no_nearer >= static_cast<int>(std::ceil(4.0 * body.sensing_range_m / body.max_step_m));
   // Where to go: the navigable cell within the base radius nearest the robot; else, once this trip has taken the way
   // home (below), along it; else the navigable cell nearest the base when that is nearer than the robot by at least a
   // cell; else (the window holds no way nearer: a pocket whose exit lies beyond it) the way home over the robot's own
@@ -570,11 +579,11 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
   constexpr double kNone = std::numeric_limits<double>::infinity();
   std::optional<CellIndex> goal = best_navigable_cell(
       local, kNone, [&](Position p) { return distance(p, base) <= radius ? distance(p, robot) : kNone; });
-  if (!goal && !memory_.home.empty()) goal = home_goal(local);
+  if (!goal && (!memory_.home.empty() || patience_out)) goal = home_goal(local), trace.home_route = goal.has_value();
   if (!goal)
     goal = best_navigable_cell(local, distance(robot, base) - local.geometry().cell_size_m,
                                [&](Position p) { return distance(p, base); });
-  if (!goal) goal = home_goal(local);
+  if (!goal) goal = home_goal(local), trace.home_route = goal.has_value();
   if (!goal) goal = oldest_navigable_trajectory_cell(local);
   if (!goal) return false;
   trace.plan = modules_->router.plan(local.gap, local.navigable, local.robot, *goal);
@@ -587,12 +596,18 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
   if (motion) {
     move(*motion, trace, request);
     if (distance(motion->target, base) <= radius) {
-      request.refill = trace.refill = true;
-      memory_.home.clear();
+      refilled(trace, request);
       return true;
     }
   }
   return false;
+}
+
+void RampSteps::refilled(BuildTrace& trace, protocol::ActionRequest& request) {
+  request.refill = trace.refill = true;
+  memory_.home.clear();
+  memory_.return_nearest_m = std::numeric_limits<double>::infinity();
+  memory_.return_no_nearer = 0;
 }
 
 std::optional<CellIndex> RampSteps::home_goal(const deliberative::LocalMap& local) {

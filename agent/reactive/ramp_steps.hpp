@@ -26,6 +26,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -80,6 +81,7 @@ struct BuildTrace {
   std::optional<executive::Motion> motion;  ///< local indices
   executive::DepositionPlan deposition;
   bool refill = false;
+  bool home_route = false;  ///< return_step() headed along the trip's way home over the robot's map (home_goal)
 };
 
 /// What the robot sees in one frame: the augmented local map around it and its target.
@@ -224,6 +226,8 @@ class RampSteps {
     CellMask corridor;                             ///< the last local map's navigable cells, neighbours not taken out
     CellMask terrain_occupiable;                   ///< and its occupiable cells
     std::vector<CellIndex> home;                   ///< the way home of this trip (world cells), empty: not planned
+    double return_nearest_m = std::numeric_limits<double>::infinity();  ///< this trip's nearest to the base [m]
+    int return_no_nearer = 0;  ///< return steps since the robot last got nearer the base than return_nearest_m
     std::optional<executive::RaisedCells> raised;  ///< set_band_centre(): the structure seen built (first heights)
     Position target;                               ///< this frame's target (synthesize_view()) [m]
   };
@@ -258,6 +262,8 @@ class RampSteps {
   /// since) or whose gap fewer than kConfirmScans scans in a row showed (one scan's misread surface is no gap). The
   /// path is still planned on the whole gap.
   void clear_unconfirmed_gap(deliberative::LocalMap& local) const;
+  /// At the base: the refill asked for; the trip's way home and return progress forgotten.
+  void refilled(BuildTrace& trace, protocol::ActionRequest& request);
   /// On the way back: the cell of the way home (deliberative/home_route.hpp, planned when the trip has none or the
   /// robot left it) farthest along it that the robot can reach in its window; nullopt when bodies cut it there.
   std::optional<CellIndex> home_goal(const deliberative::LocalMap& local);
