@@ -529,7 +529,8 @@ TEST(MappingSystem, AFaceSeenFromBelowIsABoundNotASurface) {
 }
 
 // A face hit belongs to the cell whose face the ray crossed, found from the ray's crossings with the grid lines within
-// the hit's noise reach (3 spreads), not to the cell holding the hit point. Camera 0.5 m up at (1.55, 2.05), 0.1 m
+// the hit's noise reach (3 noise sd), not to the cell holding the hit point; none when two cells' faces lie within
+// 5 sd of it. Camera 0.5 m up at (1.55, 2.05), 0.1 m
 // cells (col = floor(x / 0.1), row = 59 - floor(y / 0.1)); rising hits ~0.45 m away: sd 2 mm + 2 mm/m^2 * 0.2 m^2 =
 // 2.4 mm, reach 7.2 mm.
 TEST(MappingSystem, AFaceHitIsCreditedToTheFaceTheRayCrossed) {
@@ -554,6 +555,16 @@ TEST(MappingSystem, AFaceHitIsCreditedToTheFaceTheRayCrossed) {
   corner.integrate_scan({hit(2.005, 1.9995, 0.55)}, origin);
   EXPECT_FALSE(corner.is_known({39, 20}));
   EXPECT_FALSE(corner.is_known({40, 20}));
+  // A crossing within 3 sd and a rival one within 5 sd: the ray (3, 1) / sqrt(10) from (1.55, 2.05191) to
+  // (1.99241, 2.199368) (range 0.47 m: sd 2.44 mm) crosses y = 2.2 into (37, 19) 2 mm past the hit, then x = 2.0 into
+  // (37, 20) 8 mm past it (over 3 sd, under 5): a hit past 3 sd is rare, but a scan holds thousands of hits, and
+  // neither cell is credited.
+  const Point3 east_north_east{1.55, 2.05191, 0.5};
+  MappingSystem rival(grid, 16, sensor_defaults(SensorKind::kRgbd));
+  rival.integrate_scan({{static_cast<float>(1.99241 - 1.55), static_cast<float>(2.199368 - 2.05191), 0.05F}},
+                       east_north_east);
+  EXPECT_FALSE(rival.is_known({37, 19}));
+  EXPECT_FALSE(rival.is_known({37, 20}));
   // The same direction 4.5 cm north of the corner: only x = 2.0 lies within reach, (39, 20) holds the face.
   MappingSystem beside(grid, 16, sensor_defaults(SensorKind::kRgbd));
   beside.integrate_scan({hit(2.005, 2.0445, 0.55)}, origin);
