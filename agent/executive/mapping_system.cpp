@@ -53,7 +53,7 @@ FaceCell face_cell(const GridGeometry& g, Point3 o, Point3 hit, double within_m,
   if (!(run > 0.0)) return {};
   const double cs = g.cell_size_m, ux = dx / run, uy = dy / run;
   // The nearest grid line of each axis is that axis's only crossing within reach (lines of one axis lie at least a
-  // cell apart along the ray; the reach is under half a cell): its signed distance from the hit along the ray [m].
+  // cell apart along the ray; the reach is at most half a cell): its signed distance from the hit along the ray [m].
   struct Crossing {
     CellIndex cell;
     double distance_m;
