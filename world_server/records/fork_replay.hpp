@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "idl/run_log.pb.h"
@@ -32,6 +33,7 @@ struct ForkOrigin {
   std::uint32_t parent_agents = 0;    ///< the parent's team [count]
   std::uint32_t agents = 0;           ///< the fork's team from step K on (<= parent_agents) [count]
   std::string parent_sha256_at_step;  ///< SHA-256 of the parent's terrain after its first K steps
+  std::vector<std::string> overrides;  ///< the fork's own --set FIELD=VALUE (world-only fields), from step 0
 };
 
 /// The parent's first K steps as recorded, checked against and substituted for the live requests.
@@ -41,6 +43,8 @@ class ForkReplay {
   ForkReplay(ForkOrigin origin, std::vector<proto::StepRecord> steps);
 
   const ForkOrigin& origin() const { return origin_; }
+  /// Records the fork's own --set (world-only fields, checked by the caller) in its origin.
+  void set_overrides(std::vector<std::string> overrides) { origin_.overrides = std::move(overrides); }
   /// True while `step` is one of the replayed ones (before K).
   bool replaying(std::uint64_t step) const { return step < origin_.at_step; }
   /// Empty when the live submissions of `step` are, agent by agent and in each agent's order, the recorded ones

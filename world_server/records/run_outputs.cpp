@@ -136,6 +136,8 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
     f->set_parent_sha256_at_step(info.fork->parent_sha256_at_step);
     f->set_parent_agents(info.fork->parent_agents);
     f->set_agents(info.fork->agents);
+    for (const std::string& o : info.fork->overrides) f->add_overrides(o);
+    for (std::uint32_t id = info.fork->agents + 1; id <= info.fork->parent_agents; ++id) f->add_left_agents(id);
   }
   s.set_run_id(info.run_id);
   s.set_seed(info.seed);
@@ -180,7 +182,7 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   }
   s.set_admitted(admitted);
   s.set_dropped(dropped);
-  const std::vector<std::uint32_t> missing = missing_slots(state);
+  const std::vector<std::uint32_t> missing = missing_slots(state, info.fork ? &*info.fork : nullptr);
   s.set_slots_missing(static_cast<std::uint32_t>(missing.size()));
   for (std::uint32_t id : missing) s.add_missing_agents(id);
   s.set_missed_deadlines(missed);
@@ -244,10 +246,11 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
 
 }  // namespace
 
-std::vector<std::uint32_t> missing_slots(const WorldState& state) {
+std::vector<std::uint32_t> missing_slots(const WorldState& state, const ForkOrigin* fork) {
+  const auto left_at_fork = [&](std::uint32_t id) { return fork && id > fork->agents && id <= fork->parent_agents; };
   std::vector<std::uint32_t> ids;
   for (const AgentRecord& a : state.agents)
-    if (!a.alive) ids.push_back(a.id);  // alive: admitted and not dropped (world_state.hpp)
+    if (!a.alive && !left_at_fork(a.id)) ids.push_back(a.id);  // alive: admitted and not dropped (world_state.hpp)
   std::sort(ids.begin(), ids.end());
   return ids;
 }

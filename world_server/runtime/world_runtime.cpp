@@ -706,7 +706,8 @@ struct WorldRuntime::Impl {
     recorder.finish(state, std::move(info), options.search_path);
     for (const AgentRecord& a : state.agents) result.admitted += a.admitted ? 1 : 0;
     result.team = static_cast<std::uint32_t>(state.agents.size());
-    result.slots_missing = static_cast<std::uint32_t>(missing_slots(state).size());
+    result.slots_missing =
+        static_cast<std::uint32_t>(missing_slots(state, fork ? &fork->origin() : nullptr).size());
     result.terrain_sha256 = runlog::terrain_sha256(state.terrain);
     if (resume) result.resumed_at_step = resume_step;
     spdlog::info("run over ({}): {} steps in {:.3f} s, {:.6f} m3 deposited, terrain sha256 {}", to_string(end_reason),
