@@ -36,7 +36,8 @@
 #                 afresh with its scenario (DIR/summary.json's scenario_file, or --scenario), seed and --set; the world
 #                 replays the parent's first K steps (--at K), checking each request against DIR/run.log (exit 8
 #                 naming the agent and the step when one differs), then goes on live: --agents M (fewer than the
-#                 parent's: the others leave at K), --max-steps, --set of fields only the world reads (max_steps,
+#                 parent's: the others leave at K; more: the slots above the parent's join at K, started with
+#                 the others and admitted at K), --max-steps, --set of fields only the world reads (max_steps,
 #                 step_deadline_s, stall_steps, goal, payload_path, site; applied from step 0). --seed and --set of a
 #                 field the agents read may not change (exit 2, nothing written); NEW's run.log header and
 #                 events.log say where the run came from
@@ -163,9 +164,12 @@ while [ $# -gt 0 ]; do
     *) echo "spawn.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
-fork_agents=""
+fork_agents="" parent_team=""
 if [ -n "$fork" ]; then
   fork_options  # sets scenario, agents, seed and set_args from the parent; fork_agents from --agents
+  parent_team="$agents"
+  # A larger team: its late slots start with the others and wait (unanswered) until the world admits them at K.
+  [[ "$fork_agents" =~ ^[0-9]+$ ]] && [ "$fork_agents" -gt "$agents" ] && agents="$fork_agents"
 elif [ -n "$fork_at" ]; then
   echo "spawn.sh: --at K is for --fork DIR" >&2; exit 2
 fi
@@ -276,7 +280,9 @@ trap 'echo "spawn.sh: interrupted, stopping children" >&2; exit 130' INT TERM
 world_pid=$!
 pids+=("$world_pid")
 for id in $(seq 1 "$agents"); do
-  "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds "$agent_dds" --domain "$domain" \
+  late_args=()  # a fork's late slot waits for K, up to the run's time limit
+  [ -n "$parent_team" ] && [ "$id" -gt "$parent_team" ] && late_args=(--admit-timeout "$timeout_s")
+  "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds "$agent_dds" --domain "$domain" "${late_args[@]}" \
     "${seed_args[@]}" "${set_args[@]}" "${sec_args[@]}" "${agent_args[@]}" "${key_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
   pids+=("$!")
 done

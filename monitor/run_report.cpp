@@ -51,15 +51,20 @@ std::string stall_account(const proto::StallAccount& stall) {
 
 /// Where a fork came from (docs/runtime.md#fork): its parent, K, the team from K on and its own --set.
 std::string fork_line(const proto::ForkOrigin& fork) {
-  const std::string left =
-      fork.left_agents().empty()
-          ? std::string()
-          : fmt::format(" (agent{} {} left at step {} by choice: not missing)", fork.left_agents_size() == 1 ? "" : "s",
-                        fmt::join(fork.left_agents(), ", "), fork.at_step());
+  std::string left;
+  if (!fork.left_agents().empty())
+    left = fmt::format(" (agent{} {} left at step {} by choice: not missing)", fork.left_agents_size() == 1 ? "" : "s",
+                       fmt::join(fork.left_agents(), ", "), fork.at_step());
+  else if (fork.agents() > fork.parent_agents())
+    left = fmt::format(" ({} of {} late slot{} joined at step {}{}{})", fork.joined_agents_size(),
+                       fork.agents() - fork.parent_agents(), fork.agents() - fork.parent_agents() == 1 ? "" : "s",
+                       fork.at_step(),
+                       fork.joined_agents().empty() ? "" : fork.joined_agents_size() == 1 ? ": agent " : ": agents ",
+                       fmt::join(fork.joined_agents(), ", "));
   const std::string set =
       fork.overrides().empty() ? std::string() : fmt::format(", --set {}", fmt::join(fork.overrides(), " "));
-  return fmt::format("  fork of {} at step {}: {} of {} agents{}{}\n", printable(fork.parent()), fork.at_step(),
-                     fork.agents(), fork.parent_agents(), left, printable(set));
+  return fmt::format("  fork of {} at step {}: team {} -> {}{}{}\n", printable(fork.parent()), fork.at_step(),
+                     fork.parent_agents(), fork.agents(), left, printable(set));
 }
 
 }  // namespace

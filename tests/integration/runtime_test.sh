@@ -31,7 +31,8 @@
 #                                                                    unchanged, it ends on the parent's terrain; a
 #                                                                    world-only --set (a goal) ends where the parent
 #                                                                    stood then; --agents 2 has the parent's terrain at
-#                                                                    K, diverges, completes with exit 0; agents of
+#                                                                    K, diverges, completes with exit 0; a third
+#                                                                    agent joins a fork of a 2-agent run at K; agents of
 #                                                                    another scenario: exit 8; bad input (an agents'
 #                                                                    field in --set too): exit 2, nothing written
 set -euo pipefail
@@ -608,11 +609,30 @@ case "$case_name" in
       [ ! -e "$work/bad" ] || fail "--fork $bad wrote $work/bad"
       [ "$(wc -l <"$work/bad.out")" -le 2 ] || { cat "$work/bad.out"; fail "--fork $bad said more than a line"; }
     done
+    # A larger team: a parent of 2, forked at 30 with 3; slot 3 joins at K (admitted then, on its start).
+    rc=0
+    "$root/deploy/spawn.sh" --scenario "$scenario" --agents 2 --domain "$domain" --out "$work/pair" --max-steps 60 \
+      --quiet --timeout 120 || rc=$?
+    [ "$rc" -eq 3 ] || fail "the parent of 2 exited $rc, not 3 (max_steps)"
+    rc=0
+    "$root/deploy/spawn.sh" --fork "$work/pair" --at 30 --agents 3 --domain "$domain" --out "$work/trio" --quiet \
+      --timeout 120 >"$work/trio.out" 2>&1 || rc=$?
+    [ "$rc" -eq 3 ] || { cat "$work/trio.out"; fail "the fork with a third agent exited $rc, not 3"; }
+    grep -q '"step":30,"agent":3,"kind":"admitted"' "$work/trio/events.log" || fail "agent 3 was not admitted at step 30"
+    tr -d '\n ' <"$work/trio/summary.json" | grep -q '"joined_agents":\[3\]' || fail "summary.json: no joined_agents"
+    [ "$(field slots_missing "$work/trio/summary.json")" = 0 ] || fail "the fork with a third agent misses a slot"
+    [ "$("$bin/marsala-monitor" replay "$work/trio" --to-step 30 | tail -1)" = \
+      "$("$bin/marsala-monitor" replay "$work/pair" --to-step 30 | tail -1)" ] ||
+      fail "the fork with a third agent did not have the parent's terrain at step 30"
+    # From its start at x 5.05 m, 30 steps of at most 0.2 m: it drove towards its ramp after joining.
+    x3=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["per_agent"][2]["x_m"])' "$work/trio/summary.json")
+    awk -v x="$x3" 'BEGIN { exit !(x > 7.0) }' || fail "agent 3 did not drive after joining (x $x3 m)"
     rc=0
     "$root/deploy/spawn.sh" --fork "$work/none" --at 1 --out "$work/bad" --quiet >/dev/null 2>&1 || rc=$?
     [ "$rc" -eq 2 ] && [ ! -e "$work/bad" ] || fail "a fork of no run exited $rc"
     echo "ok: fork at 100 unchanged ends on the parent's $parent_sha; with a goal it ends after $goal_steps steps as" \
       "the parent stood there; with 2 agents it has the parent's $at_k at step 100 and ends on $fewer_sha, exit 0;" \
+      "a third agent joins a fork of 2 at step 30;" \
       "other agents exit 8: $(grep -o 'agent [1-3] at step [0-9]*' "$work/other.out")"
     ;;
   *) echo "unknown case '$case_name'" >&2; exit 2 ;;

@@ -138,6 +138,8 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
     f->set_agents(info.fork->agents);
     for (const std::string& o : info.fork->overrides) f->add_overrides(o);
     for (std::uint32_t id = info.fork->agents + 1; id <= info.fork->parent_agents; ++id) f->add_left_agents(id);
+    for (std::uint32_t id = info.fork->parent_agents + 1; id <= info.fork->agents; ++id)
+      if (state.has_agent(id) && state.agent(id).admitted) f->add_joined_agents(id);
   }
   s.set_run_id(info.run_id);
   s.set_seed(info.seed);

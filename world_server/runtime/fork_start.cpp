@@ -14,6 +14,7 @@
 #include "marsala/scenario/terrain_builder.hpp"
 #include "marsala/world_server/records/persistence.hpp"
 #include "marsala/world_server/records/run_outputs.hpp"
+#include "marsala/world_server/rules/initial_state.hpp"
 
 namespace marsala::world_server {
 namespace {
@@ -22,6 +23,22 @@ namespace {
 bool sets(const std::vector<std::string>& overrides, const std::string& name) {
   return std::any_of(overrides.begin(), overrides.end(),
                      [&](const std::string& o) { return o.compare(0, name.size() + 1, name + "=") == 0; });
+}
+
+/// A larger team at a fork (docs/runtime.md#fork): its late slots are in the world's state from step 0, unadmitted;
+/// the rules must judge the parent's team as they did (the same starts, the same deposit bound). Throws
+/// InvalidArgument naming the slot that would change them.
+void check_late_slots(const WorldStart& start, std::uint32_t parent_agents, const std::string& dir) {
+  const WorldState parent = make_world_state(start.scenario, start.state.terrain, parent_agents);
+  for (std::uint32_t id = 1; id <= parent_agents; ++id)
+    if (!(parent.agent(id).start == start.state.agent(id).start))
+      throw InvalidArgument(fmt::format("--fork {} --agents {}: agent {} would start elsewhere than in the parent", dir,
+                                        start.state.agents.size(), id));
+  if (parent.deposit_bound_kappa != start.state.deposit_bound_kappa)
+    throw InvalidArgument(fmt::format(
+        "--fork {} --agents {}: the late slots' robot types change the world's deposit bound (kappa {} instead of "
+        "the parent's {}) from step 0, so the replay would differ; join robots of the parent's types",
+        dir, start.state.agents.size(), start.state.deposit_bound_kappa, parent.deposit_bound_kappa));
 }
 
 }  // namespace
@@ -45,7 +62,7 @@ WorldStart prepare_fork(const std::string& dir, std::uint64_t at, RuntimeOptions
   if (options.seed)
     throw InvalidArgument(fmt::format(
         "--fork {}: --seed may not change at a fork (the agents replay the parent's seed from step 0); --agents "
-        "(fewer), --max-steps, --step-deadline and --set of world-only fields may",
+        "(fewer or more), --max-steps, --step-deadline and --set of world-only fields may",
         dir));
   std::error_code ec;
   if (!options.out_dir.empty() && fs::exists(options.out_dir) && fs::equivalent(options.out_dir, dir, ec))
@@ -64,7 +81,7 @@ WorldStart prepare_fork(const std::string& dir, std::uint64_t at, RuntimeOptions
   if (runlog::terrain_sha256(terrain) != h.initial_terrain_sha256())
     throw InvalidArgument(fmt::format("--fork {}: the header's scenario builds another terrain than the run's", dir));
   const std::uint32_t fork_agents = options.agents;
-  options.agents = h.agents();
+  options.agents = std::max(h.agents(), fork_agents);  // a larger team: its late slots join at K
   options.seed = h.seed();
   // The parent's limits, unless the fork gives its own (--max-steps, --step-deadline, or --set of the field).
   if (options.max_steps == 0) options.max_steps = sets(fork_overrides, "max_steps") ? scenario.max_steps : h.max_steps();
@@ -79,6 +96,7 @@ WorldStart prepare_fork(const std::string& dir, std::uint64_t at, RuntimeOptions
   const std::string out_dir = options.out_dir;
   options.out_dir.clear();  // checked below, once the fork is known to be possible
   WorldStart start = prepare_world_start(scenario, std::move(terrain), std::move(options), domain_id);
+  if (fork_agents > h.agents()) check_late_slots(start, h.agents(), dir);
   start.fork.emplace(read_fork(dir, at, fork_agents, start.state));
   start.fork->set_overrides(fork_overrides);
   start.options.out_dir = out_dir;

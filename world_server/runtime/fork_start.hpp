@@ -22,10 +22,12 @@ std::string fork_override_problem(const std::string& field_value);
 /// A fork of the run in `dir` at step `at`: the scenario, seed and team from run.log's header (the terrain built from
 /// it and checked against the header's digest), max_steps and the step deadline the parent's unless `options` sets
 /// them, the parent's first `at` steps to replay (read_fork()), and from step `at` on a team of options.agents (0: the
-/// parent's; fewer: the slots above it leave at step `at`). options.overrides (--set) are applied after the parent's,
+/// parent's; fewer: the slots above it leave at step `at`; more: the slots above the parent's join at step `at`,
+/// unadmitted before). options.overrides (--set) are applied after the parent's,
 /// from step 0, and may name only world-only fields (fork_override_problem()). The run id and output folder are the
 /// fork's own. Throws InvalidArgument (one line; nothing written) when the fork cannot be made: `dir` not a run, a
-/// torn log, `at` beyond the parent's steps, a larger team, --seed or a --set of a field the agents read, max_steps
+/// torn log, `at` beyond the parent's steps, a team beyond the scenario's slots or whose late slots would change how
+/// the parent's team is judged, --seed or a --set of a field the agents read, max_steps
 /// below `at`, --out naming the parent's folder. An empty options.out_dir checks the fork only (marsala-world --check
 /// --fork): no folder is touched.
 WorldStart prepare_fork(const std::string& dir, std::uint64_t at, RuntimeOptions options, int domain_id);

@@ -266,14 +266,20 @@ TEST_F(RunReport, AForkNamesItsParentTheSlotsThatLeftAtKAndItsSet) {
     "fork": {"parent": "out/parent", "at_step": "100", "parent_agents": 3, "agents": 2, "left_agents": [3],
              "overrides": ["stall_steps=50", "goal.min_height_m=0.2"]}})");
   const std::string report = run_report(dir_.string());
-  EXPECT_NE(report.find("\n  fork of out/parent at step 100: 2 of 3 agents (agent 3 left at step 100 by choice: not "
+  EXPECT_NE(report.find("\n  fork of out/parent at step 100: team 3 -> 2 (agent 3 left at step 100 by choice: not "
                         "missing), --set stall_steps=50 goal.min_height_m=0.2\n"),
             std::string::npos)
       << report;
   EXPECT_EQ(report.find("short of"), std::string::npos) << report;
   write_summary(R"({"scenario": "ramp", "completed": true, "agents": 3, "admitted": 3,
     "fork": {"parent": "p", "at_step": "7", "parent_agents": 3, "agents": 3}})");
-  EXPECT_NE(run_report(dir_.string()).find("\n  fork of p at step 7: 3 of 3 agents\n"), std::string::npos);
+  EXPECT_NE(run_report(dir_.string()).find("\n  fork of p at step 7: team 3 -> 3\n"), std::string::npos);
+  write_summary(R"({"scenario": "ramp", "completed": true, "agents": 5, "admitted": 4, "slots_missing": 1,
+    "fork": {"parent": "p", "at_step": "7", "parent_agents": 3, "agents": 5, "joined_agents": [4]}})");
+  EXPECT_NE(run_report(dir_.string()).find("\n  fork of p at step 7: team 3 -> 5 (1 of 2 late slots joined at step 7: "
+                                           "agent 4)\n"),
+            std::string::npos)
+      << run_report(dir_.string());
 }
 
 TEST_F(RunReport, SaysWhatLandedOutsideTheConstructionBand) {

@@ -159,6 +159,20 @@ TEST(RunSummary, AForksSlotsThatLeftAtKAreNotMissingButItsOwnDeadSlotsAre) {
   drop_agent(s, 2, "request writer lost liveliness");  // a slot of the fork's own team dies for real: missing
   EXPECT_EQ(missing_slots(s, &fork), (std::vector<std::uint32_t>{2}));
   EXPECT_EQ(json_number(summary_json(s, info), "slots_missing"), 1.0);
+  // A fork that grew from 1 to 3 agents: slot 3 joined at K, slot 2 did not come (missing, honestly).
+  WorldState grown = make_world_state(testing::small_scenario(), flat_terrain(), 3);
+  admit(grown, testing::hello_for(grown, 1, 1001));
+  admit(grown, testing::hello_for(grown, 3, 1003));
+  fork.parent_agents = 1;
+  fork.agents = 3;
+  fork.overrides.clear();
+  info.fork = fork;
+  EXPECT_EQ(missing_slots(grown, &fork), (std::vector<std::uint32_t>{2}));
+  compact = summary_json(grown, info);
+  compact.erase(std::remove_if(compact.begin(), compact.end(), [](char c) { return c == ' ' || c == '\n'; }),
+                compact.end());
+  EXPECT_TRUE(has(compact, "\"joined_agents\":[3]")) << compact;
+  EXPECT_TRUE(has(compact, "\"left_agents\":[]")) << compact;
 }
 
 TEST(FinalPicture, PayloadRunsShowThePathEndsAgentsAndDepositors) {

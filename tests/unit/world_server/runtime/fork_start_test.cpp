@@ -88,31 +88,33 @@ class ForkStartTest : public testing::RecordedRunTest {
  protected:
   ForkStartTest() : RecordedRunTest("marsala_fork_start_") {}
 
-  void record(int steps) {
-    WorldState state = make_world_state(scenario_, scenario::build_terrain(scenario_), 3);
+  void record(int steps, std::uint32_t team = 3) {
+    WorldState state = make_world_state(scenario_, scenario::build_terrain(scenario_), team);
     LogStart start;
     start.run_id = "small-d1";
-    start.agents = 3;
+    start.agents = team;
     start.max_steps = 500;
     start.step_deadline_s = 10.0;
     start.scenario_text = small_scenario_text_completing(site_block(4, 1.0));
     runlog::RunLogWriter log =
         runlog::RunLogWriter::create(log_path(), log_header(scenario_, start, state.terrain));
-    for (std::uint32_t id = 1; id <= 3; ++id) {
+    for (std::uint32_t id = 1; id <= team; ++id) {
       admit(state, hello_for(state, id, 100 + id), AdmissionKind::kFirst);
       log.append(admitted_record(state, id, AdmissionKind::kFirst));
     }
     for (int k = 0; k < steps; ++k) {
       std::vector<Submission> idle;
-      for (std::uint32_t id = 1; id <= 3; ++id) idle.push_back({id, request_for(state, id)});
+      for (std::uint32_t id = 1; id <= team; ++id) idle.push_back({id, request_for(state, id)});
       const StepOutcome outcome = apply_step(state, idle);
       log.append(step_record(idle, outcome, state));
     }
   }
 
   /// A check of the fork (no folder) with these --set and --max-steps.
-  WorldStart fork_at(std::uint64_t at, const std::vector<std::string>& overrides, std::uint64_t max_steps = 0) const {
+  WorldStart fork_at(std::uint64_t at, const std::vector<std::string>& overrides, std::uint64_t max_steps = 0,
+                     std::uint32_t agents = 0) const {
     RuntimeOptions options;
+    options.agents = agents;
     options.out_dir.clear();
     options.overrides = overrides;
     options.max_steps = max_steps;
@@ -157,6 +159,22 @@ TEST_F(ForkStartTest, AFieldTheAgentsReadOrALimitBeforeKIsRefusedWithOneLine) {
             std::string::npos);
   EXPECT_NE(refusal(5, {}, 3).find("max_steps 3 would end the fork before it goes live at 5"), std::string::npos);
   EXPECT_EQ(refusal(5, {"max_steps=5"}), "accepted");
+}
+
+TEST_F(ForkStartTest, ALargerTeamHoldsItsLateSlotsUnadmittedUntilK) {
+  record(6, 2);  // a parent of 2 on the scenario's 3 slots
+  const WorldStart grown = fork_at(4, {}, 0, 3);
+  ASSERT_EQ(grown.state.agents.size(), 3u);
+  EXPECT_FALSE(grown.state.agent(3).admitted);
+  EXPECT_EQ(grown.fork->origin().parent_agents, 2u);
+  EXPECT_EQ(grown.fork->origin().agents, 3u);
+  EXPECT_EQ(grown.fork->origin().parent_sha256_at_step, fork_at(4, {}).fork->origin().parent_sha256_at_step);
+  try {
+    fork_at(4, {}, 0, 4);
+    ADD_FAILURE() << "a team beyond the scenario's slots was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("--agents 4 exceeds the 3 agent slots"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
