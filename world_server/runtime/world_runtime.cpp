@@ -309,9 +309,9 @@ struct WorldRuntime::Impl {
       const protocol::AgentHello& hello = received.sample;
       const SenderKey sender = sender_of(hello, received.from.prefix);
       if (!owned_session(hello, received.from) || waits_for_takeover(hello, sender, now)) continue;
-      if (late_slot(hello.agent_id) && !fork_live) continue;  // a fork's late slot: answered at K, not before
       const bool started = run_started && !(admitting_late && late_slot(hello.agent_id));
       const AdmissionDecision decision = decide_admission(state, hello, started, holder_connected(hello.agent_id));
+      if (late_slot(decision.agent_id) && !fork_live) continue;  // a fork's late slot: answered at K, not before
       // A live agent asking again holds no frame it takes: a negative acknowledgement (docs/runtime.md#resends).
       if (decision.accepted && decision.kind == AdmissionKind::kRepeat && run_started) {
         const std::uint32_t id = slot_hello(state, hello, decision).agent_id;  // "any slot": the one it holds
