@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <algorithm>
 #include <limits>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/mars_processor.hpp"
 
 namespace marsala::agent::executive {
 
@@ -39,6 +41,21 @@ CellMask RaisedCells::raised(const deliberative::LocalMap& local, double toleran
 
 double RaisedCells::first_height_m(CellIndex cell) const {
   return on_grid(cell) ? first_m_[index(cell)] : std::numeric_limits<double>::quiet_NaN();
+}
+
+Heightmap first_seen_gap(const deliberative::LocalMap& local, const RaisedCells& raised, double kappa) {
+  Heightmap first = local.heights;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      const double seen = raised.first_height_m(local.to_global({r, c}));
+      if (!std::isnan(seen)) first(r, c) = seen;
+    }
+  const Heightmap bound = MarsProcessor(kappa).project(first);
+  Heightmap gap = local.gap;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c)
+      gap(r, c) = std::min(gap(r, c), std::max(0.0, bound(r, c) - local.heights(r, c)));
+  return gap;
 }
 
 }  // namespace marsala::agent::executive

@@ -233,7 +233,8 @@ void RampSteps::keep_clear(const protocol::SensorFrame& frame, BuildView& view) 
 
 bool RampSteps::plan_path(const deliberative::LocalMap& local, BuildTrace& trace) {
   if (!trace.planned) {
-    trace.plan = modules_->planner.plan(local.gap, local.passable, local.robot, local.goal);
+    trace.plan = memory_.raised ? modules_->planner.plan(plan_gap(local), local.passable, local.robot, local.goal)
+                                : modules_->planner.plan(local.gap, local.passable, local.robot, local.goal);
     trace.planned = true;
   }
   return trace.plan.found;
@@ -333,6 +334,13 @@ Heightmap RampSteps::band_gap(const deliberative::LocalMap& local, const std::ve
   // strips, high ground along the way) neither raise its target nor widen it.
   const CellMask band = executive::band_mask(local, {ahead}, 0.5 * corridor_width_m_);
   return executive::band_fill_gap(local, band, construction_params(context_.type).kappa);
+}
+
+Heightmap RampSteps::plan_gap(const deliberative::LocalMap& local) const {
+  // Every front prices its way by the same terrain, the one first seen, not by what other fronts raised since: a
+  // strip built beside a robot's way would otherwise price the cells along it (the strip raises their MARS bound) and
+  // send the next front round it, to build a strip of its own (docs/runtime.md#the-construction-band).
+  return executive::first_seen_gap(local, *memory_.raised, construction_params(context_.type).kappa);
 }
 
 void RampSteps::move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) {
