@@ -155,14 +155,7 @@ TEST_F(ForkReplayTest, ALateJoinCannotBeRepeatedByATeamStartedAfresh) {
   // A parent in which agent 3 took a first admission at step 3 (as a fork's late slot does): a fork before it is
   // fine, one after it is refused.
   WorldState state = initial();
-  LogStart start;
-  start.run_id = "small-d1";
-  start.agents = 3;
-  runlog::RunLogWriter log = runlog::RunLogWriter::create(log_path(), log_header(scenario_, start, state.terrain));
-  for (std::uint32_t id = 1; id <= 2; ++id) {
-    admit(state, hello_for(state, id, 100 + id), AdmissionKind::kFirst);
-    log.append(admitted_record(state, id, AdmissionKind::kFirst));
-  }
+  runlog::RunLogWriter log = start_log(state, 2);
   std::mt19937_64 random(7);
   for (int k = 0; k < 6; ++k) {
     if (k == 3) {
