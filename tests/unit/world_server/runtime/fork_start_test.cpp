@@ -88,14 +88,16 @@ class ForkStartTest : public testing::RecordedRunTest {
  protected:
   ForkStartTest() : RecordedRunTest("marsala_fork_start_") {}
 
-  void record(int steps, std::uint32_t team = 3) {
+  /// Records the parent; `text` (default: the fixture's scenario) becomes the fixture's scenario and the header's.
+  void record(int steps, std::uint32_t team = 3, std::string text = small_scenario_text_completing(site_block(4, 1.0))) {
+    scenario_ = scenario::parse_scenario(text, "small.pbtxt");
     WorldState state = make_world_state(scenario_, scenario::build_terrain(scenario_), team);
     LogStart start;
     start.run_id = "small-d1";
     start.agents = team;
     start.max_steps = 500;
     start.step_deadline_s = 10.0;
-    start.scenario_text = small_scenario_text_completing(site_block(4, 1.0));
+    start.scenario_text = text;
     runlog::RunLogWriter log =
         runlog::RunLogWriter::create(log_path(), log_header(scenario_, start, state.terrain));
     for (std::uint32_t id = 1; id <= team; ++id) {
@@ -174,6 +176,34 @@ TEST_F(ForkStartTest, ALargerTeamHoldsItsLateSlotsUnadmittedUntilK) {
     ADD_FAILURE() << "a team beyond the scenario's slots was accepted";
   } catch (const InvalidArgument& e) {
     EXPECT_NE(std::string(e.what()).find("--agents 4 exceeds the 3 agent slots"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(ForkStartTest, LateSlotsThatWouldChangeTheDepositBoundAreRefused) {
+  // Slot 3 deposits cubes and builds at kappa 0.2: a team holding it judges deposits against a bound at 0.2 from step
+  // 0 (docs/runtime.md#deposit-bound); the parent of 2 layer robots had none.
+  std::string text = small_scenario_text_completing(site_block(4, 1.0), R"(
+robot_type {
+  name: "cuber"
+  behaviour: "scripted"
+  body { kappa: 0.3 delta_m: 1.0 eps_m: 0.05 max_step_m: 0.2 max_deposit_m3: 0.02 material_capacity_m3: 0.05
+         reach_m: 1.2 sensing_range_m: 1.0 proximity_range_m: 1.5 cube_size_m: 0.05 }
+  construction { kappa: 0.2 }
+  depositor { name: "cube" cube_size_m: 0.1 }
+}
+)");
+  const std::string third = R"(agent { robot_type: "tester" start { x_m: 1.05 y_m: 3.05 })";
+  text.replace(text.find(third), third.size(), R"(agent { robot_type: "cuber" start { x_m: 1.05 y_m: 3.05 })");
+  record(6, 2, text);
+  EXPECT_EQ(fork_at(4, {}).state.agents.size(), 2u);  // the parent's team forks as it was
+  try {
+    fork_at(4, {}, 0, 3);
+    ADD_FAILURE() << "a late slot changing the deposit bound was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("--agents 3: the late slots' robot types change the world's deposit bound"),
+              std::string::npos)
+        << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
   }
 }
 
