@@ -321,7 +321,9 @@ class FastDdsWriter final : public Writer<T> {
     qos.liveliness().lease_duration = duration(kWriterLease);
     qos.liveliness().announcement_period = duration(kLivelinessAnnouncement);
     fastdds::fast_repair(qos.reliable_writer_qos().times);  // docs/runtime.md#lossy-links
-    fastdds::follow_team(qos.reliable_writer_qos().times, context_->serves_team());
+    // A writer in a partition of its own (an agent's, partition_for()) serves one reader: the world's frames to an
+    // agent, the critical path of every step, heartbeat as fast as the agent's requests (docs/runtime.md#lossy-links).
+    fastdds::follow_team(qos.reliable_writer_qos().times, context_->serves_team() && options.partition.empty());
     // Readers filter what they receive themselves (the decode filter): the writer does not decode each sample again
     // per reader for them.
     qos.writer_resource_limits().reader_filters_allocation.maximum = 0;
