@@ -287,6 +287,37 @@ TEST(RampSteps, ReturnStepHeadsForTheBaseAndRefillsWithinItsRadius) {
   EXPECT_TRUE(q.refill);
 }
 
+TEST(RampSteps, ARobotNoNearerTheBaseForTwoWindowCrossingsTakesItsWayHomeForTheRestOfTheTrip) {
+  const auto owned = admitted_steps();
+  RampSteps& steps = *owned;
+  const RobotBody& body = steps.context().type.body;
+  // The robot's motions are never carried out (it stays at x = 6.05 m): as it would be when its window's nearest
+  // cell to the base lies one way from one cell and the other way from the next.
+  const int patience = static_cast<int>(std::ceil(4.0 * body.sensing_range_m / body.max_step_m));
+  for (int k = 0; k <= patience + 2; ++k) {
+    BuildTrace trace;
+    const protocol::SensorFrame f = frame(steps, static_cast<std::uint64_t>(k), {6.05, 3.05}, 0.0);
+    const BuildView view = steps.look(f, trace);
+    protocol::ActionRequest q = empty(steps, f);
+    EXPECT_FALSE(steps.return_step(view.local, f, trace, q));
+    EXPECT_TRUE(q.move) << k;
+    // The first call sets the trip's nearest distance; `patience` calls later without getting nearer, the way home.
+    EXPECT_EQ(trace.home_route, k >= patience) << k;
+  }
+  // At the base the trip ends: the next trip starts with the nearest cell of its window again.
+  BuildTrace trace;
+  protocol::SensorFrame f = frame(steps, 100, {0.85, 3.05}, 0.0);
+  BuildView view = steps.look(f, trace);
+  protocol::ActionRequest q = empty(steps, f);
+  EXPECT_TRUE(steps.return_step(view.local, f, trace, q));
+  trace = BuildTrace{};
+  f = frame(steps, 101, {6.05, 3.05}, 0.0);
+  view = steps.look(f, trace);
+  q = empty(steps, f);
+  EXPECT_FALSE(steps.return_step(view.local, f, trace, q));
+  EXPECT_FALSE(trace.home_route);
+}
+
 TEST(RampSteps, StepBackGoesAwayFromTheGoalBeforeTheRobotHasMoved) {
   const auto owned = admitted_steps();
   RampSteps& steps = *owned;
