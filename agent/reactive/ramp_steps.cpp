@@ -321,10 +321,7 @@ std::vector<CellIndex> RampSteps::on_band_centre(const deliberative::LocalMap& l
                              std::sqrt(2.0) * local.geometry().cell_size_m;
   if (!memory_.raised) return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m);
   // Nothing is built along a path that runs beside the structure (the cells seen raised): the band is there already.
-  // A cell counts as raised by at least half a cube layer (the least a deposition adds), and beyond a scanned map's
-  // noise margin.
-  const executive::DepositionParams& deposits = modules_->depositions.params();
-  const CellMask built = memory_.raised->raised(local, std::max(deposits.gap_margin_m, 0.5 * deposits.cube_layer_m));
+  const CellMask built = built_cells(local);
   return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m, &built);
 }
 
@@ -336,11 +333,25 @@ Heightmap RampSteps::band_gap(const deliberative::LocalMap& local, const std::ve
   return executive::band_fill_gap(local, band, construction_params(context_.type).kappa);
 }
 
+CellMask RampSteps::built_cells(const deliberative::LocalMap& local) const {
+  // A cell counts as raised by at least half a cube layer (the least a deposition adds), and beyond a scanned map's
+  // noise margin.
+  const executive::DepositionParams& deposits = modules_->depositions.params();
+  return memory_.raised->raised(local, std::max(deposits.gap_margin_m, 0.5 * deposits.cube_layer_m));
+}
+
 Heightmap RampSteps::plan_gap(const deliberative::LocalMap& local) const {
   // Every front prices its way by the same terrain, the one first seen, not by what other fronts raised since: a
   // strip built beside a robot's way would otherwise price the cells along it (the strip raises their MARS bound) and
   // send the next front round it, to build a strip of its own (docs/runtime.md#the-construction-band).
-  return executive::first_seen_gap(local, *memory_.raised, construction_params(context_.type).kappa);
+  Heightmap gap = executive::first_seen_gap(local, *memory_.raised, construction_params(context_.type).kappa);
+  // What is built is the structure: its cells cost nothing, so a front that meets a strip drives on along it and
+  // extends it at its tip.
+  const CellMask built = built_cells(local);
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c)
+      if (built(r, c) != 0) gap(r, c) = 0.0;
+  return gap;
 }
 
 void RampSteps::move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) {

@@ -244,9 +244,11 @@ class RampSteps {
   std::vector<CellIndex> on_band_centre(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const;
   // set_band_centre(): the window's gap against the band along `ahead` alone (executive::band_fill_gap).
   Heightmap band_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const;
-  // set_band_centre(): the window's gap against the terrain as first seen (executive::first_seen_gap): the price the
-  // planner routes by, so what is built raises no price beside it.
+  // set_band_centre(): the price the planner routes by: the window's gap against the terrain as first seen
+  // (executive::first_seen_gap), so what is built raises no price beside it, and 0 on the cells built (built_cells).
   Heightmap plan_gap(const deliberative::LocalMap& local) const;
+  // set_band_centre(): the window's cells seen raised since first seen (RaisedCells::raised), the structure.
+  CellMask built_cells(const deliberative::LocalMap& local) const;
   std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
   void clear_pad_gap(deliberative::LocalMap& local) const;  // no work on the base station's pad
   /// A scanned map: counts, per cell of the window, the scans in a row that showed its gap (beyond the margin) on a
