@@ -195,6 +195,22 @@ void run_brute(benchmark::State& state, Input kind) {
   state.counters["cells"] = static_cast<double>(h.size());
 }
 
+// An agent's local window (41 x 41 cells: a 5 m sensing range on 0.25 m cells in the shipped scenarios), one per
+// iteration, sliding a cell at a time over a 256^2 input as a driving robot's window does.
+void run_window(benchmark::State& state, Input kind) {
+  constexpr int kSide = 41, kSpan = 256 - kSide;
+  const Heightmap& h = input(kind, 256);
+  const MarsProcessor mars(kKappa);
+  int at = 0;
+  for (auto _ : state) {
+    const marsala::CellIndex corner{(at / kSpan) % kSpan, at % kSpan};
+    ++at;
+    Heightmap p = mars.project(h.window(corner, kSide, kSide));
+    benchmark::DoNotOptimize(p.data());
+  }
+  state.counters["cells"] = kSide * kSide;
+}
+
 // Required cases: terrain at several sizes; adversarial (a) MARS output fed back, (b) cones of
 // slope exactly kappa with apexes anywhere, (c) a plane of slope exactly kappa at 30 degrees.
 void BM_MarsTerrain(benchmark::State& state) { run_fast(state, Input::kTerrain); }
@@ -207,6 +223,9 @@ void BM_MarsPlane30(benchmark::State& state) { run_fast(state, Input::kPlane); }
 // than kappa.
 void BM_MarsRoof(benchmark::State& state) { run_fast(state, Input::kRoof); }
 void BM_MarsSteepPlane(benchmark::State& state) { run_fast(state, Input::kSteepPlane); }
+// Local windows of rough terrain and of a built surface (its MARS fed back).
+void BM_MarsWindowTerrain(benchmark::State& state) { run_window(state, Input::kTerrain); }
+void BM_MarsWindowFedBack(benchmark::State& state) { run_window(state, Input::kFedBack); }
 // Brute-force reference at the small sizes, for the speed-up ratio.
 void BM_BruteTerrain(benchmark::State& state) { run_brute(state, Input::kTerrain); }
 void BM_BruteFedBack(benchmark::State& state) { run_brute(state, Input::kFedBack); }
@@ -221,6 +240,8 @@ BENCHMARK(BM_MarsCones)->Arg(64)->Arg(1024)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MarsPlane30)->Arg(64)->Arg(1024)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MarsRoof)->Arg(1024)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MarsSteepPlane)->Arg(1024)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MarsWindowTerrain)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_MarsWindowFedBack)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_BruteTerrain)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BruteFedBack)->Arg(64)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BruteCones)->Arg(64)->Unit(benchmark::kMillisecond);

@@ -14,11 +14,14 @@
 #   terrain      the terrain_sha256's first 8 hex digits; "same" when it equals the unthrottled run's
 # It changes lo's MTU and qdisc, so run it inside a private network namespace:
 #   unshare -n bash -c 'ip link set lo up; bench/wire_bench.sh'
+# --fastdds-profile FILE: Fast DDS runs use this profile (MARSALA_DDS_CONFIG), e.g. deploy/dds/fastdds-slow.xml, the
+# rate-limited one for slow links (docs/runtime.md#slow-links); default: spawn.sh's loopback profile.
 # Usage: bench/wire_bench.sh [--dds "cyclone fastdds"] [--rates "none 1mbit"] [--runs N] [--steps N] [--timeout S]
+#                            [--fastdds-profile FILE]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${MARSALA_BUILD_DIR:-$root/build}"
-vendors="cyclone fastdds" rates="none 1mbit" runs=3 steps=100 timeout=150
+vendors="cyclone fastdds" rates="none 1mbit" runs=3 steps=100 timeout=150 fastdds_profile=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --dds) vendors="$2"; shift 2 ;;
@@ -26,6 +29,7 @@ while [ $# -gt 0 ]; do
     --runs) runs="$2"; shift 2 ;;
     --steps) steps="$2"; shift 2 ;;
     --timeout) timeout="$2"; shift 2 ;;
+    --fastdds-profile) fastdds_profile="$(realpath "$2")"; shift 2 ;;
     -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "wire_bench.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
@@ -34,6 +38,8 @@ for n in "$runs" "$steps" "$timeout"; do
   [[ "$n" =~ ^[0-9]+$ ]] && [ "$n" -ge 1 ] || { echo "wire_bench.sh: --runs, --steps, --timeout take N >= 1, got '$n'" >&2; exit 2; }
 done
 [ "${rates%%none*}" = "" ] || { echo "wire_bench.sh: --rates must start with none (the reference), got '$rates'" >&2; exit 2; }
+[ -z "$fastdds_profile" ] || [ -r "$fastdds_profile" ] ||
+  { echo "wire_bench.sh: --fastdds-profile: '$fastdds_profile' cannot be read" >&2; exit 2; }
 ip link set lo mtu 1500 2>/dev/null || { echo "wire_bench.sh: cannot set lo's MTU: run it inside unshare -n" >&2; exit 2; }
 [ -x "$build/bin/marsala-world" ] || "$root/deploy/build.sh" >/dev/null
 work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-wire.XXXXXX")"
@@ -55,8 +61,11 @@ for dds in $vendors; do
       domain=$((domain + 1))
       out="$work/$dds-$rate-$run"
       b0=$(lo 10) p0=$(lo 11) t0=$(date +%s.%N)
-      "$root/deploy/spawn.sh" --scenario "$root/deploy/scenarios/ramp.pbtxt" --agents 3 --dds "$dds" \
-        --domain "$domain" --max-steps "$steps" --out "$out" --quiet --timeout "$timeout" >/dev/null 2>&1 || true
+      profile=()
+      [ "$dds" = fastdds ] && [ -n "$fastdds_profile" ] && profile=("MARSALA_DDS_CONFIG=$fastdds_profile")
+      env "${profile[@]}" "$root/deploy/spawn.sh" --scenario "$root/deploy/scenarios/ramp.pbtxt" --agents 3 \
+        --dds "$dds" --domain "$domain" --max-steps "$steps" --out "$out" --quiet --timeout "$timeout" >/dev/null 2>&1 ||
+        true
       b1=$(lo 10) p1=$(lo 11) t1=$(date +%s.%N)
       s=$(jq -r '.steps // 0' "$out/summary.json" 2>/dev/null || echo 0)
       sha=$(jq -r '.terrain_sha256 // "none"' "$out/summary.json" 2>/dev/null || echo none)

@@ -9,7 +9,8 @@
 #                        [--quiet] [--profile lo|lan|unicast] [--peers ADDR[,ADDR...]] [--secure | --insecure]
 #                        [--identities DIR] [--frames-every K] [--dump-maps] [--metrics-port P] [--trace FILE]
 #                        [--set FIELD=VALUE ...]
-#        deploy/spawn.sh --fork DIR --at K --out NEW [--agents M] [--max-steps N] [--scenario FILE] [options above]
+#        deploy/spawn.sh --fork DIR --at K --out NEW [--agents M] [--max-steps N] [--set FIELD=VALUE ...]
+#                        [--scenario FILE] [options above]
 #   --out         output folder (default out/<scenario>-<N>, whose previous run is replaced); the world refuses a
 #                 folder that holds another run's files, unless --replace removes them (and logs/, maps/) first, and
 #                 a folder a live (or paused) world holds, --replace or not (exit 2 naming its pid)
@@ -35,8 +36,11 @@
 #                 afresh with its scenario (DIR/summary.json's scenario_file, or --scenario), seed and --set; the world
 #                 replays the parent's first K steps (--at K), checking each request against DIR/run.log (exit 8
 #                 naming the agent and the step when one differs), then goes on live: --agents M (fewer than the
-#                 parent's: the others leave at K), --max-steps. --set and --seed may not change (exit 2, nothing
-#                 written); NEW's run.log header and events.log say where the run came from
+#                 parent's: the others leave at K; more: the slots above the parent's join at K, started with
+#                 the others and admitted at K), --max-steps, --set of fields only the world reads (max_steps,
+#                 step_deadline_s, stall_steps, goal, payload_path, site; applied from step 0). --seed and --set of a
+#                 field the agents read may not change (exit 2, nothing written); NEW's run.log header and
+#                 events.log say where the run came from
 #   --profile     where DDS traffic goes (deploy/dds/<vendor>-<profile>.xml): lo (default: this host's loopback only,
 #                 unsecured unless --secure), lan (a subnet, multicast discovery) or unicast (no multicast: every
 #                 process finds the world at --peers); lan and unicast run secured unless --insecure
@@ -63,7 +67,7 @@ bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
 scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0 frames_every=""
 replace=0 secure=0 insecure=0 dump_maps=0 set_args=() observe_args=() profile="" peers="" identities=""
-fork="" fork_at=""
+fork="" fork_at="" fork_set_args=()
 usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; }  # the whole header comment
 # The profile and security options, checked and settled: secure=1 for --secure and for lan/unicast without
 # --insecure; identities and peers get their defaults (--peers implies --profile unicast). Exit 2 naming what is wrong.
@@ -104,9 +108,11 @@ identities_domain() { sed -n 's/^domain=\([0-9][0-9]*\)$/\1/p' "$identities/mani
 # A fork's parent (--fork DIR --at K): its team, scenario file, seed and --set from DIR/summary.json, for the agents;
 # the world takes them from DIR/run.log and checks the rest. Exit 2 naming what is wrong, nothing written.
 fork_options() {
-  [ -z "$seed" ] && [ ${#set_args[@]} -eq 0 ] ||
-    { echo "spawn.sh: --set and --seed may not change at a fork (the parent's apply); --agents, --max-steps may" >&2
+  [ -z "$seed" ] ||
+    { echo "spawn.sh: --seed may not change at a fork (the parent's applies); --agents, --max-steps, --set of world-only fields may" >&2
       exit 2; }
+  fork_set_args=("${set_args[@]}")  # the fork's own: for the world alone, which refuses fields the agents read
+  set_args=()
   [[ "$fork_at" =~ ^[0-9]+$ ]] || { echo "spawn.sh: --fork needs --at K (K >= 0), got '$fork_at'" >&2; exit 2; }
   [ -f "$fork/summary.json" ] && [ -f "$fork/run.log" ] ||
     { echo "spawn.sh: --fork $fork: not a finished run folder (no summary.json and run.log)" >&2; exit 2; }
@@ -158,9 +164,12 @@ while [ $# -gt 0 ]; do
     *) echo "spawn.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
-fork_agents=""
+fork_agents="" parent_team=""
 if [ -n "$fork" ]; then
   fork_options  # sets scenario, agents, seed and set_args from the parent; fork_agents from --agents
+  parent_team="$agents"
+  # A larger team: its late slots start with the others and wait (unanswered) until the world admits them at K.
+  [[ "$fork_agents" =~ ^[0-9]+$ ]] && [ "$fork_agents" -gt "$agents" ] && agents="$fork_agents"
 elif [ -n "$fork_at" ]; then
   echo "spawn.sh: --at K is for --fork DIR" >&2; exit 2
 fi
@@ -222,7 +231,8 @@ seed_args=()
 [ -n "$seed" ] && seed_args=(--seed "$seed")
 agent_args=()
 [ "$dump_maps" -eq 1 ] && agent_args=(--dump-map "$out/maps")
-[ -z "$fork" ] && world_args+=("${seed_args[@]}" "${set_args[@]}")  # a fork's world takes them from the parent's log
+# A fork's world takes the parent's from its log, and only the fork's own --set from here.
+if [ -z "$fork" ]; then world_args+=("${seed_args[@]}" "${set_args[@]}"); else world_args+=("${fork_set_args[@]}"); fi
 world_args+=("${observe_args[@]}")
 
 # The world's own start-up checks with the run's arguments (scenario, terrain, completion, slots, --agents), before
@@ -270,7 +280,9 @@ trap 'echo "spawn.sh: interrupted, stopping children" >&2; exit 130' INT TERM
 world_pid=$!
 pids+=("$world_pid")
 for id in $(seq 1 "$agents"); do
-  "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds "$agent_dds" --domain "$domain" \
+  late_args=()  # a fork's late slot waits for K, up to the run's time limit
+  [ -n "$parent_team" ] && [ "$id" -gt "$parent_team" ] && late_args=(--admit-timeout "$timeout_s")
+  "$bin/marsala-agent" --scenario "$scenario" --id "$id" --dds "$agent_dds" --domain "$domain" "${late_args[@]}" \
     "${seed_args[@]}" "${set_args[@]}" "${sec_args[@]}" "${agent_args[@]}" "${key_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
   pids+=("$!")
 done

@@ -49,6 +49,24 @@ std::string stall_account(const proto::StallAccount& stall) {
   return out;
 }
 
+/// Where a fork came from (docs/runtime.md#fork): its parent, K, the team from K on and its own --set.
+std::string fork_line(const proto::ForkOrigin& fork) {
+  std::string left;
+  if (!fork.left_agents().empty())
+    left = fmt::format(" (agent{} {} left at step {} by choice: not missing)", fork.left_agents_size() == 1 ? "" : "s",
+                       fmt::join(fork.left_agents(), ", "), fork.at_step());
+  else if (fork.agents() > fork.parent_agents())
+    left = fmt::format(" ({} of {} late slot{} joined at step {}{}{})", fork.joined_agents_size(),
+                       fork.agents() - fork.parent_agents(), fork.agents() - fork.parent_agents() == 1 ? "" : "s",
+                       fork.at_step(),
+                       fork.joined_agents().empty() ? "" : fork.joined_agents_size() == 1 ? ": agent " : ": agents ",
+                       fmt::join(fork.joined_agents(), ", "));
+  const std::string set =
+      fork.overrides().empty() ? std::string() : fmt::format(", --set {}", fmt::join(fork.overrides(), " "));
+  return fmt::format("  fork of {} at step {}: team {} -> {}{}{}\n", printable(fork.parent()), fork.at_step(),
+                     fork.parent_agents(), fork.agents(), left, printable(set));
+}
+
 }  // namespace
 
 std::string run_report(const std::string& dir) {
@@ -81,6 +99,7 @@ std::string run_report(const std::string& dir) {
                        "the band\n",
                        s.material().deposited_m3(), s.material().needed_m3(), s.material().ratio(),
                        s.material().off_band_m3());
+  if (s.has_fork()) out += fork_line(s.fork());
   if (s.slots_missing() > 0)
     out += fmt::format("  short of {} of {} slots at the end (never admitted, or dropped and not back): agent{} {}\n",
                        s.slots_missing(), s.agents(), s.missing_agents_size() == 1 ? "" : "s",

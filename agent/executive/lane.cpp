@@ -202,6 +202,10 @@ Heightmap band_fill_gap(const deliberative::LocalMap& local, const CellMask& ban
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c)
       if (band(r, c) == 0) sources(r, c) = low;
+  return gap_below_bound_of(local, sources, kappa);
+}
+
+Heightmap gap_below_bound_of(const deliberative::LocalMap& local, const Heightmap& sources, double kappa) {
   const Heightmap target = MarsProcessor(kappa).project(sources);
   Heightmap gap = local.gap;
   for (int r = 0; r < local.rows(); ++r)

@@ -34,27 +34,43 @@ constexpr double kMaxEdgeBand = 0.3;
 /// A hit this close to a cell edge lies on it, within the precision of a scan's float offsets [m]; a sensor whose
 /// noise is smaller places it there only when the ray struck a face standing on the edge (docs/runtime.md#mapping).
 constexpr double kOnEdgeM = 1e-5;
+/// A face hit is credited to a cell only when no other cell's face lies within kFaceRivalNoise range-noise standard
+/// deviations of it along the ray: a scan holds thousands of hits, and some lie past 3 of them [1].
+constexpr double kFaceRivalNoise = 5.0;
 
-/// The cell whose face a hit struck, when the ray's horizontal path crosses a cell edge within within_m [m] of the
-/// hit (range noise moves a hit along its ray): the cell the ray enters at the crossing nearest to the hit; nullopt
-/// when the ray is (nearly) vertical or crosses no edge that near.
-std::optional<CellIndex> face_cell(const GridGeometry& g, Point3 o, Point3 hit, double within_m) {
+/// Where a face hit may have struck: the faces of the cells the ray's horizontal path enters at the cell edges it
+/// crosses near the hit along the ray (range noise moves a hit along its ray, before or past the face). kOne: one
+/// crossing within within_m [m] of the hit, into `cell`, and no crossing into another cell within rival_m [m]
+/// (>= within_m); kTwo: near a cell corner the ray enters two cells within rival_m, one across an x line and one
+/// across a y line, and the hit may lie on either's face; kNone: no crossing within within_m (or a (nearly) vertical
+/// ray) (docs/runtime.md#mapping).
+struct FaceCell {
+  enum Kind { kNone, kOne, kTwo } kind = kNone;
+  CellIndex cell{-1, -1};
+};
+FaceCell face_cell(const GridGeometry& g, Point3 o, Point3 hit, double within_m, double rival_m) {
   const double dx = hit.x - o.x, dy = hit.y - o.y, run = std::hypot(dx, dy);
-  if (!(run > 0.0)) return std::nullopt;
+  if (!(run > 0.0)) return {};
   const double cs = g.cell_size_m, ux = dx / run, uy = dy / run;
-  double best = std::numeric_limits<double>::infinity(), along = 0.0;
-  // The nearest grid line of each axis is the nearest crossing with that axis's lines (signed distance along the ray).
-  if (std::abs(ux) > 1e-9) {
-    const double s = (g.xll_m + std::round((hit.x - g.xll_m) / cs) * cs - hit.x) / ux;
-    if (std::abs(s) < best) best = std::abs(s), along = s;
-  }
-  if (std::abs(uy) > 1e-9) {
-    const double s = (g.yll_m + std::round((hit.y - g.yll_m) / cs) * cs - hit.y) / uy;
-    if (std::abs(s) < best) best = std::abs(s), along = s;
-  }
-  if (!(best <= within_m)) return std::nullopt;
-  const double past = along + 10.0 * kOnEdgeM;  // just past the crossing, in the cell the ray enters
-  return g.cell_at({hit.x + past * ux, hit.y + past * uy});
+  // The nearest grid line of each axis is that axis's only crossing within reach (lines of one axis lie at least a
+  // cell apart along the ray; the reach is at most half a cell): its signed distance from the hit along the ray [m].
+  struct Crossing {
+    CellIndex cell;
+    double distance_m;
+  };
+  std::optional<Crossing> near[2];
+  const auto cross = [&](int axis, double along) {
+    if (!(std::abs(along) <= rival_m)) return;
+    const double past = along + 10.0 * kOnEdgeM;  // just past the crossing, in the cell the ray enters
+    const std::optional<CellIndex> entered = g.cell_at({hit.x + past * ux, hit.y + past * uy});
+    if (entered) near[axis] = Crossing{*entered, std::abs(along)};
+  };
+  if (std::abs(ux) > 1e-9) cross(0, (g.xll_m + std::round((hit.x - g.xll_m) / cs) * cs - hit.x) / ux);
+  if (std::abs(uy) > 1e-9) cross(1, (g.yll_m + std::round((hit.y - g.yll_m) / cs) * cs - hit.y) / uy);
+  if (near[0] && near[1] && near[0]->cell != near[1]->cell) return {FaceCell::kTwo, {-1, -1}};
+  for (const std::optional<Crossing>& c : near)
+    if (c && c->distance_m <= within_m) return {FaceCell::kOne, c->cell};
+  return {};
 }
 
 /// Where a ray from `o` to `p` entered the column of `cell` (the cell holding p): the cell it crossed just before and
@@ -358,14 +374,17 @@ MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& p
     // it, and a wall seen only from the side (above the sensor) would never be mapped.
     const bool exact = spread < kOnEdgeM, rising = hit.z >= origin.z;
     if (exact || rising) {
-      const auto face = face_cell(g, origin, hit, exact ? kOnEdgeM : spread);
-      if (!face && rising) continue;  // farther from every edge than noise carries a hit: an outlier
-      if (face && spread <= kMaxEdgeBand * cs + 1e-12) {
-        const Position in = g.cell_center(*face);
+      const FaceCell face = exact ? face_cell(g, origin, hit, kOnEdgeM, kOnEdgeM)
+                                  : face_cell(g, origin, hit, spread, kFaceRivalNoise / kEdgeBandNoise * spread);
+      // Farther from every edge than noise carries a hit: an outlier. Within reach of two cells' faces at a corner:
+      // either may be the one struck, and crediting the other raised a pit's floor to its neighbour's face.
+      if ((face.kind == FaceCell::kNone && rising) || face.kind == FaceCell::kTwo) continue;
+      if (face.kind == FaceCell::kOne && spread <= kMaxEdgeBand * cs + 1e-12) {
+        const Position in = g.cell_center(face.cell);
         const Position at{std::clamp(hit.x, in.x - 0.49 * cs, in.x + 0.49 * cs),
                           std::clamp(hit.y, in.y - 0.49 * cs, in.y + 0.49 * cs)};
         batch.cloud.push_back(tree_point(g, at.x, at.y, hit.z));
-        batch.faces.push_back({*face, hit.z});
+        batch.faces.push_back({face.cell, hit.z});
         continue;
       }
     }

@@ -3,8 +3,10 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <algorithm>
 #include <limits>
 
+#include "marsala/agent/executive/lane.hpp"
 #include "marsala/core/error.hpp"
 
 namespace marsala::agent::executive {
@@ -39,6 +41,16 @@ CellMask RaisedCells::raised(const deliberative::LocalMap& local, double toleran
 
 double RaisedCells::first_height_m(CellIndex cell) const {
   return on_grid(cell) ? first_m_[index(cell)] : std::numeric_limits<double>::quiet_NaN();
+}
+
+Heightmap first_seen_gap(const deliberative::LocalMap& local, const RaisedCells& raised, double kappa) {
+  Heightmap first = local.heights;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      const double seen = raised.first_height_m(local.to_global({r, c}));
+      if (!std::isnan(seen)) first(r, c) = seen;
+    }
+  return gap_below_bound_of(local, first, kappa);
 }
 
 }  // namespace marsala::agent::executive

@@ -233,7 +233,8 @@ void RampSteps::keep_clear(const protocol::SensorFrame& frame, BuildView& view) 
 
 bool RampSteps::plan_path(const deliberative::LocalMap& local, BuildTrace& trace) {
   if (!trace.planned) {
-    trace.plan = modules_->planner.plan(local.gap, local.passable, local.robot, local.goal);
+    trace.plan = memory_.raised ? modules_->planner.plan(plan_gap(local), local.passable, local.robot, local.goal)
+                                : modules_->planner.plan(local.gap, local.passable, local.robot, local.goal);
     trace.planned = true;
   }
   return trace.plan.found;
@@ -320,10 +321,7 @@ std::vector<CellIndex> RampSteps::on_band_centre(const deliberative::LocalMap& l
                              std::sqrt(2.0) * local.geometry().cell_size_m;
   if (!memory_.raised) return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m);
   // Nothing is built along a path that runs beside the structure (the cells seen raised): the band is there already.
-  // A cell counts as raised by at least half a cube layer (the least a deposition adds), and beyond a scanned map's
-  // noise margin.
-  const executive::DepositionParams& deposits = modules_->depositions.params();
-  const CellMask built = memory_.raised->raised(local, std::max(deposits.gap_margin_m, 0.5 * deposits.cube_layer_m));
+  const CellMask built = built_cells(local);
   return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m, &built);
 }
 
@@ -333,6 +331,27 @@ Heightmap RampSteps::band_gap(const deliberative::LocalMap& local, const std::ve
   // strips, high ground along the way) neither raise its target nor widen it.
   const CellMask band = executive::band_mask(local, {ahead}, 0.5 * corridor_width_m_);
   return executive::band_fill_gap(local, band, construction_params(context_.type).kappa);
+}
+
+CellMask RampSteps::built_cells(const deliberative::LocalMap& local) const {
+  // A cell counts as raised by at least half a cube layer (the least a deposition adds), and beyond a scanned map's
+  // noise margin.
+  const executive::DepositionParams& deposits = modules_->depositions.params();
+  return memory_.raised->raised(local, std::max(deposits.gap_margin_m, 0.5 * deposits.cube_layer_m));
+}
+
+Heightmap RampSteps::plan_gap(const deliberative::LocalMap& local) const {
+  // Every front prices its way by the same terrain, the one first seen, not by what other fronts raised since: a
+  // strip built beside a robot's way would otherwise price the cells along it (the strip raises their MARS bound) and
+  // send the next front round it, to build a strip of its own (docs/runtime.md#the-construction-band).
+  Heightmap gap = executive::first_seen_gap(local, *memory_.raised, construction_params(context_.type).kappa);
+  // What is built is the structure: its cells cost nothing, so a front that meets a strip drives on along it and
+  // extends it at its tip.
+  const CellMask built = built_cells(local);
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c)
+      if (built(r, c) != 0) gap(r, c) = 0.0;
+  return gap;
 }
 
 void RampSteps::move(const executive::Motion& motion, BuildTrace& trace, protocol::ActionRequest& request) {
@@ -550,10 +569,19 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
   const Position base = context_.assignment.base;
   const double radius = context_.assignment.base_radius_m - kBaseMarginM;
   if (distance(robot, base) <= radius) {
-    request.refill = trace.refill = true;
-    memory_.home.clear();
+    refilled(trace, request);
     return true;
   }
+  // A robot that has got no nearer the base for as many steps as it takes to cross its window twice takes the way
+  // home over its own map and keeps it for the rest of the trip: the nearest cell of a window that moves with the
+  // robot can lie one way from here and the other way from the next cell, and a robot that follows it oscillates.
+  const double to_base_m = distance(robot, base);
+  if (to_base_m < memory_.return_nearest_m - 1e-9)
+    memory_.return_nearest_m = to_base_m, memory_.return_no_nearer = 0;
+  else
+    ++memory_.return_no_nearer;
+  const RobotBody& body = context_.type.body;
+  const bool patience_out = memory_.return_no_nearer >= static_cast<int>(std::ceil(4.0 * body.sensing_range_m / body.max_step_m));
   // Where to go: the navigable cell within the base radius nearest the robot; else, once this trip has taken the way
   // home (below), along it; else the navigable cell nearest the base when that is nearer than the robot by at least a
   // cell; else (the window holds no way nearer: a pocket whose exit lies beyond it) the way home over the robot's own
@@ -562,11 +590,11 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
   constexpr double kNone = std::numeric_limits<double>::infinity();
   std::optional<CellIndex> goal = best_navigable_cell(
       local, kNone, [&](Position p) { return distance(p, base) <= radius ? distance(p, robot) : kNone; });
-  if (!goal && !memory_.home.empty()) goal = home_goal(local);
+  if (!goal && (!memory_.home.empty() || patience_out)) goal = home_goal(local), trace.home_route = goal.has_value();
   if (!goal)
     goal = best_navigable_cell(local, distance(robot, base) - local.geometry().cell_size_m,
                                [&](Position p) { return distance(p, base); });
-  if (!goal) goal = home_goal(local);
+  if (!goal) goal = home_goal(local), trace.home_route = goal.has_value();
   if (!goal) goal = oldest_navigable_trajectory_cell(local);
   if (!goal) return false;
   trace.plan = modules_->router.plan(local.gap, local.navigable, local.robot, *goal);
@@ -579,12 +607,18 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
   if (motion) {
     move(*motion, trace, request);
     if (distance(motion->target, base) <= radius) {
-      request.refill = trace.refill = true;
-      memory_.home.clear();
+      refilled(trace, request);
       return true;
     }
   }
   return false;
+}
+
+void RampSteps::refilled(BuildTrace& trace, protocol::ActionRequest& request) {
+  request.refill = trace.refill = true;
+  memory_.home.clear();
+  memory_.return_nearest_m = std::numeric_limits<double>::infinity();
+  memory_.return_no_nearer = 0;
 }
 
 std::optional<CellIndex> RampSteps::home_goal(const deliberative::LocalMap& local) {

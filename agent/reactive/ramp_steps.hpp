@@ -26,6 +26,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -80,6 +81,7 @@ struct BuildTrace {
   std::optional<executive::Motion> motion;  ///< local indices
   executive::DepositionPlan deposition;
   bool refill = false;
+  bool home_route = false;  ///< return_step() headed along the trip's way home over the robot's map (home_goal)
 };
 
 /// What the robot sees in one frame: the augmented local map around it and its target.
@@ -224,6 +226,8 @@ class RampSteps {
     CellMask corridor;                             ///< the last local map's navigable cells, neighbours not taken out
     CellMask terrain_occupiable;                   ///< and its occupiable cells
     std::vector<CellIndex> home;                   ///< the way home of this trip (world cells), empty: not planned
+    double return_nearest_m = std::numeric_limits<double>::infinity();  ///< this trip's nearest to the base [m]
+    int return_no_nearer = 0;  ///< return steps since the robot last got nearer the base than return_nearest_m
     std::optional<executive::RaisedCells> raised;  ///< set_band_centre(): the structure seen built (first heights)
     Position target;                               ///< this frame's target (synthesize_view()) [m]
   };
@@ -240,6 +244,11 @@ class RampSteps {
   std::vector<CellIndex> on_band_centre(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const;
   // set_band_centre(): the window's gap against the band along `ahead` alone (executive::band_fill_gap).
   Heightmap band_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const;
+  // set_band_centre(): the price the planner routes by: the window's gap against the terrain as first seen
+  // (executive::first_seen_gap), so what is built raises no price beside it, and 0 on the cells built (built_cells).
+  Heightmap plan_gap(const deliberative::LocalMap& local) const;
+  // set_band_centre(): the window's cells seen raised since first seen (RaisedCells::raised), the structure.
+  CellMask built_cells(const deliberative::LocalMap& local) const;
   std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
   void clear_pad_gap(deliberative::LocalMap& local) const;  // no work on the base station's pad
   /// A scanned map: counts, per cell of the window, the scans in a row that showed its gap (beyond the margin) on a
@@ -255,6 +264,8 @@ class RampSteps {
   /// since) or whose gap fewer than kConfirmScans scans in a row showed (one scan's misread surface is no gap). The
   /// path is still planned on the whole gap.
   void clear_unconfirmed_gap(deliberative::LocalMap& local) const;
+  /// At the base: the refill asked for; the trip's way home and return progress forgotten.
+  void refilled(BuildTrace& trace, protocol::ActionRequest& request);
   /// On the way back: the cell of the way home (deliberative/home_route.hpp, planned when the trip has none or the
   /// robot left it) farthest along it that the robot can reach in its window; nullopt when bodies cut it there.
   std::optional<CellIndex> home_goal(const deliberative::LocalMap& local);

@@ -28,10 +28,13 @@
 #                                                                    and events in the world's name, also during a
 #                                                                    4 s pause of the world, changes nothing
 #   fork                                                             spawn.sh --fork of a 160-step run at K = 100:
-#                                                                    unchanged, it ends on the parent's terrain; with
-#                                                                    --agents 2 it has the parent's terrain at K, then
-#                                                                    diverges; agents of another scenario: exit 8;
-#                                                                    bad input: exit 2, nothing written
+#                                                                    unchanged, it ends on the parent's terrain; a
+#                                                                    world-only --set (a goal) ends where the parent
+#                                                                    stood then; --agents 2 has the parent's terrain at
+#                                                                    K, diverges, completes with exit 0; a third
+#                                                                    agent joins a fork of a 2-agent run at K; agents of
+#                                                                    another scenario: exit 8; bad input (an agents'
+#                                                                    field in --set too): exit 2, nothing written
 set -euo pipefail
 case_name="$1"
 domain="$2"
@@ -569,7 +572,21 @@ case "$case_name" in
       fail "the unchanged fork ended on $(field terrain_sha256 "$work/same/summary.json"), the parent on $parent_sha"
     [ "$(field at_step "$work/same/summary.json")" = 100 ] || fail "summary.json does not say the fork's K"
     [ "$(field parent_sha256_at_step "$work/same/summary.json")" = "$at_k" ] || fail "summary.json's parent digest"
-    [ "$(forked fewer --at 100 --agents 2)" = 3 ] || { cat "$work/fewer.out"; fail "the fork with 2 agents failed"; }
+    # A world-only --set (a goal reached at about step 127, as fresh runs with it find): the fork ends where the
+    # parent stood at that step, since no request changes; with 2 agents it completes too, exit 0 (slot 3 left by
+    # choice, not missing).
+    goal=(--set goal.x0_m=0 --set goal.target_radius_m=30 --set goal.min_height_m=0.2)
+    [ "$(forked goal --at 100 "${goal[@]}")" = 0 ] || { cat "$work/goal.out"; fail "the fork with a goal did not complete"; }
+    goal_steps=$(field steps "$work/goal/summary.json")
+    [ "$goal_steps" -gt 100 ] && [ "$goal_steps" -lt 160 ] || fail "the fork with a goal ended after $goal_steps steps"
+    [ "$("$bin/marsala-monitor" replay "$work/parent" --to-step "$goal_steps" | tail -1)" = \
+      "terrain_sha256 $(field terrain_sha256 "$work/goal/summary.json")" ] ||
+      fail "the fork with a goal ended after $goal_steps steps on another terrain than the parent's there"
+    tr -d '\n ' <"$work/goal/summary.json" | grep -q '"overrides":\["goal.x0_m=0","goal.target_radius_m=30","goal.min_height_m=0.2"\]' ||
+      fail "summary.json does not list the fork's --set"
+    [ "$(forked fewer --at 100 --agents 2 "${goal[@]}")" = 0 ] || { cat "$work/fewer.out"; fail "the fork with 2 agents failed"; }
+    [ "$(field slots_missing "$work/fewer/summary.json")" = 0 ] && tr -d '\n ' <"$work/fewer/summary.json" |
+      grep -q '"left_agents":\[3\]' || fail "summary.json does not say slot 3 left at K"
     fewer_sha=$(field terrain_sha256 "$work/fewer/summary.json")
     [ "$fewer_sha" != "$parent_sha" ] || fail "the fork with 2 agents did not diverge from its parent"
     # The fork's own run.log, replayed to K by the monitor, has the parent's terrain there; then agent 3 leaves.
@@ -585,17 +602,38 @@ case "$case_name" in
     grep -q "error: fork of .* at step 100: agent [1-3] at step [0-9]*: its request differs" "$work/other.out" ||
       { cat "$work/other.out"; fail "the mismatch was not named"; }
     # Bad input: one line, exit 2, nothing written.
-    for bad in "--at 161" "--at -1" "--at 100 --agents 4" "--at 100 --set max_steps=5" "--at 100 --seed 2"; do
+    for bad in "--at 161" "--at -1" "--at 100 --agents 4" "--at 100 --set max_steps=5" "--at 100 --seed 2" \
+      "--at 100 --set robot_type.body.kappa=0.2"; do
       # shellcheck disable=SC2086
       [ "$(forked bad $bad)" = 2 ] || { cat "$work/bad.out"; fail "--fork $bad did not exit 2"; }
       [ ! -e "$work/bad" ] || fail "--fork $bad wrote $work/bad"
       [ "$(wc -l <"$work/bad.out")" -le 2 ] || { cat "$work/bad.out"; fail "--fork $bad said more than a line"; }
     done
+    # A larger team: a parent of 2, forked at 30 with 3; slot 3 joins at K (admitted then, on its start).
+    rc=0
+    "$root/deploy/spawn.sh" --scenario "$scenario" --agents 2 --domain "$domain" --out "$work/pair" --max-steps 60 \
+      --quiet --timeout 120 || rc=$?
+    [ "$rc" -eq 3 ] || fail "the parent of 2 exited $rc, not 3 (max_steps)"
+    rc=0
+    "$root/deploy/spawn.sh" --fork "$work/pair" --at 30 --agents 3 --domain "$domain" --out "$work/trio" --quiet \
+      --timeout 120 >"$work/trio.out" 2>&1 || rc=$?
+    [ "$rc" -eq 3 ] || { cat "$work/trio.out"; fail "the fork with a third agent exited $rc, not 3"; }
+    grep -q '"step":30,"agent":3,"kind":"admitted"' "$work/trio/events.log" || fail "agent 3 was not admitted at step 30"
+    tr -d '\n ' <"$work/trio/summary.json" | grep -q '"joined_agents":\[3\]' || fail "summary.json: no joined_agents"
+    [ "$(field slots_missing "$work/trio/summary.json")" = 0 ] || fail "the fork with a third agent misses a slot"
+    [ "$("$bin/marsala-monitor" replay "$work/trio" --to-step 30 | tail -1)" = \
+      "$("$bin/marsala-monitor" replay "$work/pair" --to-step 30 | tail -1)" ] ||
+      fail "the fork with a third agent did not have the parent's terrain at step 30"
+    # From its start at x 5.05 m, 30 steps of at most 0.2 m: it drove towards its ramp after joining.
+    x3=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["per_agent"][2]["x_m"])' "$work/trio/summary.json")
+    awk -v x="$x3" 'BEGIN { exit !(x > 7.0) }' || fail "agent 3 did not drive after joining (x $x3 m)"
     rc=0
     "$root/deploy/spawn.sh" --fork "$work/none" --at 1 --out "$work/bad" --quiet >/dev/null 2>&1 || rc=$?
     [ "$rc" -eq 2 ] && [ ! -e "$work/bad" ] || fail "a fork of no run exited $rc"
-    echo "ok: fork at 100 unchanged ends on the parent's $parent_sha; with 2 agents it has the parent's $at_k at" \
-      "step 100 and ends on $fewer_sha; other agents exit 8: $(grep -o 'agent [1-3] at step [0-9]*' "$work/other.out")"
+    echo "ok: fork at 100 unchanged ends on the parent's $parent_sha; with a goal it ends after $goal_steps steps as" \
+      "the parent stood there; with 2 agents it has the parent's $at_k at step 100 and ends on $fewer_sha, exit 0;" \
+      "a third agent joins a fork of 2 at step 30;" \
+      "other agents exit 8: $(grep -o 'agent [1-3] at step [0-9]*' "$work/other.out")"
     ;;
   *) echo "unknown case '$case_name'" >&2; exit 2 ;;
 esac

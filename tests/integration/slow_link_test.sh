@@ -1,19 +1,28 @@
 #!/usr/bin/env bash
-# A slow link does not collapse (issue 30 deliverable 4, docs/runtime.md#resends): ramp 3 on Cyclone, its first
+# A slow link does not collapse (issue 30 deliverable 4, docs/runtime.md#resends): ramp 3 on VENDOR, its first
 # STEPS steps over loopback limited to 1 Mbit/s with MTU 1500 (tc tbf; netem is not in every kernel), end on the
 # terrain of the same steps unthrottled, run first in the same test, with no missed deadline, no drop, and at most
 # 3 times the unthrottled run's bytes on the wire. Before the resend rule every agent was dropped by step 4 there.
 #
-# Usage: slow_link_test.sh STEPS DOMAIN, inside run_isolated.sh (tc changes this namespace's lo only); 77 = skipped
-# where tbf cannot be set up.
+# VENDOR is cyclone (default, its loopback profile) or fastdds (deploy/dds/fastdds-slow.xml, the Fast DDS profile for
+# slow links, docs/runtime.md#slow-links, in both runs).
+#
+# Usage: slow_link_test.sh STEPS DOMAIN [VENDOR], inside run_isolated.sh (tc changes this namespace's lo only);
+# 77 = skipped where tbf cannot be set up.
 set -euo pipefail
 case_name="slow-link"
 steps="$1"
 domain="$2"
+vendor="${3:-cyclone}"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 . "$here/lib.sh"  # field, test_workspace
 test_workspace slow_link
 scenario="$root/deploy/scenarios/ramp.pbtxt"
+case "$vendor" in
+  cyclone) unset MARSALA_DDS_CONFIG ;;
+  fastdds) export MARSALA_DDS_CONFIG="$root/deploy/dds/fastdds-slow.xml" ;;
+  *) fail "VENDOR must be cyclone or fastdds, got '$vendor'" ;;
+esac
 
 # lo_bytes: bytes sent on this namespace's lo so far (/proc/net/dev is per namespace; /sys may show the host's).
 lo_bytes() { awk '/^ *lo:/ { print $10 }' /proc/net/dev; }
@@ -22,7 +31,7 @@ run() {
   local before
   before=$(lo_bytes)
   MARSALA_BUILD_DIR="$(dirname "$bin")" "$root/deploy/spawn.sh" --scenario "$scenario" --agents 3 --domain "$domain" \
-    --dds cyclone --max-steps "$steps" --out "$work/$1" --quiet --timeout 240 >/dev/null 2>"$work/$1.err" || true
+    --dds "$vendor" --max-steps "$steps" --out "$work/$1" --quiet --timeout 240 >/dev/null 2>"$work/$1.err" || true
   [ -f "$work/$1/summary.json" ] || { cat "$work/$1.err"; fail "$1: no summary.json"; }
   echo $(($(lo_bytes) - before))
 }
@@ -45,5 +54,5 @@ summary="$work/slow/summary.json"
   { grep '"kind":"\(missed\|dropped\)"' "$work/slow/events.log" | head; fail "missed deadlines or drops at 1 Mbit/s"; }
 [ "$slow_bytes" -le $((3 * clean_bytes)) ] ||
   fail "at 1 Mbit/s $slow_bytes bytes on the wire, more than 3 times the unthrottled $clean_bytes"
-echo "ok: $steps steps at 1 Mbit/s in $seconds s on the unthrottled terrain $sha; bytes on lo $slow_bytes" \
+echo "ok: $vendor: $steps steps at 1 Mbit/s in $seconds s on the unthrottled terrain $sha; bytes on lo $slow_bytes" \
   "(unthrottled $clean_bytes); tbf dropped $(tc -s qdisc show dev lo | grep -o 'dropped [0-9]*' | cut -d' ' -f2) packets"

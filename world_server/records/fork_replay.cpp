@@ -36,6 +36,8 @@ std::string unrepeatable(const proto::LogRecord& record) {
   if (record.has_resumed()) return "the run was resumed";
   if (record.has_admitted() && (record.admitted().readmission() || record.admitted().takeover()))
     return fmt::format("agent {} was admitted again", record.admitted().agent_id());
+  if (record.has_admitted() && record.admitted().step() > 0)  // a fork's late slot: not in a team started afresh
+    return fmt::format("agent {} joined at step {}", record.admitted().agent_id(), record.admitted().step());
   return {};
 }
 
@@ -98,11 +100,12 @@ ForkReplay read_fork(const std::string& dir, std::uint64_t at, std::uint32_t age
   origin.at_step = at;
   origin.parent_agents = reader.header().agents();
   origin.agents = agents == 0 ? origin.parent_agents : agents;
-  if (origin.agents > origin.parent_agents)
-    throw InvalidArgument(
-        fmt::format("--fork {}: --agents {} exceeds the parent's team of {}: a fork may only shrink "
-                    "the team",
-                    dir, origin.agents, origin.parent_agents));
+  const proto::LogHeader& h = reader.header();
+  if (h.fork_agents() > h.fork_parent_agents() && h.fork_parent_agents() > 0)
+    throw InvalidArgument(fmt::format(
+        "--fork {}: that run is a fork whose team grew at step {} (slots {}..{} joined late): a team started afresh "
+        "would hold them from step 0; fork its parent {} instead",
+        dir, h.fork_step(), h.fork_parent_agents() + 1, h.fork_agents(), h.fork_parent()));
   std::vector<proto::StepRecord> steps;
   std::uint64_t parent_steps = 0;
   std::string unrepeatable_before_k;

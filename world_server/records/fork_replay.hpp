@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "idl/run_log.pb.h"
@@ -30,8 +31,9 @@ struct ForkOrigin {
   std::string parent_run_id;          ///< its run id
   std::uint64_t at_step = 0;          ///< K: steps 0..K-1 replayed, live from step K on
   std::uint32_t parent_agents = 0;    ///< the parent's team [count]
-  std::uint32_t agents = 0;           ///< the fork's team from step K on (<= parent_agents) [count]
+  std::uint32_t agents = 0;           ///< the fork's team from step K on (above parent_agents: late slots) [count]
   std::string parent_sha256_at_step;  ///< SHA-256 of the parent's terrain after its first K steps
+  std::vector<std::string> overrides;  ///< the fork's own --set FIELD=VALUE (world-only fields), from step 0
 };
 
 /// The parent's first K steps as recorded, checked against and substituted for the live requests.
@@ -41,6 +43,8 @@ class ForkReplay {
   ForkReplay(ForkOrigin origin, std::vector<proto::StepRecord> steps);
 
   const ForkOrigin& origin() const { return origin_; }
+  /// Records the fork's own --set (world-only fields, checked by the caller) in its origin.
+  void set_overrides(std::vector<std::string> overrides) { origin_.overrides = std::move(overrides); }
   /// True while `step` is one of the replayed ones (before K).
   bool replaying(std::uint64_t step) const { return step < origin_.at_step; }
   /// Empty when the live submissions of `step` are, agent by agent and in each agent's order, the recorded ones
@@ -64,7 +68,8 @@ class ForkReplay {
 /// after them (replayed onto `initial`, make_world_state() of the header's scenario, terrain and team). Throws
 /// InvalidArgument (one line naming the folder) when there is no run.log, its tail is torn, `at` lies beyond the
 /// parent's steps, or the first `at` steps hold what a fork cannot repeat (a drop, a re-admission, a takeover, a
-/// resume); ParseError when run.log cannot be read or disagrees with the rules.
+/// resume, a late slot's join) or the parent is a fork whose team grew; ParseError when run.log cannot be read or
+/// disagrees with the rules.
 ForkReplay read_fork(const std::string& dir, std::uint64_t at, std::uint32_t agents, WorldState initial);
 
 }  // namespace marsala::world_server

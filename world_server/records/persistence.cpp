@@ -120,6 +120,8 @@ proto::LogHeader log_header(const scenario::Scenario& scenario, const LogStart& 
     h.set_fork_step(start.fork->at_step);
     h.set_fork_parent_sha256(start.fork->parent_sha256_at_step);
     h.set_fork_agents(start.fork->agents);
+    h.set_fork_parent_agents(start.fork->parent_agents);
+    for (const std::string& o : start.fork->overrides) h.add_fork_overrides(o);
   }
   return h;
 }

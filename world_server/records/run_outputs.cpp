@@ -122,21 +122,30 @@ void fill_stall_account(const WorldState& state, proto::StallAccount& account) {
   }
 }
 
+/// summary.json's `fork`: where a fork came from, its own --set, the slots that left at K and the late ones that
+/// joined then (docs/runtime.md#fork).
+proto::ForkOrigin fork_summary(const ForkOrigin& fork, const WorldState& state) {
+  proto::ForkOrigin f;
+  f.set_parent(fork.parent_dir);
+  f.set_parent_run_id(fork.parent_run_id);
+  f.set_at_step(fork.at_step);
+  f.set_parent_sha256_at_step(fork.parent_sha256_at_step);
+  f.set_parent_agents(fork.parent_agents);
+  f.set_agents(fork.agents);
+  for (const std::string& o : fork.overrides) f.add_overrides(o);
+  for (std::uint32_t id = fork.agents + 1; id <= fork.parent_agents; ++id) f.add_left_agents(id);
+  for (std::uint32_t id = fork.parent_agents + 1; id <= fork.agents; ++id)
+    if (state.has_agent(id) && state.agent(id).admitted) f.add_joined_agents(id);
+  return f;
+}
+
 /// "140.25" (no trailing zeros, no rounding noise of the cell arithmetic).
 std::string summary_text(const WorldState& state, const RunInfo& info, const FinalTerrainReport& report) {
   proto::RunSummary s;
   s.set_scenario(info.scenario);
   s.set_scenario_file(info.scenario_file);
   for (const std::string& o : info.overrides) s.add_overrides(o);
-  if (info.fork) {
-    proto::ForkOrigin* f = s.mutable_fork();
-    f->set_parent(info.fork->parent_dir);
-    f->set_parent_run_id(info.fork->parent_run_id);
-    f->set_at_step(info.fork->at_step);
-    f->set_parent_sha256_at_step(info.fork->parent_sha256_at_step);
-    f->set_parent_agents(info.fork->parent_agents);
-    f->set_agents(info.fork->agents);
-  }
+  if (info.fork) *s.mutable_fork() = fork_summary(*info.fork, state);
   s.set_run_id(info.run_id);
   s.set_seed(info.seed);
   s.set_dds(info.dds);
@@ -180,7 +189,7 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
   }
   s.set_admitted(admitted);
   s.set_dropped(dropped);
-  const std::vector<std::uint32_t> missing = missing_slots(state);
+  const std::vector<std::uint32_t> missing = missing_slots(state, info.fork ? &*info.fork : nullptr);
   s.set_slots_missing(static_cast<std::uint32_t>(missing.size()));
   for (std::uint32_t id : missing) s.add_missing_agents(id);
   s.set_missed_deadlines(missed);
@@ -244,10 +253,11 @@ std::string summary_text(const WorldState& state, const RunInfo& info, const Fin
 
 }  // namespace
 
-std::vector<std::uint32_t> missing_slots(const WorldState& state) {
+std::vector<std::uint32_t> missing_slots(const WorldState& state, const ForkOrigin* fork) {
+  const auto left_at_fork = [&](std::uint32_t id) { return fork && id > fork->agents && id <= fork->parent_agents; };
   std::vector<std::uint32_t> ids;
   for (const AgentRecord& a : state.agents)
-    if (!a.alive) ids.push_back(a.id);  // alive: admitted and not dropped (world_state.hpp)
+    if (!a.alive && !left_at_fork(a.id)) ids.push_back(a.id);  // alive: admitted and not dropped (world_state.hpp)
   std::sort(ids.begin(), ids.end());
   return ids;
 }

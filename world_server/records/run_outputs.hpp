@@ -64,8 +64,10 @@ struct RunInfo {
   std::optional<ForkOrigin> fork;  ///< where a fork came from (none: no fork)
 };
 
-/// The ids of the slots of `state`'s team not in the run now (never admitted, or dropped and not back), in order.
-std::vector<std::uint32_t> missing_slots(const WorldState& state);
+/// The ids of the slots of `state`'s team not in the run now (never admitted, or dropped and not back), in order. For a
+/// fork (`fork` not null) the slots above its team (fork->agents + 1 .. fork->parent_agents), which left at its K by
+/// the user's choice (docs/runtime.md#fork), are not missing.
+std::vector<std::uint32_t> missing_slots(const WorldState& state, const ForkOrigin* fork = nullptr);
 
 /// summary.json's text: every field present (zeros included); steps = state.step; terrain_sha256 of state.terrain;
 /// payload_path: path_found and path_length_m of payload_path() on state.terrain; level_site: site_level_fraction()

@@ -159,7 +159,8 @@ CLI::Option* add_fork_options(CLI::App& app, ForkRequest& fork, const std::vecto
       app.add_option("--fork", fork.dir,
                      "start a new run (in --out) from the run in DIR: its first K steps (--at) replayed with fresh\n"
                      "agents, each request checked against DIR/run.log (exit 8 naming the agent and step when one\n"
-                     "differs), then live with --agents (fewer), --max-steps, --step-deadline (docs/runtime.md#fork)")
+                     "differs), then live with --agents (fewer leave at K, more join at K), --max-steps,\n"
+                     "--step-deadline, --set of world-only fields (docs/runtime.md#fork)")
           ->type_name("DIR");
   for (CLI::Option* other : others) fork_option->excludes(other);
   app.add_option("--at", fork.at, "with --fork: the step K the fork goes live at (0 .. the parent's steps)")

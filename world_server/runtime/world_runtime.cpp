@@ -309,7 +309,9 @@ struct WorldRuntime::Impl {
       const protocol::AgentHello& hello = received.sample;
       const SenderKey sender = sender_of(hello, received.from.prefix);
       if (!owned_session(hello, received.from) || waits_for_takeover(hello, sender, now)) continue;
-      const AdmissionDecision decision = decide_admission(state, hello, run_started, holder_connected(hello.agent_id));
+      const bool started = run_started && !(admitting_late && late_slot(hello.agent_id));
+      const AdmissionDecision decision = decide_admission(state, hello, started, holder_connected(hello.agent_id));
+      if (late_slot(decision.agent_id) && !fork_live) continue;  // a fork's late slot: answered at K, not before
       // A live agent asking again holds no frame it takes: a negative acknowledgement (docs/runtime.md#resends).
       if (decision.accepted && decision.kind == AdmissionKind::kRepeat && run_started) {
         const std::uint32_t id = slot_hello(state, hello, decision).agent_id;  // "any slot": the one it holds
@@ -380,13 +382,14 @@ struct WorldRuntime::Impl {
   /// none was admitted.
   void admit_agents(const std::atomic<bool>& stop) {
     const Clock::time_point deadline = Clock::now() + seconds(options.admit_timeout_s);
-    const std::size_t expected = state.agents.size();
+    const std::size_t expected = state.agents.size() - late_slots().size();
     for (;;) {
       service_hellos(true);
       check_liveliness();
       std::size_t admitted = 0;
       bool all_ready = true;
       for (const AgentRecord& a : state.agents) {
+        if (late_slot(a.id)) continue;
         admitted += a.admitted ? 1 : 0;
         if (a.alive && !links->ready(a.id)) all_ready = false;
       }
@@ -518,7 +521,7 @@ struct WorldRuntime::Impl {
     const CollectDuties duties{[this] { service_hellos(); }, [this] { check_liveliness(); },
                                [this](std::uint32_t id) { send_frame(id, false); }, [this] { return silence.held(); }};
     for (;;) {
-      if (fork && state.step == fork->origin().at_step && !fork_live) go_live();
+      if (fork && state.step == fork->origin().at_step && !fork_live) go_live(stop);
       recorder.frame(state, scenario.name, false);
       if (const auto end = end_before_step(stop)) return *end;
       StepTimes times;  // the phases' ends, for the step time and the trace
@@ -553,15 +556,55 @@ struct WorldRuntime::Impl {
     collected.submissions = fork->recorded(state.step, state);
   }
 
-  /// A fork at step K: checks the terrain against the parent's at K, then lets the slots above the fork's team leave.
-  void go_live() {
+  /// True for a fork's late slot (above the parent's team, docs/runtime.md#fork): not admitted before K.
+  bool late_slot(std::uint32_t id) const { return fork && id > fork->origin().parent_agents && state.has_agent(id); }
+
+  /// A fork's late slots, in order (none for a run that is no fork, or a fork without a larger team).
+  std::vector<std::uint32_t> late_slots() const {
+    std::vector<std::uint32_t> ids;
+    for (const AgentRecord& a : state.agents)
+      if (late_slot(a.id)) ids.push_back(a.id);
+    return ids;
+  }
+
+  /// A fork's late slots join at K (docs/runtime.md#fork): first admissions at their scenario starts with full
+  /// material, waited for (answering hellos) up to the admit timeout before step K's frames go out; a slot that has
+  /// not joined by then stays out of the run (refused later, missing at its end).
+  void admit_late_slots(const std::atomic<bool>& stop) {
+    const std::vector<std::uint32_t> late = late_slots();
+    if (late.empty()) return;
+    admitting_late = true;
+    const Clock::time_point deadline = Clock::now() + seconds(options.admit_timeout_s);
+    const auto joined = [&](std::uint32_t id) { return state.agent(id).alive && links->ready(id); };
+    for (;;) {
+      service_hellos(true);
+      if (std::all_of(late.begin(), late.end(), joined)) break;
+      const Clock::time_point now = Clock::now();
+      if (stop || now >= deadline) break;
+      signal->wait_until(std::min(deadline, now + std::chrono::duration_cast<Clock::duration>(kHelloInterval)));
+    }
+    admitting_late = false;
+    std::vector<std::uint32_t> absent;
+    for (std::uint32_t id : late)
+      if (!joined(id)) absent.push_back(id);
+    note(fmt::format("fork: {} of {} late slots joined at step {}{}", late.size() - absent.size(), late.size(),
+                     state.step,
+                     absent.empty() ? std::string()
+                                    : fmt::format(" (not within the admit timeout of {} s: {})",
+                                                  options.admit_timeout_s, fmt::join(absent, ", "))));
+  }
+
+  /// A fork at step K: checks the terrain against the parent's at K, then lets the slots above the fork's team leave
+  /// or, for a larger team, admits the late slots.
+  void go_live(const std::atomic<bool>& stop) {
     fork_live = true;
     const ForkOrigin& o = fork->origin();
     const std::string sha = runlog::terrain_sha256(state.terrain);
     if (sha != o.parent_sha256_at_step)
       throw ForkMismatch(fmt::format("fork of {}: the terrain at step {} is {}, the parent's was {}", o.parent_dir,
                                      o.at_step, sha, o.parent_sha256_at_step));
-    note(fmt::format("fork of {} (run '{}') live from step {} with {} of {} agents: terrain sha256 {} as the parent's",
+    note(fmt::format("fork of {} (run '{}') live from step {} with {} agents (the parent's team: {}): terrain sha256 {} "
+                     "as the parent's",
                      o.parent_dir, o.parent_run_id, o.at_step, o.agents, o.parent_agents, sha));
     for (std::uint32_t id = o.agents + 1; id <= o.parent_agents; ++id) {
       if (!state.has_agent(id) || !state.agent(id).alive) continue;
@@ -570,6 +613,7 @@ struct WorldRuntime::Impl {
       emit(drop_agent(state, id, reason));
       send_frame(id, true);
     }
+    admit_late_slots(stop);
   }
 
   /// A step's spans into the trace, when one is written (docs/runtime.md#step-traces).
@@ -706,7 +750,8 @@ struct WorldRuntime::Impl {
     recorder.finish(state, std::move(info), options.search_path);
     for (const AgentRecord& a : state.agents) result.admitted += a.admitted ? 1 : 0;
     result.team = static_cast<std::uint32_t>(state.agents.size());
-    result.slots_missing = static_cast<std::uint32_t>(missing_slots(state).size());
+    result.slots_missing =
+        static_cast<std::uint32_t>(missing_slots(state, fork ? &fork->origin() : nullptr).size());
     result.terrain_sha256 = runlog::terrain_sha256(state.terrain);
     if (resume) result.resumed_at_step = resume_step;
     spdlog::info("run over ({}): {} steps in {:.3f} s, {:.6f} m3 deposited, terrain sha256 {}", to_string(end_reason),
@@ -723,6 +768,7 @@ struct WorldRuntime::Impl {
   std::uint64_t resume_step = 0;  ///< the step a resumed run continued at
   std::optional<ForkReplay> fork;  ///< a fork's replay of its parent's first K steps (docs/runtime.md#fork)
   bool fork_live = false;          ///< the fork has reached K
+  bool admitting_late = false;     ///< a fork's late slots may take their first admission (admit_late_slots())
   RunRecorder recorder;           ///< run.log, snapshots, events.log, frames, final outputs
   TeamSilence silence;            ///< whether the step is held for a silent team
   std::optional<SensingService> sensing;

@@ -21,14 +21,16 @@ void fast_repair(eprosima::fastrtps::rtps::WriterTimes& times);
 /// A reader's timing: the profile's when it sets a heartbeat response delay, else answers heartbeats at once.
 void fast_repair(eprosima::fastrtps::rtps::ReaderTimes& times);
 
-/// An agent's writers heartbeat this many times as often as the profile's period [count]: the profile's period is
-/// the one of a writer that serves the whole team (the world's), an agent's serve one reader, the world.
-inline constexpr int kOneReaderHeartbeatDivisor = 5;
+/// A writer that serves one reader heartbeats this many times as often as the profile's period [count]: the
+/// profile's period is the one of a writer that serves the team (the world's status, events and admissions, read by
+/// every agent and monitor); an agent's writers serve the world alone, and the world's writers in an agent's
+/// partition (its frames, the critical path of every step) serve that agent alone.
+inline constexpr int kOneReaderHeartbeatDivisor = 10;
 /// The shortest heartbeat period follow_team() gives [ms].
-inline constexpr std::chrono::milliseconds kShortestHeartbeat{10};
+inline constexpr std::chrono::milliseconds kShortestHeartbeat{5};
 
 /// Heartbeat period of a writer [ns] under the profile's (or fast_repair's) period `period_ns` [ns]: as it is for a
-/// writer that serves the team (`serves_team`), else divided by kOneReaderHeartbeatDivisor but not below
+/// writer that serves the team (`serves_team`), else (one reader) divided by kOneReaderHeartbeatDivisor but not below
 /// kShortestHeartbeat nor above `period_ns` (docs/runtime.md#lossy-links).
 long long team_heartbeat_ns(long long period_ns, bool serves_team);
 /// Sets `times`' heartbeat period to team_heartbeat_ns() of it.
@@ -37,7 +39,7 @@ void follow_team(eprosima::fastrtps::rtps::WriterTimes& times, bool serves_team)
 /// The reliability timing endpoints get [ns].
 struct RepairTiming {
   long long heartbeat_period_ns = 0;          ///< writer serving the team: heartbeat period while a reader lags [ns]
-  long long one_reader_heartbeat_ns = 0;      ///< an agent's writer (one reader): its heartbeat period [ns]
+  long long one_reader_heartbeat_ns = 0;      ///< a writer serving one reader: its heartbeat period [ns]
   long long nack_response_delay_ns = 0;       ///< writer: wait before repairing what a reader asked for [ns]
   long long heartbeat_response_delay_ns = 0;  ///< reader: wait before answering a heartbeat [ns]
   bool from_profile = false;  ///< the profile set both the writer's and the reader's timing (fast_repair left them)

@@ -11,6 +11,10 @@ namespace {
 // candidate surface exactly over their sources when merging the children's bounds is loose.
 constexpr int kExactLevels = 3;
 
+// Euclidean length of (a, b): only bounds and fits use it (every bound is taken as a max over the sources or pruned
+// against tol, so an ulp here never changes an output), and it costs a fraction of std::hypot's careful rounding.
+inline double length(double a, double b) { return std::sqrt(a * a + b * b); }
+
 struct Point {
   double r, c, h;
 };
@@ -78,13 +82,13 @@ struct Moments {
         ur = crr >= ccc ? 1 : 0;
         uc = 1 - ur;
       }
-      const double norm = std::hypot(ur, uc);
+      const double norm = length(ur, uc);
       const double slope = (ur * crh + uc * cch) / (norm * lambda);
       ar = slope * ur / norm;
       ac = slope * uc / norm;
     }
     if (!std::isfinite(ar) || !std::isfinite(ac)) ar = ac = 0;
-    const double norm = std::hypot(ar, ac), limit = kcs * (1.0 - 1e-12);
+    const double norm = length(ar, ac), limit = kcs * (1.0 - 1e-12);
     if (raw_slope) *raw_slope = norm;
     if (norm > limit) {
       ar *= limit / norm;
@@ -96,7 +100,7 @@ struct Moments {
     s.c = mc;
     s.ar = ar;
     s.ac = ac;
-    const double deficit = kcs - std::hypot(ar, ac);
+    const double deficit = kcs - length(ar, ac);
     s.deficit2 = deficit > 0 ? deficit * deficit : 0.0;
     return s;
   }
@@ -176,8 +180,8 @@ struct Candidate {
 // True when two shapes bound differently enough to be worth keeping both.
 bool distinct(const Shape& a, const Shape& b, double kcs) {
   if (a.kind != b.kind) return true;
-  if (a.kind == Shape::Kind::kPlane) return std::hypot(a.ar - b.ar, a.ac - b.ac) > 1e-6 * kcs;
-  return std::hypot(a.r - b.r, a.c - b.c) > 1e-6;
+  if (a.kind == Shape::Kind::kPlane) return length(a.ar - b.ar, a.ac - b.ac) > 1e-6 * kcs;
+  return length(a.r - b.r, a.c - b.c) > 1e-6;
 }
 
 // Chooses a node's two shapes: the two best distinct exact pieces (quality <= gate) when there
@@ -229,10 +233,10 @@ double bound_over_child(const Shape& x, const SourceNode& kid, double kcs) {
   if (x.kind == Shape::Kind::kPlane) {
     best = kid.max_h + corner_max([&](double r, double c) { return -x.ar * (r - x.r) - x.ac * (c - x.c); });
   } else if (x.kind == Shape::Kind::kCone) {
-    best = kid.max_h + corner_max([&](double r, double c) { return kcs * std::hypot(r - x.r, c - x.c); });
+    best = kid.max_h + corner_max([&](double r, double c) { return kcs * length(r - x.r, c - x.c); });
   } else {
     const double nr = std::max({0.0, kid.r0 - x.r, x.r - kid.r1}), nc = std::max({0.0, kid.c0 - x.c, x.c - kid.c1});
-    best = kid.max_h - kcs * std::hypot(nr, nc);
+    best = kid.max_h - kcs * length(nr, nc);
   }
   for (const Shape& y : kid.shapes) {
     if (y.kind == Shape::Kind::kNone) continue;
@@ -245,17 +249,17 @@ double bound_over_child(const Shape& x, const SourceNode& kid, double kcs) {
         });
       } else if (x.kind == Shape::Kind::kCone) {
         b = corner_max([&](double r, double c) {
-          return y.m + y.ar * (r - y.r) + y.ac * (c - y.c) + kcs * std::hypot(r - x.r, c - x.c);
+          return y.m + y.ar * (r - y.r) + y.ac * (c - y.c) + kcs * length(r - x.r, c - x.c);
         });
       }
     } else {
       const double y_sign = y.kind == Shape::Kind::kCone ? 1.0 : -1.0;
-      const double apart = kcs * std::hypot(x.r - y.r, x.c - y.c);
+      const double apart = kcs * length(x.r - y.r, x.c - y.c);
       if (x.kind == Shape::Kind::kPlane) {
         // h(q) <= y.m + kcs |q - c_y| (bowl): convex after subtracting a plane.
         if (y_sign < 0)
           b = corner_max([&](double r, double c) {
-            return y.m + kcs * std::hypot(r - y.r, c - y.c) - x.ar * (r - x.r) - x.ac * (c - x.c);
+            return y.m + kcs * length(r - y.r, c - y.c) - x.ar * (r - x.r) - x.ac * (c - x.c);
           });
       } else if (x_sign == y_sign) {
         b = y.m + apart;  // |q - c_x| - |q - c_y| <= |c_x - c_y|
@@ -263,7 +267,7 @@ double bound_over_child(const Shape& x, const SourceNode& kid, double kcs) {
         b = y.m - apart;  // bowl over a cone: -|q - c_x| - |q - c_y| <= -|c_x - c_y|
       } else {
         b = corner_max([&](double r, double c) {
-          return y.m + kcs * (std::hypot(r - y.r, c - y.c) + std::hypot(r - x.r, c - x.c));
+          return y.m + kcs * (length(r - y.r, c - y.c) + length(r - x.r, c - x.c));
         });
       }
     }

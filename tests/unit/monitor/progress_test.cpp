@@ -260,6 +260,28 @@ TEST_F(RunReport, ACompletedRunShortOfSlotsNamesThem) {
   EXPECT_EQ(run_report(dir_.string()).find("short of"), std::string::npos);
 }
 
+TEST_F(RunReport, AForkNamesItsParentTheSlotsThatLeftAtKAndItsSet) {
+  write_summary(R"({"scenario": "ramp", "completed": true, "end_reason": "completed", "steps": 127,
+    "agents": 3, "admitted": 3, "dropped": 1, "completion": "agents_at_goal", "progress": 1, "slots_missing": 0,
+    "fork": {"parent": "out/parent", "at_step": "100", "parent_agents": 3, "agents": 2, "left_agents": [3],
+             "overrides": ["stall_steps=50", "goal.min_height_m=0.2"]}})");
+  const std::string report = run_report(dir_.string());
+  EXPECT_NE(report.find("\n  fork of out/parent at step 100: team 3 -> 2 (agent 3 left at step 100 by choice: not "
+                        "missing), --set stall_steps=50 goal.min_height_m=0.2\n"),
+            std::string::npos)
+      << report;
+  EXPECT_EQ(report.find("short of"), std::string::npos) << report;
+  write_summary(R"({"scenario": "ramp", "completed": true, "agents": 3, "admitted": 3,
+    "fork": {"parent": "p", "at_step": "7", "parent_agents": 3, "agents": 3}})");
+  EXPECT_NE(run_report(dir_.string()).find("\n  fork of p at step 7: team 3 -> 3\n"), std::string::npos);
+  write_summary(R"({"scenario": "ramp", "completed": true, "agents": 5, "admitted": 4, "slots_missing": 1,
+    "fork": {"parent": "p", "at_step": "7", "parent_agents": 3, "agents": 5, "joined_agents": [4]}})");
+  EXPECT_NE(run_report(dir_.string()).find("\n  fork of p at step 7: team 3 -> 5 (1 of 2 late slots joined at step 7: "
+                                           "agent 4)\n"),
+            std::string::npos)
+      << run_report(dir_.string());
+}
+
 TEST_F(RunReport, SaysWhatLandedOutsideTheConstructionBand) {
   write_summary(R"({"scenario": "path_gale", "completed": true, "end_reason": "completed", "steps": 3500,
     "agents": 1, "admitted": 1, "deposited_volume_m3": 30.361, "completion": "payload_path", "path_found": true,

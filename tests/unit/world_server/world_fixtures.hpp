@@ -136,13 +136,13 @@ class RecordedRunTest : public ::testing::Test {
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
   std::string log_path() const { return (dir_ / kRunLogFile).string(); }
-  /// Opens run.log for `state` (run id small-d1, 3 agents) and admits agents 1..3 into both, as a run starts.
-  runlog::RunLogWriter start_log(WorldState& state) const {
+  /// Opens run.log for `state` (run id small-d1, 3 agents) and admits agents 1..admitted into both, as a run starts.
+  runlog::RunLogWriter start_log(WorldState& state, std::uint32_t admitted = 3) const {
     LogStart start;
     start.run_id = "small-d1";
     start.agents = 3;
     runlog::RunLogWriter log = runlog::RunLogWriter::create(log_path(), log_header(scenario_, start, state.terrain));
-    for (std::uint32_t id = 1; id <= 3; ++id) {
+    for (std::uint32_t id = 1; id <= admitted; ++id) {
       admit(state, hello_for(state, id, 100 + id), AdmissionKind::kFirst);
       log.append(admitted_record(state, id, AdmissionKind::kFirst));
     }

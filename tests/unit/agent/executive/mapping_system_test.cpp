@@ -528,6 +528,61 @@ TEST(MappingSystem, AFaceSeenFromBelowIsABoundNotASurface) {
   EXPECT_FALSE(map.bound()(9, 10));
 }
 
+// A face hit belongs to the cell whose face the ray crossed, found from the ray's crossings with the grid lines within
+// the hit's noise reach (3 noise sd), not to the cell holding the hit point; none when two cells' faces lie within
+// 5 sd of it. Camera 0.5 m up at (1.55, 2.05), 0.1 m
+// cells (col = floor(x / 0.1), row = 59 - floor(y / 0.1)); rising hits ~0.45 m away: sd 2 mm + 2 mm/m^2 * 0.2 m^2 =
+// 2.4 mm, reach 7.2 mm.
+TEST(MappingSystem, AFaceHitIsCreditedToTheFaceTheRayCrossed) {
+  const GridGeometry grid{60, 100, 0.0, 0.0, 0.1};
+  const Point3 origin{1.55, 2.05, 0.5};
+  const auto hit = [&](double x, double y, double z) {
+    return ScanPoint{static_cast<float>(x - origin.x), static_cast<float>(y - origin.y),
+                     static_cast<float>(z - origin.z)};
+  };
+  // Noise left the hit 3 mm short of the face on x = 2.0 (in col 19); the y lines lie metres away along this ray:
+  // the face is that of the cell the ray enters at x = 2.0, (39, 20), at least 0.55 m high; col 19 stays unknown.
+  MappingSystem wall(grid, 16, sensor_defaults(SensorKind::kRgbd));
+  wall.integrate_scan({hit(1.997, 2.045, 0.55)}, origin);
+  ASSERT_TRUE(wall.is_known({39, 20}));
+  EXPECT_NEAR(wall.heights()(39, 20), 0.55, 1e-6);
+  EXPECT_TRUE(wall.bound()(39, 20));
+  EXPECT_FALSE(wall.is_known({39, 19}));
+  // Grazing the corner (2.0, 2.0): the ray (0.455, -0.0505) to (2.005, 1.9995) crosses x = 2.0 into (39, 20) 5.0 mm
+  // before the hit, then y = 2.0 into (40, 20) 4.5 mm before it: both within the reach, either face may be the one
+  // struck, so neither cell is credited.
+  MappingSystem corner(grid, 16, sensor_defaults(SensorKind::kRgbd));
+  corner.integrate_scan({hit(2.005, 1.9995, 0.55)}, origin);
+  EXPECT_FALSE(corner.is_known({39, 20}));
+  EXPECT_FALSE(corner.is_known({40, 20}));
+  // A crossing within 3 sd and a rival one within 5 sd: the ray (3, 1) / sqrt(10) from (1.55, 2.05191) to
+  // (1.99241, 2.199368) (range 0.47 m: sd 2.44 mm) crosses y = 2.2 into (37, 19) 2 mm past the hit, then x = 2.0 into
+  // (37, 20) 8 mm past it (over 3 sd, under 5): a hit past 3 sd is rare, but a scan holds thousands of hits, and
+  // neither cell is credited.
+  const Point3 east_north_east{1.55, 2.05191, 0.5};
+  MappingSystem rival(grid, 16, sensor_defaults(SensorKind::kRgbd));
+  rival.integrate_scan({{static_cast<float>(1.99241 - 1.55), static_cast<float>(2.199368 - 2.05191), 0.05F}},
+                       east_north_east);
+  EXPECT_FALSE(rival.is_known({37, 19}));
+  EXPECT_FALSE(rival.is_known({37, 20}));
+  // The same direction 4.5 cm north of the corner: only x = 2.0 lies within reach, (39, 20) holds the face.
+  MappingSystem beside(grid, 16, sensor_defaults(SensorKind::kRgbd));
+  beside.integrate_scan({hit(2.005, 2.0445, 0.55)}, origin);
+  EXPECT_TRUE(beside.is_known({39, 20}));
+  // A noise-free ray exactly through the corner from the north-west crosses both lines at once into the south-east
+  // cell (40, 20): that cell's face (its corner edge) is the one struck.
+  SensorSpec exact = sensor_defaults(SensorKind::kRgbd);
+  exact.noise_sd_m = 0.0;
+  exact.noise_sd_per_m2 = 0.0;
+  MappingSystem through(grid, 16, exact);
+  const Point3 nw{1.55, 2.45, 0.5};
+  through.integrate_scan({{0.45F, -0.45F, 0.1F}}, nw);
+  ASSERT_TRUE(through.is_known({40, 20}));
+  EXPECT_NEAR(through.heights()(40, 20), 0.6, 1e-6);
+  EXPECT_FALSE(through.is_known({39, 20}));
+  EXPECT_FALSE(through.is_known({40, 19}));
+}
+
 // hit_within(cell, n): one of the last n scans hit the cell's surface.
 TEST(MappingSystem, HitWithinSaysWhetherARecentScanHitTheCell) {
   MappingSystem map(GridGeometry{60, 60, 0.0, 0.0, 0.1}, 16, sensor_defaults(SensorKind::kLaser));

@@ -2,10 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/mars_processor.hpp"
 #include "unit/agent/agent_test_support.hpp"
 
 namespace marsala::agent::executive {
@@ -63,6 +65,39 @@ TEST(RaisedCells, AWindowReachingOffTheGridAndAnUnknownCellAreLeftOut) {
   EXPECT_EQ(raised(0, 0), 0);  // unknown now
   EXPECT_EQ(raised(4, 4), 1);  // world (19, 29)
   EXPECT_EQ(raised(5, 4), 0);  // world (20, 29): off the grid
+}
+
+TEST(FirstSeenGap, CellsBesideABuiltStripKeepThePriceOfTheTerrainFirstSeen) {
+  // A slope falling 0.1 m per cell along the columns (steeper than kappa 0.2 on 0.25 m cells), first seen as it is;
+  // then a strip of row 4 raised by 0.3 m (built). Brute force: the cones of slope kappa from the first heights.
+  const double kappa = 0.2;
+  const GridGeometry g{10, 12, 0.0, 0.0, 0.25};
+  Heightmap first(g, 0.0);
+  for (int r = 0; r < 10; ++r)
+    for (int c = 0; c < 12; ++c) first(r, c) = 2.0 - 0.1 * c;
+  RaisedCells cells(20, 30);
+  CellMask known = CellMask::Ones(10, 12);
+  known(7, 9) = 0;  // never seen: counted at its current height
+  cells.observe(window(first, known));
+  Heightmap now = first;
+  for (int c = 0; c < 12; ++c) now(4, c) += 0.3;
+  now(7, 9) += 0.5;
+  deliberative::LocalMap m = window(now, CellMask::Ones(10, 12));
+  m.gap = MarsProcessor(kappa).gap(now);
+  const Heightmap price = first_seen_gap(m, cells, kappa);
+  Heightmap sources = first;
+  sources(7, 9) = now(7, 9);
+  for (int r = 0; r < 10; ++r)
+    for (int c = 0; c < 12; ++c) {
+      double top = sources(r, c);
+      for (int qr = 0; qr < 10; ++qr)
+        for (int qc = 0; qc < 12; ++qc)
+          top = std::max(top, sources(qr, qc) - kappa * 0.25 * std::hypot(qr - r, qc - c));
+      EXPECT_NEAR(price(r, c), std::min(m.gap(r, c), std::max(0.0, top - now(r, c))), 1e-9) << r << ", " << c;
+    }
+  // Beside the strip (row 5) the built 0.3 m raise the window's gap; the price is the natural slope's alone.
+  EXPECT_GT(m.gap(5, 6), price(5, 6) + 0.2);
+  EXPECT_NEAR(price(4, 6), 0.0, 1e-12);  // the strip itself stands above the first terrain's bound: free
 }
 
 TEST(RaisedCells, RefusesAnEmptyGrid) {

@@ -39,6 +39,21 @@ protocol::ActionRequest empty(const RampSteps& steps, const protocol::SensorFram
   return empty_request(steps.context(), f, "");
 }
 
+/// One return_step() of `steps` at `pose` with no material left: whether it refilled, its request and its trace.
+struct Returned {
+  bool refilled = false;
+  protocol::ActionRequest request;
+  BuildTrace trace;
+};
+Returned return_once(RampSteps& steps, std::uint64_t step, Position pose) {
+  Returned out;
+  const protocol::SensorFrame f = frame(steps, step, pose, 0.0);
+  const BuildView view = steps.look(f, out.trace);
+  out.request = empty(steps, f);
+  out.refilled = steps.return_step(view.local, f, out.trace, out.request);
+  return out;
+}
+
 TEST(BuildPhase, Names) {
   EXPECT_EQ(to_string(BuildPhase::kAdvance), "advance");
   EXPECT_EQ(to_string(BuildPhase::kBuild), "build");
@@ -258,33 +273,43 @@ TEST(RampSteps, BuildStepWithoutAPathThroughKnownCellsRequestsNothing) {
 
 TEST(RampSteps, ReturnStepHeadsForTheBaseAndRefillsWithinItsRadius) {
   const auto owned = admitted_steps();
-  RampSteps& steps = *owned;
-  BuildTrace trace;
-  protocol::SensorFrame f = frame(steps, 0, {2.05, 3.05}, 0.0);
-  BuildView view = steps.look(f, trace);
-  protocol::ActionRequest q = empty(steps, f);
-  EXPECT_FALSE(steps.return_step(view.local, f, trace, q));
-  ASSERT_TRUE(q.move);
-  EXPECT_NEAR(q.target_x_m, 1.85, 1e-12);  // a whole step west
-  EXPECT_FALSE(q.refill);
-  EXPECT_TRUE(trace.planned);
+  Returned r = return_once(*owned, 0, {2.05, 3.05});
+  EXPECT_FALSE(r.refilled);
+  ASSERT_TRUE(r.request.move);
+  EXPECT_NEAR(r.request.target_x_m, 1.85, 1e-12);  // a whole step west
+  EXPECT_FALSE(r.request.refill);
+  EXPECT_TRUE(r.trace.planned);
   // A step from the base radius (0.5 m): the motion ends inside it, so the same request refills.
-  trace = BuildTrace{};
-  f = frame(steps, 1, {1.15, 3.05}, 0.0);
-  view = steps.look(f, trace);
-  q = empty(steps, f);
-  EXPECT_TRUE(steps.return_step(view.local, f, trace, q));
-  EXPECT_TRUE(q.move);
-  EXPECT_TRUE(q.refill);
-  EXPECT_TRUE(trace.refill);
+  r = return_once(*owned, 1, {1.15, 3.05});
+  EXPECT_TRUE(r.refilled);
+  EXPECT_TRUE(r.request.move);
+  EXPECT_TRUE(r.request.refill);
+  EXPECT_TRUE(r.trace.refill);
   // Inside it already: refill in place.
-  trace = BuildTrace{};
-  f = frame(steps, 2, {0.85, 3.05}, 0.0);
-  view = steps.look(f, trace);
-  q = empty(steps, f);
-  EXPECT_TRUE(steps.return_step(view.local, f, trace, q));
-  EXPECT_FALSE(q.move);
-  EXPECT_TRUE(q.refill);
+  r = return_once(*owned, 2, {0.85, 3.05});
+  EXPECT_TRUE(r.refilled);
+  EXPECT_FALSE(r.request.move);
+  EXPECT_TRUE(r.request.refill);
+}
+
+TEST(RampSteps, ARobotNoNearerTheBaseForTwoWindowCrossingsTakesItsWayHomeForTheRestOfTheTrip) {
+  const auto owned = admitted_steps();
+  const RobotBody& body = owned->context().type.body;
+  // The robot's motions are never carried out (it stays at x = 6.05 m): as it would be when its window's nearest
+  // cell to the base lies one way from one cell and the other way from the next.
+  const int patience = static_cast<int>(std::ceil(4.0 * body.sensing_range_m / body.max_step_m));
+  for (int k = 0; k <= patience + 2; ++k) {
+    const Returned r = return_once(*owned, static_cast<std::uint64_t>(k), {6.05, 3.05});
+    EXPECT_FALSE(r.refilled);
+    EXPECT_TRUE(r.request.move) << k;
+    // The first call sets the trip's nearest distance; `patience` calls later without getting nearer, the way home.
+    EXPECT_EQ(r.trace.home_route, k >= patience) << k;
+  }
+  // At the base the trip ends: the next trip starts with the nearest cell of its window again.
+  EXPECT_TRUE(return_once(*owned, 100, {0.85, 3.05}).refilled);
+  const Returned next = return_once(*owned, 101, {6.05, 3.05});
+  EXPECT_FALSE(next.refilled);
+  EXPECT_FALSE(next.trace.home_route);
 }
 
 TEST(RampSteps, StepBackGoesAwayFromTheGoalBeforeTheRobotHasMoved) {

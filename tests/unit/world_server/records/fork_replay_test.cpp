@@ -145,11 +145,57 @@ TEST_F(ForkReplayTest, WhatCannotBeForkedIsRefusedWithOneLine) {
   record(10, 6);
   refused(11, 0, "the parent ran 10 steps; K must lie in 0..10");
   refused(7, 0, "agent 3 was dropped before step 7");
-  refused(3, 4, "--agents 4 exceeds the parent's team of 3");
   EXPECT_EQ(read_fork(dir_.string(), 6, 0, initial()).origin().parent_sha256_at_step, sha_after_[6]);
   EXPECT_EQ(read_fork(dir_.string(), 0, 0, initial()).origin().parent_sha256_at_step, sha_after_[0]);
   fs::resize_file(log_path(), fs::file_size(log_path()) - 3);  // a torn last record
   refused(2, 0, "torn run.log");
+}
+
+TEST_F(ForkReplayTest, ALateJoinCannotBeRepeatedByATeamStartedAfresh) {
+  // A parent in which agent 3 took a first admission at step 3 (as a fork's late slot does): a fork before it is
+  // fine, one after it is refused.
+  WorldState state = initial();
+  runlog::RunLogWriter log = start_log(state, 2);
+  std::mt19937_64 random(7);
+  for (int k = 0; k < 6; ++k) {
+    if (k == 3) {
+      admit(state, hello_for(state, 3, 103), AdmissionKind::kFirst);
+      log.append(admitted_record(state, 3, AdmissionKind::kFirst));
+    }
+    const std::vector<Submission> submissions = requests(state, random);
+    log.append(step_record(submissions, apply_step(state, submissions), state));
+  }
+  log.sync();
+  EXPECT_EQ(read_fork(dir_.string(), 3, 0, initial()).origin().at_step, 3u);
+  try {
+    read_fork(dir_.string(), 5, 0, initial());
+    ADD_FAILURE() << "a fork after the late join was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("agent 3 joined at step 3 before step 5"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(ForkReplayTest, AForkWhoseTeamGrewIsNotForkedAgain) {
+  WorldState state = initial();
+  ForkOrigin grown;
+  grown.parent_dir = "out/parent";
+  grown.at_step = 4;
+  grown.parent_agents = 2;
+  grown.agents = 3;
+  LogStart start;
+  start.run_id = "small-d2";
+  start.agents = 3;
+  start.fork = &grown;
+  runlog::RunLogWriter::create(log_path(), log_header(scenario_, start, state.terrain)).sync();
+  try {
+    read_fork(dir_.string(), 0, 0, initial());
+    ADD_FAILURE() << "a fork of a grown fork was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("a fork whose team grew at step 4 (slots 3..3 joined late)"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("fork its parent out/parent instead"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -135,6 +135,46 @@ TEST(RunSummary, SaysWhichSlotsOfTheTeamWereNotInTheRunAtItsEnd) {
   EXPECT_EQ(json_number(summary_json(whole, info_for("small", true)), "slots_missing"), 0.0);
 }
 
+TEST(RunSummary, AForksSlotsThatLeftAtKAreNotMissingButItsOwnDeadSlotsAre) {
+  // A fork of a 3-agent run at K = 40 with a team of 2: slot 3 left at K (the user's choice); then slot 2 dies.
+  WorldState s = admitted_state(testing::small_scenario(), flat_terrain(), 3);
+  drop_agent(s, 3, "not in the fork's team of 2");
+  RunInfo info = info_for("small", true);
+  ForkOrigin fork;
+  fork.parent_dir = "parent";
+  fork.at_step = 40;
+  fork.parent_agents = 3;
+  fork.agents = 2;
+  fork.overrides = {"stall_steps=50"};
+  info.fork = fork;
+  EXPECT_EQ(missing_slots(s), (std::vector<std::uint32_t>{3}));  // as a run that is no fork
+  EXPECT_TRUE(missing_slots(s, &fork).empty());
+  std::string json = summary_json(s, info);
+  EXPECT_EQ(json_number(json, "slots_missing"), 0.0) << json;
+  std::string compact = json;
+  compact.erase(std::remove_if(compact.begin(), compact.end(), [](char c) { return c == ' ' || c == '\n'; }),
+                compact.end());
+  EXPECT_TRUE(has(compact, "\"left_agents\":[3]")) << json;
+  EXPECT_TRUE(has(compact, "\"overrides\":[\"stall_steps=50\"]")) << json;
+  drop_agent(s, 2, "request writer lost liveliness");  // a slot of the fork's own team dies for real: missing
+  EXPECT_EQ(missing_slots(s, &fork), (std::vector<std::uint32_t>{2}));
+  EXPECT_EQ(json_number(summary_json(s, info), "slots_missing"), 1.0);
+  // A fork that grew from 1 to 3 agents: slot 3 joined at K, slot 2 did not come (missing, honestly).
+  WorldState grown = make_world_state(testing::small_scenario(), flat_terrain(), 3);
+  admit(grown, testing::hello_for(grown, 1, 1001));
+  admit(grown, testing::hello_for(grown, 3, 1003));
+  fork.parent_agents = 1;
+  fork.agents = 3;
+  fork.overrides.clear();
+  info.fork = fork;
+  EXPECT_EQ(missing_slots(grown, &fork), (std::vector<std::uint32_t>{2}));
+  compact = summary_json(grown, info);
+  compact.erase(std::remove_if(compact.begin(), compact.end(), [](char c) { return c == ' ' || c == '\n'; }),
+                compact.end());
+  EXPECT_TRUE(has(compact, "\"joined_agents\":[3]")) << compact;
+  EXPECT_TRUE(has(compact, "\"left_agents\":[]")) << compact;
+}
+
 TEST(FinalPicture, PayloadRunsShowThePathEndsAgentsAndDepositors) {
   WorldState s = admitted_state(scenario_with(payload_block()), flat_terrain(), 2);
   deposit_then_idle(s);
