@@ -581,7 +581,8 @@ bool RampSteps::return_step(const deliberative::LocalMap& local, const protocol:
   else
     ++memory_.return_no_nearer;
   const RobotBody& body = context_.type.body;
-  const bool patience_out = memory_.return_no_nearer >= static_cast<int>(std::ceil(4.0 * body.sensing_range_m / body.max_step_m));
+  const int patience_steps = static_cast<int>(std::ceil(4.0 * body.sensing_range_m / body.max_step_m));
+  const bool patience_out = memory_.return_no_nearer >= patience_steps;
   // Where to go: the navigable cell within the base radius nearest the robot; else, once this trip has taken the way
   // home (below), along it; else the navigable cell nearest the base when that is nearer than the robot by at least a
   // cell; else (the window holds no way nearer: a pocket whose exit lies beyond it) the way home over the robot's own
