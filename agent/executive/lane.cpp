@@ -206,7 +206,10 @@ Heightmap band_fill_gap(const deliberative::LocalMap& local, const CellMask& ban
 }
 
 Heightmap gap_below_bound_of(const deliberative::LocalMap& local, const Heightmap& sources, double kappa) {
-  const Heightmap target = MarsProcessor(kappa).project(sources);
+  return gap_below(local, MarsProcessor(kappa).project(sources));
+}
+
+Heightmap gap_below(const deliberative::LocalMap& local, const Heightmap& target) {
   Heightmap gap = local.gap;
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c)

@@ -68,5 +68,8 @@ Heightmap band_fill_gap(const deliberative::LocalMap& local, const CellMask& ban
 /// The window's gap capped by another surface's bound: min(local.gap, max(0, P_kappa[sources] - h)) [m] per cell,
 /// `sources` [m] the window's size (band_fill_gap: the band's heights; first_seen_gap: the heights first seen).
 Heightmap gap_below_bound_of(const deliberative::LocalMap& local, const Heightmap& sources, double kappa);
+/// The window's gap capped by `target` [m] (a bound already projected, the window's size): min(local.gap,
+/// max(0, target - h)) [m] per cell.
+Heightmap gap_below(const deliberative::LocalMap& local, const Heightmap& target);
 
 }  // namespace marsala::agent::executive

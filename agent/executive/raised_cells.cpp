@@ -43,14 +43,18 @@ double RaisedCells::first_height_m(CellIndex cell) const {
   return on_grid(cell) ? first_m_[index(cell)] : std::numeric_limits<double>::quiet_NaN();
 }
 
-Heightmap first_seen_gap(const deliberative::LocalMap& local, const RaisedCells& raised, double kappa) {
+Heightmap first_seen_heights(const deliberative::LocalMap& local, const RaisedCells& raised) {
   Heightmap first = local.heights;
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c) {
       const double seen = raised.first_height_m(local.to_global({r, c}));
       if (!std::isnan(seen)) first(r, c) = seen;
     }
-  return gap_below_bound_of(local, first, kappa);
+  return first;
+}
+
+Heightmap first_seen_gap(const deliberative::LocalMap& local, const RaisedCells& raised, double kappa) {
+  return gap_below_bound_of(local, first_seen_heights(local, raised), kappa);
 }
 
 }  // namespace marsala::agent::executive

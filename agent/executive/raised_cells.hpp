@@ -38,6 +38,8 @@ class RaisedCells {
   std::vector<double> first_m_;  // per world cell (row-major); NaN: never known
 };
 
+/// The window's heights as first seen (`raised`), a cell never recorded at its current height [m]; the window's size.
+Heightmap first_seen_heights(const deliberative::LocalMap& local, const RaisedCells& raised);
 /// The window's gap against the MARS bound at `kappa` [m/m] of its heights as first seen (`raised`; a cell never
 /// recorded at its current height): min(local.gap, max(0, P_kappa[h_first] - h)) [m] per cell, the window's size.
 /// Structure built since raises nothing in it: the cells beside a built strip keep the price of the natural terrain.

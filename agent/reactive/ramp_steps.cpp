@@ -16,6 +16,7 @@
 #include "marsala/core/enum_names.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/iterators.hpp"
+#include "marsala/core/mars_processor.hpp"
 #include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::agent::reactive {
@@ -340,11 +341,21 @@ CellMask RampSteps::built_cells(const deliberative::LocalMap& local) const {
   return memory_.raised->raised(local, std::max(deposits.gap_margin_m, 0.5 * deposits.cube_layer_m));
 }
 
-Heightmap RampSteps::plan_gap(const deliberative::LocalMap& local) const {
+Heightmap RampSteps::plan_gap(const deliberative::LocalMap& local) {
   // Every front prices its way by the same terrain, the one first seen, not by what other fronts raised since: a
   // strip built beside a robot's way would otherwise price the cells along it (the strip raises their MARS bound) and
   // send the next front round it, to build a strip of its own (docs/runtime.md#the-construction-band).
-  Heightmap gap = executive::first_seen_gap(local, *memory_.raised, construction_params(context_.type).kappa);
+  // The bound of the first-seen heights changes only when the window moves or sees new cells: a robot building in
+  // place reuses the last one.
+  Heightmap first = executive::first_seen_heights(local, *memory_.raised);
+  PlanBound& last = memory_.plan_bound;
+  if (!(last.offset == local.offset && last.first.rows() == first.rows() && last.first.cols() == first.cols() &&
+        (last.first.heights().array() == first.heights().array()).all())) {
+    last.bound = MarsProcessor(construction_params(context_.type).kappa).project(first);
+    last.first = std::move(first);
+    last.offset = local.offset;
+  }
+  Heightmap gap = executive::gap_below(local, last.bound);
   // What is built is the structure: its cells cost nothing, so a front that meets a strip drives on along it and
   // extends it at its tip.
   const CellMask built = built_cells(local);

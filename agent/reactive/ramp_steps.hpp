@@ -200,6 +200,12 @@ class RampSteps {
     std::vector<Deposit> deposits;
   };
   /// What the steps remember from one frame to the next.
+  // plan_gap(): the last window's first-seen heights and their MARS bound at the construction kappa.
+  struct PlanBound {
+    CellIndex offset{-1, -1};
+    Heightmap first;
+    Heightmap bound;
+  };
   struct Memory {
     Sent sent;
     /// The world gives deposits (cube, cone) their shape and may judge one the prediction passed: after a rejected
@@ -228,6 +234,7 @@ class RampSteps {
     std::vector<CellIndex> home;                   ///< the way home of this trip (world cells), empty: not planned
     double return_nearest_m = std::numeric_limits<double>::infinity();  ///< this trip's nearest to the base [m]
     int return_no_nearer = 0;  ///< return steps since the robot last got nearer the base than return_nearest_m
+    PlanBound plan_bound;  ///< plan_gap()'s memo
     std::optional<executive::RaisedCells> raised;  ///< set_band_centre(): the structure seen built (first heights)
     Position target;                               ///< this frame's target (synthesize_view()) [m]
   };
@@ -246,7 +253,7 @@ class RampSteps {
   Heightmap band_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const;
   // set_band_centre(): the price the planner routes by: the window's gap against the terrain as first seen
   // (executive::first_seen_gap), so what is built raises no price beside it, and 0 on the cells built (built_cells).
-  Heightmap plan_gap(const deliberative::LocalMap& local) const;
+  Heightmap plan_gap(const deliberative::LocalMap& local);
   // set_band_centre(): the window's cells seen raised since first seen (RaisedCells::raised), the structure.
   CellMask built_cells(const deliberative::LocalMap& local) const;
   std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
