@@ -5,6 +5,7 @@
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
+#include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::agent::deliberative {
 
@@ -13,10 +14,12 @@ std::optional<Position> FixedTarget::target(const GoalQuery& /*query*/) { return
 GoalVectorMapSynthesizer::GoalVectorMapSynthesizer(const AgentContext& context)
     : self_id_(context.agent_id),
       cell_size_m_(context.assignment.world.cell_size_m),
+      map_grid_(context.assignment.world),
       map_(context.goal_vector_map ? *context.goal_vector_map
                                    : throw InvalidArgument("goal synthesizer 'goal_vector_map' needs the "
                                                            "scenario's goal_vector_map block"),
            context.assignment.world),
+      area_cells_(cells_centred_in(context.assignment.world, map_.spec().area)),
       finished_(map_.arrows().size(), false) {}
 
 namespace {
@@ -65,6 +68,7 @@ std::optional<Position> GoalVectorMapSynthesizer::target(const GoalQuery& query)
         fmt::format("goal synthesizer 'goal_vector_map' of agent {}: the robot's position {} is not finite", self_id_,
                     query.robot));
   const std::vector<GoalArrow>& arrows = map_.arrows();
+  bool reopened = false;
   // Every pass returns, reaches a tail (once per pick) or finishes an arrow, so the loop ends.
   for (;;) {
     // A tail still ahead is given up as soon as a neighbour stands nearer to it, with the same rule that picks
@@ -73,6 +77,10 @@ std::optional<Position> GoalVectorMapSynthesizer::target(const GoalQuery& query)
                       neighbour_takes(arrows[*current_].tail, query, self_id_))) {
       current_ = pick_tail(map_, finished_, query, self_id_);
       to_tail_ = true;
+      if (!current_ && !reopened && reopen_unlevel(query)) {
+        reopened = true;  // at most once a frame, so the loop ends even when the robot stands on such an arrow
+        current_ = pick_tail(map_, finished_, query, self_id_);
+      }
       if (!current_) return std::nullopt;
     }
     const GoalArrow& arrow = arrows[*current_];
@@ -90,6 +98,58 @@ std::optional<Position> GoalVectorMapSynthesizer::target(const GoalQuery& query)
       current_.reset();
     }
   }
+}
+
+bool GoalVectorMapSynthesizer::reopen_unlevel(const GoalQuery& query) {
+  if (!query.unlevel || area_cells_.empty()) return false;
+  const CellMask unlevel = query.unlevel(area_cells_);
+  if (unlevel.rows() != area_cells_.rows || unlevel.cols() != area_cells_.cols)
+    throw InvalidArgument(fmt::format("goal synthesizer 'goal_vector_map' of agent {}: the unlevel mask is {} x {}, "
+                                      "the map's area {} x {} cells",
+                                      self_id_, unlevel.rows(), unlevel.cols(), area_cells_.rows, area_cells_.cols));
+  const GridGeometry& grid = map_grid_;
+  bool any = false;
+  for (int r = 0; r < area_cells_.rows; ++r)
+    for (int c = 0; c < area_cells_.cols; ++c) {
+      if (unlevel(r, c) == 0) continue;
+      const Position centre = grid.cell_center({area_cells_.first.row + r, area_cells_.first.col + c});
+      const std::optional<std::size_t> arrow = map_.arrow_at(centre);
+      if (arrow && finished_[*arrow]) {
+        finished_[*arrow] = false;
+        any = true;
+      }
+    }
+  if (any) ++reopenings_;
+  return any;
+}
+
+CellMask unlevel_cells(const KnownMap& map, const CellRect& area, const NavigabilityParams& level) {
+  const GridGeometry& grid = map.geometry();
+  if (area.empty() || !grid.contains(area.first) ||
+      !grid.contains({area.first.row + area.rows - 1, area.first.col + area.cols - 1}))
+    throw InvalidArgument(fmt::format("unlevel cells: the area of {} x {} cells from {} is empty or leaves the "
+                                      "{} x {} grid",
+                                      area.rows, area.cols, area.first, grid.rows, grid.cols));
+  const Heightmap cut = map.heights.window(area.first, area.rows, area.cols);
+  const CellMask occupiable = NavigabilityProcessor(level).occupiable(cut);
+  // Cells whose reading is a guess (unknown, or assumed ground) and the cells within delta/2 of one are not judged.
+  const int ring = static_cast<int>(std::floor(0.5 * level.delta_m / grid.cell_size_m + tolerance::kLengthM));
+  const double ring2 = (0.5 * level.delta_m / grid.cell_size_m) * (0.5 * level.delta_m / grid.cell_size_m) + 1e-9;
+  CellMask judged = CellMask::Ones(area.rows, area.cols);
+  for (int r = 0; r < area.rows; ++r)
+    for (int c = 0; c < area.cols; ++c) {
+      const int gr = area.first.row + r, gc = area.first.col + c;
+      if (map.known(gr, gc) != 0 && map.assumed(gr, gc) == 0) continue;
+      for (int dr = -ring; dr <= ring; ++dr)
+        for (int dc = -ring; dc <= ring; ++dc) {
+          const int rr = r + dr, cc = c + dc;
+          if (dr * dr + dc * dc <= ring2 && rr >= 0 && rr < area.rows && cc >= 0 && cc < area.cols) judged(rr, cc) = 0;
+        }
+    }
+  CellMask unlevel = CellMask::Zero(area.rows, area.cols);
+  for (int r = 0; r < area.rows; ++r)
+    for (int c = 0; c < area.cols; ++c) unlevel(r, c) = judged(r, c) != 0 && occupiable(r, c) == 0 ? 1 : 0;
+  return unlevel;
 }
 
 GoalSynthesizerRegistry make_goal_synthesizer_registry() { return GoalSynthesizerRegistry("goal synthesizer"); }

@@ -8,12 +8,14 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "marsala/agent/agent_context.hpp"
+#include "marsala/agent/deliberative/known_map.hpp"
 #include "marsala/core/goal_vector_map.hpp"
 #include "marsala/core/registry.hpp"
 #include "marsala/core/types.hpp"
@@ -24,7 +26,16 @@ namespace marsala::agent::deliberative {
 struct GoalQuery {
   Position robot;                     ///< where the robot stands [m]
   std::vector<Neighbour> neighbours;  ///< robots within proximity range (from the frame)
+  /// Site preparation: 1 where the robot's map shows a cell of the given rectangle of world cells not yet level, on
+  /// a mask of its size (unlevel_cells()). Asked only once the robot has finished every arrow; empty: never asked.
+  std::function<CellMask(const CellRect&)> unlevel;
 };
+
+/// The cells of `area` (world cell indices) that `map` shows not level for `level`: not occupiable (paper eq. 1) on
+/// the map cut to the area, as the world judges a site (docs/runtime.md#level_site), where every cell within
+/// delta/2 is known from a sensor reading (not unknown, not assumed ground). A mask of area.rows x area.cols; throws
+/// InvalidArgument when the area is empty or leaves the map's grid.
+CellMask unlevel_cells(const KnownMap& map, const CellRect& area, const NavigabilityParams& level);
 
 /// Picks the target location [m] for the robot's current state.
 class GoalSynthesizer {
@@ -54,7 +65,8 @@ class FixedTarget final : public GoalSynthesizer {
 ///   on the tail cell -> target = the arrow's head
 ///   on the head cell -> the arrow is finished; the next arrow of the strip continues (target its head at once),
 ///                       else the nearest free tail again
-///   all finished     -> nullopt
+///   all finished     -> the arrows whose stretch holds a cell the robot's map shows not level (query.unlevel) are
+///                       open again (once per frame), and the nearest free tail is picked; when none is, nullopt
 /// "Stands on" means the robot's position is within half a cell (Chebyshev, in metres) of the point.
 class GoalVectorMapSynthesizer final : public GoalSynthesizer {
  public:
@@ -71,14 +83,22 @@ class GoalVectorMapSynthesizer final : public GoalSynthesizer {
   bool heading_for_tail() const { return to_tail_; }
   /// Arrows this robot has finished.
   const std::vector<bool>& finished() const { return finished_; }
+  /// How many times finished arrows were opened again for ground still not level.
+  int reopenings() const { return reopenings_; }
 
  private:
   std::uint32_t self_id_;
   double cell_size_m_;
+  GridGeometry map_grid_;
   GoalVectorMap map_;
+  CellRect area_cells_;  ///< the world cells whose centres lie in the map's rectangle
   std::optional<std::size_t> current_;
   bool to_tail_ = true;
   std::vector<bool> finished_;
+  int reopenings_ = 0;
+
+  // Opens the finished arrows whose stretch holds a cell query.unlevel shows; true when it opened any.
+  bool reopen_unlevel(const GoalQuery& query);
 };
 
 /// Goal synthesizers by name; each is made from the admitted agent's context.

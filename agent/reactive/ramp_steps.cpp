@@ -209,7 +209,14 @@ void RampSteps::update_map(const protocol::SensorFrame& frame) {
 
 BuildView RampSteps::synthesize_view(const protocol::SensorFrame& frame) {
   const Position robot{frame.x_m, frame.y_m};
-  const std::optional<Position> goal = goal_->target({robot, frame.neighbours});
+  deliberative::GoalQuery query{robot, frame.neighbours, {}};
+  // Level for what it builds: the construction's slope and discontinuity under the robot's own body.
+  NavigabilityParams level = construction_params(context_.type);
+  level.delta_m = context_.type.body.navigability.delta_m;
+  query.unlevel = [this, level](const CellRect& area) {
+    return deliberative::unlevel_cells(modules_->map.known_map(), area, level);
+  };
+  const std::optional<Position> goal = goal_->target(query);
   const Position target = goal.value_or(robot);  // nothing left to build towards: stay
   memory_.target = target;
   BuildView view{modules_->synthesizer.synthesize(modules_->map.known_map(), robot, target), robot, target};

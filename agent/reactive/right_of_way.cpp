@@ -60,7 +60,7 @@ void RightOfWay::observe(Position self, const std::vector<Neighbour>& neighbours
   // (a robot parked at its goal does not start to "hold" again each time another comes back into range).
   for (const Neighbour& n : neighbours) {
     const auto old = seen_.find(n.agent_id);
-    Seen s{n.position, 0, {0.0, 0.0}, n.radius_m, {}, frame_};
+    Seen s{n.position, 0, {0.0, 0.0}, n.radius_m, {}, frame_, std::nullopt, false};
     if (old != seen_.end()) {
       const double dx = n.position.x - old->second.at.x, dy = n.position.y - old->second.at.y;
       const double moved = std::hypot(dx, dy);

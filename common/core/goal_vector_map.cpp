@@ -169,6 +169,27 @@ std::optional<std::size_t> GoalVectorMap::nearest_free_tail(Position p, const st
   return best;
 }
 
+std::optional<std::size_t> GoalVectorMap::arrow_at(Position p) const {
+  const Rect& a = spec_.area;
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || p.x < a.x0 - kTolM || p.x > a.x1 + kTolM || p.y < a.y0 - kTolM ||
+      p.y > a.y1 + kTolM)
+    return std::nullopt;
+  const bool ax = along_x(spec_.heading);
+  const double across = ax ? p.y - a.y0 : p.x - a.x0;
+  const int strip =
+      std::clamp(static_cast<int>(std::ceil(across / spec_.strip_width_m - kTolM)) - 1, 0, strips_ - 1);
+  const std::size_t per_strip = arrows_.size() / static_cast<std::size_t>(strips_);
+  const std::size_t first = static_cast<std::size_t>(strip) * per_strip;
+  // Coordinates along the heading grow downwind.
+  const double sign = forward(spec_.heading) ? 1.0 : -1.0;
+  const double along = sign * (ax ? p.x : p.y);
+  for (std::size_t i = first; i + 1 < first + per_strip; ++i) {
+    const Position head = arrows_[i].head;
+    if (along <= sign * (ax ? head.x : head.y) + kTolM) return i;
+  }
+  return first + per_strip - 1;
+}
+
 std::optional<std::size_t> GoalVectorMap::next(std::size_t i) const {
   if (i >= arrows_.size()) fail(fmt::format("arrow {} is out of range (the map has {} arrows)", i, arrows_.size()));
   if (i + 1 < arrows_.size() && arrows_[i + 1].strip == arrows_[i].strip) return i + 1;

@@ -67,6 +67,11 @@ class GoalVectorMap {
   /// The arrow whose tail is nearest `p` [m] among those with excluded[i] == false (excluded may be shorter than
   /// arrows(): missing entries count as false); ties go to the lower index. nullopt when every arrow is excluded.
   std::optional<std::size_t> nearest_free_tail(Position p, const std::vector<bool>& excluded) const;
+  /// The arrow whose stretch of the site holds `p` [m]: the strip whose band holds p across the heading (a point on
+  /// the line between two bands belongs to the lower strip), and along it the first arrow whose head is not behind
+  /// p (the first arrow's stretch reaches back to the upwind edge, the last one's on to the downwind edge). nullopt
+  /// when p lies outside the rectangle (edges included) or is not finite.
+  std::optional<std::size_t> arrow_at(Position p) const;
   /// The arrow after arrow i on its strip (its tail is arrow i's head), or nullopt at the strip's end; throws
   /// InvalidArgument when i is out of range.
   std::optional<std::size_t> next(std::size_t i) const;

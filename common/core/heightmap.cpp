@@ -1,5 +1,6 @@
 #include "marsala/core/heightmap.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -24,6 +25,22 @@ std::optional<CellIndex> GridGeometry::cell_at(Position p) const {
   const double row_from_south = std::floor((p.y - yll_m) / cell_size_m);
   if (!(col >= 0 && col < cols && row_from_south >= 0 && row_from_south < rows)) return std::nullopt;
   return CellIndex{rows - 1 - static_cast<int>(row_from_south), static_cast<int>(col)};
+}
+
+CellRect cells_centred_in(const GridGeometry& grid, const Rect& area) {
+  constexpr double tol = tolerance::kLengthM;
+  // Scanning every row and column decides each centre exactly as the definition says, with no rounding shortcut.
+  int r0 = grid.rows, r1 = -1, c0 = grid.cols, c1 = -1;
+  for (int r = 0; r < grid.rows; ++r) {
+    const double y = grid.cell_center({r, 0}).y;
+    if (y >= area.y0 - tol && y <= area.y1 + tol) r0 = std::min(r0, r), r1 = std::max(r1, r);
+  }
+  for (int c = 0; c < grid.cols; ++c) {
+    const double x = grid.cell_center({0, c}).x;
+    if (x >= area.x0 - tol && x <= area.x1 + tol) c0 = std::min(c0, c), c1 = std::max(c1, c);
+  }
+  if (r1 < 0 || c1 < 0) return {};
+  return {{r0, c0}, r1 - r0 + 1, c1 - c0 + 1};
 }
 
 Heightmap::Heightmap(GridGeometry geometry, double fill) : geometry_(geometry) {

@@ -51,6 +51,10 @@ struct GridGeometry {
   }
 };
 
+/// The cells of `grid` whose centres lie in `area` [m] (edges included, within tolerance::kLengthM), as a rectangle;
+/// empty when no centre does. The cells a site or a goal vector map covers, for the world and the agents alike.
+CellRect cells_centred_in(const GridGeometry& grid, const Rect& area);
+
 /// A grid of heights [m] placed in the world frame.
 class Heightmap {
  public:

@@ -157,19 +157,7 @@ double largest_cube_layer_m(const WorldState& state) {
 }
 
 CellRect site_cells(const GridGeometry& grid, const scenario::Site& site) {
-  constexpr double tol = tolerance::kLengthM;
-  // Scanning every row and column decides each centre exactly as the definition says, with no rounding shortcut.
-  int r0 = grid.rows, r1 = -1, c0 = grid.cols, c1 = -1;
-  for (int r = 0; r < grid.rows; ++r) {
-    const double y = grid.cell_center({r, 0}).y;
-    if (y >= site.area.y0 - tol && y <= site.area.y1 + tol) r0 = std::min(r0, r), r1 = std::max(r1, r);
-  }
-  for (int c = 0; c < grid.cols; ++c) {
-    const double x = grid.cell_center({0, c}).x;
-    if (x >= site.area.x0 - tol && x <= site.area.x1 + tol) c0 = std::min(c0, c), c1 = std::max(c1, c);
-  }
-  if (r1 < 0 || c1 < 0) return {};
-  return {{r0, c0}, r1 - r0 + 1, c1 - c0 + 1};
+  return cells_centred_in(grid, site.area);
 }
 
 long long largest_component(const CellMask& mask) {

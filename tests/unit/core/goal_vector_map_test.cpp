@@ -281,6 +281,50 @@ TEST(GoalVectorMap, StripsCoverTheRectangleBruteForce) {
   }
 }
 
+// arrow_at against its definition, checked per arrow: the point lies in its strip's band across the heading (a
+// point on the line between two bands in the lower strip) and between its tail and head along it (the first arrow
+// open to the upwind side, the last one to the downwind side, a point on a head in the arrow that ends there).
+TEST(GoalVectorMap, ArrowAtMatchesTheStretchOfEachArrow) {
+  RandomSpecs random;
+  int points = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const bool aligned = trial % 2 == 0;
+    const GoalVectorMapSpec s = random.make(aligned);
+    const std::optional<GoalVectorMap> map = try_make(s, random.grid, aligned);
+    if (!map) continue;
+    const std::vector<GoalArrow>& arrows = map->arrows();
+    const double lo = s.heading == Heading::kEast || s.heading == Heading::kWest ? s.area.y0 : s.area.x0;
+    // Cell centres of the grid, the arrows' own tails and heads, and random points in and around the rectangle.
+    std::vector<Position> probes;
+    for (int r = 0; r < random.grid.rows; ++r)
+      for (int c = 0; c < random.grid.cols; ++c) probes.push_back(random.grid.cell_center({r, c}));
+    for (const GoalArrow& a : arrows) probes.insert(probes.end(), {a.tail, a.head});
+    for (int k = 0; k < 200; ++k)
+      probes.push_back({random.uniform(s.area.x0 - 1.0, s.area.x1 + 1.0), random.uniform(s.area.y0 - 1.0, s.area.y1 + 1.0)});
+    for (const Position p : probes) {
+      const bool inside = p.x >= s.area.x0 && p.x <= s.area.x1 && p.y >= s.area.y0 && p.y <= s.area.y1;
+      const std::optional<std::size_t> at = map->arrow_at(p);
+      ASSERT_EQ(at.has_value(), inside) << "trial " << trial << " point (" << p.x << ", " << p.y << ")";
+      if (!at) continue;
+      ++points;
+      const GoalArrow& a = arrows[*at];
+      const double band_lo = lo + a.strip * s.strip_width_m;
+      const double band_hi = band_lo + s.strip_width_m;
+      const double x = across(s, p);
+      EXPECT_TRUE((x > band_lo + 1e-9 || a.strip == 0) && (x <= band_hi + 1e-9 || a.strip == map->strips() - 1))
+          << "trial " << trial << " strip " << a.strip << " across " << x;
+      const bool first = a.index == 0;
+      const bool last = *at + 1 == arrows.size() || arrows[*at + 1].strip != a.strip;
+      EXPECT_TRUE(first || along(s, p) > along(s, a.tail) + 1e-9) << "trial " << trial << " arrow " << *at;
+      EXPECT_TRUE(last || along(s, p) <= along(s, a.head) + 1e-9) << "trial " << trial << " arrow " << *at;
+    }
+  }
+  EXPECT_GT(points, 50000);
+  const GoalVectorMap map(spec(100.5, -19, 111, -9.5, 1.5, 2.5, Heading::kNorth), grid_1m());
+  EXPECT_FALSE(map.arrow_at({std::nan(""), -15.0}).has_value());
+  EXPECT_FALSE(map.arrow_at({105.0, std::numeric_limits<double>::infinity()}).has_value());
+}
+
 TEST(GoalVectorMap, NearestFreeTailMatchesBruteForce) {
   const GoalVectorMap map(spec(100.5, -19, 111, -9.5, 1.5, 2.5, Heading::kNorth), grid_1m());
   const std::size_t n = map.arrows().size();

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
+#include <vector>
 #include <utility>
 
 #include "unit/agent/agent_test_support.hpp"
@@ -17,7 +19,7 @@ TEST(GoalSynthesizer, FixedTargetIsTheAdmissionsTargetWhereverTheRobotIs) {
   const auto goal = make_goal_synthesizer("fixed_target", context);
   EXPECT_EQ(goal->name(), "fixed_target");
   for (const Position robot : {Position{0.0, 0.0}, Position{12.5, -3.25}, Position{-100.0, 7.0}}) {
-    const std::optional<Position> t = goal->target({robot, {}});
+    const std::optional<Position> t = goal->target({robot, {}, {}});
     ASSERT_TRUE(t.has_value());
     EXPECT_EQ(t->x, 12.5);
     EXPECT_EQ(t->y, -3.25);
@@ -71,12 +73,18 @@ const auto neighbour = test::neighbour_at;
 // The target, which must exist, as a pair for EXPECT_EQ.
 std::pair<double, double> target_of(GoalVectorMapSynthesizer& goal, Position robot,
                                     std::vector<Neighbour> neighbours = {}) {
-  const std::optional<Position> t = goal.target({robot, std::move(neighbours)});
+  const std::optional<Position> t = goal.target({robot, std::move(neighbours), {}});
   if (!t) ADD_FAILURE() << "no target from (" << robot.x << ", " << robot.y << ")";
   return t ? std::make_pair(t->x, t->y) : std::make_pair(std::nan(""), std::nan(""));
 }
 
 using XY = std::pair<double, double>;
+
+std::pair<double, double> target_of_query(GoalVectorMapSynthesizer& goal, const GoalQuery& query) {
+  const std::optional<Position> t = goal.target(query);
+  if (!t) ADD_FAILURE() << "no target from (" << query.robot.x << ", " << query.robot.y << ")";
+  return t ? std::make_pair(t->x, t->y) : std::make_pair(std::nan(""), std::nan(""));
+}
 
 TEST(GoalVectorMapSynthesizer, CompilesTheScenariosMap) {
   const auto goal = make_goal_synthesizer("goal_vector_map", site_context(1));
@@ -120,10 +128,126 @@ TEST(GoalVectorMapSynthesizer, WalksTheArrowsAsTheTableSays) {
   EXPECT_EQ(goal.current_arrow(), std::optional<std::size_t>(2));
   EXPECT_EQ(target_of(goal, {2.5, 5.5}), XY(6.5, 5.5));
   // Arrow 2's next arrow (3) is finished already: nothing is left.
-  EXPECT_FALSE(goal.target({{6.5, 5.5}, {}}).has_value());
+  EXPECT_FALSE(goal.target({{6.5, 5.5}, {}, {}}).has_value());
   EXPECT_EQ(goal.finished(), std::vector<bool>(4, true));
   EXPECT_FALSE(goal.current_arrow().has_value());
-  EXPECT_FALSE(goal.target({{0.5, 0.5}, {}}).has_value());
+  EXPECT_FALSE(goal.target({{0.5, 0.5}, {}, {}}).has_value());
+}
+
+// Walks the robot to every target it is given (standing on it) until it has none: every arrow is finished.
+void finish_every_arrow(GoalVectorMapSynthesizer& goal) {
+  Position robot{0.5, 0.5};
+  for (int i = 0; i < 100; ++i) {
+    const std::optional<Position> t = goal.target({robot, {}, {}});
+    if (!t) break;
+    robot = *t;
+  }
+  ASSERT_EQ(goal.finished(), std::vector<bool>(goal.map().arrows().size(), true));
+}
+
+// A robot that finished every arrow while its map shows ground not level opens again the arrows whose stretch holds
+// it, and builds along them; with a level map (or nobody to ask) it is done.
+TEST(GoalVectorMapSynthesizer, OpensAgainTheArrowsWhoseStretchTheMapShowsNotLevel) {
+  GoalVectorMapSynthesizer goal(site_context(1));
+  finish_every_arrow(goal);
+  // The site [2, 10] x [2, 6] on the 12 x 12 grid of 1 m: cell centres at x 2.5 .. 9.5 (cols 2-9) and y 5.5 .. 2.5
+  // (rows 6-9).
+  CellRect asked;
+  std::vector<CellIndex> unlevel{{3, 5}};  // area cell: world cell (9, 7), centre (7.5, 2.5): strip 0, past 6.5
+  GoalQuery query{{9.5, 5.5}, {}, [&](const CellRect& area) {
+                    asked = area;
+                    CellMask mask = CellMask::Zero(area.rows, area.cols);
+                    for (const CellIndex c : unlevel) mask(c.row, c.col) = 1;
+                    return mask;
+                  }};
+  EXPECT_EQ(target_of_query(goal, query), XY(6.5, 3.5));  // arrow 1's tail
+  EXPECT_EQ(asked.first, (CellIndex{6, 2}));
+  EXPECT_EQ(asked.rows, 4);
+  EXPECT_EQ(asked.cols, 8);
+  EXPECT_EQ(goal.finished(), (std::vector<bool>{true, false, true, true}));
+  EXPECT_EQ(goal.reopenings(), 1);
+  query.robot = {6.5, 3.5};
+  EXPECT_EQ(target_of_query(goal, query), XY(9.5, 3.5));
+  // Still not level when it gets there: the same arrow again, from its tail.
+  query.robot = {9.5, 3.5};
+  EXPECT_EQ(target_of_query(goal, query), XY(6.5, 3.5));
+  EXPECT_EQ(goal.reopenings(), 2);
+  // Area cell (0, 0): world cell (6, 2), centre (2.5, 5.5): strip 1, before arrow 2's head.
+  finish_every_arrow(goal);
+  unlevel = {{0, 0}};
+  query.robot = {9.5, 5.5};
+  EXPECT_EQ(target_of_query(goal, query), XY(2.5, 5.5));
+  EXPECT_EQ(goal.finished(), (std::vector<bool>{true, true, false, true}));
+  // Level: done, and it stays where it is.
+  finish_every_arrow(goal);
+  unlevel.clear();
+  EXPECT_FALSE(goal.target(query).has_value());
+  EXPECT_FALSE(goal.target({{9.5, 5.5}, {}, {}}).has_value());
+  // A mask of another size is a broken contract.
+  query.unlevel = [](const CellRect&) { return CellMask::Zero(2, 2); };
+  EXPECT_THROW(goal.target(query), InvalidArgument);
+}
+
+// unlevel_cells against eq. 1 checked pair by pair on the map cut to the area, where every cell of the ball is read.
+TEST(GoalVectorMapSynthesizer, UnlevelCellsMatchAPairByPairCheckOfTheReadBalls) {
+  std::mt19937 rng(11);
+  const GridGeometry grid{14, 16, 0.0, 0.0, 0.25};
+  const NavigabilityParams level{0.1, 1.0, 0.05};
+  long long unlevel_seen = 0, level_seen = 0, unjudged_seen = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    Heightmap heights(grid);
+    CellMask known = CellMask::Ones(grid.rows, grid.cols), assumed = CellMask::Zero(grid.rows, grid.cols);
+    CellMask bound = CellMask::Zero(grid.rows, grid.cols);
+    std::uniform_real_distribution<double> bump(-0.03, 0.03), coin(0.0, 1.0);
+    const double tilt = 0.05 * (trial % 5);
+    for (int r = 0; r < grid.rows; ++r)
+      for (int c = 0; c < grid.cols; ++c) {
+        heights(r, c) = tilt * c * grid.cell_size_m + (coin(rng) < 0.15 ? bump(rng) * 4.0 : bump(rng) * 0.2);
+        if (coin(rng) < 0.04) known(r, c) = 0, heights(r, c) = 0.0;
+        else if (coin(rng) < 0.03) assumed(r, c) = 1;
+      }
+    const std::vector<CellIndex> trajectory;
+    const KnownMap map{heights, known, assumed, bound, trajectory};
+    const CellRect area{{2, 1}, 10, 13};
+    const CellMask got = unlevel_cells(map, area, level);
+    ASSERT_EQ(got.rows(), area.rows);
+    ASSERT_EQ(got.cols(), area.cols);
+    const double r2 = 0.25 * level.delta_m * level.delta_m;
+    for (int r = 0; r < area.rows; ++r)
+      for (int c = 0; c < area.cols; ++c) {
+        std::vector<CellIndex> ball;  // area cells whose centres lie within delta/2 of (r, c)'s
+        for (int rr = 0; rr < area.rows; ++rr)
+          for (int cc = 0; cc < area.cols; ++cc) {
+            const double dy = (rr - r) * grid.cell_size_m, dx = (cc - c) * grid.cell_size_m;
+            if (dx * dx + dy * dy <= r2 + 1e-12) ball.push_back({rr, cc});
+          }
+        bool read = true, occupiable = true;
+        for (const CellIndex a : ball) {
+          const int ar = area.first.row + a.row, ac = area.first.col + a.col;
+          read = read && known(ar, ac) != 0 && assumed(ar, ac) == 0;
+          for (const CellIndex b : ball) {
+            const int br = area.first.row + b.row, bc = area.first.col + b.col;
+            const double d = grid.cell_size_m * std::hypot(a.row - b.row, a.col - b.col);
+            if (std::abs(heights(ar, ac) - heights(br, bc)) > level.eps_m + level.kappa * d + 1e-9) occupiable = false;
+          }
+        }
+        const int expected = read && !occupiable ? 1 : 0;
+        EXPECT_EQ(got(r, c), expected) << "trial " << trial << " cell (" << r << ", " << c << ")";
+        unlevel_seen += expected;
+        level_seen += read && occupiable;
+        unjudged_seen += !read;
+      }
+  }
+  // The draws hold all three kinds, so the check tells them apart.
+  EXPECT_GT(unlevel_seen, 500);
+  EXPECT_GT(level_seen, 500);
+  EXPECT_GT(unjudged_seen, 500);
+  const Heightmap heights(grid);
+  const CellMask ones = CellMask::Ones(grid.rows, grid.cols);
+  const std::vector<CellIndex> trajectory;
+  const KnownMap map{heights, ones, ones, ones, trajectory};
+  EXPECT_THROW(unlevel_cells(map, {{10, 10}, 5, 2}, level), InvalidArgument);
+  EXPECT_THROW(unlevel_cells(map, {{0, 0}, 0, 3}, level), InvalidArgument);
 }
 
 TEST(GoalVectorMapSynthesizer, SkipsATailANeighbourIsNearerTo) {
@@ -183,8 +307,8 @@ TEST(GoalVectorMapSynthesizer, TwoRobotsFinishEveryArrowDeterministically) {
     while ((!a_done || !b_done) && frames < 100) {
       ++frames;
       std::optional<Position> ta, tb;
-      if (!a_done) ta = a.target({pa, {neighbour(2, pb.x, pb.y)}});
-      if (!b_done) tb = b.target({pb, {neighbour(1, pa.x, pa.y)}});
+      if (!a_done) ta = a.target({pa, {neighbour(2, pb.x, pb.y)}, {}});
+      if (!b_done) tb = b.target({pb, {neighbour(1, pa.x, pa.y)}, {}});
       if (ta && tb && a.heading_for_tail() && b.heading_for_tail()) {
         EXPECT_NE(a.current_arrow(), b.current_arrow()) << "frame " << frames;
       }
@@ -226,7 +350,7 @@ TEST(GoalVectorMapSynthesizer, RejectsAContextWithoutAUsableMap) {
   no_grid.assignment.world.cell_size_m = 0.0;
   EXPECT_THROW(GoalVectorMapSynthesizer{no_grid}, InvalidArgument);
   GoalVectorMapSynthesizer goal(site_context(1));
-  EXPECT_THROW(goal.target({{std::nan(""), 1.0}, {}}), InvalidArgument);
+  EXPECT_THROW(goal.target({{std::nan(""), 1.0}, {}, {}}), InvalidArgument);
 }
 
 }  // namespace
