@@ -95,6 +95,19 @@ int main(int argc, char** argv) {
   marsala::cli::setup_logging("agent", id, log_options);
   std::shared_ptr<agent::runtime::MapDump> dump;
   std::string world_key;
+  const bus::BusConfig bus_config{bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kClient,
+                                  bus::Security::of(dds.security, dds.identity, fmt::format("agent-{}", id)),
+                                  dds.peers};
+  try {
+    if (!dds.security.empty() && id == 0 && dds.identity.empty())
+      throw InvalidArgument(
+          "--id auto with --security needs --identity: the identity cannot follow a slot not yet "
+          "assigned");
+    bus::check_config(bus_config);  // a bad profile or identity folder: refused before anything runs
+  } catch (const InvalidArgument& e) {
+    marsala::cli::write_exit_error(std::cerr, fmt::format("marsala-agent: {}", e.what()));
+    return marsala::cli::kExitUsage;
+  }
   try {
     if (!dump_dir.empty()) dump = std::make_shared<agent::runtime::MapDump>(dump_dir);
     if (!run_key.empty()) world_key = protocol::world_key_of(protocol::load_run_key(run_key));
@@ -126,13 +139,7 @@ int main(int argc, char** argv) {
     config.world_key = world_key;
     if (dump) agent::runtime::dump_maps_into(dump, config);
 
-    if (!dds.security.empty() && id == 0 && dds.identity.empty())
-      throw InvalidArgument(
-          "--id auto with --security needs --identity: the identity cannot follow a slot not yet "
-          "assigned");
-    const auto participant =
-        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kClient,
-                               bus::Security::of(dds.security, dds.identity, fmt::format("agent-{}", id)), dds.peers});
+    const auto participant = bus::make_participant(bus_config);
     agent::runtime::AgentRuntime agent(*participant, config);
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);

@@ -67,11 +67,14 @@ int terminal_columns() {
   return 80;
 }
 
-/// Joins the DDS domain of the command line, read only.
-std::unique_ptr<bus::Participant> join_domain(const cli::DdsOptions& dds) {
-  return bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,
-                                bus::Security::of(dds.security, dds.identity, "monitor"), dds.peers});
+/// The monitor's DDS participant as the command line asks for it.
+bus::BusConfig bus_config(const cli::DdsOptions& dds) {
+  return {bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kServer,
+          bus::Security::of(dds.security, dds.identity, "monitor"), dds.peers};
 }
+
+/// Joins the DDS domain of the command line, read only.
+std::unique_ptr<bus::Participant> join_domain(const cli::DdsOptions& dds) { return bus::make_participant(bus_config(dds)); }
 
 /// The tail subcommand: its options (define_tail binds them) and its CLI11 subcommand.
 struct TailCommand {
@@ -354,6 +357,7 @@ int run_chosen(MonitorCommands& c, const StopSource& stop, std::ostream& out, st
     if (*c.export_.cmd) return run_export_command(c.export_, out, err);
     try {
       WorldGate::world_key_from_environment();  // a bad run key file is bad input: exit 2 before any traffic
+      bus::check_config(bus_config(c.dds));     // so are a bad profile and an identity folder of another domain
     } catch (const InvalidArgument& e) {
       err << fmt::format("marsala-monitor: {}\n", e.what());
       return cli::kExitUsage;

@@ -116,6 +116,7 @@ void check_profile(Vendor vendor, const std::string& path) {
         fmt::format("DDS profile '{}' is not a Fast DDS profile (no <dds> or <profiles> element){}", path,
                     cyclone ? ": it is a Cyclone DDS one; use --dds cyclone or a fastdds-*.xml" : ""));
   check_world_address(vendor, path);
+  if (vendor == Vendor::kFastDds) detail::check_fastdds_profile(path);
 }
 
 }  // namespace
@@ -177,12 +178,24 @@ void check_security(const Security& security, int domain_id) {
                                       *made_for, domain_id, manifest.string()));
 }
 
-std::unique_ptr<Participant> make_participant(const BusConfig& config) {
+void check_config(const BusConfig& config) {
   if (config.vendor == Vendor::kInProcess && config.security.enabled())
     throw InvalidArgument("DDS Security needs a DDS vendor (cyclone or fastdds), not inprocess");
   check_security(config.security, config.domain_id);
   if (config.domain_id < 0 || config.domain_id > 232)
     throw InvalidArgument(fmt::format("DDS domain id must be in 0..232, got {}", config.domain_id));
+  resolve_profile(config.vendor, config.profile, !config.peers.empty());  // a given profile: checked whole
+  // A Fast DDS profile from the vendor's own variable: its MARSala properties, when Fast DDS can load it at all (one
+  // it cannot load, Fast DDS itself ignores).
+  const char* own = std::getenv(profile_variable(Vendor::kFastDds));
+  if (config.vendor == Vendor::kFastDds && config.profile.empty() && own != nullptr && *own != '\0') {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(own, ec)) detail::check_fastdds_profile(own);
+  }
+}
+
+std::unique_ptr<Participant> make_participant(const BusConfig& config) {
+  check_config(config);
   // The vendors are given addresses: a name is resolved once, here, and one that does not resolve is refused by name.
   BusConfig resolved = config;
   resolved.peers = resolve_peers(config.peers);

@@ -233,6 +233,12 @@ struct BusConfig {
 /// Always empty for kInProcess.
 std::string resolve_profile(Vendor vendor, const std::string& given, bool unicast = false);
 
+/// What make_participant() would refuse in `config` before it makes anything: DDS Security's folder (check_security()),
+/// the domain, the profile file (resolve_profile(); a Fast DDS one, given or the vendor's variable, also with valid
+/// MARSala properties, docs/runtime.md#slow-links). Throws InvalidArgument naming the file, property or value, so a
+/// program can refuse a bad configuration (exit 2) before it writes anything.
+void check_config(const BusConfig& config);
+
 /// Creates a participant of the chosen vendor with the profile resolve_profile() gives (set into the vendor's
 /// variable before the vendor reads it); throws BusError naming vendor and domain on failure, InvalidArgument for a
 /// bad domain or profile.

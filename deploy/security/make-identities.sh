@@ -84,7 +84,9 @@ fi
 umask 077
 parent="$(dirname "$out")"
 mkdir -p "$parent"
+parent="$(cd "$parent" && pwd)"  # absolute: the work below happens in another folder (a relative --out broke it)
 work="$(mktemp -d "$parent/.identities.XXXXXX")"
+final="$parent/$(basename "$out")"
 trap 'rm -rf "$work"' EXIT
 cd "$work"
 log="$work/openssl.log"
@@ -189,7 +191,7 @@ chmod 600 ./*.key
 chmod 644 ./*.pem ./*.xml ./*.p7s manifest
 chmod 700 "$work"
 # Into place: DIR is new or empty (checked above).
-[ -d "$out" ] && rmdir "$out"
-mv "$work" "$out"
+[ -d "$final" ] && rmdir "$final"
+mv "$work" "$final"
 trap - EXIT
 echo "identities: made $out for domain $wanted_domain, $agents agents (CA sha256 ${fingerprint:0:23}...)"

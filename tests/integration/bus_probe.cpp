@@ -131,7 +131,9 @@ int run_read(Participant& participant, const Args& args) {
       if (received >= count || f.step != static_cast<std::uint64_t>(received) ||
           !marsala::probe::same(f, marsala::probe::frame(f.step, tiles))) {
         wrong = true;
-        std::cerr << "probe: unexpected or wrong frame, step " << f.step << std::endl;
+        std::cerr << "probe: unexpected or wrong frame, step " << f.step << " (frame " << received
+                  << " expected): " << marsala::probe::first_difference(f, marsala::probe::frame(f.step, tiles))
+                  << std::endl;
       }
       ++received;
     }

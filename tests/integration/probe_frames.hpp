@@ -69,4 +69,25 @@ inline bool same(const protocol::SensorFrame& a, const protocol::SensorFrame& b)
   return true;
 }
 
+/// Where `got` first differs from `want` (empty when they are the same): the field, and for a tile's heights the
+/// tile, the height and its byte offset in the tile's heights, so that a corrupted frame shows where it was hit.
+inline std::string first_difference(const protocol::SensorFrame& got, const protocol::SensorFrame& want) {
+  if (got.tiles.size() != want.tiles.size())
+    return "tiles " + std::to_string(got.tiles.size()) + " instead of " + std::to_string(want.tiles.size());
+  for (std::size_t i = 0; i < got.tiles.size(); ++i) {
+    const protocol::TerrainTile& x = got.tiles[i];
+    const protocol::TerrainTile& y = want.tiles[i];
+    if (x.heights.size() != y.heights.size())
+      return "tile " + std::to_string(i) + ": " + std::to_string(x.heights.size()) + " heights";
+    for (std::size_t k = 0; k < x.heights.size(); ++k)
+      if (!same_bits(x.heights[k], y.heights[k])) {
+        std::size_t wrong = 0;
+        for (std::size_t m = k; m < x.heights.size(); ++m) wrong += same_bits(x.heights[m], y.heights[m]) ? 0 : 1;
+        return "tile " + std::to_string(i) + " height " + std::to_string(k) + " (byte " + std::to_string(k * 8) +
+               "), " + std::to_string(wrong) + " of its heights from there differ";
+      }
+  }
+  return same(got, want) ? "" : "a field outside the tiles";
+}
+
 }  // namespace marsala::probe

@@ -27,6 +27,8 @@
 #   impostor                                                         a participant forging admissions, frames, statuses
 #                                                                    and events in the world's name, also during a
 #                                                                    4 s pause of the world, changes nothing
+#   foreign                                                          a foreign type flooding the agents' partitions of
+#                                                                    a Fast DDS run: bounded log, same terrain
 #   fork                                                             spawn.sh --fork of a 160-step run at K = 100:
 #                                                                    unchanged, it ends on the parent's terrain; a
 #                                                                    world-only --set (a goal) ends where the parent
@@ -634,6 +636,31 @@ case "$case_name" in
       "the parent stood there; with 2 agents it has the parent's $at_k at step 100 and ends on $fewer_sha, exit 0;" \
       "a third agent joins a fork of 2 at step 30;" \
       "other agents exit 8: $(grep -o 'agent [1-3] at step [0-9]*' "$work/other.out")"
+    ;;
+  foreign)
+    # A foreign type under ActionRequest's name (the 12-byte ScanPoint layout, marsala-foreign-type) flooding every
+    # agent's partition for 5 s of a Fast DDS run (world and agents): the world's readers drop it unread with bounded log
+    # (docs/runtime.md#foreign-types), no agent is dropped, and the run ends on the terrain of the unflooded run
+    # (marsala-lockstep-sim, the same steps in-process).
+    "$bin/marsala-lockstep-sim" --scenario "$scenario" --agents 3 --seeds 1 --csv "$work/sim.csv" >/dev/null 2>&1 &
+    sim=$!
+    "$bin/marsala-foreign-type" "$domain" ActionRequest "ramp-d$domain/agent-*" 5 >"$work/foreign.txt" 2>&1 &
+    foreign=$!
+    s=$(run_spawn run 3 fastdds)
+    wait "$foreign" || fail "the foreign writer failed: $(cat "$work/foreign.txt")"
+    grep -q "^wrote [1-9][0-9]* samples of a foreign marsala::wire::ActionRequest" "$work/foreign.txt" ||
+      fail "no foreign sample written: $(cat "$work/foreign.txt")"
+    expect_completed "$s" 3
+    wait "$sim" || fail "marsala-lockstep-sim failed"
+    want=$(csv_last "$work/sim.csv" terrain_sha256)
+    [ "$(field terrain_sha256 "$s")" = "$want" ] || fail "terrain $(field terrain_sha256 "$s") is not the unflooded $want"
+    ! grep -q '"kind":"dropped"' "$work/run/events.log" || fail "the foreign flood dropped an agent"
+    said=$(grep -c "does not decode" "$work/run/logs/world.log" || true)
+    lines=$(wc -l <"$work/run/logs/world.log")
+    [ "$said" -ge 1 ] || fail "the world's log does not say it dropped foreign samples"
+    [ "$lines" -le 200 ] || fail "the world's log grew to $lines lines under the foreign flood"
+    echo "ok: $(grep -o '^wrote [0-9]*' "$work/foreign.txt" | cut -d' ' -f2) foreign ActionRequest samples in 5 s: the run completed" \
+      "on the unflooded terrain ${want:0:8}, nobody dropped, $said 'does not decode' lines in a world log of $lines"
     ;;
   *) echo "unknown case '$case_name'" >&2; exit 2 ;;
 esac

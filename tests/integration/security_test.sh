@@ -46,6 +46,10 @@ spawn() {  # spawn OUT ARGS...: spawn.sh's exit code in rc, its stderr in $work/
 
 # 0. Bad inputs: exit 2, one line naming what is wrong, nothing written.
 "$root/deploy/security/make-identities.sh" --out "$work/two" --agents 2 --domain "$domain" >/dev/null
+# A relative --out (README's by-hand line) makes the folder where it says.
+(cd "$work" && "$root/deploy/security/make-identities.sh" --out rel/ids --agents 1 --domain "$domain" >/dev/null) ||
+  fail "make-identities.sh --out rel/ids failed"
+[ -f "$work/rel/ids/manifest" ] && [ -f "$work/rel/ids/agent-1.key" ] || fail "make-identities.sh --out rel/ids made no folder"
 spawn_refused() {  # spawn_refused WORDS ARGS...: spawn.sh ARGS exits 2, one line holding WORDS, no run folder
   local words="$1"
   shift

@@ -36,6 +36,27 @@ run() {
   echo $(($(lo_bytes) - before))
 }
 
+# A bad rate limit in the profile (docs/runtime.md#slow-links): every program refuses it before anything runs, one line
+# naming the property and the file, exit 2, the world's folder never made.
+if [ "$vendor" = fastdds ]; then
+  bad="$work/bad-rate.xml"
+  sed 's#<name>marsala.rate.period_ms</name><value>40</value>#<name>marsala.rate.period_ms</name><value>soon</value>#' \
+    "$MARSALA_DDS_CONFIG" >"$bad"
+  grep -q '<value>soon</value>' "$bad" || fail "fastdds-slow.xml has no marsala.rate.period_ms of 40 to spoil"
+  for program in "world --scenario $scenario --agents 3 --out $work/bad-out" "agent --scenario $scenario --id 1" \
+                 "monitor status"; do
+    set +e
+    # shellcheck disable=SC2086  # the program's words
+    MARSALA_DDS_CONFIG="$bad" "$bin"/marsala-$program --dds fastdds --domain "$domain" \
+      >/dev/null 2>"$work/bad.err"
+    code=$?
+    set -e
+    [ "$code" = 2 ] && [ "$(wc -l <"$work/bad.err")" = 1 ] && grep -q "marsala.rate.period_ms.*'soon'" "$work/bad.err" &&
+      grep -q "$bad" "$work/bad.err" || { cat "$work/bad.err"; fail "marsala-${program%% *}: exit $code on a bad rate"; }
+  done
+  [ ! -e "$work/bad-out" ] || fail "the world made its folder before refusing a bad rate"
+fi
+
 ip link set lo mtu 1500 || { echo "SKIP: cannot set lo's MTU"; exit 77; }
 clean_bytes=$(run clean)
 sha=$(field terrain_sha256 "$work/clean/summary.json")

@@ -132,6 +132,25 @@ std::optional<int> refuse_bad_run_key(const std::string& path, std::ostream& err
   }
 }
 
+/// The world's DDS participant as the command line asks for it.
+bus::BusConfig bus_config(const cli::DdsOptions& dds) {
+  return {bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kWorld,
+          bus::Security::of(dds.security, dds.identity, "world"), dds.peers};
+}
+
+/// Exit code 2 (one line naming the file, property or value) when the DDS options are ones the participant would refuse
+/// (a profile that cannot be read, of the other vendor or with a bad rate limit; a DDS Security folder made for another
+/// domain): refused before the folder is touched.
+std::optional<int> refuse_bad_dds(const cli::DdsOptions& dds, std::ostream& err) {
+  try {
+    bus::check_config(bus_config(dds));
+    return std::nullopt;
+  } catch (const InvalidArgument& e) {
+    cli::write_exit_error(err, fmt::format("marsala-world: error: {}", e.what()));
+    return cli::kExitUsage;
+  }
+}
+
 /// Locks the run's output folder into `lock` (docs/runtime.md#run-folders); the exit code when it cannot: 2 (one line
 /// naming the holder's pid) when another world holds it, 1 when the folder or its lock file cannot be made.
 std::optional<int> lock_folder(std::optional<OutputLock>& lock, const std::string& dir, std::ostream& err) {
@@ -215,9 +234,7 @@ int run_in_folder(const std::string& scenario_path, const std::string& resume_di
       }
     }
     start.options.run_key = settle_run_key(run_key, start.options.out_dir, !resume_dir.empty());
-    const auto participant =
-        bus::make_participant({bus::vendor_from_string(dds.vendor), dds.domain, dds.profile, bus::Role::kWorld,
-                               bus::Security::of(dds.security, dds.identity, "world"), dds.peers});
+    const auto participant = bus::make_participant(bus_config(dds));
     WorldRuntime runtime(std::move(start), *participant);
     if (metrics != nullptr) runtime.serve_metrics(*metrics);
     if (trace != nullptr) runtime.trace_steps(*trace);
@@ -348,6 +365,7 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   if (quiet && app.get_option("--log-level")->count() == 0) log_options.level = "warn";
   const cli::LoggingScope logging("world", 0, log_options);
   if (const auto code = refuse_bad_run_key(run_key, err)) return *code;
+  if (const auto code = refuse_bad_dds(dds, err)) return *code;
   std::unique_ptr<MetricsServer> metrics;
   if (const auto code = start_metrics(metrics, metrics_options, err)) return *code;
   std::unique_ptr<StepTrace> trace;

@@ -16,7 +16,10 @@ namespace marsala::bus::detail {
 /// Keeps a volatile reader volatile on transient-local writers (topics.hpp): passes only samples whose source
 /// timestamp [ns since the epoch, the writer's wall clock] is not before the reader's creation. Transient-local
 /// readers pass everything. Across hosts, a writer whose clock lags by d loses what it writes within d of the
-/// reader's creation: keep clocks synchronised.
+/// reader's creation: keep clocks synchronised. A sample without a source timestamp (<= 0) passes: its age is
+/// unknown, and a genuine sample arrives so when Fast DDS reassembles it from fragments whose first arrived without a
+/// timestamp (Cyclone puts one only in the first datagram of a fragmented sample; the rest of a sample lost in part is
+/// repaired without one), docs/runtime.md#foreign-types.
 class VolatileFilter {
  public:
   explicit VolatileFilter(Durability durability)
@@ -25,7 +28,9 @@ class VolatileFilter {
             std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
                 .count()) {}
   /// Whether a sample with this source timestamp [ns since the epoch] is delivered.
-  bool passes(std::int64_t source_timestamp_ns) const { return !volatile_ || source_timestamp_ns >= created_ns_; }
+  bool passes(std::int64_t source_timestamp_ns) const {
+    return !volatile_ || source_timestamp_ns <= 0 || source_timestamp_ns >= created_ns_;
+  }
 
  private:
   bool volatile_;

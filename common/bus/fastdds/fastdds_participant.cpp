@@ -529,4 +529,6 @@ std::unique_ptr<Participant> make_fastdds_participant(const BusConfig& config) {
   return std::make_unique<FastDdsParticipant>(config);
 }
 
+void check_fastdds_profile(const std::string& path) { fastdds::rate_limit_of_profile(path); }
+
 }  // namespace marsala::bus::detail

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 
 namespace eprosima::fastrtps::rtps {
 class PropertyPolicy;
@@ -32,6 +33,11 @@ struct RateLimit {
 /// defaults to 100 ms), none without kRateBytesProperty. Throws InvalidArgument naming the property when a value is
 /// not a positive integer (bytes at least 1500: a datagram must fit in one period).
 std::optional<RateLimit> rate_limit_of(const eprosima::fastrtps::rtps::PropertyPolicy& properties);
+
+/// The rate limit a participant profile of the Fast DDS profile file `path` names (rate_limit_of() of its properties;
+/// the last one found), none without one. Throws InvalidArgument naming the file when it is not XML or a value of any
+/// participant profile is not valid, so that a bad profile is refused before anything runs.
+std::optional<RateLimit> rate_limit_of_profile(const std::string& path);
 
 /// Registers `limit` as the flow controller kRateController of participants made with `qos`.
 void limit_rate(eprosima::fastdds::dds::DomainParticipantQos& qos, const RateLimit& limit);

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include "marsala/bus/bus.hpp"
 #include "marsala/core/error.hpp"
@@ -103,6 +104,54 @@ TEST_F(ProfileTest, AProfileStillHoldingTheWorldsAddressVariableIsRefusedPointin
     ::setenv("MARSALA_WORLD_ADDRESS", kept.c_str(), 1);
   else
     ::unsetenv("MARSALA_WORLD_ADDRESS");
+}
+
+/// The shipped slow-link profile with the rate property `name`'s value replaced by `value`.
+std::string slow_profile_with(const std::string& name, const std::string& value) {
+  const char* root = std::getenv("MARSALA_SOURCE_DIR");
+  std::ifstream in(fs::path(root ? root : ".") / "deploy/dds/fastdds-slow.xml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string open = "<name>" + name + "</name><value>";
+  const std::size_t at = text.find(open);
+  if (at == std::string::npos) return {};
+  const std::size_t from = at + open.size();
+  return text.replace(from, text.find("</value>", from) - from, value);
+}
+
+// A bad rate limit in a Fast DDS profile (docs/runtime.md#slow-links) is refused by the checks made before anything
+// runs, with the property, the value and the file named; the shipped one passes.
+TEST_F(ProfileTest, ABadRateLimitInAFastDdsProfileIsRefusedNamingPropertyAndFile) {
+  struct Case {
+    std::string name, value;
+  };
+  const std::vector<Case> bad{{"marsala.rate.bytes_per_period", "lots"},
+                              {"marsala.rate.bytes_per_period", "1000"},  // below one datagram
+                              {"marsala.rate.period_ms", "0"},
+                              {"marsala.rate.period_ms", "-40"}};
+  int n = 0;
+  for (const Case& c : bad) {
+    const std::string text = slow_profile_with(c.name, c.value);
+    ASSERT_FALSE(text.empty()) << c.name << " not in fastdds-slow.xml";
+    const std::string file = write("bad-rate-" + std::to_string(n++) + ".xml", text);
+    try {
+      check_config({Vendor::kFastDds, 7, file});
+      ADD_FAILURE() << c.name << "=" << c.value << ": no throw";
+    } catch (const InvalidArgument& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(file), std::string::npos) << what;
+      EXPECT_NE(what.find(c.name), std::string::npos) << what;
+      EXPECT_NE(what.find("'" + c.value + "'"), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+    }
+  }
+  // The same through the vendor's own variable, no profile given.
+  const std::string bad_env = write("bad-rate-env.xml", slow_profile_with("marsala.rate.period_ms", "soon"));
+  ::setenv("FASTRTPS_DEFAULT_PROFILES_FILE", bad_env.c_str(), 1);
+  EXPECT_THROW(check_config({Vendor::kFastDds, 7}), InvalidArgument);
+  EXPECT_NO_THROW(check_config({Vendor::kCyclone, 7}));  // the other vendor's variable is none of Cyclone's business
+  ::unsetenv("FASTRTPS_DEFAULT_PROFILES_FILE");
+  EXPECT_NO_THROW(check_config({Vendor::kFastDds, 7, source("deploy/dds/fastdds-slow.xml")}));
+  EXPECT_NO_THROW(check_config({Vendor::kFastDds, 7, source("deploy/dds/fastdds-lan.xml")}));  // no rate limit
 }
 
 // With peers (and no profile given nor set): the shipped unicast profile, every interface and no multicast.
