@@ -19,24 +19,23 @@ int clamp_int(double v, int lo, int hi) {
   return static_cast<int>(v);
 }
 
-// How far a cell the map holds as no surface may be raised [m]: a bound (faces seen from below, the floor never read)
-// whose four neighbours all hold a surface or bound at least as high is a pit, raised at most to its lowest rim;
-// anything else (assumed ground, a bound beside lower ground: a wall's foot or side) is no deposition target, 0
-// (docs/runtime.md#mapping, pits).
-double pit_rim_gap(const KnownMap& map, CellIndex cell) {
-  if (map.bound(cell.row, cell.col) == 0) return 0.0;
-  const double floor_m = map.heights(cell);
-  double rim_m = std::numeric_limits<double>::infinity();
-  for (const CellIndex step : {CellIndex{-1, 0}, CellIndex{1, 0}, CellIndex{0, -1}, CellIndex{0, 1}}) {
-    const CellIndex n{cell.row + step.row, cell.col + step.col};
-    if (!map.heights.contains(n) || map.known(n.row, n.col) == 0) return 0.0;
-    if (map.assumed(n.row, n.col) != 0 && map.bound(n.row, n.col) == 0) return 0.0;  // a guess is no rim
-    rim_m = std::min(rim_m, map.heights(n));
-  }
-  return std::max(0.0, rim_m - floor_m);
+bool rim(const KnownMap& map, CellIndex n) {
+  if (!map.heights.contains(n) || map.known(n.row, n.col) == 0) return false;
+  return map.assumed(n.row, n.col) == 0 || map.bound(n.row, n.col) != 0;  // a guess is no rim
 }
 
 }  // namespace
+
+double notch_fill(const KnownMap& map, CellIndex cell) {
+  if (!map.heights.contains(cell) || map.bound(cell.row, cell.col) == 0) return 0.0;
+  const double floor_m = map.heights(cell);
+  double level_m = floor_m;
+  for (const CellIndex step : {CellIndex{1, 0}, CellIndex{0, 1}}) {
+    const CellIndex a{cell.row - step.row, cell.col - step.col}, b{cell.row + step.row, cell.col + step.col};
+    if (rim(map, a) && rim(map, b)) level_m = std::max(level_m, std::min(map.heights(a), map.heights(b)));
+  }
+  return level_m - floor_m;
+}
 
 Window sensing_window(const GridGeometry& world, Position robot, double range_m) {
   if (!(range_m >= 0.0) || !std::isfinite(range_m))
@@ -90,11 +89,19 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
     }
 
   // Ground the map only assumes (under and around the robot's body: KnownMap::assumed) is no deposition
-  // target: building on it would never show in the map. A bound in a pit is filled up to its rim (pit_rim_gap).
+  // target: building on it would never show in the map. A bound in a notch is filled up to its notch level
+  // (notch_fill), a cap the map's noise margin does not shrink: the level is the lower of two readings, not a maximum
+  // over many like the MARS height, and a notch left a margin deep is still one the body cannot cross.
   const auto assumed = map.assumed.block(w.top_left.row, w.top_left.col, w.rows, w.cols);
+  if (map.bound.block(w.top_left.row, w.top_left.col, w.rows, w.cols).any())
+    local.fill_cap = Heightmap(local.geometry(), std::numeric_limits<double>::infinity());
   for (int r = 0; r < w.rows; ++r)
-    for (int c = 0; c < w.cols; ++c)
-      if (assumed(r, c) != 0) local.gap(r, c) = std::min(local.gap(r, c), pit_rim_gap(map, local.to_global({r, c})));
+    for (int c = 0; c < w.cols; ++c) {
+      if (assumed(r, c) == 0) continue;
+      const double fill_m = notch_fill(map, local.to_global({r, c}));
+      if (!(fill_m > 0.0)) local.gap(r, c) = 0.0;
+      if (local.fill_cap.rows() == w.rows) local.fill_cap(r, c) = fill_m;
+    }
 
   local.robot = local.to_local(*map.geometry().cell_at(robot));
   // A scanned map may hold the robot's own cell not occupiable (a reading that changed under it, a face beside it);

@@ -11,6 +11,7 @@
 //   |         \__ R ------------- g |   g: where the straight line from R to the target leaves the window
 //   +-------------------------------+      (or the target cell when it lies inside)
 
+#include <algorithm>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -31,7 +32,10 @@ struct LocalMap {
   Heightmap heights;                ///< the window [m], placed in the world frame; unknown cells hold the lowest known
   CellMask known;                   ///< 1 where the agent's map knows the cell
   Heightmap gap;                    ///< MARS gap P_kappa[h] - h of the window at the construction kappa [m]; 0 on
-                                    ///< unknown cells
+                                    ///< unknown cells and on cells held as no surface but a notch's (fill_cap)
+  /// How far a cell may be raised whatever the map's noise margin [m]: a bound in a notch (notch_fill()) up to its
+  /// notch level, +inf on every other cell. Empty (0 x 0) on a map that holds no bound: no cap.
+  Heightmap fill_cap;
   CellMask blind;                   ///< 1 where the cell's ball holds an unknown cell: it is never occupiable
   CellMask passable;                ///< where a deposition path may run: known cells; on a scanned map known cells
                                     ///< that are not blind, when they reach the local goal
@@ -61,6 +65,22 @@ struct LocalMap {
     return contains(local) ? std::optional<CellIndex>(local) : std::nullopt;
   }
 };
+
+/// How far `cell` (world index) may be raised when `map` holds it as a bound (faces seen from below, no surface read)
+/// [m]: a bound lying below both its neighbours along a grid axis (north-south or east-west), each known as a
+/// surface or a bound, is a notch in that line, filled up to its notch level: the higher over the two axes of the
+/// lower neighbour of the pair. 0 for any other cell (a bound with no such pair: a wall's foot or side; ground only
+/// assumed, unknown or off the grid) (docs/runtime.md#mapping, notches).
+double notch_fill(const KnownMap& map, CellIndex cell);
+
+/// How far a cell of the local map (local index) may be raised [m]: its MARS gap less `margin_m` (the map's noise
+/// margin), at most its fill cap.
+inline double rise_wanted_m(const LocalMap& local, CellIndex cell, double margin_m) {
+  const double rise_m = local.gap(cell) - margin_m;
+  return local.fill_cap.rows() == local.rows() && local.fill_cap.cols() == local.cols()
+             ? std::min(rise_m, local.fill_cap(cell))
+             : rise_m;
+}
 
 /// Window of a world grid: top-left cell and size [cells].
 struct Window {

@@ -118,8 +118,9 @@ std::vector<DepositionCandidate> DepositionManager::candidates(const deliberativ
       if (map.known(cell.row, cell.col) == 0) continue;
       // Whole layers, rounded down: never above the local MARS height (1e-9 absorbs rounding in gaps that are
       // exact multiples).
-      int layers =
-          std::min(static_cast<int>(std::floor((map.gap(cell) - params_.gap_margin_m) / q + 1e-9)), max_layers);
+      int layers = std::min(
+          static_cast<int>(std::floor(deliberative::rise_wanted_m(map, cell, params_.gap_margin_m) / q + 1e-9)),
+          max_layers);
       if (layers < 1) continue;
       const Position centre = map.center(cell);
       const double d = distance(centre, robot);
@@ -159,8 +160,9 @@ std::vector<WantedCell> DepositionManager::wanted(const deliberative::LocalMap& 
       std::uint8_t& s = seen[static_cast<std::size_t>(cell.row) * map.cols() + cell.col];
       if (s) continue;
       s = 1;
-      if (!(map.gap(cell) > 0.0) || !may_raise(map, cell, robot, neighbours)) continue;
-      out.push_back({cell, map.gap(cell)});
+      const double rise_m = deliberative::rise_wanted_m(map, cell, 0.0);
+      if (!(rise_m > 0.0) || !may_raise(map, cell, robot, neighbours)) continue;
+      out.push_back({cell, rise_m});
     }
   return out;
 }

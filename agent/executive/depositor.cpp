@@ -148,7 +148,7 @@ class ConeDepositor final : public Depositor {
     for (int r = 0; r < map.rows(); ++r)
       for (int c = 0; c < map.cols(); ++c)
         if (map.blind(r, c) == 0 && manager.may_raise(map, {r, c}, robot, neighbours))
-          remaining[index({r, c})] = std::max(0.0, map.gap(r, c));
+          remaining[index({r, c})] = std::max(0.0, deliberative::rise_wanted_m(map, {r, c}, 0.0));
     const std::vector<WantedCell> wanted = manager.wanted(map, path, robot, neighbours);
     std::vector<std::uint8_t> in_band(remaining.size(), 0);  // the cells the path's footprint wants
     for (const WantedCell& w : wanted) in_band[index(w.cell)] = 1;

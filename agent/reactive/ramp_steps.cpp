@@ -269,7 +269,7 @@ void RampSteps::count_gap_scans(const deliberative::LocalMap& local, bool scanne
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c) {
       const CellIndex g = local.to_global({r, c});
-      if (!(local.gap(r, c) > margin) || !current(g)) continue;
+      if (!(deliberative::rise_wanted_m(local, {r, c}, margin) > 0.0) || !current(g)) continue;
       GapStreak& streak = memory_.gap_streaks[static_cast<std::size_t>(g.row) * cols + g.col];
       streak.scans = streak.last_scan == map.scans() - 1 ? streak.scans + 1 : 1;
       streak.last_scan = map.scans();

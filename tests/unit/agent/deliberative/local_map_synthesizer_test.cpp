@@ -276,39 +276,55 @@ TEST(LocalMapSynthesizer, AScannedMapKeepsTheRobotsWayOutOfItsOwnCell) {
   }
 }
 
-// A one-cell pit whose floor no scan read (its height a bound from faces) is raised, but never above its lowest rim; a
-// bound beside lower ground (a wall's foot) and ground only assumed are no targets (docs/runtime.md#mapping, pits).
-TEST(LocalMapSynthesizer, ABoundInAPitIsFilledUpToItsLowestRim) {
+// A bound (faces seen from below, no surface read) lying below both its neighbours along a grid axis is a notch in
+// that line: its MARS gap counts, capped at its notch level (the higher over the two axes of the lower neighbour of
+// the pair), and the map's noise margin shrinks the MARS gap, not that cap. Before, only a bound below all four
+// neighbours was filled, up to the lowest of them less the margin: a notch on a ramp's edge (beside the ground) and a
+// two-cell dip were never filled, and a pit on a slope stopped a margin under its downhill rim, too deep for the body
+// between it and its uphill neighbour.
+TEST(LocalMapSynthesizer, ABoundInANotchIsFilledUpToItsNotchLevel) {
+  // A slope rising east by 0.05 m a cell, exactly kappa (0.5) steep: its MARS height is itself, 0.05 c at column c.
+  Heightmap h(kWorld, 0.0);
+  for (int r = 0; r < kWorld.rows; ++r)
+    for (int c = 0; c < kWorld.cols; ++c) h(r, c) = 0.05 * c;
   const CellMask known = CellMask::Ones(kWorld.rows, kWorld.cols);
+  CellMask assumed = CellMask::Zero(kWorld.rows, kWorld.cols), bound = assumed;
+  const CellIndex pit{30, 45}, edge{20, 45}, dip_west{40, 45}, dip_east{40, 46}, wall{30, 60}, guess{10, 45};
+  for (const CellIndex c : {pit, edge, dip_west, dip_east, wall, guess}) h(c) -= 0.10, assumed(c.row, c.col) = 1;
+  for (const CellIndex c : {pit, edge, dip_west, dip_east, wall}) bound(c.row, c.col) = 1;
+  h(edge.row - 1, edge.col) = 0.0;                        // the ground beside a ramp's edge, north of it
+  h(wall.row, wall.col - 1) = h(wall.row - 1, wall.col) = 0.0;  // a wall's corner: ground west and north
   const std::vector<CellIndex> trajectory{{30, 40}};
-  const LocalMapSynthesizer synthesizer(kBody, 2.5);  // kappa 0.5: a cell may lie 0.05 m under its 1 m neighbours
-  const CellIndex pit{30, 45}, wall{30, 50}, guess{25, 45};
-  struct Case {
-    double west_rim_m;  // the pit's west neighbour; its other three stand at 1 m like the ground around
-    double wall_foot_m;
-    double expected_pit_gap_m;
-  };
-  // Hand-derived: the pit's MARS height is 1 - 0.5 x 0.1 = 0.95 m over its 1 m neighbours, a gap of 0.45 m over its
-  // 0.5 m bound; a 0.6 m rim caps it at 0.1 m. The wall's foot (bound 0.5 m beside a 0 m cell) and the assumed ground
-  // (0.5 m among 1 m cells, gap 0.45 m over its reading) get none.
-  for (const Case& k : {Case{1.0, 0.0, 0.45}, Case{0.6, 0.0, 0.1}}) {
-    Heightmap h(kWorld, 1.0);
-    CellMask assumed = CellMask::Zero(kWorld.rows, kWorld.cols), bound = assumed;
-    h(pit) = 0.5, h(pit.row, pit.col - 1) = k.west_rim_m;
-    h(wall) = 0.5, h(wall.row, wall.col + 1) = k.wall_foot_m;
-    h(guess) = 0.5;
-    for (const CellIndex c : {pit, wall}) assumed(c.row, c.col) = bound(c.row, c.col) = 1;
-    assumed(guess.row, guess.col) = 1;
-    const LocalMap local = synthesizer.synthesize({h, known, assumed, bound, trajectory, true}, kRobot, {7.0, 2.95});
-    const auto gap = [&](CellIndex c) { return local.gap(c.row - local.offset.row, c.col - local.offset.col); };
-    EXPECT_NEAR(gap(pit), k.expected_pit_gap_m, 1e-9);
-    EXPECT_EQ(gap(wall), 0.0);
-    EXPECT_EQ(gap(guess), 0.0);
-    // The same cells as surfaces read: their full MARS gaps (0.45 m each), as before the rule.
-    const CellMask none = CellMask::Zero(kWorld.rows, kWorld.cols);
-    const LocalMap read = synthesizer.synthesize({h, known, none, none, trajectory, true}, kRobot, {7.0, 2.95});
-    EXPECT_NEAR(read.gap(guess.row - read.offset.row, guess.col - read.offset.col), 0.45, 1e-9);
+  const LocalMapSynthesizer synthesizer(kBody, 2.5);
+  const LocalMap local = synthesizer.synthesize({h, known, assumed, bound, trajectory, true}, kRobot, {7.0, 2.95});
+  const auto at = [&](CellIndex c) { return local.to_local(c); };
+  const auto gap = [&](CellIndex c) { return local.gap(at(c)); };
+  const auto rise = [&](CellIndex c, double margin_m) { return rise_wanted_m(local, at(c), margin_m); };
+  // Hand-derived (heights 0.05 c, each cell above 0.10 m under its own): every notch's MARS gap is 0.10 m.
+  // pit (45): west 2.20, east 2.30, north and south 2.25: notch level max(2.20, 2.25) = 2.25, a cap of 0.10 m (the
+  // lowest rim gave 0.05 m). edge: north 0 m, so only east-west counts: 2.20, a cap of 0.05 m (no pit before: 0).
+  // The dip: west cell between 2.20 (west) and its partner at 2.20, north-south 2.25: 0.10 m; east cell between its
+  // partner at 2.15 and 2.35, north-south 2.30: 0.10 m (before: 0.05 m and none). The wall's corner (ground on two
+  // sides) and the assumed ground get none.
+  for (const CellIndex c : {pit, edge, dip_west, dip_east}) EXPECT_NEAR(gap(c), 0.10, 1e-9) << c.row << ", " << c.col;
+  EXPECT_NEAR(local.fill_cap(at(pit)), 0.10, 1e-9);
+  EXPECT_NEAR(local.fill_cap(at(edge)), 0.05, 1e-9);
+  EXPECT_NEAR(local.fill_cap(at(dip_west)), 0.10, 1e-9);
+  EXPECT_NEAR(local.fill_cap(at(dip_east)), 0.10, 1e-9);
+  for (const CellIndex c : {wall, guess}) {
+    EXPECT_EQ(gap(c), 0.0) << c.row << ", " << c.col;
+    EXPECT_FALSE(rise(c, 0.0) > 0.0) << c.row << ", " << c.col;
   }
+  // A margin of 0.04 m: the MARS gap less it (0.06 m) where the cap is wider, the whole cap (0.05 m) on the edge.
+  EXPECT_NEAR(rise(pit, 0.04), 0.06, 1e-9);
+  EXPECT_NEAR(rise(edge, 0.04), 0.05, 1e-9);
+  EXPECT_NEAR(notch_fill({h, known, assumed, bound, trajectory, true}, edge), 0.05, 1e-9);
+  // The same cells as surfaces read: their full MARS gaps, no cap.
+  const CellMask none = CellMask::Zero(kWorld.rows, kWorld.cols);
+  const LocalMap read = synthesizer.synthesize({h, known, none, none, trajectory, true}, kRobot, {7.0, 2.95});
+  EXPECT_EQ(read.fill_cap.rows(), 0);
+  EXPECT_NEAR(read.gap(read.to_local(guess)), 0.10, 1e-9);
+  EXPECT_NEAR(rise_wanted_m(read, read.to_local(edge), 0.04), 0.06, 1e-9);
 }
 
 // A scanned map whose goal (where the line to the target leaves the window) cannot be judged yet: a hole in the

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -65,6 +66,31 @@ TEST(DepositionManager, RoundsDownToWholeCubeLayersAndCapsOneMetre) {
   EXPECT_EQ(c[2].cell, (CellIndex{10, 23}));
   EXPECT_EQ(c[2].layers, 80);
   EXPECT_DOUBLE_EQ(c[2].height_m, 1.0);
+}
+
+// A scanning robot leaves its noise margin of each MARS gap unfilled, but a notch's cap (LocalMap::fill_cap) is not
+// shrunk by it: a cell raised up to its notch level, not a margin under it (docs/runtime.md#mapping, notches).
+TEST(DepositionManager, TheNoiseMarginShrinksTheGapNotANotchsCap) {
+  Heightmap gap(kGrid, 0.0), cap(kGrid, std::numeric_limits<double>::infinity());
+  gap(10, 20) = 10.0 * kQ, cap(10, 20) = 4.0 * kQ;  // a notch: gap - margin 6.4 layers, cap 4 -> 4 (before: 0)
+  gap(10, 21) = 10.0 * kQ, cap(10, 21) = 8.0 * kQ;  // the margin binds: 6.4 -> 6 layers
+  gap(10, 22) = 10.0 * kQ;                          // no cap: 6 layers
+  LocalMap map = make_map(Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, {{10, 0}});
+  map.fill_cap = cap;
+  DepositionParams p = params(0.4, 1.0);
+  p.gap_margin_m = 3.6 * kQ;
+  const DepositionManager dm(p);
+  const Position robot = kGrid.cell_center({10, 10});
+  const auto c = dm.candidates(map, row_path(10, 10, 25), robot, 10.0, {1, robot, {}});
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_EQ(c[0].cell, (CellIndex{10, 20}));
+  EXPECT_EQ(c[0].layers, 4);
+  EXPECT_EQ(c[1].layers, 6);
+  EXPECT_EQ(c[2].layers, 6);
+  // The cone depositor's wish (wanted(), no margin) is capped alike.
+  const auto w = dm.wanted(map, row_path(10, 10, 25), robot, {1, robot, {}});
+  ASSERT_GE(w.size(), 3u);
+  EXPECT_NEAR(w[0].gap_m, 4.0 * kQ, 1e-12);
 }
 
 TEST(DepositionManager, RespectsReachBudgetAndNeverDepositsUnderTheRobot) {
