@@ -203,7 +203,7 @@ if [ -z "$domain" ]; then
   for _ in 1 2 3 4 5; do
     domain=$(( (RANDOM % 200) + 20 ))
     [ -x "$bin/marsala-monitor" ] || break
-    "$bin/marsala-monitor" status --dds "$dds" --domain "$domain" --timeout 1 >/dev/null 2>&1 || break
+    "$bin/marsala-monitor" status --dds "$dds" --domain "$domain" --timeout 1 --listen 0 >/dev/null 2>&1 || break
     [ "$quiet" -eq 1 ] || echo "spawn.sh: domain $domain is busy (a world answers there), trying another"
   done
 fi

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <set>
 #include <utility>
@@ -254,16 +255,21 @@ int run_status(bus::Participant& participant, const StatusOptions& options, cons
       participant.create_reader<protocol::WorldStatus>({"", stop.signal(), bus::Durability::kTransientLocal, 1});
   const Clock::time_point deadline = Clock::now() + to_clock(options.timeout);
   WorldGate gate(err);  // only a world that proves itself speaks for its run
+  std::optional<protocol::WorldStatus> latest;
+  std::optional<Clock::time_point> print_at;
   for (;;) {
-    const std::vector<protocol::WorldStatus> batch = gate.statuses(statuses->take_received());
-    if (!batch.empty()) {
-      // The newest (the last of the highest step): a transient-local replay may arrive after a live sample.
-      const protocol::WorldStatus* latest = &batch.front();
-      for (const protocol::WorldStatus& s : batch)
-        if (s.step >= latest->step) latest = &s;
+    // The newest (the last of the highest step): a transient-local replay may arrive after a live sample.
+    for (protocol::WorldStatus& s : gate.statuses(statuses->take_received()))
+      if (!latest || s.step >= latest->step) latest = std::move(s);
+    if (latest && !print_at) print_at = Clock::now() + to_clock(options.listen);
+    if (latest && (Clock::now() >= *print_at || stop.stop_requested())) {
       for (const std::string& line : format_status_table(*latest)) out << line << '\n';
       out.flush();
       return 0;
+    }
+    if (print_at) {
+      stop.signal()->wait_until(*print_at);
+      continue;
     }
     if (stop.stop_requested()) {
       err << "marsala-monitor: stopped before a world status arrived" << std::endl;

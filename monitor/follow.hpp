@@ -36,6 +36,9 @@ inline constexpr int kExitWorldGone = 3;
 /// Options of `status`.
 struct StatusOptions {
   std::chrono::duration<double> timeout = std::chrono::seconds(5);  ///< how long to wait for a world [s]
+  /// How long it goes on listening after the first status it believes, so that another publisher of the run's
+  /// statuses is named even when its status arrives after the world's [s].
+  std::chrono::duration<double> listen = std::chrono::seconds(1);
 };
 
 /// Prints one line per step (and per event) until the run ends (final summary, 0), `stop` is requested
@@ -45,8 +48,9 @@ struct StatusOptions {
 int run_tail(bus::Participant& participant, const TailOptions& options, const StopSource& stop, std::ostream& out,
              std::ostream& err);
 
-/// Waits for the latest WorldStatus and prints the status table (0); no status within options.timeout or
-/// `stop` requested first: a message on `err` and 1.
+/// Waits for a WorldStatus it believes, listens options.listen longer (statuses of another publisher are named on
+/// `err`, never believed), and prints the newest believed status as a table (0); no status within options.timeout
+/// or `stop` requested first: a message on `err` and 1.
 int run_status(bus::Participant& participant, const StatusOptions& options, const StopSource& stop, std::ostream& out,
                std::ostream& err);
 

@@ -175,6 +175,7 @@ struct StatusCommand {
   CLI::App* cmd = nullptr;
   StatusOptions options;
   double timeout_s = options.timeout.count();
+  double listen_s = options.listen.count();
 };
 
 void define_status(CLI::App& app, StatusCommand& c, cli::DdsOptions& dds) {
@@ -183,11 +184,17 @@ void define_status(CLI::App& app, StatusCommand& c, cli::DdsOptions& dds) {
   c.cmd->add_option("--timeout", c.timeout_s, "exit 1 when no world status arrives within this long [s]")
       ->check(cli::seconds_within(1e-3, 1e6))
       ->capture_default_str();
+  c.cmd->add_option("--listen", c.listen_s,
+                    "after the first status it believes, listen this long more, naming any other publisher of the "
+                    "run's statuses on stderr, then print the newest [s]")
+      ->check(cli::seconds_within(0.0, 60.0))
+      ->capture_default_str();
 }
 
 int run_status_command(StatusCommand& c, bus::Participant& participant, const StopSource& stop, std::ostream& out,
                        std::ostream& err) {
   c.options.timeout = std::chrono::duration<double>(c.timeout_s);
+  c.options.listen = std::chrono::duration<double>(c.listen_s);
   return run_status(participant, c.options, stop, out, err);
 }
 

@@ -524,7 +524,7 @@ case "$case_name" in
     # Mid-run (agent 2 has deposited), the world stops for 4 s: the agents say hello again, the impostor answers.
     for _ in $(seq 1 3000); do grep -q '"agent":2,"kind":"deposited"' "$out/events.log" 2>/dev/null && break; sleep 0.02; done
     kill -STOP "$world"; sleep 4; kill -CONT "$world"
-    "$bin/marsala-monitor" status --dds cyclone --domain "$domain" --timeout 5 >"$work/status.txt" 2>&1 ||
+    "$bin/marsala-monitor" status --dds cyclone --domain "$domain" --timeout 5 --listen 2 >"$work/status.txt" 2>&1 ||
       { cat "$work/status.txt"; fail "marsala-monitor status failed during the run"; }
     wait "$world" || { tail -30 "$logs/world.log"; fail "world exited non-zero"; }
     for p in "${pids[@]}"; do wait "$p" || fail "an agent exited non-zero (see $logs)"; done
@@ -550,6 +550,9 @@ case "$case_name" in
     ! grep -q "999999" "$work/tail.txt" "$work/status.txt" || { cat "$work/tail.txt" "$work/status.txt"; fail "a monitor believed the forged status"; }
     grep -q "ignoring statuses from participant .*: another world/publisher" "$work/tail.txt" ||
       fail "the monitor did not say what it ignored"
+    # The impostor forges a status every 0.5 s: within status's 2 s of listening it is named, and not believed.
+    grep -q "ignoring statuses from participant .*: another world/publisher" "$work/status.txt" ||
+      { cat "$work/status.txt"; fail "marsala-monitor status did not name the other publisher"; }
     echo "ok: forged admissions, frames, statuses and events ignored through a 4 s pause; the run completed at" \
       "step $steps on the unperturbed terrain $want"
     ;;
