@@ -191,7 +191,9 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
 void PathBuilder::follow_step(const BuildView& view, Position front, protocol::ActionRequest& request) {
   state_ = PathState::kHold;
   std::optional<executive::Motion> motion;
-  if (steps_.plan_path(view.local, trace_))
+  // The way to the front neighbour, not its own line to the target: it goes where the front builds, so whoever is
+  // the front next builds on from there (docs/runtime.md#the-construction-band).
+  if (steps_.plan_path_towards(view.local, front, trace_))
     motion = steps_.advance(view.local, steps_.in_lane(view.local, trace_.plan.path), view.robot);
   if (motion && distance(motion->target, front) >= pipeline_.params().separation_m) {
     steps_.move(*motion, trace_, request);

@@ -23,7 +23,8 @@
 //   otherwise, by the pipeline role of this frame:
 //     kActive  -> the ramp builder's building steps: from kRetreat its retreat step, else its build step
 //                 (-> kAdvance / kBuild / kRetreat); no deposition path through known cells: the state stays
-//     kFollow  -> advance along the deposition path through navigable cells without depositing ------> kFollow
+//     kFollow  -> advance without depositing along the deposition path to the front neighbour's cell (not
+//                 its own line to the target: it goes where the front builds) through navigable cells --> kFollow
 //                 no motion, or it would end closer than the separation to the front neighbour -----> kHold
 //                 (after kPatienceSteps frames in a row at the same position: make way as kHold does)
 //     kHold    -> stand still; after kPatienceSteps frames in a row at the same position, a step aside off the

@@ -248,6 +248,15 @@ bool RampSteps::plan_path(const deliberative::LocalMap& local, BuildTrace& trace
   return trace.plan.found;
 }
 
+bool RampSteps::plan_path_towards(const deliberative::LocalMap& local, Position towards, BuildTrace& trace) {
+  const auto cell = local.cell_at(towards);
+  if (!cell || local.passable(cell->row, cell->col) == 0) return plan_path(local, trace);
+  deliberative::LocalMap to = local;
+  to.goal = *cell;
+  trace.planned = false;
+  return plan_path(to, trace);
+}
+
 std::optional<executive::Motion> RampSteps::advance(const deliberative::LocalMap& local,
                                                     const std::vector<CellIndex>& path, Position robot) const {
   return modules_->actions.advance(local, path, robot, memory_.others);

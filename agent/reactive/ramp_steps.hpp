@@ -125,6 +125,10 @@ class RampSteps {
   /// Plans the deposition path from the robot to the local goal into trace.plan, unless this frame planned one;
   /// true when one was found.
   bool plan_path(const deliberative::LocalMap& local, BuildTrace& trace);
+  /// Plans the deposition path from the robot to the cell of `towards` [m] (priced as plan_path() prices it) into
+  /// trace.plan, instead of to the local goal; to the local goal when `towards` lies outside the window or is not
+  /// passable. True when one was found.
+  bool plan_path_towards(const deliberative::LocalMap& local, Position towards, BuildTrace& trace);
   /// The action manager's motion along `path` (local indices) from `robot` [m], or nullopt when no progress is
   /// possible.
   std::optional<executive::Motion> advance(const deliberative::LocalMap& local, const std::vector<CellIndex>& path,

@@ -149,6 +149,35 @@ TEST(PathBuilder, FollowsAFrontNeighbourBeyondTheSeparationWithoutDepositing) {
   EXPECT_FALSE(q.refill);
 }
 
+TEST(PathBuilder, AFollowerTakesTheWayToItsFrontNeighbourNotItsOwnLineToTheTarget) {
+  // Wherever the front neighbour stands ahead (bearings up to 40 degrees off the line to the target, 2.5-3 m away),
+  // the follower's path leads to the front neighbour's cell and its step brings it nearer: it goes where the front
+  // builds, so the front that follows on builds on the same way (docs/runtime.md#the-construction-band).
+  const AgentContext c = context();
+  const Position at{1.05, 3.05};
+  int cases = 0;
+  for (int deg = -40; deg <= 40; deg += 10)
+    for (const double r : {2.5, 3.0}) {
+      PathBuilder pb(c);
+      pb.on_admission(admission(c, kTarget));
+      const double a = deg * std::acos(-1.0) / 180.0;
+      const protocol::Neighbour front = test::neighbour_at(5, at.x + r * std::cos(a), at.y + r * std::sin(a));
+      const protocol::ActionRequest q = pb.decide(frame(c, 0, at, 1.0, {front}));
+      ASSERT_EQ(pb.last_trace().role, PipelineRole::kFollow) << deg << " deg, " << r << " m";
+      const PathBuilderTrace& t = pb.last_trace();
+      ASSERT_TRUE(t.planned && t.plan.found) << deg << " deg, " << r << " m";
+      const CellIndex front_cell = *test::platform_world().geometry().cell_at(front.position);
+      const CellIndex end{t.plan.path.back().row + t.window_offset.row, t.plan.path.back().col + t.window_offset.col};
+      EXPECT_EQ(end, front_cell) << deg << " deg, " << r << " m";
+      ASSERT_TRUE(q.move) << deg << " deg, " << r << " m";
+      EXPECT_LT(distance({q.target_x_m, q.target_y_m}, front.position), distance(at, front.position) - 0.1)
+          << deg << " deg, " << r << " m";
+      EXPECT_TRUE(q.depositions.empty());
+      ++cases;
+    }
+  EXPECT_EQ(cases, 18);
+}
+
 TEST(PathBuilder, HoldsWhenFollowingWouldComeWithinTheSeparation) {
   const AgentContext c = context();
   PathBuilder pb(c);
