@@ -35,8 +35,9 @@ packages=(
   cyclonedds-dev cyclonedds-tools libfastrtps-dev libfastcdr-dev fastddsgen
   # marsala-monitor serve: HTTP server and JSON (header-only / small libraries)
   libcpp-httplib-dev nlohmann-json3-dev
-  # multi-process tests run inside a private network namespace (unshare -n, ip link set lo up)
-  iproute2 util-linux
+  # multi-process tests run inside a private network namespace (unshare -n, ip link set lo up); the multi-host tests
+  # and benches drop multicast with a packet filter (tests/integration/lib.sh, bench/loss_bench.sh)
+  iproute2 util-linux nftables
   # deploy/marsala_tools (sweep, experiment, route search) and its tests (tests/python, ctest's tools.pytest), jq for
   # spawn.sh/demo.sh (marsala-world --check --json), the sweep's and experiments' plots
   python3 python3-pytest jq gnuplot-nox
