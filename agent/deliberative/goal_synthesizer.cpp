@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/core/navigability_processor.hpp"
@@ -13,7 +14,6 @@ std::optional<Position> FixedTarget::target(const GoalQuery& /*query*/) { return
 
 GoalVectorMapSynthesizer::GoalVectorMapSynthesizer(const AgentContext& context)
     : self_id_(context.agent_id),
-      cell_size_m_(context.assignment.world.cell_size_m),
       map_grid_(context.assignment.world),
       map_(context.goal_vector_map ? *context.goal_vector_map
                                    : throw InvalidArgument("goal synthesizer 'goal_vector_map' needs the "
@@ -73,7 +73,7 @@ std::optional<Position> GoalVectorMapSynthesizer::target(const GoalQuery& query)
   for (;;) {
     // A tail still ahead is given up as soon as a neighbour stands nearer to it, with the same rule that picks
     // tails: two robots that see each other never head for the same tail.
-    if (!current_ || (to_tail_ && !stands_on(query.robot, arrows[*current_].tail, cell_size_m_) &&
+    if (!current_ || (to_tail_ && !stands_on(query.robot, arrows[*current_].tail, map_grid_.cell_size_m) &&
                       neighbour_takes(arrows[*current_].tail, query, self_id_))) {
       current_ = pick_tail(map_, finished_, query, self_id_);
       to_tail_ = true;
@@ -85,10 +85,10 @@ std::optional<Position> GoalVectorMapSynthesizer::target(const GoalQuery& query)
     }
     const GoalArrow& arrow = arrows[*current_];
     if (to_tail_) {
-      if (!stands_on(query.robot, arrow.tail, cell_size_m_)) return arrow.tail;
+      if (!stands_on(query.robot, arrow.tail, map_grid_.cell_size_m)) return arrow.tail;
       to_tail_ = false;
     }
-    if (!stands_on(query.robot, arrow.head, cell_size_m_)) return arrow.head;
+    if (!stands_on(query.robot, arrow.head, map_grid_.cell_size_m)) return arrow.head;
     finished_[*current_] = true;
     const std::optional<std::size_t> next = map_.next(*current_);
     if (next && !finished_[*next]) {
@@ -132,24 +132,12 @@ CellMask unlevel_cells(const KnownMap& map, const CellRect& area, const Navigabi
                                       area.rows, area.cols, area.first, grid.rows, grid.cols));
   const Heightmap cut = map.heights.window(area.first, area.rows, area.cols);
   const CellMask occupiable = NavigabilityProcessor(level).occupiable(cut);
-  // Cells whose reading is a guess (unknown, or assumed ground) and the cells within delta/2 of one are not judged.
-  const int ring = static_cast<int>(std::floor(0.5 * level.delta_m / grid.cell_size_m + tolerance::kLengthM));
-  const double ring2 = (0.5 * level.delta_m / grid.cell_size_m) * (0.5 * level.delta_m / grid.cell_size_m) + 1e-9;
-  CellMask judged = CellMask::Ones(area.rows, area.cols);
-  for (int r = 0; r < area.rows; ++r)
-    for (int c = 0; c < area.cols; ++c) {
-      const int gr = area.first.row + r, gc = area.first.col + c;
-      if (map.known(gr, gc) != 0 && map.assumed(gr, gc) == 0) continue;
-      for (int dr = -ring; dr <= ring; ++dr)
-        for (int dc = -ring; dc <= ring; ++dc) {
-          const int rr = r + dr, cc = c + dc;
-          if (dr * dr + dc * dc <= ring2 && rr >= 0 && rr < area.rows && cc >= 0 && cc < area.cols) judged(rr, cc) = 0;
-        }
-    }
-  CellMask unlevel = CellMask::Zero(area.rows, area.cols);
-  for (int r = 0; r < area.rows; ++r)
-    for (int c = 0; c < area.cols; ++c) unlevel(r, c) = judged(r, c) != 0 && occupiable(r, c) == 0 ? 1 : 0;
-  return unlevel;
+  // Cells whose ball holds a guess (unknown, or assumed ground) are not judged.
+  const CellMask read = (map.known.block(area.first.row, area.first.col, area.rows, area.cols).array() != 0 &&
+                         map.assumed.block(area.first.row, area.first.col, area.rows, area.cols).array() == 0)
+                            .cast<std::uint8_t>();
+  const CellMask blind = blind_cells(read, 0.5 * level.delta_m / grid.cell_size_m);
+  return (blind.array() == 0 && occupiable.array() == 0).cast<std::uint8_t>();
 }
 
 GoalSynthesizerRegistry make_goal_synthesizer_registry() { return GoalSynthesizerRegistry("goal synthesizer"); }

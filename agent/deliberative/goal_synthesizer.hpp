@@ -88,7 +88,6 @@ class GoalVectorMapSynthesizer final : public GoalSynthesizer {
 
  private:
   std::uint32_t self_id_;
-  double cell_size_m_;
   GridGeometry map_grid_;
   GoalVectorMap map_;
   CellRect area_cells_;  ///< the world cells whose centres lie in the map's rectangle

@@ -240,21 +240,21 @@ void RampSteps::keep_clear(const protocol::SensorFrame& frame, BuildView& view) 
 }
 
 bool RampSteps::plan_path(const deliberative::LocalMap& local, BuildTrace& trace) {
-  if (!trace.planned) {
-    trace.plan = memory_.raised ? modules_->planner.plan(plan_gap(local), local.passable, local.robot, local.goal)
-                                : modules_->planner.plan(local.gap, local.passable, local.robot, local.goal);
-    trace.planned = true;
-  }
+  if (!trace.planned) plan_to(local, local.goal, trace);
   return trace.plan.found;
 }
 
 bool RampSteps::plan_path_towards(const deliberative::LocalMap& local, Position towards, BuildTrace& trace) {
   const auto cell = local.cell_at(towards);
   if (!cell || local.passable(cell->row, cell->col) == 0) return plan_path(local, trace);
-  deliberative::LocalMap to = local;
-  to.goal = *cell;
-  trace.planned = false;
-  return plan_path(to, trace);
+  plan_to(local, *cell, trace);
+  return trace.plan.found;
+}
+
+void RampSteps::plan_to(const deliberative::LocalMap& local, CellIndex goal, BuildTrace& trace) {
+  trace.plan = memory_.raised ? modules_->planner.plan(plan_gap(local), local.passable, local.robot, goal)
+                              : modules_->planner.plan(local.gap, local.passable, local.robot, goal);
+  trace.planned = true;
 }
 
 std::optional<executive::Motion> RampSteps::advance(const deliberative::LocalMap& local,

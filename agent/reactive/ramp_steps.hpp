@@ -258,6 +258,8 @@ class RampSteps {
   // set_band_centre(): the price the planner routes by: the window's gap against the terrain as first seen
   // (executive::first_seen_gap), so what is built raises no price beside it, and 0 on the cells built (built_cells).
   Heightmap plan_gap(const deliberative::LocalMap& local);
+  // Plans the deposition path from the robot to local cell `goal` (priced as plan_path() prices it) into trace.plan.
+  void plan_to(const deliberative::LocalMap& local, CellIndex goal, BuildTrace& trace);
   // set_band_centre(): the window's cells seen raised since first seen (RaisedCells::raised), the structure.
   CellMask built_cells(const deliberative::LocalMap& local) const;
   std::optional<CellIndex> oldest_navigable_trajectory_cell(const deliberative::LocalMap& local) const;
