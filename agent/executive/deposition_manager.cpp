@@ -8,6 +8,7 @@
 #include <string>
 
 #include "marsala/agent/agent_context.hpp"
+#include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/iterators.hpp"
 
@@ -103,7 +104,7 @@ std::vector<DepositionCandidate> DepositionManager::candidates(const deliberativ
   const double q = params_.cube_layer_m;
   const double layer_volume = q * area;
   const int max_layers = static_cast<int>(std::floor(params_.max_height_m / q + 1e-9));
-  const double clear_m = 0.5 * params_.navigability.delta_m + kUnderRobotMarginM;
+  const double clear_m = clearance_m(map, robot);
   const auto ball = sorted_ball(params_.footprint_m / (2.0 * cs));
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(map.rows()) * map.cols(), 0);
   const std::optional<CellIndex> self_cell = map.world.cell_at(neighbours.self);
@@ -138,11 +139,29 @@ std::vector<DepositionCandidate> DepositionManager::candidates(const deliberativ
   return out;
 }
 
+double DepositionManager::clearance_m(const deliberative::LocalMap& map, Position robot) const {
+  const NavigabilityParams& body = params_.navigability;
+  const double under_m = 0.5 * body.delta_m + kUnderRobotMarginM;
+  if (!(params_.exit_margin_m > 0.0)) return under_m;
+  const auto cell = map.cell_at(robot);
+  if (!cell) return under_m;
+  NavigabilityParams sure = body;
+  sure.eps_m = std::max(0.0, body.eps_m - params_.exit_margin_m);
+  for (int dr = -1; dr <= 1; ++dr)
+    for (int dc = -1; dc <= 1; ++dc) {
+      const CellIndex n{cell->row + dr, cell->col + dc};
+      if ((dr == 0 && dc == 0) || !map.contains(n) || map.blind(n.row, n.col) != 0 || map.known(n.row, n.col) == 0)
+        continue;
+      if (cell_occupiable(map.heights, n, sure)) return under_m;
+    }
+  return under_m + std::sqrt(2.0) * map.geometry().cell_size_m;
+}
+
 bool DepositionManager::may_raise(const deliberative::LocalMap& map, CellIndex cell, Position robot,
-                                  const Neighbourhood& neighbours) const {
+                                  const Neighbourhood& neighbours, double clearance_m) const {
   if (!map.contains(cell) || map.known(cell.row, cell.col) == 0) return false;
   const Position centre = map.center(cell);
-  if (distance(centre, robot) <= 0.5 * params_.navigability.delta_m + kUnderRobotMarginM) return false;
+  if (distance(centre, robot) <= clearance_m) return false;
   if (params_.pad_radius_m > 0.0 && distance(centre, params_.pad_centre) <= params_.pad_radius_m) return false;
   return in_territory(map, cell, centre, neighbours, map.world.cell_at(neighbours.self));
 }
@@ -151,6 +170,7 @@ std::vector<WantedCell> DepositionManager::wanted(const deliberative::LocalMap& 
                                                   Position robot, const Neighbourhood& neighbours) const {
   std::vector<WantedCell> out;
   const double cs = map.geometry().cell_size_m;
+  const double clear_m = clearance_m(map, robot);
   const auto ball = sorted_ball(params_.footprint_m / (2.0 * cs));
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(map.rows()) * map.cols(), 0);
   for (const CellIndex p : path)
@@ -161,7 +181,7 @@ std::vector<WantedCell> DepositionManager::wanted(const deliberative::LocalMap& 
       if (s) continue;
       s = 1;
       const double rise_m = deliberative::rise_wanted_m(map, cell, 0.0);
-      if (!(rise_m > 0.0) || !may_raise(map, cell, robot, neighbours)) continue;
+      if (!(rise_m > 0.0) || !may_raise(map, cell, robot, neighbours, clear_m)) continue;
       out.push_back({cell, rise_m});
     }
   return out;

@@ -38,6 +38,10 @@ struct DepositionParams {
   /// robot must not chase (a cell read a little low filled, a cell read a little high lifts the MARS bound of its
   /// neighbours: filled too, the bound rises again). 0 for exact maps [m].
   double gap_margin_m = 0.0;
+  /// A map built from range scans: the noise of a pair of its readings [m]; 0 for exact maps. One of the robot's 8
+  /// neighbour cells is a sure way out when it is occupiable with eps less this margin; without one, nothing is raised
+  /// where it could close a neighbour cell (clearance_m()).
+  double exit_margin_m = 0.0;
 };
 
 /// The deposition parameters of a body on a grid of cell_size_m [m], with the team's keep-out [m]; the footprint is
@@ -101,10 +105,17 @@ class DepositionManager {
   /// or budget: the cube and cone depositors place whole shapes (executive/depositor.hpp).
   std::vector<WantedCell> wanted(const deliberative::LocalMap& map, const std::vector<CellIndex>& path, Position robot,
                                  const Neighbourhood& neighbours) const;
-  /// True when local `cell` may be raised at all by a robot standing at `robot` [m]: known, farther than delta / 2
-  /// from it, in its territory, beyond the keep-out of every neighbour, off the base station's pad.
-  bool may_raise(const deliberative::LocalMap& map, CellIndex cell, Position robot,
-                 const Neighbourhood& neighbours) const;
+  /// True when local `cell` may be raised at all by a robot standing at `robot` [m]: known, farther than
+  /// `clearance_m` (clearance_m()) from it, in its territory, beyond the keep-out of every neighbour, off the base
+  /// station's pad.
+  bool may_raise(const deliberative::LocalMap& map, CellIndex cell, Position robot, const Neighbourhood& neighbours,
+                 double clearance_m) const;
+  /// How near a robot standing at `robot` [m] nothing is raised [m]: under its body (delta / 2). On a scanned map
+  /// (exit_margin_m > 0) without a sure way out (none of its 8 neighbour cells occupiable with eps less the margin,
+  /// known and in the window), also nothing whose raise could close a neighbour cell (delta / 2 + a cell's
+  /// diagonal): the way out it believes may be noise, and the one it has must not be built shut
+  /// (docs/runtime.md#a-sure-way-out).
+  double clearance_m(const deliberative::LocalMap& map, Position robot) const;
   /// candidates() reduced to the longest prefix that keeps the way back (keeps_way_back()).
   DepositionPlan plan(const deliberative::LocalMap& map, const std::vector<CellIndex>& path, Position robot,
                       double material_m3, const Neighbourhood& neighbours) const;

@@ -145,9 +145,10 @@ class ConeDepositor final : public Depositor {
     const auto index = [&](CellIndex c) { return static_cast<std::size_t>(c.row) * map.cols() + c.col; };
     // What each cell may still take [m]: its MARS gap where it may be raised at all, negative where it may not.
     std::vector<double> remaining(static_cast<std::size_t>(map.rows()) * map.cols(), -1.0);
+    const double clear_m = manager.clearance_m(map, robot);
     for (int r = 0; r < map.rows(); ++r)
       for (int c = 0; c < map.cols(); ++c)
-        if (map.blind(r, c) == 0 && manager.may_raise(map, {r, c}, robot, neighbours))
+        if (map.blind(r, c) == 0 && manager.may_raise(map, {r, c}, robot, neighbours, clear_m))
           remaining[index({r, c})] = std::max(0.0, deliberative::rise_wanted_m(map, {r, c}, 0.0));
     const std::vector<WantedCell> wanted = manager.wanted(map, path, robot, neighbours);
     std::vector<std::uint8_t> in_band(remaining.size(), 0);  // the cells the path's footprint wants

@@ -93,8 +93,12 @@ void RampSteps::admit(const protocol::Admission& admission) {
   deposits.pad_centre = context_.assignment.base;
   deposits.pad_radius_m = kPadFraction * context_.assignment.base_radius_m;
   // A scanned map reads each surface within a few noise spreads at the manipulator's reach: leave that much unfilled.
-  if (context_.type.sensor.casts_rays())
+  if (context_.type.sensor.casts_rays()) {
     deposits.gap_margin_m = kScanGapMargin * context_.type.sensor.noise_sd_at(body.reach_m + body.navigability.delta_m);
+    // The cells next to the robot are read from about a body length away; a pair of them differs by noise of up to
+    // about two spreads.
+    deposits.exit_margin_m = kScanExitMargin * context_.type.sensor.noise_sd_at(body.navigability.delta_m);
+  }
   const std::size_t streak_cells =
       context_.type.sensor.casts_rays() ? static_cast<std::size_t>(world.rows) * world.cols : 0;
   memory_.gap_streaks.assign(streak_cells, {});

@@ -53,6 +53,9 @@ inline constexpr double kPadFraction = 0.5;
 /// A robot that maps with range scans leaves this many noise spreads (its sensor's sd at its reach plus a body
 /// length) of each cell's MARS gap unfilled (DepositionParams::gap_margin_m).
 inline constexpr double kScanGapMargin = 3.0;
+/// The noise margin of the robot's sure way out on a scanned map (executive::DepositionParams::exit_margin_m): this
+/// many noise spreads at a body length [count].
+inline constexpr double kScanExitMargin = 2.0;
 /// A scanning robot deposits only on cells one of its last kFreshScans scans hit: an older reading may be from before
 /// another robot built there, and filling that stale gap again overbuilds [scans].
 inline constexpr int kFreshScans = 3;

@@ -129,6 +129,49 @@ TEST(DepositionManager, RespectsReachBudgetAndNeverDepositsUnderTheRobot) {
   EXPECT_TRUE(dm.plan(map, row_path(10, 10, 30), robot, 1e-4, {1, robot, {}}).depositions.empty());  // < a cube
 }
 
+TEST(DepositionManager, WithoutASureWayOutNothingIsRaisedThatCouldCloseANeighbourCell) {
+  // A scanned map: a pair of readings next to the robot may be off by 0.02 m.
+  DepositionParams scanned = params(0.4);
+  scanned.exit_margin_m = 0.02;
+  const NavigabilityParams& nav = scanned.navigability;  // kappa 0.5, delta 0.4 (a ball of radius 2 cells), eps 0.05
+  const CellIndex robot_cell{10, 10};
+  const Position robot = kGrid.cell_center(robot_cell);
+  const double under_m = 0.2;
+  const double neighbours_m = 0.2 + std::sqrt(2.0) * kCs;  // a cell whose raise can reach a neighbour's ball
+  const Heightmap gap(kGrid, 0.3);
+
+  // Ground whose cells next to each other differ by 0.09 m (a checkerboard): occupiable with eps (0.09 <= 0.05 +
+  // 0.5 * 0.1), not with eps less the margin (0.09 > 0.03 + 0.05), so the robot's way out may be the map's noise.
+  Heightmap bumpy(kGrid, 0.0);
+  for (int r = 0; r < bumpy.rows(); ++r)
+    for (int c = 0; c < bumpy.cols(); ++c) bumpy(r, c) = (r + c) % 2 == 0 ? 0.0 : 0.09;
+  const LocalMap rough = make_map(bumpy, gap, nav, robot_cell, {{10, 0}});
+  ASSERT_EQ(rough.navigable.cast<int>().sum(), rough.rows() * rough.cols());
+  const DepositionManager dm(scanned);
+  EXPECT_NEAR(dm.clearance_m(rough, robot), neighbours_m, 1e-5);
+  const auto plan = dm.plan(rough, row_path(10, 10, 30), robot, 10.0, {1, robot, {}});
+  ASSERT_FALSE(plan.depositions.empty());
+  Heightmap after = bumpy;
+  for (const auto& d : plan.depositions) {
+    EXPECT_GT(dist(kGrid.cell_center({d.row, d.col}), robot), neighbours_m);
+    after(d.row, d.col) += d.height_m;
+  }
+  // So every neighbour cell is as occupiable as before, whatever was raised (an independent check on the grid).
+  const CellMask before_occ = NavigabilityProcessor(nav).occupiable(bumpy);
+  const CellMask after_occ = NavigabilityProcessor(nav).occupiable(after);
+  for (int dr = -1; dr <= 1; ++dr)
+    for (int dc = -1; dc <= 1; ++dc)
+      EXPECT_EQ(after_occ(10 + dr, 10 + dc), before_occ(10 + dr, 10 + dc)) << dr << " " << dc;
+  // An exact map (no margin) or a sure way out (flat ground) keeps only the body clear.
+  EXPECT_NEAR(DepositionManager(params(0.4)).clearance_m(rough, robot), under_m, 1e-5);
+  const LocalMap flat = make_map(Heightmap(kGrid, 0.0), gap, nav, robot_cell, {{10, 0}});
+  EXPECT_NEAR(dm.clearance_m(flat, robot), under_m, 1e-5);
+  bool near = false;
+  for (const auto& d : dm.plan(flat, row_path(10, 10, 30), robot, 10.0, {1, robot, {}}).depositions)
+    near = near || dist(kGrid.cell_center({d.row, d.col}), robot) <= neighbours_m;
+  EXPECT_TRUE(near);
+}
+
 TEST(DepositionManager, NeighboursKeepOutAndTerritoriesDoNotOverlap) {
   const Heightmap gap(kGrid, 0.3);
   const LocalMap map = make_map(Heightmap(kGrid, 0.0), gap, params().navigability, {10, 10}, std::nullopt);
