@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Lockstep benchmark: the wall time of one world step with 1, 4 and 12 idle agent processes (behaviour "idle": an
-# empty request per frame), beside the raw DDS round trip measured in the same run, as a ratio.
+# Lockstep benchmark: the wall time of one world step with 1, 4 and 12 (--teams: up to 120) idle agent processes
+# (behaviour "idle": an empty request per frame), beside the raw DDS round trip measured in the same run, as a ratio.
 # Reports the world's per-step median and 90th percentile (summary.json) over --steps steps.
 # Usage: bench/lockstep_bench.sh [--dds cyclone|fastdds] [--steps N] [--teams "1 4 12"]
 set -euo pipefail
@@ -20,7 +20,14 @@ done
 work="$(mktemp -d "${TMPDIR:-/tmp}/marsala-lockstep.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 
-# A flat 20 x 20 m site with 12 idle robots in a row; the goal is out of everyone's way, so the run lasts --steps.
+# A flat 20 x 20 m site with as many idle robots as the largest team, in rows of 12 (1 m apart, rows 1.5 m apart);
+# the goal is out of everyone's way, so the run lasts --steps.
+slots=12
+for n in $teams; do
+  [[ "$n" =~ ^[0-9]+$ ]] && [ "$n" -ge 1 ] && [ "$n" -le 120 ] ||
+    { echo "lockstep_bench.sh: --teams takes team sizes from 1 to 120, not '$n'" >&2; exit 2; }
+  [ "$n" -gt "$slots" ] && slots=$n
+done
 scenario="$work/idle.pbtxt"
 {
   echo 'name: "idle" description: "lockstep benchmark: idle robots on flat ground"'
@@ -28,8 +35,10 @@ scenario="$work/idle.pbtxt"
   echo 'robot_type { name: "idler" behaviour: "idle" body { kappa: 0.3 delta_m: 1.0 eps_m: 0.05 max_step_m: 0.2'
   echo '  max_deposit_m3: 0.02 material_capacity_m3: 1.0 reach_m: 1.5 sensing_range_m: 4.0 proximity_range_m: 3.0'
   echo '  cube_size_m: 0.05 } }'
-  for id in $(seq 1 12); do
-    echo "agent { id: $id robot_type: \"idler\" start { x_m: $((id + 2)).05 y_m: 5.05 } target { x_m: 10.05 y_m: 15.05 } }"
+  for id in $(seq 1 "$slots"); do
+    x=$(((id - 1) % 12 + 3)).05
+    y=$(awk -v r=$(((id - 1) / 12)) 'BEGIN { printf "%.2f", 5.05 + 1.5 * r }')
+    echo "agent { id: $id robot_type: \"idler\" start { x_m: $x y_m: $y } target { x_m: 10.05 y_m: 15.05 } }"
   done
   echo 'goal { x0_m: 18 y0_m: 18 x1_m: 19 y1_m: 19 min_height_m: 0 }'
   echo "base { x_m: 3.05 y_m: 3.05 radius_m: 1.0 } max_steps: $steps step_deadline_s: 10 tile_size: 16 seed: 1"

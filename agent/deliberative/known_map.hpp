@@ -3,12 +3,22 @@
 // (executive::MappingSystem::known_map()); the local map synthesizer reads it and never sees the mapping system, so
 // the layers point one way: executive -> deliberative.
 
+#include <unordered_map>
 #include <vector>
 
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/types.hpp"
 
 namespace marsala::agent::deliberative {
+
+/// The cells a robot stood on, as its map read their body balls then: row-major world index -> the heights of the
+/// cells of its ball in disc_offsets(radius_cells) order, NaN where the cell was unknown or off the grid
+/// (executive::MappingSystem::record_stood).
+struct StoodCells {
+  double radius_cells = 0.0;  ///< the body ball's radius [cells]: delta / (2 cs)
+  double margin_m = 0.0;      ///< a ball reads as then when each cell is within this of its height then [m]
+  std::unordered_map<long long, std::vector<double>> balls;
+};
 
 /// A read-only view of the agent's own map of the world grid; it refers to the map that made it and lives no longer.
 struct KnownMap {
@@ -18,6 +28,7 @@ struct KnownMap {
   const CellMask& bound;                     ///< 1 where `assumed` is a lower bound from faces (not assumed ground)
   const std::vector<CellIndex>& trajectory;  ///< cells stood on, oldest first (world indices)
   bool scanned = false;                      ///< built from range scans (holes, shadows), not ground-truth tiles
+  const StoodCells* stood = nullptr;         ///< cells stood on with their balls then (a scanned map), or none
 
   /// The world grid.
   const GridGeometry& geometry() const { return heights.geometry(); }

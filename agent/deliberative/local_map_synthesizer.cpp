@@ -9,6 +9,7 @@
 #include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
+#include "marsala/core/iterators.hpp"
 
 namespace marsala::agent::deliberative {
 namespace {
@@ -108,6 +109,10 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
   // the world lets a robot drive out of its own cell (docs/runtime.md#rule-2-motion), so it counts as occupiable and
   // the robot keeps its way out instead of standing still for good.
   if (map.scanned) local.occupiable(local.robot.row, local.robot.col) = 1;
+  // So is every cell it stood on while its ball reads as it did then: the world put the body there, so it was
+  // occupiable, and a reading a few mm off (a step within noise of eps + kappa cs) must not wall the robot in on an
+  // island of its own map (docs/runtime.md#cells-stood-on).
+  if (map.scanned && map.stood) open_stood_cells(local, map);
   local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
   local.origin = local_origin(local, map.trajectory, robot, sensing_range_m_);
   const auto [goal, is_target] = local_goal(local, robot, target);
@@ -145,6 +150,27 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
     }
   }
   return local;
+}
+
+void LocalMapSynthesizer::open_stood_cells(LocalMap& local, const KnownMap& map) {
+  const StoodCells& stood = *map.stood;
+  const std::vector<CellIndex> ball = disc_offsets(stood.radius_cells);
+  const long long cols = map.heights.cols();
+  for (const auto& [index, then] : stood.balls) {
+    const CellIndex global{static_cast<int>(index / cols), static_cast<int>(index % cols)};
+    const CellIndex p = local.to_local(global);
+    if (!local.contains(p) || local.occupiable(p.row, p.col) != 0 || local.blind(p.row, p.col) != 0 ||
+        then.size() != ball.size())
+      continue;
+    bool same = true;
+    for (std::size_t i = 0; i < ball.size() && same; ++i) {
+      const CellIndex b{global.row + ball[i].row, global.col + ball[i].col};
+      if (!map.heights.contains(b)) continue;
+      same = std::isfinite(then[i]) && map.known(b.row, b.col) != 0 &&
+             std::abs(map.heights(b) - then[i]) <= stood.margin_m;
+    }
+    if (same) local.occupiable(p.row, p.col) = 1;
+  }
 }
 
 void LocalMapSynthesizer::gap_and_occupiable(LocalMap& local) const {

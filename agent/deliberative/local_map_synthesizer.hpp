@@ -134,6 +134,8 @@ class LocalMapSynthesizer {
   };
   /// Fills local.gap and local.occupiable from local.heights, from the memo when the window is the last one.
   void gap_and_occupiable(LocalMap& local) const;
+  // The cells of `map.stood` in the window whose balls read as when the robot stood there become occupiable.
+  static void open_stood_cells(LocalMap& local, const KnownMap& map);
 
   MarsProcessor mars_;
   NavigabilityProcessor navigability_;

@@ -12,6 +12,7 @@
 #include "marsala/core/cpu_time.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
+#include "marsala/core/iterators.hpp"
 
 namespace marsala::agent::executive {
 namespace {
@@ -239,6 +240,7 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       face_hit_scan_(other.face_hit_scan_),
       sensor_(other.sensor_),
       trajectory_(other.trajectory_),
+      stood_(other.stood_),
       octree_(other.octree_ ? std::make_unique<Octree>(*other.octree_) : nullptr) {}
 MappingSystem& MappingSystem::operator=(const MappingSystem& other) {
   if (this != &other) *this = MappingSystem(other);
@@ -468,6 +470,13 @@ int MappingSystem::last_hit_scan(CellIndex cell) const {
 
 void MappingSystem::record_built(CellIndex cell, double rise_m) {
   if (!heights_.contains(cell) || !std::isfinite(rise_m) || !(rise_m > 0.0)) return;
+  // The robot's own construction changes every ball it lands in: what it stood on there is no longer a fact.
+  if (!stood_.balls.empty())
+    for (const CellIndex o : disc_offsets(stood_.radius_cells)) {
+      const CellIndex centre{cell.row - o.row, cell.col - o.col};
+      if (heights_.contains(centre))
+        stood_.balls.erase(static_cast<long long>(centre.row) * heights_.cols() + centre.col);
+    }
   const long long index = static_cast<long long>(cell.row) * heights_.cols() + cell.col;
   // A cell whose surface no sensor read has no height to add to.
   const bool surface_read =
@@ -604,6 +613,21 @@ void MappingSystem::assume_ground(Position pose, double ground_z_m, double radiu
 }
 
 std::size_t MappingSystem::octree_leaves() const { return octree_ ? octree_->tree.leaves() : 0; }
+
+void MappingSystem::record_stood(Position pose, double radius_cells, double margin_m) {
+  const auto cell = std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;
+  if (!cell || !(radius_cells >= 0.0) || !(margin_m >= 0.0)) return;
+  if (stood_.radius_cells != radius_cells) stood_.balls.clear();
+  stood_.radius_cells = radius_cells;
+  stood_.margin_m = margin_m;
+  std::vector<double> ball;
+  for (const CellIndex o : disc_offsets(radius_cells)) {
+    const CellIndex b{cell->row + o.row, cell->col + o.col};
+    ball.push_back(heights_.contains(b) && known_(b.row, b.col) != 0 ? heights_(b)
+                                                                     : std::numeric_limits<double>::quiet_NaN());
+  }
+  stood_.balls[static_cast<long long>(cell->row) * heights_.cols() + cell->col] = std::move(ball);
+}
 
 void MappingSystem::record_pose(Position pose) {
   const auto cell = std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;

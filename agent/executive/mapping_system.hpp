@@ -88,6 +88,12 @@ class MappingSystem {
   /// Appends the cell under `pose` [m] to the trajectory (consecutive repeats are kept once); throws
   /// InvalidArgument when the pose is off the grid or not finite.
   void record_pose(Position pose);
+  /// The robot stands on the cell under `pose` [m]: the world put it there, so that cell was occupiable for its body,
+  /// whatever this map's readings of its ball say. Remembers the ball (radius_cells = delta / (2 cs)) as the map
+  /// reads it now; known_map().stood holds it while each of its cells reads within margin_m of that
+  /// (LocalMapSynthesizer: occupiable on a scanned map), until the robot's own construction lands in the ball
+  /// (record_built()). Off-grid or non-finite poses are ignored; radius_cells and margin_m >= 0.
+  void record_stood(Position pose, double radius_cells, double margin_m);
 
   /// The map: known cells hold the sensed heights [m], unknown cells 0.
   const Heightmap& heights() const { return heights_; }
@@ -115,7 +121,7 @@ class MappingSystem {
   const GridGeometry& geometry() const { return heights_.geometry(); }
   /// This map as the deliberative layer reads it (the local map synthesizer); valid while this map lives, unchanged.
   deliberative::KnownMap known_map() const {
-    return {heights_, known_, assumed_, bound_, trajectory_, sensor_.casts_rays()};
+    return {heights_, known_, assumed_, bound_, trajectory_, sensor_.casts_rays(), stood_.balls.empty() ? nullptr : &stood_};
   }
   int tile_size() const { return tile_size_; }
   const SensorSpec& sensor() const { return sensor_; }
@@ -160,6 +166,7 @@ class MappingSystem {
   std::unordered_map<long long, int> face_hit_scan_;  ///< the last scan with a face hit on the cell (1, 2, ...)
   SensorSpec sensor_;
   std::vector<CellIndex> trajectory_;
+  deliberative::StoodCells stood_;  ///< record_stood()
   std::unique_ptr<Octree> octree_;  // made at the first scan
   ScanCost last_scan_cost_;
 };

@@ -208,6 +208,11 @@ void RampSteps::update_map(const protocol::SensorFrame& frame) {
     const NavigabilityParams& body = context_.type.body.navigability;
     const double radius_m = 0.5 * body.delta_m + context_.type.body.max_step_m;
     modules_->map.assume_ground(robot, frame.z_m, radius_m, body.eps_m + body.kappa * radius_m);
+    // The cell it stands on was occupiable: a fact its map keeps while the ball reads the same, within the map's
+    // noise margin (at least half a cube layer, as for refused cells).
+    const executive::DepositionParams& deposits = modules_->depositions.params();
+    modules_->map.record_stood(robot, body.delta_m / (2.0 * modules_->map.geometry().cell_size_m),
+                               std::max(deposits.gap_margin_m, 0.5 * deposits.cube_layer_m));
   }
 }
 

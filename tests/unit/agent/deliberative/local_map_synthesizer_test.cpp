@@ -276,6 +276,43 @@ TEST(LocalMapSynthesizer, AScannedMapKeepsTheRobotsWayOutOfItsOwnCell) {
   }
 }
 
+// A cell the robot stood on was occupiable (the world put its body there): a scanned map keeps it so while its ball
+// reads as it did then, within the margin, even where its readings break the rule by a few mm. Before, a step read 1
+// cm above eps + kappa cs walled a laser robot in on an island of its own map, and its depositions closed the true way
+// down.
+TEST(LocalMapSynthesizer, AScannedMapKeepsTheCellsItStoodOnWhileTheirBallsReadTheSame) {
+  Heightmap h(kWorld, 0.0);
+  // West of the robot, cell (30, 36) holds in its ball (radius 2 cells) a step of 0.11 m between (30, 37) and
+  // (30, 38): 0.01 m more than eps + kappa cs (0.05 + 0.05).
+  for (int r = 0; r < kWorld.rows; ++r)
+    for (int c = 38; c < kWorld.cols; ++c) h(r, c) = 0.11;
+  const CellIndex stood{30, 36};
+  ASSERT_FALSE(cell_occupiable(h, stood, kBody));
+  const CellMask known = CellMask::Ones(kWorld.rows, kWorld.cols);
+  const CellMask none = CellMask::Zero(kWorld.rows, kWorld.cols);
+  const std::vector<CellIndex> trajectory{stood, {30, 40}};
+  // The ball as the map read it when the robot stood there: 0.1 m at the step, within the margin of 0.11.
+  StoodCells cells;
+  cells.radius_cells = 2.0;
+  cells.margin_m = 0.015;
+  std::vector<double> then;
+  for (const CellIndex o : disc_offsets(2.0)) then.push_back(stood.col + o.col >= 38 ? 0.10 : 0.0);
+  cells.balls[static_cast<long long>(stood.row) * kWorld.cols + stood.col] = then;
+  const LocalMapSynthesizer synthesizer(kBody, 2.5);
+  const auto occupiable_at = [&](const Heightmap& heights, bool scanned, const StoodCells* with) {
+    const LocalMap local = synthesizer.synthesize({heights, known, none, none, trajectory, scanned, with}, kRobot,
+                                                  {7.0, 2.95});
+    return local.occupiable(local.to_local(stood).row, local.to_local(stood).col);
+  };
+  EXPECT_EQ(occupiable_at(h, true, nullptr), 0);
+  EXPECT_EQ(occupiable_at(h, true, &cells), 1);
+  EXPECT_EQ(occupiable_at(h, false, &cells), 0);  // an exact map is the truth: nothing kept against it
+  // A ball cell raised beyond the margin since (0.13 m read, 0.10 then): the fact is gone.
+  Heightmap raised = h;
+  raised(30, 38) = 0.13;
+  EXPECT_EQ(occupiable_at(raised, true, &cells), 0);
+}
+
 // A bound (faces seen from below, no surface read) lying below both its neighbours along a grid axis is a notch in
 // that line: its MARS gap counts, capped at its notch level (the higher over the two axes of the lower neighbour of
 // the pair), and the map's noise margin shrinks the MARS gap, not that cap. Before, only a bound below all four

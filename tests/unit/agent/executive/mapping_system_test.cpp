@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/iterators.hpp"
 #include "marsala/core/ray_caster.hpp"
 #include "marsala/terrain/generators.hpp"
 
@@ -626,6 +627,30 @@ TEST(MappingSystem, ABuiltCellGetsAFloorOnlyWhereItsSurfaceWasRead) {
   scan_into(map, truth, 4.05, 4.05, 0.0, 4);  // the next scan still reads the old surface there
   EXPECT_GE(map.heights()(*read), before + 0.25 - 1e-9);
   EXPECT_FALSE(map.is_known(*unread));
+}
+
+TEST(MappingSystem, ACellStoodOnKeepsItsBallUntilTheRobotBuildsInIt) {
+  MappingSystem map(kWorld, 3);
+  map.integrate({tile(0, 0, 3, 3, 1.0), tile(0, 1, 3, 3, 2.0), tile(1, 0, 2, 3, 3.0), tile(1, 1, 2, 3, 4.0)},
+                {11.25, 21.75});  // cell (1, 2); column 6 stays unknown
+  EXPECT_EQ(map.known_map().stood, nullptr);  // nothing stood on yet
+  map.record_stood({11.25, 21.75}, 1.0, 0.01);  // the ball: (1, 2) and its 4 axis neighbours
+  map.record_stood({9.0, 21.75}, 1.0, 0.01);    // off the grid: ignored
+  const deliberative::StoodCells* stood = map.known_map().stood;
+  ASSERT_NE(stood, nullptr);
+  ASSERT_EQ(stood->balls.size(), 1u);
+  const std::vector<double>& ball = stood->balls.at(1 * kWorld.cols + 2);
+  const std::vector<CellIndex> offsets = disc_offsets(1.0);
+  ASSERT_EQ(ball.size(), offsets.size());
+  for (std::size_t i = 0; i < ball.size(); ++i)
+    EXPECT_TRUE(same_bits(ball[i], map.heights()(CellIndex{1 + offsets[i].row, 2 + offsets[i].col})));
+  EXPECT_DOUBLE_EQ(stood->radius_cells, 1.0);
+  EXPECT_DOUBLE_EQ(stood->margin_m, 0.01);
+  // A deposition outside its ball changes nothing; one inside it (the robot's own) ends the fact.
+  map.record_built({1, 4}, 0.1);
+  EXPECT_EQ(map.known_map().stood->balls.count(1 * kWorld.cols + 2), 1u);
+  map.record_built({2, 2}, 0.1);
+  EXPECT_EQ(map.known_map().stood, nullptr);
 }
 
 }  // namespace marsala::agent::executive
