@@ -389,8 +389,7 @@ MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& p
       }
     }
     const double band = std::max(kEdgeBand * cs, spread);
-    if (band > kMaxEdgeBand * cs + 1e-12 || near_cell_edge(g, hit, band) || behind_edge(origin, hit, *cell, spread) ||
-        short_of_face(origin, hit, *cell, kFaceRivalNoise / kEdgeBandNoise * spread))
+    if (band > kMaxEdgeBand * cs + 1e-12 || near_cell_edge(g, hit, band) || behind_edge(origin, hit, *cell, spread))
       continue;
     const octomap::point3d end = tree_point(g, hit.x, hit.y, hit.z);
     octomap::OcTreeKey key;
@@ -419,31 +418,6 @@ bool MappingSystem::behind_edge(Point3 origin, Point3 hit, CellIndex cell, doubl
   const double edge = heights_(entry->from);
   const bool lower = known_(cell.row, cell.col) == 0 || heights_(cell) < edge - spread;
   return lower && entry->z_m <= edge + spread;
-}
-
-bool MappingSystem::short_of_face(Point3 origin, Point3 hit, CellIndex cell, double reach_m) const {
-  // A descending hit whose ray, carried on by what range noise may have taken off it, enters a cell known higher than
-  // the ray there: it may be that cell's face, struck and read short. In a pit's column (a cell between higher ones)
-  // nothing else lands, its floor out of sight, so such hits alone read the pit at the height of its rim, never to be
-  // filled. Judged on the map before this scan.
-  const GridGeometry& g = heights_.geometry();
-  const double dx = hit.x - origin.x, dy = hit.y - origin.y, dz = hit.z - origin.z;
-  const double length = std::sqrt(dx * dx + dy * dy + dz * dz), run = std::hypot(dx, dy);
-  if (!(dz < 0.0) || !(run > 0.0) || !(reach_m > 0.0)) return false;
-  const double cs = g.cell_size_m, ux = dx / length, uy = dy / length, uz = dz / length;
-  const Position centre = g.cell_center(cell);
-  // The edges the ray leaves the cell by, ahead of the hit: their distance along the ray [m].
-  const auto ahead = [&](double u, double from, double mid) {
-    if (std::abs(u) < 1e-12) return std::numeric_limits<double>::infinity();
-    return ((u > 0.0 ? mid + 0.5 * cs : mid - 0.5 * cs) - from) / u;
-  };
-  for (const double t : {ahead(ux, hit.x, centre.x), ahead(uy, hit.y, centre.y)}) {
-    if (!(t <= reach_m)) continue;
-    const double past = t + 10.0 * kOnEdgeM;
-    const std::optional<CellIndex> next = g.cell_at({hit.x + past * ux, hit.y + past * uy});
-    if (next && *next != cell && known_(next->row, next->col) != 0 && heights_(*next) > hit.z + t * uz) return true;
-  }
-  return false;
 }
 
 void MappingSystem::rederive_heights(const ScanBatch& batch) {
