@@ -20,6 +20,7 @@
 
 #include "lockstep_sim.hpp"
 #include "marsala/agent/reactive/path_builder.hpp"
+#include "marsala/agent/reactive/ramp_builder.hpp"
 #include "marsala/cli/command_line.hpp"
 #include "marsala/core/mars_processor.hpp"
 #include "marsala/core/navigability_processor.hpp"
@@ -46,6 +47,20 @@ void show(const LockstepSim& sim) {
                static_cast<int>(a.last_result), a.last_reason, q.move, q.target_x_m, q.target_y_m,
                q.depositions.size() + q.deposits.size(), q.refill ? "refill" : "",
                q.waiting_for.empty() ? "" : " | waits: ", q.waiting_for);
+    if (const auto* rb = dynamic_cast<const marsala::agent::reactive::RampBuilder*>(&sim.behaviour(q.agent_id))) {
+      // Where a ramp builder was heading and what it found to build (world indices), to trace a stall.
+      const auto& t = rb->last_trace();
+      const auto o = t.window_offset;
+      fmt::print("      goal ({}, {}) path found {} cells {}", o.row + t.local_goal.row, o.col + t.local_goal.col,
+                 t.plan.found, t.plan.path.size());
+      if (!t.plan.path.empty())
+        fmt::print(" ({}, {}) -> ({}, {})", o.row + t.plan.path.front().row, o.col + t.plan.path.front().col,
+                   o.row + t.plan.path.back().row, o.col + t.plan.path.back().col);
+      fmt::print(" origin {} navigable {} candidates {} dropped for the way back {}\n",
+                 t.local_origin ? fmt::format("({}, {})", o.row + t.local_origin->row, o.col + t.local_origin->col)
+                                : "-",
+                 t.navigable_cells, t.deposition.candidates, t.deposition.dropped_for_way_back);
+    }
     if (const auto* pb = dynamic_cast<const marsala::agent::reactive::PathBuilder*>(&sim.behaviour(q.agent_id))) {
       const auto& t = pb->last_trace();
       const auto front = pb->pipeline().front({a.position.x, a.position.y}, a.target);
