@@ -1,7 +1,12 @@
 #include "marsala/core/detail/mars_search.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace marsala::detail {
 namespace {
@@ -10,13 +15,42 @@ namespace {
 // been applied exactly by apply_local_sources().
 constexpr long long kFloor2 = kLocalRadius2 + 1;
 
+constexpr int kTargets = kBlock * kBlock;
+
+// Two doubles at once: GCC/Clang vector extensions (SSE2 on x86-64, NEON on AArch64, plain code elsewhere).
+// Only exactly rounded operations (+ - *), element by element, so every value is the scalar one.
+typedef double Pair __attribute__((vector_size(16)));
+
+inline Pair load(const double* p) {
+  Pair v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// Bit k set when a[k] > b[k], k = 0, 1.
+inline unsigned greater(Pair a, Pair b) {
+#if defined(__SSE2__)
+  return static_cast<unsigned>(
+      _mm_movemask_pd(_mm_cmpgt_pd(reinterpret_cast<__m128d>(a), reinterpret_cast<__m128d>(b))));
+#else
+  return static_cast<unsigned>(a[0] > b[0]) | static_cast<unsigned>(a[1] > b[1]) << 1;
+#endif
+}
+
 // Searches the tree for one kBlock x kBlock block of targets at a time, depth first, children in
 // decreasing order of their upper bound; a node is dropped for a target as soon as one of its
-// bounds is <= the target's current value + tol.
+// bounds is <= the target's current value + tol. A node's bounds are tested on all 64 targets of
+// the block at once, two at a time and without branches; the mask of live targets then selects
+// which targets go on.
 class BlockSearch {
  public:
   BlockSearch(const Problem& pb, const SourceTree& tree, double* lower)
-      : pb_(pb), tree_(tree), lower_(lower), kcs2_(pb.kcs * pb.kcs) {}
+      : pb_(pb), tree_(tree), lower_(lower), kcs2_(pb.kcs * pb.kcs) {
+    for (int t = 0; t < kTargets; ++t) {
+      local_r_[t] = t / kBlock;
+      local_c_[t] = t % kBlock;
+    }
+  }
 
   void run() {
     for (int bi = 0; bi < tree_.height(0); ++bi)
@@ -31,6 +65,11 @@ class BlockSearch {
     c1_ = std::min(pb_.cols, c0_ + kBlock) - 1;
     std::uint64_t targets = 0;
     min_limit_ = kInf;
+    for (int t = 0; t < kTargets; ++t) {
+      tr_[t] = r0_ + local_r_[t];
+      tc_[t] = c0_ + local_c_[t];
+      limit_[t] = kInf;  // off the grid: every bound is below it
+    }
     for (int r = r0_; r <= r1_; ++r)
       for (int c = c0_; c <= c1_; ++c) {
         const int t = (r - r0_) * kBlock + (c - c0_);
@@ -47,34 +86,57 @@ class BlockSearch {
     return std::max(dr * dr + dc * dc, kFloor2);
   }
 
-  // True when no source of the node can exceed `limit` at target (r, c).
-  bool pruned(const SourceNode& nd, int r, int c, double limit) const {
-    const double x = nd.max_h - limit;
-    if (x <= 0) return true;
-    const long long dr = std::max({0, nd.r0 - r, r - nd.r1}), dc = std::max({0, nd.c0 - c, c - nd.c1});
-    const double d2 = static_cast<double>(std::max(dr * dr + dc * dc, kFloor2));
-    if (x * x <= kcs2_ * d2) return true;  // height: max h - kcs d <= limit
+  // Targets of the block at which some source of the node may exceed the limit: those where no
+  // bound is <= the limit (max h - kcs d, then each shape of the node; Shape documents them).
+  std::uint64_t live_targets(const SourceNode& nd) {
+    double dr2[kBlock], dc2[kBlock];
+    for (int k = 0; k < kBlock; ++k) {
+      const long long r = r0_ + k, c = c0_ + k;
+      const long long dr = std::max({0LL, nd.r0 - r, r - nd.r1}), dc = std::max({0LL, nd.c0 - c, c - nd.c1});
+      dr2[k] = static_cast<double>(dr * dr);
+      dc2[k] = static_cast<double>(dc * dc);
+    }
+    const double floor2 = static_cast<double>(kFloor2);
+    for (int t = 0; t < kTargets; ++t) d2_[t] = std::max(dr2[t / kBlock] + dc2[t % kBlock], floor2);
+    const Pair zero = {0.0, 0.0};
+    const double kcs2 = kcs2_;
+    std::uint64_t live = 0;
+    for (int t = 0; t < kTargets; t += 2) {
+      const Pair x = nd.max_h - load(limit_ + t);
+      live |= std::uint64_t{greater(x, zero) & greater(x * x, kcs2 * load(d2_ + t))} << t;
+    }
     for (const Shape& s : nd.shapes) {
+      if (!live) break;
+      const double m = s.m, sr = s.r, sc = s.c;
+      std::uint64_t keep = 0;
       switch (s.kind) {
-        case Shape::Kind::kNone: return false;
+        case Shape::Kind::kNone: return live;
         case Shape::Kind::kPlane: {
-          const double y = s.m + s.ar * (r - s.r) + s.ac * (c - s.c) - limit;
-          if (y <= 0 || y * y <= s.deficit2 * d2) return true;
+          const double ar = s.ar, ac = s.ac, deficit2 = s.deficit2;
+          for (int t = 0; t < kTargets; t += 2) {
+            const Pair y = m + ar * (load(tr_ + t) - sr) + ac * (load(tc_ + t) - sc) - load(limit_ + t);
+            keep |= std::uint64_t{greater(y, zero) & greater(y * y, deficit2 * load(d2_ + t))} << t;
+          }
           break;
         }
         case Shape::Kind::kCone: {
-          const double z = s.m - limit, er = r - s.r, ec = c - s.c;
-          if (z <= 0 || z * z <= kcs2_ * (er * er + ec * ec)) return true;
+          for (int t = 0; t < kTargets; t += 2) {
+            const Pair z = m - load(limit_ + t), er = load(tr_ + t) - sr, ec = load(tc_ + t) - sc;
+            keep |= std::uint64_t{greater(z, zero) & greater(z * z, kcs2 * (er * er + ec * ec))} << t;
+          }
           break;
         }
         case Shape::Kind::kBowl: {
-          const double z = s.m - limit, er = r - s.r, ec = c - s.c;
-          if (z <= 0 && z * z >= kcs2_ * (er * er + ec * ec)) return true;
+          for (int t = 0; t < kTargets; t += 2) {
+            const Pair z = m - load(limit_ + t), er = load(tr_ + t) - sr, ec = load(tc_ + t) - sc;
+            keep |= std::uint64_t{greater(z, zero) | greater(kcs2 * (er * er + ec * ec), z * z)} << t;
+          }
           break;
         }
       }
+      live &= keep;
     }
-    return false;
+    return live;
   }
 
   void visit(int level, int i, int j, std::uint64_t targets) {
@@ -82,11 +144,7 @@ class BlockSearch {
     if (nd.empty()) return;
     const double x = nd.max_h - min_limit_;
     if (x <= 0 || x * x <= kcs2_ * static_cast<double>(block_distance2(nd))) return;
-    std::uint64_t keep = 0;
-    for (std::uint64_t bits = targets; bits; bits &= bits - 1) {
-      const int t = __builtin_ctzll(bits);
-      if (!pruned(nd, r0_ + t / kBlock, c0_ + t % kBlock, limit_[t])) keep |= std::uint64_t{1} << t;
-    }
+    const std::uint64_t keep = targets & live_targets(nd);
     if (!keep) return;
     if (level == 0) {
       evaluate_leaf(i, j, keep);
@@ -112,25 +170,46 @@ class BlockSearch {
     for (int k = 0; k < n; ++k) visit(below, kids[k].i, kids[k].j, keep);
   }
 
+  // Applies the leaf's sources to the targets. A first branch-free pass over all 64 cells of the
+  // leaf (non-sources at -inf) asks whether any source beats the target's limit; only then are the
+  // sources applied one by one in bit order, each against the limit as it rises.
   void evaluate_leaf(int i, int j, std::uint64_t targets) {
     const std::uint64_t sources = tree_.leaf_mask(i, j);
+    const int sr0 = i * kBlock, sc0 = j * kBlock;
+    alignas(16) double hs[kTargets];
+    for (int s = 0; s < kTargets; ++s) {
+      const int sr = sr0 + s / kBlock, sc = sc0 + s % kBlock;
+      hs[s] = sources >> s & 1 ? pb_.h[static_cast<std::int64_t>(sr) * pb_.cols + sc] : -kInf;
+    }
+    const Pair zero = {0.0, 0.0};
+    const double kcs2 = kcs2_;
     for (std::uint64_t tb = targets; tb; tb &= tb - 1) {
       const int t = __builtin_ctzll(tb);
-      const int r = r0_ + t / kBlock, c = c0_ + t % kBlock;
-      double& out = lower_[static_cast<std::int64_t>(r) * pb_.cols + c];
-      for (std::uint64_t sb = sources; sb; sb &= sb - 1) {
-        const int s = __builtin_ctzll(sb);
-        const int sr = i * kBlock + s / kBlock, sc = j * kBlock + s % kBlock;
-        const double hs = pb_.h[static_cast<std::int64_t>(sr) * pb_.cols + sc];
-        const double x = hs - limit_[t];
-        if (x <= 0) continue;
-        const long long dr = r - sr, dc = c - sc, d2 = dr * dr + dc * dc;
-        if (d2 <= kLocalRadius2 || x * x <= kcs2_ * static_cast<double>(d2)) continue;
-        const double v = cone_value(hs, pb_.kcs, d2);
-        if (v > out) {
-          out = v;
-          limit_[t] = v + pb_.tol;
-        }
+      const double limit = limit_[t], er = tr_[t] - sr0, ec = tc_[t] - sc0;
+      unsigned any = 0;
+      for (int s = 0; s < kTargets; s += 2) {
+        const Pair x = load(hs + s) - limit, dr = er - load(local_r_ + s), dc = ec - load(local_c_ + s);
+        any |= greater(x, zero) & greater(x * x, kcs2 * (dr * dr + dc * dc));
+      }
+      if (any) apply_leaf(i, j, sources, t);
+    }
+  }
+
+  void apply_leaf(int i, int j, std::uint64_t sources, int t) {
+    const int r = r0_ + t / kBlock, c = c0_ + t % kBlock;
+    double& out = lower_[static_cast<std::int64_t>(r) * pb_.cols + c];
+    for (std::uint64_t sb = sources; sb; sb &= sb - 1) {
+      const int s = __builtin_ctzll(sb);
+      const int sr = i * kBlock + s / kBlock, sc = j * kBlock + s % kBlock;
+      const double hs = pb_.h[static_cast<std::int64_t>(sr) * pb_.cols + sc];
+      const double x = hs - limit_[t];
+      if (x <= 0) continue;
+      const long long dr = r - sr, dc = c - sc, d2 = dr * dr + dc * dc;
+      if (d2 <= kLocalRadius2 || x * x <= kcs2_ * static_cast<double>(d2)) continue;
+      const double v = cone_value(hs, pb_.kcs, d2);
+      if (v > out) {
+        out = v;
+        limit_[t] = v + pb_.tol;
       }
     }
   }
@@ -139,9 +218,14 @@ class BlockSearch {
   const SourceTree& tree_;
   double* lower_;
   double kcs2_;
-  int r0_ = 0, r1_ = 0, c0_ = 0, c1_ = 0;  // target block [cells]
-  double limit_[kBlock * kBlock] = {};     // current value + tol per target [m]
-  double min_limit_ = 0;                   // min of limit_ when the block started [m]
+  int r0_ = 0, r1_ = 0, c0_ = 0, c1_ = 0;    // target block [cells]
+  alignas(16) double local_r_[kTargets];     // row of bit t within a block or leaf [cells]
+  alignas(16) double local_c_[kTargets];     // column of bit t within a block or leaf [cells]
+  alignas(16) double tr_[kTargets] = {};     // row of each target [cells]
+  alignas(16) double tc_[kTargets] = {};     // column of each target [cells]
+  alignas(16) double limit_[kTargets] = {};  // current value + tol per target; +inf off the grid [m]
+  alignas(16) double d2_[kTargets] = {};     // floored squared distance of each target to the node [cells^2]
+  double min_limit_ = 0;                     // min of limit_ when the block started [m]
 };
 
 }  // namespace
