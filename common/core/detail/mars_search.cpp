@@ -86,9 +86,52 @@ class BlockSearch {
     return std::max(dr * dr + dc * dc, kFloor2);
   }
 
-  // Targets of the block at which some source of the node may exceed the limit: those where no
-  // bound is <= the limit (max h - kcs d, then each shape of the node; Shape documents them).
-  std::uint64_t live_targets(const SourceNode& nd) {
+  // OR of test(t) << t over the pairs of targets t, t + 1 in the rows of the block where `rows_of` has a bit.
+  template <class Test>
+  static std::uint64_t pairs_where(std::uint64_t rows_of, Test test) {
+    std::uint64_t out = 0;
+    for (int k = 0; k < kBlock; ++k) {
+      if (!(rows_of >> (k * kBlock) & 0xff)) continue;
+      for (int t = k * kBlock; t < (k + 1) * kBlock; t += 2) out |= std::uint64_t{test(t)} << t;
+    }
+    return out;
+  }
+
+  // True when one of the node's bounds is <= min_limit_ on the whole block (then it is so at every
+  // target, whose limit is >= min_limit_): the tests of live_targets() on the block's box, for a
+  // target distance of `d2` [cells^2] (block_distance2()).
+  bool block_pruned(const SourceNode& nd, long long d2) const {
+    const double fr[2] = {static_cast<double>(r0_), static_cast<double>(r1_)};
+    const double fc[2] = {static_cast<double>(c0_), static_cast<double>(c1_)};
+    for (const Shape& s : nd.shapes) {
+      const double z = s.m - min_limit_;
+      switch (s.kind) {
+        case Shape::Kind::kNone: return false;
+        case Shape::Kind::kPlane: {
+          const double y = s.m + std::max(s.ar * (fr[0] - s.r), s.ar * (fr[1] - s.r)) +
+                           std::max(s.ac * (fc[0] - s.c), s.ac * (fc[1] - s.c)) - min_limit_;
+          if (y <= 0 || y * y <= s.deficit2 * static_cast<double>(d2)) return true;
+          break;
+        }
+        case Shape::Kind::kCone: {
+          const double er = std::max({0.0, fr[0] - s.r, s.r - fr[1]}), ec = std::max({0.0, fc[0] - s.c, s.c - fc[1]});
+          if (z <= 0 || z * z <= kcs2_ * (er * er + ec * ec)) return true;
+          break;
+        }
+        case Shape::Kind::kBowl: {
+          const double er = std::max(std::abs(fr[0] - s.r), std::abs(fr[1] - s.r));
+          const double ec = std::max(std::abs(fc[0] - s.c), std::abs(fc[1] - s.c));
+          if (z <= 0 && z * z >= kcs2_ * (er * er + ec * ec)) return true;
+          break;
+        }
+      }
+    }
+    return false;
+  }
+
+  // Of `targets`, those at which some source of the node may exceed the limit: where no bound is
+  // <= the limit (max h - kcs d, then each shape of the node; Shape documents them).
+  std::uint64_t live_targets(const SourceNode& nd, std::uint64_t targets) {
     double dr2[kBlock], dc2[kBlock];
     for (int k = 0; k < kBlock; ++k) {
       const long long r = r0_ + k, c = c0_ + k;
@@ -99,42 +142,39 @@ class BlockSearch {
     const double floor2 = static_cast<double>(kFloor2);
     for (int t = 0; t < kTargets; ++t) d2_[t] = std::max(dr2[t / kBlock] + dc2[t % kBlock], floor2);
     const Pair zero = {0.0, 0.0};
-    const double kcs2 = kcs2_;
-    std::uint64_t live = 0;
-    for (int t = 0; t < kTargets; t += 2) {
-      const Pair x = nd.max_h - load(limit_ + t);
-      live |= std::uint64_t{greater(x, zero) & greater(x * x, kcs2 * load(d2_ + t))} << t;
-    }
+    const double kcs2 = kcs2_, max_h = nd.max_h;
+    std::uint64_t live = targets & pairs_where(targets, [&](int t) {
+                           const Pair x = max_h - load(limit_ + t);
+                           return greater(x, zero) & greater(x * x, kcs2 * load(d2_ + t));
+                         });
     for (const Shape& s : nd.shapes) {
       if (!live) break;
       const double m = s.m, sr = s.r, sc = s.c;
-      std::uint64_t keep = 0;
       switch (s.kind) {
         case Shape::Kind::kNone: return live;
         case Shape::Kind::kPlane: {
           const double ar = s.ar, ac = s.ac, deficit2 = s.deficit2;
-          for (int t = 0; t < kTargets; t += 2) {
+          live &= pairs_where(live, [&](int t) {
             const Pair y = m + ar * (load(tr_ + t) - sr) + ac * (load(tc_ + t) - sc) - load(limit_ + t);
-            keep |= std::uint64_t{greater(y, zero) & greater(y * y, deficit2 * load(d2_ + t))} << t;
-          }
+            return greater(y, zero) & greater(y * y, deficit2 * load(d2_ + t));
+          });
           break;
         }
         case Shape::Kind::kCone: {
-          for (int t = 0; t < kTargets; t += 2) {
+          live &= pairs_where(live, [&](int t) {
             const Pair z = m - load(limit_ + t), er = load(tr_ + t) - sr, ec = load(tc_ + t) - sc;
-            keep |= std::uint64_t{greater(z, zero) & greater(z * z, kcs2 * (er * er + ec * ec))} << t;
-          }
+            return greater(z, zero) & greater(z * z, kcs2 * (er * er + ec * ec));
+          });
           break;
         }
         case Shape::Kind::kBowl: {
-          for (int t = 0; t < kTargets; t += 2) {
+          live &= pairs_where(live, [&](int t) {
             const Pair z = m - load(limit_ + t), er = load(tr_ + t) - sr, ec = load(tc_ + t) - sc;
-            keep |= std::uint64_t{greater(z, zero) | greater(kcs2 * (er * er + ec * ec), z * z)} << t;
-          }
+            return greater(z, zero) | greater(kcs2 * (er * er + ec * ec), z * z);
+          });
           break;
         }
       }
-      live &= keep;
     }
     return live;
   }
@@ -143,8 +183,9 @@ class BlockSearch {
     const SourceNode& nd = tree_.node(level, i, j);
     if (nd.empty()) return;
     const double x = nd.max_h - min_limit_;
-    if (x <= 0 || x * x <= kcs2_ * static_cast<double>(block_distance2(nd))) return;
-    const std::uint64_t keep = targets & live_targets(nd);
+    const long long d2 = block_distance2(nd);
+    if (x <= 0 || x * x <= kcs2_ * static_cast<double>(d2) || block_pruned(nd, d2)) return;
+    const std::uint64_t keep = live_targets(nd, targets);
     if (!keep) return;
     if (level == 0) {
       evaluate_leaf(i, j, keep);
