@@ -17,7 +17,8 @@ class ForeignSourcePropagation {
       : pb_(pb),
         value_(value),
         src_(src),
-        inv_cols_(1.0 / pb.cols),
+        row_of_(pb.cols),
+        cone_(pb.kcs),
         drop_side_(pb.kcs * std::sqrt(1.0)),
         drop_diagonal_(pb.kcs * std::sqrt(2.0)) {}
 
@@ -64,9 +65,9 @@ class ForeignSourcePropagation {
     }
     const std::int32_t s = src_[n];
     if (s < 0 || s == i || s == src_[i]) return;
-    const int sr = row_of(s, inv_cols_);
+    const int sr = row_of_(s);
     const long long er = r - sr, ec = c - (s - static_cast<std::int64_t>(sr) * pb_.cols);
-    const double v = cone_value(pb_.h[s], pb_.kcs, er * er + ec * ec);
+    const double v = cone_(pb_.h[s], er * er + ec * ec);
     if (v > value_[i]) {
       value_[i] = v;
       src_[i] = s;
@@ -76,7 +77,8 @@ class ForeignSourcePropagation {
   const Problem& pb_;
   double* value_;
   std::int32_t* src_;
-  double inv_cols_;
+  RowOf row_of_;
+  ConeValues cone_;
   double drop_side_, drop_diagonal_;
 };
 
@@ -85,7 +87,8 @@ class ForeignSourcePropagation {
 // along a chain; a cell failing the direct check survives. Pointers always climb in height
 // (tol < kcs), so chains end.
 void resolve_chains(const Problem& pb, std::int32_t* src) {
-  const double inv_cols = 1.0 / pb.cols;
+  const RowOf row_of(pb.cols);
+  const ConeValues cone(pb.kcs);
   const std::int64_t n = static_cast<std::int64_t>(pb.rows) * pb.cols;
   auto resolved = [&](std::int64_t i) { return src[i] == i || src[src[i]] == src[i]; };
   std::vector<std::int32_t> chain;
@@ -96,11 +99,11 @@ void resolve_chains(const Problem& pb, std::int32_t* src) {
     for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
       const std::int32_t q = *it;
       const std::int32_t root = src[src[q]];  // src[q] is resolved: a survivor or points at one
-      const int qr = row_of(q, inv_cols), rr = row_of(root, inv_cols);
+      const int qr = row_of(q), rr = row_of(root);
       const long long dr = qr - rr;
       const long long dc =
           (q - static_cast<std::int64_t>(qr) * pb.cols) - (root - static_cast<std::int64_t>(rr) * pb.cols);
-      src[q] = cone_value(pb.h[root], pb.kcs, dr * dr + dc * dc) >= pb.h[q] - pb.tol ? root : q;
+      src[q] = cone(pb.h[root], dr * dr + dc * dc) >= pb.h[q] - pb.tol ? root : q;
     }
   }
 }
