@@ -27,6 +27,17 @@ inline Pair load(const double* p) {
   return v;
 }
 
+inline void store(double* p, Pair v) { std::memcpy(p, &v, sizeof v); }
+
+// Element-wise max (no NaNs here).
+inline Pair max(Pair a, Pair b) {
+#if defined(__SSE2__)
+  return reinterpret_cast<Pair>(_mm_max_pd(reinterpret_cast<__m128d>(a), reinterpret_cast<__m128d>(b)));
+#else
+  return Pair{std::max(a[0], b[0]), std::max(a[1], b[1])};
+#endif
+}
+
 // Bit k set when a[k] > b[k], k = 0, 1.
 inline unsigned greater(Pair a, Pair b) {
 #if defined(__SSE2__)
@@ -132,15 +143,18 @@ class BlockSearch {
   // Of `targets`, those at which some source of the node may exceed the limit: where no bound is
   // <= the limit (max h - kcs d, then each shape of the node; Shape documents them).
   std::uint64_t live_targets(const SourceNode& nd, std::uint64_t targets) {
-    double dr2[kBlock], dc2[kBlock];
+    alignas(16) double dr2[kBlock], dc2[kBlock];
     for (int k = 0; k < kBlock; ++k) {
       const long long r = r0_ + k, c = c0_ + k;
       const long long dr = std::max({0LL, nd.r0 - r, r - nd.r1}), dc = std::max({0LL, nd.c0 - c, c - nd.c1});
       dr2[k] = static_cast<double>(dr * dr);
       dc2[k] = static_cast<double>(dc * dc);
     }
-    const double floor2 = static_cast<double>(kFloor2);
-    for (int t = 0; t < kTargets; ++t) d2_[t] = std::max(dr2[t / kBlock] + dc2[t % kBlock], floor2);
+    const Pair floor2 = {static_cast<double>(kFloor2), static_cast<double>(kFloor2)};
+    for (int k = 0; k < kBlock; ++k) {
+      if (!(targets >> (k * kBlock) & 0xff)) continue;
+      for (int p = 0; p < kBlock; p += 2) store(d2_ + k * kBlock + p, max(dr2[k] + load(dc2 + p), floor2));
+    }
     const Pair zero = {0.0, 0.0};
     const double kcs2 = kcs2_, max_h = nd.max_h;
     std::uint64_t live = targets & pairs_where(targets, [&](int t) {
@@ -211,26 +225,46 @@ class BlockSearch {
     for (int k = 0; k < n; ++k) visit(below, kids[k].i, kids[k].j, keep);
   }
 
-  // Applies the leaf's sources to the targets. A first branch-free pass over all 64 cells of the
-  // leaf (non-sources at -inf) asks whether any source beats the target's limit; only then are the
-  // sources applied one by one in bit order, each against the limit as it rises.
+  // Applies the leaf's sources to the targets. For each target, each 4 x 4 quarter of the leaf is
+  // first bounded by its highest source at its box's floored distance; the sources of the quarters
+  // left are then checked two at a time without branches (non-sources at -inf) for one that beats
+  // the target's limit, and only then are the leaf's sources applied one by one in bit order, each
+  // against the limit as it rises.
   void evaluate_leaf(int i, int j, std::uint64_t targets) {
+    constexpr int kHalf = kBlock / 2;
     const std::uint64_t sources = tree_.leaf_mask(i, j);
     const int sr0 = i * kBlock, sc0 = j * kBlock;
     alignas(16) double hs[kTargets];
+    double top[4] = {-kInf, -kInf, -kInf, -kInf};  // highest source of each quarter [m]
     for (int s = 0; s < kTargets; ++s) {
       const int sr = sr0 + s / kBlock, sc = sc0 + s % kBlock;
       hs[s] = sources >> s & 1 ? pb_.h[static_cast<std::int64_t>(sr) * pb_.cols + sc] : -kInf;
+      double& q = top[(s / kBlock >= kHalf ? 2 : 0) + (s % kBlock >= kHalf ? 1 : 0)];
+      q = std::max(q, hs[s]);
     }
     const Pair zero = {0.0, 0.0};
-    const double kcs2 = kcs2_;
+    const double kcs2 = kcs2_, floor2 = static_cast<double>(kFloor2);
     for (std::uint64_t tb = targets; tb; tb &= tb - 1) {
       const int t = __builtin_ctzll(tb);
       const double limit = limit_[t], er = tr_[t] - sr0, ec = tc_[t] - sc0;
+      // Distances to the quarters' boxes: rows 0..3 and 4..7, columns 0..3 and 4..7 of the leaf.
+      const double dr_top = std::max(0.0, er - (kHalf - 1)), dr_bottom = std::max(0.0, kHalf - er);
+      const double dc_left = std::max(0.0, ec - (kHalf - 1)), dc_right = std::max(0.0, kHalf - ec);
+      const double dq2[4] = {dr_top * dr_top + dc_left * dc_left, dr_top * dr_top + dc_right * dc_right,
+                             dr_bottom * dr_bottom + dc_left * dc_left, dr_bottom * dr_bottom + dc_right * dc_right};
+      unsigned quarters = 0;
+      for (int q = 0; q < 4; ++q) {
+        const double x = top[q] - limit;
+        quarters |= static_cast<unsigned>((x > 0) & (x * x > kcs2 * std::max(dq2[q], floor2))) << q;
+      }
       unsigned any = 0;
-      for (int s = 0; s < kTargets; s += 2) {
-        const Pair x = load(hs + s) - limit, dr = er - load(local_r_ + s), dc = ec - load(local_c_ + s);
-        any |= greater(x, zero) & greater(x * x, kcs2 * (dr * dr + dc * dc));
+      for (; quarters && !any; quarters &= quarters - 1) {
+        const int q = __builtin_ctz(quarters), qr = q / 2 * kHalf, qc = q % 2 * kHalf;
+        for (int k = qr; k < qr + kHalf; ++k)
+          for (int s = k * kBlock + qc; s < k * kBlock + qc + kHalf; s += 2) {
+            const Pair y = load(hs + s) - limit, sdr = er - load(local_r_ + s), sdc = ec - load(local_c_ + s);
+            any |= greater(y, zero) & greater(y * y, kcs2 * (sdr * sdr + sdc * sdc));
+          }
       }
       if (any) apply_leaf(i, j, sources, t);
     }
