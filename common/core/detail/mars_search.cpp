@@ -38,6 +38,44 @@ inline Pair max(Pair a, Pair b) {
 #endif
 }
 
+// All bits of lane k set when a[k] > b[k], else none (lanes as doubles: only either() and any_set() read them).
+inline Pair greater_mask(Pair a, Pair b) {
+#if defined(__SSE2__)
+  return reinterpret_cast<Pair>(_mm_cmpgt_pd(reinterpret_cast<__m128d>(a), reinterpret_cast<__m128d>(b)));
+#else
+  std::uint64_t m[2] = {a[0] > b[0] ? ~std::uint64_t{0} : 0, a[1] > b[1] ? ~std::uint64_t{0} : 0};
+  Pair v;
+  std::memcpy(&v, m, sizeof v);
+  return v;
+#endif
+}
+
+// Lane-wise OR of two greater_mask() results.
+inline Pair either(Pair a, Pair b) {
+#if defined(__SSE2__)
+  return reinterpret_cast<Pair>(_mm_or_pd(reinterpret_cast<__m128d>(a), reinterpret_cast<__m128d>(b)));
+#else
+  std::uint64_t x[2], y[2];
+  std::memcpy(x, &a, sizeof x);
+  std::memcpy(y, &b, sizeof y);
+  x[0] |= y[0];
+  x[1] |= y[1];
+  std::memcpy(&a, x, sizeof x);
+  return a;
+#endif
+}
+
+// True when some lane of a greater_mask() result is set.
+inline bool any_set(Pair m) {
+#if defined(__SSE2__)
+  return _mm_movemask_pd(reinterpret_cast<__m128d>(m)) != 0;
+#else
+  std::uint64_t x[2];
+  std::memcpy(x, &m, sizeof x);
+  return (x[0] | x[1]) != 0;
+#endif
+}
+
 // Bit k set when a[k] > b[k], k = 0, 1.
 inline unsigned greater(Pair a, Pair b) {
 #if defined(__SSE2__)
@@ -248,8 +286,10 @@ class BlockSearch {
       const int t = __builtin_ctzll(tb);
       const double limit = limit_[t], er = tr_[t] - sr0, ec = tc_[t] - sc0;
       // Distances to the quarters' boxes: rows 0..3 and 4..7, columns 0..3 and 4..7 of the leaf.
-      const double dr_top = std::max(0.0, er - (kHalf - 1)), dr_bottom = std::max(0.0, kHalf - er);
-      const double dc_left = std::max(0.0, ec - (kHalf - 1)), dc_right = std::max(0.0, kHalf - ec);
+      const double dr_top = std::max({0.0, -er, er - (kHalf - 1)});
+      const double dr_bottom = std::max({0.0, kHalf - er, er - (kBlock - 1)});
+      const double dc_left = std::max({0.0, -ec, ec - (kHalf - 1)});
+      const double dc_right = std::max({0.0, kHalf - ec, ec - (kBlock - 1)});
       const double dq2[4] = {dr_top * dr_top + dc_left * dc_left, dr_top * dr_top + dc_right * dc_right,
                              dr_bottom * dr_bottom + dc_left * dc_left, dr_bottom * dr_bottom + dc_right * dc_right};
       unsigned quarters = 0;
@@ -257,14 +297,21 @@ class BlockSearch {
         const double x = top[q] - limit;
         quarters |= static_cast<unsigned>((x > 0) & (x * x > kcs2 * std::max(dq2[q], floor2))) << q;
       }
-      unsigned any = 0;
+      bool any = false;
       for (; quarters && !any; quarters &= quarters - 1) {
         const int q = __builtin_ctz(quarters), qr = q / 2 * kHalf, qc = q % 2 * kHalf;
-        for (int k = qr; k < qr + kHalf; ++k)
-          for (int s = k * kBlock + qc; s < k * kBlock + qc + kHalf; s += 2) {
-            const Pair y = load(hs + s) - limit, sdr = er - load(local_r_ + s), sdc = ec - load(local_c_ + s);
-            any |= greater(y, zero) & greater(y * y, kcs2 * (sdr * sdr + sdc * sdc));
-          }
+        // max(h - limit, 0)^2 > kcs^2 d2 exactly when h - limit > 0 and (h - limit)^2 > kcs^2 d2, apply_leaf()'s test.
+        const Pair dc_a = ec - load(local_c_ + qc), dc_b = ec - load(local_c_ + qc + 2);
+        const Pair dc2_a = dc_a * dc_a, dc2_b = dc_b * dc_b;
+        Pair beats = zero;
+        for (int k = qr; k < qr + kHalf; ++k) {
+          const double dr = er - k, dr2 = dr * dr;
+          const Pair y_a = max(load(hs + k * kBlock + qc) - limit, zero);
+          const Pair y_b = max(load(hs + k * kBlock + qc + 2) - limit, zero);
+          beats = either(beats, either(greater_mask(y_a * y_a, kcs2 * (dr2 + dc2_a)),
+                                       greater_mask(y_b * y_b, kcs2 * (dr2 + dc2_b))));
+        }
+        any = any_set(beats);
       }
       if (any) apply_leaf(i, j, sources, t);
     }
