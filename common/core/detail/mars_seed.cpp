@@ -1,5 +1,7 @@
 #include "marsala/core/detail/mars_seed.hpp"
 
+#include "marsala/core/detail/mars_pair.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -144,14 +146,15 @@ void apply_local_sources(const Problem& pb, double* lower) {
       const long long d2 = static_cast<long long>(dr) * dr + static_cast<long long>(dc) * dc;
       if (d2 > 0 && d2 <= kLocalRadius2) offsets.push_back({dr, dc, pb.kcs * std::sqrt(static_cast<double>(d2))});
     }
-  const int cols = pb.cols;
-  for (int r = 0; r < pb.rows; ++r) {
+  const int cols = pb.cols, rows = pb.rows;
+  // Every offset over columns [c_from, c_to) of row r, one offset at a time.
+  auto offset_by_offset = [&](int r, int c_from, int c_to) {
     double* out = lower + static_cast<std::int64_t>(r) * cols;
     for (const Offset& o : offsets) {
       const int sr = r + o.dr;
-      if (sr < 0 || sr >= pb.rows) continue;
+      if (sr < 0 || sr >= rows) continue;
       const double* in = pb.h + static_cast<std::int64_t>(sr) * cols;
-      const int c_begin = std::max(0, -o.dc), c_end = std::min(cols, cols - o.dc);
+      const int c_begin = std::max(c_from, -o.dc), c_end = std::min(c_to, cols - o.dc);
       const double drop = o.drop;
       const int dc = o.dc;
       // Same bits as cone_value(); written as a plain max so that it vectorises.
@@ -160,6 +163,34 @@ void apply_local_sources(const Problem& pb, double* lower) {
         out[c] = out[c] < v ? v : out[c];
       }
     }
+  };
+  // Away from the edges every offset is inside the grid: 8 cells at a time stay in registers across all offsets
+  // (one load and store of the output per 8 cells instead of one per offset). max(v, out) is out < v ? v : out.
+  constexpr int kChunk = 8;
+  const int interior = std::max(0, cols - 2 * radius) / kChunk * kChunk;
+  for (int r = 0; r < rows; ++r) {
+    if (r < radius || r >= rows - radius || interior == 0) {
+      offset_by_offset(r, 0, cols);
+      continue;
+    }
+    double* out = lower + static_cast<std::int64_t>(r) * cols;
+    for (int c = radius; c < radius + interior; c += kChunk) {
+      Pair a0 = load(out + c), a1 = load(out + c + 2), a2 = load(out + c + 4), a3 = load(out + c + 6);
+      for (const Offset& o : offsets) {
+        const double* in = pb.h + static_cast<std::int64_t>(r + o.dr) * cols + c + o.dc;
+        const double drop = o.drop;
+        a0 = max(load(in) - drop, a0);
+        a1 = max(load(in + 2) - drop, a1);
+        a2 = max(load(in + 4) - drop, a2);
+        a3 = max(load(in + 6) - drop, a3);
+      }
+      store(out + c, a0);
+      store(out + c + 2, a1);
+      store(out + c + 4, a2);
+      store(out + c + 6, a3);
+    }
+    offset_by_offset(r, 0, radius);
+    offset_by_offset(r, radius + interior, cols);
   }
 }
 
