@@ -43,6 +43,7 @@ class BlockSearch {
     c1_ = std::min(pb_.cols, c0_ + kBlock) - 1;
     std::uint64_t targets = 0;
     min_limit_ = kInf;
+    max_limit_ = -kInf;
     for (int t = 0; t < kTargets; ++t) {
       tr_[t] = r0_ + local_r_[t];
       tc_[t] = c0_ + local_c_[t];
@@ -54,6 +55,7 @@ class BlockSearch {
         targets |= std::uint64_t{1} << t;
         limit_[t] = lower_[static_cast<std::int64_t>(r) * pb_.cols + c] + pb_.tol;
         min_limit_ = std::min(min_limit_, limit_[t]);
+        max_limit_ = std::max(max_limit_, limit_[t]);
       }
     visit(tree_.top_level(), 0, 0, targets);
   }
@@ -120,10 +122,16 @@ class BlockSearch {
       for (int p = 0; p < kBlock; p += 2) store(d2_ + k * kBlock + p, max(dr2[k] + load(dc2 + p), floor2));
     const Pair zero = {0.0, 0.0};
     const double kcs2 = kcs2_, max_h = nd.max_h;
-    std::uint64_t live = targets & pairs_where([&](int t) {
-                           const Pair x = max(max_h - load(limit_ + t), zero);
-                           return greater(x * x, kcs2 * load(d2_ + t));
-                         });
+    // When the height bound clears the block's largest limit at its farthest target it clears every target's.
+    const double far2 = std::max(*std::max_element(dr2, dr2 + kBlock) + *std::max_element(dc2, dc2 + kBlock),
+                                 static_cast<double>(kFloor2));
+    const double x_all = max_h - max_limit_;
+    std::uint64_t live = targets;
+    if (!(x_all > 0 && x_all * x_all > kcs2 * far2))
+      live &= pairs_where([&](int t) {
+        const Pair x = max(max_h - load(limit_ + t), zero);
+        return greater(x * x, kcs2 * load(d2_ + t));
+      });
     for (const Shape& s : nd.shapes) {
       if (!live) break;
       const double m = s.m, sr = s.r, sc = s.c;
@@ -257,6 +265,7 @@ class BlockSearch {
       if (v > out) {
         out = v;
         limit_[t] = v + pb_.tol;
+        max_limit_ = std::max(max_limit_, limit_[t]);
       }
     }
   }
@@ -273,6 +282,7 @@ class BlockSearch {
   alignas(16) double limit_[kTargets] = {};  // current value + tol per target; +inf off the grid [m]
   alignas(16) double d2_[kTargets] = {};     // floored squared distance of each target to the node [cells^2]
   double min_limit_ = 0;                     // min of limit_ when the block started [m]
+  double max_limit_ = 0;                     // max of limit_ over the block's targets on the grid [m]
 };
 
 }  // namespace
