@@ -336,9 +336,17 @@ struct SourceTree::Builder {
       for (int k = 0; k < n; ++k) s.m = std::max(s.m, residual(s, pb.kcs, pts[k].r, pts[k].c, pts[k].h));
       cands[count++] = {s, s.m - own_min};
     };
-    add(mom.plane(pb.kcs), all, n, false);
+    double raw_slope = 0;
+    add(mom.plane(pb.kcs, &raw_slope), all, n, false);
+    double lowest = kInf;
+    for (int k = 0; k < n; ++k) lowest = std::min(lowest, pts[k].h);
+    // A slope-kappa cone or bowl rises by at least 4.25 cells' drop across a whole leaf (from its apex to the farthest
+    // corner when the apex is inside, the leaf's width of 7 cells or more when it is outside), and away from its apex
+    // the leaf's least-squares slope is near kappa: a leaf that is flatter and lower than that (most of a rough
+    // terrain's) gets no fit. The fit only tightens bounds; a partial leaf that loses it stays exact.
+    const bool may_be_apex = raw_slope >= 0.5 * pb.kcs || node.max_h - lowest >= 4.0 * pb.kcs;
     // A cone or bowl only where the plane is not already exact and the points may lie on one.
-    if (cands[0].quality > gate) add(fit_apex(pts, all, n, pb.kcs, kFitSpread * pb.kcs), all, n, false);
+    if (cands[0].quality > gate && may_be_apex) add(fit_apex(pts, all, n, pb.kcs, kFitSpread * pb.kcs), all, n, false);
     int top = 0;
     for (int k = 1; k < n; ++k)
       if (pts[k].h > pts[top].h) top = k;
