@@ -24,11 +24,15 @@
 //     cones and bowls of slope exactly kappa (any angle, any apex) and on ridges where two meet,
 //     so such inputs prune near the root although every cell is a near-tied source.
 //
-// Speed (0.1 m cells, kappa 0.3, one core, bench/mars_bench.cpp): about 0.12 s for 1024 x 1024
-// generated terrain, 0.8 s for 2048 x 2048, 0.1-0.2 s for the slope-kappa inputs above at 1024 x 1024.
-// Known slow case: surfaces steeper than kappa by less than ~0.1%, e.g. a plane of slope
-// 1.001 kappa (0.75 s at 1024 x 1024) or a cone of slope 1.0001 kappa with its apex between cell
-// centres (~4 s): near-ties that no node bound separates. Results stay exact.
+// The bounds of a node are tested on all 64 targets of a block at once, two at a time without branches; a leaf's
+// sources are applied, in bit order, only to targets where a branch-free check finds one above the limit.
+//
+// Speed (0.1 m cells, kappa 0.3, one core's CPU time, bench/mars_bench.cpp, README "Performance"): about 0.19 s
+// (generated mix) and 0.27 s (fractal) at 1024 x 1024, 0.9 and 1.3 s at 2048 x 2048, 0.08-0.2 s for the
+// slope-kappa inputs above at 1024 x 1024. Known slow case: surfaces steeper than kappa by less than ~0.1%, e.g. a
+// plane of slope 1.001 kappa (0.61 s at 1024 x 1024) or a cone of slope 1.0001 kappa with its apex between cell
+// centres (~4 s before the block-wide tests, not measured since): near-ties that no node bound separates. Results
+// stay exact.
 #include <string>
 
 #include "marsala/core/heightmap.hpp"

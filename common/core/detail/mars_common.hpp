@@ -3,6 +3,7 @@
 // heights are metres; kcs = kappa * cell size is the drop per cell of distance [m/cell].
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace marsala::detail {
@@ -29,7 +30,41 @@ inline double cone_value(double h_source, double kcs, long long d2) {
   return h_source - kcs * std::sqrt(static_cast<double>(d2));
 }
 
-/// Row of linear index i in a grid with 1 / cols = inv_cols; exact for any grid below 2^31 cells.
-inline int row_of(long long i, double inv_cols) { return static_cast<int>((static_cast<double>(i) + 0.5) * inv_cols); }
+/// cone_value() with the drops kcs sqrt(d2) of the nearer distances read from a table: the same bits, without the
+/// square root's latency in the raster sweeps, where most sources are a few cells away.
+class ConeValues {
+ public:
+  explicit ConeValues(double kcs) : kcs_(kcs) {
+    for (int d2 = 0; d2 < kSize; ++d2) drop_[d2] = kcs * std::sqrt(static_cast<double>(d2));
+  }
+  /// cone_value(h_source, kcs, d2) [m].
+  double operator()(double h_source, long long d2) const {
+    return d2 < kSize ? h_source - drop_[d2] : cone_value(h_source, kcs_, d2);
+  }
+
+ private:
+  static constexpr int kSize = 1024;
+  double kcs_;
+  double drop_[kSize];
+};
+
+/// Row of a linear index in a grid of `cols` columns by one multiplication: q = (i m) >> k with k = 32 +
+/// ceil(log2 cols) and m = ceil(2^k / cols) < 2^33 is floor(i / cols) exactly for every i < 2^31 (m cols = 2^k + e
+/// with e < cols, and i e < 2^k keeps the rounding below one row); i m < 2^64.
+class RowOf {
+ public:
+  explicit RowOf(int cols) {
+    int log2 = 0;
+    while ((1LL << log2) < cols) ++log2;
+    shift_ = 32 + log2;
+    magic_ = ((std::uint64_t{1} << shift_) + static_cast<std::uint64_t>(cols) - 1) / static_cast<std::uint64_t>(cols);
+  }
+  /// floor(i / cols) for 0 <= i < 2^31.
+  int operator()(long long i) const { return static_cast<int>((static_cast<std::uint64_t>(i) * magic_) >> shift_); }
+
+ private:
+  std::uint64_t magic_ = 1;
+  int shift_ = 32;
+};
 
 }  // namespace marsala::detail

@@ -11,6 +11,10 @@ namespace {
 // candidate surface exactly over their sources when merging the children's bounds is loose.
 constexpr int kExactLevels = 3;
 
+// A cone or bowl fit goes on to its Gauss-Newton steps only when its algebraic start leaves the points within this
+// many cells' drop (kcs) of one slope-kappa surface [cells].
+constexpr double kFitSpread = 0.25;
+
 // Euclidean length of (a, b): only bounds and fits use it (every bound is taken as a max over the sources or pruned
 // against tol, so an ulp here never changes an output), and it costs a fraction of std::hypot's careful rounding.
 inline double length(double a, double b) { return std::sqrt(a * a + b * b); }
@@ -120,9 +124,11 @@ inline double residual(const Shape& s, double kcs, double r, double c, double h)
 
 // Fits a cone or bowl of slope kcs to the points: algebraic fit of (H - h)^2 = kcs^2 |q - c|^2
 // (linear in H, c and kcs^2 |c|^2 - H^2, exact on exact data), then Gauss-Newton steps on
-// h + sign kcs |q - c| = H. Returns kNone when degenerate. Any result is a valid shape once its
-// m is taken over the sources; the fit only decides how tight it is.
-Shape fit_apex(const Point* pts, const int* idx, int n, double kcs) {
+// h + sign kcs |q - c| = H. Returns kNone when degenerate, or when the algebraic fit leaves the
+// points further than max_spread [m] from one surface (rough ground: no cone or bowl of slope
+// kappa is near it, and the Gauss-Newton steps would cost more than the bound saves). Any result
+// is a valid shape once its m is taken over the sources; the fit only decides how tight it is.
+Shape fit_apex(const Point* pts, const int* idx, int n, double kcs, double max_spread) {
   Shape s;
   if (n < 5) return s;
   double r0 = 0, c0 = 0, h0 = 0;
@@ -148,6 +154,14 @@ Shape fit_apex(const Point* pts, const int* idx, int n, double kcs) {
   double top = theta(0), cr = theta(1), cc = theta(2);
   if (!theta.allFinite()) return s;
   const double sign = top >= 0 ? 1.0 : -1.0;  // centred heights: a cone's apex lies above them
+  double lowest = kInf, highest = -kInf;
+  for (int k = 0; k < n; ++k) {
+    const double er = cr - (pts[idx[k]].r - r0), ec = cc - (pts[idx[k]].c - c0);
+    const double v = pts[idx[k]].h - h0 + sign * kcs * std::sqrt(er * er + ec * ec);
+    lowest = std::min(lowest, v);
+    highest = std::max(highest, v);
+  }
+  if (!(highest - lowest <= max_spread)) return s;
   for (int iter = 0; iter < 3; ++iter) {
     Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
     Eigen::Vector3d jte = Eigen::Vector3d::Zero();
@@ -266,9 +280,8 @@ double bound_over_child(const Shape& x, const SourceNode& kid, double kcs) {
       } else if (x_sign < 0) {
         b = y.m - apart;  // bowl over a cone: -|q - c_x| - |q - c_y| <= -|c_x - c_y|
       } else {
-        b = corner_max([&](double r, double c) {
-          return y.m + kcs * (length(r - y.r, c - y.c) + length(r - x.r, c - x.c));
-        });
+        b = corner_max(
+            [&](double r, double c) { return y.m + kcs * (length(r - y.r, c - y.c) + length(r - x.r, c - x.c)); });
       }
     }
     best = std::min(best, b);
@@ -323,8 +336,17 @@ struct SourceTree::Builder {
       for (int k = 0; k < n; ++k) s.m = std::max(s.m, residual(s, pb.kcs, pts[k].r, pts[k].c, pts[k].h));
       cands[count++] = {s, s.m - own_min};
     };
-    add(mom.plane(pb.kcs), all, n, false);
-    add(fit_apex(pts, all, n, pb.kcs), all, n, false);
+    double raw_slope = 0;
+    add(mom.plane(pb.kcs, &raw_slope), all, n, false);
+    double lowest = kInf;
+    for (int k = 0; k < n; ++k) lowest = std::min(lowest, pts[k].h);
+    // A slope-kappa cone or bowl rises by at least 4.25 cells' drop across a whole leaf (from its apex to the farthest
+    // corner when the apex is inside, the leaf's width of 7 cells or more when it is outside), and away from its apex
+    // the leaf's least-squares slope is near kappa: a leaf that is flatter and lower than that (most of a rough
+    // terrain's) gets no fit. The fit only tightens bounds; a partial leaf that loses it stays exact.
+    const bool may_be_apex = raw_slope >= 0.5 * pb.kcs || node.max_h - lowest >= 4.0 * pb.kcs;
+    // A cone or bowl only where the plane is not already exact and the points may lie on one.
+    if (cands[0].quality > gate && may_be_apex) add(fit_apex(pts, all, n, pb.kcs, kFitSpread * pb.kcs), all, n, false);
     int top = 0;
     for (int k = 1; k < n; ++k)
       if (pts[k].h > pts[top].h) top = k;
@@ -344,7 +366,8 @@ struct SourceTree::Builder {
         add(Moments::of(pts, quadrant[qi], quadrant_n[qi]).plane(pb.kcs, &raw_slope), quadrant[qi], quadrant_n[qi],
             true);
         if (raw_slope >= 0.5 * pb.kcs && raw_slope <= 1.5 * pb.kcs)
-          add(fit_apex(pts, quadrant[qi], quadrant_n[qi], pb.kcs), quadrant[qi], quadrant_n[qi], true);
+          add(fit_apex(pts, quadrant[qi], quadrant_n[qi], pb.kcs, kFitSpread * pb.kcs), quadrant[qi], quadrant_n[qi],
+              true);
       }
     }
     select_shapes(cands, count, gate, pb.kcs, -1, node, q);
