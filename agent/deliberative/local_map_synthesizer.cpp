@@ -156,21 +156,23 @@ void LocalMapSynthesizer::open_stood_cells(LocalMap& local, const KnownMap& map)
   const StoodCells& stood = *map.stood;
   const std::vector<CellIndex> ball = disc_offsets(stood.radius_cells);
   const long long cols = map.heights.cols();
-  for (const auto& [index, then] : stood.balls) {
-    const CellIndex global{static_cast<int>(index / cols), static_cast<int>(index % cols)};
-    const CellIndex p = local.to_local(global);
-    if (!local.contains(p) || local.occupiable(p.row, p.col) != 0 || local.blind(p.row, p.col) != 0 ||
-        then.size() != ball.size())
-      continue;
-    bool same = true;
-    for (std::size_t i = 0; i < ball.size() && same; ++i) {
-      const CellIndex b{global.row + ball[i].row, global.col + ball[i].col};
-      if (!map.heights.contains(b)) continue;
-      same = std::isfinite(then[i]) && map.known(b.row, b.col) != 0 &&
-             std::abs(map.heights(b) - then[i]) <= stood.margin_m;
+  // The window's cells, not every cell ever stood on: the work is bounded by the window, not by the run's length.
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      if (local.occupiable(r, c) != 0 || local.blind(r, c) != 0) continue;
+      const CellIndex global = local.to_global({r, c});
+      const auto found = stood.balls.find(global.row * cols + global.col);
+      if (found == stood.balls.end() || found->second.size() != ball.size()) continue;
+      const std::vector<double>& then = found->second;
+      bool same = true;
+      for (std::size_t i = 0; i < ball.size() && same; ++i) {
+        const CellIndex b{global.row + ball[i].row, global.col + ball[i].col};
+        if (!map.heights.contains(b)) continue;
+        same = std::isfinite(then[i]) && map.known(b.row, b.col) != 0 &&
+               std::abs(map.heights(b) - then[i]) <= stood.margin_m;
+      }
+      if (same) local.occupiable(r, c) = 1;
     }
-    if (same) local.occupiable(p.row, p.col) = 1;
-  }
 }
 
 void LocalMapSynthesizer::gap_and_occupiable(LocalMap& local) const {

@@ -168,9 +168,14 @@ bool DepositionManager::may_raise(const deliberative::LocalMap& map, CellIndex c
 
 std::vector<WantedCell> DepositionManager::wanted(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
                                                   Position robot, const Neighbourhood& neighbours) const {
+  return wanted(map, path, robot, neighbours, clearance_m(map, robot));
+}
+
+std::vector<WantedCell> DepositionManager::wanted(const deliberative::LocalMap& map, const std::vector<CellIndex>& path,
+                                                  Position robot, const Neighbourhood& neighbours,
+                                                  double clear_m) const {
   std::vector<WantedCell> out;
   const double cs = map.geometry().cell_size_m;
-  const double clear_m = clearance_m(map, robot);
   const auto ball = sorted_ball(params_.footprint_m / (2.0 * cs));
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(map.rows()) * map.cols(), 0);
   for (const CellIndex p : path)

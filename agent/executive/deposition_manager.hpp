@@ -105,6 +105,9 @@ class DepositionManager {
   /// or budget: the cube and cone depositors place whole shapes (executive/depositor.hpp).
   std::vector<WantedCell> wanted(const deliberative::LocalMap& map, const std::vector<CellIndex>& path, Position robot,
                                  const Neighbourhood& neighbours) const;
+  /// The same, for a caller that has the robot's clearance_m() already.
+  std::vector<WantedCell> wanted(const deliberative::LocalMap& map, const std::vector<CellIndex>& path, Position robot,
+                                 const Neighbourhood& neighbours, double clearance_m) const;
   /// True when local `cell` may be raised at all by a robot standing at `robot` [m]: known, farther than
   /// `clearance_m` (clearance_m()) from it, in its territory, beyond the keep-out of every neighbour, off the base
   /// station's pad.

@@ -150,7 +150,7 @@ class ConeDepositor final : public Depositor {
       for (int c = 0; c < map.cols(); ++c)
         if (map.blind(r, c) == 0 && manager.may_raise(map, {r, c}, robot, neighbours, clear_m))
           remaining[index({r, c})] = std::max(0.0, deliberative::rise_wanted_m(map, {r, c}, 0.0));
-    const std::vector<WantedCell> wanted = manager.wanted(map, path, robot, neighbours);
+    const std::vector<WantedCell> wanted = manager.wanted(map, path, robot, neighbours, clear_m);
     std::vector<std::uint8_t> in_band(remaining.size(), 0);  // the cells the path's footprint wants
     for (const WantedCell& w : wanted) in_band[index(w.cell)] = 1;
     Heightmap heights = map.heights;  // the piles chosen so far land on it

@@ -241,6 +241,7 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       sensor_(other.sensor_),
       trajectory_(other.trajectory_),
       stood_(other.stood_),
+      stood_ball_(other.stood_ball_),
       octree_(other.octree_ ? std::make_unique<Octree>(*other.octree_) : nullptr) {}
 MappingSystem& MappingSystem::operator=(const MappingSystem& other) {
   if (this != &other) *this = MappingSystem(other);
@@ -472,7 +473,7 @@ void MappingSystem::record_built(CellIndex cell, double rise_m) {
   if (!heights_.contains(cell) || !std::isfinite(rise_m) || !(rise_m > 0.0)) return;
   // The robot's own construction changes every ball it lands in: what it stood on there is no longer a fact.
   if (!stood_.balls.empty())
-    for (const CellIndex o : disc_offsets(stood_.radius_cells)) {
+    for (const CellIndex o : stood_ball_) {
       const CellIndex centre{cell.row - o.row, cell.col - o.col};
       if (heights_.contains(centre))
         stood_.balls.erase(static_cast<long long>(centre.row) * heights_.cols() + centre.col);
@@ -614,14 +615,21 @@ void MappingSystem::assume_ground(Position pose, double ground_z_m, double radiu
 
 std::size_t MappingSystem::octree_leaves() const { return octree_ ? octree_->tree.leaves() : 0; }
 
-void MappingSystem::record_stood(Position pose, double radius_cells, double margin_m) {
+void MappingSystem::keep_stood_cells(double radius_cells, double margin_m) {
+  if (!(radius_cells >= 0.0) || !std::isfinite(radius_cells) || !(margin_m >= 0.0) || !std::isfinite(margin_m))
+    throw InvalidArgument(fmt::format("mapping system: cells stood on need a ball radius ({} cells) and a margin ({} m) "
+                                      "finite and >= 0",
+                                      radius_cells, margin_m));
+  stood_ = {radius_cells, margin_m, {}};
+  stood_ball_ = disc_offsets(radius_cells);
+}
+
+void MappingSystem::record_stood(Position pose) {
   const auto cell = std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;
-  if (!cell || !(radius_cells >= 0.0) || !(margin_m >= 0.0)) return;
-  if (stood_.radius_cells != radius_cells) stood_.balls.clear();
-  stood_.radius_cells = radius_cells;
-  stood_.margin_m = margin_m;
+  if (!cell || stood_ball_.empty()) return;
   std::vector<double> ball;
-  for (const CellIndex o : disc_offsets(radius_cells)) {
+  ball.reserve(stood_ball_.size());
+  for (const CellIndex o : stood_ball_) {
     const CellIndex b{cell->row + o.row, cell->col + o.col};
     ball.push_back(heights_.contains(b) && known_(b.row, b.col) != 0 ? heights_(b)
                                                                      : std::numeric_limits<double>::quiet_NaN());

@@ -88,12 +88,16 @@ class MappingSystem {
   /// Appends the cell under `pose` [m] to the trajectory (consecutive repeats are kept once); throws
   /// InvalidArgument when the pose is off the grid or not finite.
   void record_pose(Position pose);
+  /// From now on record_stood() remembers the cells stood on with their body balls (radius_cells = delta / (2 cs)),
+  /// each kept while every cell of its ball reads within margin_m of then. Throws InvalidArgument unless both are
+  /// finite and >= 0.
+  void keep_stood_cells(double radius_cells, double margin_m);
   /// The robot stands on the cell under `pose` [m]: the world put it there, so that cell was occupiable for its body,
-  /// whatever this map's readings of its ball say. Remembers the ball (radius_cells = delta / (2 cs)) as the map
-  /// reads it now; known_map().stood holds it while each of its cells reads within margin_m of that
-  /// (LocalMapSynthesizer: occupiable on a scanned map), until the robot's own construction lands in the ball
-  /// (record_built()). Off-grid or non-finite poses are ignored; radius_cells and margin_m >= 0.
-  void record_stood(Position pose, double radius_cells, double margin_m);
+  /// whatever this map's readings of its ball say. Remembers the ball as the map reads it now; known_map().stood
+  /// holds it while its cells read within the margin of that (LocalMapSynthesizer: occupiable on a scanned map), until
+  /// the robot's own construction lands in the ball (record_built()). Nothing before keep_stood_cells(); off-grid or
+  /// non-finite poses are ignored.
+  void record_stood(Position pose);
 
   /// The map: known cells hold the sensed heights [m], unknown cells 0.
   const Heightmap& heights() const { return heights_; }
@@ -166,7 +170,8 @@ class MappingSystem {
   std::unordered_map<long long, int> face_hit_scan_;  ///< the last scan with a face hit on the cell (1, 2, ...)
   SensorSpec sensor_;
   std::vector<CellIndex> trajectory_;
-  deliberative::StoodCells stood_;  ///< record_stood()
+  deliberative::StoodCells stood_;     ///< record_stood()
+  std::vector<CellIndex> stood_ball_;  ///< disc_offsets(stood_.radius_cells); empty: no cells stood on kept
   std::unique_ptr<Octree> octree_;  // made at the first scan
   ScanCost last_scan_cost_;
 };

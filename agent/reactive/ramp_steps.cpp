@@ -107,8 +107,9 @@ void RampSteps::admit(const protocol::Admission& admission) {
   // A refused cell comes back once its ball reads differently: by more than the map's noise margin, at least half a
   // cube layer (the least another robot's deposit changes a cell).
   const double ball_cells = build.delta_m / (2.0 * world.cell_size_m);
+  const double body_ball_cells = body.navigability.delta_m / (2.0 * world.cell_size_m);
   const double change = std::max(deposits.gap_margin_m, 0.5 * deposits.cube_layer_m);
-  memory_.refused.emplace(body.navigability.delta_m / (2.0 * world.cell_size_m), change, kRefusedMotionSteps);
+  memory_.refused.emplace(body_ball_cells, change, kRefusedMotionSteps);
   memory_.refused_depositions.emplace(ball_cells, change, kRefusedMotionSteps);
   PlannerParams router = planner;
   router.alpha = 0.0;
@@ -120,6 +121,9 @@ void RampSteps::admit(const protocol::Admission& admission) {
               executive::DepositionManager(deposits),
               static_cast<int>(std::ceil((body.reach_m + body.navigability.delta_m) / body.max_step_m)) + 1,
               executive::make_depositor(context_.type)});
+  // The cells a scanning robot stands on were occupiable (docs/runtime.md#cells-stood-on): a fact its map keeps while
+  // the ball reads the same, within the change that brings a refused cell back.
+  if (context_.type.sensor.casts_rays()) modules_->map.keep_stood_cells(body_ball_cells, change);
   goal_ = deliberative::make_goal_synthesizer(context_.type.goal_synthesizer, context_);
 }
 
@@ -208,11 +212,7 @@ void RampSteps::update_map(const protocol::SensorFrame& frame) {
     const NavigabilityParams& body = context_.type.body.navigability;
     const double radius_m = 0.5 * body.delta_m + context_.type.body.max_step_m;
     modules_->map.assume_ground(robot, frame.z_m, radius_m, body.eps_m + body.kappa * radius_m);
-    // The cell it stands on was occupiable: a fact its map keeps while the ball reads the same, within the map's
-    // noise margin (at least half a cube layer, as for refused cells).
-    const executive::DepositionParams& deposits = modules_->depositions.params();
-    modules_->map.record_stood(robot, body.delta_m / (2.0 * modules_->map.geometry().cell_size_m),
-                               std::max(deposits.gap_margin_m, 0.5 * deposits.cube_layer_m));
+    modules_->map.record_stood(robot);  // the cell it stands on was occupiable
   }
 }
 

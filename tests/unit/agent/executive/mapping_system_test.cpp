@@ -634,8 +634,13 @@ TEST(MappingSystem, ACellStoodOnKeepsItsBallUntilTheRobotBuildsInIt) {
   map.integrate({tile(0, 0, 3, 3, 1.0), tile(0, 1, 3, 3, 2.0), tile(1, 0, 2, 3, 3.0), tile(1, 1, 2, 3, 4.0)},
                 {11.25, 21.75});  // cell (1, 2); column 6 stays unknown
   EXPECT_EQ(map.known_map().stood, nullptr);  // nothing stood on yet
-  map.record_stood({11.25, 21.75}, 1.0, 0.01);  // the ball: (1, 2) and its 4 axis neighbours
-  map.record_stood({9.0, 21.75}, 1.0, 0.01);    // off the grid: ignored
+  map.record_stood({11.25, 21.75});  // nothing kept before keep_stood_cells()
+  EXPECT_EQ(map.known_map().stood, nullptr);
+  EXPECT_THROW(map.keep_stood_cells(-1.0, 0.01), InvalidArgument);
+  EXPECT_THROW(map.keep_stood_cells(1.0, std::nan("")), InvalidArgument);
+  map.keep_stood_cells(1.0, 0.01);
+  map.record_stood({11.25, 21.75});  // the ball: (1, 2) and its 4 axis neighbours
+  map.record_stood({9.0, 21.75});    // off the grid: ignored
   const deliberative::StoodCells* stood = map.known_map().stood;
   ASSERT_NE(stood, nullptr);
   ASSERT_EQ(stood->balls.size(), 1u);
