@@ -253,6 +253,63 @@ TEST(NavigabilityProcessor, NavigableEqualsBruteForceBfs) {
   EXPECT_GT(origins_blocked, 20);
 }
 
+// The origin's component by a plain breadth-first search over the mask: the reference for navigable_from() on masks
+// no terrain would give (mazes, runs across the 64-cell words of a row).
+CellMask component_by_search(const CellMask& occupiable, CellIndex origin) {
+  const int rows = static_cast<int>(occupiable.rows()), cols = static_cast<int>(occupiable.cols());
+  CellMask out = CellMask::Zero(rows, cols);
+  if (occupiable(origin.row, origin.col) == 0) return out;
+  std::vector<CellIndex> queue{origin};
+  out(origin.row, origin.col) = 1;
+  for (std::size_t next = 0; next < queue.size(); ++next)
+    for (int dr = -1; dr <= 1; ++dr)
+      for (int dc = -1; dc <= 1; ++dc) {
+        const int r = queue[next].row + dr, c = queue[next].col + dc;
+        if (r < 0 || r >= rows || c < 0 || c >= cols || out(r, c) != 0 || occupiable(r, c) == 0) continue;
+        out(r, c) = 1;
+        queue.push_back({r, c});
+      }
+  return out;
+}
+
+TEST(NavigabilityProcessor, NavigableFromEqualsASearchOnRandomAndMazeMasks) {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<int> side(1, 200);
+  std::uniform_real_distribution<double> density(0.45, 0.75), unit(0.0, 1.0);
+  long long reached = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int rows = side(rng), cols = side(rng);
+    CellMask occupiable(rows, cols);
+    const double d = density(rng);
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c) occupiable(r, c) = unit(rng) < d ? 1 : 0;
+    const CellIndex origin{std::uniform_int_distribution<int>(0, rows - 1)(rng),
+                           std::uniform_int_distribution<int>(0, cols - 1)(rng)};
+    const CellMask reference = component_by_search(occupiable, origin);
+    reached += count(reference);
+    EXPECT_EQ(first_difference(NavigabilityProcessor::navigable_from(occupiable, origin), reference), "")
+        << rows << " x " << cols << " density " << d;
+  }
+  EXPECT_GT(reached, 100000);  // large components, not only single cells
+  // A comb: one-cell corridors joined alternately at the top and the bottom, so every corridor turns the way back;
+  // 40 of them across more than two words of a row, and a diagonal-only link between two corridors.
+  for (const int corridors : {3, 40}) {
+    const int rows = 30, cols = 3 * corridors;
+    CellMask comb = CellMask::Zero(rows, cols);
+    for (int k = 0; k < corridors; ++k) {
+      for (int r = 1; r < rows - 1; ++r) comb(r, 3 * k) = 1;
+      if (k + 1 < corridors)
+        for (int c = 3 * k; c <= 3 * k + 3; ++c) comb(k % 2 == 0 ? rows - 1 : 0, c) = 1;
+    }
+    comb(rows - 1, 3 * corridors - 3) = 0;  // the last bend, as two diagonal steps instead
+    comb(rows - 1, 3 * corridors - 2) = 1;
+    comb(rows - 2, 3 * corridors - 1) = 1;
+    const CellMask reference = component_by_search(comb, {1, 0});
+    EXPECT_EQ(first_difference(NavigabilityProcessor::navigable_from(comb, {1, 0}), reference), "") << corridors;
+    EXPECT_EQ(reference(1, 3 * (corridors - 1)), 1);  // the whole comb is one component
+  }
+}
+
 // ---- hand-derived cases ----------------------------------------------------------------------------------
 
 TEST(NavigabilityProcessor, FlatGroundIsOccupiableAndNavigableEverywhere) {
