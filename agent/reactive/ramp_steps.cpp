@@ -276,7 +276,7 @@ void RampSteps::clear_pad_gap(deliberative::LocalMap& local) const {
   const double radius = kPadFraction * context_.assignment.base_radius_m;
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c)
-      if (std::hypot(local.center({r, c}).x - base.x, local.center({r, c}).y - base.y) <= radius) local.gap(r, c) = 0.0;
+      if (within(local.center({r, c}).x - base.x, local.center({r, c}).y - base.y, radius)) local.gap(r, c) = 0.0;
 }
 
 void RampSteps::count_gap_scans(const deliberative::LocalMap& local, bool scanned) {

@@ -153,7 +153,7 @@ bool in_any(const std::vector<Lane>& lanes, Position p) {
 bool Lane::contains(Position p) const {
   const double dx = to.x - from.x, dy = to.y - from.y, l2 = dx * dx + dy * dy;
   const double t = l2 > 0.0 ? std::clamp(((p.x - from.x) * dx + (p.y - from.y) * dy) / l2, 0.0, 1.0) : 0.0;
-  return std::hypot(p.x - (from.x + t * dx), p.y - (from.y + t * dy)) <= radius_m;
+  return within(p.x - (from.x + t * dx), p.y - (from.y + t * dy), radius_m);
 }
 
 std::vector<Lane> RightOfWay::lanes(double length_m, double clearance_m) const {

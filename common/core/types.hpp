@@ -1,6 +1,7 @@
 #pragma once
 // Vocabulary types shared by every layer, in the paper's language.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -40,6 +41,12 @@ struct Position {
 
 /// The planar (Euclidean) distance between two positions [m].
 inline double distance(Position a, Position b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+/// std::hypot(dx, dy) <= r, the same answer for less work where many offsets lie far: hypot() rounds the true length to
+/// a neighbouring double, so it is never below the larger of |dx| and |dy|, and when that exceeds r so does the length.
+inline bool within(double dx, double dy, double r) {
+  return std::max(std::abs(dx), std::abs(dy)) <= r && std::hypot(dx, dy) <= r;
+}
 
 /// An axis-aligned rectangle of the world frame [m]: [x0, x1] x [y0, y1] (x0 <= x1 and y0 <= y1 once validated).
 struct Rect {
