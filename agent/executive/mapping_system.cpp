@@ -99,27 +99,15 @@ octomap::point3d tree_point(const GridGeometry& g, double x, double y, double z)
   return octomap::point3d(static_cast<float>(x - g.xll_m), static_cast<float>(y - g.yll_m), static_cast<float>(z));
 }
 
-/// True when `hit` [m] lies within band_x_m [m] of an x edge (a line x = const) of its cell or within band_y_m of a
-/// y edge.
-bool near_cell_edge(const GridGeometry& g, Point3 hit, double band_x_m, double band_y_m) {
+/// True when `hit` [m] lies within band_m [m] of an edge of its cell.
+bool near_cell_edge(const GridGeometry& g, Point3 hit, double band_m) {
   const double cs = g.cell_size_m;
   const double u = (hit.x - g.xll_m) / cs, v = (hit.y - g.yll_m) / cs;
   const double fu = (u - std::floor(u)) * cs, fv = (v - std::floor(v)) * cs;
-  return fu < band_x_m || fu > cs - band_x_m || fv < band_y_m || fv > cs - band_y_m;
+  return fu < band_m || fu > cs - band_m || fv < band_m || fv > cs - band_m;
 }
 
 }  // namespace
-
-bool hit_near_cell_edge(const GridGeometry& g, Point3 origin, Point3 hit, double spread_m, double least_m) {
-  // Range noise moves a hit along its ray only: across an x edge by at most the spread times the ray's share of its
-  // length along x, across a y edge likewise. A band of the whole spread on every edge leaves out hits no noise could
-  // have carried over an edge (a laser's 3 cm band on 0.1 m cells kept 16 % of a cell's area; docs/runtime.md#mapping).
-  const double dx = hit.x - origin.x, dy = hit.y - origin.y, dz = hit.z - origin.z;
-  const double range = std::sqrt(dx * dx + dy * dy + dz * dz);
-  if (!(range > 0.0)) return true;
-  return near_cell_edge(g, hit, std::max(least_m, spread_m * std::abs(dx) / range),
-                        std::max(least_m, spread_m * std::abs(dy) / range));
-}
 
 /// The octree, in a frame shifted by the grid's lower-left corner so that voxel columns are exactly the grid's cells,
 /// and per cell the hits its voxels received: the octree says which voxels are occupied, the hits say where in the
@@ -404,8 +392,7 @@ MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& p
       }
     }
     const double band = std::max(kEdgeBand * cs, spread);
-    if (band > kMaxEdgeBand * cs + 1e-12 || hit_near_cell_edge(g, origin, hit, spread, kEdgeBand * cs) ||
-        behind_edge(origin, hit, *cell, spread))
+    if (band > kMaxEdgeBand * cs + 1e-12 || near_cell_edge(g, hit, band) || behind_edge(origin, hit, *cell, spread))
       continue;
     const octomap::point3d end = tree_point(g, hit.x, hit.y, hit.z);
     octomap::OcTreeKey key;

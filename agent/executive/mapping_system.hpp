@@ -28,11 +28,6 @@ std::string tile_problem(const TerrainTile& tile, const GridGeometry& world, int
 /// its max range plus 6 noise standard deviations (and 1 m); otherwise the problem, naming the first bad point.
 std::string scan_problem(const std::vector<ScanPoint>& points, const SensorSpec& sensor);
 
-/// True when a scan's hit at `hit` [m], from a ray cast at `origin` [m], may lie in another cell than the one it
-/// fell in: range noise of spread_m [m] moves it along its ray, so it lies within that spread's share along x of an x
-/// edge of its cell, or along y of a y edge; and always within least_m [m] of any edge (docs/runtime.md#mapping).
-bool hit_near_cell_edge(const GridGeometry& g, Point3 origin, Point3 hit, double spread_m, double least_m);
-
 /// The sensor origin the agent believes [m]: its believed position, the terrain height under it, plus the mount.
 inline Point3 believed_sensor_origin(Position pose, double ground_z_m, const SensorSpec& sensor) {
   return {pose.x, pose.y, ground_z_m + sensor.mount_height_m};
