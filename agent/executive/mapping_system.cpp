@@ -365,22 +365,6 @@ MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& p
   // A hit on a wall between two cells lies on their common edge, and range noise puts it on either side: in the
   // lower cell's column it would read as a surface high above that cell. Hits within kEdgeBand of a cell edge are
   // therefore left out; the cell's interior hits say where its surface is (docs/runtime.md#mapping).
-  std::vector<std::pair<Point3, CellIndex>> lone;
-  const auto place = [&](Point3 hit, CellIndex cell) {
-    const octomap::point3d end = tree_point(g, hit.x, hit.y, hit.z);
-    octomap::OcTreeKey key;
-    if (!octree_->tree.key_of(end, key)) return;
-    batch.cloud.push_back(end);
-    const std::size_t index = static_cast<std::size_t>(cell.row) * g.cols + cell.col;
-    Octree::VoxelHits& voxel = octree_->voxel(index, key[2]);
-    if (voxel.scan_count == 0) batch.touched.push_back(index);
-    batch.min_row = std::min(batch.min_row, cell.row);
-    batch.max_row = std::max(batch.max_row, cell.row);
-    batch.min_col = std::min(batch.min_col, cell.col);
-    batch.max_col = std::max(batch.max_col, cell.col);
-    voxel.scan_sum_m += hit.z;
-    ++voxel.scan_count;
-  };
   for (const ScanPoint& p : points) {
     const Point3 hit{origin.x + p.x_m, origin.y + p.y_m, origin.z + p.z_m};
     const std::optional<CellIndex> cell = g.cell_at({hit.x, hit.y});
@@ -410,45 +394,21 @@ MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& p
     const double band = std::max(kEdgeBand * cs, spread);
     if (band > kMaxEdgeBand * cs + 1e-12 || near_cell_edge(g, hit, band) || behind_edge(origin, hit, *cell, spread))
       continue;
-    if (short_of_face(origin, hit, kFaceRivalNoise / kEdgeBandNoise * spread)) {
-      lone.push_back({hit, *cell});
-      continue;
-    }
-    place(hit, *cell);
-  }
-  // A hit that may be a higher neighbour's face hit moved short by noise counts only in a cell this scan hit elsewhere
-  // too: alone, it would be the only reading of a pit whose floor no ray reaches, at its rim's height, and nothing
-  // would outvote it (docs/runtime.md#mapping).
-  for (const auto& [hit, cell] : lone) {
-    const std::size_t index = static_cast<std::size_t>(cell.row) * g.cols + cell.col;
-    const auto& voxels = octree_->hits[index];
-    if (std::any_of(voxels.begin(), voxels.end(), [](const Octree::VoxelHits& v) { return v.scan_count > 0; }))
-      place(hit, cell);
+    const octomap::point3d end = tree_point(g, hit.x, hit.y, hit.z);
+    octomap::OcTreeKey key;
+    if (!octree_->tree.key_of(end, key)) continue;
+    batch.cloud.push_back(end);
+    const std::size_t index = static_cast<std::size_t>(cell->row) * g.cols + cell->col;
+    Octree::VoxelHits& voxel = octree_->voxel(index, key[2]);
+    if (voxel.scan_count == 0) batch.touched.push_back(index);
+    batch.min_row = std::min(batch.min_row, cell->row);
+    batch.max_row = std::max(batch.max_row, cell->row);
+    batch.min_col = std::min(batch.min_col, cell->col);
+    batch.max_col = std::max(batch.max_col, cell->col);
+    voxel.scan_sum_m += hit.z;
+    ++voxel.scan_count;
   }
   return batch;
-}
-
-bool MappingSystem::short_of_face(Point3 origin, Point3 hit, double ahead_m) const {
-  // Descending rays only (a rising one's hits are face hits already). Walk the ray past the hit by ahead_m [m] of
-  // range: at each cell edge it crosses there, the cell it enters is known above the ray.
-  const GridGeometry& g = heights_.geometry();
-  const double dx = hit.x - origin.x, dy = hit.y - origin.y, dz = hit.z - origin.z;
-  const double run = std::hypot(dx, dy), range = std::sqrt(run * run + dz * dz);
-  if (!(dz < 0.0) || !(run > 0.0)) return false;
-  const double reach = ahead_m * run / range, ux = dx / run, uy = dy / run, slope = dz / run, cs = g.cell_size_m;
-  const auto entered_above = [&](double t) {
-    if (!(t >= 0.0) || t > reach) return false;
-    const double past = t + 10.0 * kOnEdgeM;
-    const std::optional<CellIndex> next = g.cell_at({hit.x + past * ux, hit.y + past * uy});
-    return next && known_(next->row, next->col) != 0 && heights_(*next) > hit.z + t * slope;
-  };
-  const auto next_line = [&](double at, double lower, double u) {
-    const double k = (at - lower) / cs;
-    return lower + (u > 0.0 ? std::floor(k) + 1.0 : std::ceil(k) - 1.0) * cs;
-  };
-  if (std::abs(ux) > 1e-9 && entered_above((next_line(hit.x, g.xll_m, ux) - hit.x) / ux)) return true;
-  if (std::abs(uy) > 1e-9 && entered_above((next_line(hit.y, g.yll_m, uy) - hit.y) / uy)) return true;
-  return false;
 }
 
 bool MappingSystem::behind_edge(Point3 origin, Point3 hit, CellIndex cell, double spread) const {

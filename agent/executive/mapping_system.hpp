@@ -146,7 +146,6 @@ class MappingSystem {
   // integrate_scan()'s steps: bin the hits a scan can place, judge a hit in an edge's shadow, re-derive the heights.
   ScanBatch bin_hits(const std::vector<ScanPoint>& points, Point3 origin);
   bool behind_edge(Point3 origin, Point3 hit, CellIndex cell, double spread_m) const;
-  bool short_of_face(Point3 origin, Point3 hit, double ahead_m) const;
   bool carved_below(CellIndex cell, double z_m) const;  // a scan's ray left a voxel of its column free under z_m
   bool was_assumed_ground(CellIndex cell) const;        // known only from assume_ground(): never hit, no face
   bool rose_since_read(CellIndex cell) const;  // its surface was last read before a scan that raised its face floor
