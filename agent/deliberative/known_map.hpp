@@ -12,11 +12,11 @@
 namespace marsala::agent::deliberative {
 
 /// The cells a robot stood on, as its map read their body balls then: row-major world index -> the heights of the
-/// cells of its ball in disc_offsets(radius_cells) order, NaN where the cell was unknown or off the grid
+/// cells of its ball in `ball` order, NaN where the cell was unknown or off the grid
 /// (executive::MappingSystem::record_stood).
 struct StoodCells {
-  double radius_cells = 0.0;  ///< the body ball's radius [cells]: delta / (2 cs)
-  double margin_m = 0.0;      ///< a ball reads as then when each cell is within this of its height then [m]
+  std::vector<CellIndex> ball;  ///< the body ball's offsets, disc_offsets(delta / (2 cs)) [cells]
+  double margin_m = 0.0;        ///< a ball reads as then when each cell is within this of its height then [m]
   std::unordered_map<long long, std::vector<double>> balls;
 };
 

@@ -154,7 +154,7 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
 
 void LocalMapSynthesizer::open_stood_cells(LocalMap& local, const KnownMap& map) {
   const StoodCells& stood = *map.stood;
-  const std::vector<CellIndex> ball = disc_offsets(stood.radius_cells);
+  const std::vector<CellIndex>& ball = stood.ball;
   const long long cols = map.heights.cols();
   // The window's cells, not every cell ever stood on: the work is bounded by the window, not by the run's length.
   for (int r = 0; r < local.rows(); ++r)

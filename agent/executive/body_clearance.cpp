@@ -32,10 +32,8 @@ std::vector<BodyClearance> body_clearances(const std::vector<Neighbour>& neighbo
 
 bool clear_of(const std::vector<BodyClearance>& others, Position from, Position to) {
   for (const BodyClearance& o : others) {
-    // distance() is never below the larger coordinate difference: hypot() rounds the true distance to a neighbouring
-    // double, and that difference is a double no greater than it. An end that far off along an axis is thus clear
-    // without it: the same answer for a fraction of the work in a crowd, where keep_clear() asks this of every window
-    // cell and every neighbour.
+    // An end that far off along an axis is clear without the square root (distance() is never below the larger
+    // coordinate difference, as for within()): keep_clear() asks this of every window cell and every neighbour.
     if (std::max(std::abs(to.x - o.centre.x), std::abs(to.y - o.centre.y)) >= o.min_distance_m) continue;
     const double after = distance(to, o.centre);
     if (after >= o.min_distance_m) continue;

@@ -241,7 +241,6 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       sensor_(other.sensor_),
       trajectory_(other.trajectory_),
       stood_(other.stood_),
-      stood_ball_(other.stood_ball_),
       octree_(other.octree_ ? std::make_unique<Octree>(*other.octree_) : nullptr) {}
 MappingSystem& MappingSystem::operator=(const MappingSystem& other) {
   if (this != &other) *this = MappingSystem(other);
@@ -473,7 +472,7 @@ void MappingSystem::record_built(CellIndex cell, double rise_m) {
   if (!heights_.contains(cell) || !std::isfinite(rise_m) || !(rise_m > 0.0)) return;
   // The robot's own construction changes every ball it lands in: what it stood on there is no longer a fact.
   if (!stood_.balls.empty())
-    for (const CellIndex o : stood_ball_) {
+    for (const CellIndex o : stood_.ball) {
       const CellIndex centre{cell.row - o.row, cell.col - o.col};
       if (heights_.contains(centre))
         stood_.balls.erase(static_cast<long long>(centre.row) * heights_.cols() + centre.col);
@@ -620,16 +619,15 @@ void MappingSystem::keep_stood_cells(double radius_cells, double margin_m) {
     throw InvalidArgument(fmt::format("mapping system: cells stood on need a ball radius ({} cells) and a margin ({} m) "
                                       "finite and >= 0",
                                       radius_cells, margin_m));
-  stood_ = {radius_cells, margin_m, {}};
-  stood_ball_ = disc_offsets(radius_cells);
+  stood_ = {disc_offsets(radius_cells), margin_m, {}};
 }
 
 void MappingSystem::record_stood(Position pose) {
   const auto cell = std::isfinite(pose.x) && std::isfinite(pose.y) ? heights_.cell_at(pose) : std::nullopt;
-  if (!cell || stood_ball_.empty()) return;
+  if (!cell || stood_.ball.empty()) return;
   std::vector<double> ball;
-  ball.reserve(stood_ball_.size());
-  for (const CellIndex o : stood_ball_) {
+  ball.reserve(stood_.ball.size());
+  for (const CellIndex o : stood_.ball) {
     const CellIndex b{cell->row + o.row, cell->col + o.col};
     ball.push_back(heights_.contains(b) && known_(b.row, b.col) != 0 ? heights_(b)
                                                                      : std::numeric_limits<double>::quiet_NaN());

@@ -170,8 +170,7 @@ class MappingSystem {
   std::unordered_map<long long, int> face_hit_scan_;  ///< the last scan with a face hit on the cell (1, 2, ...)
   SensorSpec sensor_;
   std::vector<CellIndex> trajectory_;
-  deliberative::StoodCells stood_;     ///< record_stood()
-  std::vector<CellIndex> stood_ball_;  ///< disc_offsets(stood_.radius_cells); empty: no cells stood on kept
+  deliberative::StoodCells stood_;  ///< record_stood(); an empty ball: no cells stood on kept
   std::unique_ptr<Octree> octree_;  // made at the first scan
   ScanCost last_scan_cost_;
 };

@@ -35,11 +35,11 @@ void check_origin(int rows, int cols, CellIndex origin) {
     throw InvalidArgument(fmt::format("NavigabilityProcessor: origin {} is off the {} x {} grid", origin, rows, cols));
 }
 
-/// The origin's 8-connected component of the occupiable cells, one bit per cell, rows of `words` 64-bit words: rows
-/// are swept down and up, each row taking what its reached neighbours rows touch (8 neighbours: the row above and
-/// below widened by a cell each way) and then the whole runs of occupiable cells that hold a reached cell (the cells
-/// of a run are neighbours in a row). The sweeps stop when a pair of them reaches nothing new, or after kSweeps pairs
-/// (a maze), when a search from every cell reached so far finishes the component.
+/// The origin's 8-connected component of the occupiable cells, one bit per cell, each row in words of 64 cells: rows
+/// are swept down and up, each row taking what its neighbour rows reach (8 neighbours: the row above and below
+/// widened by a cell each way) and then the whole runs of occupiable cells that hold a reached cell (the cells of a
+/// run are neighbours in a row). The sweeps stop when a pair of them reaches nothing new, or after kSweeps pairs (a
+/// maze), when a search from every cell reached so far finishes the component.
 class BitFill {
  public:
   BitFill(const CellMask& occupiable, CellIndex origin)
@@ -51,8 +51,8 @@ class BitFill {
         seed_(static_cast<std::size_t>(words_), 0) {
     for (int r = 0; r < rows_; ++r)
       for (int c = 0; c < cols_; ++c)
-        if (occupiable(r, c) != 0) occ_[index(r, c / 64)] |= std::uint64_t{1} << (c % 64);
-    reach_[index(origin.row, origin.col / 64)] |= std::uint64_t{1} << (origin.col % 64);
+        if (occupiable(r, c) != 0) occ_[index(r, c / 64)] |= bit(c);
+    reach_[index(origin.row, origin.col / 64)] |= bit(origin.col);
   }
 
   /// The component as a mask of the grid's shape.
@@ -75,7 +75,10 @@ class BitFill {
  private:
   static constexpr int kSweeps = 8;
 
+  /// Word w of row r.
   std::size_t index(int r, int w) const { return static_cast<std::size_t>(r) * words_ + w; }
+  /// Column c's bit in its word.
+  static std::uint64_t bit(int c) { return std::uint64_t{1} << (c % 64); }
 
   /// Bits of `seed` (within `run`) spread towards higher bits along runs of set bits of `run`.
   static std::uint64_t fill_up(std::uint64_t seed, std::uint64_t run) {
@@ -132,7 +135,7 @@ class BitFill {
   /// A depth-first search from every reached cell through the occupiable cells.
   void finish_by_search() {
     std::vector<CellIndex> frontier;
-    auto reached = [&](int r, int c) { return (reach_[index(r, c / 64)] >> (c % 64) & 1) != 0; };
+    auto reached = [&](int r, int c) { return (reach_[index(r, c / 64)] & bit(c)) != 0; };
     for (int r = 0; r < rows_; ++r)
       for (int c = 0; c < cols_; ++c)
         if (reached(r, c)) frontier.push_back({r, c});
@@ -141,9 +144,8 @@ class BitFill {
       frontier.pop_back();
       for (int r = std::max(cell.row - 1, 0); r <= std::min(cell.row + 1, rows_ - 1); ++r)
         for (int c = std::max(cell.col - 1, 0); c <= std::min(cell.col + 1, cols_ - 1); ++c) {
-          const std::uint64_t bit = std::uint64_t{1} << (c % 64);
-          if ((occ_[index(r, c / 64)] & bit) == 0 || reached(r, c)) continue;
-          reach_[index(r, c / 64)] |= bit;
+          if ((occ_[index(r, c / 64)] & bit(c)) == 0 || reached(r, c)) continue;
+          reach_[index(r, c / 64)] |= bit(c);
           frontier.push_back({r, c});
         }
     }

@@ -293,7 +293,7 @@ TEST(LocalMapSynthesizer, AScannedMapKeepsTheCellsItStoodOnWhileTheirBallsReadTh
   const std::vector<CellIndex> trajectory{stood, {30, 40}};
   // The ball as the map read it when the robot stood there: 0.1 m at the step, within the margin of 0.11.
   StoodCells cells;
-  cells.radius_cells = 2.0;
+  cells.ball = disc_offsets(2.0);
   cells.margin_m = 0.015;
   std::vector<double> then;
   for (const CellIndex o : disc_offsets(2.0)) then.push_back(stood.col + o.col >= 38 ? 0.10 : 0.0);

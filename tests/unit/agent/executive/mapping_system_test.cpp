@@ -649,7 +649,7 @@ TEST(MappingSystem, ACellStoodOnKeepsItsBallUntilTheRobotBuildsInIt) {
   ASSERT_EQ(ball.size(), offsets.size());
   for (std::size_t i = 0; i < ball.size(); ++i)
     EXPECT_TRUE(same_bits(ball[i], map.heights()(CellIndex{1 + offsets[i].row, 2 + offsets[i].col})));
-  EXPECT_DOUBLE_EQ(stood->radius_cells, 1.0);
+  EXPECT_EQ(stood->ball, offsets);
   EXPECT_DOUBLE_EQ(stood->margin_m, 0.01);
   // A deposition outside its ball changes nothing; one inside it (the robot's own) ends the fact.
   map.record_built({1, 4}, 0.1);
