@@ -235,6 +235,7 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       tile_size_(other.tile_size_),
       registration_(other.registration_),
       built_(other.built_),
+      ceiling_(other.ceiling_),
       face_floor_(other.face_floor_),
       face_scan_(other.face_scan_),
       face_hit_scan_(other.face_hit_scan_),
@@ -336,6 +337,7 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   // A face's hit bounds its cell from below for good (terrain only rises), as the robot's own construction does.
   for (const ScanBatch::Face& f : batch.faces) {
     const long long index = static_cast<long long>(f.cell.row) * g.cols + f.cell.col;
+    ceiling_.erase(index);  // a hit on its face reads the cell anew
     double& least = face_floor_.try_emplace(index, f.z_m).first->second;
     if (f.z_m > least || face_scan_.count(index) == 0) face_scan_[index] = scans_;
     face_hit_scan_[index] = scans_;
@@ -450,7 +452,34 @@ void MappingSystem::rederive_heights(const ScanBatch& batch) {
         assumed_(row, col) = 1;
         bound_(row, col) = 1;
       }
+      // A ceiling the world's refusal set holds until a scan hits the cell again: a hit reads what is there now.
+      const auto ceiling = ceiling_.find(key_rc);
+      if (ceiling == ceiling_.end()) continue;
+      if (hit) {
+        ceiling_.erase(ceiling);
+      } else {
+        heights_(row, col) = std::min(heights_(row, col), ceiling->second);
+        assumed_(row, col) = 0;
+        bound_(row, col) = 0;
+      }
     }
+}
+
+void MappingSystem::record_drop(CellIndex low, CellIndex high, double allowed_m, double margin_m) {
+  if (!is_known(low) || !is_known(high) || !std::isfinite(allowed_m) || !std::isfinite(margin_m)) return;
+  if (heights_(high) - heights_(low) > allowed_m) return;  // the map knows the drop already
+  if (last_hit_scan(low) >= last_hit_scan(high)) return;    // low read as late: the map may be wrong at high instead
+  const long long index = static_cast<long long>(low.row) * heights_.cols() + low.col;
+  const double most = heights_(high) - allowed_m - margin_m;
+  double& ceiling = ceiling_.try_emplace(index, most).first->second;
+  ceiling = std::min(ceiling, most);
+  // What the map held there (its reading, the floor of its own construction, a face's bound) lies above the truth.
+  heights_(low) = std::min(heights_(low), ceiling);
+  if (const auto built = built_.find(index); built != built_.end()) built->second = std::min(built->second, ceiling);
+  if (const auto face = face_floor_.find(index); face != face_floor_.end())
+    face->second = std::min(face->second, ceiling);
+  assumed_(low.row, low.col) = 0;
+  bound_(low.row, low.col) = 0;
 }
 
 bool MappingSystem::hit_within(CellIndex cell, int scans) const {
@@ -484,6 +513,7 @@ void MappingSystem::record_built(CellIndex cell, double rise_m) {
       (assumed_(cell.row, cell.col) == 0 || face_floor_.count(index) > 0 || built_.count(index) > 0);
   if (!surface_read) return;
   const double floor_m = heights_(cell) + rise_m;
+  if (const auto ceiling = ceiling_.find(index); ceiling != ceiling_.end()) ceiling->second += rise_m;
   double& built = built_.try_emplace(index, floor_m).first->second;
   built = std::max(built, floor_m);
   heights_(cell) = std::max(heights_(cell), built);

@@ -76,6 +76,14 @@ class MappingSystem {
   /// through such cells on the same side of its path (offset from the nearest cell stood on, dot product > 0): the
   /// whole edge it guessed wrong along its path, not one ball of it. Off-grid cells are ignored. [m]
   void forget_assumed_ground(CellIndex cell, double radius_m);
+  /// The world refused a motion because, in the body ball it asked for, cell `low` lies below cell `high` by more
+  /// than allowed_m (eps + kappa times their distance; world indices as the map registers them) [m]. Where this map
+  /// holds the pair within allowed_m and `low`'s reading is no newer than `high`'s, the reading of `low` is what it got
+  /// wrong (a pit read at its rim's height: no ray reaches a narrow pit's floor, docs/runtime.md#refused-requests): low
+  /// gets a ceiling, its height at most high's less allowed_m and margin_m, a surface the robot may build on (what it
+  /// adds to a height that is at most the truth never overshoots). The ceiling rises with the robot's own construction
+  /// there (record_built()) and goes when a scan hits the cell again. Off-grid or unknown cells are ignored.
+  void record_drop(CellIndex low, CellIndex high, double allowed_m, double margin_m);
   /// The robot's own construction: the world accepted its request to raise `cell` (world index, as the map registers
   /// it) by rise_m [m]. Terrain only ever rises (depositions add material), so the cell is at least its map height
   /// plus rise_m from now on, whatever a later scan reads there: a scan may not see the top of what the robot just
@@ -165,6 +173,7 @@ class MappingSystem {
   int tile_size_;
   CellIndex registration_{0, 0};
   std::unordered_map<long long, double> built_;  ///< record_built(): the least height of a cell (row-major index) [m]
+  std::unordered_map<long long, double> ceiling_;     ///< record_drop(): the most a cell can be (row-major index) [m]
   std::unordered_map<long long, double> face_floor_;  ///< the highest face hit of a cell (row-major index) [m]
   std::unordered_map<long long, int> face_scan_;      ///< the scan that set face_floor_ (1, 2, ...)
   std::unordered_map<long long, int> face_hit_scan_;  ///< the last scan with a face hit on the cell (1, 2, ...)

@@ -20,6 +20,16 @@ std::optional<CellIndex> cell_named(const std::string& reason) {
   return CellIndex{row, col};
 }
 
+std::optional<std::pair<CellIndex, CellIndex>> drop_named(const std::string& reason) {
+  const std::size_t at = reason.find(": cell (");
+  if (at == std::string::npos) return std::nullopt;
+  CellIndex low, high;
+  if (std::sscanf(reason.c_str() + at, ": cell (%d, %d) lies too far below cell (%d, %d)", &low.row, &low.col,
+                  &high.row, &high.col) != 4)
+    return std::nullopt;
+  return std::make_pair(low, high);
+}
+
 bool refused_for_terrain(const std::string& reason) { return reason.find("not occupiable") != std::string::npos; }
 
 RefusedCells::RefusedCells(double ball_radius_cells, double change_m, std::uint64_t hold_steps)

@@ -11,6 +11,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "marsala/core/heightmap.hpp"
@@ -20,6 +21,10 @@ namespace marsala::agent::executive {
 
 /// The cell (world index) a refusal reason names ("... cell (r, c) ..."), if any.
 std::optional<CellIndex> cell_named(const std::string& reason);
+
+/// The pair of cells a terrain refusal names as the drop the body found (": cell (r, c) lies too far below cell (r, c)"):
+/// first the lower, then the higher (world indices); nullopt when it names none.
+std::optional<std::pair<CellIndex, CellIndex>> drop_named(const std::string& reason);
 
 /// True when the reason says a cell is not occupiable for the body (rules 2.3, 2.4): the terrain there, not the
 /// neighbours.

@@ -27,6 +27,10 @@ constexpr EnumName<BuildPhase> kBuildPhaseNames[] = {
 
 /// Kept inside the world's base radius so a refill is never rejected on a tie [m].
 constexpr double kBaseMarginM = 1e-6;
+/// How far below the world's allowance a drop the world named is put on the map (MappingSystem::record_drop): enough
+/// for the map to break the rule there too, little enough that the lower cell's ceiling stays above its truth but for
+/// the higher cell's reading error [m].
+constexpr double kDropMarginM = 1e-3;
 
 executive::Neighbourhood neighbourhood(const protocol::SensorFrame& frame) {
   return {frame.agent_id, {frame.x_m, frame.y_m}, frame.neighbours};
@@ -176,18 +180,31 @@ void RampSteps::remember_result(const protocol::SensorFrame& frame) {
     if (named) cell = {named->row + registration_.row, named->col + registration_.col};
     const auto starts = [&](const char* word) { return frame.last_reason.rfind(word, 0) == 0; };
     const bool motion = !starts("deposit") && !starts("refill") && !starts("robot type");  // rules 1, 2
-    if (sent.motion && motion)
-      memory_.refusal = Memory::Refusal{cell, executive::refused_for_terrain(frame.last_reason), true};
-    else if (named && !motion)
-      memory_.refusal = Memory::Refusal{cell, false, false};
+    if (sent.motion && motion) {
+      memory_.refusal = Memory::Refusal{cell, executive::refused_for_terrain(frame.last_reason), true, std::nullopt};
+      if (const auto drop = executive::drop_named(frame.last_reason))
+        memory_.refusal->drop = std::make_pair(
+            CellIndex{drop->first.row + registration_.row, drop->first.col + registration_.col},
+            CellIndex{drop->second.row + registration_.row, drop->second.col + registration_.col});
+    } else if (named && !motion) {
+      memory_.refusal = Memory::Refusal{cell, false, false, std::nullopt};
+    }
   }
   sent = Sent{};
 }
 
 void RampSteps::learn_refusals(const protocol::SensorFrame& frame) {
   // A motion refused for the terrain: the ground the map only assumed in the target's ball is what it guessed wrong.
-  if (memory_.refusal && memory_.refusal->terrain && memory_.refusal->motion)
+  if (memory_.refusal && memory_.refusal->terrain && memory_.refusal->motion) {
     modules_->map.forget_assumed_ground(memory_.refusal->cell, 0.5 * context_.type.body.navigability.delta_m);
+    // The drop the body found, where the map holds none: the lower cell's reading was too high.
+    if (const auto& drop = memory_.refusal->drop; drop && context_.type.sensor.casts_rays()) {
+      const NavigabilityParams& body = context_.type.body.navigability;
+      const double cs = modules_->map.geometry().cell_size_m;
+      const double apart_m = cs * std::hypot(drop->first.row - drop->second.row, drop->first.col - drop->second.col);
+      modules_->map.record_drop(drop->first, drop->second, body.eps_m + body.kappa * apart_m, kDropMarginM);
+    }
+  }
   const executive::MappingSystem& map = modules_->map;
   memory_.refused->update(map.heights(), map.known(), frame.step);
   memory_.refused_depositions->update(map.heights(), map.known(), frame.step);

@@ -227,6 +227,7 @@ class RampSteps {
       CellIndex cell;
       bool terrain = false;
       bool motion = false;
+      std::optional<std::pair<CellIndex, CellIndex>> drop;  ///< the drop the world named: lower, higher cell
     };
     std::optional<Refusal> refusal;
     std::vector<GapStreak> gap_streaks;            ///< scanned maps, per world cell (row-major): count_gap_scans()

@@ -66,6 +66,33 @@ bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const Navigabilit
                                            : occupiable_by_window(terrain, cell, params, offsets);
 }
 
+std::optional<OccupancyBreach> occupancy_breach(const Heightmap& terrain, CellIndex cell,
+                                                const NavigabilityParams& params) {
+  if (!terrain.contains(cell))
+    throw InvalidArgument(
+        fmt::format("occupancy_breach: cell {} is off the {} x {} grid", cell, terrain.rows(), terrain.cols()));
+  std::vector<CellIndex> ball;
+  for (const CellIndex& o : disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m()))) {
+    const CellIndex c{cell.row + o.row, cell.col + o.col};
+    if (terrain.contains(c)) ball.push_back(c);
+  }
+  const double cs = terrain.cell_size_m();
+  std::optional<OccupancyBreach> worst;
+  double worst_excess = 0.0;
+  for (std::size_t a = 0; a < ball.size(); ++a)
+    for (std::size_t b = a + 1; b < ball.size(); ++b) {
+      const long long dr = ball[a].row - ball[b].row, dc = ball[a].col - ball[b].col;
+      // The threshold expression of occupiable_by_pairs, so that a breach is found exactly where it says no.
+      const double threshold =
+          params.eps_m + params.kappa * (cs * std::sqrt(static_cast<double>(dr * dr + dc * dc))) + tolerance::kHeightM;
+      const double excess = std::abs(terrain(ball[a]) - terrain(ball[b])) - threshold;
+      if (!(excess > worst_excess)) continue;
+      worst_excess = excess;
+      worst = terrain(ball[a]) < terrain(ball[b]) ? OccupancyBreach{ball[a], ball[b]} : OccupancyBreach{ball[b], ball[a]};
+    }
+  return worst;
+}
+
 CellMask blind_cells(const CellMask& known, double radius_cells) {
   const int rows = static_cast<int>(known.rows()), cols = static_cast<int>(known.cols());
   CellMask blind = CellMask::Zero(rows, cols);

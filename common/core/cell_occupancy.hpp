@@ -2,6 +2,8 @@
 // Whether one cell is occupiable (ARCHITECTURE.md, grid conventions): the single-cell question the world asks of every
 // motion and start, and the agent of its own body, answered exactly as NavigabilityProcessor answers it for a grid.
 
+#include <optional>
+
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/types.hpp"
 
@@ -19,6 +21,19 @@ enum class OccupancyMethod {
 /// cell is off the grid.
 bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
                      OccupancyMethod method = OccupancyMethod::kAutomatic);
+
+/// Two cells of a ball whose heights break the occupancy rule: `low` lies below `high` by more than eps + kappa |low -
+/// high| allows.
+struct OccupancyBreach {
+  CellIndex low;
+  CellIndex high;
+};
+
+/// Why on-grid `cell` is not occupiable for `params`: the pair of its ball that breaks the rule by the most (the first
+/// in disc_offsets order among equals); nullopt when the cell is occupiable. What a robot that tried to stand there
+/// would feel: where its body found a drop. Throws InvalidArgument when the cell is off the grid.
+std::optional<OccupancyBreach> occupancy_breach(const Heightmap& terrain, CellIndex cell,
+                                                const NavigabilityParams& params);
 
 /// 1 where the body ball of a cell (radius_cells = delta / (2 cs), disc_offsets) holds a cell that `known` marks 0:
 /// whether such a cell is occupiable cannot be judged (an agent's map, a robot's believed map). Cells off the mask do

@@ -197,6 +197,13 @@ std::optional<std::string> envelope_problem(const WorldState& state, std::uint32
   return std::nullopt;
 }
 
+/// What a body that tried to stand on `cell` would feel (docs/runtime.md#refused-requests): ": cell (r, c) lies too far
+/// below cell (r, c)", or nothing when the cell is occupiable.
+std::string breach_of(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& body) {
+  const std::optional<OccupancyBreach> breach = occupancy_breach(terrain, cell, body);
+  return breach ? fmt::format(": cell {} lies too far below cell {}", breach->low, breach->high) : std::string();
+}
+
 /// Rule 2, the motion of `me` to the request's target (docs/runtime.md#rule-2-motion); nullopt when it passes.
 std::optional<std::string> motion_problem(const WorldState& state, const AgentRecord& me,
                                           const protocol::ActionRequest& r) {
@@ -209,14 +216,15 @@ std::optional<std::string> motion_problem(const WorldState& state, const AgentRe
   if (!cell) return fmt::format("target {} is off the grid", Position{r.target_x_m, r.target_y_m});
   const NavigabilityParams body = me.type.body.navigability;
   if (!cell_occupiable(terrain, *cell, body))
-    return fmt::format("target cell {} is not occupiable for this body", *cell);
+    return fmt::format("target cell {} is not occupiable for this body{}", *cell, breach_of(terrain, *cell, body));
   // The body must be on occupiable terrain all along the way: every cell the segment passes through, except the
   // one it leaves (a robot whose own cell stopped being occupiable may still drive out of it).
   const std::vector<CellIndex> swept = cells_on_segment(terrain.geometry(), {x, y}, {r.target_x_m, r.target_y_m});
   for (std::size_t i = 1; i + 1 < swept.size(); ++i) {
     if (swept[i] == swept.front()) continue;
     if (!terrain.contains(swept[i]) || !cell_occupiable(terrain, swept[i], body))
-      return fmt::format("motion passes through cell {}, not occupiable for this body", swept[i]);
+      return fmt::format("motion passes through cell {}, not occupiable for this body{}", swept[i],
+                         terrain.contains(swept[i]) ? breach_of(terrain, swept[i], body) : std::string());
   }
   // Robot bodies may not overlap where the motion ends: the others stand where this step's lower ids left them
   // and the higher ids where the step found them. Bodies that already overlap (jittered starts, a readmission)

@@ -2,10 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/iterators.hpp"
 #include "marsala/core/navigability_processor.hpp"
 
 namespace marsala {
@@ -90,6 +92,55 @@ TEST(CellOccupiable, OffGridThrows) {
   g.cols = 4;
   EXPECT_THROW(cell_occupiable(Heightmap(g, 0.0), {4, 0}, {}), InvalidArgument);
   EXPECT_THROW(cell_occupiable(Heightmap(g, 0.0), {0, -1}, {}), InvalidArgument);
+}
+
+TEST(OccupancyBreach, NamesThePairThatBreaksTheRuleByTheMostExactlyWhereTheCellIsNotOccupiable) {
+  // Brute force over the ball's pairs on rough grids with spikes and pits: the breach is there exactly when the cell
+  // is not occupiable, its cells lie in the ball, the lower first, and no pair breaks the rule by more.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> noise(0.0, 0.03), u(0.0, 1.0);
+  int breaches = 0, clear = 0;
+  for (int trial = 0; trial < 5; ++trial) {
+    Heightmap h({15 + trial, 17, 0.0, 0.0, 0.1}, 0.0);
+    for (long long i = 0; i < h.size(); ++i) {
+      const double v = u(rng);
+      h.data()[i] = noise(rng) + (v < 0.02 ? 0.3 : v < 0.04 ? -0.25 : 0.0);
+    }
+    const NavigabilityParams params{0.3, 0.5 + 0.1 * trial, 0.05};
+    const std::vector<CellIndex> offsets = disc_offsets(params.delta_m / (2.0 * h.cell_size_m()));
+    for (int r = 0; r < h.rows(); ++r)
+      for (int c = 0; c < h.cols(); ++c) {
+        const std::optional<OccupancyBreach> breach = occupancy_breach(h, {r, c}, params);
+        ASSERT_EQ(breach.has_value(), !cell_occupiable(h, {r, c}, params)) << trial << ": " << r << ", " << c;
+        if (!breach) {
+          ++clear;
+          continue;
+        }
+        ++breaches;
+        const auto in_ball = [&](CellIndex q) {
+          return std::find(offsets.begin(), offsets.end(), CellIndex{q.row - r, q.col - c}) != offsets.end();
+        };
+        ASSERT_TRUE(in_ball(breach->low) && in_ball(breach->high));
+        const auto excess = [&](CellIndex a, CellIndex b) {
+          const double d = h.cell_size_m() * std::hypot(a.row - b.row, a.col - b.col);
+          return std::abs(h(a) - h(b)) - (params.eps_m + params.kappa * d);
+        };
+        EXPECT_LT(h(breach->low), h(breach->high));
+        const double named = excess(breach->low, breach->high);
+        EXPECT_GT(named, 0.0);
+        for (const CellIndex& a : offsets)
+          for (const CellIndex& b : offsets) {
+            const CellIndex p{r + a.row, c + a.col}, q{r + b.row, c + b.col};
+            if (h.contains(p) && h.contains(q)) {
+              ASSERT_LE(excess(p, q), named + 1e-12);
+            }
+          }
+      }
+  }
+  // Both answers occur, so the comparison means something.
+  EXPECT_GT(breaches, 0);
+  EXPECT_GT(clear, 0);
+  EXPECT_THROW(occupancy_breach(Heightmap({4, 4, 0.0, 0.0, 0.1}, 0.0), {4, 0}, {0.3, 0.5, 0.05}), InvalidArgument);
 }
 
 TEST(BlindCells, AreTheCellsWhoseBallHoldsAnUnknownCell) {

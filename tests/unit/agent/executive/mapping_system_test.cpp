@@ -629,6 +629,44 @@ TEST(MappingSystem, ABuiltCellGetsAFloorOnlyWhereItsSurfaceWasRead) {
   EXPECT_FALSE(map.is_known(*unread));
 }
 
+// A drop the world named (record_drop): where the map holds none and the lower cell's reading is the older one, that
+// reading gets a ceiling below the higher cell by the rule's allowance and the margin; it holds while no scan hits the
+// cell, rises with the robot's own construction there, and goes when a scan hits the cell again.
+TEST(MappingSystem, ADropTheWorldNamedCapsTheOlderReadingUntilAScanHitsItAgain) {
+  MappingSystem map(GridGeometry{60, 60, 0.0, 0.0, 0.1}, 16, sensor_defaults(SensorKind::kLaser));
+  const Point3 origin{3.05, 3.05, 0.5};
+  const CellIndex low{29, 35}, high{29, 36}, beside{29, 34};
+  map.integrate_scan({{0.5F, 0.0F, -0.5F}, {0.6F, 0.0F, -0.5F}}, origin);  // both read at 0 m
+  map.integrate_scan({{0.6F, 0.0F, -0.5F}}, origin);                       // high read again, low not
+  ASSERT_TRUE(map.is_known(low) && map.is_known(high));
+  ASSERT_LT(map.last_hit_scan(low), map.last_hit_scan(high));
+  const double allowed = 0.13, margin = 0.01;
+  // The newer reading is not the one capped.
+  map.record_drop(high, low, allowed, margin);
+  EXPECT_NEAR(map.heights()(high), 0.0, 1e-6);
+  map.record_drop(low, high, allowed, margin);
+  EXPECT_NEAR(map.heights()(low), map.heights()(high) - allowed - margin, 1e-6);
+  EXPECT_EQ(map.assumed()(low.row, low.col), 0);  // a surface to build on
+  // The map now holds the drop: naming it again changes nothing.
+  map.record_drop(low, high, allowed, margin);
+  EXPECT_NEAR(map.heights()(low), -0.14, 1e-6);
+  // A scan around it that does not hit it keeps the ceiling.
+  map.integrate_scan({{0.4F, 0.0F, -0.5F}, {0.6F, 0.0F, -0.5F}}, origin);
+  ASSERT_TRUE(map.is_known(beside));
+  EXPECT_NEAR(map.heights()(low), -0.14, 1e-6);
+  // The robot's construction there raises it.
+  map.record_built(low, 0.05);
+  map.integrate_scan({{0.4F, 0.0F, -0.5F}, {0.6F, 0.0F, -0.5F}}, origin);
+  EXPECT_NEAR(map.heights()(low), -0.09, 1e-6);
+  // A hit reads it anew.
+  map.integrate_scan({{0.5F, 0.0F, -0.45F}}, origin);
+  EXPECT_NEAR(map.heights()(low), 0.05, 1e-6);
+  // Unknown or off-grid cells are ignored.
+  map.record_drop({0, 0}, high, allowed, margin);
+  map.record_drop({-1, 70}, high, allowed, margin);
+  EXPECT_FALSE(map.is_known({0, 0}));
+}
+
 TEST(MappingSystem, ACellStoodOnKeepsItsBallUntilTheRobotBuildsInIt) {
   MappingSystem map(kWorld, 3);
   map.integrate({tile(0, 0, 3, 3, 1.0), tile(0, 1, 3, 3, 2.0), tile(1, 0, 2, 3, 3.0), tile(1, 1, 2, 3, 4.0)},

@@ -23,6 +23,15 @@ TEST(RefusedCells, ReadsTheCellTheWorldsReasonsName) {
   EXPECT_TRUE(refused_for_terrain("target cell (99, 158) is not occupiable for this body"));
   EXPECT_TRUE(refused_for_terrain("motion passes through cell (3, 4), not occupiable for this body"));
   EXPECT_FALSE(refused_for_terrain("motion ends 0.8 m from agent 2, whose body it would overlap (bodies need 1 m)"));
+  // The drop the body found, when the world names it: the lower cell first.
+  const std::string dropped = "target cell (119, 128) is not occupiable for this body: cell (120, 131) lies too far "
+                              "below cell (119, 127)";
+  EXPECT_EQ(cell_named(dropped), (CellIndex{119, 128}));
+  ASSERT_TRUE(drop_named(dropped).has_value());
+  EXPECT_EQ(drop_named(dropped)->first, (CellIndex{120, 131}));
+  EXPECT_EQ(drop_named(dropped)->second, (CellIndex{119, 127}));
+  EXPECT_FALSE(drop_named("target cell (99, 158) is not occupiable for this body").has_value());
+  EXPECT_FALSE(drop_named("target cell (1, 2) is not occupiable for this body: cell (3, x) lies").has_value());
 }
 
 TEST(RefusedCells, ATerrainRefusalHoldsUntilTheMapAroundTheCellChanges) {

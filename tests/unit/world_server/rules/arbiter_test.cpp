@@ -161,8 +161,11 @@ TEST_F(ArbiterTest, MotionAcrossANonOccupiableCellIsRejected) {
   state_.agent(2).position.y = 0.35;
   // 0.2 m east, from column 19 to column 21, across column 20: its end cell is occupiable, its way is not.
   expect_rejected(move_to(state_, 1, 2.15, 1.95), "motion passes through cell (20, 20), not occupiable");
-  // Onto the wall, named as the target.
+  // Onto the wall, named as the target, with the drop a body there finds: the ball's end cells on the slope's foot and
+  // top (the only pairs that differ by more than the rule allows).
   expect_rejected(move_to(state_, 1, 2.05, 1.95), "target cell (20, 20) is not occupiable");
+  const Verdict onto = check(move_to(state_, 1, 2.05, 1.95));
+  EXPECT_NE(onto.reason.find(": cell (20, 15) lies too far below cell (20, 25)"), std::string::npos) << onto.reason;
   // Along it (north, in column 19), fine.
   EXPECT_TRUE(check(move_to(state_, 1, 1.95, 2.15)).accepted);
   // A robot standing on the wall may leave it: its own cell is not part of the way.
