@@ -519,6 +519,18 @@ void MappingSystem::record_built(CellIndex cell, double rise_m) {
   heights_(cell) = std::max(heights_(cell), built);
 }
 
+void MappingSystem::record_floor(CellIndex cell, double floor_m) {
+  if (!is_known(cell) || !std::isfinite(floor_m) || std::abs(floor_m) >= kMaxMagnitude) return;
+  const long long index = static_cast<long long>(cell.row) * heights_.cols() + cell.col;
+  if (const auto ceiling = ceiling_.find(index); ceiling != ceiling_.end() && ceiling->second < floor_m)
+    ceiling_.erase(ceiling);
+  double& built = built_.try_emplace(index, floor_m).first->second;
+  built = std::max(built, floor_m);
+  heights_(cell) = std::max(heights_(cell), built);
+  assumed_(cell.row, cell.col) = 0;
+  bound_(cell.row, cell.col) = 0;
+}
+
 bool MappingSystem::rose_since_read(CellIndex cell) const {
   const long long index = static_cast<long long>(cell.row) * heights_.cols() + cell.col;
   const auto face = face_scan_.find(index);

@@ -84,6 +84,11 @@ class MappingSystem {
   /// adds to a height that is at most the truth never overshoots). The ceiling rises with the robot's own construction
   /// there (record_built()) and goes when a scan hits the cell again. Off-grid or unknown cells are ignored.
   void record_drop(CellIndex low, CellIndex high, double allowed_m, double margin_m);
+  /// The world says `cell` (world index, as the map registers it) stands at least floor_m [m] now (a deposition it
+  /// refused for the deposit bound named the height it would have left: that less the rise asked for). Kept as the
+  /// robot's own construction is (record_built()): the cell is at least that high from now on, whatever a stale
+  /// reading says. Unknown or off-grid cells and floors that are not finite are ignored.
+  void record_floor(CellIndex cell, double floor_m);
   /// The robot's own construction: the world accepted its request to raise `cell` (world index, as the map registers
   /// it) by rise_m [m]. Terrain only ever rises (depositions add material), so the cell is at least its map height
   /// plus rise_m from now on, whatever a later scan reads there: a scan may not see the top of what the robot just

@@ -30,6 +30,17 @@ std::optional<std::pair<CellIndex, CellIndex>> drop_named(const std::string& rea
   return std::make_pair(low, high);
 }
 
+std::optional<BoundRefusal> bound_named(const std::string& reason) {
+  const std::size_t at = reason.find("would leave cell (");
+  if (at == std::string::npos || reason.find("above the deposit bound") == std::string::npos) return std::nullopt;
+  BoundRefusal out;
+  if (std::sscanf(reason.c_str() + at, "would leave cell (%d, %d) at %lf m", &out.cell.row, &out.cell.col,
+                  &out.height_m) != 3 ||
+      !std::isfinite(out.height_m))
+    return std::nullopt;
+  return out;
+}
+
 bool refused_for_terrain(const std::string& reason) { return reason.find("not occupiable") != std::string::npos; }
 
 RefusedCells::RefusedCells(double ball_radius_cells, double change_m, std::uint64_t hold_steps)

@@ -26,6 +26,15 @@ std::optional<CellIndex> cell_named(const std::string& reason);
 /// first the lower, then the higher (world indices); nullopt when it names none.
 std::optional<std::pair<CellIndex, CellIndex>> drop_named(const std::string& reason);
 
+/// What a refusal for the deposit bound says (docs/runtime.md#deposit-bound, rules 3.5b and 3d.10): the cell and the
+/// height the request would have left it at ("... would leave cell (r, c) at h m, ... above the deposit bound ...")
+/// [world index, m]; nullopt for any other reason.
+struct BoundRefusal {
+  CellIndex cell;
+  double height_m = 0.0;
+};
+std::optional<BoundRefusal> bound_named(const std::string& reason);
+
 /// True when the reason says a cell is not occupiable for the body (rules 2.3, 2.4): the terrain there, not the
 /// neighbours.
 bool refused_for_terrain(const std::string& reason);

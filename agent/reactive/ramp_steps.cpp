@@ -189,6 +189,12 @@ void RampSteps::remember_result(const protocol::SensorFrame& frame) {
     } else if (named && !motion) {
       memory_.refusal = Memory::Refusal{cell, false, false, std::nullopt};
     }
+    // A deposition refused for the deposit bound names the height it would have left (in the cells the request
+    // named): the cell stands at that less the rise asked for, whatever the map read there (a stale reading,
+    // docs/runtime.md#deposit-bound).
+    if (const auto bound = executive::bound_named(frame.last_reason); bound && context_.type.sensor.casts_rays())
+      for (const Deposition& d : sent.layers)
+        if (CellIndex{d.row, d.col} == bound->cell) modules_->map.record_floor(bound->cell, bound->height_m - d.height_m);
   }
   sent = Sent{};
 }

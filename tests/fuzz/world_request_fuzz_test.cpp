@@ -476,6 +476,11 @@ void check_step(WorldState& state, const std::vector<Submission>& submissions,
     double volume = 0.0;
     for (const Deposition& d : r.depositions) {
       expected(d.row, d.col) += d.height_m;
+      if (before.deposit_bound.size() > 0) {  // rule 3.5b: at most 0.1 eps above the deposit bound
+        ASSERT_LE(expected(d.row, d.col), before.deposit_bound(d.row, d.col) +
+                                              0.1 * construction_params(was.type).eps_m + tol::kLengthM)
+            << report();
+      }
       expected_depositor[static_cast<std::size_t>(d.row) * expected.cols() + d.col] = was.id;
       volume += d.height_m * expected.cell_size_m() * expected.cell_size_m();
     }

@@ -71,10 +71,13 @@ WorldState world_state_at(const scenario::Scenario& scenario, Heightmap terrain,
     s.agents.push_back(std::move(a));
   }
   // docs/runtime.md#deposit-bound: one MARS of the initial terrain, at the slope of the flattest structure any robot
-  // of the team builds (the highest bound), so every robot may build what any other builds for. Only deposits (cube
-  // and cone robots) are judged by it: a team of layer robots does not pay for it.
-  const auto deposits = [](const AgentRecord& a) { return a.type.depositor.kind != DepositorKind::kLayer; };
-  if (std::any_of(s.agents.begin(), s.agents.end(), deposits)) {
+  // of the team builds (the highest bound), so every robot may build what any other builds for. A team that has a
+  // cube or cone robot, or a robot that builds from its own scans, is judged by it; a team of layer robots with exact
+  // maps (which never exceed it) does not pay for it.
+  const auto judged = [](const AgentRecord& a) {
+    return a.type.depositor.kind != DepositorKind::kLayer || a.type.sensor.casts_rays();
+  };
+  if (std::any_of(s.agents.begin(), s.agents.end(), judged)) {
     s.deposit_bound_kappa = construction_params(s.agents.front().type).kappa;
     for (const AgentRecord& a : s.agents)
       s.deposit_bound_kappa = std::min(s.deposit_bound_kappa, construction_params(a.type).kappa);

@@ -667,6 +667,25 @@ TEST(MappingSystem, ADropTheWorldNamedCapsTheOlderReadingUntilAScanHitsItAgain) 
   EXPECT_FALSE(map.is_known({0, 0}));
 }
 
+// A floor the world named (record_floor): the cell is at least that high from then on, as after the robot's own
+// construction, whatever an older reading says; unknown cells get none.
+TEST(MappingSystem, AFloorTheWorldNamedHoldsAgainstAStaleReading) {
+  MappingSystem map(GridGeometry{60, 60, 0.0, 0.0, 0.1}, 16, sensor_defaults(SensorKind::kLaser));
+  const Point3 origin{3.05, 3.05, 0.5};
+  const CellIndex cell{29, 35};
+  map.integrate_scan({{0.5F, 0.0F, -0.5F}, {0.4F, 0.0F, -0.5F}}, origin);  // read at 0 m
+  map.record_floor(cell, 0.325);
+  EXPECT_NEAR(map.heights()(cell), 0.325, 1e-9);
+  map.integrate_scan({{0.4F, 0.0F, -0.5F}, {0.6F, 0.0F, -0.5F}}, origin);  // around it, not on it
+  EXPECT_NEAR(map.heights()(cell), 0.325, 1e-9);
+  map.record_floor(cell, 0.2);  // a lower floor changes nothing
+  EXPECT_NEAR(map.heights()(cell), 0.325, 1e-9);
+  map.record_floor({0, 0}, 1.0);
+  map.record_floor(cell, std::numeric_limits<double>::quiet_NaN());
+  EXPECT_FALSE(map.is_known({0, 0}));
+  EXPECT_NEAR(map.heights()(cell), 0.325, 1e-9);
+}
+
 TEST(MappingSystem, ACellStoodOnKeepsItsBallUntilTheRobotBuildsInIt) {
   MappingSystem map(kWorld, 3);
   map.integrate({tile(0, 0, 3, 3, 1.0), tile(0, 1, 3, 3, 2.0), tile(1, 0, 2, 3, 3.0), tile(1, 1, 2, 3, 4.0)},

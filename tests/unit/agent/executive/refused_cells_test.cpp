@@ -31,6 +31,17 @@ TEST(RefusedCells, ReadsTheCellTheWorldsReasonsName) {
   EXPECT_EQ(drop_named(dropped)->first, (CellIndex{120, 131}));
   EXPECT_EQ(drop_named(dropped)->second, (CellIndex{119, 127}));
   EXPECT_FALSE(drop_named("target cell (99, 158) is not occupiable for this body").has_value());
+  // The deposit bound's refusals (rules 3.5b, 3d.10) name the height the request would have left.
+  const auto bound = bound_named("deposition would leave cell (113, 141) at 0.6 m, 0.27 m above the deposit bound "
+                                 "0.33 m (MARS of the initial terrain at kappa 0.3), more than 0.005 m");
+  ASSERT_TRUE(bound.has_value());
+  EXPECT_EQ(bound->cell, (CellIndex{113, 141}));
+  EXPECT_DOUBLE_EQ(bound->height_m, 0.6);
+  EXPECT_TRUE(bound_named("deposit at (2.85, 1.95) would leave cell (20, 28) at -0.0245 m, 0.0055 m above the deposit "
+                          "bound -0.03 m (MARS of the initial terrain at kappa 0.3), more than 0.005 m")
+                  .has_value());
+  EXPECT_FALSE(bound_named("deposition cell (7, 12) is under agent 2").has_value());
+  EXPECT_FALSE(bound_named("deposition would leave cell (1, 2) at nan m, x m above the deposit bound").has_value());
   EXPECT_FALSE(drop_named("target cell (1, 2) is not occupiable for this body: cell (3, x) lies").has_value());
 }
 

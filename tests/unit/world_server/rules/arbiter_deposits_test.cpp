@@ -286,6 +286,44 @@ TEST_F(DepositBound, ACubeColumnIsJudgedByTheSameBound) {
   EXPECT_NE(v.reason.find("above the deposit bound 0 m"), std::string::npos) << v.reason;
 }
 
+TEST_F(DepositBound, ALayerRobotsDepositionsAreJudgedByTheSameBound) {
+  // Agent 3 (layers of 0.0125 m: 0.05 m cubes on 0.1 m cells) at (1.05, 3.05), cell (9, 17) 0.7 m east of it. On flat
+  // ground the bound is the ground: one layer leaves the cell 0.0125 m above it, more than 0.1 eps (0.005 m).
+  const CellIndex cell{9, 17};
+  ASSERT_NEAR(state_.deposit_bound(cell), 0.0, 1e-12);
+  protocol::ActionRequest r = request_for(state_, 3);
+  r.depositions = {{cell.row, cell.col, 0.0125}};
+  const Verdict over = validate_request(state_, 3, r);
+  EXPECT_FALSE(over.accepted);
+  EXPECT_EQ(over.rule, 3);
+  EXPECT_NE(over.reason.find("deposition would leave cell (9, 17) at 0.0125 m, 0.0125 m above the deposit bound 0 m"),
+            std::string::npos)
+      << over.reason;
+  // Where the bound stands 0.02 m high (as beside a higher initial cell), one layer fits and three do not.
+  state_.deposit_bound(cell) = 0.02;
+  EXPECT_TRUE(validate_request(state_, 3, r).accepted);
+  r.depositions = {{cell.row, cell.col, 0.0375}};
+  EXPECT_FALSE(validate_request(state_, 3, r).accepted);
+}
+
+TEST(DepositBoundStart, ATeamOfLayerRobotsWithAScanningRobotHasTheBound) {
+  // Exact layer robots never build above the bound (they fill up to their map's MARS height); a robot that builds
+  // from its own scans may read a cell low and overshoot, so its team is judged.
+  std::string text = kScenario;
+  for (const char* kind : {"depositor { name: \"cube\" cube_size_m: 0.1 }", "depositor { name: \"cone\" repose_deg: 34 }"})
+    text.replace(text.find(kind), std::string(kind).size(), "");
+  text.insert(text.find("agent {"), "robot_type { name: \"scout\" behaviour: \"scripted\" body { kappa: 0.3 delta_m: 1.0 "
+                                    "eps_m: 0.05 max_step_m: 0.2 max_deposit_m3: 0.02 material_capacity_m3: 0.05 reach_m: "
+                                    "1.2 sensing_range_m: 1.0 proximity_range_m: 1.5 cube_size_m: 0.05 } sensor { name: "
+                                    "\"laser\" } }\n");
+  const std::string layers_only = text;
+  text.replace(text.find("robot_type: \"layerer\""), 21, "robot_type: \"scout\"");
+  const WorldState exact = make_world_state(scenario::parse_scenario(layers_only, "layers.pbtxt"), flat_terrain(), 3);
+  EXPECT_EQ(exact.deposit_bound.size(), 0);
+  const WorldState scanning = make_world_state(scenario::parse_scenario(text, "scanning.pbtxt"), flat_terrain(), 3);
+  EXPECT_EQ(scanning.deposit_bound.rows(), 40);
+}
+
 TEST(DepositBoundStart, ATeamOfLayerRobotsHasNoBound) {
   std::string text = kScenario;
   for (const char* kind : {"depositor { name: \"cube\" cube_size_m: 0.1 }", "depositor { name: \"cone\" repose_deg: 34 }"})
