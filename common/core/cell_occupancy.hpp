@@ -2,6 +2,8 @@
 // Whether one cell is occupiable (ARCHITECTURE.md, grid conventions): the single-cell question the world asks of every
 // motion and start, and the agent of its own body, answered exactly as NavigabilityProcessor answers it for a grid.
 
+#include <vector>
+
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/types.hpp"
 
@@ -19,6 +21,11 @@ enum class OccupancyMethod {
 /// cell is off the grid.
 bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
                      OccupancyMethod method = OccupancyMethod::kAutomatic);
+
+/// cell_occupiable() by every pair of `ball`, the offsets disc_offsets(delta / (2 cs)) the caller computed once for
+/// many cells of one grid (quadratic in the ball's size). Throws InvalidArgument when the cell is off the grid.
+bool cell_occupiable_in_ball(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
+                             const std::vector<CellIndex>& ball);
 
 /// 1 where the body ball of a cell (radius_cells = delta / (2 cs), disc_offsets) holds a cell that `known` marks 0:
 /// whether such a cell is occupiable cannot be judged (an agent's map, a robot's believed map). Cells off the mask do
