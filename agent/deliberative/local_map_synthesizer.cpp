@@ -88,6 +88,8 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
       if (local.blind(r, c) != 0) local.occupiable(r, c) = 0;
       if (local.known(r, c) == 0) local.gap(r, c) = 0.0;
     }
+  local.heights_occupiable = local.occupiable;
+  local.heights_navigability = params();
 
   // Ground the map only assumes (under and around the robot's body: KnownMap::assumed) is no deposition
   // target: building on it would never show in the map. A bound in a notch is filled up to its notch level

@@ -40,6 +40,11 @@ struct LocalMap {
   CellMask passable;                ///< where a deposition path may run: known cells; on a scanned map known cells
                                     ///< that are not blind, when they reach the local goal
   CellMask occupiable;              ///< occupiable cells; never a blind one
+  /// The cells the heights alone make occupiable for `heights_navigability` (NavigabilityProcessor::occupiable()),
+  /// 0 on blind cells: `occupiable` before the robot's own and stood-on cells are opened and any caller takes cells
+  /// out. Empty (0 x 0) on a map built without it.
+  CellMask heights_occupiable;
+  NavigabilityParams heights_navigability;  ///< the body heights_occupiable was computed for
   CellMask navigable;               ///< occupiable cells 8-connected to the robot's cell
   CellIndex robot;                  ///< the robot's cell
   std::optional<CellIndex> origin;  ///< the local origin, when some trajectory cell in the window is occupiable

@@ -205,44 +205,110 @@ bool reaches_border(const CellMask& reach) {
 bool DepositionManager::keeps_way_back(const deliberative::LocalMap& map, Position robot,
                                        const std::vector<DepositionCandidate>& depositions,
                                        const Neighbourhood& neighbours) const {
-  const auto cell = map.cell_at(robot);
-  if (!cell) return false;
+  if (!map.cell_at(robot)) return false;
   if (depositions.empty()) return true;
-  // Robots whose way back must survive: this one at its new position, then the neighbours in the window.
-  std::vector<CellIndex> robots{*cell};
+  WayBack context = way_back(map, robot, neighbours);
+  return keeps_way_back(context, depositions);
+}
+
+DepositionManager::WayBack DepositionManager::way_back(const deliberative::LocalMap& map, Position robot,
+                                                       const Neighbourhood& neighbours) const {
+  WayBack w;
+  w.map = &map;
+  w.neighbours = &neighbours;
+  w.cell = map.cell_at(robot);
+  return w;
+}
+
+void DepositionManager::prepare(WayBack& w) const {
+  const deliberative::LocalMap& map = *w.map;
+  w.ready = true;
   const double cs = map.geometry().cell_size_m;
+  // The heights' own occupiable cells: the synthesizer's when it judged them for this body, else computed here.
+  if (map.heights_navigability == params_.navigability && map.heights_occupiable.rows() == map.rows() &&
+      map.heights_occupiable.cols() == map.cols()) {
+    w.occupiable = map.heights_occupiable;
+  } else {
+    w.occupiable = navigability_.occupiable(map.heights);
+    for (int r = 0; r < map.rows(); ++r)
+      for (int c = 0; c < map.cols(); ++c)
+        if (map.blind(r, c) != 0) w.occupiable(r, c) = 0;
+  }
+  w.after = map.heights;
+  w.ball = disc_offsets(params_.navigability.delta_m / (2.0 * cs));
+  w.touched.assign(static_cast<std::size_t>(map.rows()) * map.cols(), 0);
+  if (!w.cell) return;
+  const CellIndex cell = *w.cell;
+  // Robots whose way back must survive: this one at its new position, then the neighbours in the window.
+  w.robots.push_back(cell);
   const auto step_disc = disc_offsets(params_.neighbour_step_m / cs);
-  for (const Neighbour& n : neighbours.others)
+  for (const Neighbour& n : w.neighbours->others)
     if (const auto c = map.cell_at(n.position))
       for (const CellIndex o : step_disc) {
         const CellIndex p{c->row + o.row, c->col + o.col};
-        if (map.contains(p)) robots.push_back(p);
+        if (map.contains(p)) w.robots.push_back(p);
       }
-  const bool has_origin = map.origin && map.occupiable(map.origin->row, map.origin->col) != 0;
-  const CellMask before = has_origin ? NavigabilityProcessor::navigable_from(map.occupiable, *map.origin) : CellMask();
+  w.has_origin = map.origin && map.occupiable(map.origin->row, map.origin->col) != 0;
+  if (w.has_origin) w.before = NavigabilityProcessor::navigable_from(map.occupiable, *map.origin);
+  // The reach before the depositions is the local map's own navigable mask when the robot stays on its cell.
+  w.had_way_out = map.occupiable(cell.row, cell.col) != 0 &&
+                  reaches_border(cell == map.robot && map.navigable.size() == map.occupiable.size()
+                                     ? map.navigable
+                                     : NavigabilityProcessor::navigable_from(map.occupiable, cell));
+}
 
-  Heightmap after = map.heights;
-  for (const auto& d : depositions) after(d.cell) += d.height_m;
-  CellMask occupiable = navigability_.occupiable(after);
-  for (int r = 0; r < map.rows(); ++r)
-    for (int c = 0; c < map.cols(); ++c)
-      if (map.blind(r, c) != 0) occupiable(r, c) = 0;
+CellMask DepositionManager::occupiable_after(WayBack& w, const std::vector<DepositionCandidate>& depositions) const {
+  if (!w.ready) prepare(w);
+  const deliberative::LocalMap& map = *w.map;
+  for (const auto& d : depositions) w.after(d.cell) += d.height_m;
+  // A cell's occupiability reads only the heights in its body ball: the cells whose ball holds a raised cell.
+  std::vector<CellIndex> changed;
+  for (const auto& d : depositions)
+    for (const CellIndex o : w.ball) {
+      const CellIndex p{d.cell.row - o.row, d.cell.col - o.col};
+      if (!map.contains(p)) continue;
+      std::uint8_t& t = w.touched[static_cast<std::size_t>(p.row) * map.cols() + p.col];
+      if (t != 0) continue;
+      t = 1;
+      changed.push_back(p);
+    }
+  for (const CellIndex p : changed) w.touched[static_cast<std::size_t>(p.row) * map.cols() + p.col] = 0;
+  CellMask occupiable;
+  // Each pair check costs the ball's size squared: beyond about the whole window's worth, the processor's full pass.
+  const double pair_work = static_cast<double>(changed.size()) * static_cast<double>(w.ball.size()) *
+                           static_cast<double>(w.ball.size());
+  if (pair_work > 64.0 * static_cast<double>(map.rows()) * map.cols()) {
+    occupiable = navigability_.occupiable(w.after);
+    for (int r = 0; r < map.rows(); ++r)
+      for (int c = 0; c < map.cols(); ++c)
+        if (map.blind(r, c) != 0) occupiable(r, c) = 0;
+  } else {
+    occupiable = w.occupiable;
+    for (const CellIndex p : changed)
+      occupiable(p.row, p.col) =
+          map.blind(p.row, p.col) == 0 && cell_occupiable_in_ball(w.after, p, params_.navigability, w.ball) ? 1 : 0;
+  }
+  for (const auto& d : depositions) w.after(d.cell) = map.heights(d.cell);
+  return occupiable;
+}
+
+bool DepositionManager::keeps_way_back(WayBack& w, const std::vector<DepositionCandidate>& depositions) const {
+  if (!w.cell) return false;
+  if (depositions.empty()) return true;
+  if (!w.ready) prepare(w);
+  const deliberative::LocalMap& map = *w.map;
+  const CellIndex cell = *w.cell;
+  const CellMask occupiable = occupiable_after(w, depositions);
   // This robot's own cell must stay occupiable if it was (the world checks only motion targets, but a robot on a
   // cell it cannot occupy has no navigable move).
-  if (map.occupiable(cell->row, cell->col) != 0 && occupiable(cell->row, cell->col) == 0) return false;
+  if (map.occupiable(cell.row, cell.col) != 0 && occupiable(cell.row, cell.col) == 0) return false;
   // And it must keep a way out of the window if it had one: near the start of its trajectory the local origin may
   // be its own cell, and a ring of deposits around it would pass the origin test below.
-  // (The reach before the depositions is the local map's own navigable mask when the robot stays on its cell.)
-  if (map.occupiable(cell->row, cell->col) != 0 &&
-      reaches_border(*cell == map.robot && map.navigable.size() == map.occupiable.size()
-                         ? map.navigable
-                         : NavigabilityProcessor::navigable_from(map.occupiable, *cell)) &&
-      !reaches_border(NavigabilityProcessor::navigable_from(occupiable, *cell)))
-    return false;
-  if (!has_origin) return true;
+  if (w.had_way_out && !reaches_border(NavigabilityProcessor::navigable_from(occupiable, cell))) return false;
+  if (!w.has_origin) return true;
   const CellMask reach = NavigabilityProcessor::navigable_from(occupiable, *map.origin);
-  for (const CellIndex p : robots)
-    if (before(p.row, p.col) != 0 && reach(p.row, p.col) == 0) return false;
+  for (const CellIndex p : w.robots)
+    if (w.before(p.row, p.col) != 0 && reach(p.row, p.col) == 0) return false;
   return true;
 }
 
@@ -251,12 +317,13 @@ DepositionPlan DepositionManager::plan(const deliberative::LocalMap& map, const 
   DepositionPlan plan;
   std::vector<DepositionCandidate> chosen = candidates(map, path, robot, material_m3, neighbours);
   plan.candidates = static_cast<int>(chosen.size());
-  if (!keeps_way_back(map, robot, chosen, neighbours)) {
+  WayBack way = way_back(map, robot, neighbours);
+  if (!keeps_way_back(way, chosen)) {
     // The longest prefix that keeps the way back (the empty one always does): binary search.
     std::size_t good = 0, bad = chosen.size();
     while (bad - good > 1) {
       const std::size_t mid = good + (bad - good) / 2;
-      if (keeps_way_back(map, robot, {chosen.begin(), chosen.begin() + static_cast<std::ptrdiff_t>(mid)}, neighbours))
+      if (keeps_way_back(way, {chosen.begin(), chosen.begin() + static_cast<std::ptrdiff_t>(mid)}))
         good = mid;
       else
         bad = mid;

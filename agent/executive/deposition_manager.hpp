@@ -130,7 +130,34 @@ class DepositionManager {
   bool keeps_way_back(const deliberative::LocalMap& map, Position robot,
                       const std::vector<DepositionCandidate>& depositions, const Neighbourhood& neighbours) const;
 
+  /// What keeps_way_back() judges every set of depositions of one step against, built once (at the first non-empty
+  /// set) and kept: the window's occupiable mask before them (blind cells never occupiable) and the reaches before
+  /// them, which do not depend on the depositions tried. A search over prefixes of a deposition list asks it many
+  /// times. It refers to the map and neighbourhood given to way_back(), which must outlive it.
+  struct WayBack {
+    const deliberative::LocalMap* map = nullptr;
+    const Neighbourhood* neighbours = nullptr;
+    bool ready = false;             ///< the members below are built
+    std::optional<CellIndex> cell;  ///< the robot's cell, nullopt when it is outside the window
+    std::vector<CellIndex> robots;  ///< this robot's cell, then each neighbour's cells within its step
+    bool has_origin = false;        ///< the local origin is occupiable on the map
+    CellMask before;                ///< cells navigable from the local origin before the depositions
+    bool had_way_out = false;       ///< the robot's cell was occupiable and reached the window's border
+    CellMask occupiable;            ///< NavigabilityProcessor::occupiable(map.heights), 0 on blind cells
+    Heightmap after;                ///< scratch: map.heights with the depositions tried, restored after each try
+    std::vector<CellIndex> ball;    ///< the body ball's offsets (delta / 2)
+    std::vector<std::uint8_t> touched;  ///< scratch: 0 per window cell between tries
+  };
+  WayBack way_back(const deliberative::LocalMap& map, Position robot, const Neighbourhood& neighbours) const;
+  /// keeps_way_back() on the context of way_back() (the same answer).
+  bool keeps_way_back(WayBack& context, const std::vector<DepositionCandidate>& depositions) const;
+  /// The window's occupiable mask after `depositions` (blind cells never occupiable): the mask before them,
+  /// recomputed only on the cells whose body ball holds a raised cell; equal, cell by cell, to
+  /// NavigabilityProcessor::occupiable() of the raised heights with the blind cells cleared.
+  CellMask occupiable_after(WayBack& context, const std::vector<DepositionCandidate>& depositions) const;
+
  private:
+  void prepare(WayBack& context) const;
   bool in_territory(const deliberative::LocalMap& map, CellIndex cell, Position centre, const Neighbourhood& neighbours,
                     std::optional<CellIndex> self_cell) const;
   DepositionParams params_;

@@ -27,11 +27,12 @@ DepositionPlan keep_way_back(const DepositionManager& manager, const deliberativ
   DepositionPlan plan;
   plan.candidates = static_cast<int>(placed.size());
   std::size_t good = placed.size();
-  if (!manager.keeps_way_back(map, robot, rises_of(good), neighbours)) {
+  DepositionManager::WayBack way = manager.way_back(map, robot, neighbours);
+  if (!manager.keeps_way_back(way, rises_of(good))) {
     std::size_t ok = 0, bad = placed.size();
     while (bad - ok > 1) {
       const std::size_t mid = ok + (bad - ok) / 2;
-      (manager.keeps_way_back(map, robot, rises_of(mid), neighbours) ? ok : bad) = mid;
+      (manager.keeps_way_back(way, rises_of(mid)) ? ok : bad) = mid;
     }
     good = ok;
   }

@@ -195,14 +195,18 @@ CellMask band_mask(const deliberative::LocalMap& local, const std::vector<std::v
   return out;
 }
 
-Heightmap band_fill_gap(const deliberative::LocalMap& local, const CellMask& band, double kappa) {
+Heightmap band_sources(const deliberative::LocalMap& local, const CellMask& band) {
   // The lowest height of the window is no source: every cone from it lies under every cell.
   Heightmap sources = local.heights;
   const double low = local.heights.heights().minCoeff();
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c)
       if (band(r, c) == 0) sources(r, c) = low;
-  return gap_below_bound_of(local, sources, kappa);
+  return sources;
+}
+
+Heightmap band_fill_gap(const deliberative::LocalMap& local, const CellMask& band, double kappa) {
+  return gap_below_bound_of(local, band_sources(local, band), kappa);
 }
 
 Heightmap gap_below_bound_of(const deliberative::LocalMap& local, const Heightmap& sources, double kappa) {

@@ -65,6 +65,8 @@ CellMask band_mask(const deliberative::LocalMap& local, const std::vector<std::v
 /// structure beside the band, natural or built, neither raise the band's target nor are filled from it by more
 /// than the band's own slopes ask.
 Heightmap band_fill_gap(const deliberative::LocalMap& local, const CellMask& band, double kappa);
+/// h_band of band_fill_gap(): the window's heights on the cells of `band`, its lowest height elsewhere [m].
+Heightmap band_sources(const deliberative::LocalMap& local, const CellMask& band);
 /// The window's gap capped by another surface's bound: min(local.gap, max(0, P_kappa[sources] - h)) [m] per cell,
 /// `sources` [m] the window's size (band_fill_gap: the band's heights; first_seen_gap: the heights first seen).
 Heightmap gap_below_bound_of(const deliberative::LocalMap& local, const Heightmap& sources, double kappa);

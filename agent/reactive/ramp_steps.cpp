@@ -374,12 +374,24 @@ std::vector<CellIndex> RampSteps::on_band_centre(const deliberative::LocalMap& l
   return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m, &built);
 }
 
-Heightmap RampSteps::band_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const {
+Heightmap RampSteps::band_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) {
   if (!(corridor_width_m_ > 0.0)) return local.gap;
   // What is left to fill is judged against the band's own slope: the terrain and structure beside it (other fronts'
-  // strips, high ground along the way) neither raise its target nor widen it.
+  // strips, high ground along the way) neither raise its target nor widen it (executive::band_fill_gap). A robot
+  // that waits or is refused sees the same band on the same heights: it reuses the last bound.
   const CellMask band = executive::band_mask(local, {ahead}, 0.5 * corridor_width_m_);
-  return executive::band_fill_gap(local, band, construction_params(context_.type).kappa);
+  return executive::gap_below(local,
+                              bound_of(memory_.band_bound, local.offset, executive::band_sources(local, band)));
+}
+
+const Heightmap& RampSteps::bound_of(PlanBound& memo, CellIndex offset, Heightmap sources) const {
+  if (!(memo.offset == offset && memo.first.rows() == sources.rows() && memo.first.cols() == sources.cols() &&
+        (memo.first.heights().array() == sources.heights().array()).all())) {
+    memo.bound = MarsProcessor(construction_params(context_.type).kappa).project(sources);
+    memo.first = std::move(sources);
+    memo.offset = offset;
+  }
+  return memo.bound;
 }
 
 CellMask RampSteps::built_cells(const deliberative::LocalMap& local) const {
@@ -395,15 +407,8 @@ Heightmap RampSteps::plan_gap(const deliberative::LocalMap& local) {
   // send the next front round it, to build a strip of its own (docs/runtime.md#the-construction-band).
   // The bound of the first-seen heights changes only when the window moves or sees new cells: a robot building in
   // place reuses the last one.
-  Heightmap first = executive::first_seen_heights(local, *memory_.raised);
-  PlanBound& last = memory_.plan_bound;
-  if (!(last.offset == local.offset && last.first.rows() == first.rows() && last.first.cols() == first.cols() &&
-        (last.first.heights().array() == first.heights().array()).all())) {
-    last.bound = MarsProcessor(construction_params(context_.type).kappa).project(first);
-    last.first = std::move(first);
-    last.offset = local.offset;
-  }
-  Heightmap gap = executive::gap_below(local, last.bound);
+  Heightmap gap = executive::gap_below(
+      local, bound_of(memory_.plan_bound, local.offset, executive::first_seen_heights(local, *memory_.raised)));
   // What is built is the structure: its cells cost nothing, so a front that meets a strip drives on along it and
   // extends it at its tip.
   const CellMask built = built_cells(local);

@@ -207,12 +207,16 @@ class RampSteps {
     std::vector<Deposit> deposits;
   };
   /// What the steps remember from one frame to the next.
-  // plan_gap(): the last window's first-seen heights and their MARS bound at the construction kappa.
+  // plan_gap(), band_gap(): the last window's sources (the first-seen heights, the band's heights) and their MARS
+  // bound at the construction kappa.
   struct PlanBound {
     CellIndex offset{-1, -1};
     Heightmap first;
     Heightmap bound;
   };
+  // The MARS bound of `sources` (window at `offset`) at the construction kappa, from `memo` when its sources are
+  // these, bit for bit.
+  const Heightmap& bound_of(PlanBound& memo, CellIndex offset, Heightmap sources) const;
   struct Memory {
     Sent sent;
     /// The world gives deposits (cube, cone) their shape and may judge one the prediction passed: after a rejected
@@ -243,6 +247,7 @@ class RampSteps {
     double return_nearest_m = std::numeric_limits<double>::infinity();  ///< this trip's nearest to the base [m]
     int return_no_nearer = 0;  ///< return steps since the robot last got nearer the base than return_nearest_m
     PlanBound plan_bound;  ///< plan_gap()'s memo
+    PlanBound band_bound;  ///< band_gap()'s memo
     std::optional<executive::RaisedCells> raised;  ///< set_band_centre(): the structure seen built (first heights)
     Position target;                               ///< this frame's target (synthesize_view()) [m]
   };
@@ -258,7 +263,7 @@ class RampSteps {
   // set_band_centre(): `ahead` (local indices, from where the robot will stand) on the corridor's centre line.
   std::vector<CellIndex> on_band_centre(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const;
   // set_band_centre(): the window's gap against the band along `ahead` alone (executive::band_fill_gap).
-  Heightmap band_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const;
+  Heightmap band_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead);
   // set_band_centre(): the price the planner routes by: the window's gap against the terrain as first seen
   // (executive::first_seen_gap), so what is built raises no price beside it, and 0 on the cells built (built_cells).
   Heightmap plan_gap(const deliberative::LocalMap& local);

@@ -93,6 +93,14 @@ std::optional<OccupancyBreach> occupancy_breach(const Heightmap& terrain, CellIn
   return worst;
 }
 
+bool cell_occupiable_in_ball(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
+                             const std::vector<CellIndex>& ball) {
+  if (!terrain.contains(cell))
+    throw InvalidArgument(
+        fmt::format("cell_occupiable: cell {} is off the {} x {} grid", cell, terrain.rows(), terrain.cols()));
+  return occupiable_by_pairs(terrain, cell, params, ball);
+}
+
 CellMask blind_cells(const CellMask& known, double radius_cells) {
   const int rows = static_cast<int>(known.rows()), cols = static_cast<int>(known.cols());
   CellMask blind = CellMask::Zero(rows, cols);

@@ -3,6 +3,7 @@
 // motion and start, and the agent of its own body, answered exactly as NavigabilityProcessor answers it for a grid.
 
 #include <optional>
+#include <vector>
 
 #include "marsala/core/heightmap.hpp"
 #include "marsala/core/types.hpp"
@@ -34,6 +35,11 @@ struct OccupancyBreach {
 /// would feel: where its body found a drop. Throws InvalidArgument when the cell is off the grid.
 std::optional<OccupancyBreach> occupancy_breach(const Heightmap& terrain, CellIndex cell,
                                                 const NavigabilityParams& params);
+
+/// cell_occupiable() by every pair of `ball`, the offsets disc_offsets(delta / (2 cs)) the caller computed once for
+/// many cells of one grid (quadratic in the ball's size). Throws InvalidArgument when the cell is off the grid.
+bool cell_occupiable_in_ball(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,
+                             const std::vector<CellIndex>& ball);
 
 /// 1 where the body ball of a cell (radius_cells = delta / (2 cs), disc_offsets) holds a cell that `known` marks 0:
 /// whether such a cell is occupiable cannot be judged (an agent's map, a robot's believed map). Cells off the mask do

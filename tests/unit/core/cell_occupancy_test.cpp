@@ -26,6 +26,7 @@ TEST(CellOccupiable, MatchesTheNavigabilityProcessorOnRoughTerrains) {
     for (long long i = 0; i < h.size(); ++i) h.data()[i] = noise(rng) + (spike(rng) < 0.03 ? 0.3 : 0.0);
     const NavigabilityParams params{0.3, 0.4 + 0.15 * trial, 0.05};
     const CellMask want = NavigabilityProcessor(params).occupiable(h);
+    const std::vector<CellIndex> ball = disc_offsets(params.delta_m / (2.0 * g.cell_size_m));
     int occupiable = 0;
     for (int r = 0; r < h.rows(); ++r)
       for (int c = 0; c < h.cols(); ++c) {
@@ -33,6 +34,7 @@ TEST(CellOccupiable, MatchesTheNavigabilityProcessorOnRoughTerrains) {
         ASSERT_EQ(cell_occupiable(h, {r, c}, params, OccupancyMethod::kPairs), want(r, c) != 0)
             << "trial " << trial << " cell " << r << ", " << c;
         ASSERT_EQ(cell_occupiable(h, {r, c}, params, OccupancyMethod::kWindow), want(r, c) != 0);
+        ASSERT_EQ(cell_occupiable_in_ball(h, {r, c}, params, ball), want(r, c) != 0);
       }
     // Both answers occur, so the comparison means something.
     EXPECT_GT(occupiable, 0) << trial;
@@ -92,6 +94,7 @@ TEST(CellOccupiable, OffGridThrows) {
   g.cols = 4;
   EXPECT_THROW(cell_occupiable(Heightmap(g, 0.0), {4, 0}, {}), InvalidArgument);
   EXPECT_THROW(cell_occupiable(Heightmap(g, 0.0), {0, -1}, {}), InvalidArgument);
+  EXPECT_THROW(cell_occupiable_in_ball(Heightmap(g, 0.0), {0, 4}, {}, disc_offsets(1.0)), InvalidArgument);
 }
 
 TEST(OccupancyBreach, NamesThePairThatBreaksTheRuleByTheMostExactlyWhereTheCellIsNotOccupiable) {

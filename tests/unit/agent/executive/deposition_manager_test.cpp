@@ -4,11 +4,14 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <set>
 #include <utility>
 
 #include "unit/agent/agent_test_support.hpp"
+#include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/iterators.hpp"
 #include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::agent::executive {
@@ -331,6 +334,146 @@ TEST(DepositionManager, AGapOnTheLineToTheTargetOffThePathIsACandidateAlongThatL
   EXPECT_EQ(c[1].cell, (CellIndex{15, 10}));
   EXPECT_EQ(c[0].layers, 5);
   EXPECT_EQ(c[1].layers, 5);
+}
+
+/// The way-back check as first written, the reference for the incremental one: the whole window's occupiable mask
+/// recomputed from the raised heights, and every reach before the depositions searched again.
+bool reaches_border_ref(const CellMask& reach) {
+  const auto rows = reach.rows(), cols = reach.cols();
+  for (Eigen::Index r = 0; r < rows; ++r)
+    for (Eigen::Index c = 0; c < cols; ++c)
+      if ((r == 0 || c == 0 || r == rows - 1 || c == cols - 1) && reach(r, c) != 0) return true;
+  return false;
+}
+
+CellMask occupiable_after_ref(const LocalMap& map, const NavigabilityParams& nav,
+                              const std::vector<DepositionCandidate>& depositions) {
+  Heightmap after = map.heights;
+  for (const auto& d : depositions) after(d.cell) += d.height_m;
+  CellMask occupiable = NavigabilityProcessor(nav).occupiable(after);
+  for (int r = 0; r < map.rows(); ++r)
+    for (int c = 0; c < map.cols(); ++c)
+      if (map.blind(r, c) != 0) occupiable(r, c) = 0;
+  return occupiable;
+}
+
+bool keeps_way_back_ref(const LocalMap& map, const DepositionParams& p, Position robot,
+                        const std::vector<DepositionCandidate>& depositions, const Neighbourhood& neighbours) {
+  const auto cell = map.cell_at(robot);
+  if (!cell) return false;
+  if (depositions.empty()) return true;
+  std::vector<CellIndex> robots{*cell};
+  const double cs = map.geometry().cell_size_m;
+  for (const Neighbour& n : neighbours.others)
+    if (const auto c = map.cell_at(n.position))
+      for (const CellIndex o : disc_offsets(p.neighbour_step_m / cs)) {
+        const CellIndex q{c->row + o.row, c->col + o.col};
+        if (map.contains(q)) robots.push_back(q);
+      }
+  const bool has_origin = map.origin && map.occupiable(map.origin->row, map.origin->col) != 0;
+  const CellMask occupiable = occupiable_after_ref(map, p.navigability, depositions);
+  if (map.occupiable(cell->row, cell->col) != 0 && occupiable(cell->row, cell->col) == 0) return false;
+  if (map.occupiable(cell->row, cell->col) != 0 &&
+      reaches_border_ref(NavigabilityProcessor::navigable_from(map.occupiable, *cell)) &&
+      !reaches_border_ref(NavigabilityProcessor::navigable_from(occupiable, *cell)))
+    return false;
+  if (!has_origin) return true;
+  const CellMask before = NavigabilityProcessor::navigable_from(map.occupiable, *map.origin);
+  const CellMask reach = NavigabilityProcessor::navigable_from(occupiable, *map.origin);
+  for (const CellIndex q : robots)
+    if (before(q.row, q.col) != 0 && reach(q.row, q.col) == 0) return false;
+  return true;
+}
+
+/// A random small window: terraces and rough patches (heights on a 0.0125 m lattice, so pairs land exactly on the
+/// eps threshold too), some unknown cells and their blind balls, the robot and the origin anywhere.
+struct RandomWindow {
+  LocalMap map;
+  Position robot;
+  Neighbourhood neighbours;
+};
+
+RandomWindow random_window(std::mt19937& rng, const NavigabilityParams& nav, bool synthesized) {
+  std::uniform_int_distribution<int> rows_d(6, 16), cols_d(6, 16), level(0, 8), coin(0, 3);
+  const GridGeometry grid{rows_d(rng), cols_d(rng), 0.0, 0.0, kCs};
+  Heightmap h(grid, 0.0);
+  const int terrace = std::uniform_int_distribution<int>(0, grid.cols - 1)(rng);
+  for (int r = 0; r < grid.rows; ++r)
+    for (int c = 0; c < grid.cols; ++c)
+      h(r, c) = (c >= terrace ? 4 * kQ : 0.0) + (coin(rng) == 0 ? level(rng) * kQ : 0.0);
+  std::uniform_int_distribution<int> row_d(0, grid.rows - 1), col_d(0, grid.cols - 1);
+  const CellIndex robot{row_d(rng), col_d(rng)};
+  const CellIndex origin{row_d(rng), col_d(rng)};
+  RandomWindow w{test::make_local_map(h, Heightmap(grid, 0.0), nav, robot, origin), grid.cell_center(robot),
+                 {1, grid.cell_center(robot), {}}};
+  CellMask known = CellMask::Ones(grid.rows, grid.cols);
+  if (coin(rng) != 0)
+    for (int k = std::uniform_int_distribution<int>(1, 4)(rng); k > 0; --k) known(row_d(rng), col_d(rng)) = 0;
+  w.map.known = known;
+  w.map.blind = blind_cells(known, nav.delta_m / (2.0 * kCs));
+  for (int r = 0; r < grid.rows; ++r)
+    for (int c = 0; c < grid.cols; ++c)
+      if (w.map.blind(r, c) != 0) w.map.occupiable(r, c) = 0;
+  if (synthesized) {  // as the synthesizer leaves it: the heights' own mask kept before any cell is opened
+    w.map.heights_occupiable = w.map.occupiable;
+    w.map.heights_navigability = nav;
+  }
+  // A scanned map opens the robot's own cell whatever its heights say.
+  if (coin(rng) == 0) w.map.occupiable(robot.row, robot.col) = 1;
+  w.map.navigable = NavigabilityProcessor::navigable_from(w.map.occupiable, robot);
+  for (int k = std::uniform_int_distribution<int>(0, 2)(rng); k > 0; --k) {
+    const Position n = grid.cell_center({row_d(rng), col_d(rng)});
+    w.neighbours.others.push_back({static_cast<std::uint32_t>(2 + k), n, 0.0, 0.2});
+  }
+  return w;
+}
+
+std::vector<DepositionCandidate> random_depositions(std::mt19937& rng, const LocalMap& map) {
+  std::uniform_int_distribution<int> count(0, 40), row_d(0, map.rows() - 1), col_d(0, map.cols() - 1), layers(1, 8);
+  std::vector<DepositionCandidate> out;
+  for (int k = count(rng); k > 0; --k) {
+    const int n = layers(rng);
+    out.push_back({{row_d(rng), col_d(rng)}, n, n * kQ});  // a cell may repeat: the cube depositors' rises do
+  }
+  return out;
+}
+
+// keeps_way_back() recomputes occupiability only where a deposit lies in a cell's body ball, and searches the reaches
+// before the depositions once per context: against the whole-window recomputation on random windows, cell by cell,
+// for every prefix of random deposition lists (as the binary search asks them), with and without the synthesizer's
+// mask, and for bodies whose balls hold 5 to 29 cells.
+TEST(DepositionManager, IncrementalWayBackEqualsTheFullRecomputation) {
+  std::mt19937 rng(20261129);
+  int differing_masks = 0, kept = 0, refused = 0;
+  for (const double delta : {0.2, 0.4, 0.6}) {
+    DepositionParams p = params(delta);
+    const DepositionManager dm(p);
+    for (int trial = 0; trial < 150; ++trial) {
+      const RandomWindow w = random_window(rng, p.navigability, trial % 2 == 0);
+      const auto deps = random_depositions(rng, w.map);
+      DepositionManager::WayBack way = dm.way_back(w.map, w.robot, w.neighbours);
+      for (std::size_t n = 0; n <= deps.size(); ++n) {
+        const std::vector<DepositionCandidate> prefix(deps.begin(), deps.begin() + static_cast<std::ptrdiff_t>(n));
+        const CellMask want = occupiable_after_ref(w.map, p.navigability, prefix);
+        const CellMask got = dm.occupiable_after(way, prefix);
+        ASSERT_EQ(got.rows(), want.rows());
+        ASSERT_EQ(got.cols(), want.cols());
+        for (int r = 0; r < want.rows(); ++r)
+          for (int c = 0; c < want.cols(); ++c)
+            ASSERT_EQ(got(r, c), want(r, c)) << "delta " << delta << " trial " << trial << " prefix " << n << " cell ("
+                                             << r << ", " << c << ")";
+        if (want != w.map.heights_occupiable && w.map.heights_occupiable.size() != 0) ++differing_masks;
+        const bool ref = keeps_way_back_ref(w.map, p, w.robot, prefix, w.neighbours);
+        ASSERT_EQ(dm.keeps_way_back(way, prefix), ref) << "delta " << delta << " trial " << trial << " prefix " << n;
+        ASSERT_EQ(dm.keeps_way_back(w.map, w.robot, prefix, w.neighbours), ref);
+        ++(ref ? kept : refused);
+      }
+    }
+  }
+  // The draws exercise both answers and masks the deposits really change.
+  EXPECT_GT(differing_masks, 100);
+  EXPECT_GT(kept, 100);
+  EXPECT_GT(refused, 100);
 }
 
 TEST(DepositionManager, RejectsInvalidLimits) {
