@@ -512,11 +512,8 @@ void MappingSystem::record_built(CellIndex cell, double rise_m) {
       known_(cell.row, cell.col) != 0 &&
       (assumed_(cell.row, cell.col) == 0 || face_floor_.count(index) > 0 || built_.count(index) > 0);
   if (!surface_read) return;
-  const double floor_m = heights_(cell) + rise_m;
   if (const auto ceiling = ceiling_.find(index); ceiling != ceiling_.end()) ceiling->second += rise_m;
-  double& built = built_.try_emplace(index, floor_m).first->second;
-  built = std::max(built, floor_m);
-  heights_(cell) = std::max(heights_(cell), built);
+  keep_floor(cell, heights_(cell) + rise_m);
 }
 
 void MappingSystem::record_floor(CellIndex cell, double floor_m) {
@@ -524,11 +521,16 @@ void MappingSystem::record_floor(CellIndex cell, double floor_m) {
   const long long index = static_cast<long long>(cell.row) * heights_.cols() + cell.col;
   if (const auto ceiling = ceiling_.find(index); ceiling != ceiling_.end() && ceiling->second < floor_m)
     ceiling_.erase(ceiling);
+  keep_floor(cell, floor_m);
+  assumed_(cell.row, cell.col) = 0;
+  bound_(cell.row, cell.col) = 0;
+}
+
+void MappingSystem::keep_floor(CellIndex cell, double floor_m) {
+  const long long index = static_cast<long long>(cell.row) * heights_.cols() + cell.col;
   double& built = built_.try_emplace(index, floor_m).first->second;
   built = std::max(built, floor_m);
   heights_(cell) = std::max(heights_(cell), built);
-  assumed_(cell.row, cell.col) = 0;
-  bound_(cell.row, cell.col) = 0;
 }
 
 bool MappingSystem::rose_since_read(CellIndex cell) const {

@@ -163,6 +163,7 @@ class MappingSystem {
   bool was_assumed_ground(CellIndex cell) const;        // known only from assume_ground(): never hit, no face
   bool rose_since_read(CellIndex cell) const;  // its surface was last read before a scan that raised its face floor
   void forget(CellIndex cell);                 // unknown again
+  void keep_floor(CellIndex cell, double floor_m);  // built_: the cell is at least floor_m from now on [m]
   // forget_assumed_ground()'s edge: the guessed cells connected to `seeds` outside every ball the robot stood in.
   void forget_along_edge(const std::vector<CellIndex>& seeds, double radius_cells);
   void rederive_heights(const ScanBatch& batch);

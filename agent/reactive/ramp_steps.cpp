@@ -175,17 +175,16 @@ void RampSteps::remember_result(const protocol::SensorFrame& frame) {
   // The world names cells in its own grid; the map registers them shifted by the localisation offset.
   memory_.refusal.reset();
   if (rejected) {
+    const auto registered = [&](CellIndex c) { return CellIndex{c.row + registration_.row, c.col + registration_.col}; };
     const auto named = executive::cell_named(frame.last_reason);
     CellIndex cell = sent.motion.value_or(CellIndex{});
-    if (named) cell = {named->row + registration_.row, named->col + registration_.col};
+    if (named) cell = registered(*named);
     const auto starts = [&](const char* word) { return frame.last_reason.rfind(word, 0) == 0; };
     const bool motion = !starts("deposit") && !starts("refill") && !starts("robot type");  // rules 1, 2
     if (sent.motion && motion) {
       memory_.refusal = Memory::Refusal{cell, executive::refused_for_terrain(frame.last_reason), true, std::nullopt};
       if (const auto drop = executive::drop_named(frame.last_reason))
-        memory_.refusal->drop = std::make_pair(
-            CellIndex{drop->first.row + registration_.row, drop->first.col + registration_.col},
-            CellIndex{drop->second.row + registration_.row, drop->second.col + registration_.col});
+        memory_.refusal->drop = std::make_pair(registered(drop->first), registered(drop->second));
     } else if (named && !motion) {
       memory_.refusal = Memory::Refusal{cell, false, false, std::nullopt};
     }

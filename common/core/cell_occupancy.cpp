@@ -17,27 +17,35 @@ namespace {
 // Balls above this many cells are checked by the processor on a window: the pair check is quadratic.
 constexpr std::size_t kMaxPairBallCells = 2000;
 
-bool occupiable_by_pairs(const Heightmap& h, CellIndex cell, const NavigabilityParams& p,
-                         const std::vector<CellIndex>& offsets) {
-  struct BallCell {
-    int dr, dc;
-    double height;
-  };
+/// The cells of `cell`'s ball on the grid (offsets `offsets`) with their heights.
+struct BallCell {
+  CellIndex cell;
+  double height;
+};
+std::vector<BallCell> ball_cells(const Heightmap& h, CellIndex cell, const std::vector<CellIndex>& offsets) {
   std::vector<BallCell> ball;
   ball.reserve(offsets.size());
   for (const CellIndex& o : offsets) {
     const CellIndex c{cell.row + o.row, cell.col + o.col};
-    if (h.contains(c)) ball.push_back({o.row, o.col, h(c)});
+    if (h.contains(c)) ball.push_back({c, h(c)});
   }
+  return ball;
+}
+
+/// How much the heights of two ball cells may differ [m]: the expression NavigabilityProcessor's kernel uses, so that
+/// ties are decided identically.
+double pair_threshold(const NavigabilityParams& p, double cs, const BallCell& a, const BallCell& b) {
+  const long long dr = a.cell.row - b.cell.row, dc = a.cell.col - b.cell.col;
+  return p.eps_m + p.kappa * (cs * std::sqrt(static_cast<double>(dr * dr + dc * dc))) + tolerance::kHeightM;
+}
+
+bool occupiable_by_pairs(const Heightmap& h, CellIndex cell, const NavigabilityParams& p,
+                         const std::vector<CellIndex>& offsets) {
+  const std::vector<BallCell> ball = ball_cells(h, cell, offsets);
   const double cs = h.cell_size_m();
   for (std::size_t a = 0; a < ball.size(); ++a)
-    for (std::size_t b = a + 1; b < ball.size(); ++b) {
-      const long long dr = ball[a].dr - ball[b].dr, dc = ball[a].dc - ball[b].dc;
-      // The expression NavigabilityProcessor's kernel uses, so that ties are decided identically.
-      const double threshold =
-          p.eps_m + p.kappa * (cs * std::sqrt(static_cast<double>(dr * dr + dc * dc))) + tolerance::kHeightM;
-      if (std::abs(ball[a].height - ball[b].height) > threshold) return false;
-    }
+    for (std::size_t b = a + 1; b < ball.size(); ++b)
+      if (std::abs(ball[a].height - ball[b].height) > pair_threshold(p, cs, ball[a], ball[b])) return false;
   return true;
 }
 
@@ -71,24 +79,19 @@ std::optional<OccupancyBreach> occupancy_breach(const Heightmap& terrain, CellIn
   if (!terrain.contains(cell))
     throw InvalidArgument(
         fmt::format("occupancy_breach: cell {} is off the {} x {} grid", cell, terrain.rows(), terrain.cols()));
-  std::vector<CellIndex> ball;
-  for (const CellIndex& o : disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m()))) {
-    const CellIndex c{cell.row + o.row, cell.col + o.col};
-    if (terrain.contains(c)) ball.push_back(c);
-  }
+  // The pairs occupiable_by_pairs() judges, by the same threshold, so that a breach is found exactly where it says no.
+  const std::vector<BallCell> ball =
+      ball_cells(terrain, cell, disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m())));
   const double cs = terrain.cell_size_m();
   std::optional<OccupancyBreach> worst;
   double worst_excess = 0.0;
   for (std::size_t a = 0; a < ball.size(); ++a)
     for (std::size_t b = a + 1; b < ball.size(); ++b) {
-      const long long dr = ball[a].row - ball[b].row, dc = ball[a].col - ball[b].col;
-      // The threshold expression of occupiable_by_pairs, so that a breach is found exactly where it says no.
-      const double threshold =
-          params.eps_m + params.kappa * (cs * std::sqrt(static_cast<double>(dr * dr + dc * dc))) + tolerance::kHeightM;
-      const double excess = std::abs(terrain(ball[a]) - terrain(ball[b])) - threshold;
+      const double excess = std::abs(ball[a].height - ball[b].height) - pair_threshold(params, cs, ball[a], ball[b]);
       if (!(excess > worst_excess)) continue;
       worst_excess = excess;
-      worst = terrain(ball[a]) < terrain(ball[b]) ? OccupancyBreach{ball[a], ball[b]} : OccupancyBreach{ball[b], ball[a]};
+      const bool a_low = ball[a].height < ball[b].height;
+      worst = OccupancyBreach{a_low ? ball[a].cell : ball[b].cell, a_low ? ball[b].cell : ball[a].cell};
     }
   return worst;
 }

@@ -63,8 +63,8 @@ const AgentRecord* agent_over(const WorldState& state, const AgentRecord& me, do
 
 /// Rules 3.5b and 3d.10 (docs/runtime.md#deposit-bound): what `me` deposits may leave `cell` at `height_m` [m] only
 /// up to the deposit bound plus kDepositOvershootFraction of `me`'s construction eps; nullopt when it passes (or the
-/// state has no bound). `what` names the deposition or deposit at the start of the reason.
-std::optional<std::string> bound_problem(const WorldState& state, const AgentRecord& me, const std::string& what,
+/// state has no bound). The reason names `deposit`, or "deposition" (a layer robot's) when it is null.
+std::optional<std::string> bound_problem(const WorldState& state, const AgentRecord& me, const Deposit* deposit,
                                          CellIndex cell, double height_m) {
   if (state.deposit_bound.rows() != state.terrain.rows() || state.deposit_bound.cols() != state.terrain.cols())
     return std::nullopt;
@@ -74,7 +74,8 @@ std::optional<std::string> bound_problem(const WorldState& state, const AgentRec
   return fmt::format(
       "{} would leave cell {} at {} m, {} m above the deposit bound {} m (MARS of the initial terrain at kappa {}), "
       "more than {} m",
-      what, cell, height_m, height_m - bound, bound, state.deposit_bound_kappa, allowed);
+      deposit ? fmt::format("deposit at {}", at(*deposit)) : std::string("deposition"), cell, height_m,
+      height_m - bound, bound, state.deposit_bound_kappa, allowed);
 }
 
 /// Rule 3 for a cube or cone depositor (docs/runtime.md#rule-3-deposits), judged from (x, y), the position after the
@@ -123,7 +124,7 @@ Verdict validate_deposits(const WorldState& state, const AgentRecord& me, double
       if (!(total <= kMaxDepositionM + tol::kLengthM))
         return reject(
             fmt::format("deposit at {} raises cell {} by {} m in this request, more than 1 m", at(d), c.cell, total));
-      if (auto problem = bound_problem(state, me, fmt::format("deposit at {}", at(d)), c.cell, terrain(c.cell) + total))
+      if (auto problem = bound_problem(state, me, &d, c.cell, terrain(c.cell) + total))
         return reject(std::move(*problem));
       if (layered) (*after)(c.cell) += c.rise_m;
       ok.rises.push_back({c.cell.row, c.cell.col, c.rise_m});
@@ -161,7 +162,7 @@ Verdict validate_depositions(const WorldState& state, const AgentRecord& me, dou
           fmt::format("deposition cell {} is {} m away, beyond reach_m {}", c, from_me, me.type.body.reach_m));
     if (const AgentRecord* other = agent_over(state, me, x, y, centre))
       return reject(fmt::format("deposition cell {} is under agent {}", c, other->id));
-    if (auto problem = bound_problem(state, me, "deposition", c, terrain(c) + d.height_m))
+    if (auto problem = bound_problem(state, me, nullptr, c, terrain(c) + d.height_m))
       return reject(std::move(*problem));
     volume += d.height_m * cs * cs;
   }

@@ -661,10 +661,11 @@ TEST(MappingSystem, ADropTheWorldNamedCapsTheOlderReadingUntilAScanHitsItAgain) 
   // A hit reads it anew.
   map.integrate_scan({{0.5F, 0.0F, -0.45F}}, origin);
   EXPECT_NEAR(map.heights()(low), 0.05, 1e-6);
-  // Unknown or off-grid cells are ignored.
+  // Unknown or off-grid cells are ignored: an unknown cell gets no ceiling written into its height.
   map.record_drop({0, 0}, high, allowed, margin);
-  map.record_drop({-1, 70}, high, allowed, margin);
+  EXPECT_NO_THROW(map.record_drop({-1, 70}, high, allowed, margin));
   EXPECT_FALSE(map.is_known({0, 0}));
+  EXPECT_EQ(map.heights()(0, 0), 0.0);
 }
 
 // A floor the world named (record_floor): the cell is at least that high from then on, as after the robot's own
@@ -674,15 +675,18 @@ TEST(MappingSystem, AFloorTheWorldNamedHoldsAgainstAStaleReading) {
   const Point3 origin{3.05, 3.05, 0.5};
   const CellIndex cell{29, 35};
   map.integrate_scan({{0.5F, 0.0F, -0.5F}, {0.4F, 0.0F, -0.5F}}, origin);  // read at 0 m
+  // A floor that is not finite is no floor: one kept would hide the next (max(NaN, x) is NaN).
+  map.record_floor(cell, std::numeric_limits<double>::quiet_NaN());
   map.record_floor(cell, 0.325);
   EXPECT_NEAR(map.heights()(cell), 0.325, 1e-9);
   map.integrate_scan({{0.4F, 0.0F, -0.5F}, {0.6F, 0.0F, -0.5F}}, origin);  // around it, not on it
   EXPECT_NEAR(map.heights()(cell), 0.325, 1e-9);
   map.record_floor(cell, 0.2);  // a lower floor changes nothing
   EXPECT_NEAR(map.heights()(cell), 0.325, 1e-9);
+  // An unknown cell gets none (its height stays the unknown 0 m).
   map.record_floor({0, 0}, 1.0);
-  map.record_floor(cell, std::numeric_limits<double>::quiet_NaN());
   EXPECT_FALSE(map.is_known({0, 0}));
+  EXPECT_EQ(map.heights()(0, 0), 0.0);
   EXPECT_NEAR(map.heights()(cell), 0.325, 1e-9);
 }
 
