@@ -42,6 +42,9 @@ struct DepositionParams {
   /// neighbour cells is a sure way out when it is occupiable with eps less this margin; without one, nothing is raised
   /// where it could close a neighbour cell (clearance_m()).
   double exit_margin_m = 0.0;
+  /// A map built from range scans: a cone pile stays this far [m] below every cell it may not raise (under a robot,
+  /// on the pad, unread), which the map reads within its noise; 0 for exact maps.
+  double pile_margin_m = 0.0;
 };
 
 /// The deposition parameters of a body on a grid of cell_size_m [m], with the team's keep-out [m]; the footprint is

@@ -110,12 +110,12 @@ class CubeDepositor final : public Depositor {
 
 /// The largest pile [m^3] dumped at `dump` [m] on `heights` whose every cell stays within what it may still take
 /// (`remaining` [m] per cell of the window, row-major; negative: it may not rise at all; at most `max_rise_m`), and
-/// that reaches no cell of the window's outermost ring (beyond it the map is not known). A pile at apex z raises the
-/// cells whose base h(p) + slope |p - dump| lies below z, each to z - slope |p - dump|: the pile fits when z stays at
-/// or below every cell's base plus what the cell may take, so the largest apex is the least of those, and its volume
-/// follows (as cone_pile_shape() fills, up to rounding).
+/// that reaches no cell of the window's outermost ring (beyond it the map is not known) and stays `margin_m` below
+/// every cell it may not raise. A pile at apex z raises the cells whose base h(p) + slope |p - dump| lies below z, each
+/// to z - slope |p - dump|: the pile fits when z stays at or below every cell's base plus what the cell may take, so
+/// the largest apex is the least of those, and its volume follows (as cone_pile_shape() fills, up to rounding).
 double largest_pile_m3(const Heightmap& heights, const std::vector<double>& remaining, Position dump, double slope,
-                       double max_rise_m) {
+                       double max_rise_m, double margin_m) {
   const int rows = heights.rows(), cols = heights.cols();
   std::vector<double> base(remaining.size());
   double apex = std::numeric_limits<double>::infinity();
@@ -126,7 +126,7 @@ double largest_pile_m3(const Heightmap& heights, const std::vector<double>& rema
       base[i] = heights(r, c) + slope * distance(centre, dump);
       const bool edge = r == 0 || c == 0 || r == rows - 1 || c == cols - 1;
       const double may = edge ? 0.0 : std::min(remaining[i], max_rise_m);
-      apex = std::min(apex, base[i] + std::max(may, 0.0));
+      apex = std::min(apex, base[i] + (may < 0.0 ? -margin_m : may));
     }
   double fill_m = 0.0;
   for (const double b : base) fill_m += std::max(0.0, apex - b);
@@ -165,7 +165,7 @@ class ConeDepositor final : public Depositor {
         const Position dump = map.center(w.cell);
         if (!(remaining[index(w.cell)] > 0.0) || !(distance(dump, robot) <= p.reach_m)) continue;
         ++points;
-        consider(heights, remaining, in_band, dump, budget, p.max_height_m, best);
+        consider(heights, remaining, in_band, dump, budget, p.max_height_m, p.pile_margin_m, best);
       }
       if (!(best.band_m3 > 0.0)) break;
       Placed pile_placed{{best.dump.x, best.dump.y, best.volume_m3}, {}};
@@ -193,11 +193,12 @@ class ConeDepositor final : public Depositor {
   /// the cells' caps allow), the budget and its halvings, and what fills the dump cell alone; the one with most
   /// volume on the path's footprint wins.
   void consider(const Heightmap& heights, const std::vector<double>& remaining, const std::vector<std::uint8_t>& in_band,
-                Position dump, double budget, double max_rise_m, Choice& best) const {
+                Position dump, double budget, double max_rise_m, double margin_m, Choice& best) const {
     const double area = heights.cell_size_m() * heights.cell_size_m();
     const auto index = [&](CellIndex c) { return static_cast<std::size_t>(c.row) * heights.cols() + c.col; };
     std::vector<double> volumes{
-        std::min(budget, largest_pile_m3(heights, remaining, dump, slope_, max_rise_m) * (1.0 - kShrinkFraction))};
+        std::min(budget, largest_pile_m3(heights, remaining, dump, slope_, max_rise_m, margin_m) *
+                             (1.0 - kShrinkFraction))};
     for (double v = budget; volumes.size() <= kVolumeHalvings; v *= 0.5) volumes.push_back(v);
     const double here = remaining[index(*heights.geometry().cell_at(dump))] * area;
     if (here < budget) volumes.push_back(here);  // fills the dump cell alone when the pile stays in it
@@ -223,9 +224,30 @@ class ConeDepositor final : public Depositor {
       bool guarded = guard.on_grid;
       for (const CellRise& r : guard.rises)
         if (remaining[index(r.cell)] < 0.0) guarded = false;
-      if (!guarded) continue;
+      if (!guarded || !clear_by(heights, remaining, dump, shape, margin_m)) continue;
       best = {band, dump, v, std::move(shape)};
     }
+  }
+
+  /// True when the pile `shape` dumped at `dump` stays margin_m [m] below every cell of the window it may not raise
+  /// (remaining < 0): on a scanned map those cells read within noise, and the world settles the pile on the truth.
+  bool clear_by(const Heightmap& heights, const std::vector<double>& remaining, Position dump, const DepositShape& shape,
+                double margin_m) const {
+    if (!(margin_m > 0.0) || shape.rises.empty()) return true;
+    const double cs = heights.cell_size_m();
+    double apex = -std::numeric_limits<double>::infinity();
+    for (const CellRise& r : shape.rises)
+      apex = std::max(apex, heights(r.cell) + r.rise_m + slope_ * distance(heights.cell_center(r.cell), dump));
+    // Cells farther than this from the dump point lie below the pile only if they are lower than the window's lowest.
+    const double reach_m = (apex + margin_m - heights.min_height()) / slope_;
+    const int span = static_cast<int>(std::ceil(reach_m / cs)) + 1;
+    const CellIndex at = *heights.geometry().cell_at(dump);
+    for (int r = std::max(0, at.row - span); r <= std::min(heights.rows() - 1, at.row + span); ++r)
+      for (int c = std::max(0, at.col - span); c <= std::min(heights.cols() - 1, at.col + span); ++c)
+        if (remaining[static_cast<std::size_t>(r) * heights.cols() + c] < 0.0 &&
+            apex - slope_ * distance(heights.cell_center({r, c}), dump) > heights(r, c) - margin_m)
+          return false;
+    return true;
   }
 
   static constexpr double kMinVolumeM3 = 1e-7;  // smaller piles are not worth a deposit [m^3]

@@ -41,6 +41,15 @@ std::optional<BoundRefusal> bound_named(const std::string& reason) {
   return out;
 }
 
+std::optional<Position> pile_under_robot_named(const std::string& reason) {
+  if (reason.rfind("deposit at (", 0) != 0 || reason.find(", under agent ") == std::string::npos) return std::nullopt;
+  Position at;
+  if (std::sscanf(reason.c_str(), "deposit at (%lf, %lf) m raises cell (", &at.x, &at.y) != 2 ||
+      !std::isfinite(at.x) || !std::isfinite(at.y))
+    return std::nullopt;
+  return at;
+}
+
 bool refused_for_terrain(const std::string& reason) { return reason.find("not occupiable") != std::string::npos; }
 
 RefusedCells::RefusedCells(double ball_radius_cells, double change_m, std::uint64_t hold_steps)

@@ -35,6 +35,10 @@ struct BoundRefusal {
 };
 std::optional<BoundRefusal> bound_named(const std::string& reason);
 
+/// Where the pile stood that a refusal for a robot's body names (rule 3d.8: "deposit at (x, y) m raises cell (r, c),
+/// under agent N") [m]; nullopt for any other reason.
+std::optional<Position> pile_under_robot_named(const std::string& reason);
+
 /// True when the reason says a cell is not occupiable for the body (rules 2.3, 2.4): the terrain there, not the
 /// neighbours.
 bool refused_for_terrain(const std::string& reason);

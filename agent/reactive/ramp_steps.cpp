@@ -102,6 +102,8 @@ void RampSteps::admit(const protocol::Admission& admission) {
     // The cells next to the robot are read from about a body length away; a pair of them differs by noise of up to
     // about two spreads.
     deposits.exit_margin_m = kScanExitMargin * context_.type.sensor.noise_sd_at(body.navigability.delta_m);
+    // A pile's edge beside the robot lands on cells read from about a body length away, within the same noise.
+    deposits.pile_margin_m = deposits.exit_margin_m;
   }
   const std::size_t streak_cells =
       context_.type.sensor.casts_rays() ? static_cast<std::size_t>(world.rows) * world.cols : 0;
@@ -169,6 +171,14 @@ void RampSteps::remember_result(const protocol::SensorFrame& frame) {
                                                    static_cast<int>(whole_cubes(d.volume_m3, side)))
                                      .rises)
           modules_->map.record_built(r.cell, r.rise_m);
+    } else if (context_.type.depositor.kind == DepositorKind::kCone) {
+      // A pile settles on the terrain as the map reads it, each on the piles before it in the request (as the world
+      // settles them): without it, a pile dumped beside the robot, where its camera does not look, stays unread and
+      // the next pile there is planned on the bare ground it covered.
+      for (const Deposit& d : sent.deposits)
+        for (const CellRise& r :
+             cone_pile_shape(modules_->map.heights(), d.centre, d.volume_m3, context_.type.depositor.repose_deg).rises)
+          modules_->map.record_built(r.cell, r.rise_m);
     }
   }
   // A refusal is information (docs/runtime.md#refused-requests): which cell, and whether the terrain was the reason.
@@ -186,6 +196,10 @@ void RampSteps::remember_result(const protocol::SensorFrame& frame) {
       if (const auto drop = executive::drop_named(frame.last_reason))
         memory_.refusal->drop = std::make_pair(registered(drop->first), registered(drop->second));
     } else if (named && !motion) {
+      // A pile that reached a robot's body: where it was dumped is held out, not the cell under the body (never a
+      // target anyway), or the same pile is asked for again from the same place.
+      if (const auto pile = executive::pile_under_robot_named(frame.last_reason))
+        if (const auto dumped = modules_->map.geometry().cell_at(*pile)) cell = *dumped;
       memory_.refusal = Memory::Refusal{cell, false, false, std::nullopt};
     }
     // A deposition refused for the deposit bound names the height it would have left (in the cells the request

@@ -201,6 +201,52 @@ TEST(Depositor, AConePileReachesTheMarsHeightOfItsDumpCellWhenTheBudgetAllows) {
   EXPECT_NEAR(at_dump, map.gap(*dump), 1e-5);
 }
 
+// On a scanned map the cells a pile may not raise (here under the robot and around a neighbour) read within noise, and
+// the world settles the pile on the truth. With pile_margin_m the piles planned on the map leave those cells unraised
+// even where the truth lies the margin lower there; without it, the same check finds a pile that reaches one.
+TEST(Depositor, ConePilesStayClearOfCellsTheyMayNotRaiseByTheMarginOfAScannedMap) {
+  const RobotType type = type_with("cone");
+  const Position robot = kGrid.cell_center({10, 10});
+  Neighbour n;
+  n.agent_id = 2;
+  n.position = kGrid.cell_center({7, 16});
+  n.radius_m = 0.2;
+  const Neighbourhood around{1, robot, {n}};
+  // A gap everywhere, so piles press against the cells kept clear.
+  const LocalMap map =
+      test::make_local_map(Heightmap(kGrid, 0.0), Heightmap(kGrid, 0.25), params().navigability, {10, 10}, {{10, 0}});
+  // The truth: every cell the robot may not raise lies `low_m` under the map's reading. How many of them the plan's
+  // piles raise there.
+  const auto reached = [&](double margin_m, double low_m) {
+    DepositionParams p = params();
+    p.max_deposit_m3 = 0.5;
+    p.pile_margin_m = margin_m;
+    const DepositionManager dm(p);
+    const DepositionPlan plan = make_depositor(type)->plan(dm, map, row_path(10, 10, 40), robot, 10.0, around);
+    EXPECT_FALSE(plan.deposits.empty());
+    const double clear_m = dm.clearance_m(map, robot);
+    CellMask kept(kGrid.rows, kGrid.cols);
+    kept.setZero();
+    LocalMap truth = map;
+    for (int r = 0; r < kGrid.rows; ++r)
+      for (int c = 0; c < kGrid.cols; ++c)
+        if (!dm.may_raise(map, {r, c}, robot, around, clear_m)) {
+          kept(r, c) = 1;
+          truth.heights(r, c) -= low_m;
+        }
+    const Heightmap h = after(truth, plan, type);
+    int cells = 0;
+    for (int r = 0; r < kGrid.rows; ++r)
+      for (int c = 0; c < kGrid.cols; ++c)
+        if (kept(r, c) != 0 && h(r, c) > truth.heights(r, c)) ++cells;
+    return cells;
+  };
+  EXPECT_EQ(reached(0.0, 0.0), 0);    // the map is the truth: nothing reached
+  EXPECT_GT(reached(0.0, 0.01), 0);   // the truth 1 cm lower there: a pile planned without a margin reaches one
+  EXPECT_EQ(reached(0.01, 0.01), 0);  // with the margin none
+  EXPECT_EQ(reached(0.02, 0.015), 0);
+}
+
 TEST(Depositor, ConeRespectsMaterialAndStopsOnShallowGaps) {
   const DepositionManager dm(params());
   const RobotType type = type_with("cone");

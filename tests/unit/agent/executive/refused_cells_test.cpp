@@ -43,6 +43,13 @@ TEST(RefusedCells, ReadsTheCellTheWorldsReasonsName) {
   EXPECT_FALSE(bound_named("deposition cell (7, 12) is under agent 2").has_value());
   EXPECT_FALSE(bound_named("deposition would leave cell (1, 2) at nan m, x m above the deposit bound").has_value());
   EXPECT_FALSE(drop_named("target cell (1, 2) is not occupiable for this body: cell (3, x) lies").has_value());
+  // A pile that reached a robot's body (rule 3d.8) names where it was dumped, to the last bit the world printed.
+  const auto pile = pile_under_robot_named("deposit at (17.150000000000002, 11.25) m raises cell (86, 170), under agent 3");
+  ASSERT_TRUE(pile.has_value());
+  EXPECT_EQ(*pile, (Position{17.150000000000002, 11.25}));
+  EXPECT_FALSE(pile_under_robot_named("deposition cell (7, 12) is under agent 2").has_value());
+  EXPECT_FALSE(pile_under_robot_named("deposit at (2.85, 1.95) m is 1.6 m away, beyond reach_m 1.5").has_value());
+  EXPECT_FALSE(pile_under_robot_named("deposit at (nan, 1.95) m raises cell (1, 2), under agent 3").has_value());
 }
 
 TEST(RefusedCells, ATerrainRefusalHoldsUntilTheMapAroundTheCellChanges) {

@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "marsala/agent/reactive/behaviour.hpp"
+#include "marsala/core/deposit_shapes.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
 #include "marsala/core/ray_caster.hpp"
@@ -364,6 +365,47 @@ TEST(RampSteps, AfterARejectedRequestWithDepositsTheNextCarriesAtMostHalfAsManyU
   EXPECT_EQ(deposits_with(protocol::ActionResult::kAccepted), full);
 }
 
+// A pile the world refused because it reached a robot's body (rule 3d.8) is not dumped in the same cell again while
+// the refusal holds: the request after it differs, although the map is the same.
+TEST(RampSteps, APileThatReachedARobotsBodyIsNotDumpedThereAgain) {
+  AgentContext c = test::agent_context(3, test::husky());
+  c.type.depositor.kind = DepositorKind::kCone;
+  RampSteps steps(c);
+  const GridGeometry grid = test::platform_world().geometry();
+  steps.admit(test::admission_on(c, grid, kTarget, kBase));
+  const Position robot{6.45, 3.05};  // blocked at the foot of the platform: builds in place
+  const auto request_after = [&](std::uint64_t step, protocol::ActionResult last, const std::string& reason) {
+    protocol::SensorFrame f = frame(steps, step, robot);
+    f.last_result = last;
+    f.last_reason = reason;
+    BuildTrace trace;
+    const BuildView view = steps.look(f, trace);
+    protocol::ActionRequest q = empty(steps, f);
+    steps.build_step(view.local, f, trace, q);
+    return q;
+  };
+  const protocol::ActionRequest first = request_after(0, protocol::ActionResult::kNone, "");
+  ASSERT_FALSE(first.deposits.empty());
+  const Position dumped = first.deposits.front().centre;
+  const CellIndex cell = *grid.cell_at(dumped);
+  // The same request is what an accepted one would be followed by on this unchanged map.
+  const protocol::ActionRequest again = request_after(1, protocol::ActionResult::kAccepted, "");
+  ASSERT_FALSE(again.deposits.empty());
+  EXPECT_EQ(again.deposits.front().centre, dumped);
+  const std::string reason = fmt::format("deposit at ({}, {}) m raises cell ({}, {}), under agent 3", dumped.x,
+                                         dumped.y, cell.row, cell.col - 3);
+  int with_deposits = 0;
+  for (std::uint64_t step = 2; step < 2 + 30; ++step) {
+    const bool refused = step == 2;
+    const protocol::ActionRequest next =
+        request_after(step, refused ? protocol::ActionResult::kRejected : protocol::ActionResult::kAccepted,
+                      refused ? reason : std::string());
+    for (const Deposit& d : next.deposits) EXPECT_NE(*grid.cell_at(d.centre), cell) << "step " << step;
+    if (!next.deposits.empty()) ++with_deposits;
+  }
+  EXPECT_GT(with_deposits, 20);  // it builds on beside the pile it may not dump
+}
+
 /// The platform world with a 0.3 m step instead of the 1.5 m platform: its top lies below the laser (0.5 m up), which
 /// sees no higher than 10 degrees up.
 Heightmap step_world() {
@@ -433,6 +475,47 @@ TEST(RampSteps, AScanningRobotFillsAGapOnlyOnceItsLastScansAgree) {
   protocol::ActionRequest q = empty(now, f);
   (void)now.build_step(view.local, f, trace, q);
   EXPECT_FALSE(q.depositions.empty());
+}
+
+// A scanning robot's accepted pile is in its map as the pile settles on the map's terrain (the world settles it on
+// the truth): no scan need see it, and the next pile beside it is planned on top of it.
+TEST(RampSteps, AScanningRobotsAcceptedPileIsInItsMap) {
+  const Heightmap h = step_world();
+  AgentContext c = test::agent_context(3, test::husky());
+  c.type.sensor = sensor_defaults(SensorKind::kLaser);
+  c.type.depositor.kind = DepositorKind::kCone;
+  RampSteps steps(c);
+  steps.admit(test::admission_on(c, h.geometry(), kTarget, kBase));
+  const Position robot{6.05, 3.05};
+  const Point3 origin = sensor_origin(h, robot.x, robot.y, c.type.sensor);
+  protocol::ActionRequest q;
+  for (std::uint64_t step = 0; step < 8 && q.deposits.empty(); ++step) {
+    protocol::SensorFrame f = scan_frame(step, robot);
+    f.points = cast_scan(h, origin, 0.0, c.type.sensor, step + 1);
+    BuildTrace trace;
+    const BuildView view = steps.look(f, trace);
+    q = empty(steps, f);
+    (void)steps.build_step(view.local, f, trace, q);
+  }
+  ASSERT_FALSE(q.deposits.empty());
+  // The piles as the world would settle them on the map the robot planned on, one on another.
+  const Heightmap before = steps.map().heights();
+  Heightmap expected = before;
+  for (const Deposit& d : q.deposits)
+    for (const CellRise& r : cone_pile_shape(expected, d.centre, d.volume_m3, c.type.depositor.repose_deg).rises)
+      expected(r.cell) += r.rise_m;
+  protocol::SensorFrame f = scan_frame(3, robot);  // a frame without points: nothing seen anew
+  f.scanned = false;
+  f.last_result = protocol::ActionResult::kAccepted;
+  BuildTrace trace;
+  (void)steps.look(f, trace);
+  const Heightmap& now = steps.map().heights();
+  const CellIndex dump = *h.geometry().cell_at(q.deposits.front().centre);
+  EXPECT_GT(now(dump) - before(dump), 0.01);
+  EXPECT_NEAR(now(dump), expected(dump), 1e-9);
+  for (int r = 0; r < h.rows(); ++r)
+    for (int col = 0; col < h.cols(); ++col)
+      if (now(r, col) != before(r, col)) EXPECT_NEAR(now(r, col), expected(r, col), 1e-9) << r << "," << col;
 }
 
 // docs/runtime.md#mapping: a gap stays current after the scans stop hitting it (the robot turned away, built cells hide
