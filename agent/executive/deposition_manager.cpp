@@ -255,6 +255,7 @@ void DepositionManager::prepare(WayBack& w) const {
                   reaches_border(cell == map.robot && map.navigable.size() == map.occupiable.size()
                                      ? map.navigable
                                      : NavigabilityProcessor::navigable_from(map.occupiable, cell));
+  if (!w.had_way_out) w.reach = NavigabilityProcessor::navigable_from(w.occupiable, cell);
 }
 
 CellMask DepositionManager::occupiable_after(WayBack& w, const std::vector<DepositionCandidate>& depositions) const {
@@ -305,6 +306,14 @@ bool DepositionManager::keeps_way_back(WayBack& w, const std::vector<DepositionC
   // And it must keep a way out of the window if it had one: near the start of its trajectory the local origin may
   // be its own cell, and a ring of deposits around it would pass the origin test below.
   if (w.had_way_out && !reaches_border(NavigabilityProcessor::navigable_from(occupiable, cell))) return false;
+  // Without one, it keeps every cell it can still reach: a robot whose own depositions took its last moves stood
+  // walled in for good, the drops that close its neighbour cells lying under its own body, where it may not build.
+  if (!w.had_way_out && w.reach.size() > 0) {
+    const CellMask now = NavigabilityProcessor::navigable_from(occupiable, cell);
+    for (Eigen::Index r = 0; r < now.rows(); ++r)
+      for (Eigen::Index c = 0; c < now.cols(); ++c)
+        if (w.reach(r, c) != 0 && now(r, c) == 0) return false;
+  }
   if (!w.has_origin) return true;
   const CellMask reach = NavigabilityProcessor::navigable_from(occupiable, *map.origin);
   for (const CellIndex p : w.robots)

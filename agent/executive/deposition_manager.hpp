@@ -146,6 +146,9 @@ class DepositionManager {
     bool has_origin = false;        ///< the local origin is occupiable on the map
     CellMask before;                ///< cells navigable from the local origin before the depositions
     bool had_way_out = false;       ///< the robot's cell was occupiable and reached the window's border
+    /// Without a way out: the cells navigable from the robot's cell on the heights alone (`occupiable`), none of
+    /// which the depositions may cut off; empty otherwise.
+    CellMask reach;
     CellMask occupiable;            ///< NavigabilityProcessor::occupiable(map.heights), 0 on blind cells
     Heightmap after;                ///< scratch: map.heights with the depositions tried, restored after each try
     std::vector<CellIndex> ball;    ///< the body ball's offsets (delta / 2)

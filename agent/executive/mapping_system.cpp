@@ -236,6 +236,7 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       registration_(other.registration_),
       built_(other.built_),
       ceiling_(other.ceiling_),
+      told_scan_(other.told_scan_),
       face_floor_(other.face_floor_),
       face_scan_(other.face_scan_),
       face_hit_scan_(other.face_hit_scan_),
@@ -337,7 +338,7 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
   // A face's hit bounds its cell from below for good (terrain only rises), as the robot's own construction does.
   for (const ScanBatch::Face& f : batch.faces) {
     const long long index = static_cast<long long>(f.cell.row) * g.cols + f.cell.col;
-    ceiling_.erase(index);  // a hit on its face reads the cell anew
+    if (ceiling_.count(index) > 0) continue;  // the height the world told holds (record_drop())
     double& least = face_floor_.try_emplace(index, f.z_m).first->second;
     if (f.z_m > least || face_scan_.count(index) == 0) face_scan_[index] = scans_;
     face_hit_scan_[index] = scans_;
@@ -452,34 +453,34 @@ void MappingSystem::rederive_heights(const ScanBatch& batch) {
         assumed_(row, col) = 1;
         bound_(row, col) = 1;
       }
-      // A ceiling the world's refusal set holds until a scan hits the cell again: a hit reads what is there now.
+      // The height the world told holds against later scans (record_drop()).
       const auto ceiling = ceiling_.find(key_rc);
       if (ceiling == ceiling_.end()) continue;
-      if (hit) {
-        ceiling_.erase(ceiling);
-      } else {
-        heights_(row, col) = std::min(heights_(row, col), ceiling->second);
-        assumed_(row, col) = 0;
-        bound_(row, col) = 0;
-      }
+      heights_(row, col) = std::min(heights_(row, col), ceiling->second);
+      assumed_(row, col) = 0;
+      bound_(row, col) = 0;
     }
 }
 
-void MappingSystem::record_drop(CellIndex low, CellIndex high, double allowed_m, double margin_m) {
-  if (!is_known(low) || !is_known(high) || !std::isfinite(allowed_m) || !std::isfinite(margin_m)) return;
-  if (heights_(high) - heights_(low) > allowed_m) return;  // the map knows the drop already
-  if (last_hit_scan(low) >= last_hit_scan(high)) return;    // low read as late: the map may be wrong at high instead
+void MappingSystem::record_drop(CellIndex low, double low_m, CellIndex high, double high_m) {
+  if (!heights_.contains(low) || !std::isfinite(low_m) || std::abs(low_m) >= kMaxMagnitude) return;
   const long long index = static_cast<long long>(low.row) * heights_.cols() + low.col;
-  const double most = heights_(high) - allowed_m - margin_m;
-  double& ceiling = ceiling_.try_emplace(index, most).first->second;
-  ceiling = std::min(ceiling, most);
-  // What the map held there (its reading, the floor of its own construction, a face's bound) lies above the truth.
-  heights_(low) = std::min(heights_(low), ceiling);
-  if (const auto built = built_.find(index); built != built_.end()) built->second = std::min(built->second, ceiling);
-  if (const auto face = face_floor_.find(index); face != face_floor_.end())
-    face->second = std::min(face->second, ceiling);
+  ceiling_[index] = low_m;
+  told_scan_[index] = scans_;
+  // What the map held there (its reading, the floor of its own construction, a face's bound) was not the surface.
+  heights_(low) = low_m;
+  mark_known(low.row, low.col);
+  if (const auto built = built_.find(index); built != built_.end()) built->second = std::min(built->second, low_m);
+  if (const auto face = face_floor_.find(index); face != face_floor_.end()) face->second = std::min(face->second, low_m);
   assumed_(low.row, low.col) = 0;
   bound_(low.row, low.col) = 0;
+  if (std::isfinite(high_m)) record_floor(high, high_m);
+}
+
+int MappingSystem::told_scan(CellIndex cell) const {
+  if (!heights_.contains(cell)) return 0;
+  const auto told = told_scan_.find(static_cast<long long>(cell.row) * heights_.cols() + cell.col);
+  return told == told_scan_.end() ? 0 : told->second;
 }
 
 bool MappingSystem::hit_within(CellIndex cell, int scans) const {

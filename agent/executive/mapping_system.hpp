@@ -76,14 +76,14 @@ class MappingSystem {
   /// through such cells on the same side of its path (offset from the nearest cell stood on, dot product > 0): the
   /// whole edge it guessed wrong along its path, not one ball of it. Off-grid cells are ignored. [m]
   void forget_assumed_ground(CellIndex cell, double radius_m);
-  /// The world refused a motion because, in the body ball it asked for, cell `low` lies below cell `high` by more
-  /// than allowed_m (eps + kappa times their distance; world indices as the map registers them) [m]. Where this map
-  /// holds the pair within allowed_m and `low`'s reading is no newer than `high`'s, the reading of `low` is what it got
-  /// wrong (a pit read at its rim's height: no ray reaches a narrow pit's floor, docs/runtime.md#refused-requests): low
-  /// gets a ceiling, its height at most high's less allowed_m and margin_m, a surface the robot may build on (what it
-  /// adds to a height that is at most the truth never overshoots). The ceiling rises with the robot's own construction
-  /// there (record_built()) and goes when a scan hits the cell again. Off-grid or unknown cells are ignored.
-  void record_drop(CellIndex low, CellIndex high, double allowed_m, double margin_m);
+  /// The world refused a motion because, in the body ball it asked for, cell `low` at low_m lies too far below cell
+  /// `high` at high_m (world indices as the map registers them) [m]: what the body found there. `low` stands at low_m
+  /// now: a pit read at its rim's height, which no ray corrects (a camera sees no narrow pit's floor,
+  /// docs/runtime.md#refused-requests), gets its height and a ceiling there that later scans do not lift (an outlier
+  /// hit short of the rim's face keeps landing in it); the ceiling rises with the robot's own construction there
+  /// (record_built()) and goes when the world names the cell higher (record_floor()). `high` stands at least at high_m
+  /// (record_floor()). Off-grid cells and heights that are not finite are ignored.
+  void record_drop(CellIndex low, double low_m, CellIndex high, double high_m);
   /// The world says `cell` (world index, as the map registers it) stands at least floor_m [m] now (a deposition it
   /// refused for the deposit bound named the height it would have left: that less the rise asked for). Kept as the
   /// robot's own construction is (record_built()): the cell is at least that high from now on, whatever a stale
@@ -132,6 +132,9 @@ class MappingSystem {
   bool hit_within(CellIndex cell, int scans) const;
   /// The scan (1, 2, ...) that last hit the cell's surface, 0 when none did or the cell is off the grid.
   int last_hit_scan(CellIndex cell) const;
+  /// The scan count when the world last told this cell's height (record_drop()), 0 when never: as recent a reading
+  /// as a hit of that scan.
+  int told_scan(CellIndex cell) const;
   /// Cells stood on, oldest first, consecutive repeats removed (global indices).
   const std::vector<CellIndex>& trajectory() const { return trajectory_; }
   /// The world grid.
@@ -180,6 +183,7 @@ class MappingSystem {
   CellIndex registration_{0, 0};
   std::unordered_map<long long, double> built_;  ///< record_built(): the least height of a cell (row-major index) [m]
   std::unordered_map<long long, double> ceiling_;     ///< record_drop(): the most a cell can be (row-major index) [m]
+  std::unordered_map<long long, int> told_scan_;      ///< record_drop(): the scan count when the world told it
   std::unordered_map<long long, double> face_floor_;  ///< the highest face hit of a cell (row-major index) [m]
   std::unordered_map<long long, int> face_scan_;      ///< the scan that set face_floor_ (1, 2, ...)
   std::unordered_map<long long, int> face_hit_scan_;  ///< the last scan with a face hit on the cell (1, 2, ...)

@@ -20,14 +20,15 @@ std::optional<CellIndex> cell_named(const std::string& reason) {
   return CellIndex{row, col};
 }
 
-std::optional<std::pair<CellIndex, CellIndex>> drop_named(const std::string& reason) {
+std::optional<DropRefusal> drop_named(const std::string& reason) {
   const std::size_t at = reason.find(": cell (");
   if (at == std::string::npos) return std::nullopt;
-  CellIndex low, high;
-  if (std::sscanf(reason.c_str() + at, ": cell (%d, %d) lies too far below cell (%d, %d)", &low.row, &low.col,
-                  &high.row, &high.col) != 4)
+  DropRefusal out;
+  if (std::sscanf(reason.c_str() + at, ": cell (%d, %d) at %lf m lies too far below cell (%d, %d) at %lf m",
+                  &out.low.row, &out.low.col, &out.low_m, &out.high.row, &out.high.col, &out.high_m) != 6 ||
+      !std::isfinite(out.low_m) || !std::isfinite(out.high_m))
     return std::nullopt;
-  return std::make_pair(low, high);
+  return out;
 }
 
 std::optional<BoundRefusal> bound_named(const std::string& reason) {
@@ -80,10 +81,16 @@ bool RefusedCells::changed(const std::vector<double>& before, const std::vector<
   return false;
 }
 
-void RefusedCells::refuse_terrain(CellIndex cell, const Heightmap& heights, const CellMask& known) {
+void RefusedCells::refuse_terrain(CellIndex cell, const Heightmap& heights, const CellMask& known,
+                                  std::optional<CellIndex> drop_low) {
   ++refusals_;
   const int earlier = terrain_refusals_[cell]++;
-  cells_[cell] = Entry{0, ball(cell, heights, known), std::ldexp(change_m_, std::min(earlier, 20))};
+  Entry e{0, ball(cell, heights, known), std::ldexp(change_m_, std::min(earlier, 20)), std::nullopt, 0.0};
+  if (drop_low && heights.contains(*drop_low)) {
+    e.drop_low = drop_low;
+    e.drop_low_m = heights(*drop_low);
+  }
+  cells_[cell] = std::move(e);
 }
 
 void RefusedCells::refuse_for_now(CellIndex cell, std::uint64_t step) {
@@ -95,8 +102,9 @@ void RefusedCells::refuse_for_now(CellIndex cell, std::uint64_t step) {
 void RefusedCells::update(const Heightmap& heights, const CellMask& known, std::uint64_t step) {
   for (auto it = cells_.begin(); it != cells_.end();) {
     const Entry& e = it->second;
-    const bool over =
-        e.ball.empty() ? e.until_step <= step : changed(e.ball, ball(it->first, heights, known), e.change_m);
+    const bool over = e.ball.empty() ? e.until_step <= step
+                                     : changed(e.ball, ball(it->first, heights, known), e.change_m) ||
+                                           (e.drop_low && heights(*e.drop_low) > e.drop_low_m);
     it = over ? cells_.erase(it) : std::next(it);
   }
 }

@@ -22,9 +22,15 @@ namespace marsala::agent::executive {
 /// The cell (world index) a refusal reason names ("... cell (r, c) ..."), if any.
 std::optional<CellIndex> cell_named(const std::string& reason);
 
-/// The pair of cells a terrain refusal names as the drop the body found (": cell (r, c) lies too far below cell (r, c)"):
-/// first the lower, then the higher (world indices); nullopt when it names none.
-std::optional<std::pair<CellIndex, CellIndex>> drop_named(const std::string& reason);
+/// The drop a terrain refusal names, as the body found it (": cell (r, c) at h m lies too far below cell (r, c) at h
+/// m"): the lower cell and its height, then the higher (world indices, m); nullopt when it names none.
+struct DropRefusal {
+  CellIndex low;
+  double low_m = 0.0;
+  CellIndex high;
+  double high_m = 0.0;
+};
+std::optional<DropRefusal> drop_named(const std::string& reason);
 
 /// What a refusal for the deposit bound says (docs/runtime.md#deposit-bound, rules 3.5b and 3d.10): the cell and the
 /// height the request would have left it at ("... would leave cell (r, c) at h m, ... above the deposit bound ...")
@@ -55,12 +61,17 @@ class RefusedCells {
   /// The world refused a motion into `cell` (world index, as the map registers it) for the terrain: remembered with
   /// the map's heights and known mask of its ball, until they change (update()). Each earlier terrain refusal of the
   /// same cell doubles the change that counts (a noisy map that flickers there earns no new try each time).
-  void refuse_terrain(CellIndex cell, const Heightmap& heights, const CellMask& known);
+  /// `drop_low`: the lower cell of the drop the world named, when it did (world index): its height is then a fact the
+  /// map keeps against scans (MappingSystem::record_drop()), and any rise of it (the robot's own construction there)
+  /// releases the refusal too, however small.
+  void refuse_terrain(CellIndex cell, const Heightmap& heights, const CellMask& known,
+                      std::optional<CellIndex> drop_low = std::nullopt);
   /// The world refused a request for a reason that does not depend on the terrain: `cell` held out until `step` +
   /// hold_steps.
   void refuse_for_now(CellIndex cell, std::uint64_t step);
   /// Forgets the terrain refusals whose ball the map now reads differently (a known height moved by more than
-  /// change_m, or a cell became known or unknown) and the others once their hold has passed at `step`.
+  /// change_m, or a cell became known or unknown) or whose named drop's lower cell rose, and the others once their
+  /// hold has passed at `step`.
   void update(const Heightmap& heights, const CellMask& known, std::uint64_t step);
 
   /// True when no cell is held out.
@@ -77,6 +88,8 @@ class RefusedCells {
     std::uint64_t until_step = 0;  ///< a hold for a reason other than the terrain; 0 for a terrain refusal
     std::vector<double> ball;      ///< a terrain refusal: the ball's heights when refused, NaN where unknown [m]
     double change_m = 0.0;         ///< a terrain refusal: the change of a height that releases it [m]
+    std::optional<CellIndex> drop_low;  ///< a terrain refusal that named its drop: the lower cell
+    double drop_low_m = 0.0;            ///< and its height when refused [m]
   };
   std::vector<double> ball(CellIndex cell, const Heightmap& heights, const CellMask& known) const;
   static bool changed(const std::vector<double>& before, const std::vector<double>& now, double change_m);

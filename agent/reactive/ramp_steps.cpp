@@ -27,10 +27,6 @@ constexpr EnumName<BuildPhase> kBuildPhaseNames[] = {
 
 /// Kept inside the world's base radius so a refill is never rejected on a tie [m].
 constexpr double kBaseMarginM = 1e-6;
-/// How far below the world's allowance a drop the world named is put on the map (MappingSystem::record_drop): enough
-/// for the map to break the rule there too, little enough that the lower cell's ceiling stays above its truth but for
-/// the higher cell's reading error [m].
-constexpr double kDropMarginM = 1e-3;
 
 executive::Neighbourhood neighbourhood(const protocol::SensorFrame& frame) {
   return {frame.agent_id, {frame.x_m, frame.y_m}, frame.neighbours};
@@ -193,8 +189,11 @@ void RampSteps::remember_result(const protocol::SensorFrame& frame) {
     const bool motion = !starts("deposit") && !starts("refill") && !starts("robot type");  // rules 1, 2
     if (sent.motion && motion) {
       memory_.refusal = Memory::Refusal{cell, executive::refused_for_terrain(frame.last_reason), true, std::nullopt};
-      if (const auto drop = executive::drop_named(frame.last_reason))
-        memory_.refusal->drop = std::make_pair(registered(drop->first), registered(drop->second));
+      if (auto drop = executive::drop_named(frame.last_reason)) {
+        drop->low = registered(drop->low);
+        drop->high = registered(drop->high);
+        memory_.refusal->drop = drop;
+      }
     } else if (named && !motion) {
       // A pile that reached a robot's body: where it was dumped is held out, not the cell under the body (never a
       // target anyway), or the same pile is asked for again from the same place.
@@ -216,13 +215,9 @@ void RampSteps::learn_refusals(const protocol::SensorFrame& frame) {
   // A motion refused for the terrain: the ground the map only assumed in the target's ball is what it guessed wrong.
   if (memory_.refusal && memory_.refusal->terrain && memory_.refusal->motion) {
     modules_->map.forget_assumed_ground(memory_.refusal->cell, 0.5 * context_.type.body.navigability.delta_m);
-    // The drop the body found, where the map holds none: the lower cell's reading was too high.
-    if (const auto& drop = memory_.refusal->drop; drop && context_.type.sensor.casts_rays()) {
-      const NavigabilityParams& body = context_.type.body.navigability;
-      const double cs = modules_->map.geometry().cell_size_m;
-      const double apart_m = cs * std::hypot(drop->first.row - drop->second.row, drop->first.col - drop->second.col);
-      modules_->map.record_drop(drop->first, drop->second, body.eps_m + body.kappa * apart_m, kDropMarginM);
-    }
+    // The drop the body found: its heights are facts the map keeps (a pit read at its rim's height).
+    if (const auto& drop = memory_.refusal->drop; drop && context_.type.sensor.casts_rays())
+      modules_->map.record_drop(drop->low, drop->low_m, drop->high, drop->high_m);
   }
   const executive::MappingSystem& map = modules_->map;
   memory_.refused->update(map.heights(), map.known(), frame.step);
@@ -231,7 +226,9 @@ void RampSteps::learn_refusals(const protocol::SensorFrame& frame) {
   const Memory::Refusal& r = *memory_.refusal;
   executive::RefusedCells& cells = r.motion ? *memory_.refused : *memory_.refused_depositions;
   if (r.terrain)
-    cells.refuse_terrain(r.cell, map.heights(), map.known());
+    cells.refuse_terrain(r.cell, map.heights(), map.known(),
+                         r.drop && context_.type.sensor.casts_rays() ? std::optional<CellIndex>(r.drop->low)
+                                                                     : std::nullopt);
   else
     cells.refuse_for_now(r.cell, frame.step);
 }
@@ -345,7 +342,7 @@ void RampSteps::mark_others_near(const protocol::SensorFrame& frame) {
 bool RampSteps::current(CellIndex cell) const {
   const executive::MappingSystem& map = modules_->map;
   if (map.hit_within(cell, kFreshScans)) return true;
-  const int last = map.last_hit_scan(cell);
+  const int last = std::max(map.last_hit_scan(cell), map.told_scan(cell));
   return last > 0 && memory_.others_near[static_cast<std::size_t>(cell.row) * map.geometry().cols + cell.col] < last;
 }
 
@@ -521,7 +518,8 @@ BuildPhase RampSteps::retreat_step(const deliberative::LocalMap& local, const pr
   }
   // Step back the way the robot came and fill what comes into reach: the gap where it stood.
   ++memory_.idle_retreat_moves;
-  const auto motion = step_back(local, robot);
+  auto motion = step_back(local, robot);
+  if (!motion) motion = retrace(local, robot);
   if (!motion) return BuildPhase::kRetreat;
   move(*motion, trace, request);
   deposit(local, frame, motion->target, 0, trace, request);
@@ -547,6 +545,22 @@ std::optional<executive::Motion> RampSteps::step_back(const deliberative::LocalM
     if (!route.found) return std::nullopt;
   }
   return advance(local, route.path, robot);
+}
+
+std::optional<executive::Motion> RampSteps::retrace(const deliberative::LocalMap& local, Position robot) const {
+  if (!context_.type.sensor.casts_rays() || local.navigable.cast<long long>().sum() > 1) return std::nullopt;
+  const CellIndex here = local.to_global(local.robot);
+  const auto& trajectory = modules_->map.trajectory();
+  for (auto it = trajectory.rbegin(); it != trajectory.rend(); ++it) {
+    if (*it == here) continue;
+    const CellIndex cell = local.to_local(*it);
+    if (memory_.refused->contains(*it) || !local.contains(cell)) return std::nullopt;
+    const Position target = local.center(cell);
+    const double d = distance(target, robot);
+    if (!(d <= context_.type.body.max_step_m + tolerance::kLengthM)) return std::nullopt;
+    return executive::Motion{cell, target, 0, d};
+  }
+  return std::nullopt;
 }
 
 std::optional<executive::Motion> RampSteps::step_away(const deliberative::LocalMap& local, Position robot,

@@ -156,6 +156,11 @@ class RampSteps {
   /// the local goal; when another robot cuts the way there, towards the navigable cell farthest from the local goal;
   /// nullopt when there is none or no route to it.
   std::optional<executive::Motion> step_back(const deliberative::LocalMap& local, Position robot) const;
+  /// A scanning robot whose map leaves it no move (its own cell the only navigable one) asks the world the way it came:
+  /// a motion to the last cell it stood on other than its own, when that lies within a step and the world has not
+  /// refused it since (docs/runtime.md#a-sure-way-out). Its map of the cells around it reads within noise; the world
+  /// judges on the truth, and a refusal names the drop with its heights. nullopt otherwise.
+  std::optional<executive::Motion> retrace(const deliberative::LocalMap& local, Position robot) const;
 
   /// A step away from a robot at `from` [m] (giving way, reactive/right_of_way.hpp): towards the navigable cell within
   /// two body lengths farthest from it, when that is farther than the robot stands; nullopt when there is none.
@@ -231,7 +236,7 @@ class RampSteps {
       CellIndex cell;
       bool terrain = false;
       bool motion = false;
-      std::optional<std::pair<CellIndex, CellIndex>> drop;  ///< the drop the world named: lower, higher cell
+      std::optional<executive::DropRefusal> drop;  ///< the drop the world named
     };
     std::optional<Refusal> refusal;
     std::vector<GapStreak> gap_streaks;            ///< scanned maps, per world cell (row-major): count_gap_scans()

@@ -200,11 +200,13 @@ std::optional<std::string> envelope_problem(const WorldState& state, std::uint32
   return std::nullopt;
 }
 
-/// What a body that tried to stand on `cell` would feel (docs/runtime.md#refused-requests): ": cell (r, c) lies too far
-/// below cell (r, c)", or nothing when the cell is occupiable.
+/// What a body that tried to stand on `cell` would feel (docs/runtime.md#refused-requests): ": cell (r, c) at h m lies
+/// too far below cell (r, c) at h m", or nothing when the cell is occupiable.
 std::string breach_of(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& body) {
   const std::optional<OccupancyBreach> breach = occupancy_breach(terrain, cell, body);
-  return breach ? fmt::format(": cell {} lies too far below cell {}", breach->low, breach->high) : std::string();
+  return breach ? fmt::format(": cell {} at {} m lies too far below cell {} at {} m", breach->low,
+                              terrain(breach->low), breach->high, terrain(breach->high))
+                : std::string();
 }
 
 /// Rule 2, the motion of `me` to the request's target (docs/runtime.md#rule-2-motion); nullopt when it passes.

@@ -265,6 +265,44 @@ TEST(DepositionManager, NeverRingsInARobotWhoseOriginIsItsOwnCell) {
               reach.col(kGrid.cols - 1).any());
 }
 
+// A robot in a pocket its map gives no way out of (a 1 m wall all round): the depositions keep every cell it can still
+// reach. The gap across the pocket is a thin layer on its west half (within eps: it cuts nothing) and a 0.3 m wall on
+// its east half, which would cut the cells beside it off; the plan keeps the layer and none of the wall, checked on the
+// heights after it.
+TEST(DepositionManager, WithoutAWayOutTheRobotKeepsEveryCellItCanStillReach) {
+  const CellIndex centre{10, 15};
+  Heightmap h(kGrid, 0.0);
+  for (int r = 0; r < kGrid.rows; ++r)
+    for (int c = 0; c < kGrid.cols; ++c)
+      if (std::max(std::abs(r - centre.row), std::abs(c - centre.col)) >= 8) h(r, c) = 1.0;
+  Heightmap gap(kGrid, 0.0);
+  std::vector<CellIndex> line;
+  for (int c = centre.col - 7; c <= centre.col + 7; ++c) {
+    line.push_back({centre.row - 3, c});
+    gap(centre.row - 3, c) = c < centre.col ? 0.04 : 0.3;
+  }
+  const DepositionParams p = params(0.4, 10.0);
+  const LocalMap map = make_map(h, gap, p.navigability, centre, centre);
+  const NavigabilityProcessor nav(p.navigability);
+  const CellMask before = NavigabilityProcessor::navigable_from(nav.occupiable(h), centre);
+  ASSERT_FALSE(before.row(0).any() || before.row(kGrid.rows - 1).any() || before.col(0).any() ||
+               before.col(kGrid.cols - 1).any());  // no way out
+  const DepositionManager dm(p);
+  const Position robot = kGrid.cell_center(centre);
+  const auto all = dm.candidates(map, line, robot, 10.0, {1, robot, {}});
+  ASSERT_EQ(all.size(), line.size());
+  EXPECT_FALSE(dm.keeps_way_back(map, robot, all, {1, robot, {}}));
+  const DepositionPlan plan = dm.plan(map, line, robot, 10.0, {1, robot, {}});
+  EXPECT_EQ(plan.depositions.size(), 7u);  // the layer's cells
+  for (const Deposition& d : plan.depositions) EXPECT_LT(d.col, centre.col);
+  Heightmap after = h;
+  for (const Deposition& d : plan.depositions) after(CellIndex{d.row, d.col}) += d.height_m;
+  const CellMask now = NavigabilityProcessor::navigable_from(nav.occupiable(after), centre);
+  for (int r = 0; r < kGrid.rows; ++r)
+    for (int c = 0; c < kGrid.cols; ++c)
+      if (before(r, c) != 0) EXPECT_NE(now(r, c), 0) << r << "," << c;
+}
+
 TEST(DepositionManager, KeepsANeighboursWayBack) {
   const Heightmap h = corridor();
   Heightmap gap(kGrid, 0.0);

@@ -629,43 +629,42 @@ TEST(MappingSystem, ABuiltCellGetsAFloorOnlyWhereItsSurfaceWasRead) {
   EXPECT_FALSE(map.is_known(*unread));
 }
 
-// A drop the world named (record_drop): where the map holds none and the lower cell's reading is the older one, that
-// reading gets a ceiling below the higher cell by the rule's allowance and the margin; it holds while no scan hits the
-// cell, rises with the robot's own construction there, and goes when a scan hits the cell again.
-TEST(MappingSystem, ADropTheWorldNamedCapsTheOlderReadingUntilAScanHitsItAgain) {
+// A drop the world named (record_drop): the lower cell stands at the height the body found there, whatever the map
+// read, and keeps it against later scans that hit it or its face (an outlier short of the rim's face keeps landing in
+// a pit); the robot's own construction raises it, the world naming it higher (record_floor) ends it; the higher cell
+// is at least its named height. An unknown cell becomes known at it; off-grid cells and non-finite heights are ignored.
+TEST(MappingSystem, ADropTheWorldNamedHoldsItsHeightsAgainstLaterScans) {
   MappingSystem map(GridGeometry{60, 60, 0.0, 0.0, 0.1}, 16, sensor_defaults(SensorKind::kLaser));
   const Point3 origin{3.05, 3.05, 0.5};
-  const CellIndex low{29, 35}, high{29, 36}, beside{29, 34};
-  map.integrate_scan({{0.5F, 0.0F, -0.5F}, {0.6F, 0.0F, -0.5F}}, origin);  // both read at 0 m
-  map.integrate_scan({{0.6F, 0.0F, -0.5F}}, origin);                       // high read again, low not
+  const CellIndex low{29, 35}, high{29, 36};
+  map.integrate_scan({{0.5F, 0.0F, -0.1F}, {0.6F, 0.0F, -0.1F}}, origin);  // both read at 0.4 m
   ASSERT_TRUE(map.is_known(low) && map.is_known(high));
-  ASSERT_LT(map.last_hit_scan(low), map.last_hit_scan(high));
-  const double allowed = 0.13, margin = 0.01;
-  // The newer reading is not the one capped.
-  map.record_drop(high, low, allowed, margin);
-  EXPECT_NEAR(map.heights()(high), 0.0, 1e-6);
-  map.record_drop(low, high, allowed, margin);
-  EXPECT_NEAR(map.heights()(low), map.heights()(high) - allowed - margin, 1e-6);
+  ASSERT_NEAR(map.heights()(low), 0.4, 1e-6);
+  map.record_drop(low, 0.02, high, 0.45);
+  EXPECT_EQ(map.heights()(low), 0.02);
   EXPECT_EQ(map.assumed()(low.row, low.col), 0);  // a surface to build on
-  // The map now holds the drop: naming it again changes nothing.
-  map.record_drop(low, high, allowed, margin);
-  EXPECT_NEAR(map.heights()(low), -0.14, 1e-6);
-  // A scan around it that does not hit it keeps the ceiling.
-  map.integrate_scan({{0.4F, 0.0F, -0.5F}, {0.6F, 0.0F, -0.5F}}, origin);
-  ASSERT_TRUE(map.is_known(beside));
-  EXPECT_NEAR(map.heights()(low), -0.14, 1e-6);
+  EXPECT_GE(map.heights()(high), 0.45);
+  EXPECT_EQ(map.told_scan(low), map.scans());
+  // Scans that hit it again at the rim's height do not lift it.
+  for (int i = 0; i < 3; ++i) map.integrate_scan({{0.5F, 0.0F, -0.1F}, {0.6F, 0.0F, -0.1F}}, origin);
+  EXPECT_EQ(map.heights()(low), 0.02);
+  EXPECT_GE(map.heights()(high), 0.45);
   // The robot's construction there raises it.
-  map.record_built(low, 0.05);
-  map.integrate_scan({{0.4F, 0.0F, -0.5F}, {0.6F, 0.0F, -0.5F}}, origin);
-  EXPECT_NEAR(map.heights()(low), -0.09, 1e-6);
-  // A hit reads it anew.
-  map.integrate_scan({{0.5F, 0.0F, -0.45F}}, origin);
-  EXPECT_NEAR(map.heights()(low), 0.05, 1e-6);
-  // Unknown or off-grid cells are ignored: an unknown cell gets no ceiling written into its height.
-  map.record_drop({0, 0}, high, allowed, margin);
-  EXPECT_NO_THROW(map.record_drop({-1, 70}, high, allowed, margin));
-  EXPECT_FALSE(map.is_known({0, 0}));
-  EXPECT_EQ(map.heights()(0, 0), 0.0);
+  map.record_built(low, 0.3);
+  map.integrate_scan({{0.5F, 0.0F, -0.1F}}, origin);
+  EXPECT_NEAR(map.heights()(low), 0.32, 1e-9);
+  // The world naming it higher ends the ceiling: the next scan reads it again.
+  map.record_floor(low, 0.38);
+  map.integrate_scan({{0.5F, 0.0F, -0.1F}}, origin);
+  EXPECT_NEAR(map.heights()(low), 0.4, 1e-6);
+  // An unknown cell becomes known at the height told; off the grid or not finite: nothing.
+  ASSERT_FALSE(map.is_known({0, 0}));
+  map.record_drop({0, 0}, 0.1, {0, 1}, 0.5);
+  EXPECT_TRUE(map.is_known({0, 0}));
+  EXPECT_EQ(map.heights()(0, 0), 0.1);
+  EXPECT_NO_THROW(map.record_drop({-1, 70}, 0.1, high, 0.5));
+  map.record_drop({5, 5}, std::numeric_limits<double>::quiet_NaN(), high, 0.5);
+  EXPECT_FALSE(map.is_known({5, 5}));
 }
 
 // A floor the world named (record_floor): the cell is at least that high from then on, as after the robot's own

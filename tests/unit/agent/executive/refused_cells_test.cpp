@@ -23,13 +23,22 @@ TEST(RefusedCells, ReadsTheCellTheWorldsReasonsName) {
   EXPECT_TRUE(refused_for_terrain("target cell (99, 158) is not occupiable for this body"));
   EXPECT_TRUE(refused_for_terrain("motion passes through cell (3, 4), not occupiable for this body"));
   EXPECT_FALSE(refused_for_terrain("motion ends 0.8 m from agent 2, whose body it would overlap (bodies need 1 m)"));
-  // The drop the body found, when the world names it: the lower cell first.
-  const std::string dropped = "target cell (119, 128) is not occupiable for this body: cell (120, 131) lies too far "
-                              "below cell (119, 127)";
+  // The drop the body found, when the world names it: the lower cell first, each with its height to the last bit.
+  const std::string dropped = "target cell (119, 128) is not occupiable for this body: cell (120, 131) at 0.05 m lies "
+                              "too far below cell (119, 127) at 1.3750000000000002 m";
   EXPECT_EQ(cell_named(dropped), (CellIndex{119, 128}));
-  ASSERT_TRUE(drop_named(dropped).has_value());
-  EXPECT_EQ(drop_named(dropped)->first, (CellIndex{120, 131}));
-  EXPECT_EQ(drop_named(dropped)->second, (CellIndex{119, 127}));
+  const auto drop = drop_named(dropped);
+  ASSERT_TRUE(drop.has_value());
+  EXPECT_EQ(drop->low, (CellIndex{120, 131}));
+  EXPECT_EQ(drop->low_m, 0.05);
+  EXPECT_EQ(drop->high, (CellIndex{119, 127}));
+  EXPECT_EQ(drop->high_m, 1.3750000000000002);
+  EXPECT_FALSE(drop_named("target cell (1, 2) is not occupiable for this body: cell (3, 4) lies too far below cell "
+                          "(5, 6)")
+                   .has_value());  // no heights: nothing to learn
+  EXPECT_FALSE(drop_named("target cell (1, 2) is not occupiable for this body: cell (3, 4) at nan m lies too far "
+                          "below cell (5, 6) at 1 m")
+                   .has_value());
   EXPECT_FALSE(drop_named("target cell (99, 158) is not occupiable for this body").has_value());
   // The deposit bound's refusals (rules 3.5b, 3d.10) name the height the request would have left.
   const auto bound = bound_named("deposition would leave cell (113, 141) at 0.6 m, 0.27 m above the deposit bound "
@@ -80,6 +89,27 @@ TEST(RefusedCells, ATerrainRefusalHoldsUntilTheMapAroundTheCellChanges) {
   refused.update(h, known, 2002);
   EXPECT_FALSE(refused.contains({10, 10}));
   EXPECT_EQ(refused.refusals(), 2);
+}
+
+// A refusal that named its drop: the lower cell rising at all (the robot's own construction in the pit, a layer less
+// than the change that counts) releases it; the same rise elsewhere in the ball does not. Even beyond the ball.
+TEST(RefusedCells, ARiseOfTheNamedDropsLowerCellReleasesTheRefusal) {
+  RefusedCells refused(2.0, 0.04, 40);
+  Heightmap h = flat();
+  const CellMask known = all_known();
+  refused.refuse_terrain({10, 10}, h, known, CellIndex{10, 14});
+  h(11, 11) = 0.0125;  // a layer in the ball, under the change that counts
+  refused.update(h, known, 1);
+  EXPECT_TRUE(refused.contains({10, 10}));
+  h(10, 14) = 0.0125;  // the same layer in the named pit
+  refused.update(h, known, 2);
+  EXPECT_FALSE(refused.contains({10, 10}));
+  // Without a named drop the pit's layer is no news.
+  h = flat();
+  refused.refuse_terrain({10, 10}, h, known);
+  h(10, 12) = 0.0125;
+  refused.update(h, known, 3);
+  EXPECT_TRUE(refused.contains({10, 10}));
 }
 
 // A cell refused again after its map changed needs twice the change the time after: 0.01, 0.02, 0.04 m.

@@ -406,6 +406,53 @@ TEST(RampSteps, APileThatReachedARobotsBodyIsNotDumpedThereAgain) {
   EXPECT_GT(with_deposits, 20);  // it builds on beside the pile it may not dump
 }
 
+// A scanning robot whose map leaves it no move asks the world the way it came. Flat ground with eight 0.5 m spikes six
+// cells (0.6 m) from the cell B it stands on, along the axes and diagonals (4, 4): each of B's eight neighbour cells
+// holds one of them in its body ball (radius 5 cells), B's own ball none. It came from A, 0.2 m west of B; with
+// nothing to fill (no material) and no navigable cell but its own, it asks for a motion back to A, and once the
+// world has refused that, it asks nothing until its map changes. A robot that reads exact heights asks nothing.
+TEST(RampSteps, AScanningRobotWalledInOnItsMapAsksTheWorldTheWayItCame) {
+  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
+  const CellIndex b{30, 40};
+  for (const CellIndex o : {CellIndex{0, 6}, CellIndex{0, -6}, CellIndex{6, 0}, CellIndex{-6, 0}, CellIndex{4, 4},
+                            CellIndex{4, -4}, CellIndex{-4, 4}, CellIndex{-4, -4}})
+    h(b.row + o.row, b.col + o.col) = 0.5;
+  const Position at_b = h.geometry().cell_center(b);
+  const Position at_a{at_b.x - 0.2, at_b.y};
+  const auto request_of = [&](bool scanning, protocol::ActionResult last, const std::string& reason) {
+    AgentContext c = test::agent_context(3, test::husky());
+    if (scanning) c.type.sensor = sensor_defaults(SensorKind::kLaser);
+    RampSteps steps(c);
+    steps.admit(test::admission_on(c, h.geometry(), {9.05, at_b.y}, {0.55, at_b.y}));
+    std::optional<protocol::ActionRequest> out;
+    for (std::uint64_t step = 0; step < 3; ++step) {
+      protocol::SensorFrame f = test::full_frame(c, step, step == 0 ? at_a : at_b, 0.0, h);
+      if (step == 2) {
+        f.last_result = last;
+        f.last_reason = reason;
+      }
+      BuildTrace trace;
+      const BuildView view = steps.look(f, trace);
+      protocol::ActionRequest q = empty_request(c, f, "");
+      if (step > 0) (void)steps.build_step(view.local, f, trace, q);
+      if (step > 0) EXPECT_EQ(trace.navigable_cells, 1) << "step " << step;
+      out = q;
+    }
+    return *out;
+  };
+  const protocol::ActionRequest asked = request_of(true, protocol::ActionResult::kAccepted, "");
+  ASSERT_TRUE(asked.move);
+  EXPECT_NEAR(asked.target_x_m, at_a.x, 1e-9);
+  EXPECT_NEAR(asked.target_y_m, at_a.y, 1e-9);
+  const CellIndex a = *h.geometry().cell_at(at_a);
+  const std::string refused = fmt::format(
+      "target cell ({}, {}) is not occupiable for this body: cell ({}, {}) at 0 m lies too far below cell ({}, {}) at "
+      "0.5 m",
+      a.row, a.col, a.row, a.col - 5, a.row, a.col - 4);
+  EXPECT_FALSE(request_of(true, protocol::ActionResult::kRejected, refused).move);
+  EXPECT_FALSE(request_of(false, protocol::ActionResult::kAccepted, "").move);
+}
+
 /// The platform world with a 0.3 m step instead of the 1.5 m platform: its top lies below the laser (0.5 m up), which
 /// sees no higher than 10 degrees up.
 Heightmap step_world() {
