@@ -147,50 +147,54 @@ void apply_local_sources(const Problem& pb, double* lower) {
       if (d2 > 0 && d2 <= kLocalRadius2) offsets.push_back({dr, dc, pb.kcs * std::sqrt(static_cast<double>(d2))});
     }
   const int cols = pb.cols, rows = pb.rows;
-  // Every offset over columns [c_from, c_to) of row r, one offset at a time.
-  auto offset_by_offset = [&](int r, int c_from, int c_to) {
-    double* out = lower + static_cast<std::int64_t>(r) * cols;
-    for (const Offset& o : offsets) {
-      const int sr = r + o.dr;
-      if (sr < 0 || sr >= rows) continue;
-      const double* in = pb.h + static_cast<std::int64_t>(sr) * cols;
-      const int c_begin = std::max(c_from, -o.dc), c_end = std::min(c_to, cols - o.dc);
-      const double drop = o.drop;
-      const int dc = o.dc;
-      // Same bits as cone_value(); written as a plain max so that it vectorises.
-      for (int c = c_begin; c < c_end; ++c) {
-        const double v = in[c + dc] - drop;
-        out[c] = out[c] < v ? v : out[c];
-      }
+  // The input rows r - radius .. r + radius, each with radius cells at -inf on its left and at least radius + kChunk on
+  // its right, and rows off the grid all -inf: every offset of every cell then reads inside these rows, so every
+  // cell takes the chunked loop below (a source at -inf is below every value, as a missing one is). A ring of
+  // 2 radius + 1 rows, each row stored twice (slots k and k + 2 radius + 1) so that the rows around r are always
+  // consecutive: the extra memory is O(cols).
+  constexpr int kChunk = 16;
+  const int chunks = (cols + kChunk - 1) / kChunk;
+  const int padded = chunks * kChunk + 2 * radius;
+  const int ring_rows = 2 * radius + 1;
+  std::vector<double> ring(static_cast<std::size_t>(2 * ring_rows) * padded, -kInf);
+  auto load_row = [&](int sr) {  // input row sr (or -inf off the grid) into both its ring slots
+    const int slot = (sr + ring_rows) % ring_rows;
+    for (int copy = 0; copy < 2; ++copy) {
+      double* row = ring.data() + static_cast<std::size_t>(slot + copy * ring_rows) * padded;
+      std::fill(row, row + padded, -kInf);
+      if (sr >= 0 && sr < rows)
+        std::copy(pb.h + static_cast<std::int64_t>(sr) * cols, pb.h + static_cast<std::int64_t>(sr + 1) * cols,
+                  row + radius);
     }
   };
-  // Away from the edges every offset is inside the grid: 8 cells at a time stay in registers across all offsets
-  // (one load and store of the output per 8 cells instead of one per offset). max(v, out) is out < v ? v : out.
-  constexpr int kChunk = 8;
-  const int interior = std::max(0, cols - 2 * radius) / kChunk * kChunk;
+  for (int sr = -radius; sr < radius; ++sr) load_row(sr);
+  std::vector<std::ptrdiff_t> at_offset(offsets.size());  // where an offset reads, from the ring's row r - radius
+  for (std::size_t k = 0; k < offsets.size(); ++k)
+    at_offset[k] = static_cast<std::ptrdiff_t>(offsets[k].dr + radius) * padded + radius + offsets[k].dc;
+  alignas(16) double tail[kChunk];
   for (int r = 0; r < rows; ++r) {
-    if (r < radius || r >= rows - radius || interior == 0) {
-      offset_by_offset(r, 0, cols);
-      continue;
-    }
+    load_row(r + radius);
+    const double* first = ring.data() + static_cast<std::size_t>((r - radius + ring_rows) % ring_rows) * padded;
     double* out = lower + static_cast<std::int64_t>(r) * cols;
-    for (int c = radius; c < radius + interior; c += kChunk) {
-      Pair a0 = load(out + c), a1 = load(out + c + 2), a2 = load(out + c + 4), a3 = load(out + c + 6);
-      for (const Offset& o : offsets) {
-        const double* in = pb.h + static_cast<std::int64_t>(r + o.dr) * cols + c + o.dc;
-        const double drop = o.drop;
-        a0 = max(load(in) - drop, a0);
-        a1 = max(load(in + 2) - drop, a1);
-        a2 = max(load(in + 4) - drop, a2);
-        a3 = max(load(in + 6) - drop, a3);
+    for (int c = 0; c < cols; c += kChunk) {
+      // max(v, out) is out < v ? v : out: the same bits as cone_value(), in the same order of offsets as ever.
+      double* at = out + c;
+      if (c + kChunk > cols) {  // the last, partial chunk through a buffer
+        std::fill(tail, tail + kChunk, -kInf);
+        std::copy(out + c, out + cols, tail);
+        at = tail;
       }
-      store(out + c, a0);
-      store(out + c + 2, a1);
-      store(out + c + 4, a2);
-      store(out + c + 6, a3);
+      // kChunk cells stay in registers across all offsets: one load and store of the output per chunk.
+      Pair a[kChunk / 2];
+      for (int p = 0; p < kChunk / 2; ++p) a[p] = load(at + 2 * p);
+      for (std::size_t k = 0; k < offsets.size(); ++k) {
+        const double* in = first + c + at_offset[k];
+        const double drop = offsets[k].drop;
+        for (int p = 0; p < kChunk / 2; ++p) a[p] = max(load(in + 2 * p) - drop, a[p]);
+      }
+      for (int p = 0; p < kChunk / 2; ++p) store(at + 2 * p, a[p]);
+      if (at == tail) std::copy(tail, tail + (cols - c), out + c);
     }
-    offset_by_offset(r, 0, radius);
-    offset_by_offset(r, radius + interior, cols);
   }
 }
 
