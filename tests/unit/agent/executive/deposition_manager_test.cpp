@@ -233,6 +233,18 @@ TEST(DepositionManager, KeepsTheRobotsWayBack) {
   EXPECT_EQ(east.dropped_for_way_back, 0);
 }
 
+/// The plan of a robot at `centre` along `cells` with 10 m^3 on board, after checking that every cell is a candidate
+/// and that all of them together would not keep its way back.
+DepositionPlan plan_cut_short(const LocalMap& map, const DepositionParams& p, CellIndex centre,
+                              const std::vector<CellIndex>& cells) {
+  const DepositionManager dm(p);
+  const Position robot = kGrid.cell_center(centre);
+  const auto all = dm.candidates(map, cells, robot, 10.0, {1, robot, {}});
+  EXPECT_EQ(all.size(), cells.size());
+  EXPECT_FALSE(dm.keeps_way_back(map, robot, all, {1, robot, {}}));
+  return dm.plan(map, cells, robot, 10.0, {1, robot, {}});
+}
+
 TEST(DepositionManager, NeverRingsInARobotWhoseOriginIsItsOwnCell) {
   // A robot that has not moved yet: its local origin is its own cell, so the origin test alone is vacuous. The gap
   // is a square ring three cells from it; filled whole, the ring's walls (0.3 m against eps 0.05 m) would leave it
@@ -248,12 +260,7 @@ TEST(DepositionManager, NeverRingsInARobotWhoseOriginIsItsOwnCell) {
   for (const CellIndex p : ring) gap(p) = 0.3;
   const DepositionParams p = params(0.4, 10.0);
   const LocalMap map = make_map(flat, gap, p.navigability, centre, centre);
-  const DepositionManager dm(p);
-  const Position robot = kGrid.cell_center(centre);
-  const auto all = dm.candidates(map, ring, robot, 10.0, {1, robot, {}});
-  ASSERT_EQ(all.size(), ring.size());
-  EXPECT_FALSE(dm.keeps_way_back(map, robot, all, {1, robot, {}}));
-  const DepositionPlan plan = dm.plan(map, ring, robot, 10.0, {1, robot, {}});
+  const DepositionPlan plan = plan_cut_short(map, p, centre, ring);
   EXPECT_GT(plan.depositions.size(), 0u);
   EXPECT_LT(plan.depositions.size(), ring.size());
   // Independent check: after the plan's depositions the robot still reaches the window's border.
@@ -287,12 +294,7 @@ TEST(DepositionManager, WithoutAWayOutTheRobotKeepsEveryCellItCanStillReach) {
   const CellMask before = NavigabilityProcessor::navigable_from(nav.occupiable(h), centre);
   ASSERT_FALSE(before.row(0).any() || before.row(kGrid.rows - 1).any() || before.col(0).any() ||
                before.col(kGrid.cols - 1).any());  // no way out
-  const DepositionManager dm(p);
-  const Position robot = kGrid.cell_center(centre);
-  const auto all = dm.candidates(map, line, robot, 10.0, {1, robot, {}});
-  ASSERT_EQ(all.size(), line.size());
-  EXPECT_FALSE(dm.keeps_way_back(map, robot, all, {1, robot, {}}));
-  const DepositionPlan plan = dm.plan(map, line, robot, 10.0, {1, robot, {}});
+  const DepositionPlan plan = plan_cut_short(map, p, centre, line);
   EXPECT_EQ(plan.depositions.size(), 7u);  // the layer's cells
   for (const Deposition& d : plan.depositions) EXPECT_LT(d.col, centre.col);
   Heightmap after = h;
