@@ -209,6 +209,11 @@ Heightmap band_fill_gap(const deliberative::LocalMap& local, const CellMask& ban
   return gap_below_bound_of(local, band_sources(local, band), kappa);
 }
 
+Heightmap way_fill_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& path, double radius_m,
+                       double kappa) {
+  return band_fill_gap(local, band_mask(local, {path}, radius_m), kappa);
+}
+
 Heightmap gap_below_bound_of(const deliberative::LocalMap& local, const Heightmap& sources, double kappa) {
   return gap_below(local, MarsProcessor(kappa).project(sources));
 }

@@ -65,6 +65,11 @@ CellMask band_mask(const deliberative::LocalMap& local, const std::vector<std::v
 /// structure beside the band, natural or built, neither raise the band's target nor are filled from it by more
 /// than the band's own slopes ask.
 Heightmap band_fill_gap(const deliberative::LocalMap& local, const CellMask& band, double kappa);
+/// What is left to fill along a way (docs/runtime.md#the-construction-band, "The way's own surface"):
+/// band_fill_gap() with the cells within radius_m [m] of a cell of `path` (local indices) as the only sources, the
+/// surface a body of that radius drives on along the path; high ground elsewhere in the band is no source.
+Heightmap way_fill_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& path, double radius_m,
+                       double kappa);
 /// h_band of band_fill_gap(): the window's heights on the cells of `band`, its lowest height elsewhere [m].
 Heightmap band_sources(const deliberative::LocalMap& local, const CellMask& band);
 /// The window's gap capped by another surface's bound: min(local.gap, max(0, P_kappa[sources] - h)) [m] per cell,

@@ -35,7 +35,8 @@
 // One band for every front robot (docs/runtime.md#the-construction-band): what the active robot fills follows its
 // deposition path moved towards the centre line of the corridor it builds in, on its own map
 // (RampSteps::set_band_centre), not the path from where it stands; it still drives its own path. What is left to fill
-// there is the MARS gap of the band's own surface: high ground and structure beside the band raise nothing in it.
+// there is the MARS gap of the way's own surface (the cells the body drives on along that path): high ground and
+// structure beside it, in the band or beyond, raise nothing in it.
 // Lanes: followers and robots on their way back keep lane_offset_m to the right of the band's centre line
 // (executive/lane.hpp), so a returning robot passes followers in the other lane; the world rejects motions that
 // would make bodies overlap, and every route goes around the bodies the frame shows (ramp_steps.hpp).

@@ -384,14 +384,20 @@ std::vector<CellIndex> RampSteps::on_band_centre(const deliberative::LocalMap& l
   return executive::band_centre_path(local, memory_.corridor, ahead, corridor_width_m_, max_shift_m, &built);
 }
 
+double RampSteps::way_radius_m() const {
+  // The band holds the way and, each side of it, the room of a lane: what is left of its half-width without the
+  // lane's offset; never less than the robot's own half body.
+  return std::max(0.5 * context_.type.body.navigability.delta_m, 0.5 * corridor_width_m_ - lane_offset_m_);
+}
+
 Heightmap RampSteps::band_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) {
   if (!(corridor_width_m_ > 0.0)) return local.gap;
-  // What is left to fill is judged against the band's own slope: the terrain and structure beside it (other fronts'
-  // strips, high ground along the way) neither raise its target nor widen it (executive::band_fill_gap). A robot
-  // that waits or is refused sees the same band on the same heights: it reuses the last bound.
-  const CellMask band = executive::band_mask(local, {ahead}, 0.5 * corridor_width_m_);
-  return executive::gap_below(local,
-                              bound_of(memory_.band_bound, local.offset, executive::band_sources(local, band)));
+  // What is left to fill is judged against the slope of the way's own surface, the cells the body drives on along
+  // the footprint's path from where it will stand (executive::way_fill_gap): the terrain and structure beside it,
+  // also inside the band (other fronts' strips, high ground the band's edge reaches), neither raise its target nor
+  // widen it. A robot that waits or is refused sees the same way on the same heights: it reuses the last bound.
+  const CellMask way = executive::band_mask(local, {ahead}, way_radius_m());
+  return executive::gap_below(local, bound_of(memory_.band_bound, local.offset, executive::band_sources(local, way)));
 }
 
 const Heightmap& RampSteps::bound_of(PlanBound& memo, CellIndex offset, Heightmap sources) const {

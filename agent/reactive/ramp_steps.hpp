@@ -143,8 +143,8 @@ class RampSteps {
   /// fills follows its deposition path moved onto the centre line of the corridor it runs in (executive/lane.hpp
   /// band_centre_path, on its own map without the other robots), not the path from where it stands; it still drives
   /// its own path; nothing along a stretch of it that runs beside the structure (the cells its map saw raised,
-  /// executive/raised_cells.hpp); and what is left to fill is the band's own MARS gap (executive::band_fill_gap: the
-  /// terrain beside the band raises nothing in it). Needs set_lane()'s corridor width; off by default; set before
+  /// executive/raised_cells.hpp); and what is left to fill is the MARS gap of the way's own surface, the cells the
+  /// body drives on along that path (executive::way_fill_gap: the terrain beside it raises nothing in it). Needs set_lane()'s corridor width; off by default; set before
   /// admit().
   void set_band_centre(bool on) { band_centre_ = on; }
   /// `path` moved into this robot's lane on the last look()'s map (unchanged without lanes).
@@ -212,7 +212,7 @@ class RampSteps {
     std::vector<Deposit> deposits;
   };
   /// What the steps remember from one frame to the next.
-  // plan_gap(), band_gap(): the last window's sources (the first-seen heights, the band's heights) and their MARS
+  // plan_gap(), band_gap(): the last window's sources (the first-seen heights, the way's heights) and their MARS
   // bound at the construction kappa.
   struct PlanBound {
     CellIndex offset{-1, -1};
@@ -267,8 +267,10 @@ class RampSteps {
                BuildTrace& trace, protocol::ActionRequest& request);
   // set_band_centre(): `ahead` (local indices, from where the robot will stand) on the corridor's centre line.
   std::vector<CellIndex> on_band_centre(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead) const;
-  // set_band_centre(): the window's gap against the band along `ahead` alone (executive::band_fill_gap).
+  // set_band_centre(): the window's gap against the way's surface along `ahead` alone (executive::way_fill_gap).
   Heightmap band_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& ahead);
+  // band_gap(): the half-width of the way whose surface is the fill's only source [m].
+  double way_radius_m() const;
   // set_band_centre(): the price the planner routes by: the window's gap against the terrain as first seen
   // (executive::first_seen_gap), so what is built raises no price beside it, and 0 on the cells built (built_cells).
   Heightmap plan_gap(const deliberative::LocalMap& local);

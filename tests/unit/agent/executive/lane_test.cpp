@@ -275,5 +275,48 @@ TEST(BandFill, WhatIsLeftToFillIsTheBandsOwnMarsGap) {
   EXPECT_LT(gap(6, 10), 0.01);
 }
 
+TEST(BandFill, WhatIsLeftToFillAlongAWayIsTheMarsGapOfTheSurfaceTheBodyDrivesOn) {
+  // 16 x 20 cells of 0.25 m, fractal-free but uneven: a slope along the columns, a 0.6 m ridge on row 3 (inside a
+  // 3 m band centred on row 8, outside a 0.5 m body radius of the way on row 8), a 0.35 m top on the way at (8, 4)
+  // and a pit on the way at (8, 12).
+  const GridGeometry g{16, 20, 0.0, 0.0, 0.25};
+  const double kappa = 0.2;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> noise(0.0, 0.05);
+  Heightmap h(g, 0.0);
+  for (int r = 0; r < 16; ++r)
+    for (int c = 0; c < 20; ++c) h(r, c) = 0.3 - 0.01 * c + noise(rng);
+  for (int c = 0; c < 20; ++c) h(3, c) = 0.6;
+  h(8, 4) = 0.35;
+  h(8, 12) = -0.2;
+  h(15, 19) = -0.5;  // the window's lowest cell
+  const deliberative::LocalMap map =
+      test::make_local_map(h, MarsProcessor(kappa).gap(h), kBody, {8, 1}, std::nullopt);
+  const std::vector<CellIndex> way = row_path(8, 1, 18);
+  const double radius = 0.5;  // 2 cells
+  const Heightmap gap = way_fill_gap(map, way, radius, kappa);
+  // Brute force: cones of slope kappa from the cells within the radius of a cell of the way; never above the
+  // window's own gap.
+  for (int r = 0; r < 16; ++r)
+    for (int c = 0; c < 20; ++c) {
+      double top = h(r, c);
+      for (int qr = 0; qr < 16; ++qr)
+        for (int qc = 0; qc < 20; ++qc) {
+          const bool source = std::any_of(way.begin(), way.end(), [&](CellIndex p) {
+            return 0.25 * std::hypot(qr - p.row, qc - p.col) <= radius + 1e-9;
+          });
+          if (source) top = std::max(top, h(qr, qc) - kappa * 0.25 * std::hypot(qr - r, qc - c));
+        }
+      EXPECT_NEAR(gap(r, c), std::min(map.gap(r, c), top - h(r, c)), 1e-9) << r << ", " << c;
+    }
+  // The pit on the way is filled from the way's own surface around it, not from the ridge inside the band: the band's
+  // own surface asks more there.
+  const CellMask band = band_mask(map, {way}, 1.5);
+  const Heightmap band_gap = band_fill_gap(map, band, kappa);
+  EXPECT_GT(gap(8, 12), 0.2);
+  EXPECT_GT(band_gap(8, 12), gap(8, 12) + 0.05);
+  EXPECT_GT(band_gap(7, 10), gap(7, 10) + 0.05);
+}
+
 }  // namespace
 }  // namespace marsala::agent::executive
