@@ -255,7 +255,8 @@ void DepositionManager::prepare(WayBack& w) const {
                   reaches_border(cell == map.robot && map.navigable.size() == map.occupiable.size()
                                      ? map.navigable
                                      : NavigabilityProcessor::navigable_from(map.occupiable, cell));
-  if (!w.had_way_out) w.reach = NavigabilityProcessor::navigable_from(w.occupiable, cell);
+  if (!w.had_way_out && params_.keep_reach_without_way_out)
+    w.reach = NavigabilityProcessor::navigable_from(w.occupiable, cell);
 }
 
 CellMask DepositionManager::occupiable_after(WayBack& w, const std::vector<DepositionCandidate>& depositions) const {

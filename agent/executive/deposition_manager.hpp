@@ -45,6 +45,9 @@ struct DepositionParams {
   /// A map built from range scans: a cone pile stays this far [m] below every cell it may not raise (under a robot,
   /// on the pad, unread), which the map reads within its noise; 0 for exact maps.
   double pile_margin_m = 0.0;
+  /// A map built from range scans: a robot whose map gives it no way out of its window keeps every cell it can still
+  /// reach (keeps_way_back()). Exact maps keep only the way out they have, as before.
+  bool keep_reach_without_way_out = false;
 };
 
 /// The deposition parameters of a body on a grid of cell_size_m [m], with the team's keep-out [m]; the footprint is

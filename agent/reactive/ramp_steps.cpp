@@ -100,6 +100,7 @@ void RampSteps::admit(const protocol::Admission& admission) {
     deposits.exit_margin_m = kScanExitMargin * context_.type.sensor.noise_sd_at(body.navigability.delta_m);
     // A pile's edge beside the robot lands on cells read from about a body length away, within the same noise.
     deposits.pile_margin_m = deposits.exit_margin_m;
+    deposits.keep_reach_without_way_out = true;
   }
   const std::size_t streak_cells =
       context_.type.sensor.casts_rays() ? static_cast<std::size_t>(world.rows) * world.cols : 0;

@@ -288,7 +288,8 @@ TEST(DepositionManager, WithoutAWayOutTheRobotKeepsEveryCellItCanStillReach) {
     line.push_back({centre.row - 3, c});
     gap(centre.row - 3, c) = c < centre.col ? 0.04 : 0.3;
   }
-  const DepositionParams p = params(0.4, 10.0);
+  DepositionParams p = params(0.4, 10.0);
+  p.keep_reach_without_way_out = true;
   const LocalMap map = make_map(h, gap, p.navigability, centre, centre);
   const NavigabilityProcessor nav(p.navigability);
   const CellMask before = NavigabilityProcessor::navigable_from(nav.occupiable(h), centre);
@@ -303,6 +304,11 @@ TEST(DepositionManager, WithoutAWayOutTheRobotKeepsEveryCellItCanStillReach) {
   for (int r = 0; r < kGrid.rows; ++r)
     for (int c = 0; c < kGrid.cols; ++c)
       if (before(r, c) != 0) EXPECT_NE(now(r, c), 0) << r << "," << c;
+  // Without the rule (an exact map) the whole line is filled: the pocket's way out was already gone.
+  p.keep_reach_without_way_out = false;
+  EXPECT_EQ(DepositionManager(p).plan(map, line, kGrid.cell_center(centre), 10.0, {1, kGrid.cell_center(centre), {}})
+                .depositions.size(),
+            line.size());
 }
 
 TEST(DepositionManager, KeepsANeighboursWayBack) {
