@@ -309,12 +309,9 @@ bool DepositionManager::keeps_way_back(WayBack& w, const std::vector<DepositionC
   if (w.had_way_out && !reaches_border(NavigabilityProcessor::navigable_from(occupiable, cell))) return false;
   // Without one, it keeps every cell it can still reach: a robot whose own depositions took its last moves stood
   // walled in for good, the drops that close its neighbour cells lying under its own body, where it may not build.
-  if (!w.had_way_out && w.reach.size() > 0) {
-    const CellMask now = NavigabilityProcessor::navigable_from(occupiable, cell);
-    for (Eigen::Index r = 0; r < now.rows(); ++r)
-      for (Eigen::Index c = 0; c < now.cols(); ++c)
-        if (w.reach(r, c) != 0 && now(r, c) == 0) return false;
-  }
+  if (w.reach.size() > 0 &&
+      (w.reach.array() > NavigabilityProcessor::navigable_from(occupiable, cell).array()).any())
+    return false;
   if (!w.has_origin) return true;
   const CellMask reach = NavigabilityProcessor::navigable_from(occupiable, *map.origin);
   for (const CellIndex p : w.robots)

@@ -155,6 +155,7 @@ class ConeDepositor final : public Depositor {
     std::vector<std::uint8_t> in_band(remaining.size(), 0);  // the cells the path's footprint wants
     for (const WantedCell& w : wanted) in_band[index(w.cell)] = 1;
     Heightmap heights = map.heights;  // the piles chosen so far land on it
+    const double lowest = heights.min_height();  // the piles only raise cells: still the window's lowest after them
     double budget = budget_m3(manager, material_m3);
     std::vector<Placed> placed;
     for (int pile = 0; pile < kMaxConesPerStep && budget > kMinVolumeM3; ++pile) {
@@ -165,7 +166,7 @@ class ConeDepositor final : public Depositor {
         const Position dump = map.center(w.cell);
         if (!(remaining[index(w.cell)] > 0.0) || !(distance(dump, robot) <= p.reach_m)) continue;
         ++points;
-        consider(heights, remaining, in_band, dump, budget, p.max_height_m, p.pile_margin_m, best);
+        consider(heights, remaining, in_band, dump, budget, p.max_height_m, {p.pile_margin_m, lowest}, best);
       }
       if (!(best.band_m3 > 0.0)) break;
       Placed pile_placed{{best.dump.x, best.dump.y, best.volume_m3}, {}};
@@ -181,6 +182,12 @@ class ConeDepositor final : public Depositor {
   }
 
  private:
+  /// How far a pile stays below the cells it may not raise (clear_by()), with the window's lowest height [m].
+  struct Clearance {
+    double margin_m = 0.0;
+    double lowest_m = 0.0;
+  };
+
   /// The best pile found so far.
   struct Choice {
     double band_m3 = 0.0;  // its volume on the path's footprint [m^3]
@@ -193,11 +200,11 @@ class ConeDepositor final : public Depositor {
   /// the cells' caps allow), the budget and its halvings, and what fills the dump cell alone; the one with most
   /// volume on the path's footprint wins.
   void consider(const Heightmap& heights, const std::vector<double>& remaining, const std::vector<std::uint8_t>& in_band,
-                Position dump, double budget, double max_rise_m, double margin_m, Choice& best) const {
+                Position dump, double budget, double max_rise_m, Clearance clearance, Choice& best) const {
     const double area = heights.cell_size_m() * heights.cell_size_m();
     const auto index = [&](CellIndex c) { return static_cast<std::size_t>(c.row) * heights.cols() + c.col; };
     std::vector<double> volumes{
-        std::min(budget, largest_pile_m3(heights, remaining, dump, slope_, max_rise_m, margin_m) *
+        std::min(budget, largest_pile_m3(heights, remaining, dump, slope_, max_rise_m, clearance.margin_m) *
                              (1.0 - kShrinkFraction))};
     for (double v = budget; volumes.size() <= kVolumeHalvings; v *= 0.5) volumes.push_back(v);
     const double here = remaining[index(*heights.geometry().cell_at(dump))] * area;
@@ -224,22 +231,24 @@ class ConeDepositor final : public Depositor {
       bool guarded = guard.on_grid;
       for (const CellRise& r : guard.rises)
         if (remaining[index(r.cell)] < 0.0) guarded = false;
-      if (!guarded || !clear_by(heights, remaining, dump, shape, margin_m)) continue;
+      if (!guarded || !clear_by(heights, remaining, dump, shape, clearance)) continue;
       best = {band, dump, v, std::move(shape)};
     }
   }
 
-  /// True when the pile `shape` dumped at `dump` stays margin_m [m] below every cell of the window it may not raise
-  /// (remaining < 0): on a scanned map those cells read within noise, and the world settles the pile on the truth.
+  /// True when the pile `shape` dumped at `dump` stays the clearance's margin below every cell of the window it may
+  /// not raise (remaining < 0): on a scanned map those cells read within noise, and the world settles the pile on the
+  /// truth.
   bool clear_by(const Heightmap& heights, const std::vector<double>& remaining, Position dump, const DepositShape& shape,
-                double margin_m) const {
+                Clearance clearance) const {
+    const double margin_m = clearance.margin_m;
     if (!(margin_m > 0.0) || shape.rises.empty()) return true;
     const double cs = heights.cell_size_m();
     double apex = -std::numeric_limits<double>::infinity();
     for (const CellRise& r : shape.rises)
       apex = std::max(apex, heights(r.cell) + r.rise_m + slope_ * distance(heights.cell_center(r.cell), dump));
     // Cells farther than this from the dump point lie below the pile only if they are lower than the window's lowest.
-    const double reach_m = (apex + margin_m - heights.min_height()) / slope_;
+    const double reach_m = (apex + margin_m - clearance.lowest_m) / slope_;
     const int span = static_cast<int>(std::ceil(reach_m / cs)) + 1;
     const CellIndex at = *heights.geometry().cell_at(dump);
     for (int r = std::max(0, at.row - span); r <= std::min(heights.rows() - 1, at.row + span); ++r)

@@ -211,7 +211,11 @@ Heightmap band_fill_gap(const deliberative::LocalMap& local, const CellMask& ban
 
 Heightmap way_fill_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& path, double radius_m,
                        double kappa) {
-  return band_fill_gap(local, band_mask(local, {path}, radius_m), kappa);
+  return gap_below_bound_of(local, way_sources(local, path, radius_m), kappa);
+}
+
+Heightmap way_sources(const deliberative::LocalMap& local, const std::vector<CellIndex>& path, double radius_m) {
+  return band_sources(local, band_mask(local, {path}, radius_m));
 }
 
 Heightmap gap_below_bound_of(const deliberative::LocalMap& local, const Heightmap& sources, double kappa) {

@@ -70,6 +70,8 @@ Heightmap band_fill_gap(const deliberative::LocalMap& local, const CellMask& ban
 /// surface a body of that radius drives on along the path; high ground elsewhere in the band is no source.
 Heightmap way_fill_gap(const deliberative::LocalMap& local, const std::vector<CellIndex>& path, double radius_m,
                        double kappa);
+/// The sources of way_fill_gap(): band_sources() of the cells within radius_m [m] of a cell of `path`.
+Heightmap way_sources(const deliberative::LocalMap& local, const std::vector<CellIndex>& path, double radius_m);
 /// h_band of band_fill_gap(): the window's heights on the cells of `band`, its lowest height elsewhere [m].
 Heightmap band_sources(const deliberative::LocalMap& local, const CellMask& band);
 /// The window's gap capped by another surface's bound: min(local.gap, max(0, P_kappa[sources] - h)) [m] per cell,

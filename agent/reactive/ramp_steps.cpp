@@ -397,8 +397,8 @@ Heightmap RampSteps::band_gap(const deliberative::LocalMap& local, const std::ve
   // the footprint's path from where it will stand (executive::way_fill_gap): the terrain and structure beside it,
   // also inside the band (other fronts' strips, high ground the band's edge reaches), neither raise its target nor
   // widen it. A robot that waits or is refused sees the same way on the same heights: it reuses the last bound.
-  const CellMask way = executive::band_mask(local, {ahead}, way_radius_m());
-  return executive::gap_below(local, bound_of(memory_.band_bound, local.offset, executive::band_sources(local, way)));
+  return executive::gap_below(
+      local, bound_of(memory_.band_bound, local.offset, executive::way_sources(local, ahead, way_radius_m())));
 }
 
 const Heightmap& RampSteps::bound_of(PlanBound& memo, CellIndex offset, Heightmap sources) const {
