@@ -255,8 +255,18 @@ void DepositionManager::prepare(WayBack& w) const {
                   reaches_border(cell == map.robot && map.navigable.size() == map.occupiable.size()
                                      ? map.navigable
                                      : NavigabilityProcessor::navigable_from(map.occupiable, cell));
-  if (!w.had_way_out && params_.keep_reach_without_way_out)
+  if (!w.had_way_out && params_.keep_reach_without_way_out) {
     w.reach = NavigabilityProcessor::navigable_from(w.occupiable, cell);
+    // The cells it keeps are its way back, those no nearer its goal than it stands: what lies ahead is what it builds.
+    const auto to_goal = [&](CellIndex p) {
+      const long long dr = p.row - map.goal.row, dc = p.col - map.goal.col;
+      return dr * dr + dc * dc;
+    };
+    const long long here = to_goal(cell);
+    for (int r = 0; r < map.rows(); ++r)
+      for (int c = 0; c < map.cols(); ++c)
+        if (w.reach(r, c) != 0 && to_goal({r, c}) < here) w.reach(r, c) = 0;
+  }
 }
 
 CellMask DepositionManager::occupiable_after(WayBack& w, const std::vector<DepositionCandidate>& depositions) const {

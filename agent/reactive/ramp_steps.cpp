@@ -217,8 +217,10 @@ void RampSteps::learn_refusals(const protocol::SensorFrame& frame) {
   if (memory_.refusal && memory_.refusal->terrain && memory_.refusal->motion) {
     modules_->map.forget_assumed_ground(memory_.refusal->cell, 0.5 * context_.type.body.navigability.delta_m);
     // The drop the body found: its heights are facts the map keeps (a pit read at its rim's height).
-    if (const auto& drop = memory_.refusal->drop; drop && context_.type.sensor.casts_rays())
+    if (const auto& drop = memory_.refusal->drop; drop && context_.type.sensor.casts_rays()) {
       modules_->map.record_drop(drop->low, drop->low_m, drop->high, drop->high_m);
+      record_drop_level(*drop);
+    }
   }
   const executive::MappingSystem& map = modules_->map;
   memory_.refused->update(map.heights(), map.known(), frame.step);
@@ -232,6 +234,46 @@ void RampSteps::learn_refusals(const protocol::SensorFrame& frame) {
                                                                      : std::nullopt);
   else
     cells.refuse_for_now(r.cell, frame.step);
+}
+
+void RampSteps::record_drop_level(const executive::DropRefusal& drop) {
+  const GridGeometry& g = modules_->map.geometry();
+  if (!g.contains(drop.low) || !std::isfinite(drop.high_m)) return;
+  const NavigabilityParams build = construction_params(context_.type);
+  const double d = g.cell_size_m * std::hypot(drop.high.row - drop.low.row, drop.high.col - drop.low.col);
+  const double layer = modules_->depositions.params().cube_layer_m;
+  // The pair passes (rule 2.3) once the low cell stands within eps + kappa d of the high one; a layer's rounding and
+  // half the rest of eps below that level keep it passing, and the level stays under the high cell's slope, so under
+  // every bound the world holds the cell to.
+  const double level = drop.high_m - build.kappa * d - 0.5 * std::max(0.0, build.eps_m - layer);
+  const long long index = static_cast<long long>(drop.low.row) * g.cols + drop.low.col;
+  auto [it, added] = memory_.drop_levels.try_emplace(index, level);
+  if (!added) it->second = std::max(it->second, level);
+}
+
+bool RampSteps::fails_a_told_drop(const deliberative::LocalMap& local, CellIndex cell) const {
+  const NavigabilityParams build = construction_params(context_.type);
+  const double radius = 0.5 * context_.type.body.navigability.delta_m / local.geometry().cell_size_m;
+  const double rounding = 0.5 * (build.eps_m + modules_->depositions.params().cube_layer_m);
+  const int cols = modules_->map.geometry().cols;
+  for (const auto& [index, level] : memory_.drop_levels) {
+    const CellIndex p = local.to_local({static_cast<int>(index / cols), static_cast<int>(index % cols)});
+    const double dr = p.row - cell.row, dc = p.col - cell.col;
+    if (!local.contains(p) || dr * dr + dc * dc > radius * radius + 1e-9) continue;
+    if (local.heights(p.row, p.col) < level - rounding) return true;
+  }
+  return false;
+}
+
+void RampSteps::fill_to_drop_levels(deliberative::LocalMap& local) const {
+  const double margin = modules_->depositions.params().gap_margin_m;
+  const int cols = modules_->map.geometry().cols;
+  for (const auto& [index, level] : memory_.drop_levels) {
+    const CellIndex p = local.to_local({static_cast<int>(index / cols), static_cast<int>(index % cols)});
+    if (!local.contains(p) || local.known(p.row, p.col) == 0) continue;
+    const double rise = level - local.heights(p.row, p.col);
+    if (rise > 0.0) local.gap(p.row, p.col) = std::max(local.gap(p.row, p.col), rise + margin);
+  }
 }
 
 void RampSteps::update_map(const protocol::SensorFrame& frame) {
@@ -458,6 +500,7 @@ void RampSteps::deposit(const deliberative::LocalMap& local, const protocol::Sen
   }
   if (context_.type.sensor.casts_rays()) clear_unconfirmed_gap(terrain_only);
   if (band_centre_) terrain_only.gap = band_gap(terrain_only, ahead);
+  if (context_.type.sensor.casts_rays()) fill_to_drop_levels(terrain_only);
   for (const CellIndex g : memory_.refused_depositions->cells()) {
     const CellIndex p = terrain_only.to_local(g);
     if (terrain_only.contains(p)) terrain_only.gap(p.row, p.col) = 0.0;
@@ -494,6 +537,10 @@ std::optional<BuildPhase> RampSteps::build_step(const deliberative::LocalMap& lo
   }
   deposit(local, frame, robot, 0, trace, request);
   if (trace.deposition.any()) return BuildPhase::kBuild;
+  if (const auto motion = ask_ahead(local, trace.plan.path, robot)) {
+    move(*motion, trace, request);
+    return BuildPhase::kAdvance;
+  }
   memory_.deposited_since_blocked = false;
   memory_.idle_retreat_moves = 0;
   return retreat_step(local, frame, trace, request);
@@ -525,8 +572,12 @@ BuildPhase RampSteps::retreat_step(const deliberative::LocalMap& local, const pr
   }
   // Step back the way the robot came and fill what comes into reach: the gap where it stood.
   ++memory_.idle_retreat_moves;
-  auto motion = step_back(local, robot);
+  // A scanning robot its map walls in (no navigable cell a body length away) asks the world the way it came first:
+  // stepping back and forth on its island would never change its map.
+  auto motion = walled_in(local, robot) ? ask_back(local, robot) : std::nullopt;
+  if (!motion) motion = step_back(local, robot);
   if (!motion) motion = retrace(local, robot);
+  if (!motion) motion = ask_back(local, robot);
   if (!motion) return BuildPhase::kRetreat;
   move(*motion, trace, request);
   deposit(local, frame, motion->target, 0, trace, request);
@@ -568,6 +619,56 @@ std::optional<executive::Motion> RampSteps::retrace(const deliberative::LocalMap
     return executive::Motion{cell, target, 0, d};
   }
   return std::nullopt;
+}
+
+std::optional<executive::Motion> RampSteps::ask_ahead(const deliberative::LocalMap& local,
+                                                      const std::vector<CellIndex>& path, Position robot) const {
+  if (!context_.type.sensor.casts_rays() || path.size() < 2) return std::nullopt;
+  const CellIndex next = path[1];
+  if (!local.contains(next) || local.known(next.row, next.col) == 0) return std::nullopt;
+  // The robot's map of the terrain holds the cell out (a neighbour's body is no question for the world), and the
+  // world has not refused it on the map as it reads now.
+  const CellMask& terrain = memory_.terrain_occupiable;
+  if (terrain.rows() != local.rows() || terrain.cols() != local.cols() || terrain(next.row, next.col) != 0)
+    return std::nullopt;
+  if (memory_.refused->contains(local.to_global(next))) return std::nullopt;
+  if (fails_a_told_drop(local, next)) return std::nullopt;
+  const Position target = local.center(next);
+  const double d = distance(target, robot);
+  if (!(d <= context_.type.body.max_step_m + tolerance::kLengthM) || !executive::clear_of(memory_.others, robot, target))
+    return std::nullopt;
+  return executive::Motion{next, target, 1, d};
+}
+
+bool RampSteps::walled_in(const deliberative::LocalMap& local, Position robot) const {
+  if (!context_.type.sensor.casts_rays()) return false;
+  const double far_m = context_.type.body.navigability.delta_m;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c)
+      if (local.navigable(r, c) != 0 && distance(local.center({r, c}), robot) >= far_m) return false;
+  return true;
+}
+
+std::optional<executive::Motion> RampSteps::ask_back(const deliberative::LocalMap& local, Position robot) const {
+  if (!context_.type.sensor.casts_rays()) return std::nullopt;
+  // Where the robot came from: the latest cell of its trajectory a body length away and no nearer its goal, known on
+  // its map.
+  const double far_m = context_.type.body.navigability.delta_m;
+  const Position goal = local.center(local.goal);
+  const double here_m = distance(robot, goal);
+  const auto& trajectory = modules_->map.trajectory();
+  std::optional<CellIndex> anchor;
+  for (auto it = trajectory.rbegin(); it != trajectory.rend() && !anchor; ++it) {
+    const CellIndex cell = local.to_local(*it);
+    if (!local.contains(cell) || local.known(cell.row, cell.col) == 0) break;
+    const Position at = local.center(cell);
+    if (distance(at, robot) >= far_m && distance(at, goal) >= here_m) anchor = cell;
+  }
+  if (!anchor) return std::nullopt;
+  const auto route = modules_->router.plan(local.gap, local.known, local.robot, *anchor);
+  if (!route.found || route.path.size() < 2) return std::nullopt;
+  if (const auto motion = advance(local, route.path, robot)) return motion;
+  return ask_ahead(local, route.path, robot);
 }
 
 std::optional<executive::Motion> RampSteps::step_away(const deliberative::LocalMap& local, Position robot,

@@ -29,6 +29,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "marsala/agent/agent_context.hpp"
@@ -162,6 +163,23 @@ class RampSteps {
   /// judges on the truth, and a refusal names the drop with its heights. nullopt otherwise.
   std::optional<executive::Motion> retrace(const deliberative::LocalMap& local, Position robot) const;
 
+  /// A scanning robot blocked on its path with nothing to fill asks the world the path's next cell: a motion to it when
+  /// its map holds the cell out for the terrain alone (a ball it cannot judge, a pit it never saw, a step read within
+  /// noise too high), the cell lies within a step and clear of the neighbours, and the world has not refused it on the
+  /// map as it reads now (docs/runtime.md#refused-requests). The world judges on the truth: it accepts, or its
+  /// refusal names the drop with its heights, which the map keeps (MappingSystem::record_drop) and the robot fills.
+  /// nullopt otherwise.
+  std::optional<executive::Motion> ask_ahead(const deliberative::LocalMap& local, const std::vector<CellIndex>& path,
+                                             Position robot) const;
+
+  /// A scanning robot whose map leaves it no way back (step_back() and retrace() found none) asks the world the way it
+  /// came: along a route over its known cells to the latest cell of its trajectory a body length away, the route's
+  /// next cell (advance(), or ask_ahead() when the map holds it out). nullopt otherwise.
+  std::optional<executive::Motion> ask_back(const deliberative::LocalMap& local, Position robot) const;
+  /// A scanning robot on an island of its map: no navigable cell lies a body length away. Always false for a robot
+  /// that reads exact heights.
+  bool walled_in(const deliberative::LocalMap& local, Position robot) const;
+
   /// A step away from a robot at `from` [m] (giving way, reactive/right_of_way.hpp): towards the navigable cell within
   /// two body lengths farthest from it, when that is farther than the robot stands; nullopt when there is none.
   std::optional<executive::Motion> step_away(const deliberative::LocalMap& local, Position robot, Position from) const;
@@ -255,11 +273,22 @@ class RampSteps {
     PlanBound band_bound;  ///< band_gap()'s memo
     std::optional<executive::RaisedCells> raised;  ///< set_band_centre(): the structure seen built (first heights)
     Position target;                               ///< this frame's target (synthesize_view()) [m]
+    /// Scanned maps: the level each drop's lower cell (row-major world index) must reach for the pair the world named
+    /// to pass (record_drop_level()) [m].
+    std::unordered_map<long long, double> drop_levels;
   };
 
   // look()'s steps, in order.
   void remember_result(const protocol::SensorFrame& frame);              // what the world made of the last request
   void update_map(const protocol::SensorFrame& frame);                   // tiles, scan and the ground under the body
+  // A drop the world named: the level its lower cell must reach for the pair to pass (Memory::drop_levels).
+  void record_drop_level(const executive::DropRefusal& drop);
+  // Scanned maps: the gap of each told drop's lower cell in the window is at least what its level asks (less nothing
+  // for noise: the heights were told).
+  void fill_to_drop_levels(deliberative::LocalMap& local) const;
+  // A told drop in the body ball of `cell` (local index) still lies lower than its pair lets it (its level less the
+  // rounding record_drop_level() leaves): the world would refuse the cell again.
+  bool fails_a_told_drop(const deliberative::LocalMap& local, CellIndex cell) const;
   void learn_refusals(const protocol::SensorFrame& frame);               // the world's refusals on the new map
   BuildView synthesize_view(const protocol::SensorFrame& frame);         // target, local map, the gap to work on
   void keep_clear(const protocol::SensorFrame& frame, BuildView& view);  // the neighbours and the refused cells

@@ -311,6 +311,54 @@ TEST(DepositionManager, WithoutAWayOutTheRobotKeepsEveryCellItCanStillReach) {
             line.size());
 }
 
+// The cells kept without a way out are the robot's way back, those no nearer its goal than it stands: what lies ahead
+// is what it builds. The same pocket; a 0.3 m wall to fill on the east half of the row three cells north (listed from
+// the east). With the goal east, the wall's eastern cells are built (they cut only cells nearer the goal), and every
+// cell it could reach that is no nearer the goal stays reachable; with the goal west, nothing of it is built.
+TEST(DepositionManager, WithoutAWayOutTheRobotKeepsTheCellsBehindItNotThoseAhead) {
+  const CellIndex centre{10, 15};
+  Heightmap h(kGrid, 0.0);
+  for (int r = 0; r < kGrid.rows; ++r)
+    for (int c = 0; c < kGrid.cols; ++c)
+      if (std::max(std::abs(r - centre.row), std::abs(c - centre.col)) >= 8) h(r, c) = 1.0;
+  Heightmap gap(kGrid, 0.0);
+  std::vector<CellIndex> line;
+  for (int c = centre.col + 7; c > centre.col; --c) {
+    line.push_back({centre.row - 3, c});
+    gap(centre.row - 3, c) = 0.3;
+  }
+  DepositionParams p = params(0.4, 10.0);
+  p.keep_reach_without_way_out = true;
+  const NavigabilityProcessor nav(p.navigability);
+  const CellMask before = NavigabilityProcessor::navigable_from(nav.occupiable(h), centre);
+  const Position robot = kGrid.cell_center(centre);
+  const auto plan_towards = [&](CellIndex goal) {
+    LocalMap map = make_map(h, gap, p.navigability, centre, centre);
+    map.goal = goal;
+    return DepositionManager(p).plan(map, line, robot, 10.0, {1, robot, {}});
+  };
+  const auto to = [](CellIndex a, CellIndex b) {
+    return (a.row - b.row) * (a.row - b.row) + (a.col - b.col) * (a.col - b.col);
+  };
+  const CellIndex east{centre.row, kGrid.cols - 1};
+  const DepositionPlan ahead = plan_towards(east);
+  ASSERT_FALSE(ahead.depositions.empty());
+  Heightmap after = h;
+  for (const Deposition& d : ahead.depositions) after(CellIndex{d.row, d.col}) += d.height_m;
+  const CellMask now = NavigabilityProcessor::navigable_from(nav.occupiable(after), centre);
+  int cut_ahead = 0;
+  for (int r = 0; r < kGrid.rows; ++r)
+    for (int c = 0; c < kGrid.cols; ++c) {
+      if (before(r, c) == 0) continue;
+      if (to({r, c}, east) >= to(centre, east))
+        EXPECT_NE(now(r, c), 0) << r << "," << c;
+      else if (now(r, c) == 0)
+        ++cut_ahead;
+    }
+  EXPECT_GT(cut_ahead, 0);
+  EXPECT_TRUE(plan_towards({centre.row, 0}).depositions.empty());
+}
+
 TEST(DepositionManager, KeepsANeighboursWayBack) {
   const Heightmap h = corridor();
   Heightmap gap(kGrid, 0.0);

@@ -9,6 +9,9 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "marsala/agent/reactive/behaviour.hpp"
 #include "marsala/core/deposit_shapes.hpp"
@@ -406,11 +409,12 @@ TEST(RampSteps, APileThatReachedARobotsBodyIsNotDumpedThereAgain) {
   EXPECT_GT(with_deposits, 20);  // it builds on beside the pile it may not dump
 }
 
-// A scanning robot whose map leaves it no move asks the world the way it came. Flat ground with eight 0.5 m spikes six
-// cells (0.6 m) from the cell B it stands on, along the axes and diagonals (4, 4): each of B's eight neighbour cells
-// holds one of them in its body ball (radius 5 cells), B's own ball none. It came from A, 0.2 m west of B; with
-// nothing to fill (no material) and no navigable cell but its own, it asks for a motion back to A, and once the
-// world has refused that, it asks nothing until its map changes. A robot that reads exact heights asks nothing.
+// A scanning robot whose map leaves it no move asks the world: first the path's next cell, then the way it came. Flat
+// ground with eight 0.5 m spikes six cells (0.6 m) from the cell B it stands on, along the axes and diagonals (4, 4):
+// each of B's eight neighbour cells holds one of them in its body ball (radius 5 cells), B's own ball none. It came
+// from A, 0.2 m west of B; with nothing to fill (no material) and no navigable cell but its own, it asks for the next
+// cell east (towards its target); once the world has refused that, for a motion back to A; once the world has refused
+// that too, it asks nothing until its map changes. A robot that reads exact heights asks nothing.
 TEST(RampSteps, AScanningRobotWalledInOnItsMapAsksTheWorldTheWayItCame) {
   Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
   const CellIndex b{30, 40};
@@ -419,38 +423,145 @@ TEST(RampSteps, AScanningRobotWalledInOnItsMapAsksTheWorldTheWayItCame) {
     h(b.row + o.row, b.col + o.col) = 0.5;
   const Position at_b = h.geometry().cell_center(b);
   const Position at_a{at_b.x - 0.2, at_b.y};
-  const auto request_of = [&](bool scanning, protocol::ActionResult last, const std::string& reason) {
+  const CellIndex a = *h.geometry().cell_at(at_a);
+  const CellIndex east{b.row, b.col + 1};
+  const auto requests_of = [&](bool scanning, const std::vector<std::string>& refusals) {
     AgentContext c = test::agent_context(3, test::husky());
     if (scanning) c.type.sensor = sensor_defaults(SensorKind::kLaser);
     RampSteps steps(c);
     steps.admit(test::admission_on(c, h.geometry(), {9.05, at_b.y}, {0.55, at_b.y}));
-    std::optional<protocol::ActionRequest> out;
-    for (std::uint64_t step = 0; step < 3; ++step) {
+    std::vector<protocol::ActionRequest> out;
+    for (std::uint64_t step = 0; step <= refusals.size() + 1; ++step) {
       protocol::SensorFrame f = test::full_frame(c, step, step == 0 ? at_a : at_b, 0.0, h);
-      if (step == 2) {
-        f.last_result = last;
-        f.last_reason = reason;
+      if (step >= 2) {
+        f.last_result = protocol::ActionResult::kRejected;
+        f.last_reason = refusals[step - 2];
       }
       BuildTrace trace;
       const BuildView view = steps.look(f, trace);
       protocol::ActionRequest q = empty_request(c, f, "");
       if (step > 0) (void)steps.build_step(view.local, f, trace, q);
       if (step > 0) EXPECT_EQ(trace.navigable_cells, 1) << "step " << step;
-      out = q;
+      if (step > 0) out.push_back(q);
     }
-    return *out;
+    return out;
   };
-  const protocol::ActionRequest asked = request_of(true, protocol::ActionResult::kAccepted, "");
-  ASSERT_TRUE(asked.move);
-  EXPECT_NEAR(asked.target_x_m, at_a.x, 1e-9);
-  EXPECT_NEAR(asked.target_y_m, at_a.y, 1e-9);
-  const CellIndex a = *h.geometry().cell_at(at_a);
-  const std::string refused = fmt::format(
-      "target cell ({}, {}) is not occupiable for this body: cell ({}, {}) at 0 m lies too far below cell ({}, {}) at "
-      "0.5 m",
-      a.row, a.col, a.row, a.col - 5, a.row, a.col - 4);
-  EXPECT_FALSE(request_of(true, protocol::ActionResult::kRejected, refused).move);
-  EXPECT_FALSE(request_of(false, protocol::ActionResult::kAccepted, "").move);
+  const auto refused = [](CellIndex target, CellIndex low, CellIndex high) {
+    return fmt::format(
+        "target cell ({}, {}) is not occupiable for this body: cell ({}, {}) at 0 m lies too far below cell ({}, {}) "
+        "at 0.5 m",
+        target.row, target.col, low.row, low.col, high.row, high.col);
+  };
+  const auto cell_of = [&](const protocol::ActionRequest& q) { return h.geometry().cell_at({q.target_x_m, q.target_y_m}); };
+  const auto asked = requests_of(true, {refused(east, {b.row, b.col + 5}, {b.row, b.col + 6}),
+                                        refused(a, {a.row, a.col - 5}, {a.row, a.col - 4})});
+  ASSERT_EQ(asked.size(), 3u);
+  ASSERT_TRUE(asked[0].move);
+  EXPECT_EQ(cell_of(asked[0]), east);
+  ASSERT_TRUE(asked[1].move);
+  EXPECT_NEAR(asked[1].target_x_m, at_a.x, 1e-9);
+  EXPECT_NEAR(asked[1].target_y_m, at_a.y, 1e-9);
+  EXPECT_FALSE(asked[2].move);
+  const auto exact = requests_of(false, {});
+  ASSERT_EQ(exact.size(), 1u);
+  EXPECT_FALSE(exact[0].move);
+}
+
+/// Flat ground 6 x 10 m (0.1 m cells) with a step of `step_m` from column 50 east.
+Heightmap ridge_world(double step_m) {
+  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
+  for (int r = 0; r < h.rows(); ++r)
+    for (int col = 50; col < h.cols(); ++col) h(r, col) = step_m;
+  return h;
+}
+
+/// The requests of agent 3 (a laser robot when `scanning`) that stands at `from`, then at `at` on `h` with
+/// `material_m3` on board, one build_step() per frame; the frame at each step of `results` carries that result and
+/// reason.
+std::vector<protocol::ActionRequest> build_requests(const Heightmap& h, bool scanning, Position from, Position at,
+                                                    double material_m3,
+                                                    const std::vector<std::pair<protocol::ActionResult, std::string>>&
+                                                        results) {
+  AgentContext c = test::agent_context(3, test::husky());
+  if (scanning) c.type.sensor = sensor_defaults(SensorKind::kLaser);
+  RampSteps steps(c);
+  steps.admit(test::admission_on(c, h.geometry(), {9.05, at.y}, {0.55, at.y}));
+  std::vector<protocol::ActionRequest> out;
+  for (std::size_t step = 0; step <= results.size(); ++step) {
+    protocol::SensorFrame f = test::full_frame(c, step, step == 0 ? from : at, material_m3, h);
+    if (step > 0) {
+      f.last_result = results[step - 1].first;
+      f.last_reason = results[step - 1].second;
+    }
+    BuildTrace trace;
+    const BuildView view = steps.look(f, trace);
+    protocol::ActionRequest q = empty_request(c, f, "");
+    if (step > 0) (void)steps.build_step(view.local, f, trace, q);
+    if (step > 0) out.push_back(q);
+  }
+  return out;
+}
+
+// A scanning robot blocked on its path with nothing to fill asks the world the path's next cell. Flat ground with a
+// 0.5 m step from column 50; the robot stands on B (30, 44), whose ball (radius 5 cells) ends at column 49, and came
+// from the west; the next cell east holds the step in its ball, so the robot's map holds it out, and with no material
+// there is nothing to fill. It asks for a motion there; once the world has refused it (naming the drop), it asks for
+// it no more while its map reads the same. A robot that reads exact heights never asks a cell its map holds out.
+TEST(RampSteps, AScanningRobotBlockedWithNothingToFillAsksTheWorldThePathsNextCell) {
+  const Heightmap h = ridge_world(0.5);
+  const CellIndex b{30, 44};
+  const Position at_b = h.geometry().cell_center(b);
+  const Position at_a{at_b.x - 0.2, at_b.y};
+  const CellIndex next{b.row, b.col + 1};
+  const auto moves_to = [&](const protocol::ActionRequest& q, CellIndex cell) {
+    return q.move && h.geometry().cell_at({q.target_x_m, q.target_y_m}) == cell;
+  };
+  const std::string refused =
+      "target cell (30, 45) is not occupiable for this body: cell (30, 49) at 0 m lies too far below cell (30, 50) at "
+      "0.5 m";
+  using R = protocol::ActionResult;
+  const auto scanning = build_requests(h, true, at_a, at_b, 0.0, {{R::kAccepted, ""}, {R::kRejected, refused},
+                                                                  {R::kAccepted, ""}});
+  ASSERT_EQ(scanning.size(), 3u);
+  EXPECT_TRUE(moves_to(scanning[0], next));
+  EXPECT_FALSE(moves_to(scanning[1], next));
+  EXPECT_FALSE(moves_to(scanning[2], next));
+  const auto exact = build_requests(h, false, at_a, at_b, 0.0, {{R::kAccepted, ""}});
+  ASSERT_EQ(exact.size(), 1u);
+  EXPECT_FALSE(moves_to(exact[0], next));
+  EXPECT_FALSE(exact[0].move && exact[0].target_x_m > at_b.x);
+}
+
+// The drop the world named is filled until the pair passes the occupancy rule (rule 2.3), whatever the robot's map
+// leaves unconfirmed. A 0.3 m step from column 50; a laser robot on B (30, 44) whose map comes from tiles alone (no
+// scan confirms a gap, so it fills nothing) asks for the next cell east and is told that (27, 49) at 0 m lies too far
+// below (30, 50) at 0.3 m (both in that cell's ball, 0.316 m apart; (27, 49) is outside B's own): it then raises
+// (27, 49) to within eps + kappa d of the step's top and no higher than the step's slope allows.
+TEST(RampSteps, TheDropTheWorldNamedIsFilledUntilThePairPasses) {
+  const double top_m = 0.3;
+  const Heightmap h = ridge_world(top_m);
+  const Position at = h.geometry().cell_center({30, 44});
+  const Position from{at.x - 0.2, at.y};
+  const CellIndex low{27, 49};
+  const auto rise_of = [&](const protocol::ActionRequest& q) {
+    double rise = 0.0;
+    for (const Deposition& d : q.depositions)
+      if (CellIndex{d.row, d.col} == low) rise += d.height_m;
+    return rise;
+  };
+  using R = protocol::ActionResult;
+  const std::string refused =
+      "target cell (30, 45) is not occupiable for this body: cell (27, 49) at 0 m lies too far below cell (30, 50) at "
+      "0.3 m";
+  const auto requests = build_requests(h, true, from, at, 1.0, {{R::kAccepted, ""}, {R::kRejected, refused}});
+  ASSERT_EQ(requests.size(), 2u);
+  EXPECT_TRUE(requests[0].depositions.empty());  // nothing confirmed to fill: it asks the next cell
+  EXPECT_TRUE(requests[0].move);
+  const NavigabilityParams nav = test::husky().navigability;
+  const double slope_m = nav.kappa * 0.1 * std::hypot(3.0, 1.0);
+  const double rise = rise_of(requests[1]);
+  EXPECT_GE(rise, top_m - slope_m - nav.eps_m);
+  EXPECT_LE(rise, top_m - slope_m + 1e-12);
 }
 
 /// The platform world with a 0.3 m step instead of the 1.5 m platform: its top lies below the laser (0.5 m up), which
