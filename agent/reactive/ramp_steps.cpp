@@ -239,22 +239,23 @@ void RampSteps::learn_refusals(const protocol::SensorFrame& frame) {
 void RampSteps::record_drop_level(const executive::DropRefusal& drop) {
   const GridGeometry& g = modules_->map.geometry();
   if (!g.contains(drop.low) || !std::isfinite(drop.high_m)) return;
-  const NavigabilityParams build = construction_params(context_.type);
+  const NavigabilityParams& body = context_.type.body.navigability;
+  const double kappa = std::max(body.kappa, construction_params(context_.type).kappa);
   const double d = g.cell_size_m * std::hypot(drop.high.row - drop.low.row, drop.high.col - drop.low.col);
   const double layer = modules_->depositions.params().cube_layer_m;
-  // The pair passes (rule 2.3) once the low cell stands within eps + kappa d of the high one; a layer's rounding and
-  // half the rest of eps below that level keep it passing, and the level stays under the high cell's slope, so under
-  // every bound the world holds the cell to.
-  const double level = drop.high_m - build.kappa * d - 0.5 * std::max(0.0, build.eps_m - layer);
+  // The pair passes the body's rule (2.3) once the low cell stands within eps + kappa d of the high one; a layer's
+  // rounding and half the rest of eps below that level keep it passing, and the level stays under the high cell's
+  // slope (the steeper of the body's and the construction's), so under every bound the world holds the cell to.
+  const double level = drop.high_m - kappa * d - 0.5 * std::max(0.0, body.eps_m - layer);
   const long long index = static_cast<long long>(drop.low.row) * g.cols + drop.low.col;
   auto [it, added] = memory_.drop_levels.try_emplace(index, level);
   if (!added) it->second = std::max(it->second, level);
 }
 
 bool RampSteps::fails_a_told_drop(const deliberative::LocalMap& local, CellIndex cell) const {
-  const NavigabilityParams build = construction_params(context_.type);
-  const double radius = 0.5 * context_.type.body.navigability.delta_m / local.geometry().cell_size_m;
-  const double rounding = 0.5 * (build.eps_m + modules_->depositions.params().cube_layer_m);
+  const NavigabilityParams& body = context_.type.body.navigability;
+  const double radius = 0.5 * body.delta_m / local.geometry().cell_size_m;
+  const double rounding = 0.5 * (body.eps_m + modules_->depositions.params().cube_layer_m);
   const int cols = modules_->map.geometry().cols;
   for (const auto& [index, level] : memory_.drop_levels) {
     const CellIndex p = local.to_local({static_cast<int>(index / cols), static_cast<int>(index % cols)});

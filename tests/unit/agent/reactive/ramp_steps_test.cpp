@@ -410,8 +410,9 @@ TEST(RampSteps, APileThatReachedARobotsBodyIsNotDumpedThereAgain) {
 }
 
 // A scanning robot whose map leaves it no move asks the world: first the path's next cell, then the way it came. Flat
-// ground with eight 0.5 m spikes six cells (0.6 m) from the cell B it stands on, along the axes and diagonals (4, 4):
-// each of B's eight neighbour cells holds one of them in its body ball (radius 5 cells), B's own ball none. It came
+// ground with eight 0.12 m spikes six cells (0.6 m) from the cell B it stands on, along the axes and diagonals (4, 4):
+// each of B's eight neighbour cells holds one of them in its body ball (radius 5 cells), B's own ball none; a spike
+// breaks the rule by 2 cm against the cells beside it, within the laser map's noise margin. It came
 // from A, 0.2 m west of B; with nothing to fill (no material) and no navigable cell but its own, it asks for the next
 // cell east (towards its target); once the world has refused that, for a motion back to A; once the world has refused
 // that too, it asks nothing until its map changes. A robot that reads exact heights asks nothing.
@@ -420,7 +421,7 @@ TEST(RampSteps, AScanningRobotWalledInOnItsMapAsksTheWorldTheWayItCame) {
   const CellIndex b{30, 40};
   for (const CellIndex o : {CellIndex{0, 6}, CellIndex{0, -6}, CellIndex{6, 0}, CellIndex{-6, 0}, CellIndex{4, 4},
                             CellIndex{4, -4}, CellIndex{-4, 4}, CellIndex{-4, -4}})
-    h(b.row + o.row, b.col + o.col) = 0.5;
+    h(b.row + o.row, b.col + o.col) = 0.12;
   const Position at_b = h.geometry().cell_center(b);
   const Position at_a{at_b.x - 0.2, at_b.y};
   const CellIndex a = *h.geometry().cell_at(at_a);
@@ -449,7 +450,7 @@ TEST(RampSteps, AScanningRobotWalledInOnItsMapAsksTheWorldTheWayItCame) {
   const auto refused = [](CellIndex target, CellIndex low, CellIndex high) {
     return fmt::format(
         "target cell ({}, {}) is not occupiable for this body: cell ({}, {}) at 0 m lies too far below cell ({}, {}) "
-        "at 0.5 m",
+        "at 0.12 m",
         target.row, target.col, low.row, low.col, high.row, high.col);
   };
   const auto cell_of = [&](const protocol::ActionRequest& q) { return h.geometry().cell_at({q.target_x_m, q.target_y_m}); };
@@ -503,12 +504,13 @@ std::vector<protocol::ActionRequest> build_requests(const Heightmap& h, bool sca
 }
 
 // A scanning robot blocked on its path with nothing to fill asks the world the path's next cell. Flat ground with a
-// 0.5 m step from column 50; the robot stands on B (30, 44), whose ball (radius 5 cells) ends at column 49, and came
-// from the west; the next cell east holds the step in its ball, so the robot's map holds it out, and with no material
-// there is nothing to fill. It asks for a motion there; once the world has refused it (naming the drop), it asks for
-// it no more while its map reads the same. A robot that reads exact heights never asks a cell its map holds out.
+// 0.12 m step from column 50; the robot stands on B (30, 44), whose ball (radius 5 cells) ends at column 49, and came
+// from the west; the next cell east holds the step in its ball, which breaks the rule by 2 cm (within the laser map's
+// noise margin), so the robot's map holds it out, and with no material there is nothing to fill. It asks for a motion
+// there; once the world has refused it (naming the drop), it asks for it no more while its map reads the same. A robot
+// that reads exact heights never asks a cell its map holds out.
 TEST(RampSteps, AScanningRobotBlockedWithNothingToFillAsksTheWorldThePathsNextCell) {
-  const Heightmap h = ridge_world(0.5);
+  const Heightmap h = ridge_world(0.12);
   const CellIndex b{30, 44};
   const Position at_b = h.geometry().cell_center(b);
   const Position at_a{at_b.x - 0.2, at_b.y};
@@ -518,7 +520,7 @@ TEST(RampSteps, AScanningRobotBlockedWithNothingToFillAsksTheWorldThePathsNextCe
   };
   const std::string refused =
       "target cell (30, 45) is not occupiable for this body: cell (30, 49) at 0 m lies too far below cell (30, 50) at "
-      "0.5 m";
+      "0.12 m";
   using R = protocol::ActionResult;
   const auto scanning = build_requests(h, true, at_a, at_b, 0.0, {{R::kAccepted, ""}, {R::kRejected, refused},
                                                                   {R::kAccepted, ""}});
@@ -534,9 +536,9 @@ TEST(RampSteps, AScanningRobotBlockedWithNothingToFillAsksTheWorldThePathsNextCe
 
 // The drop the world named is filled until the pair passes the occupancy rule (rule 2.3), whatever the robot's map
 // leaves unconfirmed. A 0.3 m step from column 50; a laser robot on B (30, 44) whose map comes from tiles alone (no
-// scan confirms a gap, so it fills nothing) asks for the next cell east and is told that (27, 49) at 0 m lies too far
-// below (30, 50) at 0.3 m (both in that cell's ball, 0.316 m apart; (27, 49) is outside B's own): it then raises
-// (27, 49) to within eps + kappa d of the step's top and no higher than the step's slope allows.
+// scan confirms a gap, so it fills nothing) moves and is told that the next cell east is not occupiable: (27, 49) at
+// 0 m lies too far below (30, 50) at 0.3 m (both in that cell's ball, 0.316 m apart; (27, 49) is outside B's own). It
+// then raises (27, 49) to within eps + kappa d of the step's top and no higher than the step's slope allows.
 TEST(RampSteps, TheDropTheWorldNamedIsFilledUntilThePairPasses) {
   const double top_m = 0.3;
   const Heightmap h = ridge_world(top_m);
@@ -555,7 +557,7 @@ TEST(RampSteps, TheDropTheWorldNamedIsFilledUntilThePairPasses) {
       "0.3 m";
   const auto requests = build_requests(h, true, from, at, 1.0, {{R::kAccepted, ""}, {R::kRejected, refused}});
   ASSERT_EQ(requests.size(), 2u);
-  EXPECT_TRUE(requests[0].depositions.empty());  // nothing confirmed to fill: it asks the next cell
+  EXPECT_TRUE(requests[0].depositions.empty());  // nothing confirmed to fill
   EXPECT_TRUE(requests[0].move);
   const NavigabilityParams nav = test::husky().navigability;
   const double slope_m = nav.kappa * 0.1 * std::hypot(3.0, 1.0);
