@@ -256,7 +256,9 @@ void DepositionManager::prepare(WayBack& w) const {
                                      ? map.navigable
                                      : NavigabilityProcessor::navigable_from(map.occupiable, cell));
   if (!w.had_way_out && params_.keep_reach_without_way_out) {
-    w.reach = NavigabilityProcessor::navigable_from(w.occupiable, cell);
+    // Read within the map's noise: a pair may break the rule by up to the noise margin (a cell the map holds just
+    // not occupiable may be the real way back, and the robot's own depositions must not close it for real).
+    w.reach = NavigabilityProcessor::navigable_from(occupiable_within_noise(map, map.heights, cell), cell);
     // The cells it keeps are its way back, those no nearer its goal than it stands: what lies ahead is what it builds.
     const auto to_goal = [&](CellIndex p) {
       const long long dr = p.row - map.goal.row, dc = p.col - map.goal.col;
@@ -267,6 +269,18 @@ void DepositionManager::prepare(WayBack& w) const {
       for (int c = 0; c < map.cols(); ++c)
         if (w.reach(r, c) != 0 && to_goal({r, c}) < here) w.reach(r, c) = 0;
   }
+}
+
+CellMask DepositionManager::occupiable_within_noise(const deliberative::LocalMap& map, const Heightmap& heights,
+                                                   CellIndex cell) const {
+  NavigabilityParams loose = params_.navigability;
+  loose.eps_m += params_.gap_margin_m;
+  CellMask occupiable = NavigabilityProcessor(loose).occupiable(heights);
+  for (int r = 0; r < map.rows(); ++r)
+    for (int c = 0; c < map.cols(); ++c)
+      if (map.blind(r, c) != 0) occupiable(r, c) = 0;
+  occupiable(cell.row, cell.col) = 1;
+  return occupiable;
 }
 
 CellMask DepositionManager::occupiable_after(WayBack& w, const std::vector<DepositionCandidate>& depositions) const {
@@ -319,9 +333,12 @@ bool DepositionManager::keeps_way_back(WayBack& w, const std::vector<DepositionC
   if (w.had_way_out && !reaches_border(NavigabilityProcessor::navigable_from(occupiable, cell))) return false;
   // Without one, it keeps every cell it can still reach: a robot whose own depositions took its last moves stood
   // walled in for good, the drops that close its neighbour cells lying under its own body, where it may not build.
-  if (w.reach.size() > 0 &&
-      (w.reach.array() > NavigabilityProcessor::navigable_from(occupiable, cell).array()).any())
-    return false;
+  if (w.reach.size() > 0) {
+    Heightmap after = map.heights;
+    for (const auto& d : depositions) after(d.cell) += d.height_m;
+    const CellMask now = NavigabilityProcessor::navigable_from(occupiable_within_noise(map, after, cell), cell);
+    if ((w.reach.array() > now.array()).any()) return false;
+  }
   if (!w.has_origin) return true;
   const CellMask reach = NavigabilityProcessor::navigable_from(occupiable, *map.origin);
   for (const CellIndex p : w.robots)

@@ -46,7 +46,8 @@ struct DepositionParams {
   /// on the pad, unread), which the map reads within its noise; 0 for exact maps.
   double pile_margin_m = 0.0;
   /// A map built from range scans: a robot whose map gives it no way out of its window keeps every cell it can still
-  /// reach (keeps_way_back()). Exact maps keep only the way out they have, as before.
+  /// reach on its map read within its noise and no nearer its goal, its way back (keeps_way_back()). Exact maps keep
+  /// only the way out they have, as before.
   bool keep_reach_without_way_out = false;
 };
 
@@ -149,8 +150,9 @@ class DepositionManager {
     bool has_origin = false;        ///< the local origin is occupiable on the map
     CellMask before;                ///< cells navigable from the local origin before the depositions
     bool had_way_out = false;       ///< the robot's cell was occupiable and reached the window's border
-    /// Without a way out: the cells navigable from the robot's cell on the heights alone (`occupiable`), none of
-    /// which the depositions may cut off; empty otherwise.
+    /// Without a way out: the cells navigable from the robot's cell on the heights alone, read within the map's
+    /// noise (occupiable_within_noise()), and no nearer the local goal than the robot's cell, none of which the
+    /// depositions may cut off; empty otherwise.
     CellMask reach;
     CellMask occupiable;            ///< NavigabilityProcessor::occupiable(map.heights), 0 on blind cells
     Heightmap after;                ///< scratch: map.heights with the depositions tried, restored after each try
@@ -167,6 +169,9 @@ class DepositionManager {
 
  private:
   void prepare(WayBack& context) const;
+  // The occupiable cells of `heights` (the window's) when a pair may break the rule by up to gap_margin_m (eps widened
+  // by it), blind cells never, `cell` (the robot's) always.
+  CellMask occupiable_within_noise(const deliberative::LocalMap& map, const Heightmap& heights, CellIndex cell) const;
   bool in_territory(const deliberative::LocalMap& map, CellIndex cell, Position centre, const Neighbourhood& neighbours,
                     std::optional<CellIndex> self_cell) const;
   DepositionParams params_;

@@ -359,6 +359,36 @@ TEST(DepositionManager, WithoutAWayOutTheRobotKeepsTheCellsBehindItNotThoseAhead
   EXPECT_TRUE(plan_towards({centre.row, 0}).depositions.empty());
 }
 
+// The cells kept without a way out are read within the map's noise: a cell the map holds just not occupiable (a pair
+// in its ball 1 cm over the rule) may be the real way back. The same pocket with a 0.11 m bump four cells west of the
+// robot (1 cm over eps + kappa d against the cells beside it, so the 13 cells whose ball holds it are not occupiable
+// on the heights) and a 0.3 m gap on it: with a noise margin of 3 cm those cells count as reachable and the bump is not
+// raised (it would close them by far more than the noise); without one they were never reachable and it is.
+TEST(DepositionManager, WithoutAWayOutTheCellsKeptAreReadWithinTheMapsNoise) {
+  const CellIndex centre{10, 15};
+  const CellIndex bump{centre.row, centre.col - 4};
+  Heightmap h(kGrid, 0.0);
+  for (int r = 0; r < kGrid.rows; ++r)
+    for (int c = 0; c < kGrid.cols; ++c)
+      if (std::max(std::abs(r - centre.row), std::abs(c - centre.col)) >= 8) h(r, c) = 1.0;
+  h(bump) = 0.11;
+  Heightmap gap(kGrid, 0.0);
+  gap(bump) = 0.3;
+  const auto raises_bump = [&](double margin_m) {
+    DepositionParams p = params(0.4, 10.0);
+    p.keep_reach_without_way_out = true;
+    p.gap_margin_m = margin_m;
+    const LocalMap map = make_map(h, gap, p.navigability, centre, centre);
+    const Position robot = kGrid.cell_center(centre);
+    const DepositionPlan plan = DepositionManager(p).plan(map, {bump}, robot, 10.0, {1, robot, {}});
+    return std::any_of(plan.depositions.begin(), plan.depositions.end(),
+                       [&](const Deposition& d) { return CellIndex{d.row, d.col} == bump; });
+  };
+  ASSERT_FALSE(NavigabilityProcessor(params(0.4).navigability).occupiable(h)(bump.row, bump.col + 1));
+  EXPECT_FALSE(raises_bump(0.03));
+  EXPECT_TRUE(raises_bump(0.0));
+}
+
 TEST(DepositionManager, KeepsANeighboursWayBack) {
   const Heightmap h = corridor();
   Heightmap gap(kGrid, 0.0);
