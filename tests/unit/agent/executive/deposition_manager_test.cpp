@@ -272,16 +272,22 @@ TEST(DepositionManager, NeverRingsInARobotWhoseOriginIsItsOwnCell) {
               reach.col(kGrid.cols - 1).any());
 }
 
+/// Flat ground with a 1 m wall all round `centre`, 8 cells (Chebyshev) from it: a pocket no way leads out of.
+Heightmap pocket(CellIndex centre) {
+  Heightmap h(kGrid, 0.0);
+  for (int r = 0; r < kGrid.rows; ++r)
+    for (int c = 0; c < kGrid.cols; ++c)
+      if (std::max(std::abs(r - centre.row), std::abs(c - centre.col)) >= 8) h(r, c) = 1.0;
+  return h;
+}
+
 // A robot in a pocket its map gives no way out of (a 1 m wall all round): the depositions keep every cell it can still
 // reach. The gap across the pocket is a thin layer on its west half (within eps: it cuts nothing) and a 0.3 m wall on
 // its east half, which would cut the cells beside it off; the plan keeps the layer and none of the wall, checked on the
 // heights after it.
 TEST(DepositionManager, WithoutAWayOutTheRobotKeepsEveryCellItCanStillReach) {
   const CellIndex centre{10, 15};
-  Heightmap h(kGrid, 0.0);
-  for (int r = 0; r < kGrid.rows; ++r)
-    for (int c = 0; c < kGrid.cols; ++c)
-      if (std::max(std::abs(r - centre.row), std::abs(c - centre.col)) >= 8) h(r, c) = 1.0;
+  Heightmap h = pocket(centre);
   Heightmap gap(kGrid, 0.0);
   std::vector<CellIndex> line;
   for (int c = centre.col - 7; c <= centre.col + 7; ++c) {
@@ -317,10 +323,7 @@ TEST(DepositionManager, WithoutAWayOutTheRobotKeepsEveryCellItCanStillReach) {
 // cell it could reach that is no nearer the goal stays reachable; with the goal west, nothing of it is built.
 TEST(DepositionManager, WithoutAWayOutTheRobotKeepsTheCellsBehindItNotThoseAhead) {
   const CellIndex centre{10, 15};
-  Heightmap h(kGrid, 0.0);
-  for (int r = 0; r < kGrid.rows; ++r)
-    for (int c = 0; c < kGrid.cols; ++c)
-      if (std::max(std::abs(r - centre.row), std::abs(c - centre.col)) >= 8) h(r, c) = 1.0;
+  Heightmap h = pocket(centre);
   Heightmap gap(kGrid, 0.0);
   std::vector<CellIndex> line;
   for (int c = centre.col + 7; c > centre.col; --c) {
@@ -367,10 +370,7 @@ TEST(DepositionManager, WithoutAWayOutTheRobotKeepsTheCellsBehindItNotThoseAhead
 TEST(DepositionManager, WithoutAWayOutTheCellsKeptAreReadWithinTheMapsNoise) {
   const CellIndex centre{10, 15};
   const CellIndex bump{centre.row, centre.col - 4};
-  Heightmap h(kGrid, 0.0);
-  for (int r = 0; r < kGrid.rows; ++r)
-    for (int c = 0; c < kGrid.cols; ++c)
-      if (std::max(std::abs(r - centre.row), std::abs(c - centre.col)) >= 8) h(r, c) = 1.0;
+  Heightmap h = pocket(centre);
   h(bump) = 0.11;
   Heightmap gap(kGrid, 0.0);
   gap(bump) = 0.3;
