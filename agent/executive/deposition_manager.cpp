@@ -77,7 +77,20 @@ DepositionParams deposition_params(const RobotBody& body, double cell_size_m, do
   return p;
 }
 
-DepositionManager::DepositionManager(DepositionParams params) : params_(params), navigability_(params.navigability) {
+namespace {
+
+// The body's rule with eps widened by a scanned map's noise margin (a pair may break the rule by up to it); a margin
+// that is not finite and >= 0 widens nothing (the constructor refuses it).
+NavigabilityParams within_noise(const DepositionParams& params) {
+  NavigabilityParams p = params.navigability;
+  if (params.gap_margin_m >= 0.0 && std::isfinite(params.gap_margin_m)) p.eps_m += params.gap_margin_m;
+  return p;
+}
+
+}  // namespace
+
+DepositionManager::DepositionManager(DepositionParams params)
+    : params_(params), navigability_(params.navigability), within_noise_(within_noise(params)) {
   if (!positive_finite(params.reach_m) || !positive_finite(params.max_deposit_m3) ||
       !positive_finite(params.cube_layer_m) || !positive_finite(params.max_height_m) ||
       !positive_finite(params.footprint_m) || !(params.neighbour_keep_out_m >= 0.0) ||
@@ -258,7 +271,12 @@ void DepositionManager::prepare(WayBack& w) const {
   if (!w.had_way_out && params_.keep_reach_without_way_out) {
     // Read within the map's noise: a pair may break the rule by up to the noise margin (a cell the map holds just
     // not occupiable may be the real way back, and the robot's own depositions must not close it for real).
-    w.reach = NavigabilityProcessor::navigable_from(occupiable_within_noise(map, map.heights, cell), cell);
+    w.within_noise = within_noise_.occupiable(map.heights);
+    for (int r = 0; r < map.rows(); ++r)
+      for (int c = 0; c < map.cols(); ++c)
+        if (map.blind(r, c) != 0) w.within_noise(r, c) = 0;
+    w.within_noise(cell.row, cell.col) = 1;
+    w.reach = NavigabilityProcessor::navigable_from(w.within_noise, cell);
     // The cells it keeps are its way back, those no nearer its goal than it stands: what lies ahead is what it builds.
     const auto to_goal = [&](CellIndex p) {
       const long long dr = p.row - map.goal.row, dc = p.col - map.goal.col;
@@ -271,20 +289,13 @@ void DepositionManager::prepare(WayBack& w) const {
   }
 }
 
-CellMask DepositionManager::occupiable_within_noise(const deliberative::LocalMap& map, const Heightmap& heights,
-                                                   CellIndex cell) const {
-  NavigabilityParams loose = params_.navigability;
-  loose.eps_m += params_.gap_margin_m;
-  CellMask occupiable = NavigabilityProcessor(loose).occupiable(heights);
-  for (int r = 0; r < map.rows(); ++r)
-    for (int c = 0; c < map.cols(); ++c)
-      if (map.blind(r, c) != 0) occupiable(r, c) = 0;
-  occupiable(cell.row, cell.col) = 1;
-  return occupiable;
-}
-
 CellMask DepositionManager::occupiable_after(WayBack& w, const std::vector<DepositionCandidate>& depositions) const {
   if (!w.ready) prepare(w);
+  return raised_occupiable(w, depositions, navigability_, w.occupiable);
+}
+
+CellMask DepositionManager::raised_occupiable(WayBack& w, const std::vector<DepositionCandidate>& depositions,
+                                              const NavigabilityProcessor& rule, const CellMask& before) const {
   const deliberative::LocalMap& map = *w.map;
   for (const auto& d : depositions) w.after(d.cell) += d.height_m;
   // A cell's occupiability reads only the heights in its body ball: the cells whose ball holds a raised cell.
@@ -304,15 +315,15 @@ CellMask DepositionManager::occupiable_after(WayBack& w, const std::vector<Depos
   const double pair_work = static_cast<double>(changed.size()) * static_cast<double>(w.ball.size()) *
                            static_cast<double>(w.ball.size());
   if (pair_work > 64.0 * static_cast<double>(map.rows()) * map.cols()) {
-    occupiable = navigability_.occupiable(w.after);
+    occupiable = rule.occupiable(w.after);
     for (int r = 0; r < map.rows(); ++r)
       for (int c = 0; c < map.cols(); ++c)
         if (map.blind(r, c) != 0) occupiable(r, c) = 0;
   } else {
-    occupiable = w.occupiable;
+    occupiable = before;
     for (const CellIndex p : changed)
       occupiable(p.row, p.col) =
-          map.blind(p.row, p.col) == 0 && cell_occupiable_in_ball(w.after, p, params_.navigability, w.ball) ? 1 : 0;
+          map.blind(p.row, p.col) == 0 && cell_occupiable_in_ball(w.after, p, rule.params(), w.ball) ? 1 : 0;
   }
   for (const auto& d : depositions) w.after(d.cell) = map.heights(d.cell);
   return occupiable;
@@ -334,10 +345,9 @@ bool DepositionManager::keeps_way_back(WayBack& w, const std::vector<DepositionC
   // Without one, it keeps every cell it can still reach: a robot whose own depositions took its last moves stood
   // walled in for good, the drops that close its neighbour cells lying under its own body, where it may not build.
   if (w.reach.size() > 0) {
-    Heightmap after = map.heights;
-    for (const auto& d : depositions) after(d.cell) += d.height_m;
-    const CellMask now = NavigabilityProcessor::navigable_from(occupiable_within_noise(map, after, cell), cell);
-    if ((w.reach.array() > now.array()).any()) return false;
+    CellMask within_noise = raised_occupiable(w, depositions, within_noise_, w.within_noise);
+    within_noise(cell.row, cell.col) = 1;
+    if ((w.reach.array() > NavigabilityProcessor::navigable_from(within_noise, cell).array()).any()) return false;
   }
   if (!w.has_origin) return true;
   const CellMask reach = NavigabilityProcessor::navigable_from(occupiable, *map.origin);

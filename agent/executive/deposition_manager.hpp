@@ -151,9 +151,12 @@ class DepositionManager {
     CellMask before;                ///< cells navigable from the local origin before the depositions
     bool had_way_out = false;       ///< the robot's cell was occupiable and reached the window's border
     /// Without a way out: the cells navigable from the robot's cell on the heights alone, read within the map's
-    /// noise (occupiable_within_noise()), and no nearer the local goal than the robot's cell, none of which the
-    /// depositions may cut off; empty otherwise.
+    /// noise (`within_noise`), and no nearer the local goal than the robot's cell, none of which the depositions may
+    /// cut off; empty otherwise.
     CellMask reach;
+    /// Without a way out: the occupiable cells of map.heights when a pair may break the rule by up to gap_margin_m
+    /// (eps widened by it), 0 on blind cells, 1 on the robot's cell; empty otherwise.
+    CellMask within_noise;
     CellMask occupiable;            ///< NavigabilityProcessor::occupiable(map.heights), 0 on blind cells
     Heightmap after;                ///< scratch: map.heights with the depositions tried, restored after each try
     std::vector<CellIndex> ball;    ///< the body ball's offsets (delta / 2)
@@ -169,13 +172,14 @@ class DepositionManager {
 
  private:
   void prepare(WayBack& context) const;
-  // The occupiable cells of `heights` (the window's) when a pair may break the rule by up to gap_margin_m (eps widened
-  // by it), blind cells never, `cell` (the robot's) always.
-  CellMask occupiable_within_noise(const deliberative::LocalMap& map, const Heightmap& heights, CellIndex cell) const;
+  // occupiable_after() by `rule` from its mask `before` the depositions (blind cells never occupiable).
+  CellMask raised_occupiable(WayBack& context, const std::vector<DepositionCandidate>& depositions,
+                             const NavigabilityProcessor& rule, const CellMask& before) const;
   bool in_territory(const deliberative::LocalMap& map, CellIndex cell, Position centre, const Neighbourhood& neighbours,
                     std::optional<CellIndex> self_cell) const;
   DepositionParams params_;
   NavigabilityProcessor navigability_;
+  NavigabilityProcessor within_noise_;  ///< the rule with eps widened by gap_margin_m (WayBack::within_noise)
 };
 
 }  // namespace marsala::agent::executive

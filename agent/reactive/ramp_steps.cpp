@@ -246,33 +246,31 @@ void RampSteps::record_drop_level(const executive::DropRefusal& drop) {
   // The pair passes the body's rule (2.3) once the low cell stands within eps + kappa d of the high one; a layer's
   // rounding and half the rest of eps below that level keep it passing, and the level stays under the high cell's
   // slope (the steeper of the body's and the construction's), so under every bound the world holds the cell to.
-  const double level = drop.high_m - kappa * d - 0.5 * std::max(0.0, body.eps_m - layer);
-  const long long index = static_cast<long long>(drop.low.row) * g.cols + drop.low.col;
-  auto [it, added] = memory_.drop_levels.try_emplace(index, level);
-  if (!added) it->second = std::max(it->second, level);
+  // Below that level less the rounding (the level's own layer and half of eps), the pair still breaks the rule.
+  const double fill_m = drop.high_m - kappa * d - 0.5 * std::max(0.0, body.eps_m - layer);
+  const DropLevel level{fill_m, fill_m - 0.5 * (body.eps_m + layer)};
+  auto [it, added] = memory_.drop_levels.try_emplace(drop.low, level);
+  if (!added) it->second = {std::max(it->second.fill_m, level.fill_m), std::max(it->second.pass_m, level.pass_m)};
 }
 
 bool RampSteps::fails_a_told_drop(const deliberative::LocalMap& local, CellIndex cell) const {
   const NavigabilityParams& body = context_.type.body.navigability;
   const double radius = 0.5 * body.delta_m / local.geometry().cell_size_m;
-  const double rounding = 0.5 * (body.eps_m + modules_->depositions.params().cube_layer_m);
-  const int cols = modules_->map.geometry().cols;
-  for (const auto& [index, level] : memory_.drop_levels) {
-    const CellIndex p = local.to_local({static_cast<int>(index / cols), static_cast<int>(index % cols)});
+  for (const auto& [low, level] : memory_.drop_levels) {
+    const CellIndex p = local.to_local(low);
     const double dr = p.row - cell.row, dc = p.col - cell.col;
     if (!local.contains(p) || dr * dr + dc * dc > radius * radius + 1e-9) continue;
-    if (local.heights(p.row, p.col) < level - rounding) return true;
+    if (local.heights(p.row, p.col) < level.pass_m) return true;
   }
   return false;
 }
 
 void RampSteps::fill_to_drop_levels(deliberative::LocalMap& local) const {
   const double margin = modules_->depositions.params().gap_margin_m;
-  const int cols = modules_->map.geometry().cols;
-  for (const auto& [index, level] : memory_.drop_levels) {
-    const CellIndex p = local.to_local({static_cast<int>(index / cols), static_cast<int>(index % cols)});
+  for (const auto& [low, level] : memory_.drop_levels) {
+    const CellIndex p = local.to_local(low);
     if (!local.contains(p) || local.known(p.row, p.col) == 0) continue;
-    const double rise = level - local.heights(p.row, p.col);
+    const double rise = level.fill_m - local.heights(p.row, p.col);
     if (rise > 0.0) local.gap(p.row, p.col) = std::max(local.gap(p.row, p.col), rise + margin);
   }
 }
@@ -575,10 +573,11 @@ BuildPhase RampSteps::retreat_step(const deliberative::LocalMap& local, const pr
   ++memory_.idle_retreat_moves;
   // A scanning robot its map walls in (no navigable cell a body length away) asks the world the way it came first:
   // stepping back and forth on its island would never change its map.
-  auto motion = walled_in(local, robot) ? ask_back(local, robot) : std::nullopt;
+  const bool walled = walled_in(local, robot);
+  auto motion = walled ? ask_back(local, robot) : std::nullopt;
   if (!motion) motion = step_back(local, robot);
   if (!motion) motion = retrace(local, robot);
-  if (!motion) motion = ask_back(local, robot);
+  if (!motion && !walled) motion = ask_back(local, robot);  // a walled-in robot asked it first already
   if (!motion) return BuildPhase::kRetreat;
   move(*motion, trace, request);
   deposit(local, frame, motion->target, 0, trace, request);

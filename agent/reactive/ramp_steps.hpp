@@ -27,9 +27,9 @@
 #include <cstdint>
 #include <memory>
 #include <limits>
+#include <map>
 #include <optional>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "marsala/agent/agent_context.hpp"
@@ -166,15 +166,17 @@ class RampSteps {
   /// A scanning robot blocked on its path with nothing to fill asks the world the path's next cell: a motion to it when
   /// its map holds the cell out for the terrain alone (a ball it cannot judge, a pit it never saw, a step read within
   /// noise too high), the cell lies within a step and clear of the neighbours, and the world has not refused it on the
-  /// map as it reads now (docs/runtime.md#refused-requests). The world judges on the truth: it accepts, or its
+  /// map as it reads now, and no drop the world named in its ball still lies below its level
+  /// (docs/runtime.md#refused-requests). The world judges on the truth: it accepts, or its
   /// refusal names the drop with its heights, which the map keeps (MappingSystem::record_drop) and the robot fills.
   /// nullopt otherwise.
   std::optional<executive::Motion> ask_ahead(const deliberative::LocalMap& local, const std::vector<CellIndex>& path,
                                              Position robot) const;
 
-  /// A scanning robot whose map leaves it no way back (step_back() and retrace() found none) asks the world the way it
-  /// came: along a route over its known cells to the latest cell of its trajectory a body length away, the route's
-  /// next cell (advance(), or ask_ahead() when the map holds it out). nullopt otherwise.
+  /// A scanning robot walled in on its map (walled_in(), asked first), or whose map leaves it no way back (step_back()
+  /// and retrace() found none), asks the world the way it came: along a route over its known cells to the latest
+  /// cell of its trajectory a body length away and no nearer its goal, the route's next cell (advance(), or
+  /// ask_ahead() when the map holds it out). nullopt otherwise.
   std::optional<executive::Motion> ask_back(const deliberative::LocalMap& local, Position robot) const;
   /// A scanning robot on an island of its map: no navigable cell lies a body length away. Always false for a robot
   /// that reads exact heights.
@@ -229,6 +231,12 @@ class RampSteps {
     std::vector<Deposition> layers;
     std::vector<Deposit> deposits;
   };
+  /// A drop the world named (rule 2.3), for its lower cell: the height it is filled to, and the height below which
+  /// the pair still breaks the body's rule (the fill less its rounding) [m].
+  struct DropLevel {
+    double fill_m = 0.0;
+    double pass_m = 0.0;
+  };
   /// What the steps remember from one frame to the next.
   // plan_gap(), band_gap(): the last window's sources (the first-seen heights, the way's heights) and their MARS
   // bound at the construction kappa.
@@ -273,9 +281,9 @@ class RampSteps {
     PlanBound band_bound;  ///< band_gap()'s memo
     std::optional<executive::RaisedCells> raised;  ///< set_band_centre(): the structure seen built (first heights)
     Position target;                               ///< this frame's target (synthesize_view()) [m]
-    /// Scanned maps: the level each drop's lower cell (row-major world index) must reach for the pair the world named
-    /// to pass (record_drop_level()) [m].
-    std::unordered_map<long long, double> drop_levels;
+    /// Scanned maps: per drop's lower cell (world index), the levels of the pairs the world named there
+    /// (record_drop_level()).
+    std::map<CellIndex, DropLevel> drop_levels;
   };
 
   // look()'s steps, in order.
@@ -286,8 +294,8 @@ class RampSteps {
   // Scanned maps: the gap of each told drop's lower cell in the window is at least what its level asks (less nothing
   // for noise: the heights were told).
   void fill_to_drop_levels(deliberative::LocalMap& local) const;
-  // A told drop in the body ball of `cell` (local index) still lies lower than its pair lets it (its level less the
-  // rounding record_drop_level() leaves): the world would refuse the cell again.
+  // A told drop in the body ball of `cell` (local index) still lies below its DropLevel::pass_m: the world would
+  // refuse the cell again.
   bool fails_a_told_drop(const deliberative::LocalMap& local, CellIndex cell) const;
   void learn_refusals(const protocol::SensorFrame& frame);               // the world's refusals on the new map
   BuildView synthesize_view(const protocol::SensorFrame& frame);         // target, local map, the gap to work on

@@ -309,7 +309,9 @@ TEST(DepositionManager, WithoutAWayOutTheRobotKeepsEveryCellItCanStillReach) {
   const CellMask now = NavigabilityProcessor::navigable_from(nav.occupiable(after), centre);
   for (int r = 0; r < kGrid.rows; ++r)
     for (int c = 0; c < kGrid.cols; ++c)
-      if (before(r, c) != 0) EXPECT_NE(now(r, c), 0) << r << "," << c;
+      if (before(r, c) != 0) {
+        EXPECT_NE(now(r, c), 0) << r << "," << c;
+      }
   // Without the rule (an exact map) the whole line is filled: the pocket's way out was already gone.
   p.keep_reach_without_way_out = false;
   EXPECT_EQ(DepositionManager(p).plan(map, line, kGrid.cell_center(centre), 10.0, {1, kGrid.cell_center(centre), {}})
@@ -353,10 +355,11 @@ TEST(DepositionManager, WithoutAWayOutTheRobotKeepsTheCellsBehindItNotThoseAhead
   for (int r = 0; r < kGrid.rows; ++r)
     for (int c = 0; c < kGrid.cols; ++c) {
       if (before(r, c) == 0) continue;
-      if (to({r, c}, east) >= to(centre, east))
+      if (to({r, c}, east) >= to(centre, east)) {
         EXPECT_NE(now(r, c), 0) << r << "," << c;
-      else if (now(r, c) == 0)
+      } else if (now(r, c) == 0) {
         ++cut_ahead;
+      }
     }
   EXPECT_GT(cut_ahead, 0);
   EXPECT_TRUE(plan_towards({centre.row, 0}).depositions.empty());

@@ -440,10 +440,11 @@ TEST(RampSteps, AScanningRobotWalledInOnItsMapAsksTheWorldTheWayItCame) {
       }
       BuildTrace trace;
       const BuildView view = steps.look(f, trace);
+      if (step == 0) continue;  // the frame at A: its trajectory
       protocol::ActionRequest q = empty_request(c, f, "");
-      if (step > 0) (void)steps.build_step(view.local, f, trace, q);
-      if (step > 0) EXPECT_EQ(trace.navigable_cells, 1) << "step " << step;
-      if (step > 0) out.push_back(q);
+      (void)steps.build_step(view.local, f, trace, q);
+      EXPECT_EQ(trace.navigable_cells, 1) << "step " << step;
+      out.push_back(q);
     }
     return out;
   };
@@ -496,9 +497,10 @@ std::vector<protocol::ActionRequest> build_requests(const Heightmap& h, bool sca
     }
     BuildTrace trace;
     const BuildView view = steps.look(f, trace);
+    if (step == 0) continue;  // the frame at `from`: its trajectory
     protocol::ActionRequest q = empty_request(c, f, "");
-    if (step > 0) (void)steps.build_step(view.local, f, trace, q);
-    if (step > 0) out.push_back(q);
+    (void)steps.build_step(view.local, f, trace, q);
+    out.push_back(q);
   }
   return out;
 }
@@ -675,7 +677,9 @@ TEST(RampSteps, AScanningRobotsAcceptedPileIsInItsMap) {
   EXPECT_NEAR(now(dump), expected(dump), 1e-9);
   for (int r = 0; r < h.rows(); ++r)
     for (int col = 0; col < h.cols(); ++col)
-      if (now(r, col) != before(r, col)) EXPECT_NEAR(now(r, col), expected(r, col), 1e-9) << r << "," << col;
+      if (now(r, col) != before(r, col)) {
+        EXPECT_NEAR(now(r, col), expected(r, col), 1e-9) << r << "," << col;
+      }
 }
 
 // docs/runtime.md#mapping: a gap stays current after the scans stop hitting it (the robot turned away, built cells hide
