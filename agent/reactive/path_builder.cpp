@@ -24,6 +24,12 @@ constexpr EnumName<PathState> kPathStateNames[] = {{PathState::kWaitAdmission, "
                                                    {PathState::kDone, "done"},
                                                    {PathState::kYield, "yield"}};
 
+// The distance of `p` [m] from the line through `from` and `to` (from `from` when they coincide) [m].
+double off_line(Position from, Position to, Position p) {
+  const double dx = to.x - from.x, dy = to.y - from.y, length = std::hypot(dx, dy);
+  return length > 0.0 ? std::abs((p.x - from.x) * dy - (p.y - from.y) * dx) / length : distance(p, from);
+}
+
 PathState state_of(BuildPhase phase) {
   switch (phase) {
     case BuildPhase::kAdvance: return PathState::kAdvance;
@@ -93,6 +99,7 @@ protocol::ActionRequest PathBuilder::decide(const protocol::SensorFrame& frame) 
     // back to the base, to come again.
     const bool at_goal = view.local.goal == view.local.robot;
     pipeline_.observe(frame.neighbours, view.target);
+    remember_front(view);
     if (right_of_way_step(view, frame, request)) {
       // the protocol's frame
     } else if (state_ != PathState::kReturnToBase && (frame.material_m3 < return_below_m3_ - 1e-12 || at_goal)) {
@@ -111,6 +118,14 @@ protocol::ActionRequest PathBuilder::decide(const protocol::SensorFrame& frame) 
     } else {
       pipeline_step(view, frame, request);
     }
+  }
+  // Giving way on the way out (the right of way's step away, the pipeline's step aside) can take the robot out of
+  // sight of the front it followed: it keeps that front's way for a while (lost_front_step).
+  if (state_ == PathState::kYield && !(resume_ && *resume_ == PathState::kReturnToBase) && last_front_ &&
+      last_front_age_ <= lost_front_frames()) {
+    lost_front_ = last_front_;
+    lost_front_age_ = 0;
+    lost_front_stuck_ = 0;
   }
   trace_.after = state_;
   worked_ = !request.depositions.empty() || !request.deposits.empty() || request.refill;
@@ -162,6 +177,8 @@ void PathBuilder::pipeline_step(const BuildView& view, const protocol::SensorFra
     }
   switch (place.role) {
     case PipelineRole::kActive:
+      if (state_ != PathState::kRetreat && lost_front_step(view, request)) return;
+      last_front_.reset();  // the front itself: nobody's way to keep when it next gives way
       if (state_ == PathState::kRetreat) {
         state_ = state_of(steps_.retreat_step(view.local, frame, trace_, request));
       } else if (const auto phase = steps_.build_step(view.local, frame, trace_, request)) {
@@ -202,6 +219,49 @@ void PathBuilder::follow_step(const BuildView& view, Position front, protocol::A
   }
   // Stuck as long as a holding robot's patience: make way, as kHold does.
   if (still_steps_ >= kPatienceSteps) yield_step(view, front, request);
+}
+
+int PathBuilder::lost_front_frames() const {
+  const RobotBody& body = steps_.context().type.body;
+  return static_cast<int>(std::ceil(2.0 * body.proximity_range_m / body.max_step_m)) + kPatienceSteps;
+}
+
+void PathBuilder::remember_front(const BuildView& view) {
+  ++last_front_age_;
+  ++lost_front_age_;
+  if (const auto front = pipeline_.front(view.robot, view.target)) {
+    last_front_ = front->position, last_front_age_ = 0;
+    lost_front_.reset();  // a robot ahead in sight: the pipeline's own order
+  }
+  if (state_ == PathState::kReturnToBase || lost_front_age_ > lost_front_frames()) lost_front_.reset();
+}
+
+bool PathBuilder::lost_front_step(const BuildView& view, protocol::ActionRequest& request) {
+  if (!lost_front_) return false;
+  const Position at = *lost_front_;
+  const auto cell = view.local.cell_at(at);
+  // It is the front after all where that place is reached (within the separation), is not ahead of it, lies out of
+  // the window or is not passable, where its own line to the target passes within half the band of it (its own
+  // way is that way), or after kPatienceSteps frames in a row without a motion towards it.
+  const double half_band_m = 0.5 * construction_params(steps_.context().type).delta_m;
+  if (distance(view.robot, at) <= pipeline_.params().separation_m ||
+      !(distance(at, view.target) < distance(view.robot, view.target) - kAheadMarginM) || !cell ||
+      view.local.passable(cell->row, cell->col) == 0 || off_line(view.robot, view.target, at) <= half_band_m ||
+      lost_front_stuck_ >= kPatienceSteps) {
+    lost_front_.reset();
+    return false;
+  }
+  state_ = PathState::kHold;
+  waiting_for_ = fmt::format("the way of a front out of sight, {:.1f} m away", distance(view.robot, at));
+  if (steps_.plan_path_towards(view.local, at, trace_))
+    if (const auto motion = steps_.advance(view.local, steps_.in_lane(view.local, trace_.plan.path), view.robot)) {
+      steps_.move(*motion, trace_, request);
+      state_ = PathState::kFollow;
+      lost_front_stuck_ = 0;
+      return true;
+    }
+  ++lost_front_stuck_;
+  return true;
 }
 
 std::optional<Neighbour> PathBuilder::oncoming(const BuildView& view, const protocol::SensorFrame& frame) const {

@@ -22,7 +22,13 @@
 //                    returning robots go round it) ---------------------------------------------------> kYield
 //   otherwise, by the pipeline role of this frame:
 //     kActive  -> the ramp builder's building steps: from kRetreat its retreat step, else its build step
-//                 (-> kAdvance / kBuild / kRetreat); no deposition path through known cells: the state stays
+//                 (-> kAdvance / kBuild / kRetreat); no deposition path through known cells: the state stays.
+//                 But a robot that gave way on its way out (kYield) and has nobody ahead in sight keeps the place
+//                 where it last saw its front neighbour: it advances without depositing along the deposition path
+//                 to that place -------------------------------------------------------------------> kFollow / kHold
+//                 until that place is within the separation, not ahead of it, off its window or not passable,
+//                 within half the band of its own line to the target, after kPatienceSteps frames without a
+//                 motion or 2 x proximity range / step + kPatienceSteps frames (then it builds, as above)
 //     kFollow  -> advance without depositing along the deposition path to the front neighbour's cell (not
 //                 its own line to the target: it goes where the front builds) through navigable cells --> kFollow
 //                 no motion, or it would end closer than the separation to the front neighbour -----> kHold
@@ -125,6 +131,10 @@ class PathBuilder final : public Behaviour {
  private:
   void pipeline_step(const BuildView& view, const protocol::SensorFrame& frame, protocol::ActionRequest& request);
   void follow_step(const BuildView& view, Position front, protocol::ActionRequest& request);
+  // A robot that would be the front: true when it keeps the way to lost_front_ instead (the request filled).
+  bool lost_front_step(const BuildView& view, protocol::ActionRequest& request);
+  void remember_front(const BuildView& view);  // last_front_ from this frame's neighbours; lost_front_ dropped
+  int lost_front_frames() const;  // how long a front out of sight is kept: 2 x proximity range / step + patience
   void back_off_step(const BuildView& view, Position front, protocol::ActionRequest& request);
   std::optional<Neighbour> oncoming(const BuildView& view, const protocol::SensorFrame& frame) const;
   void yield_step(const BuildView& view, Position from, protocol::ActionRequest& request);
@@ -146,6 +156,13 @@ class PathBuilder final : public Behaviour {
   // The last request deposited or refilled, or the robot is on its way out (the pipeline's order): no knot.
   bool worked_ = false;
   std::optional<PathState> resume_;  // the state a protocol frame interrupted
+  // The way of the front it followed before it gave way (docs/runtime.md#the-construction-band, "Out of sight
+  // after giving way").
+  std::optional<Position> last_front_;  // where the last front neighbour seen stood; none once it is the front
+  int last_front_age_ = 0;              // frames since then
+  std::optional<Position> lost_front_;  // set by giving way: kept while nobody ahead is in sight
+  int lost_front_age_ = 0;              // frames since it was set
+  int lost_front_stuck_ = 0;            // frames in a row without a motion towards it
 };
 
 }  // namespace marsala::agent::reactive

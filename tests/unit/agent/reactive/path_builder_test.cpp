@@ -285,13 +285,88 @@ TEST(PathBuilder, ANeighbourTurnedBackIsNoLongerFollowedAndPassesBy) {
     return std::abs((p.x - oncoming.x) * dy - (p.y - oncoming.y) * dx) / std::hypot(dx, dy);
   };
   EXPECT_GT(off_line({q.target_x_m, q.target_y_m}), off_line(kAtFoot));
-  // Once it has passed (farther from the target than this robot) and the other has gone out of range, this robot is
-  // the front of the pipeline.
+  // Once it has passed (farther from the target than this robot) and robot 6 has gone out of range, nobody ahead is
+  // in sight: having made way, it keeps robot 6's way to where it was last seen (3.33 m off), no deposition...
   q = pb.decide(frame(c, 2, kAtFoot, 1.0, {test::neighbour_at(5, 4.0, 4.3)}));
   EXPECT_TRUE(pb.pipeline().returning(5));
   EXPECT_EQ(pb.last_trace().role, PipelineRole::kActive);
+  EXPECT_EQ(pb.state(), PathState::kFollow);
+  EXPECT_TRUE(q.depositions.empty());
+  // ... and within the separation of that place this robot is the front of the pipeline.
+  q = pb.decide(frame(c, 3, {6.55, 2.05}, 1.0, {test::neighbour_at(5, 3.0, 4.3)}));
+  EXPECT_EQ(pb.last_trace().role, PipelineRole::kActive);
   EXPECT_TRUE(pb.state() == PathState::kAdvance || pb.state() == PathState::kBuild) << to_string(pb.state());
   EXPECT_FALSE(q.depositions.empty());
+}
+
+TEST(PathBuilder, AfterMakingWayItKeepsTheWayOfAFrontOutOfSightNotALineOfItsOwn) {
+  // Robot 5 stands 1.85 m ahead and this robot holds behind it for kPatienceSteps frames, then steps aside. Robot 5
+  // drives on out of sight. Wherever this robot then stands beside robot 5's last place (farther than the separation
+  // from it, with the platform's foot in reach, where the front robot deposits), it plans its way to that place and
+  // drives it, depositing nothing; a robot that never made way is the front at once. (Its own
+  // line to the target passes robot 5's place 1.4-1.6 m off, more than half the band.)
+  const AgentContext c = context();
+  const Position held{3.05, 3.05}, last_seen{4.9, 3.05};
+  int cases = 0;
+  for (const Position aside : {Position{4.05, 0.85}, Position{4.05, 5.25}, Position{3.55, 0.95}, Position{3.55, 5.15}})
+    for (const bool made_way : {true, false}) {
+      PathBuilder pb(c);
+      pb.on_admission(admission(c, kTarget));
+      std::uint64_t step = 0;
+      if (made_way) {
+        for (; step <= kPatienceSteps; ++step)
+          pb.decide(frame(c, step, held, 1.0, {test::neighbour_at(5, last_seen.x, last_seen.y)}));
+        ASSERT_EQ(pb.state(), PathState::kYield);
+      } else {
+        pb.decide(frame(c, step++, held, 1.0, {test::neighbour_at(5, last_seen.x + 0.5, last_seen.y)}));
+        ASSERT_EQ(pb.state(), PathState::kFollow);
+      }
+      ASSERT_GT(distance(aside, last_seen), c.type.pipeline.separation_m);
+      const protocol::ActionRequest q = pb.decide(frame(c, step, aside, 1.0));
+      const PathBuilderTrace& t = pb.last_trace();
+      EXPECT_EQ(t.role, PipelineRole::kActive);
+      if (!made_way) {
+        EXPECT_TRUE(pb.state() == PathState::kAdvance || pb.state() == PathState::kBuild) << to_string(pb.state());
+        EXPECT_FALSE(q.depositions.empty()) << aside.x << ", " << aside.y;
+        ++cases;
+        continue;
+      }
+      EXPECT_EQ(pb.state(), PathState::kFollow) << aside.x << ", " << aside.y;
+      EXPECT_TRUE(q.depositions.empty()) << aside.x << ", " << aside.y;
+      ASSERT_TRUE(t.planned && t.plan.found);
+      const CellIndex end{t.plan.path.back().row + t.window_offset.row, t.plan.path.back().col + t.window_offset.col};
+      EXPECT_EQ(end, *test::platform_world().geometry().cell_at(last_seen)) << aside.x << ", " << aside.y;
+      EXPECT_TRUE(q.move);  // along that way, in its lane
+      ++cases;
+    }
+  EXPECT_EQ(cases, 8);
+}
+
+TEST(PathBuilder, AFrontOutOfSightIsKeptForABoundedTime) {
+  // Made way as above, then robot 5 out of sight: the robot cannot move (the frames keep it where it is) and never
+  // gets nearer robot 5's last place. It keeps that place for at most 2 x proximity range / step + kPatienceSteps
+  // frames, then it is the front and deposits.
+  const AgentContext c = context();
+  const Position held{3.05, 3.05}, last_seen{4.9, 3.05}, aside{4.05, 0.85};
+  PathBuilder pb(c);
+  pb.on_admission(admission(c, kTarget));
+  std::uint64_t step = 0;
+  for (; step <= kPatienceSteps; ++step)
+    pb.decide(frame(c, step, held, 1.0, {test::neighbour_at(5, last_seen.x, last_seen.y)}));
+  ASSERT_EQ(pb.state(), PathState::kYield);
+  // The frames keep the robot at `aside`: every motion it asks for comes to nothing, as if blocked.
+  int followed = 0;
+  for (int i = 0; i < 3 * kPatienceSteps && pb.state() != PathState::kAdvance && pb.state() != PathState::kBuild;
+       ++i, ++step) {
+    const protocol::ActionRequest q = pb.decide(frame(c, step, aside, 1.0));
+    if (pb.state() != PathState::kFollow) continue;
+    ++followed;
+    EXPECT_TRUE(q.depositions.empty());
+  }
+  const RobotBody& body = c.type.body;
+  EXPECT_GT(followed, 0);
+  EXPECT_LE(followed, std::ceil(2.0 * body.proximity_range_m / body.max_step_m) + kPatienceSteps);
+  EXPECT_TRUE(pb.state() == PathState::kAdvance || pb.state() == PathState::kBuild) << to_string(pb.state());
 }
 
 TEST(PathBuilder, ReturnsToBaseBelowOneDepositionThresholdAndRefillsThere) {
