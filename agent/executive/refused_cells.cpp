@@ -31,6 +31,24 @@ std::optional<DropRefusal> drop_named(const std::string& reason) {
   return out;
 }
 
+std::vector<DropRefusal> drops_named(const std::string& reason) {
+  std::vector<DropRefusal> out;
+  const auto first = drop_named(reason);
+  if (!first) return out;
+  out.push_back(*first);
+  constexpr const char* kMore = "; cell (";
+  for (std::size_t at = reason.find(kMore, reason.find(": cell (")); at != std::string::npos;
+       at = reason.find(kMore, at + 1)) {
+    DropRefusal d;
+    if (std::sscanf(reason.c_str() + at, "; cell (%d, %d) at %lf m lies too far below cell (%d, %d) at %lf m",
+                    &d.low.row, &d.low.col, &d.low_m, &d.high.row, &d.high.col, &d.high_m) != 6 ||
+        !std::isfinite(d.low_m) || !std::isfinite(d.high_m))
+      break;
+    out.push_back(d);
+  }
+  return out;
+}
+
 std::optional<BoundRefusal> bound_named(const std::string& reason) {
   const std::size_t at = reason.find("would leave cell (");
   if (at == std::string::npos || reason.find("above the deposit bound") == std::string::npos) return std::nullopt;

@@ -31,6 +31,11 @@ struct DropRefusal {
   double high_m = 0.0;
 };
 std::optional<DropRefusal> drop_named(const std::string& reason);
+/// Every drop a terrain refusal names, the worst first (drop_named()), then each "; cell (r, c) at h m lies too far
+/// below cell (r, c) at h m" that follows it: the other cells of the ball that break the rule
+/// (docs/runtime.md#refused-requests). A malformed or non-finite entry ends the list there; empty when the reason names
+/// no drop.
+std::vector<DropRefusal> drops_named(const std::string& reason);
 
 /// What a refusal for the deposit bound says (docs/runtime.md#deposit-bound, rules 3.5b and 3d.10): the cell and the
 /// height the request would have left it at ("... would leave cell (r, c) at h m, ... above the deposit bound ...")

@@ -189,18 +189,18 @@ void RampSteps::remember_result(const protocol::SensorFrame& frame) {
     const auto starts = [&](const char* word) { return frame.last_reason.rfind(word, 0) == 0; };
     const bool motion = !starts("deposit") && !starts("refill") && !starts("robot type");  // rules 1, 2
     if (sent.motion && motion) {
-      memory_.refusal = Memory::Refusal{cell, executive::refused_for_terrain(frame.last_reason), true, std::nullopt};
-      if (auto drop = executive::drop_named(frame.last_reason)) {
-        drop->low = registered(drop->low);
-        drop->high = registered(drop->high);
-        memory_.refusal->drop = drop;
+      memory_.refusal = Memory::Refusal{cell, executive::refused_for_terrain(frame.last_reason), true, {}};
+      for (executive::DropRefusal drop : executive::drops_named(frame.last_reason)) {
+        drop.low = registered(drop.low);
+        drop.high = registered(drop.high);
+        memory_.refusal->drops.push_back(drop);
       }
     } else if (named && !motion) {
       // A pile that reached a robot's body: where it was dumped is held out, not the cell under the body (never a
       // target anyway), or the same pile is asked for again from the same place.
       if (const auto pile = executive::pile_under_robot_named(frame.last_reason))
         if (const auto dumped = modules_->map.geometry().cell_at(*pile)) cell = *dumped;
-      memory_.refusal = Memory::Refusal{cell, false, false, std::nullopt};
+      memory_.refusal = Memory::Refusal{cell, false, false, {}};
     }
     // A deposition refused for the deposit bound names the height it would have left (in the cells the request
     // named): the cell stands at that less the rise asked for, whatever the map read there (a stale reading,
@@ -216,11 +216,12 @@ void RampSteps::learn_refusals(const protocol::SensorFrame& frame) {
   // A motion refused for the terrain: the ground the map only assumed in the target's ball is what it guessed wrong.
   if (memory_.refusal && memory_.refusal->terrain && memory_.refusal->motion) {
     modules_->map.forget_assumed_ground(memory_.refusal->cell, 0.5 * context_.type.body.navigability.delta_m);
-    // The drop the body found: its heights are facts the map keeps (a pit read at its rim's height).
-    if (const auto& drop = memory_.refusal->drop; drop && context_.type.sensor.casts_rays()) {
-      modules_->map.record_drop(drop->low, drop->low_m, drop->high, drop->high_m);
-      record_drop_level(*drop);
-    }
+    // The drops the body found: their heights are facts the map keeps (a pit read at its rim's height).
+    if (context_.type.sensor.casts_rays())
+      for (const executive::DropRefusal& drop : memory_.refusal->drops) {
+        modules_->map.record_drop(drop.low, drop.low_m, drop.high, drop.high_m);
+        record_drop_level(drop);
+      }
   }
   const executive::MappingSystem& map = modules_->map;
   memory_.refused->update(map.heights(), map.known(), frame.step);
@@ -230,8 +231,9 @@ void RampSteps::learn_refusals(const protocol::SensorFrame& frame) {
   executive::RefusedCells& cells = r.motion ? *memory_.refused : *memory_.refused_depositions;
   if (r.terrain)
     cells.refuse_terrain(r.cell, map.heights(), map.known(),
-                         r.drop && context_.type.sensor.casts_rays() ? std::optional<CellIndex>(r.drop->low)
-                                                                     : std::nullopt);
+                         !r.drops.empty() && context_.type.sensor.casts_rays()
+                             ? std::optional<CellIndex>(r.drops.front().low)
+                             : std::nullopt);
   else
     cells.refuse_for_now(r.cell, frame.step);
 }

@@ -262,7 +262,7 @@ class RampSteps {
       CellIndex cell;
       bool terrain = false;
       bool motion = false;
-      std::optional<executive::DropRefusal> drop;  ///< the drop the world named
+      std::vector<executive::DropRefusal> drops;  ///< the drops the world named, the worst first
     };
     std::optional<Refusal> refusal;
     std::vector<GapStreak> gap_streaks;            ///< scanned maps, per world cell (row-major): count_gap_scans()

@@ -74,26 +74,51 @@ bool cell_occupiable(const Heightmap& terrain, CellIndex cell, const Navigabilit
                                            : occupiable_by_window(terrain, cell, params, offsets);
 }
 
+std::vector<OccupancyBreach> occupancy_breaches(const Heightmap& terrain, CellIndex cell,
+                                                const NavigabilityParams& params) {
+  if (!terrain.contains(cell))
+    throw InvalidArgument(
+        fmt::format("occupancy_breaches: cell {} is off the {} x {} grid", cell, terrain.rows(), terrain.cols()));
+  // The pairs occupiable_by_pairs() judges, by the same threshold, so that a breach is found exactly where it says no.
+  const std::vector<BallCell> ball =
+      ball_cells(terrain, cell, disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m())));
+  const double cs = terrain.cell_size_m();
+  // Per lower cell, its worst pair and where that pair comes in the pair order (a < b, a first), for the ties.
+  struct Worst {
+    double excess = 0.0;
+    std::size_t rank = 0;
+    CellIndex high;
+  };
+  std::vector<Worst> worst(ball.size());
+  for (std::size_t a = 0; a < ball.size(); ++a)
+    for (std::size_t b = a + 1; b < ball.size(); ++b) {
+      const double excess = std::abs(ball[a].height - ball[b].height) - pair_threshold(params, cs, ball[a], ball[b]);
+      if (!(excess > 0.0)) continue;
+      const bool a_low = ball[a].height < ball[b].height;
+      Worst& w = worst[a_low ? a : b];
+      if (!(excess > w.excess)) continue;
+      w = Worst{excess, a * ball.size() + b, a_low ? ball[b].cell : ball[a].cell};
+    }
+  std::vector<std::size_t> lows;
+  for (std::size_t i = 0; i < ball.size(); ++i)
+    if (worst[i].excess > 0.0) lows.push_back(i);
+  std::sort(lows.begin(), lows.end(), [&](std::size_t x, std::size_t y) {
+    return worst[x].excess != worst[y].excess ? worst[x].excess > worst[y].excess : worst[x].rank < worst[y].rank;
+  });
+  std::vector<OccupancyBreach> out;
+  out.reserve(lows.size());
+  for (const std::size_t i : lows) out.push_back({ball[i].cell, worst[i].high});
+  return out;
+}
+
 std::optional<OccupancyBreach> occupancy_breach(const Heightmap& terrain, CellIndex cell,
                                                 const NavigabilityParams& params) {
   if (!terrain.contains(cell))
     throw InvalidArgument(
         fmt::format("occupancy_breach: cell {} is off the {} x {} grid", cell, terrain.rows(), terrain.cols()));
-  // The pairs occupiable_by_pairs() judges, by the same threshold, so that a breach is found exactly where it says no.
-  const std::vector<BallCell> ball =
-      ball_cells(terrain, cell, disc_offsets(params.delta_m / (2.0 * terrain.cell_size_m())));
-  const double cs = terrain.cell_size_m();
-  std::optional<OccupancyBreach> worst;
-  double worst_excess = 0.0;
-  for (std::size_t a = 0; a < ball.size(); ++a)
-    for (std::size_t b = a + 1; b < ball.size(); ++b) {
-      const double excess = std::abs(ball[a].height - ball[b].height) - pair_threshold(params, cs, ball[a], ball[b]);
-      if (!(excess > worst_excess)) continue;
-      worst_excess = excess;
-      const bool a_low = ball[a].height < ball[b].height;
-      worst = OccupancyBreach{a_low ? ball[a].cell : ball[b].cell, a_low ? ball[b].cell : ball[a].cell};
-    }
-  return worst;
+  const std::vector<OccupancyBreach> all = occupancy_breaches(terrain, cell, params);
+  if (all.empty()) return std::nullopt;
+  return all.front();
 }
 
 bool cell_occupiable_in_ball(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,

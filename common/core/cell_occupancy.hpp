@@ -36,6 +36,13 @@ struct OccupancyBreach {
 std::optional<OccupancyBreach> occupancy_breach(const Heightmap& terrain, CellIndex cell,
                                                 const NavigabilityParams& params);
 
+/// Every cell of on-grid `cell`'s ball that lies too far below another, each with the cell it breaks the rule against
+/// by the most: the worst pair first (occupancy_breach()), then by how much each breaks it, most first (ties in
+/// disc_offsets order); empty when the cell is occupiable. What a body that tried to stand there would feel all over:
+/// every drop under it, not only the deepest. Throws InvalidArgument when the cell is off the grid.
+std::vector<OccupancyBreach> occupancy_breaches(const Heightmap& terrain, CellIndex cell,
+                                                const NavigabilityParams& params);
+
 /// cell_occupiable() by every pair of `ball`, the offsets disc_offsets(delta / (2 cs)) the caller computed once for
 /// many cells of one grid (quadratic in the ball's size). Throws InvalidArgument when the cell is off the grid.
 bool cell_occupiable_in_ball(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& params,

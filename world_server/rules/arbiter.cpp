@@ -201,12 +201,16 @@ std::optional<std::string> envelope_problem(const WorldState& state, std::uint32
 }
 
 /// What a body that tried to stand on `cell` would feel (docs/runtime.md#refused-requests): ": cell (r, c) at h m lies
-/// too far below cell (r, c) at h m", or nothing when the cell is occupiable.
+/// too far below cell (r, c) at h m", the worst pair, then "; cell (r, c) at h m lies too far below cell (r, c) at h m"
+/// for each other cell of the ball that breaks the rule (kMaxNamedDrops in all at most, the most first), or nothing
+/// when the cell is occupiable.
 std::string breach_of(const Heightmap& terrain, CellIndex cell, const NavigabilityParams& body) {
-  const std::optional<OccupancyBreach> breach = occupancy_breach(terrain, cell, body);
-  return breach ? fmt::format(": cell {} at {} m lies too far below cell {} at {} m", breach->low,
-                              terrain(breach->low), breach->high, terrain(breach->high))
-                : std::string();
+  const std::vector<OccupancyBreach> breaches = occupancy_breaches(terrain, cell, body);
+  std::string out;
+  for (std::size_t i = 0; i < breaches.size() && i < kMaxNamedDrops; ++i)
+    out += fmt::format("{} cell {} at {} m lies too far below cell {} at {} m", i == 0 ? ":" : ";", breaches[i].low,
+                       terrain(breaches[i].low), breaches[i].high, terrain(breaches[i].high));
+  return out;
 }
 
 /// Rule 2, the motion of `me` to the request's target (docs/runtime.md#rule-2-motion); nullopt when it passes.

@@ -15,8 +15,9 @@
 namespace marsala::world_server {
 
 /// Limits of docs/runtime.md#validation (the tolerances are the core's, marsala::tolerance).
-inline constexpr double kMaxDepositionM = 1.0;    ///< tallest single deposition [m]
-inline constexpr std::size_t kMaxDeposits = 256;  ///< most deposits in one request
+inline constexpr double kMaxDepositionM = 1.0;     ///< tallest single deposition [m]
+inline constexpr std::size_t kMaxDeposits = 256;   ///< most deposits in one request
+inline constexpr std::size_t kMaxNamedDrops = 32;  ///< most drops a terrain refusal names (rules 2.3, 2.4)
 
 /// The arbiter's answer to one request.
 struct Verdict {

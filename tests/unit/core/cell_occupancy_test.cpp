@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
 #include <random>
+#include <set>
 
 #include "marsala/core/error.hpp"
 #include "marsala/core/iterators.hpp"
@@ -144,6 +147,61 @@ TEST(OccupancyBreach, NamesThePairThatBreaksTheRuleByTheMostExactlyWhereTheCellI
   EXPECT_GT(breaches, 0);
   EXPECT_GT(clear, 0);
   EXPECT_THROW(occupancy_breach(Heightmap({4, 4, 0.0, 0.0, 0.1}, 0.0), {4, 0}, {0.3, 0.5, 0.05}), InvalidArgument);
+}
+
+TEST(OccupancyBreach, AllBreachesNameEveryLowCellOfTheBallOnceWithItsWorstPartner) {
+  // Brute force over the ball's pairs: the cells named low are exactly those of the ball that lie too far below
+  // another, each once, with the partner it breaks the rule against by the most, the most first; the first is the
+  // worst pair occupancy_breach() names.
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> noise(0.0, 0.03), u(0.0, 1.0);
+  int several = 0;
+  for (int trial = 0; trial < 4; ++trial) {
+    Heightmap h({14 + trial, 16, 0.0, 0.0, 0.1}, 0.0);
+    for (long long i = 0; i < h.size(); ++i) {
+      const double v = u(rng);
+      h.data()[i] = noise(rng) + (v < 0.03 ? 0.3 : v < 0.05 ? -0.25 : 0.0);
+    }
+    const NavigabilityParams params{0.3, 0.6 + 0.1 * trial, 0.05};
+    const std::vector<CellIndex> offsets = disc_offsets(params.delta_m / (2.0 * h.cell_size_m()));
+    const auto excess = [&](CellIndex a, CellIndex b) {
+      const double d = h.cell_size_m() * std::hypot(a.row - b.row, a.col - b.col);
+      return h(b) - h(a) - (params.eps_m + params.kappa * d);
+    };
+    for (int r = 0; r < h.rows(); ++r)
+      for (int c = 0; c < h.cols(); ++c) {
+        std::vector<CellIndex> ball;
+        for (const CellIndex& o : offsets)
+          if (h.contains({r + o.row, c + o.col})) ball.push_back({r + o.row, c + o.col});
+        std::map<CellIndex, double> expected;  // low cell -> its largest excess
+        for (const CellIndex& p : ball)
+          for (const CellIndex& q : ball)
+            if (excess(p, q) > 1e-9) expected[p] = std::max(expected.count(p) ? expected[p] : 0.0, excess(p, q));
+        const std::vector<OccupancyBreach> all = occupancy_breaches(h, {r, c}, params);
+        ASSERT_EQ(all.size(), expected.size()) << trial << ": " << r << ", " << c;
+        if (all.empty()) {
+          EXPECT_FALSE(occupancy_breach(h, {r, c}, params).has_value());
+          continue;
+        }
+        if (all.size() > 1) ++several;
+        const std::optional<OccupancyBreach> worst = occupancy_breach(h, {r, c}, params);
+        ASSERT_TRUE(worst.has_value());
+        EXPECT_EQ(all.front().low, worst->low);
+        EXPECT_EQ(all.front().high, worst->high);
+        double before = std::numeric_limits<double>::infinity();
+        std::set<CellIndex> seen;
+        for (const OccupancyBreach& b : all) {
+          ASSERT_EQ(expected.count(b.low), 1u);
+          EXPECT_TRUE(seen.insert(b.low).second);
+          EXPECT_NE(std::find(ball.begin(), ball.end(), b.high), ball.end());
+          EXPECT_NEAR(excess(b.low, b.high), expected[b.low], 1e-12);
+          EXPECT_LE(excess(b.low, b.high), before + 1e-12);
+          before = excess(b.low, b.high);
+        }
+      }
+  }
+  EXPECT_GT(several, 0);  // balls with several low cells occur, so the list is tried
+  EXPECT_THROW(occupancy_breaches(Heightmap({4, 4, 0.0, 0.0, 0.1}, 0.0), {0, 4}, {0.3, 0.5, 0.05}), InvalidArgument);
 }
 
 TEST(BlindCells, AreTheCellsWhoseBallHoldsAnUnknownCell) {

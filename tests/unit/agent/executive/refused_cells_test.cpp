@@ -40,6 +40,24 @@ TEST(RefusedCells, ReadsTheCellTheWorldsReasonsName) {
                           "below cell (5, 6) at 1 m")
                    .has_value());
   EXPECT_FALSE(drop_named("target cell (99, 158) is not occupiable for this body").has_value());
+  // Every drop a refusal names, the worst first; a malformed entry ends the list there.
+  const auto drops = drops_named(dropped + "; cell (121, 131) at 0.1 m lies too far below cell (119, 127) at 1.375 m; "
+                                           "cell (122, 130) at 0 m lies too far below cell (118, 126) at 1.5 m");
+  ASSERT_EQ(drops.size(), 3u);
+  EXPECT_EQ(drops[0].low, drop->low);
+  EXPECT_EQ(drops[0].high_m, drop->high_m);
+  EXPECT_EQ(drops[1].low, (CellIndex{121, 131}));
+  EXPECT_EQ(drops[1].low_m, 0.1);
+  EXPECT_EQ(drops[1].high, (CellIndex{119, 127}));
+  EXPECT_EQ(drops[2].low, (CellIndex{122, 130}));
+  EXPECT_EQ(drops[2].high, (CellIndex{118, 126}));
+  EXPECT_EQ(drops[2].high_m, 1.5);
+  EXPECT_EQ(drops_named(dropped + "; cell (1, 2) at nan m lies too far below cell (3, 4) at 1 m; cell (5, 6) at 0 m "
+                                  "lies too far below cell (7, 8) at 1 m")
+                .size(),
+            1u);
+  EXPECT_EQ(drops_named(dropped).size(), 1u);
+  EXPECT_TRUE(drops_named("target cell (99, 158) is not occupiable for this body").empty());
   // The deposit bound's refusals (rules 3.5b, 3d.10) name the height the request would have left.
   const auto bound = bound_named("deposition would leave cell (113, 141) at 0.6 m, 0.27 m above the deposit bound "
                                  "0.33 m (MARS of the initial terrain at kappa 0.3), more than 0.005 m");

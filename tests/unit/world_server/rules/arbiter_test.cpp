@@ -9,6 +9,7 @@
 
 #include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
+#include "marsala/core/format.hpp"
 #include "marsala/core/navigability_processor.hpp"
 #include "marsala/core/robot_body.hpp"
 #include "unit/world_server/world_fixtures.hpp"
@@ -176,6 +177,31 @@ TEST_F(ArbiterTest, MotionAcrossANonOccupiableCellIsRejected) {
   state_.agent(1).position.x = 2.05;
   EXPECT_TRUE(check(move_to(state_, 1, 2.15, 1.95)).accepted);
   EXPECT_TRUE(check(move_to(state_, 1, 1.95, 1.95)).accepted);
+}
+
+TEST_F(ArbiterTest, ATerrainRefusalNamesEveryDropUnderTheBody) {
+  // A platform 0.4 m high from column 22 on, flat ground before it: the ball of the cell at (2.05, 2.05) m (column
+  // 20, radius 0.5 m) holds ground cells that lie too far below platform cells, more than a reason names. The reason names each low cell once, with the
+  // cell it breaks the rule against by the most and both heights, the worst first, in occupancy_breaches() order: what
+  // the robot learns from one refusal.
+  for (int r = 0; r < 40; ++r)
+    for (int c = 22; c < 40; ++c) state_.terrain(r, c) = 0.4;
+  const NavigabilityParams body = state_.agent(1).type.body.navigability;
+  state_.agent(1).position = {1.95, 2.05};  // (20, 19)
+  state_.agent(2).position = {3.55, 0.35};  // out of the way
+  const Verdict onto = check(move_to(state_, 1, 2.05, 2.05));
+  ASSERT_FALSE(onto.accepted);
+  const CellIndex target = *state_.terrain.cell_at({2.05, 2.05});
+  const std::vector<OccupancyBreach> breaches = occupancy_breaches(state_.terrain, target, body);
+  ASSERT_GT(breaches.size(), kMaxNamedDrops);  // more than a reason names: the list is cut after the worst
+  std::string expected = fmt::format("target cell {} is not occupiable for this body", target);
+  for (std::size_t i = 0; i < breaches.size() && i < kMaxNamedDrops; ++i)
+    expected += fmt::format("{} cell {} at {} m lies too far below cell {} at {} m", i == 0 ? ":" : ";",
+                            breaches[i].low, state_.terrain(breaches[i].low), breaches[i].high,
+                            state_.terrain(breaches[i].high));
+  EXPECT_EQ(onto.reason, expected);
+  // The first is the pair the rule is broken by the most.
+  EXPECT_EQ(breaches.front().low, occupancy_breach(state_.terrain, target, body)->low);
 }
 
 TEST_F(ArbiterTest, ALongStepCannotJumpAWall) {
