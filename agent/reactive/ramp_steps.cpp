@@ -250,18 +250,23 @@ void RampSteps::record_drop_level(const executive::DropRefusal& drop) {
   // slope (the steeper of the body's and the construction's), so under every bound the world holds the cell to.
   // Below that level less the rounding (the level's own layer and half of eps), the pair still breaks the rule.
   const double fill_m = drop.high_m - kappa * d - 0.5 * std::max(0.0, body.eps_m - layer);
-  const DropLevel level{fill_m, fill_m - 0.5 * (body.eps_m + layer)};
+  const DropLevel level{fill_m, fill_m - 0.5 * (body.eps_m + layer), drop.high};
   auto [it, added] = memory_.drop_levels.try_emplace(drop.low, level);
-  if (!added) it->second = {std::max(it->second.fill_m, level.fill_m), std::max(it->second.pass_m, level.pass_m)};
+  if (!added && level.pass_m > it->second.pass_m) it->second = level;
 }
 
 bool RampSteps::fails_a_told_drop(const deliberative::LocalMap& local, CellIndex cell) const {
   const NavigabilityParams& body = context_.type.body.navigability;
   const double radius = 0.5 * body.delta_m / local.geometry().cell_size_m;
+  const auto in_ball = [&](CellIndex p) {
+    const double dr = p.row - cell.row, dc = p.col - cell.col;
+    return local.contains(p) && dr * dr + dc * dc <= radius * radius + 1e-9;
+  };
+  // The pair breaks the rule only in a ball that holds both its cells: a drop named ahead does not hold out the way
+  // back, whose balls hold its low cell but not its high one.
   for (const auto& [low, level] : memory_.drop_levels) {
     const CellIndex p = local.to_local(low);
-    const double dr = p.row - cell.row, dc = p.col - cell.col;
-    if (!local.contains(p) || dr * dr + dc * dc > radius * radius + 1e-9) continue;
+    if (!in_ball(p) || !in_ball(local.to_local(level.high))) continue;
     if (local.heights(p.row, p.col) < level.pass_m) return true;
   }
   return false;

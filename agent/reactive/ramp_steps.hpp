@@ -232,10 +232,12 @@ class RampSteps {
     std::vector<Deposit> deposits;
   };
   /// A drop the world named (rule 2.3), for its lower cell: the height it is filled to, and the height below which
-  /// the pair still breaks the body's rule (the fill less its rounding) [m].
+  /// the pair still breaks the body's rule (the fill less its rounding) [m], against `high` (world index), the higher
+  /// cell of the pair that asks the most.
   struct DropLevel {
     double fill_m = 0.0;
     double pass_m = 0.0;
+    CellIndex high;
   };
   /// What the steps remember from one frame to the next.
   // plan_gap(), band_gap(): the last window's sources (the first-seen heights, the way's heights) and their MARS
@@ -294,8 +296,8 @@ class RampSteps {
   // Scanned maps: the gap of each told drop's lower cell in the window is at least what its level asks (less nothing
   // for noise: the heights were told).
   void fill_to_drop_levels(deliberative::LocalMap& local) const;
-  // A told drop in the body ball of `cell` (local index) still lies below its DropLevel::pass_m: the world would
-  // refuse the cell again.
+  // A told drop with both its cells in the body ball of `cell` (local index) still lies below its DropLevel::pass_m:
+  // the world would refuse the cell again.
   bool fails_a_told_drop(const deliberative::LocalMap& local, CellIndex cell) const;
   void learn_refusals(const protocol::SensorFrame& frame);               // the world's refusals on the new map
   BuildView synthesize_view(const protocol::SensorFrame& frame);         // target, local map, the gap to work on

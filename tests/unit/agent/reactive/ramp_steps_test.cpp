@@ -536,6 +536,36 @@ TEST(RampSteps, AScanningRobotBlockedWithNothingToFillAsksTheWorldThePathsNextCe
   EXPECT_FALSE(exact[0].move && exact[0].target_x_m > at_b.x);
 }
 
+// A told drop holds a cell out only where the cell's ball holds both its cells. The same robot as above is refused a
+// motion through (30, 47), the world naming (30, 49) at 0 m too far below (30, 52) at 0.3 m: the pair lies in the
+// ball of (30, 47) but not in that of (30, 45) (the high cell is 7 cells away), so the robot still asks for (30, 45);
+// told the pair (30, 49) / (30, 50), both in that ball, it does not.
+TEST(RampSteps, AToldDropHoldsOutOnlyTheCellsWhoseBallHoldsBothItsCells) {
+  const Heightmap h = ridge_world(0.12);
+  const CellIndex b{30, 44};
+  const Position at_b = h.geometry().cell_center(b);
+  const Position at_a{at_b.x - 0.2, at_b.y};
+  const CellIndex next{b.row, b.col + 1};
+  const auto moves_to = [&](const protocol::ActionRequest& q, CellIndex cell) {
+    return q.move && h.geometry().cell_at({q.target_x_m, q.target_y_m}) == cell;
+  };
+  using R = protocol::ActionResult;
+  const std::string beyond =
+      "motion passes through cell (30, 47), not occupiable for this body: cell (30, 49) at 0 m lies too far below "
+      "cell (30, 52) at 0.3 m";
+  const auto asked = build_requests(h, true, at_a, at_b, 0.0, {{R::kAccepted, ""}, {R::kRejected, beyond}});
+  ASSERT_EQ(asked.size(), 2u);
+  EXPECT_TRUE(moves_to(asked[0], next));
+  EXPECT_TRUE(moves_to(asked[1], next));
+  const std::string within =
+      "motion passes through cell (30, 47), not occupiable for this body: cell (30, 49) at 0 m lies too far below "
+      "cell (30, 50) at 0.3 m";
+  const auto held = build_requests(h, true, at_a, at_b, 0.0, {{R::kAccepted, ""}, {R::kRejected, within}});
+  ASSERT_EQ(held.size(), 2u);
+  EXPECT_TRUE(moves_to(held[0], next));
+  EXPECT_FALSE(moves_to(held[1], next));
+}
+
 // The drop the world named is filled until the pair passes the occupancy rule (rule 2.3), whatever the robot's map
 // leaves unconfirmed. A 0.3 m step from column 50; a laser robot on B (30, 44) whose map comes from tiles alone (no
 // scan confirms a gap, so it fills nothing) moves and is told that the next cell east is not occupiable: (27, 49) at
