@@ -100,18 +100,25 @@ TEST(CellOccupiable, OffGridThrows) {
   EXPECT_THROW(cell_occupiable_in_ball(Heightmap(g, 0.0), {0, 4}, {}, disc_offsets(1.0)), InvalidArgument);
 }
 
+/// A rough grid (cells of 0.1 m): up to 3 cm of noise, 0.3 m spikes on a share `spikes` of the cells and -0.25 m pits on
+/// as many.
+Heightmap spiky_grid(std::mt19937_64& rng, int rows, int cols, double spikes) {
+  std::uniform_real_distribution<double> noise(0.0, 0.03), u(0.0, 1.0);
+  Heightmap h({rows, cols, 0.0, 0.0, 0.1}, 0.0);
+  for (long long i = 0; i < h.size(); ++i) {
+    const double v = u(rng);
+    h.data()[i] = noise(rng) + (v < spikes ? 0.3 : v < 2.0 * spikes ? -0.25 : 0.0);
+  }
+  return h;
+}
+
 TEST(OccupancyBreach, NamesThePairThatBreaksTheRuleByTheMostExactlyWhereTheCellIsNotOccupiable) {
   // Brute force over the ball's pairs on rough grids with spikes and pits: the breach is there exactly when the cell
   // is not occupiable, its cells lie in the ball, the lower first, and no pair breaks the rule by more.
   std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> noise(0.0, 0.03), u(0.0, 1.0);
   int breaches = 0, clear = 0;
   for (int trial = 0; trial < 5; ++trial) {
-    Heightmap h({15 + trial, 17, 0.0, 0.0, 0.1}, 0.0);
-    for (long long i = 0; i < h.size(); ++i) {
-      const double v = u(rng);
-      h.data()[i] = noise(rng) + (v < 0.02 ? 0.3 : v < 0.04 ? -0.25 : 0.0);
-    }
+    const Heightmap h = spiky_grid(rng, 15 + trial, 17, 0.02);
     const NavigabilityParams params{0.3, 0.5 + 0.1 * trial, 0.05};
     const std::vector<CellIndex> offsets = disc_offsets(params.delta_m / (2.0 * h.cell_size_m()));
     for (int r = 0; r < h.rows(); ++r)
@@ -154,14 +161,9 @@ TEST(OccupancyBreach, AllBreachesNameEveryLowCellOfTheBallOnceWithItsWorstPartne
   // another, each once, with the partner it breaks the rule against by the most, the most first; the first is the
   // worst pair occupancy_breach() names.
   std::mt19937_64 rng(17);
-  std::uniform_real_distribution<double> noise(0.0, 0.03), u(0.0, 1.0);
   int several = 0;
   for (int trial = 0; trial < 4; ++trial) {
-    Heightmap h({14 + trial, 16, 0.0, 0.0, 0.1}, 0.0);
-    for (long long i = 0; i < h.size(); ++i) {
-      const double v = u(rng);
-      h.data()[i] = noise(rng) + (v < 0.03 ? 0.3 : v < 0.05 ? -0.25 : 0.0);
-    }
+    const Heightmap h = spiky_grid(rng, 14 + trial, 16, 0.03);
     const NavigabilityParams params{0.3, 0.6 + 0.1 * trial, 0.05};
     const std::vector<CellIndex> offsets = disc_offsets(params.delta_m / (2.0 * h.cell_size_m()));
     const auto excess = [&](CellIndex a, CellIndex b) {

@@ -505,65 +505,53 @@ std::vector<protocol::ActionRequest> build_requests(const Heightmap& h, bool sca
   return out;
 }
 
-// A scanning robot blocked on its path with nothing to fill asks the world the path's next cell. Flat ground with a
-// 0.12 m step from column 50; the robot stands on B (30, 44), whose ball (radius 5 cells) ends at column 49, and came
-// from the west; the next cell east holds the step in its ball, which breaks the rule by 2 cm (within the laser map's
-// noise margin), so the robot's map holds it out, and with no material there is nothing to fill. It asks for a motion
-// there; once the world has refused it (naming the drop), it asks for it no more while its map reads the same. A robot
-// that reads exact heights never asks a cell its map holds out.
-TEST(RampSteps, AScanningRobotBlockedWithNothingToFillAsksTheWorldThePathsNextCell) {
+// The robot of the next two tests, on B (30, 44) of ridge_world(0.12) (flat ground with a 0.12 m step from column 50),
+// come from the west with no material: for each of its requests (scanning or reading exact heights, the world answering
+// `results` in turn), whether it moves to the next cell east, (30, 45), and whether it moves east at all.
+struct AskedNext {
+  std::vector<bool> next;
+  std::vector<bool> east;
+};
+AskedNext asks_next(bool scanning, const std::vector<std::pair<protocol::ActionResult, std::string>>& results) {
   const Heightmap h = ridge_world(0.12);
-  const CellIndex b{30, 44};
-  const Position at_b = h.geometry().cell_center(b);
-  const Position at_a{at_b.x - 0.2, at_b.y};
-  const CellIndex next{b.row, b.col + 1};
-  const auto moves_to = [&](const protocol::ActionRequest& q, CellIndex cell) {
-    return q.move && h.geometry().cell_at({q.target_x_m, q.target_y_m}) == cell;
-  };
+  const Position at_b = h.geometry().cell_center({30, 44});
+  AskedNext out;
+  for (const protocol::ActionRequest& q : build_requests(h, scanning, {at_b.x - 0.2, at_b.y}, at_b, 0.0, results)) {
+    out.next.push_back(q.move && h.geometry().cell_at({q.target_x_m, q.target_y_m}) == CellIndex{30, 45});
+    out.east.push_back(q.move && q.target_x_m > at_b.x);
+  }
+  return out;
+}
+
+// A scanning robot blocked on its path with nothing to fill asks the world the path's next cell. B's ball (radius 5
+// cells) ends at column 49; the next cell east holds the step in its ball, which breaks the rule by 2 cm (within the
+// laser map's noise margin), so the robot's map holds it out, and with no material there is nothing to fill. It asks
+// for a motion there; once the world has refused it (naming the drop), it asks for it no more while its map reads the
+// same. A robot that reads exact heights never asks a cell its map holds out.
+TEST(RampSteps, AScanningRobotBlockedWithNothingToFillAsksTheWorldThePathsNextCell) {
   const std::string refused =
       "target cell (30, 45) is not occupiable for this body: cell (30, 49) at 0 m lies too far below cell (30, 50) at "
       "0.12 m";
   using R = protocol::ActionResult;
-  const auto scanning = build_requests(h, true, at_a, at_b, 0.0, {{R::kAccepted, ""}, {R::kRejected, refused},
-                                                                  {R::kAccepted, ""}});
-  ASSERT_EQ(scanning.size(), 3u);
-  EXPECT_TRUE(moves_to(scanning[0], next));
-  EXPECT_FALSE(moves_to(scanning[1], next));
-  EXPECT_FALSE(moves_to(scanning[2], next));
-  const auto exact = build_requests(h, false, at_a, at_b, 0.0, {{R::kAccepted, ""}});
-  ASSERT_EQ(exact.size(), 1u);
-  EXPECT_FALSE(moves_to(exact[0], next));
-  EXPECT_FALSE(exact[0].move && exact[0].target_x_m > at_b.x);
+  const AskedNext scanning = asks_next(true, {{R::kAccepted, ""}, {R::kRejected, refused}, {R::kAccepted, ""}});
+  EXPECT_EQ(scanning.next, (std::vector<bool>{true, false, false}));
+  const AskedNext exact = asks_next(false, {{R::kAccepted, ""}});
+  EXPECT_EQ(exact.next, (std::vector<bool>{false}));
+  EXPECT_EQ(exact.east, (std::vector<bool>{false}));
 }
 
-// A told drop holds a cell out only where the cell's ball holds both its cells. The same robot as above is refused a
-// motion through (30, 47), the world naming (30, 49) at 0 m too far below (30, 52) at 0.3 m: the pair lies in the
-// ball of (30, 47) but not in that of (30, 45) (the high cell is 7 cells away), so the robot still asks for (30, 45);
-// told the pair (30, 49) / (30, 50), both in that ball, it does not.
+// A told drop holds a cell out only where the cell's ball holds both its cells. The same robot is refused a motion
+// through (30, 47), the world naming (30, 49) at 0 m too far below (30, 52) at 0.3 m: the pair lies in the ball of
+// (30, 47) but not in that of (30, 45) (the high cell is 7 cells away), so the robot still asks for (30, 45); told the
+// pair (30, 49) / (30, 50), both in that ball, it does not.
 TEST(RampSteps, AToldDropHoldsOutOnlyTheCellsWhoseBallHoldsBothItsCells) {
-  const Heightmap h = ridge_world(0.12);
-  const CellIndex b{30, 44};
-  const Position at_b = h.geometry().cell_center(b);
-  const Position at_a{at_b.x - 0.2, at_b.y};
-  const CellIndex next{b.row, b.col + 1};
-  const auto moves_to = [&](const protocol::ActionRequest& q, CellIndex cell) {
-    return q.move && h.geometry().cell_at({q.target_x_m, q.target_y_m}) == cell;
-  };
   using R = protocol::ActionResult;
-  const std::string beyond =
-      "motion passes through cell (30, 47), not occupiable for this body: cell (30, 49) at 0 m lies too far below "
-      "cell (30, 52) at 0.3 m";
-  const auto asked = build_requests(h, true, at_a, at_b, 0.0, {{R::kAccepted, ""}, {R::kRejected, beyond}});
-  ASSERT_EQ(asked.size(), 2u);
-  EXPECT_TRUE(moves_to(asked[0], next));
-  EXPECT_TRUE(moves_to(asked[1], next));
-  const std::string within =
-      "motion passes through cell (30, 47), not occupiable for this body: cell (30, 49) at 0 m lies too far below "
-      "cell (30, 50) at 0.3 m";
-  const auto held = build_requests(h, true, at_a, at_b, 0.0, {{R::kAccepted, ""}, {R::kRejected, within}});
-  ASSERT_EQ(held.size(), 2u);
-  EXPECT_TRUE(moves_to(held[0], next));
-  EXPECT_FALSE(moves_to(held[1], next));
+  const std::string through = "motion passes through cell (30, 47), not occupiable for this body: cell (30, 49) at 0 m "
+                              "lies too far below cell ";
+  EXPECT_EQ(asks_next(true, {{R::kAccepted, ""}, {R::kRejected, through + "(30, 52) at 0.3 m"}}).next,
+            (std::vector<bool>{true, true}));
+  EXPECT_EQ(asks_next(true, {{R::kAccepted, ""}, {R::kRejected, through + "(30, 50) at 0.3 m"}}).next,
+            (std::vector<bool>{true, false}));
 }
 
 // The drop the world named is filled until the pair passes the occupancy rule (rule 2.3), whatever the robot's map
