@@ -20,31 +20,33 @@ std::optional<CellIndex> cell_named(const std::string& reason) {
   return CellIndex{row, col};
 }
 
-std::optional<DropRefusal> drop_named(const std::string& reason) {
-  const std::size_t at = reason.find(": cell (");
-  if (at == std::string::npos) return std::nullopt;
+namespace {
+
+// The drop a reason names at `at` (": cell (r, c) at h m lies too far below cell (r, c) at h m", or the same after
+// "; " for the drops that follow the first), its heights finite; nullopt otherwise.
+std::optional<DropRefusal> drop_at(const std::string& reason, std::size_t at) {
   DropRefusal out;
-  if (std::sscanf(reason.c_str() + at, ": cell (%d, %d) at %lf m lies too far below cell (%d, %d) at %lf m",
+  if (std::sscanf(reason.c_str() + at + 1, " cell (%d, %d) at %lf m lies too far below cell (%d, %d) at %lf m",
                   &out.low.row, &out.low.col, &out.low_m, &out.high.row, &out.high.col, &out.high_m) != 6 ||
       !std::isfinite(out.low_m) || !std::isfinite(out.high_m))
     return std::nullopt;
   return out;
 }
 
+}  // namespace
+
+std::optional<DropRefusal> drop_named(const std::string& reason) {
+  const std::size_t at = reason.find(": cell (");
+  if (at == std::string::npos) return std::nullopt;
+  return drop_at(reason, at);
+}
+
 std::vector<DropRefusal> drops_named(const std::string& reason) {
   std::vector<DropRefusal> out;
-  const auto first = drop_named(reason);
-  if (!first) return out;
-  out.push_back(*first);
-  constexpr const char* kMore = "; cell (";
-  for (std::size_t at = reason.find(kMore, reason.find(": cell (")); at != std::string::npos;
-       at = reason.find(kMore, at + 1)) {
-    DropRefusal d;
-    if (std::sscanf(reason.c_str() + at, "; cell (%d, %d) at %lf m lies too far below cell (%d, %d) at %lf m",
-                    &d.low.row, &d.low.col, &d.low_m, &d.high.row, &d.high.col, &d.high_m) != 6 ||
-        !std::isfinite(d.low_m) || !std::isfinite(d.high_m))
-      break;
-    out.push_back(d);
+  for (std::size_t at = reason.find(": cell ("); at != std::string::npos; at = reason.find("; cell (", at + 1)) {
+    const auto drop = drop_at(reason, at);
+    if (!drop) break;
+    out.push_back(*drop);
   }
   return out;
 }

@@ -281,12 +281,8 @@ void PathBuilder::yield_step(const BuildView& view, Position from, protocol::Act
   state_ = PathState::kYield;
   // Off the line from the other robot (at `from`) to the base: to whichever side gains most, one step at most.
   const Position base = steps_.context().assignment.base;
-  const double dx = base.x - from.x, dy = base.y - from.y, length = std::hypot(dx, dy);
-  const auto off_line = [&](Position p) {
-    return length > 0.0 ? std::abs((p.x - from.x) * dy - (p.y - from.y) * dx) / length : distance(p, from);
-  };
   std::optional<executive::Motion> best;
-  double best_off = off_line(view.robot) + 1e-9;
+  double best_off = off_line(from, base, view.robot) + 1e-9;
   const CellIndex at = view.local.robot;
   for (int dr = -1; dr <= 1; ++dr)
     for (int dc = -1; dc <= 1; ++dc) {
@@ -294,7 +290,8 @@ void PathBuilder::yield_step(const BuildView& view, Position from, protocol::Act
       if ((dr == 0 && dc == 0) || !view.local.contains(next) || view.local.navigable(next.row, next.col) == 0)
         continue;
       const auto motion = steps_.advance(view.local, {at, next}, view.robot);
-      if (motion && off_line(motion->target) > best_off) best_off = off_line(motion->target), best = motion;
+      if (motion && off_line(from, base, motion->target) > best_off)
+        best_off = off_line(from, base, motion->target), best = motion;
     }
   if (best) steps_.move(*best, trace_, request);
 }

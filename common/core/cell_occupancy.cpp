@@ -113,9 +113,6 @@ std::vector<OccupancyBreach> occupancy_breaches(const Heightmap& terrain, CellIn
 
 std::optional<OccupancyBreach> occupancy_breach(const Heightmap& terrain, CellIndex cell,
                                                 const NavigabilityParams& params) {
-  if (!terrain.contains(cell))
-    throw InvalidArgument(
-        fmt::format("occupancy_breach: cell {} is off the {} x {} grid", cell, terrain.rows(), terrain.cols()));
   const std::vector<OccupancyBreach> all = occupancy_breaches(terrain, cell, params);
   if (all.empty()) return std::nullopt;
   return all.front();

@@ -10,6 +10,7 @@
 #include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/format.hpp"
+#include "marsala/core/iterators.hpp"
 #include "marsala/core/navigability_processor.hpp"
 #include "marsala/core/robot_body.hpp"
 #include "unit/world_server/world_fixtures.hpp"
@@ -181,13 +182,13 @@ TEST_F(ArbiterTest, MotionAcrossANonOccupiableCellIsRejected) {
 
 TEST_F(ArbiterTest, ATerrainRefusalNamesEveryDropUnderTheBody) {
   // A platform 0.4 m high from column 22 on, flat ground before it: the ball of the cell at (2.05, 2.05) m (column
-  // 20, radius 0.5 m) holds ground cells that lie too far below platform cells, more than a reason names. The reason names each low cell once, with the
-  // cell it breaks the rule against by the most and both heights, the worst first, in occupancy_breaches() order: what
-  // the robot learns from one refusal.
+  // 20, radius 0.5 m) holds ground cells that lie too far below platform cells, more than a reason names. The reason
+  // names each low cell once, with the cell it breaks the rule against by the most and both heights, the worst first,
+  // in occupancy_breaches() order: what the robot learns from one refusal.
   for (int r = 0; r < 40; ++r)
     for (int c = 22; c < 40; ++c) state_.terrain(r, c) = 0.4;
   const NavigabilityParams body = state_.agent(1).type.body.navigability;
-  state_.agent(1).position = {1.95, 2.05};  // (20, 19)
+  state_.agent(1).position = {1.95, 2.05};  // column 19, beside the target
   state_.agent(2).position = {3.55, 0.35};  // out of the way
   const Verdict onto = check(move_to(state_, 1, 2.05, 2.05));
   ASSERT_FALSE(onto.accepted);
@@ -200,8 +201,18 @@ TEST_F(ArbiterTest, ATerrainRefusalNamesEveryDropUnderTheBody) {
                             breaches[i].low, state_.terrain(breaches[i].low), breaches[i].high,
                             state_.terrain(breaches[i].high));
   EXPECT_EQ(onto.reason, expected);
-  // The first is the pair the rule is broken by the most.
-  EXPECT_EQ(breaches.front().low, occupancy_breach(state_.terrain, target, body)->low);
+  // The first is the pair of the ball the rule is broken by the most (brute force over the ball's pairs).
+  const auto excess = [&](CellIndex low, CellIndex high) {
+    const double d = state_.terrain.cell_size_m() * std::hypot(low.row - high.row, low.col - high.col);
+    return state_.terrain(high) - state_.terrain(low) - (body.eps_m + body.kappa * d);
+  };
+  const std::vector<CellIndex> ball = disc_offsets(body.delta_m / (2.0 * state_.terrain.cell_size_m()));
+  double worst = 0.0;
+  for (const CellIndex& a : ball)
+    for (const CellIndex& b : ball)
+      worst = std::max(worst,
+                       excess({target.row + a.row, target.col + a.col}, {target.row + b.row, target.col + b.col}));
+  EXPECT_NEAR(excess(breaches.front().low, breaches.front().high), worst, 1e-12);
 }
 
 TEST_F(ArbiterTest, ALongStepCannotJumpAWall) {
