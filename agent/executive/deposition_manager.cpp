@@ -247,6 +247,14 @@ void DepositionManager::prepare(WayBack& w) const {
       for (int c = 0; c < map.cols(); ++c)
         if (map.blind(r, c) != 0) w.occupiable(r, c) = 0;
   }
+  // The cells a scanned map opens beyond its heights (the robot's own cell, cells stood on:
+  // docs/runtime.md#cells-stood-on) stay open until a deposit lands in their ball, which judges them again on the
+  // heights: the reaches before the depositions, read on map.occupiable, and after them are read on the same cells.
+  if (map.heights_occupiable.rows() == map.rows() && map.heights_occupiable.cols() == map.cols() &&
+      map.occupiable.rows() == map.rows() && map.occupiable.cols() == map.cols())
+    for (int r = 0; r < map.rows(); ++r)
+      for (int c = 0; c < map.cols(); ++c)
+        if (map.occupiable(r, c) != 0 && map.heights_occupiable(r, c) == 0) w.occupiable(r, c) = 1;
   w.after = map.heights;
   w.ball = disc_offsets(params_.navigability.delta_m / (2.0 * cs));
   w.touched.assign(static_cast<std::size_t>(map.rows()) * map.cols(), 0);
@@ -310,17 +318,16 @@ CellMask DepositionManager::raised_occupiable(WayBack& w, const std::vector<Depo
       changed.push_back(p);
     }
   for (const CellIndex p : changed) w.touched[static_cast<std::size_t>(p.row) * map.cols() + p.col] = 0;
-  CellMask occupiable;
+  // Only those cells are judged again; the others keep `before`, which may hold cells the map opened.
+  CellMask occupiable = before;
   // Each pair check costs the ball's size squared: beyond about the whole window's worth, the processor's full pass.
   const double pair_work = static_cast<double>(changed.size()) * static_cast<double>(w.ball.size()) *
                            static_cast<double>(w.ball.size());
   if (pair_work > 64.0 * static_cast<double>(map.rows()) * map.cols()) {
-    occupiable = rule.occupiable(w.after);
-    for (int r = 0; r < map.rows(); ++r)
-      for (int c = 0; c < map.cols(); ++c)
-        if (map.blind(r, c) != 0) occupiable(r, c) = 0;
+    const CellMask full = rule.occupiable(w.after);
+    for (const CellIndex p : changed)
+      occupiable(p.row, p.col) = map.blind(p.row, p.col) == 0 && full(p.row, p.col) != 0 ? 1 : 0;
   } else {
-    occupiable = before;
     for (const CellIndex p : changed)
       occupiable(p.row, p.col) =
           map.blind(p.row, p.col) == 0 && cell_occupiable_in_ball(w.after, p, rule.params(), w.ball) ? 1 : 0;

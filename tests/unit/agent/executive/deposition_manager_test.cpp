@@ -233,6 +233,46 @@ TEST(DepositionManager, KeepsTheRobotsWayBack) {
   EXPECT_EQ(east.dropped_for_way_back, 0);
 }
 
+// A scanned map opens cells the robot stood on that its heights alone hold not occupiable (a reading a few mm off:
+// docs/runtime.md#cells-stood-on). The robot's way back to its origin runs through them: a deposit ahead of it, out of
+// their balls, keeps that way as on the same corridor without the misread cell; a deposit in their ball judges them
+// again on the heights, and it is dropped.
+TEST(DepositionManager, CellsTheMapOpensStayOpenUntilADepositLandsInTheirBall) {
+  const DepositionParams p = params();
+  const DepositionManager dm(p);
+  const CellIndex centre{10, 20};
+  const Position robot = kGrid.cell_center(centre);
+  Heightmap gap(kGrid, 0.0);
+  gap(10, 26) = 0.05;  // ahead, 0.6 m from the robot
+  gap(10, 13) = 0.05;  // in the ball of (10, 11) and (10, 12)
+  const auto ahead = row_path(10, 21, 30);
+  const auto behind = row_path(10, 19, 12);
+
+  // The reference: the corridor read right. The deposit ahead is kept, the one behind too (nothing breaks there).
+  const LocalMap right = make_map(corridor(), gap, p.navigability, centre, {{10, 1}});
+  ASSERT_EQ(dm.plan(right, ahead, robot, 10.0, {1, robot, {}}).depositions.size(), 1u);
+
+  Heightmap misread = corridor();
+  misread(10, 10) = 0.12;  // 0.12 m over its neighbours, where eps + kappa cs allows 0.10 m
+  LocalMap map = make_map(misread, gap, p.navigability, centre, {{10, 1}});
+  map.heights_occupiable = map.occupiable;
+  map.heights_navigability = p.navigability;
+  for (int c = 8; c <= 12; ++c) {
+    ASSERT_EQ(map.occupiable(10, c), 0) << c;
+    map.occupiable(10, c) = 1;  // stood on
+  }
+  map.navigable = NavigabilityProcessor::navigable_from(map.occupiable, centre);
+  ASSERT_EQ(map.navigable(10, 1), 1);
+
+  const DepositionPlan kept = dm.plan(map, ahead, robot, 10.0, {1, robot, {}});
+  ASSERT_EQ(kept.depositions.size(), 1u);
+  EXPECT_EQ(kept.depositions[0].col, 26);
+  EXPECT_EQ(kept.dropped_for_way_back, 0);
+  const DepositionPlan dropped = dm.plan(map, behind, robot, 10.0, {1, robot, {}});
+  EXPECT_EQ(dropped.candidates, 1);
+  EXPECT_TRUE(dropped.depositions.empty());
+}
+
 /// The plan of a robot at `centre` along `cells` with 10 m^3 on board, after checking that every cell is a candidate
 /// and that all of them together would not keep its way back.
 DepositionPlan plan_cut_short(const LocalMap& map, const DepositionParams& p, CellIndex centre,
@@ -478,9 +518,19 @@ CellMask occupiable_after_ref(const LocalMap& map, const NavigabilityParams& nav
   Heightmap after = map.heights;
   for (const auto& d : depositions) after(d.cell) += d.height_m;
   CellMask occupiable = NavigabilityProcessor(nav).occupiable(after);
+  const double radius = nav.delta_m / (2.0 * map.geometry().cell_size_m);
+  const bool opened = map.heights_occupiable.rows() == map.rows() && map.heights_occupiable.cols() == map.cols();
   for (int r = 0; r < map.rows(); ++r)
-    for (int c = 0; c < map.cols(); ++c)
+    for (int c = 0; c < map.cols(); ++c) {
       if (map.blind(r, c) != 0) occupiable(r, c) = 0;
+      // A cell the map opened beyond its heights stays open while no deposit lies in its ball.
+      if (!opened || map.occupiable(r, c) == 0 || map.heights_occupiable(r, c) != 0) continue;
+      bool in_ball = false;
+      for (const auto& d : depositions)
+        in_ball = in_ball || static_cast<double>((d.cell.row - r) * (d.cell.row - r) + (d.cell.col - c) * (d.cell.col - c)) <=
+                                 radius * radius + tolerance::kBallCells2;
+      if (!in_ball) occupiable(r, c) = 1;
+    }
   return occupiable;
 }
 
@@ -545,8 +595,12 @@ RandomWindow random_window(std::mt19937& rng, const NavigabilityParams& nav, boo
     w.map.heights_occupiable = w.map.occupiable;
     w.map.heights_navigability = nav;
   }
-  // A scanned map opens the robot's own cell whatever its heights say.
+  // A scanned map opens the robot's own cell whatever its heights say, and cells it stood on.
   if (coin(rng) == 0) w.map.occupiable(robot.row, robot.col) = 1;
+  for (int k = std::uniform_int_distribution<int>(0, 3)(rng); k > 0; --k) {
+    const CellIndex stood{row_d(rng), col_d(rng)};
+    if (w.map.blind(stood.row, stood.col) == 0) w.map.occupiable(stood.row, stood.col) = 1;
+  }
   w.map.navigable = NavigabilityProcessor::navigable_from(w.map.occupiable, robot);
   for (int k = std::uniform_int_distribution<int>(0, 2)(rng); k > 0; --k) {
     const Position n = grid.cell_center({row_d(rng), col_d(rng)});
