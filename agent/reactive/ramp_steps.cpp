@@ -272,6 +272,25 @@ bool RampSteps::fails_a_told_drop(const deliberative::LocalMap& local, CellIndex
   return false;
 }
 
+void RampSteps::hold_out_told_drops(const deliberative::LocalMap& local, CellMask& mask) const {
+  const NavigabilityParams& body = context_.type.body.navigability;
+  const double radius = 0.5 * body.delta_m / local.geometry().cell_size_m;
+  const int reach = static_cast<int>(std::floor(radius + 1e-9));
+  const auto within = [&](CellIndex a, CellIndex b) {
+    const double dr = a.row - b.row, dc = a.col - b.col;
+    return dr * dr + dc * dc <= radius * radius + 1e-9;
+  };
+  // The cells whose ball holds both cells of a drop whose lower cell still lies below its level: those within the
+  // ball's radius of the lower cell and of the higher one (fails_a_told_drop(), drop by drop instead of cell by cell).
+  for (const auto& [low, level] : memory_.drop_levels) {
+    const CellIndex p = local.to_local(low), q = local.to_local(level.high);
+    if (!local.contains(p) || !(local.heights(p.row, p.col) < level.pass_m)) continue;
+    for (int r = p.row - reach; r <= p.row + reach; ++r)
+      for (int c = p.col - reach; c <= p.col + reach; ++c)
+        if (local.contains({r, c}) && within({r, c}, p) && within({r, c}, q)) mask(r, c) = 0;
+  }
+}
+
 void RampSteps::fill_to_drop_levels(deliberative::LocalMap& local) const {
   const double margin = modules_->depositions.params().gap_margin_m;
   for (const auto& [low, level] : memory_.drop_levels) {
@@ -672,7 +691,13 @@ std::optional<executive::Motion> RampSteps::ask_back(const deliberative::LocalMa
     if (distance(at, robot) >= far_m && distance(at, goal) >= here_m) anchor = cell;
   }
   if (!anchor) return std::nullopt;
-  const auto route = modules_->router.plan(local.gap, local.known, local.robot, *anchor);
+  // Around what the world has answered already: it would refuse those cells again.
+  CellMask open = local.known;
+  hold_out_told_drops(local, open);
+  for (const CellIndex g : memory_.refused->cells())
+    if (const CellIndex p = local.to_local(g); local.contains(p)) open(p.row, p.col) = 0;
+  open(local.robot.row, local.robot.col) = 1;
+  const auto route = modules_->router.plan(local.gap, open, local.robot, *anchor);
   if (!route.found || route.path.size() < 2) return std::nullopt;
   if (const auto motion = advance(local, route.path, robot)) return motion;
   return ask_ahead(local, route.path, robot);

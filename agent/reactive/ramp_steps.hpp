@@ -176,7 +176,8 @@ class RampSteps {
   /// A scanning robot walled in on its map (walled_in(), asked first), or whose map leaves it no way back (step_back()
   /// and retrace() found none), asks the world the way it came: along a route over its known cells to the latest
   /// cell of its trajectory a body length away and no nearer its goal, the route's next cell (advance(), or
-  /// ask_ahead() when the map holds it out). nullopt otherwise.
+  /// ask_ahead() when the map holds it out). The route runs around the cells the world has answered already (refused,
+  /// or failing a drop it named: told_drops_held_out()), which it would refuse again. nullopt otherwise.
   std::optional<executive::Motion> ask_back(const deliberative::LocalMap& local, Position robot) const;
   /// A scanning robot on an island of its map: no navigable cell lies a body length away. Always false for a robot
   /// that reads exact heights.
@@ -299,6 +300,8 @@ class RampSteps {
   // A told drop with both its cells in the body ball of `cell` (local index) still lies below its DropLevel::pass_m:
   // the world would refuse the cell again.
   bool fails_a_told_drop(const deliberative::LocalMap& local, CellIndex cell) const;
+  // The window's cells (local indices) for which fails_a_told_drop() holds, set to 0 in `mask`.
+  void hold_out_told_drops(const deliberative::LocalMap& local, CellMask& mask) const;
   void learn_refusals(const protocol::SensorFrame& frame);               // the world's refusals on the new map
   BuildView synthesize_view(const protocol::SensorFrame& frame);         // target, local map, the gap to work on
   void keep_clear(const protocol::SensorFrame& frame, BuildView& view);  // the neighbours and the refused cells

@@ -540,6 +540,40 @@ TEST(RampSteps, AScanningRobotBlockedWithNothingToFillAsksTheWorldThePathsNextCe
   EXPECT_EQ(exact.east, (std::vector<bool>{false}));
 }
 
+// A walled-in scanning robot asks the world its way back around the cells the world has answered. The spikes of the
+// walled-in test around B (30, 44) on flat ground; the robot came from A (30, 30), 1.4 m west, the way back. It asks
+// the path's next cell east first (refused: the spike east of B); then the next cell of the straight way back,
+// (30, 43); refused too (the world naming the spike west of B, (30, 38), over (30, 39): both in the ball of (30, 43)),
+// it asks a cell beside that one, whose ball does not hold both, instead of asking nothing.
+TEST(RampSteps, AWalledInRobotAsksItsWayBackAroundTheCellsTheWorldRefused) {
+  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
+  const CellIndex b{30, 44};
+  for (const CellIndex o : {CellIndex{0, 6}, CellIndex{0, -6}, CellIndex{6, 0}, CellIndex{-6, 0}, CellIndex{4, 4},
+                            CellIndex{4, -4}, CellIndex{-4, 4}, CellIndex{-4, -4}})
+    h(b.row + o.row, b.col + o.col) = 0.12;
+  const Position at_b = h.geometry().cell_center(b);
+  const Position at_a = h.geometry().cell_center({30, 30});
+  using R = protocol::ActionResult;
+  const std::string east =
+      "target cell (30, 45) is not occupiable for this body: cell (30, 49) at 0 m lies too far below cell (30, 50) at "
+      "0.12 m";
+  const std::string west =
+      "target cell (30, 43) is not occupiable for this body: cell (30, 39) at 0 m lies too far below cell (30, 38) at "
+      "0.12 m";
+  const auto requests = build_requests(h, true, at_a, at_b, 0.0,
+                                       {{R::kAccepted, ""}, {R::kRejected, east}, {R::kRejected, west}});
+  ASSERT_EQ(requests.size(), 3u);
+  const auto cell_of = [&](const protocol::ActionRequest& q) { return h.geometry().cell_at({q.target_x_m, q.target_y_m}); };
+  ASSERT_TRUE(requests[0].move);
+  EXPECT_EQ(cell_of(requests[0]), (CellIndex{30, 45}));
+  ASSERT_TRUE(requests[1].move);
+  EXPECT_EQ(cell_of(requests[1]), (CellIndex{30, 43}));
+  ASSERT_TRUE(requests[2].move);
+  const CellIndex asked = *cell_of(requests[2]);
+  EXPECT_EQ(asked.col, 43);
+  EXPECT_EQ(std::abs(asked.row - 30), 1);
+}
+
 // A told drop holds a cell out only where the cell's ball holds both its cells. The same robot is refused a motion
 // through (30, 47), the world naming (30, 49) at 0 m too far below (30, 52) at 0.3 m: the pair lies in the ball of
 // (30, 47) but not in that of (30, 45) (the high cell is 7 cells away), so the robot still asks for (30, 45); told the
