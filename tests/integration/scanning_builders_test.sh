@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Scanning builders on real processes (issue 24, docs/runtime.md#mapping), inside run_isolated.sh: deploy/scenarios/
 # ramp.pbtxt, 3 robots with the default RGB-D camera (robot_type.sensor.name=rgbd), over DDS for at most 1500 steps.
-# Case rgbd, seed 2: they complete the ramp (in-process: 1282 steps, 11.44 m^3, 1.98 % of the requests refused; on
-# seeds 1-5 three of five complete, README "Every drop under the body"); the test holds what they do: they complete
+# Case rgbd, seed 2: they complete the ramp (in-process: 663 steps, 11.40 m^3, 3.67 % of the requests refused; on
+# seeds 1-5 all five complete in 623-862 steps, README "The way back read as the map opens it"); the test holds what
+# they do: they complete
 # it (exit 0, end_reason completed), never with more than 1.25 times the ground-truth run's 12.04 m^3, no cell above
 # the MARS bound of the initial terrain (kappa 0.3), and under 5 % of their requests refused (a refusal names every
 # drop under the body; issue 24's 1 % is not met, docs/runtime.md#refused-requests). Case rgbd_exact, seed 1: the
