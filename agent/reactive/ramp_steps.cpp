@@ -600,6 +600,7 @@ BuildPhase RampSteps::retreat_step(const deliberative::LocalMap& local, const pr
   // A scanning robot its map walls in (no navigable cell a body length away) asks the world the way it came first:
   // stepping back and forth on its island would never change its map.
   const bool walled = walled_in(local, robot);
+  if (!walled) memory_.ask_back_anchor.reset();
   auto motion = walled ? ask_back(local, robot) : std::nullopt;
   if (!motion) motion = step_back(local, robot);
   if (!motion) motion = retrace(local, robot);
@@ -675,7 +676,7 @@ bool RampSteps::walled_in(const deliberative::LocalMap& local, Position robot) c
   return true;
 }
 
-std::optional<executive::Motion> RampSteps::ask_back(const deliberative::LocalMap& local, Position robot) const {
+std::optional<executive::Motion> RampSteps::ask_back(const deliberative::LocalMap& local, Position robot) {
   if (!context_.type.sensor.casts_rays()) return std::nullopt;
   // Where the robot came from: the latest cell of its trajectory a body length away and no nearer its goal, known on
   // its map.
@@ -684,6 +685,12 @@ std::optional<executive::Motion> RampSteps::ask_back(const deliberative::LocalMa
   const double here_m = distance(robot, goal);
   const auto& trajectory = modules_->map.trajectory();
   std::optional<CellIndex> anchor;
+  // The one it headed for while walled in, while in the window, known and not reached: a step within the island would
+  // otherwise turn it to another cell of its trajectory, and it would shuttle between two.
+  if (memory_.ask_back_anchor) {
+    const CellIndex cell = local.to_local(*memory_.ask_back_anchor);
+    if (local.contains(cell) && local.known(cell.row, cell.col) != 0 && cell != local.robot) anchor = cell;
+  }
   for (auto it = trajectory.rbegin(); it != trajectory.rend() && !anchor; ++it) {
     const CellIndex cell = local.to_local(*it);
     if (!local.contains(cell) || local.known(cell.row, cell.col) == 0) break;
@@ -691,6 +698,7 @@ std::optional<executive::Motion> RampSteps::ask_back(const deliberative::LocalMa
     if (distance(at, robot) >= far_m && distance(at, goal) >= here_m) anchor = cell;
   }
   if (!anchor) return std::nullopt;
+  if (walled_in(local, robot)) memory_.ask_back_anchor = local.to_global(*anchor);
   // Around what the world has answered already: it would refuse those cells again.
   CellMask open = local.known;
   hold_out_told_drops(local, open);

@@ -177,8 +177,9 @@ class RampSteps {
   /// and retrace() found none), asks the world the way it came: along a route over its known cells to the latest
   /// cell of its trajectory a body length away and no nearer its goal, the route's next cell (advance(), or
   /// ask_ahead() when the map holds it out). The route runs around the cells the world has answered already (refused,
-  /// or failing a drop it named: told_drops_held_out()), which it would refuse again. nullopt otherwise.
-  std::optional<executive::Motion> ask_back(const deliberative::LocalMap& local, Position robot) const;
+  /// or failing a drop it named: hold_out_told_drops()), which it would refuse again. A walled-in robot keeps that
+  /// cell while it stays walled in (Memory::ask_back_anchor). nullopt otherwise.
+  std::optional<executive::Motion> ask_back(const deliberative::LocalMap& local, Position robot);
   /// A scanning robot on an island of its map: no navigable cell lies a body length away. Always false for a robot
   /// that reads exact heights.
   bool walled_in(const deliberative::LocalMap& local, Position robot) const;
@@ -274,6 +275,9 @@ class RampSteps {
     std::vector<int> others_near;
     bool deposited_since_blocked = false;          ///< the retreat deposited since the path was last blocked
     int idle_retreat_moves = 0;                    ///< retreat moves without work since
+    /// Where a walled-in robot asks its way back to (ask_back(), world index): kept while it stays walled in, so that
+    /// a step within its island does not turn it to another cell of its trajectory.
+    std::optional<CellIndex> ask_back_anchor;
     std::vector<executive::BodyClearance> others;  ///< the last frame's neighbours
     CellMask corridor;                             ///< the last local map's navigable cells, neighbours not taken out
     CellMask terrain_occupiable;                   ///< and its occupiable cells

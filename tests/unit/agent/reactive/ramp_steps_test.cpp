@@ -574,6 +574,60 @@ TEST(RampSteps, AWalledInRobotAsksItsWayBackAroundTheCellsTheWorldRefused) {
   EXPECT_EQ(std::abs(asked.row - 30), 1);
 }
 
+// A walled-in robot keeps the cell it asks its way back to while it stays walled in. Flat ground; spikes wall in P
+// (30, 44) and Q (20, 58) alone (as in the walled-in test above); the robot came from A (15, 30), north-west. On P,
+// refused the path's next cell east, it asks its way back towards A, the latest cell of its trajectory a body length
+// away and no nearer the goal (east). Put down on Q, still walled in, a robot choosing afresh would head for P, south-
+// west (now the latest such cell); it keeps A and asks the cell west or north-west. (The world never moves a robot so: the frames only put it where its memory is tested.)
+TEST(RampSteps, AWalledInRobotKeepsTheCellItAsksItsWayBackTo) {
+  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
+  for (const CellIndex centre : {CellIndex{30, 44}, CellIndex{20, 58}})
+    for (const CellIndex o : {CellIndex{0, 6}, CellIndex{0, -6}, CellIndex{6, 0}, CellIndex{-6, 0}, CellIndex{4, 4},
+                              CellIndex{4, -4}, CellIndex{-4, 4}, CellIndex{-4, -4}})
+      h(centre.row + o.row, centre.col + o.col) = 0.12;
+  const GridGeometry& g = h.geometry();
+  AgentContext c = test::agent_context(3, test::husky());
+  c.type.sensor = sensor_defaults(SensorKind::kLaser);
+  RampSteps steps(c);
+  steps.admit(test::admission_on(c, g, {9.05, g.cell_center({30, 44}).y}, {0.55, g.cell_center({30, 44}).y}));
+  using R = protocol::ActionResult;
+  struct Frame {
+    CellIndex at;
+    R result;
+    std::string reason;
+  };
+  const std::vector<Frame> frames{
+      {{15, 30}, R::kNone, ""},
+      {{30, 44}, R::kAccepted, ""},
+      {{30, 44}, R::kRejected,
+       "target cell (30, 45) is not occupiable for this body: cell (30, 49) at 0 m lies too far below cell (30, 50) at "
+       "0.12 m"},
+      {{20, 58}, R::kAccepted, ""},
+  };
+  std::vector<protocol::ActionRequest> requests;
+  for (std::size_t step = 0; step < frames.size(); ++step) {
+    protocol::SensorFrame f = test::full_frame(c, step, g.cell_center(frames[step].at), 0.0, h);
+    f.last_result = frames[step].result;
+    f.last_reason = frames[step].reason;
+    BuildTrace trace;
+    const BuildView view = steps.look(f, trace);
+    protocol::ActionRequest q = empty_request(c, f, "");
+    if (step < 3)
+      (void)steps.build_step(view.local, f, trace, q);
+    else
+      (void)steps.retreat_step(view.local, f, trace, q);  // as the builder does after a retreat
+    requests.push_back(q);
+  }
+  const auto cell_of = [&](const protocol::ActionRequest& q) { return *g.cell_at({q.target_x_m, q.target_y_m}); };
+  ASSERT_TRUE(requests[1].move);
+  EXPECT_EQ(cell_of(requests[1]), (CellIndex{30, 45}));  // the path's next cell east
+  ASSERT_TRUE(requests[2].move);
+  EXPECT_EQ(cell_of(requests[2]), (CellIndex{29, 43}));  // refused: the way back, towards A
+  ASSERT_TRUE(requests[3].move);
+  EXPECT_EQ(cell_of(requests[3]).col, 57);  // on Q: still towards A, not south-west towards P
+  EXPECT_LE(cell_of(requests[3]).row, 20);
+}
+
 // A told drop holds a cell out only where the cell's ball holds both its cells. The same robot is refused a motion
 // through (30, 47), the world naming (30, 49) at 0 m too far below (30, 52) at 0.3 m: the pair lies in the ball of
 // (30, 47) but not in that of (30, 45) (the high cell is 7 cells away), so the robot still asks for (30, 45); told the
