@@ -409,6 +409,18 @@ TEST(RampSteps, APileThatReachedARobotsBodyIsNotDumpedThereAgain) {
   EXPECT_GT(with_deposits, 20);  // it builds on beside the pile it may not dump
 }
 
+/// Flat ground 6 x 10 m (0.1 m cells) with eight 0.12 m spikes six cells from each of `centres`, along the axes and
+/// the diagonals (4, 4): each of a centre's eight neighbour cells holds one in its body ball (radius 5 cells), the
+/// centre's own ball none; a spike breaks the rule by 2 cm against the cells beside it, within a laser map's noise.
+Heightmap walled_in_world(std::initializer_list<CellIndex> centres) {
+  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
+  for (const CellIndex b : centres)
+    for (const CellIndex o : {CellIndex{0, 6}, CellIndex{0, -6}, CellIndex{6, 0}, CellIndex{-6, 0}, CellIndex{4, 4},
+                              CellIndex{4, -4}, CellIndex{-4, 4}, CellIndex{-4, -4}})
+      h(b.row + o.row, b.col + o.col) = 0.12;
+  return h;
+}
+
 // A scanning robot whose map leaves it no move asks the world: first the path's next cell, then the way it came. Flat
 // ground with eight 0.12 m spikes six cells (0.6 m) from the cell B it stands on, along the axes and diagonals (4, 4):
 // each of B's eight neighbour cells holds one of them in its body ball (radius 5 cells), B's own ball none; a spike
@@ -417,11 +429,8 @@ TEST(RampSteps, APileThatReachedARobotsBodyIsNotDumpedThereAgain) {
 // cell east (towards its target); once the world has refused that, for a motion back to A; once the world has refused
 // that too, it asks nothing until its map changes. A robot that reads exact heights asks nothing.
 TEST(RampSteps, AScanningRobotWalledInOnItsMapAsksTheWorldTheWayItCame) {
-  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
   const CellIndex b{30, 40};
-  for (const CellIndex o : {CellIndex{0, 6}, CellIndex{0, -6}, CellIndex{6, 0}, CellIndex{-6, 0}, CellIndex{4, 4},
-                            CellIndex{4, -4}, CellIndex{-4, 4}, CellIndex{-4, -4}})
-    h(b.row + o.row, b.col + o.col) = 0.12;
+  const Heightmap h = walled_in_world({b});
   const Position at_b = h.geometry().cell_center(b);
   const Position at_a{at_b.x - 0.2, at_b.y};
   const CellIndex a = *h.geometry().cell_at(at_a);
@@ -546,11 +555,8 @@ TEST(RampSteps, AScanningRobotBlockedWithNothingToFillAsksTheWorldThePathsNextCe
 // (30, 43); refused too (the world naming the spike west of B, (30, 38), over (30, 39): both in the ball of (30, 43)),
 // it asks a cell beside that one, whose ball does not hold both, instead of asking nothing.
 TEST(RampSteps, AWalledInRobotAsksItsWayBackAroundTheCellsTheWorldRefused) {
-  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
   const CellIndex b{30, 44};
-  for (const CellIndex o : {CellIndex{0, 6}, CellIndex{0, -6}, CellIndex{6, 0}, CellIndex{-6, 0}, CellIndex{4, 4},
-                            CellIndex{4, -4}, CellIndex{-4, 4}, CellIndex{-4, -4}})
-    h(b.row + o.row, b.col + o.col) = 0.12;
+  const Heightmap h = walled_in_world({b});
   const Position at_b = h.geometry().cell_center(b);
   const Position at_a = h.geometry().cell_center({30, 30});
   using R = protocol::ActionResult;
@@ -580,11 +586,7 @@ TEST(RampSteps, AWalledInRobotAsksItsWayBackAroundTheCellsTheWorldRefused) {
 // away and no nearer the goal (east). Put down on Q, still walled in, a robot choosing afresh would head for P, south-
 // west (now the latest such cell); it keeps A and asks the cell west or north-west. (The world never moves a robot so: the frames only put it where its memory is tested.)
 TEST(RampSteps, AWalledInRobotKeepsTheCellItAsksItsWayBackTo) {
-  Heightmap h({60, 100, 0.0, 0.0, 0.1}, 0.0);
-  for (const CellIndex centre : {CellIndex{30, 44}, CellIndex{20, 58}})
-    for (const CellIndex o : {CellIndex{0, 6}, CellIndex{0, -6}, CellIndex{6, 0}, CellIndex{-6, 0}, CellIndex{4, 4},
-                              CellIndex{4, -4}, CellIndex{-4, 4}, CellIndex{-4, -4}})
-      h(centre.row + o.row, centre.col + o.col) = 0.12;
+  const Heightmap h = walled_in_world({{30, 44}, {20, 58}});
   const GridGeometry& g = h.geometry();
   AgentContext c = test::agent_context(3, test::husky());
   c.type.sensor = sensor_defaults(SensorKind::kLaser);
