@@ -55,10 +55,17 @@ class MarsProcessor {
   /// P_kappa[h] with the geometry of h [m]; throws InvalidArgument naming the first non-finite cell, or saying why
   /// kappa, the cell size and the heights cannot be computed together (mars_problem()).
   Heightmap project(const Heightmap& h) const;
+  /// P_kappa[h] on the cells where `wanted` is non-zero, the same bits there as project(h), and h [m] on the others:
+  /// for a caller that reads the bound on part of the grid (the search for the others is skipped; the seed and the
+  /// source tree still cover the whole grid). Throws like project(), and InvalidArgument when `wanted` is not the
+  /// size of h.
+  Heightmap project(const Heightmap& h, const CellMask& wanted) const;
   /// P_kappa[h] - h [m], >= 0 everywhere; throws like project().
   Heightmap gap(const Heightmap& h) const;
 
  private:
+  Heightmap solve(const Heightmap& h, const CellMask* wanted) const;
+
   double kappa_;
 };
 

@@ -133,7 +133,7 @@ std::vector<std::uint64_t> seed_lower_bound(const Problem& pb, double* lower) {
   return masks;
 }
 
-void apply_local_sources(const Problem& pb, double* lower) {
+void apply_local_sources(const Problem& pb, double* lower, const std::uint8_t* wanted_rows) {
   struct Offset {
     int dr, dc;
     double drop;
@@ -174,6 +174,7 @@ void apply_local_sources(const Problem& pb, double* lower) {
   alignas(16) double tail[kChunk];
   for (int r = 0; r < rows; ++r) {
     load_row(r + radius);
+    if (wanted_rows && !wanted_rows[r]) continue;
     const double* first = ring.data() + static_cast<std::size_t>((r - radius + ring_rows) % ring_rows) * padded;
     double* out = lower + static_cast<std::int64_t>(r) * cols;
     for (int c = 0; c < cols; c += kChunk) {
