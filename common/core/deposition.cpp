@@ -47,9 +47,14 @@ CellMask path_footprint(const GridGeometry& grid, const std::vector<CellIndex>& 
   if (!(delta_m > 0.0) || !std::isfinite(delta_m))
     throw InvalidArgument(fmt::format("body length delta must be finite and > 0, got {}", delta_m));
   CellMask footprint = CellMask::Zero(grid.rows, grid.cols);
+  // The disc of DiscIterator(grid, p, delta_m / 2), its offsets computed once for the whole path.
+  const std::vector<CellIndex> disc = disc_offsets(delta_m / 2.0 / grid.cell_size_m);
   for (const CellIndex p : path) {
     if (!grid.contains(p)) throw InvalidArgument(fmt::format("path cell {} is off the grid", p));
-    for (DiscIterator it(grid, p, delta_m / 2.0); !it.is_past_end(); ++it) footprint((*it).row, (*it).col) = 1;
+    for (const CellIndex o : disc) {
+      const CellIndex q{p.row + o.row, p.col + o.col};
+      if (grid.contains(q)) footprint(q.row, q.col) = 1;
+    }
   }
   return footprint;
 }
