@@ -446,15 +446,19 @@ Heightmap RampSteps::band_gap(const deliberative::LocalMap& local, const std::ve
   // also inside the band (other fronts' strips, high ground the band's edge reaches), neither raise its target nor
   // widen it. A robot that waits or is refused sees the same way on the same heights: it reuses the last bound.
   return executive::gap_below(
-      local, bound_of(memory_.band_bound, local.offset, executive::way_sources(local, ahead, way_radius_m())));
+      local, bound_of(memory_.band_bound, local, executive::way_sources(local, ahead, way_radius_m())));
 }
 
-const Heightmap& RampSteps::bound_of(PlanBound& memo, CellIndex offset, Heightmap sources) const {
-  if (!(memo.offset == offset && memo.first.rows() == sources.rows() && memo.first.cols() == sources.cols() &&
-        (memo.first.heights().array() == sources.heights().array()).all())) {
-    memo.bound = MarsProcessor(construction_params(context_.type).kappa).project(sources);
+const Heightmap& RampSteps::bound_of(PlanBound& memo, const deliberative::LocalMap& local, Heightmap sources) const {
+  // The bound is read only where the window's gap is positive (gap_below()): only those cells are projected.
+  CellMask wanted = executive::gap_cells(local);
+  if (!(memo.offset == local.offset && memo.first.rows() == sources.rows() && memo.first.cols() == sources.cols() &&
+        (memo.first.heights().array() == sources.heights().array()).all() &&
+        (memo.wanted.array() >= wanted.array()).all())) {
+    memo.bound = MarsProcessor(construction_params(context_.type).kappa).project(sources, wanted);
     memo.first = std::move(sources);
-    memo.offset = offset;
+    memo.wanted = std::move(wanted);
+    memo.offset = local.offset;
   }
   return memo.bound;
 }
@@ -473,7 +477,7 @@ Heightmap RampSteps::plan_gap(const deliberative::LocalMap& local) {
   // The bound of the first-seen heights changes only when the window moves or sees new cells: a robot building in
   // place reuses the last one.
   Heightmap gap = executive::gap_below(
-      local, bound_of(memory_.plan_bound, local.offset, executive::first_seen_heights(local, *memory_.raised)));
+      local, bound_of(memory_.plan_bound, local, executive::first_seen_heights(local, *memory_.raised)));
   // What is built is the structure: its cells cost nothing, so a front that meets a strip drives on along it and
   // extends it at its tip.
   const CellMask built = built_cells(local);
