@@ -356,8 +356,15 @@ std::optional<executive::Motion> RampSteps::advance(const deliberative::LocalMap
 void RampSteps::clear_pad_gap(deliberative::LocalMap& local) const {
   const Position base = context_.assignment.base;
   const double radius = kPadFraction * context_.assignment.base_radius_m;
-  for (int r = 0; r < local.rows(); ++r)
-    for (int c = 0; c < local.cols(); ++c)
+  // within() holds only for centres within the radius along both axes: the cells centred in that square.
+  Rect square;
+  square.x0 = base.x - radius;
+  square.x1 = base.x + radius;
+  square.y0 = base.y - radius;
+  square.y1 = base.y + radius;
+  const CellRect cells = cells_centred_in(local.geometry(), square);
+  for (int r = cells.first.row; r < cells.first.row + cells.rows; ++r)
+    for (int c = cells.first.col; c < cells.first.col + cells.cols; ++c)
       if (within(local.center({r, c}).x - base.x, local.center({r, c}).y - base.y, radius)) local.gap(r, c) = 0.0;
 }
 
@@ -697,10 +704,26 @@ std::optional<executive::Motion> RampSteps::step_away(const deliberative::LocalM
 
 bool RampSteps::keep_out_of(deliberative::LocalMap& local, Position robot, const std::vector<Lane>& lanes) {
   if (lanes.empty()) return false;
+  // Lane::contains() holds only for centres in the lane's box widened by its radius (and its 1e-6 m margin): each
+  // lane tests the cells centred in that box.
+  CellMask in_lane = CellMask::Zero(local.rows(), local.cols());
+  for (const Lane& lane : lanes) {
+    const double reach_m = lane.radius_m + 1e-6;
+    Rect box;
+    box.x0 = std::min(lane.from.x, lane.to.x) - reach_m;
+    box.x1 = std::max(lane.from.x, lane.to.x) + reach_m;
+    box.y0 = std::min(lane.from.y, lane.to.y) - reach_m;
+    box.y1 = std::max(lane.from.y, lane.to.y) + reach_m;
+    const CellRect cells = cells_centred_in(local.geometry(), box);
+    for (int r = cells.first.row; r < cells.first.row + cells.rows; ++r)
+      for (int c = cells.first.col; c < cells.first.col + cells.cols; ++c)
+        if (in_lane(r, c) == 0 && local.occupiable(r, c) != 0 && CellIndex{r, c} != local.robot &&
+            lane.contains(local.center({r, c})))
+          in_lane(r, c) = 1;
+  }
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c)
-      if (local.occupiable(r, c) != 0 && CellIndex{r, c} != local.robot && in_any(lanes, local.center({r, c})))
-        local.occupiable(r, c) = 0;
+      if (in_lane(r, c) != 0) local.occupiable(r, c) = 0;
   local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
   return in_any(lanes, robot);
 }
