@@ -33,9 +33,10 @@ double deposition_target_volume(const Heightmap& gap, const CellMask& footprint)
   if (footprint.rows() != gap.rows() || footprint.cols() != gap.cols())
     throw InvalidArgument(fmt::format("footprint mask is {} x {} but the gap grid is {} x {}", footprint.rows(),
                                       footprint.cols(), gap.rows(), gap.cols()));
-  double sum_m = 0.0;
-  for (SubmapIterator it(gap.geometry(), {0, 0}, gap.rows(), gap.cols()); !it.is_past_end(); ++it)
-    if (footprint((*it).row, (*it).col) != 0) sum_m += checked_gap(gap, *it);
+  double sum_m = 0.0;  // row-major, as ever: the same sum to the bit
+  for (int r = 0; r < gap.rows(); ++r)
+    for (int c = 0; c < gap.cols(); ++c)
+      if (footprint(r, c) != 0) sum_m += checked_gap(gap, {r, c});
   return sum_m * gap.cell_size_m() * gap.cell_size_m();
 }
 
