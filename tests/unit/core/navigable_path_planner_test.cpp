@@ -154,11 +154,15 @@ TEST(NavigablePathPlanner, GapCostIsTheBallSumsOfThePathBitForBit) {
       for (int r = 0; r < g.rows; ++r)
         for (int c = 0; c < g.cols; ++c) {
           const auto kind = next() % 4;
-          gap(r, c) = kind == 0 ? 0.0 : kind == 1 ? -0.0 : kind == 2 ? 0.25 : static_cast<double>(next() % 1000) / 997.0;
+          gap(r, c) = kind == 0   ? 0.0
+                      : kind == 1 ? -0.0
+                      : kind == 2 ? 0.25
+                                  : static_cast<double>(next() % 1000) / 997.0;
         }
       const CellIndex start{static_cast<int>(next() % g.rows), static_cast<int>(next() % g.cols)};
       const CellIndex goal{static_cast<int>(next() % g.rows), trial % 2 == 0 ? 0 : g.cols - 1};
-      const PlannerResult res = NavigablePathPlanner({0.001 * (trial % 5), 1.0, delta_m}).plan(gap, CellMask::Ones(g.rows, g.cols), start, goal);
+      const NavigablePathPlanner planner({0.001 * (trial % 5), 1.0, delta_m});
+      const PlannerResult res = planner.plan(gap, CellMask::Ones(g.rows, g.cols), start, goal);
       ASSERT_TRUE(res.found);
       double cost = 0.0;
       for (std::size_t i = 1; i < res.path.size(); ++i) {
