@@ -219,7 +219,14 @@ Heightmap way_sources(const deliberative::LocalMap& local, const std::vector<Cel
 }
 
 Heightmap gap_below_bound_of(const deliberative::LocalMap& local, const Heightmap& sources, double kappa) {
-  return gap_below(local, MarsProcessor(kappa).project(sources));
+  return gap_below(local, MarsProcessor(kappa).project(sources, gap_cells(local)));
+}
+
+CellMask gap_cells(const deliberative::LocalMap& local) {
+  CellMask cells(local.rows(), local.cols());
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) cells(r, c) = !(local.gap(r, c) <= 0.0);
+  return cells;
 }
 
 Heightmap gap_below(const deliberative::LocalMap& local, const Heightmap& target) {

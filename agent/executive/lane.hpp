@@ -80,5 +80,9 @@ Heightmap gap_below_bound_of(const deliberative::LocalMap& local, const Heightma
 /// The window's gap capped by `target` [m] (a bound already projected, the window's size): min(local.gap,
 /// max(0, target - h)) [m] per cell.
 Heightmap gap_below(const deliberative::LocalMap& local, const Heightmap& target);
+/// The cells where gap_below() reads its target: those whose local.gap is not <= 0 (1; elsewhere the result is
+/// local.gap whatever the target), the window's size. A bound needed only there is projected only there
+/// (MarsProcessor::project(h, wanted)).
+CellMask gap_cells(const deliberative::LocalMap& local);
 
 }  // namespace marsala::agent::executive

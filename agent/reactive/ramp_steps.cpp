@@ -375,8 +375,15 @@ std::optional<executive::Motion> RampSteps::advance(const deliberative::LocalMap
 void RampSteps::clear_pad_gap(deliberative::LocalMap& local) const {
   const Position base = context_.assignment.base;
   const double radius = kPadFraction * context_.assignment.base_radius_m;
-  for (int r = 0; r < local.rows(); ++r)
-    for (int c = 0; c < local.cols(); ++c)
+  // within() holds only for centres within the radius along both axes: the cells centred in that square.
+  Rect square;
+  square.x0 = base.x - radius;
+  square.x1 = base.x + radius;
+  square.y0 = base.y - radius;
+  square.y1 = base.y + radius;
+  const CellRect cells = cells_centred_in(local.geometry(), square);
+  for (int r = cells.first.row; r < cells.first.row + cells.rows; ++r)
+    for (int c = cells.first.col; c < cells.first.col + cells.cols; ++c)
       if (within(local.center({r, c}).x - base.x, local.center({r, c}).y - base.y, radius)) local.gap(r, c) = 0.0;
 }
 
@@ -465,15 +472,19 @@ Heightmap RampSteps::band_gap(const deliberative::LocalMap& local, const std::ve
   // also inside the band (other fronts' strips, high ground the band's edge reaches), neither raise its target nor
   // widen it. A robot that waits or is refused sees the same way on the same heights: it reuses the last bound.
   return executive::gap_below(
-      local, bound_of(memory_.band_bound, local.offset, executive::way_sources(local, ahead, way_radius_m())));
+      local, bound_of(memory_.band_bound, local, executive::way_sources(local, ahead, way_radius_m())));
 }
 
-const Heightmap& RampSteps::bound_of(PlanBound& memo, CellIndex offset, Heightmap sources) const {
-  if (!(memo.offset == offset && memo.first.rows() == sources.rows() && memo.first.cols() == sources.cols() &&
-        (memo.first.heights().array() == sources.heights().array()).all())) {
-    memo.bound = MarsProcessor(construction_params(context_.type).kappa).project(sources);
+const Heightmap& RampSteps::bound_of(PlanBound& memo, const deliberative::LocalMap& local, Heightmap sources) const {
+  // The bound is read only where the window's gap is positive (gap_below()): only those cells are projected.
+  CellMask wanted = executive::gap_cells(local);
+  if (!(memo.offset == local.offset && memo.first.rows() == sources.rows() && memo.first.cols() == sources.cols() &&
+        (memo.first.heights().array() == sources.heights().array()).all() &&
+        (memo.wanted.array() >= wanted.array()).all())) {
+    memo.bound = MarsProcessor(construction_params(context_.type).kappa).project(sources, wanted);
     memo.first = std::move(sources);
-    memo.offset = offset;
+    memo.wanted = std::move(wanted);
+    memo.offset = local.offset;
   }
   return memo.bound;
 }
@@ -492,7 +503,7 @@ Heightmap RampSteps::plan_gap(const deliberative::LocalMap& local) {
   // The bound of the first-seen heights changes only when the window moves or sees new cells: a robot building in
   // place reuses the last one.
   Heightmap gap = executive::gap_below(
-      local, bound_of(memory_.plan_bound, local.offset, executive::first_seen_heights(local, *memory_.raised)));
+      local, bound_of(memory_.plan_bound, local, executive::first_seen_heights(local, *memory_.raised)));
   // What is built is the structure: its cells cost nothing, so a front that meets a strip drives on along it and
   // extends it at its tip.
   const CellMask built = built_cells(local);
@@ -726,10 +737,26 @@ std::optional<executive::Motion> RampSteps::step_away(const deliberative::LocalM
 
 bool RampSteps::keep_out_of(deliberative::LocalMap& local, Position robot, const std::vector<Lane>& lanes) {
   if (lanes.empty()) return false;
+  // Lane::contains() holds only for centres in the lane's box widened by its radius (and its 1e-6 m margin): each
+  // lane tests the cells centred in that box.
+  CellMask in_lane = CellMask::Zero(local.rows(), local.cols());
+  for (const Lane& lane : lanes) {
+    const double reach_m = lane.radius_m + 1e-6;
+    Rect box;
+    box.x0 = std::min(lane.from.x, lane.to.x) - reach_m;
+    box.x1 = std::max(lane.from.x, lane.to.x) + reach_m;
+    box.y0 = std::min(lane.from.y, lane.to.y) - reach_m;
+    box.y1 = std::max(lane.from.y, lane.to.y) + reach_m;
+    const CellRect cells = cells_centred_in(local.geometry(), box);
+    for (int r = cells.first.row; r < cells.first.row + cells.rows; ++r)
+      for (int c = cells.first.col; c < cells.first.col + cells.cols; ++c)
+        if (in_lane(r, c) == 0 && local.occupiable(r, c) != 0 && CellIndex{r, c} != local.robot &&
+            lane.contains(local.center({r, c})))
+          in_lane(r, c) = 1;
+  }
   for (int r = 0; r < local.rows(); ++r)
     for (int c = 0; c < local.cols(); ++c)
-      if (local.occupiable(r, c) != 0 && CellIndex{r, c} != local.robot && in_any(lanes, local.center({r, c})))
-        local.occupiable(r, c) = 0;
+      if (in_lane(r, c) != 0) local.occupiable(r, c) = 0;
   local.navigable = NavigabilityProcessor::navigable_from(local.occupiable, local.robot);
   return in_any(lanes, robot);
 }

@@ -247,11 +247,12 @@ class RampSteps {
   struct PlanBound {
     CellIndex offset{-1, -1};
     Heightmap first;
+    CellMask wanted;  // the cells bound holds the MARS bound on (h elsewhere)
     Heightmap bound;
   };
-  // The MARS bound of `sources` (window at `offset`) at the construction kappa, from `memo` when its sources are
-  // these, bit for bit.
-  const Heightmap& bound_of(PlanBound& memo, CellIndex offset, Heightmap sources) const;
+  // The MARS bound of `sources` (window at `offset`) at the construction kappa on the cells gap_below() reads for
+  // `local` (executive::gap_cells()), from `memo` when its sources are these, bit for bit, and it holds those cells.
+  const Heightmap& bound_of(PlanBound& memo, const deliberative::LocalMap& local, Heightmap sources) const;
   struct Memory {
     Sent sent;
     /// The world gives deposits (cube, cone) their shape and may judge one the prediction passed: after a rejected

@@ -33,9 +33,10 @@ double deposition_target_volume(const Heightmap& gap, const CellMask& footprint)
   if (footprint.rows() != gap.rows() || footprint.cols() != gap.cols())
     throw InvalidArgument(fmt::format("footprint mask is {} x {} but the gap grid is {} x {}", footprint.rows(),
                                       footprint.cols(), gap.rows(), gap.cols()));
-  double sum_m = 0.0;
-  for (SubmapIterator it(gap.geometry(), {0, 0}, gap.rows(), gap.cols()); !it.is_past_end(); ++it)
-    if (footprint((*it).row, (*it).col) != 0) sum_m += checked_gap(gap, *it);
+  double sum_m = 0.0;  // row-major, as ever: the same sum to the bit
+  for (int r = 0; r < gap.rows(); ++r)
+    for (int c = 0; c < gap.cols(); ++c)
+      if (footprint(r, c) != 0) sum_m += checked_gap(gap, {r, c});
   return sum_m * gap.cell_size_m() * gap.cell_size_m();
 }
 
@@ -47,9 +48,14 @@ CellMask path_footprint(const GridGeometry& grid, const std::vector<CellIndex>& 
   if (!(delta_m > 0.0) || !std::isfinite(delta_m))
     throw InvalidArgument(fmt::format("body length delta must be finite and > 0, got {}", delta_m));
   CellMask footprint = CellMask::Zero(grid.rows, grid.cols);
+  // The disc of DiscIterator(grid, p, delta_m / 2), its offsets computed once for the whole path.
+  const std::vector<CellIndex> disc = disc_offsets(delta_m / 2.0 / grid.cell_size_m);
   for (const CellIndex p : path) {
     if (!grid.contains(p)) throw InvalidArgument(fmt::format("path cell {} is off the grid", p));
-    for (DiscIterator it(grid, p, delta_m / 2.0); !it.is_past_end(); ++it) footprint((*it).row, (*it).col) = 1;
+    for (const CellIndex o : disc) {
+      const CellIndex q{p.row + o.row, p.col + o.col};
+      if (grid.contains(q)) footprint(q.row, q.col) = 1;
+    }
   }
   return footprint;
 }

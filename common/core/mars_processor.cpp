@@ -43,7 +43,16 @@ MarsProcessor::MarsProcessor(double kappa) : kappa_(kappa) {
     throw InvalidArgument(fmt::format("MarsProcessor: kappa must be finite and > 0, got {}", kappa));
 }
 
-Heightmap MarsProcessor::project(const Heightmap& h) const {
+Heightmap MarsProcessor::project(const Heightmap& h) const { return solve(h, nullptr); }
+
+Heightmap MarsProcessor::project(const Heightmap& h, const CellMask& wanted) const {
+  if (wanted.rows() != h.rows() || wanted.cols() != h.cols())
+    throw InvalidArgument(fmt::format("MarsProcessor: the wanted cells are {} x {} but the heights {} x {}",
+                                      wanted.rows(), wanted.cols(), h.rows(), h.cols()));
+  return solve(h, &wanted);
+}
+
+Heightmap MarsProcessor::solve(const Heightmap& h, const CellMask* wanted) const {
   Heightmap out = h;
   const int rows = h.rows(), cols = h.cols();
   if (rows <= 0 || cols <= 0) return out;
@@ -70,10 +79,36 @@ Heightmap MarsProcessor::project(const Heightmap& h) const {
   pb.tol = std::min(pb.tol, 0.25 * pb.kcs);
 
   double* lower = out.data();
+  if (!wanted) {
+    std::vector<std::uint64_t> sources = detail::seed_lower_bound(pb, lower);
+    detail::apply_local_sources(pb, lower);
+    const detail::SourceTree tree(pb, std::move(sources));
+    detail::search_sources(pb, tree, lower);
+    return out;
+  }
+  // The wanted targets by row (the local pass) and by block of the search (its bit layout); each target's value
+  // depends on its own limit alone, so the rows and blocks left out change no wanted cell.
+  std::vector<std::uint8_t> wanted_rows(static_cast<std::size_t>(rows), 0);
+  const int block_cols = (cols + detail::kBlock - 1) / detail::kBlock;
+  const int block_rows = (rows + detail::kBlock - 1) / detail::kBlock;
+  std::vector<std::uint64_t> wanted_blocks(static_cast<std::size_t>(block_rows) * block_cols, 0);
+  bool any = false;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      if ((*wanted)(r, c) != 0) {
+        any = true;
+        wanted_rows[static_cast<std::size_t>(r)] = 1;
+        wanted_blocks[static_cast<std::size_t>(r / detail::kBlock) * block_cols + c / detail::kBlock] |=
+            std::uint64_t{1} << ((r % detail::kBlock) * detail::kBlock + c % detail::kBlock);
+      }
+  if (!any) return out;
   std::vector<std::uint64_t> sources = detail::seed_lower_bound(pb, lower);
-  detail::apply_local_sources(pb, lower);
+  detail::apply_local_sources(pb, lower, wanted_rows.data());
   const detail::SourceTree tree(pb, std::move(sources));
-  detail::search_sources(pb, tree, lower);
+  detail::search_sources(pb, tree, lower, wanted_blocks.data());
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      if ((*wanted)(r, c) == 0) out(r, c) = h(r, c);
   return out;
 }
 

@@ -63,10 +63,27 @@ PlannerResult NavigablePathPlanner::plan(const Heightmap& gap, const CellMask& a
   const double cs = gap.cell_size_m();
   const long long n = static_cast<long long>(rows) * cols;
   const auto ball = disc_offsets(params_.delta_m / (2.0 * cs));
+  // A cell whose whole ball lies on the grid reads its ball by linear offsets, without a bounds test, and without a
+  // test of each value when every gap value is valid; the sum is taken in the ball's order either way (the same bits).
+  int reach = 0;
+  std::vector<std::ptrdiff_t> ball_at;
+  ball_at.reserve(ball.size());
+  for (const CellIndex o : ball) {
+    reach = std::max({reach, std::abs(o.row), std::abs(o.col)});
+    ball_at.push_back(static_cast<std::ptrdiff_t>(o.row) * cols + o.col);
+  }
+  bool all_valid = true;
+  for (long long i = 0; i < n && all_valid; ++i) all_valid = gap.data()[i] >= 0.0 && std::isfinite(gap.data()[i]);
   // Ball sums of the gap (eq. 5), computed when a cell is first reached.
   std::vector<double> ball_gap(static_cast<std::size_t>(n), -1.0);
   const auto ball_sum = [&](int r, int c) {
     double& s = ball_gap[static_cast<std::size_t>(r) * cols + c];
+    if (s < 0.0 && all_valid && r >= reach && r < rows - reach && c >= reach && c < cols - reach) {
+      const double* at = gap.data() + static_cast<std::ptrdiff_t>(r) * cols + c;
+      double sum = 0.0;
+      for (const std::ptrdiff_t k : ball_at) sum += at[k];
+      s = sum;
+    }
     if (s < 0.0) {
       s = 0.0;
       int inside = 0;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 namespace marsala::detail {
 namespace {
@@ -14,6 +15,10 @@ namespace {
 constexpr long long kFloor2 = kLocalRadius2 + 1;
 
 constexpr int kTargets = kBlock * kBlock;
+constexpr int kHalf = kBlock / 2;
+// Leaves whose heights a search keeps at once (BlockSearch::leaf_heights()): every leaf of a window, a band of
+// leaves a few blocks high on a large grid [leaves].
+constexpr std::int64_t kLeafCache = 1024;
 
 // Searches the tree for one kBlock x kBlock block of targets at a time, depth first, children in
 // decreasing order of their upper bound; a node is dropped for a target as soon as one of its
@@ -22,8 +27,14 @@ constexpr int kTargets = kBlock * kBlock;
 // which targets go on.
 class BlockSearch {
  public:
-  BlockSearch(const Problem& pb, const SourceTree& tree, double* lower)
-      : pb_(pb), tree_(tree), lower_(lower), kcs2_(pb.kcs * pb.kcs) {
+  BlockSearch(const Problem& pb, const SourceTree& tree, double* lower, const std::uint64_t* wanted)
+      : pb_(pb),
+        wanted_(wanted),
+        tree_(tree),
+        lower_(lower),
+        kcs2_(pb.kcs * pb.kcs),
+        leaf_cache_(static_cast<std::size_t>(
+            std::min(kLeafCache, static_cast<std::int64_t>(tree.width(0)) * tree.height(0)))) {
     for (int t = 0; t < kTargets; ++t) {
       local_r_[t] = t / kBlock;
       local_c_[t] = t % kBlock;
@@ -37,10 +48,16 @@ class BlockSearch {
 
  private:
   void search_block(int bi, int bj) {
+    const std::uint64_t wanted =
+        wanted_ ? wanted_[static_cast<std::size_t>(bi) * tree_.width(0) + bj] : ~std::uint64_t{0};
+    if (!wanted) return;
     r0_ = bi * kBlock;
     c0_ = bj * kBlock;
     r1_ = std::min(pb_.rows, r0_ + kBlock) - 1;
     c1_ = std::min(pb_.cols, c0_ + kBlock) - 1;
+    block_rows_ = r1_ - r0_ + 1;
+    block_pair_cols_ = (c1_ - c0_ + 2) / 2 * 2;
+    whole_block_ = block_rows_ == kBlock && block_pair_cols_ == kBlock;
     std::uint64_t targets = 0;
     min_limit_ = kInf;
     max_limit_ = -kInf;
@@ -52,12 +69,13 @@ class BlockSearch {
     for (int r = r0_; r <= r1_; ++r)
       for (int c = c0_; c <= c1_; ++c) {
         const int t = (r - r0_) * kBlock + (c - c0_);
+        if (!(wanted >> t & 1)) continue;  // as off the grid
         targets |= std::uint64_t{1} << t;
         limit_[t] = lower_[static_cast<std::int64_t>(r) * pb_.cols + c] + pb_.tol;
         min_limit_ = std::min(min_limit_, limit_[t]);
         max_limit_ = std::max(max_limit_, limit_[t]);
       }
-    visit(tree_.top_level(), 0, 0, targets);
+    if (targets) visit(tree_.top_level(), 0, 0, targets);
   }
 
   // Squared distance from the target block to a node's box, floored [cells^2].
@@ -66,12 +84,18 @@ class BlockSearch {
     return std::max(dr * dr + dc * dc, kFloor2);
   }
 
-  // OR of test(t) << t over the pairs of targets t, t + 1 of the block (all of them: skipping rows without targets
-  // mispredicted more branches than it saved).
+  // OR of test(t) << t over the pairs of targets t, t + 1 of the block: all of them in a block inside the grid
+  // (skipping rows without live targets mispredicted more branches than it saved), only the rows and column pairs
+  // on the grid in a block cut by its edge (a small window's last row and column of blocks hold 1 of 8).
   template <class Test>
-  static std::uint64_t pairs_where(Test test) {
+  std::uint64_t pairs_where(Test test) const {
     std::uint64_t out = 0;
-    for (int t = 0; t < kTargets; t += 2) out |= std::uint64_t{test(t)} << t;
+    if (whole_block_) {
+      for (int t = 0; t < kTargets; t += 2) out |= std::uint64_t{test(t)} << t;
+      return out;
+    }
+    for (int k = 0; k < block_rows_; ++k)
+      for (int t = k * kBlock; t < k * kBlock + block_pair_cols_; t += 2) out |= std::uint64_t{test(t)} << t;
     return out;
   }
 
@@ -196,40 +220,79 @@ class BlockSearch {
     for (int k = 0; k < n; ++k) visit(below, kids[k].i, kids[k].j, keep);
   }
 
-  // Applies the leaf's sources to the targets. For each target, each 4 x 4 quarter of the leaf is
-  // first bounded by its highest source at its box's floored distance; the sources of the quarters
-  // left are then checked two at a time without branches (non-sources at -inf) for one that beats
-  // the target's limit, and only then are the leaf's sources applied one by one in bit order, each
-  // against the limit as it rises.
-  void evaluate_leaf(int i, int j, std::uint64_t targets) {
-    constexpr int kHalf = kBlock / 2;
+  // A leaf's heights for evaluate_leaf(): its sources' heights by bit (-inf elsewhere) and the highest of each 4 x 4
+  // quarter [m]. Neighbouring blocks read the same leaves, so the last ones read are kept (direct-mapped by index).
+  struct LeafHeights {
+    std::int64_t leaf = -1;
+    double top[4];
+    alignas(16) double hs[kTargets];
+  };
+
+  const LeafHeights& leaf_heights(int i, int j) {
+    const std::int64_t leaf = static_cast<std::int64_t>(i) * tree_.width(0) + j;
+    LeafHeights& out = leaf_cache_[static_cast<std::size_t>(leaf % static_cast<std::int64_t>(leaf_cache_.size()))];
+    if (out.leaf == leaf) return out;
+    out.leaf = leaf;
     const std::uint64_t sources = tree_.leaf_mask(i, j);
     const int sr0 = i * kBlock, sc0 = j * kBlock;
-    alignas(16) double hs[kTargets];
-    double top[4] = {-kInf, -kInf, -kInf, -kInf};  // highest source of each quarter [m]
     for (int s = 0; s < kTargets; ++s) {
       const int sr = sr0 + s / kBlock, sc = sc0 + s % kBlock;
-      hs[s] = sources >> s & 1 ? pb_.h[static_cast<std::int64_t>(sr) * pb_.cols + sc] : -kInf;
-      double& q = top[(s / kBlock >= kHalf ? 2 : 0) + (s % kBlock >= kHalf ? 1 : 0)];
-      q = std::max(q, hs[s]);
+      out.hs[s] = sources >> s & 1 ? pb_.h[static_cast<std::int64_t>(sr) * pb_.cols + sc] : -kInf;
     }
+    for (int q = 0; q < 4; ++q) {
+      const int qr = q / 2 * kHalf, qc = q % 2 * kHalf;
+      double top = -kInf;
+      for (int k = qr; k < qr + kHalf; ++k)
+        for (int c = qc; c < qc + kHalf; ++c) top = std::max(top, out.hs[k * kBlock + c]);
+      out.top[q] = top;
+    }
+    return out;
+  }
+
+  // Applies the leaf's sources to the targets. Each 4 x 4 quarter of the leaf is first bounded, at every target, by
+  // its highest source at its box's floored distance (all targets two at a time: a target's limit changes only when
+  // its own sources are applied); at each target the sources of the quarters left are then checked two at a time
+  // without branches (non-sources at -inf) for one that beats the target's limit, and only then are the leaf's
+  // sources applied one by one in bit order, each against the limit as it rises.
+  void evaluate_leaf(int i, int j, std::uint64_t targets) {
+    const std::uint64_t sources = tree_.leaf_mask(i, j);
+    const int sr0 = i * kBlock, sc0 = j * kBlock;
+    const LeafHeights& leaf = leaf_heights(i, j);
+    const double* hs = leaf.hs;
     const Pair zero = {0.0, 0.0};
     const double kcs2 = kcs2_, floor2 = static_cast<double>(kFloor2);
-    for (std::uint64_t tb = targets; tb; tb &= tb - 1) {
-      const int t = __builtin_ctzll(tb);
-      const double limit = limit_[t], er = tr_[t] - sr0, ec = tc_[t] - sc0;
-      // Distances to the quarters' boxes: rows 0..3 and 4..7, columns 0..3 and 4..7 of the leaf.
+    // Squared distances from each target row and column to the quarters' boxes: rows 0..3 (top) and 4..7 (bottom),
+    // columns 0..3 (left) and 4..7 (right) of the leaf.
+    double near2[2][kBlock];
+    alignas(16) double across2[2][kBlock];
+    for (int k = 0; k < kBlock; ++k) {
+      const double er = tr_[k * kBlock] - sr0, ec = tc_[k] - sc0;
       const double dr_top = std::max({0.0, -er, er - (kHalf - 1)});
       const double dr_bottom = std::max({0.0, kHalf - er, er - (kBlock - 1)});
       const double dc_left = std::max({0.0, -ec, ec - (kHalf - 1)});
       const double dc_right = std::max({0.0, kHalf - ec, ec - (kBlock - 1)});
-      const double dq2[4] = {dr_top * dr_top + dc_left * dc_left, dr_top * dr_top + dc_right * dc_right,
-                             dr_bottom * dr_bottom + dc_left * dc_left, dr_bottom * dr_bottom + dc_right * dc_right};
+      near2[0][k] = dr_top * dr_top;
+      near2[1][k] = dr_bottom * dr_bottom;
+      across2[0][k] = dc_left * dc_left;
+      across2[1][k] = dc_right * dc_right;
+    }
+    const Pair floor2s = {floor2, floor2};
+    std::uint64_t in_quarter[4];
+    for (int q = 0; q < 4; ++q) {
+      const double top = leaf.top[q];
+      const double* row2 = near2[q / 2];
+      const double* col2 = across2[q % 2];
+      in_quarter[q] = targets & pairs_where([&](int t) {
+        const Pair x = top - load(limit_ + t);
+        const Pair d2 = max(row2[t / kBlock] + load(col2 + t % kBlock), floor2s);
+        return greater(x, zero) & greater(x * x, kcs2 * d2);
+      });
+    }
+    for (std::uint64_t tb = in_quarter[0] | in_quarter[1] | in_quarter[2] | in_quarter[3]; tb; tb &= tb - 1) {
+      const int t = __builtin_ctzll(tb);
+      const double limit = limit_[t], er = tr_[t] - sr0, ec = tc_[t] - sc0;
       unsigned quarters = 0;
-      for (int q = 0; q < 4; ++q) {
-        const double x = top[q] - limit;
-        quarters |= static_cast<unsigned>((x > 0) & (x * x > kcs2 * std::max(dq2[q], floor2))) << q;
-      }
+      for (int q = 0; q < 4; ++q) quarters |= static_cast<unsigned>(in_quarter[q] >> t & 1) << q;
       bool any = false;
       for (; quarters && !any; quarters &= quarters - 1) {
         const int q = __builtin_ctz(quarters), qr = q / 2 * kHalf, qc = q % 2 * kHalf;
@@ -271,10 +334,15 @@ class BlockSearch {
   }
 
   const Problem& pb_;
+  const std::uint64_t* wanted_;  // targets searched per block; null: all
   const SourceTree& tree_;
   double* lower_;
   double kcs2_;
+  std::vector<LeafHeights> leaf_cache_;
   int r0_ = 0, r1_ = 0, c0_ = 0, c1_ = 0;    // target block [cells]
+  int block_rows_ = kBlock;                  // rows of the block on the grid
+  int block_pair_cols_ = kBlock;             // its columns on the grid, rounded up to pairs
+  bool whole_block_ = true;                  // the block lies inside the grid
   alignas(16) double local_r_[kTargets];     // row of bit t within a block or leaf [cells]
   alignas(16) double local_c_[kTargets];     // column of bit t within a block or leaf [cells]
   alignas(16) double tr_[kTargets] = {};     // row of each target [cells]
@@ -287,6 +355,8 @@ class BlockSearch {
 
 }  // namespace
 
-void search_sources(const Problem& pb, const SourceTree& tree, double* lower) { BlockSearch(pb, tree, lower).run(); }
+void search_sources(const Problem& pb, const SourceTree& tree, double* lower, const std::uint64_t* wanted) {
+  BlockSearch(pb, tree, lower, wanted).run();
+}
 
 }  // namespace marsala::detail

@@ -110,6 +110,27 @@ void resolve_chains(const Problem& pb, std::int32_t* src) {
   }
 }
 
+// One offset of the local pass: (dr, dc) [cells] and its drop kcs sqrt(dr^2 + dc^2) [m].
+struct LocalOffset {
+  int dr, dc;
+  double drop;
+};
+
+// The local pass on kPairs pairs of cells (out, kept in registers across all offsets: one load and store of the
+// output) from the padded input rows starting at `in` (at_offset[k]: where offset k reads from there).
+template <int kPairs>
+void apply_chunk(const std::vector<LocalOffset>& offsets, const std::vector<std::ptrdiff_t>& at_offset,
+                 const double* in, double* out) {
+  Pair a[kPairs];
+  for (int p = 0; p < kPairs; ++p) a[p] = load(out + 2 * p);
+  for (std::size_t k = 0; k < offsets.size(); ++k) {
+    const double* at = in + at_offset[k];
+    const double drop = offsets[k].drop;
+    for (int p = 0; p < kPairs; ++p) a[p] = max(load(at + 2 * p) - drop, a[p]);
+  }
+  for (int p = 0; p < kPairs; ++p) store(out + 2 * p, a[p]);
+}
+
 }  // namespace
 
 std::vector<std::uint64_t> seed_lower_bound(const Problem& pb, double* lower) {
@@ -133,18 +154,15 @@ std::vector<std::uint64_t> seed_lower_bound(const Problem& pb, double* lower) {
   return masks;
 }
 
-void apply_local_sources(const Problem& pb, double* lower) {
-  struct Offset {
-    int dr, dc;
-    double drop;
-  };
-  std::vector<Offset> offsets;
+void apply_local_sources(const Problem& pb, double* lower, const std::uint8_t* wanted_rows) {
+  std::vector<LocalOffset> offsets;
   int radius = 0;
   while ((radius + 1) * (radius + 1) <= kLocalRadius2) ++radius;
   for (int dr = -radius; dr <= radius; ++dr)
     for (int dc = -radius; dc <= radius; ++dc) {
       const long long d2 = static_cast<long long>(dr) * dr + static_cast<long long>(dc) * dc;
-      if (d2 > 0 && d2 <= kLocalRadius2) offsets.push_back({dr, dc, pb.kcs * std::sqrt(static_cast<double>(d2))});
+      if (d2 > 0 && d2 <= kLocalRadius2)
+        offsets.push_back(LocalOffset{dr, dc, pb.kcs * std::sqrt(static_cast<double>(d2))});
     }
   const int cols = pb.cols, rows = pb.rows;
   // The input rows r - radius .. r + radius, each with radius cells at -inf on its left and at least radius + kChunk on
@@ -174,26 +192,30 @@ void apply_local_sources(const Problem& pb, double* lower) {
   alignas(16) double tail[kChunk];
   for (int r = 0; r < rows; ++r) {
     load_row(r + radius);
+    if (wanted_rows && !wanted_rows[r]) continue;
     const double* first = ring.data() + static_cast<std::size_t>((r - radius + ring_rows) % ring_rows) * padded;
     double* out = lower + static_cast<std::int64_t>(r) * cols;
     for (int c = 0; c < cols; c += kChunk) {
       // max(v, out) is out < v ? v : out: the same bits as cone_value(), in the same order of offsets as ever.
-      double* at = out + c;
-      if (c + kChunk > cols) {  // the last, partial chunk through a buffer
-        std::fill(tail, tail + kChunk, -kInf);
-        std::copy(out + c, out + cols, tail);
-        at = tail;
+      if (c + kChunk <= cols) {
+        apply_chunk<kChunk / 2>(offsets, at_offset, first + c, out + c);
+        continue;
       }
-      // kChunk cells stay in registers across all offsets: one load and store of the output per chunk.
-      Pair a[kChunk / 2];
-      for (int p = 0; p < kChunk / 2; ++p) a[p] = load(at + 2 * p);
-      for (std::size_t k = 0; k < offsets.size(); ++k) {
-        const double* in = first + c + at_offset[k];
-        const double drop = offsets[k].drop;
-        for (int p = 0; p < kChunk / 2; ++p) a[p] = max(load(in + 2 * p) - drop, a[p]);
+      // The last, partial chunk through a buffer, as few pairs as it holds (41 columns: 16 + 16 + 5 pairs).
+      const int pairs = (cols - c + 1) / 2;
+      std::fill(tail, tail + kChunk, -kInf);
+      std::copy(out + c, out + cols, tail);
+      switch (pairs) {
+        case 1: apply_chunk<1>(offsets, at_offset, first + c, tail); break;
+        case 2: apply_chunk<2>(offsets, at_offset, first + c, tail); break;
+        case 3: apply_chunk<3>(offsets, at_offset, first + c, tail); break;
+        case 4: apply_chunk<4>(offsets, at_offset, first + c, tail); break;
+        case 5: apply_chunk<5>(offsets, at_offset, first + c, tail); break;
+        case 6: apply_chunk<6>(offsets, at_offset, first + c, tail); break;
+        case 7: apply_chunk<7>(offsets, at_offset, first + c, tail); break;
+        default: apply_chunk<8>(offsets, at_offset, first + c, tail); break;
       }
-      for (int p = 0; p < kChunk / 2; ++p) store(at + 2 * p, a[p]);
-      if (at == tail) std::copy(tail, tail + (cols - c), out + c);
+      std::copy(tail, tail + (cols - c), out + c);
     }
   }
 }

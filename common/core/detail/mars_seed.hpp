@@ -14,7 +14,8 @@ namespace marsala::detail {
 /// A cell is dropped when one surviving source s gives h(s) - kcs |q - s| >= h(q) - tol.
 std::vector<std::uint64_t> seed_lower_bound(const Problem& pb, double* lower);
 
-/// lower = max(lower, h(q) - kcs |p - q|) over every q with 0 < |p - q|^2 <= kLocalRadius2 [m].
-void apply_local_sources(const Problem& pb, double* lower);
+/// lower = max(lower, h(q) - kcs |p - q|) over every q with 0 < |p - q|^2 <= kLocalRadius2 [m]; with
+/// `wanted_rows` (one flag per row), only on the rows it marks.
+void apply_local_sources(const Problem& pb, double* lower, const std::uint8_t* wanted_rows = nullptr);
 
 }  // namespace marsala::detail

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "marsala/core/error.hpp"
 
@@ -52,6 +53,28 @@ TEST(PathFootprint, IsTheUnionOfBallsAlongThePath) {
   EXPECT_EQ(path_footprint(g, {{0, 0}}, 0.2).cast<int>().sum(), 3);
   EXPECT_THROW(path_footprint(g, {{10, 0}}, 0.2), InvalidArgument);
   EXPECT_THROW(path_footprint(g, {{1, 1}}, 0.0), InvalidArgument);
+}
+
+// The footprint against the cells whose centres lie within delta / 2 of a path cell's centre (the ball's tolerance
+// of ARCHITECTURE.md), for several body lengths and paths along and across the grid's edges.
+TEST(PathFootprint, EqualsTheCellsWithinHalfABodyOfThePath) {
+  const GridGeometry g{13, 17, 0.0, 0.0, 0.1};
+  const std::vector<std::vector<CellIndex>> paths = {
+      {{0, 0}}, {{6, 8}}, {{12, 16}, {12, 15}, {11, 14}}, {{0, 3}, {1, 3}, {2, 4}, {3, 5}, {4, 5}}, {{6, 0}, {6, 16}}};
+  for (const double delta_m : {0.1, 0.2, 0.3, 0.45, 0.6, 1.0})
+    for (const auto& path : paths) {
+      const CellMask footprint = path_footprint(g, path, delta_m);
+      const double radius = delta_m / (2.0 * g.cell_size_m);
+      for (int r = 0; r < g.rows; ++r)
+        for (int c = 0; c < g.cols; ++c) {
+          bool in = false;
+          for (const CellIndex p : path) {
+            const double dr = r - p.row, dc = c - p.col;
+            in = in || dr * dr + dc * dc <= radius * radius + 1e-9;
+          }
+          EXPECT_EQ(footprint(r, c) != 0, in) << "delta " << delta_m << " cell (" << r << ", " << c << ")";
+        }
+    }
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -505,6 +506,99 @@ TEST(MarsProcessor, LocalPassEqualsThePlainLoopBitForBit) {
       ASSERT_EQ(std::memcmp(&fast[i], &plain[i], sizeof(double)), 0)
           << rows << "x" << cols << " cell " << i << ": " << fast[i] << " vs " << plain[i];
   }
+}
+
+// ---- agents' windows: the solve's bits and the projection on part of the grid ----------------
+
+// A portable stream of numbers (std's distributions differ between standard libraries; a golden value must not).
+struct Stream {
+  std::uint64_t x;
+  std::uint64_t next() {  // splitmix64
+    std::uint64_t z = (x += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+  }
+  double unit() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }  // [0, 1)
+};
+
+// Windows like an agent's (0.25 m cells, kappa 0.1): rough ground, ground levelled to a few heights (ties, -0.0 on
+// the floor), a MARS output fed back (every ramp cell ties with its source), and rough ground beside a built ramp.
+Heightmap agent_window(Stream& s, int rows, int cols, double kappa) {
+  Heightmap h(GridGeometry{rows, cols, 12.0, -4.0, 0.25});
+  const int kind = static_cast<int>(s.next() % 4);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const double noise = 0.6 * s.unit();
+      h(r, c) = kind == 1 ? (s.next() % 3 == 0 ? -0.0 : std::floor(noise * 8.0) / 8.0) : noise;
+    }
+  if (kind >= 2) {
+    const Heightmap fed = MarsProcessor(kappa).project(h);
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c)
+        if (kind == 2 || c < cols / 2) h(r, c) = fed(r, c);
+  }
+  return h;
+}
+
+// The projections of 240 agent windows hash to the value the solver gave before the search kept its leaves' heights
+// and trimmed the blocks cut by the grid's edge (main 14785d3, FNV-1a over the bytes): every bit of the window solve
+// is kept, ties and -0.0 included. 41 x 41 is an agent's window; the other shapes cut the last row or column of
+// blocks anywhere, or hold a single row or column.
+TEST(MarsProcessor, AgentWindowsKeepTheirBits) {
+  Stream s{2026};
+  std::uint64_t hash = 0xcbf29ce484222325ULL;
+  const int shapes[][2] = {{41, 41}, {41, 33}, {17, 41}, {9, 9}, {64, 64}, {1, 41}, {41, 2}, {25, 70}};
+  for (int k = 0; k < 240; ++k) {
+    const auto& shape = shapes[k % 8];
+    const Heightmap h = agent_window(s, shape[0], shape[1], 0.1);
+    const Heightmap p = MarsProcessor(0.1).project(h);
+    const auto* bytes = reinterpret_cast<const unsigned char*>(p.data());
+    for (std::size_t i = 0; i < static_cast<std::size_t>(p.size()) * sizeof(double); ++i)
+      hash = (hash ^ bytes[i]) * 0x100000001b3ULL;
+  }
+  EXPECT_EQ(hash, 0x4702db89a89f4f67ULL);
+}
+
+// project(h, wanted) against project(h), bit for bit: the whole projection on the wanted cells, h on the others. The
+// masks: the cells with a gap (what the agents ask for), sparse and dense random cells, one cell, every cell, none.
+TEST(MarsProcessor, ProjectionOnWantedCellsEqualsTheWholeOneBitForBit) {
+  Stream s{7};
+  const int shapes[][2] = {{41, 41}, {41, 33}, {17, 41}, {9, 9}, {64, 64}, {1, 41}, {41, 2}, {25, 70}};
+  const MarsProcessor mars(0.1);
+  for (int k = 0; k < 120; ++k) {
+    const auto& shape = shapes[k % 8];
+    const Heightmap h = agent_window(s, shape[0], shape[1], 0.1);
+    const Heightmap whole = mars.project(h);
+    for (int variant = 0; variant < 6; ++variant) {
+      CellMask wanted = CellMask::Zero(h.rows(), h.cols());
+      const CellIndex one{static_cast<int>(s.next() % h.rows()), static_cast<int>(s.next() % h.cols())};
+      for (int r = 0; r < h.rows(); ++r)
+        for (int c = 0; c < h.cols(); ++c) {
+          const double u = s.unit();
+          wanted(r, c) = variant == 0   ? whole(r, c) != h(r, c)
+                         : variant == 1 ? u < 0.1
+                         : variant == 2 ? u < 0.6
+                         : variant == 3 ? CellIndex{r, c} == one
+                                        : variant == 4;
+        }
+      const Heightmap part = mars.project(h, wanted);
+      ASSERT_EQ(part.geometry(), h.geometry());
+      for (int r = 0; r < h.rows(); ++r)
+        for (int c = 0; c < h.cols(); ++c) {
+          const double want = wanted(r, c) != 0 ? whole(r, c) : h(r, c);
+          const double got = part(r, c);
+          ASSERT_EQ(std::memcmp(&want, &got, sizeof(double)), 0)
+              << "window " << k << " mask " << variant << " cell (" << r << ", " << c << "): " << part(r, c)
+              << " vs " << want;
+        }
+    }
+  }
+  const Heightmap h(geometry(6, 7, 0.1), 1.0);
+  EXPECT_THROW(mars.project(h, CellMask::Ones(7, 6)), InvalidArgument);
+  Heightmap bad = h;
+  bad(2, 3) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(mars.project(bad, CellMask::Zero(6, 7)), InvalidArgument);
 }
 
 // ---- hand cases with known answers ---------------------------------------------------------

@@ -4,9 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/iterators.hpp"
 
 namespace marsala {
 namespace {
@@ -131,6 +134,53 @@ TEST(NavigablePathPlanner, NoPathIsAResultAndBadInputThrows) {
   EXPECT_THROW(NavigablePathPlanner(params(-1.0)), InvalidArgument);
   EXPECT_THROW(NavigablePathPlanner(params(0.1, std::nan(""))), InvalidArgument);
   EXPECT_THROW(NavigablePathPlanner({0.1, 1.0, 0.0}), InvalidArgument);
+}
+
+// The cost at the goal is the sum, over the path's cells after the start, of each cell's ball sum of the gap (the
+// ball's cells in disc_offsets order, a ball cut by the edge scaled by its full count over the cells inside):
+// recomputed here cell by cell, it must be the planner's to the bit, on random gaps with ties, zeros and -0.0, for
+// balls inside the grid and cut by its edges, and along paths hugging the edges.
+TEST(NavigablePathPlanner, GapCostIsTheBallSumsOfThePathBitForBit) {
+  std::uint64_t x = 12345;
+  const auto next = [&x]() {
+    x = x * 6364136223846793005ULL + 1442695040888963407ULL;
+    return x >> 33;
+  };
+  for (const double delta_m : {0.2, 0.5, 0.9}) {
+    const GridGeometry g{23, 31, 0.0, 0.0, 0.1};
+    const auto ball = disc_offsets(delta_m / (2.0 * g.cell_size_m));
+    for (int trial = 0; trial < 20; ++trial) {
+      Heightmap gap(g, 0.0);
+      for (int r = 0; r < g.rows; ++r)
+        for (int c = 0; c < g.cols; ++c) {
+          const auto kind = next() % 4;
+          gap(r, c) = kind == 0   ? 0.0
+                      : kind == 1 ? -0.0
+                      : kind == 2 ? 0.25
+                                  : static_cast<double>(next() % 1000) / 997.0;
+        }
+      const CellIndex start{static_cast<int>(next() % g.rows), static_cast<int>(next() % g.cols)};
+      const CellIndex goal{static_cast<int>(next() % g.rows), trial % 2 == 0 ? 0 : g.cols - 1};
+      const NavigablePathPlanner planner({0.001 * (trial % 5), 1.0, delta_m});
+      const PlannerResult res = planner.plan(gap, CellMask::Ones(g.rows, g.cols), start, goal);
+      ASSERT_TRUE(res.found);
+      double cost = 0.0;
+      for (std::size_t i = 1; i < res.path.size(); ++i) {
+        double sum = 0.0;
+        int inside = 0;
+        for (const CellIndex o : ball) {
+          const CellIndex q{res.path[i].row + o.row, res.path[i].col + o.col};
+          if (!gap.contains(q)) continue;
+          sum += gap(q);
+          ++inside;
+        }
+        if (inside < static_cast<int>(ball.size())) sum = sum * static_cast<double>(ball.size()) / inside;
+        cost += sum;
+      }
+      EXPECT_EQ(std::memcmp(&cost, &res.gap_cost_m, sizeof cost), 0)
+          << "delta " << delta_m << " trial " << trial << ": " << cost << " vs " << res.gap_cost_m;
+    }
+  }
 }
 
 TEST(NavigablePathPlanner, DefaultAlphaIsCellSizeOverBallCells) {

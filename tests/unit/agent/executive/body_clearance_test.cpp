@@ -99,6 +99,43 @@ TEST(BodyClearance, KeepClearTakesTheDiscsOutAndReconnects) {
   EXPECT_GT(inside, 0);
 }
 
+// keep_clear() visits each neighbour's box only: the cells it takes out are those the plain rule takes out (every
+// occupiable cell but the robot's that is not clear_of() the neighbours), for neighbours inside, across and beyond the
+// window's edges, discs from a fraction of a cell to wider than the window, robots standing inside a disc, windows
+// placed off the world's origin.
+TEST(BodyClearance, KeepClearTakesOutTheCellsThePlainRuleDoes) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const GridGeometry g{17 + trial % 7, 23 - trial % 5, -3.3 + 0.07 * trial, 1.9 - 0.05 * trial, 0.25};
+    Heightmap h(g, 0.0);
+    for (int r = 0; r < g.rows; ++r)
+      for (int c = 0; c < g.cols; ++c) h(r, c) = u(rng) < 0.1 ? 1.0 : 0.0;
+    const CellIndex robot_cell{static_cast<int>(rng() % g.rows), static_cast<int>(rng() % g.cols)};
+    deliberative::LocalMap map = test::make_local_map(h, Heightmap(g, 0.0), kNav, robot_cell, std::nullopt);
+    const Position robot{map.center(robot_cell).x + 0.1 * (u(rng) - 0.5), map.center(robot_cell).y};
+    std::vector<BodyClearance> others;
+    const int count = static_cast<int>(rng() % 5);
+    for (int k = 0; k < count; ++k) {
+      const Position at{g.xll_m + (1.4 * u(rng) - 0.2) * g.cols * g.cell_size_m,
+                        g.yll_m + (1.4 * u(rng) - 0.2) * g.rows * g.cell_size_m};
+      const double radius = k == 3 ? 20.0 : (0.05 + 1.5 * u(rng));
+      others.push_back({static_cast<std::uint32_t>(k + 2), at, radius});
+    }
+    deliberative::LocalMap plain = map;
+    long long plain_removed = 0;
+    for (int r = 0; r < g.rows; ++r)
+      for (int c = 0; c < g.cols; ++c)
+        if (plain.occupiable(r, c) != 0 && CellIndex{r, c} != plain.robot &&
+            !clear_of(others, robot, plain.center({r, c}))) {
+          plain.occupiable(r, c) = 0;
+          ++plain_removed;
+        }
+    EXPECT_EQ(keep_clear(map, robot, others), plain_removed) << trial;
+    EXPECT_TRUE(map.occupiable == plain.occupiable) << trial;
+  }
+}
+
 TEST(BodyClearance, KeepOffTakesOutTheCellsAHalfCellDiscWould) {
   // A corridor of rows 14..25 between walls: cells taken out may cut it. Each trial takes a few cells out (the robot's
   // own and off-window ones among them) and compares with keep_clear on discs of half a cell around their centres,

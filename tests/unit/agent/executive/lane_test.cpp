@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <optional>
 #include <random>
 
@@ -246,6 +247,42 @@ TEST(BandFill, TheBandIsTheCellsWithinHalfTheWidthOfItsPaths) {
       count += band(r, c);
     }
   EXPECT_EQ(count, 13 + 6);
+}
+
+// gap_below_bound_of() projects the sources only on the cells whose gap it reads (gap_cells()): the result is
+// gap_below() of the whole projection, bit for bit, on rough windows with flat patches (gap 0), -0.0 heights and a
+// gap cleared on some cells, whatever the sources (the first-seen heights, a band's).
+TEST(BandFill, TheBoundOnTheCellsWithAGapIsTheWholeBoundsBitForBit) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double kappa = 0.1;
+  for (int trial = 0; trial < 40; ++trial) {
+    const GridGeometry g{41, 33 + trial % 9, 0.0, 0.0, 0.25};
+    Heightmap h(g, 0.0);
+    for (int r = 0; r < g.rows; ++r)
+      for (int c = 0; c < g.cols; ++c) {
+        const double v = u(rng);
+        h(r, c) = v < 0.3 ? -0.0 : v < 0.5 ? 0.25 : 0.6 * u(rng);
+      }
+    Heightmap gap = MarsProcessor(kappa).gap(h);
+    for (int r = 0; r < g.rows; ++r)
+      for (int c = 0; c < g.cols; ++c)
+        if (u(rng) < 0.1) gap(r, c) = 0.0;
+    const deliberative::LocalMap map = test::make_local_map(h, gap, kBody, {20, 10}, std::nullopt);
+    CellMask band = CellMask::Zero(g.rows, g.cols);
+    for (int r = 0; r < g.rows; ++r)
+      for (int c = 0; c < g.cols; ++c) band(r, c) = u(rng) < (trial % 2 == 0 ? 0.3 : 0.9);
+    const Heightmap sources = band_sources(map, band);
+    const Heightmap part = gap_below_bound_of(map, sources, kappa);
+    const Heightmap whole = gap_below(map, MarsProcessor(kappa).project(sources));
+    const CellMask cells = gap_cells(map);
+    for (int r = 0; r < g.rows; ++r)
+      for (int c = 0; c < g.cols; ++c) {
+        const double a = part(r, c), b = whole(r, c);
+        ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << trial << ": (" << r << ", " << c << ") " << a << " vs " << b;
+        EXPECT_EQ(cells(r, c) != 0, map.gap(r, c) > 0.0);
+      }
+  }
 }
 
 TEST(BandFill, WhatIsLeftToFillIsTheBandsOwnMarsGap) {

@@ -3,12 +3,42 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <random>
 #include <vector>
 
 namespace marsala::agent::reactive {
 namespace {
 
 Neighbour at(std::uint32_t id, double x, double y) { return {id, {x, y}, 0.0, 0.3}; }
+
+// Lane::contains() skips the points beyond the segment's box widened by the radius: it agrees with the capsule's
+// own test (the nearest point of the segment within the radius, within()) on points all round lanes of every
+// direction, zero length included, and on the capsule's rim.
+TEST(Lane, ContainsIsTheCapsuleTest) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  long long inside = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const Position from{20.0 + 3.0 * u(rng), -7.0 + 3.0 * u(rng)};
+    const Position to = trial % 10 == 0 ? from : Position{from.x + 2.0 * u(rng), from.y + 2.0 * u(rng)};
+    const Lane lane{from, to, 0.3 + 0.4 * (u(rng) + 1.0)};
+    for (int k = 0; k < 200; ++k) {
+      Position p{std::min(from.x, to.x) - 1.5 + (std::abs(to.x - from.x) + 3.0) * 0.5 * (u(rng) + 1.0),
+                 std::min(from.y, to.y) - 1.5 + (std::abs(to.y - from.y) + 3.0) * 0.5 * (u(rng) + 1.0)};
+      if (k % 4 == 0) {  // on the rim round an end
+        const double a = 3.14159 * u(rng);
+        p = {to.x + lane.radius_m * std::cos(a), to.y + lane.radius_m * std::sin(a)};
+      }
+      const double dx = to.x - from.x, dy = to.y - from.y, l2 = dx * dx + dy * dy;
+      const double t = l2 > 0.0 ? std::clamp(((p.x - from.x) * dx + (p.y - from.y) * dy) / l2, 0.0, 1.0) : 0.0;
+      const bool capsule = within(p.x - (from.x + t * dx), p.y - (from.y + t * dy), lane.radius_m);
+      EXPECT_EQ(lane.contains(p), capsule) << trial << " " << k;
+      inside += capsule;
+    }
+  }
+  EXPECT_GT(inside, 1000);
+}
 
 TEST(RightOfWay, ARobotAtItsGoalGivesWayOnceToOneThatWaitsBesideIt) {
   RightOfWay parked(1, 1.6, 0.9, 6);
