@@ -133,7 +133,9 @@ TEST(RightOfWay, ARobotParkedOutOfRangeForAWhileDoesNotHoldAgainWhenSeenAgain) {
     const bool away = frame >= 60 && frame < 90;
     r.observe(away ? Position{9.0, 1.0} : Position{3.0, 1.0}, away ? std::vector<Neighbour>{} : std::vector{at(1, 2.0, 1.0)},
               false, 5.0, 0.1);
-    if (frame >= 2 * (kStillFrames + 6)) EXPECT_FALSE(r.giving_way().has_value()) << frame;
+    if (frame >= 2 * (kStillFrames + 6)) {
+      EXPECT_FALSE(r.giving_way().has_value()) << frame;
+    }
   }
 }
 
