@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 
+#include "marsala/core/heightmap.hpp"
 #include "marsala/core/navigability_processor.hpp"
 
 namespace marsala::agent::executive {
@@ -44,17 +44,6 @@ bool clear_of_one(const BodyClearance& o, Position from, Position to) {
   return before < o.min_distance_m && after >= before;  // already too close: moving apart is fine
 }
 
-/// The first and last index in [0, n - 1] of the cells whose centre coordinate, lo_m + (k + 0.5) cs [m] along an
-/// axis, may lie within reach_m of at_m (one cell more each side than rounding could need); the whole axis when
-/// reach_m is not finite.
-std::pair<int, int> cells_near(double at_m, double reach_m, double lo_m, double cs, int n) {
-  const double first = std::floor((at_m - reach_m - lo_m) / cs - 0.5) - 1.0;
-  const double last = std::ceil((at_m + reach_m - lo_m) / cs - 0.5) + 1.0;
-  if (!std::isfinite(first) || !std::isfinite(last)) return {0, n - 1};
-  return {static_cast<int>(std::clamp(first, 0.0, static_cast<double>(n))),
-          static_cast<int>(std::clamp(last, -1.0, static_cast<double>(n - 1)))};
-}
-
 }  // namespace
 
 bool clear_of(const std::vector<BodyClearance>& others, Position from, Position to) {
@@ -68,15 +57,16 @@ long long keep_clear(deliberative::LocalMap& local, Position robot, const std::v
   // A cell is taken out when it is not clear_of() some neighbour, which needs its centre nearer than the neighbour's
   // distance along both axes: each neighbour tests the cells of that box only (the window's other cells are clear of
   // it), the cells the same test as clear_of() gives them.
-  const GridGeometry& g = local.geometry();
-  const double cs = g.cell_size_m;
   CellMask taken = CellMask::Zero(local.rows(), local.cols());
   for (const BodyClearance& o : others) {
-    const auto [c0, c1] = cells_near(o.centre.x, o.min_distance_m, g.xll_m, cs, local.cols());
-    // Rows count from the north: the centre of row r is at y = yll + (rows - r - 0.5) cs.
-    const auto [s0, s1] = cells_near(o.centre.y, o.min_distance_m, g.yll_m, cs, local.rows());
-    for (int r = local.rows() - 1 - s1; r <= local.rows() - 1 - s0; ++r)
-      for (int c = c0; c <= c1; ++c) {
+    Rect box;
+    box.x0 = o.centre.x - o.min_distance_m;
+    box.x1 = o.centre.x + o.min_distance_m;
+    box.y0 = o.centre.y - o.min_distance_m;
+    box.y1 = o.centre.y + o.min_distance_m;
+    const CellRect cells = cells_centred_in(local.geometry(), box);
+    for (int r = cells.first.row; r < cells.first.row + cells.rows; ++r)
+      for (int c = cells.first.col; c < cells.first.col + cells.cols; ++c) {
         if (taken(r, c) != 0 || local.occupiable(r, c) == 0 || CellIndex{r, c} == local.robot) continue;
         if (!clear_of_one(o, robot, local.center({r, c}))) taken(r, c) = 1;
       }

@@ -46,6 +46,16 @@ std::optional<CellIndex> best_navigable_cell(const deliberative::LocalMap& local
   return best;
 }
 
+/// True when both `a` and `b` (local indices) lie in the window and in the body ball of radius `radius` [cells] around
+/// `cell`: where a told drop's pair breaks the rule (the ball of disc_offsets()).
+bool ball_holds(const deliberative::LocalMap& local, CellIndex cell, CellIndex a, CellIndex b, double radius) {
+  const auto in = [&](CellIndex p) {
+    const double dr = p.row - cell.row, dc = p.col - cell.col;
+    return local.contains(p) && dr * dr + dc * dc <= radius * radius + tolerance::kBallCells2;
+  };
+  return in(a) && in(b);
+}
+
 }  // namespace
 
 std::string to_string(BuildPhase phase) { return enum_to_string(kBuildPhaseNames, phase); }
@@ -256,38 +266,29 @@ void RampSteps::record_drop_level(const executive::DropRefusal& drop) {
 }
 
 bool RampSteps::fails_a_told_drop(const deliberative::LocalMap& local, CellIndex cell) const {
-  const NavigabilityParams& body = context_.type.body.navigability;
-  const double radius = 0.5 * body.delta_m / local.geometry().cell_size_m;
-  const auto in_ball = [&](CellIndex p) {
-    const double dr = p.row - cell.row, dc = p.col - cell.col;
-    return local.contains(p) && dr * dr + dc * dc <= radius * radius + 1e-9;
-  };
+  const double radius = 0.5 * context_.type.body.navigability.delta_m / local.geometry().cell_size_m;
   // The pair breaks the rule only in a ball that holds both its cells: a drop named ahead does not hold out the way
   // back, whose balls hold its low cell but not its high one.
   for (const auto& [low, level] : memory_.drop_levels) {
     const CellIndex p = local.to_local(low);
-    if (!in_ball(p) || !in_ball(local.to_local(level.high))) continue;
-    if (local.heights(p.row, p.col) < level.pass_m) return true;
+    if (ball_holds(local, cell, p, local.to_local(level.high), radius) && local.heights(p.row, p.col) < level.pass_m)
+      return true;
   }
   return false;
 }
 
 void RampSteps::hold_out_told_drops(const deliberative::LocalMap& local, CellMask& mask) const {
-  const NavigabilityParams& body = context_.type.body.navigability;
-  const double radius = 0.5 * body.delta_m / local.geometry().cell_size_m;
-  const int reach = static_cast<int>(std::floor(radius + 1e-9));
-  const auto within = [&](CellIndex a, CellIndex b) {
-    const double dr = a.row - b.row, dc = a.col - b.col;
-    return dr * dr + dc * dc <= radius * radius + 1e-9;
-  };
-  // The cells whose ball holds both cells of a drop whose lower cell still lies below its level: those within the
-  // ball's radius of the lower cell and of the higher one (fails_a_told_drop(), drop by drop instead of cell by cell).
+  const double radius = 0.5 * context_.type.body.navigability.delta_m / local.geometry().cell_size_m;
+  const std::vector<CellIndex> ball = disc_offsets(radius);
+  // fails_a_told_drop() drop by drop instead of cell by cell: a cell whose ball holds a drop's lower cell lies in the
+  // ball around that cell.
   for (const auto& [low, level] : memory_.drop_levels) {
     const CellIndex p = local.to_local(low), q = local.to_local(level.high);
     if (!local.contains(p) || !(local.heights(p.row, p.col) < level.pass_m)) continue;
-    for (int r = p.row - reach; r <= p.row + reach; ++r)
-      for (int c = p.col - reach; c <= p.col + reach; ++c)
-        if (local.contains({r, c}) && within({r, c}, p) && within({r, c}, q)) mask(r, c) = 0;
+    for (const CellIndex o : ball) {
+      const CellIndex cell{p.row + o.row, p.col + o.col};
+      if (local.contains(cell) && ball_holds(local, cell, p, q, radius)) mask(cell.row, cell.col) = 0;
+    }
   }
 }
 
@@ -612,10 +613,10 @@ BuildPhase RampSteps::retreat_step(const deliberative::LocalMap& local, const pr
   // stepping back and forth on its island would never change its map.
   const bool walled = walled_in(local, robot);
   if (!walled) memory_.ask_back_anchor.reset();
-  auto motion = walled ? ask_back(local, robot) : std::nullopt;
+  auto motion = walled ? ask_back(local, robot, true) : std::nullopt;
   if (!motion) motion = step_back(local, robot);
   if (!motion) motion = retrace(local, robot);
-  if (!motion && !walled) motion = ask_back(local, robot);  // a walled-in robot asked it first already
+  if (!motion && !walled) motion = ask_back(local, robot, false);  // a walled-in robot asked it first already
   if (!motion) return BuildPhase::kRetreat;
   move(*motion, trace, request);
   deposit(local, frame, motion->target, 0, trace, request);
@@ -687,7 +688,8 @@ bool RampSteps::walled_in(const deliberative::LocalMap& local, Position robot) c
   return true;
 }
 
-std::optional<executive::Motion> RampSteps::ask_back(const deliberative::LocalMap& local, Position robot) {
+std::optional<executive::Motion> RampSteps::ask_back(const deliberative::LocalMap& local, Position robot,
+                                                     bool walled) {
   if (!context_.type.sensor.casts_rays()) return std::nullopt;
   // Where the robot came from: the latest cell of its trajectory a body length away and no nearer its goal, known on
   // its map.
@@ -709,7 +711,7 @@ std::optional<executive::Motion> RampSteps::ask_back(const deliberative::LocalMa
     if (distance(at, robot) >= far_m && distance(at, goal) >= here_m) anchor = cell;
   }
   if (!anchor) return std::nullopt;
-  if (walled_in(local, robot)) memory_.ask_back_anchor = local.to_global(*anchor);
+  if (walled) memory_.ask_back_anchor = local.to_global(*anchor);
   // Around what the world has answered already: it would refuse those cells again.
   CellMask open = local.known;
   hold_out_told_drops(local, open);
@@ -737,17 +739,10 @@ std::optional<executive::Motion> RampSteps::step_away(const deliberative::LocalM
 
 bool RampSteps::keep_out_of(deliberative::LocalMap& local, Position robot, const std::vector<Lane>& lanes) {
   if (lanes.empty()) return false;
-  // Lane::contains() holds only for centres in the lane's box widened by its radius (and its 1e-6 m margin): each
-  // lane tests the cells centred in that box.
+  // Lane::contains() holds only for centres in Lane::box(): each lane tests the cells centred in it.
   CellMask in_lane = CellMask::Zero(local.rows(), local.cols());
   for (const Lane& lane : lanes) {
-    const double reach_m = lane.radius_m + 1e-6;
-    Rect box;
-    box.x0 = std::min(lane.from.x, lane.to.x) - reach_m;
-    box.x1 = std::max(lane.from.x, lane.to.x) + reach_m;
-    box.y0 = std::min(lane.from.y, lane.to.y) - reach_m;
-    box.y1 = std::max(lane.from.y, lane.to.y) + reach_m;
-    const CellRect cells = cells_centred_in(local.geometry(), box);
+    const CellRect cells = cells_centred_in(local.geometry(), lane.box());
     for (int r = cells.first.row; r < cells.first.row + cells.rows; ++r)
       for (int c = cells.first.col; c < cells.first.col + cells.cols; ++c)
         if (in_lane(r, c) == 0 && local.occupiable(r, c) != 0 && CellIndex{r, c} != local.robot &&

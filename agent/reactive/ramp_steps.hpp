@@ -178,8 +178,9 @@ class RampSteps {
   /// cell of its trajectory a body length away and no nearer its goal, the route's next cell (advance(), or
   /// ask_ahead() when the map holds it out). The route runs around the cells the world has answered already (refused,
   /// or failing a drop it named: hold_out_told_drops()), which it would refuse again. A walled-in robot keeps that
-  /// cell while it stays walled in (Memory::ask_back_anchor). nullopt otherwise.
-  std::optional<executive::Motion> ask_back(const deliberative::LocalMap& local, Position robot);
+  /// cell while it stays walled in (`walled`: walled_in(), as the caller found it; Memory::ask_back_anchor). nullopt
+  /// otherwise.
+  std::optional<executive::Motion> ask_back(const deliberative::LocalMap& local, Position robot, bool walled);
   /// A scanning robot on an island of its map: no navigable cell lies a body length away. Always false for a robot
   /// that reads exact heights.
   bool walled_in(const deliberative::LocalMap& local, Position robot) const;

@@ -150,15 +150,23 @@ bool in_any(const std::vector<Lane>& lanes, Position p) {
   return std::any_of(lanes.begin(), lanes.end(), [&](const Lane& lane) { return lane.contains(p); });
 }
 
-bool Lane::contains(Position p) const {
-  // Beyond the segment's box widened by the radius no point is within it (the nearest point of the segment lies in
-  // its box, to within a rounding the margin covers): most cells of a window are, and skip the projection. Callers
-  // that look for the cells of a lane visit that box only (RampSteps::keep_out_of()).
+Rect Lane::box() const {
+  // The nearest point of the segment lies in its box, to within a rounding the margin covers.
   constexpr double kMarginM = 1e-6;
   const double reach_m = radius_m + kMarginM;
-  if (p.x < std::min(from.x, to.x) - reach_m || p.x > std::max(from.x, to.x) + reach_m ||
-      p.y < std::min(from.y, to.y) - reach_m || p.y > std::max(from.y, to.y) + reach_m)
-    return false;
+  Rect b;
+  b.x0 = std::min(from.x, to.x) - reach_m;
+  b.x1 = std::max(from.x, to.x) + reach_m;
+  b.y0 = std::min(from.y, to.y) - reach_m;
+  b.y1 = std::max(from.y, to.y) + reach_m;
+  return b;
+}
+
+bool Lane::contains(Position p) const {
+  // Most cells of a window lie beyond box() and skip the projection; callers that look for the cells of a lane visit
+  // that box only (RampSteps::keep_out_of()).
+  const Rect b = box();
+  if (p.x < b.x0 || p.x > b.x1 || p.y < b.y0 || p.y > b.y1) return false;
   const double dx = to.x - from.x, dy = to.y - from.y, l2 = dx * dx + dy * dy;
   const double t = l2 > 0.0 ? std::clamp(((p.x - from.x) * dx + (p.y - from.y) * dy) / l2, 0.0, 1.0) : 0.0;
   return within(p.x - (from.x + t * dx), p.y - (from.y + t * dy), radius_m);

@@ -50,6 +50,8 @@ struct Lane {
   double radius_m = 0.0;
   /// True when `p` [m] lies within radius_m of the segment.
   bool contains(Position p) const;
+  /// The segment's box widened by radius_m and a margin that covers rounding [m]: no point beyond it is contained.
+  Rect box() const;
 };
 
 /// True when `p` [m] lies in one of `lanes`.
