@@ -128,9 +128,13 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
     // row-major order): the robot moves, its next scans fill the holes ahead. Known cells that can be judged (not
     // blind) first, and the path through them only: a path or goal on blind cells draws the robot along the edge of
     // what it knows (a structure's side, whose shadow it never sees) instead of where its map is whole. When the
-    // judged cells hold nothing nearer than the robot's own cell, the known ones: the robot would otherwise stand
-    // still, its goal reached, and a camera that sees only ahead would never learn more.
+    // judged cells bring the robot no nearer than a body radius, the known ones: the robot would otherwise stand
+    // still, its goal reached, and a camera that sees only ahead would never learn more. A body radius, not any
+    // nearer cell: a judged cell one step nearer sends the robot there, where the known cells' path leads it back one
+    // step, and it shuttles between the two for good.
     const CellMask judged = (local.known.array() != 0 && local.blind.array() == 0).cast<std::uint8_t>();
+    const auto distance = [&](CellIndex a) { return std::hypot(a.row - goal.row, a.col - goal.col); };
+    const double radius_cells = params().delta_m / (2.0 * local.geometry().cell_size_m);
     for (const CellMask* mask : std::initializer_list<const CellMask*>{&judged, &local.known}) {
       if ((*mask)(local.robot.row, local.robot.col) == 0) continue;
       const CellMask reachable = NavigabilityProcessor::navigable_from(*mask, local.robot);
@@ -143,7 +147,7 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
             const long long dr = r - goal.row, dc = c - goal.col, d = dr * dr + dc * dc;
             if (d < best) best = d, nearest = {r, c};
           }
-        if (nearest == local.robot && mask == &judged) continue;
+        if (mask == &judged && distance(nearest) > distance(local.robot) - radius_cells) continue;
         local.goal_is_target = false;
       }
       local.goal = nearest;

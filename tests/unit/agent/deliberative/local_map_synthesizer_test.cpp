@@ -412,5 +412,37 @@ TEST(LocalMapSynthesizer, AScannedMapsGoalAndPathAvoidCellsItCannotJudge) {
   EXPECT_EQ(whole.passable, whole.known);
 }
 
+// A scanned map whose judged cells bring the robot less than a body radius nearer its goal, where known cells lead
+// on: the robot heads along the known cells. Before, the judged cell one step ahead was the goal; standing there, the
+// judged cells held nothing nearer and the known cells' path was taken, and from the next cell the judged one was
+// nearer again: a laser robot shuttled between two cells at a ramp's head for 5000 steps.
+TEST(LocalMapSynthesizer, AScannedMapsJudgedCellsLeadTheRobotOnlyWhenTheyBringItABodyRadiusNearer) {
+  executive::MappingSystem map(kWorld, 16, sensor_defaults(SensorKind::kLaser));
+  // Known ground: the balls (radius 2 cells) of (30, 40) and (30, 41), and a ring's line of hits (30, 43..65). Judged
+  // (no unknown cell in the ball): (30, 40) and (30, 41) only.
+  for (const int col : {40, 41})
+    for (const CellIndex o : disc_offsets(2.0))
+      map.assume_ground(kWorld.cell_center({30 + o.row, col + o.col}), 0.0, 0.0);
+  for (int c = 43; c <= 65; ++c) map.assume_ground(kWorld.cell_center({30, c}), 0.0, 0.0);
+  const LocalMapSynthesizer synthesizer(kBody, 2.5);  // ball radius 2 cells; window cols 15..65 around (30, 40)
+  for (const CellIndex robot : {CellIndex{30, 40}, CellIndex{30, 41}}) {
+    const LocalMap local = synthesizer.synthesize(map.known_map(), kWorld.cell_center(robot), {7.05, 2.95});
+    ASSERT_EQ(local.blind(local.robot.row, local.robot.col), 0) << robot.col;
+    // The known cell nearest where the line to the target leaves the window ((30, 65) or (30, 66)), through known cells.
+    EXPECT_EQ(local.to_global(local.goal), (CellIndex{30, 65})) << robot.col;
+    EXPECT_EQ(local.passable, local.known) << robot.col;
+  }
+  // Judged cells up to (30, 43) (the balls of (30, 40..43) known): three cells nearer than the robot at (30, 40), more
+  // than the radius (2): the judged cells lead, and the path runs through them only.
+  executive::MappingSystem wider(kWorld, 16, sensor_defaults(SensorKind::kLaser));
+  for (int col = 40; col <= 43; ++col)
+    for (const CellIndex o : disc_offsets(2.0))
+      wider.assume_ground(kWorld.cell_center({30 + o.row, col + o.col}), 0.0, 0.0);
+  for (int c = 46; c <= 65; ++c) wider.assume_ground(kWorld.cell_center({30, c}), 0.0, 0.0);
+  const LocalMap judged = synthesizer.synthesize(wider.known_map(), kRobot, {7.05, 2.95});
+  EXPECT_EQ(judged.to_global(judged.goal), (CellIndex{30, 43}));
+  EXPECT_NE(judged.passable, judged.known);
+}
+
 }  // namespace
 }  // namespace marsala::agent::deliberative
