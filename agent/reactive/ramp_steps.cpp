@@ -60,6 +60,16 @@ bool ball_holds(const deliberative::LocalMap& local, CellIndex cell, CellIndex a
 
 std::string to_string(BuildPhase phase) { return enum_to_string(kBuildPhaseNames, phase); }
 
+double scan_gap_margin_m(const SensorSpec& sensor, double distance_m, double kappa) {
+  if (!(distance_m >= 0.0) || !std::isfinite(distance_m) || !(kappa >= 0.0) || !std::isfinite(kappa))
+    throw InvalidArgument(fmt::format("scan gap margin: distance {} m and kappa {} must be finite and >= 0",
+                                      distance_m, kappa));
+  const double range_m = std::hypot(distance_m, sensor.mount_height_m);
+  if (!(range_m > 0.0)) return kScanGapMargin * sensor.noise_sd_at(0.0);
+  const double up = sensor.mount_height_m / range_m, along = distance_m / range_m;
+  return kScanGapMargin * sensor.noise_sd_at(range_m) * (up + kappa * along);
+}
+
 struct RampSteps::Modules {
   executive::MappingSystem map;
   deliberative::LocalMapSynthesizer synthesizer;
@@ -104,7 +114,7 @@ void RampSteps::admit(const protocol::Admission& admission) {
   deposits.pad_radius_m = kPadFraction * context_.assignment.base_radius_m;
   // A scanned map reads each surface within a few noise spreads at the manipulator's reach: leave that much unfilled.
   if (context_.type.sensor.casts_rays()) {
-    deposits.gap_margin_m = kScanGapMargin * context_.type.sensor.noise_sd_at(body.reach_m + body.navigability.delta_m);
+    deposits.gap_margin_m = scan_gap_margin_m(context_.type.sensor, body.reach_m + body.navigability.delta_m, build.kappa);
     // The cells next to the robot are read from about a body length away; a pair of them differs by noise of up to
     // about two spreads.
     deposits.exit_margin_m = kScanExitMargin * context_.type.sensor.noise_sd_at(body.navigability.delta_m);

@@ -51,9 +51,15 @@ namespace marsala::agent::reactive {
 /// middle of the base stays as it was (a payload's start, refills); the outer ring may be built on when the
 /// construction begins there.
 inline constexpr double kPadFraction = 0.5;
-/// A robot that maps with range scans leaves this many noise spreads (its sensor's sd at its reach plus a body
-/// length) of each cell's MARS gap unfilled (DepositionParams::gap_margin_m).
+/// A robot that maps with range scans leaves this many noise spreads of a cell's height (scan_gap_margin_m()) of each
+/// cell's MARS gap unfilled (DepositionParams::gap_margin_m).
 inline constexpr double kScanGapMargin = 3.0;
+/// How far a scanned map may read a cell `distance_m` [m] away (horizontally) off its height [m]: kScanGapMargin
+/// spreads of the height a hit gives. A hit's range error moves it along its ray: up or down by the ray's vertical
+/// part (the sensor at its mount height over flat ground), and along the ground by the horizontal part, which on a
+/// surface of slope `kappa` [m/m] (the steepest the robot builds) is a height error of kappa times as much. 0 for a
+/// noise-free sensor. Throws InvalidArgument on a negative or non-finite distance or kappa.
+double scan_gap_margin_m(const SensorSpec& sensor, double distance_m, double kappa);
 /// The noise margin of the robot's sure way out on a scanned map (executive::DepositionParams::exit_margin_m): this
 /// many noise spreads at a body length [count].
 inline constexpr double kScanExitMargin = 2.0;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -23,6 +24,47 @@
 
 namespace marsala::agent::reactive {
 namespace {
+
+// The noise margin of a scanned map's depositions: kScanGapMargin spreads of the height error a hit gives on the
+// steepest surface the robot builds. Against a direct simulation: the sensor at its mount height above the hit's
+// level, each range drawn with the sensor's noise, the hit's height against the height of a slope kappa through the
+// true hit where the noisy hit lands, on either side (rising away from the sensor or towards it); the larger spread
+// of that error, times kScanGapMargin.
+TEST(ScanGapMargin, IsThreeSpreadsOfTheHeightErrorOfAHitOnTheSteepestSurface) {
+  std::mt19937_64 rng(7);
+  for (const SensorKind kind : {SensorKind::kRgbd, SensorKind::kLaser})
+    for (const double distance_m : {1.0, 2.5})
+      for (const double kappa : {0.0, 0.3, 0.5}) {
+        const SensorSpec sensor = sensor_defaults(kind);
+        const double h = sensor.mount_height_m, r = std::hypot(distance_m, h);
+        const double ux = distance_m / r, uz = -h / r;
+        std::normal_distribution<double> noise(0.0, sensor.noise_sd_at(r));
+        double worst = 0.0;
+        for (const double rises : {1.0, -1.0}) {  // the slope rising away from the sensor, then towards it
+          double sum2 = 0.0;
+          const int n = 100000;
+          for (int i = 0; i < n; ++i) {
+            const double range = r + noise(rng);
+            const double x = ux * range, z = h + uz * range;  // the hit; the true one at (distance_m, 0)
+            const double error = z - rises * kappa * (x - distance_m);
+            sum2 += error * error;
+          }
+          worst = std::max(worst, std::sqrt(sum2 / n));
+        }
+        const double simulated = kScanGapMargin * worst;
+        EXPECT_NEAR(scan_gap_margin_m(sensor, distance_m, kappa), simulated, 0.02 * simulated)
+            << to_string(kind) << " " << distance_m << " m, kappa " << kappa;
+      }
+  SensorSpec exact = sensor_defaults(SensorKind::kRgbd);
+  exact.noise_sd_m = exact.noise_sd_per_m2 = 0.0;
+  EXPECT_EQ(scan_gap_margin_m(exact, 2.5, 0.3), 0.0);
+  // Derived by hand: the camera at 2.5 m, r = hypot(2.5, 0.5) = 2.5495 m, sd = 0.002 + 0.002 r^2 = 0.0150 m,
+  // 3 sd (0.5 / r + 0.3 x 2.5 / r) = 0.02206 m; the laser (sd 0.01 m) 0.01471 m.
+  EXPECT_NEAR(scan_gap_margin_m(sensor_defaults(SensorKind::kRgbd), 2.5, 0.3), 0.02206, 1e-5);
+  EXPECT_NEAR(scan_gap_margin_m(sensor_defaults(SensorKind::kLaser), 2.5, 0.3), 0.01471, 1e-5);
+  EXPECT_THROW(scan_gap_margin_m(exact, -1.0, 0.3), InvalidArgument);
+  EXPECT_THROW(scan_gap_margin_m(exact, 1.0, std::nan("")), InvalidArgument);
+}
 
 constexpr Position kTarget{8.0, 3.05};
 constexpr Position kBase{0.55, 3.05};
