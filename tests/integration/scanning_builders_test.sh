@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # Scanning builders on real processes (issue 24, docs/runtime.md#mapping), inside run_isolated.sh: deploy/scenarios/
 # ramp.pbtxt, 3 robots with the default RGB-D camera (robot_type.sensor.name=rgbd), over DDS for at most 1500 steps.
-# Case rgbd, seed 2: they complete the ramp (in-process: 663 steps, 11.40 m^3, 3.67 % of the requests refused; on
-# seeds 1-5 all five complete in 623-862 steps, README "The way back read as the map opens it"); the test holds what
+# Case rgbd, seed 2: they complete the ramp (in-process: 484 steps, 12.37 m^3, 2.69 % of the requests refused; on
+# seeds 1-5 all five complete in 467-553 steps, README "Sensing: the noise a height reading has"); the test holds what
 # they do: they complete
 # it (exit 0, end_reason completed), never with more than 1.25 times the ground-truth run's 12.04 m^3, no cell above
-# the MARS bound of the initial terrain (kappa 0.3), and under 5 % of their requests refused (a refusal names every
+# the bound the world keeps (the MARS bound of the initial terrain at kappa 0.3, plus the world's 0.1 eps = 5 mm,
+# docs/runtime.md#deposit-bound; seed 2 ends with 3 cells up to 2 mm above the MARS bound itself), and under 5 % of
+# their requests refused (a refusal names every
 # drop under the body; issue 24's 1 % is not met, docs/runtime.md#refused-requests). Case rgbd_exact, seed 1: the
 # same cameras without range noise (noise_sd_m and noise_sd_per_m2 0) must complete the ramp (in-process: 328 steps,
 # 13.10 m^3, docs/runtime.md#mapping) within 2x the ground-truth run's steps (596) and 1.25x its volume, with under
@@ -50,11 +52,11 @@ run_steps=$(jq .steps "$summary")
 jq -e --argjson n "$run_steps" --argjson pct "$refused_pct" '(.rejected_requests | tonumber) * 100 < $pct * 3 * $n' \
   "$summary" >/dev/null ||
   fail "$(jq .rejected_requests "$summary") of $((3 * run_steps)) requests refused, $refused_pct % or more"
-# Never above the bound the world keeps (docs/runtime.md#deposit-bound): P_0.3 of the initial terrain.
+# Never above the bound the world keeps (docs/runtime.md#deposit-bound): P_0.3 of the initial terrain plus 0.1 eps.
 "$bin/marsala-terrain" mars "$out/terrain_initial.asc" --kappa 0.3 -o "$work/bound.asc" >/dev/null
 above=$(paste <(awk 'NR > 6' "$out/terrain_final.asc" | tr -s ' ' '\n' | grep -v '^$') \
   <(awk 'NR > 6' "$work/bound.asc" | tr -s ' ' '\n' | grep -v '^$') |
-  awk '$1 > $2 + 1e-6 { n++ } END { print n + 0 }')
+  awk '$1 > $2 + 0.005 + 1e-6 { n++ } END { print n + 0 }')
 [ "$above" = 0 ] || fail "$above cells above the MARS bound of the initial terrain"
 echo "ramp, 3 $case_name builders: $end after $run_steps steps, $(jq .deposited_volume_m3 "$summary") m^3," \
   "$(jq -r .rejected_requests "$summary") refused"
