@@ -29,6 +29,9 @@ struct KnownMap {
   const std::vector<CellIndex>& trajectory;  ///< cells stood on, oldest first (world indices)
   bool scanned = false;                      ///< built from range scans (holes, shadows), not ground-truth tiles
   const StoodCells* stood = nullptr;         ///< cells stood on with their balls then (a scanned map), or none
+  /// A scanned map's overflight (executive::MappingSystem::overflight()): per cell the lowest height [m] a ray of the
+  /// latest scan crossed its column at without striking it, +inf where none did; or none (not recorded).
+  const Heightmap* overflight = nullptr;
 
   /// The world grid.
   const GridGeometry& geometry() const { return heights.geometry(); }

@@ -90,6 +90,7 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
     }
   local.heights_occupiable = local.occupiable;
   local.heights_navigability = params();
+  if (map.overflight && !all_known) fill_under_rays(local, *map.overflight);
 
   // Ground the map only assumes (under and around the robot's body: KnownMap::assumed) is no deposition
   // target: building on it would never show in the map. A bound in a notch is filled up to its notch level
@@ -156,6 +157,43 @@ LocalMap LocalMapSynthesizer::synthesize(const KnownMap& map, Position robot, Po
     }
   }
   return local;
+}
+
+void LocalMapSynthesizer::fill_under_rays(LocalMap& local, const Heightmap& overflight) const {
+  local.overflown = CellMask::Zero(local.rows(), local.cols());
+  double lowest = std::numeric_limits<double>::infinity();
+  bool any = false;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c) {
+      if (local.known(r, c) != 0) {
+        lowest = std::min(lowest, local.heights(r, c));
+      } else if (std::isfinite(overflight(local.to_global({r, c})))) {
+        local.overflown(r, c) = 1;
+        any = true;
+      }
+    }
+  if (!any || !std::isfinite(lowest)) {
+    local.overflown = CellMask();
+    return;
+  }
+  // The known cells alone are the sources: an unknown cell sits below every known cell's cone anywhere in the window,
+  // so it raises no bound (the window's heights put it at the lowest known height, which may lie above a known cell's
+  // cone far from it). The overflight itself is no source either: it is where a ray passed, not where terrain is.
+  const double cs = local.geometry().cell_size_m;
+  const double below_m = mars_.kappa() * cs * std::hypot(local.rows(), local.cols()) + 1.0;
+  Heightmap sources = local.heights;
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c)
+      if (local.known(r, c) == 0) sources(r, c) = lowest - below_m;
+  const Heightmap bound = mars_.project(sources, local.overflown);
+  // Its height in the window is the overflight from now on, the most it can be: what is judged against another bound
+  // later (the band's, executive::gap_below) is then judged from there too; blind balls stay blind.
+  for (int r = 0; r < local.rows(); ++r)
+    for (int c = 0; c < local.cols(); ++c)
+      if (local.overflown(r, c) != 0) {
+        local.heights(r, c) = overflight(local.to_global({r, c}));
+        local.gap(r, c) = std::max(0.0, bound(r, c) - local.heights(r, c));
+      }
 }
 
 void LocalMapSynthesizer::open_stood_cells(LocalMap& local, const KnownMap& map) {

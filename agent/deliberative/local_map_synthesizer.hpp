@@ -29,13 +29,18 @@ namespace marsala::agent::deliberative {
 struct LocalMap {
   GridGeometry world;               ///< the world grid: positions map to cells through it, as the world maps them
   CellIndex offset;                 ///< world index of the window's top-left cell
-  Heightmap heights;                ///< the window [m], placed in the world frame; unknown cells hold the lowest known
+  Heightmap heights;                ///< the window [m], placed in the world frame; unknown cells hold the lowest known,
+                                    ///< those under the latest scan's rays (overflown) their overflight
   CellMask known;                   ///< 1 where the agent's map knows the cell
   Heightmap gap;                    ///< MARS gap P_kappa[h] - h of the window at the construction kappa [m]; 0 on
                                     ///< unknown cells and on cells held as no surface but a notch's (fill_cap)
   /// How far a cell may be raised whatever the map's noise margin [m]: a bound in a notch (notch_fill()) up to its
   /// notch level, +inf on every other cell. Empty (0 x 0) on a map that holds no bound: no cap.
   Heightmap fill_cap;
+  /// 1 on the unknown cells under a ray of the latest scan (KnownMap::overflight): their top lies below the ray, and
+  /// their gap is what raises them at most to the MARS height of the known cells (fill_under_rays()). Empty (0 x 0)
+  /// on a map without overflights.
+  CellMask overflown;
   CellMask blind;                   ///< 1 where the cell's ball holds an unknown cell: it is never occupiable
   CellMask passable;                ///< where a deposition path may run: known cells; on a scanned map known cells
                                     ///< that are not blind, when they reach the local goal
@@ -87,6 +92,14 @@ inline double rise_wanted_m(const LocalMap& local, CellIndex cell, double margin
              : rise_m;
 }
 
+/// True when a deposition may raise `cell` (local index): it is known, or unknown under the latest scan's rays
+/// (LocalMap::overflown).
+inline bool may_fill(const LocalMap& local, CellIndex cell) {
+  return local.known(cell.row, cell.col) != 0 || (local.overflown.rows() == local.rows() &&
+                                                  local.overflown.cols() == local.cols() &&
+                                                  local.overflown(cell.row, cell.col) != 0);
+}
+
 /// Window of a world grid: top-left cell and size [cells].
 struct Window {
   CellIndex top_left;
@@ -116,6 +129,13 @@ class LocalMapSynthesizer {
   /// the sensing square [x - r, x + r] x [y - r, y + r] around `robot` (r = range_m) that is navigable from the
   /// robot, else the nearest that is occupiable; ties go to the oldest. The square, not the window clipped to the
   /// grid: a world edge is no boundary of what the robot knows.
+  /// Under the rays (docs/runtime.md#mapping): each unknown cell of `local` (its heights, known mask and gap already
+  /// synthesized) whose column a ray of the latest scan crossed at `overflight` [m] (the world grid's) without striking
+  /// it stands below that height, so raising it by P - overflight, P the MARS height at this synthesizer's kappa of the
+  /// window's known cells alone, leaves it at most at P, whatever its true height: its gap; its window height becomes
+  /// the overflight, and LocalMap::overflown marks it.
+  void fill_under_rays(LocalMap& local, const Heightmap& overflight) const;
+
   static std::optional<CellIndex> local_origin(const LocalMap& local, const std::vector<CellIndex>& trajectory,
                                                Position robot, double range_m);
   /// The local goal: the target's cell when it lies in the window, else the cell where the straight line from the

@@ -129,7 +129,7 @@ std::vector<DepositionCandidate> DepositionManager::candidates(const deliberativ
       std::uint8_t& s = seen[static_cast<std::size_t>(cell.row) * map.cols() + cell.col];
       if (s) continue;
       s = 1;
-      if (map.known(cell.row, cell.col) == 0) continue;
+      if (!deliberative::may_fill(map, cell)) continue;
       // Whole layers, rounded down: never above the local MARS height (1e-9 absorbs rounding in gaps that are
       // exact multiples).
       int layers = std::min(
@@ -172,7 +172,7 @@ double DepositionManager::clearance_m(const deliberative::LocalMap& map, Positio
 
 bool DepositionManager::may_raise(const deliberative::LocalMap& map, CellIndex cell, Position robot,
                                   const Neighbourhood& neighbours, double clearance_m) const {
-  if (!map.contains(cell) || map.known(cell.row, cell.col) == 0) return false;
+  if (!map.contains(cell) || !deliberative::may_fill(map, cell)) return false;
   const Position centre = map.center(cell);
   if (distance(centre, robot) <= clearance_m) return false;
   if (params_.pad_radius_m > 0.0 && distance(centre, params_.pad_centre) <= params_.pad_radius_m) return false;

@@ -39,6 +39,40 @@ constexpr double kOnEdgeM = 1e-5;
 /// deviations of it along the ray: a scan holds thousands of hits, and some lie past 3 of them [1].
 constexpr double kFaceRivalNoise = 5.0;
 
+/// The free part of a ray ends this many range-noise standard deviations before its hit: a hit measured long by
+/// more is rare enough (3e-7 of the rays) that no overflight is set below a surface by one [1].
+constexpr double kOverflightNoise = 5.0;
+
+/// Calls visit(cell, z_m) for each cell whose column the horizontal path from `o` towards `end` crosses, up to
+/// `end` or run_m [m] from `o`, whichever comes first, in order, with the ray's lowest height over the part of
+/// the column it crossed [m] (a grid DDA; cells off the grid end the walk).
+template <class Visit>
+void cells_under_ray(const GridGeometry& g, Point3 o, Point3 end, double run_m, Visit&& visit) {
+  const double dx = end.x - o.x, dy = end.y - o.y, dz = end.z - o.z, run = std::hypot(dx, dy);
+  if (!(run > 0.0)) return;
+  const double cs = g.cell_size_m, t_end = std::min(1.0, run_m / run);
+  const double u = (o.x - g.xll_m) / cs, v = (o.y - g.yll_m) / cs;
+  long long col = static_cast<long long>(std::floor(u)), south = static_cast<long long>(std::floor(v));
+  constexpr double kNever = std::numeric_limits<double>::infinity();
+  // The ray's parameter (0 at o, 1 at end) at the next x and y grid line it crosses, and between two such lines.
+  const int step_col = dx > 0.0 ? 1 : -1, step_south = dy > 0.0 ? 1 : -1;
+  double next_x = dx != 0.0 ? (dx > 0.0 ? col + 1 - u : u - col) * cs / std::abs(dx) : kNever;
+  double next_y = dy != 0.0 ? (dy > 0.0 ? south + 1 - v : v - south) * cs / std::abs(dy) : kNever;
+  const double every_x = dx != 0.0 ? cs / std::abs(dx) : kNever, every_y = dy != 0.0 ? cs / std::abs(dy) : kNever;
+  double t = 0.0;
+  while (t < t_end && col >= 0 && col < g.cols && south >= 0 && south < g.rows) {
+    const double t_out = std::min({next_x, next_y, t_end});
+    // A cell the ray only touches at a corner is not crossed.
+    if (t_out > t)
+      visit(CellIndex{g.rows - 1 - static_cast<int>(south), static_cast<int>(col)}, o.z + dz * (dz < 0.0 ? t_out : t));
+    t = t_out;
+    if (next_x < next_y)
+      col += step_col, next_x += every_x;
+    else
+      south += step_south, next_y += every_y;
+  }
+}
+
 /// Where a face hit may have struck: the faces of the cells the ray's horizontal path enters at the cell edges it
 /// crosses near the hit along the ray (range noise moves a hit along its ray, before or past the face). kOne: one
 /// crossing within within_m [m] of the hit, into `cell`, and no crossing into another cell within rival_m [m]
@@ -243,7 +277,11 @@ MappingSystem::MappingSystem(const MappingSystem& other)
       sensor_(other.sensor_),
       trajectory_(other.trajectory_),
       stood_(other.stood_),
-      octree_(other.octree_ ? std::make_unique<Octree>(*other.octree_) : nullptr) {}
+      octree_(other.octree_ ? std::make_unique<Octree>(*other.octree_) : nullptr),
+      last_scan_cost_(other.last_scan_cost_),
+      overflight_range_m_(other.overflight_range_m_),
+      overflight_(other.overflight_),
+      overflight_cells_(other.overflight_cells_) {}
 MappingSystem& MappingSystem::operator=(const MappingSystem& other) {
   if (this != &other) *this = MappingSystem(other);
   return *this;
@@ -326,6 +364,7 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
     octree_->hits.resize(static_cast<std::size_t>(g.size()));
   }
   const double began_ms = thread_cpu_ms();
+  if (overflight_range_m_ > 0.0) record_overflight(points, origin);
   const ScanBatch batch = bin_hits(points, origin);
   // Rays carve free space up to each end voxel, which becomes more likely occupied (OctoMap's log-odds update).
   // Only leaves are ever read, so no inner node is kept (detail/voxel_occupancy.hpp).
@@ -356,6 +395,34 @@ void MappingSystem::integrate_scan(const std::vector<ScanPoint>& points, Point3 
     bound_(f.cell.row, f.cell.col) = surface ? 0 : 1;
   }
   last_scan_cost_ = {inserted_ms - began_ms, thread_cpu_ms() - inserted_ms};
+}
+
+void MappingSystem::record_overflights(double range_m) {
+  if (!(range_m >= 0.0) || !std::isfinite(range_m))
+    throw InvalidArgument(fmt::format("mapping system: overflights need a range finite and >= 0 m, got {}", range_m));
+  overflight_range_m_ = range_m;
+}
+
+void MappingSystem::record_overflight(const std::vector<ScanPoint>& points, Point3 origin) {
+  const GridGeometry& g = heights_.geometry();
+  if (overflight_.rows() == 0) overflight_ = Heightmap(g, kUnderNoRay);
+  // Only the latest scan's rays say where the terrain is now: it rises under construction.
+  double* cells = overflight_.data();
+  for (const std::size_t index : overflight_cells_) cells[index] = kUnderNoRay;
+  overflight_cells_.clear();
+  for (const ScanPoint& p : points) {
+    const double range = std::sqrt(double{p.x_m} * p.x_m + double{p.y_m} * p.y_m + double{p.z_m} * p.z_m);
+    const double free = range - kOverflightNoise * sensor_.noise_sd_at(range);
+    if (!(free > 0.0)) continue;
+    const double f = free / range;
+    const Point3 end{origin.x + f * p.x_m, origin.y + f * p.y_m, origin.z + f * p.z_m};
+    cells_under_ray(g, origin, end, overflight_range_m_, [&](CellIndex cell, double z_m) {
+      double& lowest = cells[static_cast<std::size_t>(cell.row) * g.cols + cell.col];
+      if (!(z_m < lowest)) return;
+      if (lowest == kUnderNoRay) overflight_cells_.push_back(static_cast<std::size_t>(cell.row) * g.cols + cell.col);
+      lowest = z_m;
+    });
+  }
 }
 
 MappingSystem::ScanBatch MappingSystem::bin_hits(const std::vector<ScanPoint>& points, Point3 origin) {
@@ -508,6 +575,8 @@ void MappingSystem::record_built(CellIndex cell, double rise_m) {
         stood_.balls.erase(static_cast<long long>(centre.row) * heights_.cols() + centre.col);
     }
   const long long index = static_cast<long long>(cell.row) * heights_.cols() + cell.col;
+  // Under the latest scan's rays the cell stood below them; it stands at most that plus the rise now.
+  if (overflown(cell)) overflight_(cell) += rise_m;
   // A cell whose surface no sensor read has no height to add to.
   const bool surface_read =
       known_(cell.row, cell.col) != 0 &&

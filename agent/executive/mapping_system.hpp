@@ -112,6 +112,22 @@ class MappingSystem {
   /// non-finite poses are ignored.
   void record_stood(Position pose);
 
+  /// From now on each scan also records, for every cell the free part of a ray crosses within range_m [m]
+  /// (horizontally) of the sensor, the lowest height a ray of that scan crossed the cell's column at: the ray struck
+  /// nothing there, so the cell's top lies below it (overflight(); docs/runtime.md#mapping, "Under the rays"). The free
+  /// part of a ray ends kOverflightNoise range-noise spreads before its hit, whether or not the hit itself could be
+  /// placed in a cell (a depth camera's far hits cannot). 0 (the default): nothing recorded. Throws InvalidArgument
+  /// unless finite and >= 0.
+  void record_overflights(double range_m);
+  /// Per cell, the lowest height [m] a ray of the latest scan crossed its column at without striking it, raised by the
+  /// robot's own construction there since (record_built()); +inf where no such ray passed (and without
+  /// record_overflights()). The world grid's size once a scan was recorded, else empty.
+  const Heightmap& overflight() const { return overflight_; }
+  /// True when a ray of the latest scan crossed the cell's column without striking it (overflight() is finite there).
+  bool overflown(CellIndex cell) const {
+    return overflight_.rows() > 0 && overflight_.contains(cell) && overflight_(cell) < kUnderNoRay;
+  }
+
   /// The map: known cells hold the sensed heights [m], unknown cells 0.
   const Heightmap& heights() const { return heights_; }
   /// 1 where the cell has been sensed at least once.
@@ -141,7 +157,14 @@ class MappingSystem {
   const GridGeometry& geometry() const { return heights_.geometry(); }
   /// This map as the deliberative layer reads it (the local map synthesizer); valid while this map lives, unchanged.
   deliberative::KnownMap known_map() const {
-    return {heights_, known_, assumed_, bound_, trajectory_, sensor_.casts_rays(), stood_.balls.empty() ? nullptr : &stood_};
+    return {heights_,
+            known_,
+            assumed_,
+            bound_,
+            trajectory_,
+            sensor_.casts_rays(),
+            stood_.balls.empty() ? nullptr : &stood_,
+            overflight_.rows() > 0 ? &overflight_ : nullptr};
   }
   int tile_size() const { return tile_size_; }
   const SensorSpec& sensor() const { return sensor_; }
@@ -171,6 +194,11 @@ class MappingSystem {
   void forget_along_edge(const std::vector<CellIndex>& seeds, double radius_cells);
   void rederive_heights(const ScanBatch& batch);
 
+  /// overflight()'s value where no ray passed [m].
+  static constexpr double kUnderNoRay = std::numeric_limits<double>::infinity();
+  // record_overflights(): the latest scan's rays over each cell within overflight_range_m_ of the sensor.
+  void record_overflight(const std::vector<ScanPoint>& points, Point3 origin);
+
   Heightmap heights_;
   CellMask known_;
   CellMask assumed_;
@@ -192,6 +220,9 @@ class MappingSystem {
   deliberative::StoodCells stood_;  ///< record_stood(); an empty ball: no cells stood on kept
   std::unique_ptr<Octree> octree_;  // made at the first scan
   ScanCost last_scan_cost_;
+  double overflight_range_m_ = 0.0;           ///< record_overflights() [m]; 0: none recorded
+  Heightmap overflight_;                      ///< overflight(); empty before the first recorded scan
+  std::vector<std::size_t> overflight_cells_;  ///< the cells (row-major) overflight_ holds a finite height for
 };
 
 }  // namespace marsala::agent::executive

@@ -65,6 +65,7 @@ PathBuilder::PathBuilder(const AgentContext& context, PathBuilderOptions options
       keeps_right_of_way_(context.right_of_way) {
   steps_.set_lane(context.type.pipeline.lane_offset_m, construction_params(context.type).delta_m);
   steps_.set_band_centre(true);
+  steps_.set_fill_under_rays(true);
 }
 
 const executive::MappingSystem& PathBuilder::map() const {

@@ -147,6 +147,8 @@ void RampSteps::admit(const protocol::Admission& admission) {
   // The cells a scanning robot stands on were occupiable (docs/runtime.md#cells-stood-on): a fact its map keeps while
   // the ball reads the same, within the change that brings a refused cell back.
   if (context_.type.sensor.casts_rays()) modules_->map.keep_stood_cells(body_ball_cells, change);
+  if (fill_under_rays_ && context_.type.sensor.casts_rays())
+    modules_->map.record_overflights(body.reach_m + body.navigability.delta_m + body.max_step_m);
   goal_ = deliberative::make_goal_synthesizer(context_.type.goal_synthesizer, context_);
 }
 
@@ -428,6 +430,8 @@ void RampSteps::mark_others_near(const protocol::SensorFrame& frame) {
 bool RampSteps::current(CellIndex cell) const {
   const executive::MappingSystem& map = modules_->map;
   if (map.hit_within(cell, kFreshScans)) return true;
+  // An unknown cell under the latest scan's rays: its gap is from that scan (fill_under_rays()).
+  if (!map.is_known(cell) && map.overflown(cell)) return true;
   const int last = std::max(map.last_hit_scan(cell), map.told_scan(cell));
   return last > 0 && memory_.others_near[static_cast<std::size_t>(cell.row) * map.geometry().cols + cell.col] < last;
 }

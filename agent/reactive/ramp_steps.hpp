@@ -154,6 +154,11 @@ class RampSteps {
   /// body drives on along that path (executive::way_fill_gap: the terrain beside it raises nothing in it). Needs set_lane()'s corridor width; off by default; set before
   /// admit().
   void set_band_centre(bool on) { band_centre_ = on; }
+  /// Under the rays (docs/runtime.md#mapping): when on, a scanning robot's map records the latest scan's rays over the
+  /// cells within its reach, a body and a step (executive::MappingSystem::record_overflights), and the unknown cells
+  /// under them are work up to the MARS height of the known cells (LocalMapSynthesizer::fill_under_rays), current for
+  /// as long as a scan keeps passing over them. Off by default; set before admit().
+  void set_fill_under_rays(bool on) { fill_under_rays_ = on; }
   /// `path` moved into this robot's lane on the last look()'s map (unchanged without lanes).
   std::vector<CellIndex> in_lane(const deliberative::LocalMap& local, const std::vector<CellIndex>& path) const;
   /// Requests `motion` and records it.
@@ -363,6 +368,7 @@ class RampSteps {
   double lane_offset_m_ = 0.0;        // set_lane()
   double corridor_width_m_ = 0.0;
   bool band_centre_ = false;  // set_band_centre()
+  bool fill_under_rays_ = false;  // set_fill_under_rays()
   Memory memory_;
 };
 

@@ -718,4 +718,57 @@ TEST(MappingSystem, ACellStoodOnKeepsItsBallUntilTheRobotBuildsInIt) {
   EXPECT_EQ(map.known_map().stood, nullptr);
 }
 
+// docs/runtime.md#mapping, "Under the rays": a camera 0.5 m above the top of a 3 m cliff, 0.625 m back from its edge
+// (x = 8 m, 0.25 m cells), looking over it. No ray reaches the cliff's foot (the edge hides it) and the basin floor's
+// hits are too far to place, so the cells below the edge stay unknown; but the rays that clear the edge cross their
+// columns, and each stands below the lowest of them. Checked against the truth on every cell: the overflight is never
+// below the cell's height (the one ray through the edge's corner row that clears it by the least, at 37.8 deg down,
+// lies 0.18 m under the top over the first cell below it, x = 8-8.25 m, and 0.37 m under it over the second). Only the
+// latest scan counts, a deposit accepted there raises it, and nothing is recorded beyond the range or without
+// record_overflights().
+TEST(MappingSystem, TheCellsUnderAScansRaysStandBelowThem) {
+  Heightmap truth(GridGeometry{40, 80, 0.0, 0.0, 0.25}, 0.0);
+  for (int r = 0; r < truth.rows(); ++r)
+    for (int c = 0; c < 32; ++c) truth(r, c) = 3.0;
+  const SensorSpec camera = sensor_defaults(SensorKind::kRgbd);
+  MappingSystem plain(truth.geometry(), 16, camera);
+  MappingSystem map(truth.geometry(), 16, camera);
+  EXPECT_THROW(map.record_overflights(-1.0), InvalidArgument);
+  map.record_overflights(3.25);
+  const Point3 origin = sensor_origin(truth, 7.375, 5.125, camera);
+  const auto points = cast_scan(truth, origin, 0.0, camera, 1);
+  plain.integrate_scan(points, origin);
+  map.integrate_scan(points, origin);
+  EXPECT_EQ(plain.overflight().rows(), 0);
+  EXPECT_FALSE(plain.overflown({19, 32}));
+  int overflown = 0;
+  for (int r = 0; r < truth.rows(); ++r)
+    for (int c = 0; c < truth.cols(); ++c) {
+      if (!map.overflown({r, c})) continue;
+      ++overflown;
+      EXPECT_GE(map.overflight()(r, c), truth(r, c)) << r << ", " << c;
+      const Position at = truth.cell_center({r, c});
+      EXPECT_LE(std::abs(at.x - origin.x), 3.25 + 0.25) << r << ", " << c;  // within the range (and a cell)
+    }
+  EXPECT_GT(overflown, 50);
+  // Below the edge, on the camera's row: unknown, under rays that pass well below the top.
+  for (int c = 32; c <= 36; ++c) {
+    EXPECT_FALSE(map.is_known({19, c})) << c;
+    ASSERT_TRUE(map.overflown({19, c})) << c;
+  }
+  EXPECT_NEAR(map.overflight()(19, 32), 3.0 - 0.18, 0.02);
+  EXPECT_NEAR(map.overflight()(19, 33), 3.0 - 0.37, 0.03);
+  EXPECT_LT(map.overflight()(19, 36), map.overflight()(19, 33));
+  // The robot's own deposit there raises it by the rise: the cell stood below the ray, it stands below that plus it.
+  const double before = map.overflight()(19, 33);
+  map.record_built({19, 33}, 0.5);
+  EXPECT_DOUBLE_EQ(map.overflight()(19, 33), before + 0.5);
+  EXPECT_FALSE(map.is_known({19, 33}));  // no surface read: no floor either
+  // A later scan from farther back sees nothing over those cells (its rays clearing the edge end beyond 6 m): only
+  // the latest scan counts.
+  const Point3 back = sensor_origin(truth, 6.375, 5.125, camera);
+  map.integrate_scan(cast_scan(truth, back, 0.0, camera, 2), back);
+  EXPECT_FALSE(map.overflown({19, 33}));
+}
+
 }  // namespace marsala::agent::executive

@@ -8,12 +8,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <set>
 #include <utility>
 #include <vector>
 
 #include "marsala/core/error.hpp"
+#include "marsala/core/ray_caster.hpp"
+#include "marsala/core/sensor_spec.hpp"
 #include "unit/agent/agent_test_support.hpp"
 #include "unit/agent/mini_world.hpp"
 
@@ -520,6 +523,66 @@ TEST(PathBuilder, InAPipelineOnlyTheActiveRobotDeposits) {
   }
   EXPECT_EQ(builders.size(), robots.size());
   for (PathState s : expected) EXPECT_EQ(states.count(s), 1u) << to_string(s);
+}
+
+
+// docs/runtime.md#mapping, "Under the rays": an RGB-D path builder (path_generated.pbtxt's builder, 0.25 m cells) at
+// the edge of a 3 m cliff, its centre 0.625 m back from the edge (the nearest its body stands on the top), facing
+// the basin. The edge hides the cliff's foot from its camera, 0.5 m up, out to 6 x 0.625 = 3.75 m beyond the edge,
+// and its hits on the basin floor beyond lie 5.7-6 m away, too noisy to place in a cell: no cell within its 2 m
+// reach below the edge is ever read. But the rays that clear the edge pass over those cells: each stands below the
+// lowest one that crossed it, so it may be raised by the MARS height of the known cells less that ray's height, and
+// it ends no higher than that, whatever its depth. Within a few scans from that pose the robot deposits on such
+// cells, unknown on its map, and each deposit leaves its cell under the MARS bound of the true terrain at the
+// construction's kappa (brute force here). Before the rule it deposited nothing there and stood at the edge for good.
+TEST(PathBuilder, AScanningFrontFillsTheUnseenFootOfACliffUnderItsRays) {
+  Heightmap h({40, 80, 0.0, 0.0, 0.25}, 0.0);
+  for (int r = 0; r < h.rows(); ++r)
+    for (int c = 0; c < 32; ++c) h(r, c) = 3.0;  // the top: x < 8 m
+  RobotBody body;
+  body.navigability = {0.3, 1.0, 0.05};
+  body.max_step_m = 0.25;
+  body.max_deposit_m3 = 0.05;
+  body.material_capacity_m3 = 1.0;
+  body.reach_m = 2.0;
+  body.sensing_range_m = 5.0;
+  body.proximity_range_m = 4.0;
+  body.cube_size_m = 0.1;
+  AgentContext c = test::agent_context(1, body);
+  c.type.construction = NavigabilityParams{0.2, 3.0, 0.05};
+  c.type.pipeline.separation_m = 2.0;
+  c.type.sensor = sensor_defaults(SensorKind::kRgbd);
+  const Position robot{7.375, 5.125};  // col 29: the edge at x = 8 m is 0.625 m east
+  PathBuilder b(c);
+  b.on_admission(test::admission_on(c, h.geometry(), {18.125, 5.125}, {1.125, 5.125}));
+  const Point3 origin = sensor_origin(h, robot.x, robot.y, c.type.sensor);
+  const auto bound = [&](CellIndex p) {  // P_0.2 of the true terrain at p
+    double best = -std::numeric_limits<double>::infinity();
+    const Position at = h.cell_center(p);
+    for (int r = 0; r < h.rows(); ++r)
+      for (int col = 0; col < h.cols(); ++col) best = std::max(best, h(r, col) - 0.2 * distance(at, h.cell_center({r, col})));
+    return best;
+  };
+  std::vector<Deposition> unseen;
+  for (std::uint64_t step = 0; step < 6 && unseen.empty(); ++step) {
+    protocol::SensorFrame f;
+    f.agent_id = 1;
+    f.step = step;
+    f.x_m = robot.x;
+    f.y_m = robot.y;
+    f.z_m = 3.0;
+    f.material_m3 = 1.0;
+    f.scanned = true;
+    f.points = cast_scan(h, origin, 0.0, c.type.sensor, step + 1);  // looking east
+    const protocol::ActionRequest q = b.decide(f);
+    for (const Deposition& d : q.depositions) {
+      const CellIndex cell{d.row, d.col};
+      EXPECT_LE(h(cell) + d.height_m, bound(cell) + 1e-9) << "step " << step << ": (" << d.row << ", " << d.col << ")";
+      if (!b.map().is_known(cell)) unseen.push_back(d);
+    }
+  }
+  ASSERT_FALSE(unseen.empty()) << "no deposit below the edge";
+  for (const Deposition& d : unseen) EXPECT_GE(d.col, 32) << "below the edge";
 }
 
 }  // namespace
