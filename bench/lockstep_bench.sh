@@ -2,17 +2,20 @@
 # Lockstep benchmark: the wall time of one world step with 1, 4 and 12 (--teams: up to 120) idle agent processes
 # (behaviour "idle": an empty request per frame), beside the raw DDS round trip measured in the same run, as a ratio.
 # Reports the world's per-step median and 90th percentile (summary.json) over --steps steps.
-# Usage: bench/lockstep_bench.sh [--dds cyclone|fastdds] [--steps N] [--teams "1 4 12"]
+# Usage: bench/lockstep_bench.sh [--dds cyclone|fastdds] [--steps N] [--teams "1 4 12"] [--dds-config FILE]
+#   --dds-config  a profile of the vendor for every process (default deploy/dds/<vendor>-lo.xml), e.g.
+#                 deploy/dds/fastdds-crowd.xml for Fast DDS with many agents
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${MARSALA_BUILD_DIR:-$root/build}"
-dds=cyclone steps=2000 teams="1 4 12"
+dds=cyclone steps=2000 teams="1 4 12" profile=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --dds) dds="$2"; shift 2 ;;
     --steps) steps="$2"; shift 2 ;;
     --teams) teams="$2"; shift 2 ;;
-    -h|--help) sed -n '2,5p' "$0"; exit 0 ;;
+    --dds-config) profile="$2"; shift 2 ;;
+    -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
     *) echo "lockstep_bench.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -46,6 +49,12 @@ scenario="$work/idle.pbtxt"
 
 export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
 export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-lo.xml"
+if [ -n "$profile" ]; then
+  [ -f "$profile" ] || { echo "lockstep_bench.sh: --dds-config: no file '$profile'" >&2; exit 2; }
+  profile="$(cd "$(dirname "$profile")" && pwd)/$(basename "$profile")"
+  if [ "$dds" = cyclone ]; then export CYCLONEDDS_URI="file://$profile"; else export FASTRTPS_DEFAULT_PROFILES_FILE="$profile"; fi
+  export MARSALA_DDS_CONFIG="$profile"  # the world's and agents' (spawn.sh sets the vendors' variables to its own)
+fi
 field() { grep -o "\"$1\": *[^,}]*" "$2" | head -1 | sed 's/^[^:]*: *//; s/"//g'; }
 
 raw_us=$("$build/bench/bus_pingpong_bench" --benchmark_filter="BM_BusPingPong/$dds/" --benchmark_repetitions=3 \

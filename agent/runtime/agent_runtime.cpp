@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <mutex>
 #include <optional>
 #include <random>
 #include <vector>
@@ -203,22 +205,37 @@ class AgentRuntime::Lockstep {
         result_(result),
         partition_(protocol::partition_for(admission.run_id, agent.config_.agent_id, agent.config_.session)),
         signal_(std::make_shared<bus::Signal>()),
-        frames_(agent.participant_.create_reader<protocol::SensorFrame>(
-            {partition_, signal_, bus::Durability::kVolatile, 64})),
         requests_(agent.participant_.create_writer<protocol::ActionRequest>(
             {partition_, nullptr, bus::Durability::kVolatile, 64})),
         gate_(agent.config_.agent_id, agent.assignment_, agent.config_.type.sensor, agent.world_),
-        watch_(Clock::now(), agent.config_.world_timeout, agent.config_.hello_period) {}
+        watch_(Clock::now(), agent.config_.world_timeout, agent.config_.hello_period),
+        frames_(agent.participant_.create_reader<protocol::SensorFrame>(
+            {partition_, signal_, bus::Durability::kVolatile, 64, [this] { on_frames(); }})) {
+    // Frames that came while the reader was being made wait in its queue for run()'s first turn.
+    std::lock_guard<std::mutex> lock(mutex_);
+    armed_ = true;
+  }
 
   /// Until the run is over, the world is silent for world_timeout or no longer counts this agent in, or `stop`.
+  /// Frames are taken where they arrive (on_frames()); this thread keeps the world watch and takes what came before.
   void run(const std::atomic<bool>& stop) {
-    while (!stop.load()) {
+    Closing closing{*this};  // whichever way this returns, the bus's thread takes no frame afterwards
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!stop.load() && !over_) {
+      // Asked before the lock: a backend calls on_frames() holding its reader's locks, which this query takes.
+      lock.unlock();
+      const bool writer_alive = frames_->alive_writers() >= 1;
+      lock.lock();
+      if (over_) break;
       const Clock::time_point now = Clock::now();
-      if (!world_still_there(now) || !still_counted_in()) return;
-      signal_->wait_until(std::min(watch_.wake_by(), now + kStopPoll));
-      for (const bus::Received<protocol::SensorFrame>& received : frames_->take_received())
-        if (take(received)) return;
+      if (!world_still_there(now, writer_alive) || !still_counted_in() || take_frames()) return;
+      const Clock::time_point wake_by = std::min(watch_.wake_by(), now + kStopPoll);
+      lock.unlock();
+      signal_->wait_until(wake_by);
+      lock.lock();
     }
+    if (failure_) std::rethrow_exception(failure_);
+    if (over_) return;  // the run-over frame, taken on the bus's thread
     result_.outcome = RunOutcome::kStopped;
     result_.message = fmt::format("stopped at step {}", result_.last_step);
   }
@@ -227,8 +244,8 @@ class AgentRuntime::Lockstep {
   std::uint32_t id() const { return agent_.config_.agent_id; }
 
   /// The world watch's turn: false (and the outcome) at the silence limit; says a silence once, and hello when it asks.
-  bool world_still_there(Clock::time_point now) {
-    const WatchTurn turn = watch_.turn(now, [this] { return frames_->alive_writers() >= 1; });
+  bool world_still_there(Clock::time_point now, bool writer_alive) {
+    const WatchTurn turn = watch_.turn(now, [writer_alive] { return writer_alive; });
     if (turn.state == WorldState::kWorldTimeout) {
       result_.outcome = RunOutcome::kWorldTimeout;
       result_.message = fmt::format("no sensor frame for {} s (last step {}; --world-timeout)",
@@ -278,6 +295,37 @@ class AgentRuntime::Lockstep {
     }
     return true;
   }
+
+  /// Frames as they arrive, on the bus's thread (bus::EndpointOptions::on_data): the gate, the decision and the
+  /// request are done there, so a step wakes one thread of this process, not the bus's and then the loop's (README
+  /// "Idle robots up to 120"). A failure is handed to the loop, which throws it.
+  void on_frames() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!armed_ || over_) return;
+    try {
+      if (!take_frames()) return;
+    } catch (...) {
+      failure_ = std::current_exception();
+    }
+    over_ = true;
+    signal_->notify();
+  }
+
+  /// Every frame received so far through the gate, in order; true when the run is over. Called with mutex_ held.
+  bool take_frames() {
+    for (const bus::Received<protocol::SensorFrame>& received : frames_->take_received())
+      if (take(received)) return true;
+    return false;
+  }
+
+  /// Ends the bus thread's part when run() returns, whichever way: it takes no frame after that.
+  struct Closing {
+    Lockstep& lockstep;
+    ~Closing() {
+      std::lock_guard<std::mutex> lock(lockstep.mutex_);
+      lockstep.over_ = true;
+    }
+  };
 
   /// One received frame through the gate; true when the run is over.
   bool take(const bus::Received<protocol::SensorFrame>& received) {
@@ -346,11 +394,16 @@ class AgentRuntime::Lockstep {
   RunResult& result_;
   std::string partition_;
   std::shared_ptr<bus::Signal> signal_;
-  std::unique_ptr<bus::Reader<protocol::SensorFrame>> frames_;
+  std::mutex mutex_;  // the lockstep's state below, shared by the loop and the bus's thread (on_frames())
+  bool armed_ = false;  // the reader is made: on_frames() may take frames
+  bool over_ = false;   // the run is over (or failed, or run() returned): frames are no longer taken
+  std::exception_ptr failure_;  // what on_frames() met, thrown by run()
   std::unique_ptr<bus::Writer<protocol::ActionRequest>> requests_;
   FrameGate gate_;
   WorldWatch watch_;
   DecisionCosts costs_;
+  // Last: made once everything on_frames() uses exists, and gone (its callbacks over) before any of it goes.
+  std::unique_ptr<bus::Reader<protocol::SensorFrame>> frames_;
 };
 
 void AgentRuntime::end_admitted(const RunResult& result, bool failed) const {

@@ -10,8 +10,10 @@
 //   no frame for 2 s: hello again                      ──▶  world      (refused, e.g. dropped for good: kRefused;
 //                                                                       accepted: still in, or re-admitted)
 //
-// Single-threaded: the bus backends queue samples on their own threads and wake this one through a Signal; the
-// behaviour's decide() runs here, never in a backend callback.
+// Threads: admission and the world watch run on the caller's thread; a frame is taken, decided and answered on the
+// bus's thread that received it (bus::EndpointOptions::on_data), under the lockstep's lock, so that a step wakes one
+// thread of the process, not two; what the behaviour throws there is thrown by run(). Frames that came before the
+// lockstep was ready are taken by the caller's thread.
 
 #include <atomic>
 #include <chrono>

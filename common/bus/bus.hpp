@@ -8,13 +8,15 @@
 //   auto frames = participant->create_reader<protocol::SensorFrame>({protocol::partition_for(run, id), signal});
 //   while (signal->wait_for(100ms)) for (auto& f : frames->take()) ...
 //
-// Threads: backends deliver on their own threads; readers queue samples and notify the endpoint's Signal.
-// Nothing escapes a backend callback. take() and write() may be called from any thread.
+// Threads: backends deliver on their own threads; readers queue samples and notify the endpoint's Signal, or call its
+// on_data handler on the backend's thread instead (the sample is then taken without waking another thread). Nothing
+// escapes a backend callback. take() and write() may be called from any thread.
 
 #include <array>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -63,9 +65,14 @@ enum class Durability { kVolatile, kTransientLocal };
 /// Options of one reader or writer.
 struct EndpointOptions {
   std::string partition;           ///< empty = the default partition
-  std::shared_ptr<Signal> signal;  ///< readers: notified on data and on writer liveliness changes
+  std::shared_ptr<Signal> signal;  ///< readers: notified on data (unless on_data) and on writer liveliness changes
   Durability durability = Durability::kVolatile;
   std::int32_t depth = 64;  ///< KEEP_LAST history depth per instance
+  /// Readers: when set, called on the backend's thread each time samples were queued, in place of notifying `signal`
+  /// (which then wakes only on writer liveliness and match changes). It may take the samples and write on other
+  /// endpoints, but not on a topic this process also reads (Cyclone delivers to local readers on the writing thread,
+  /// and waits for their running callbacks); it must not throw, wait for long, nor destroy the reader.
+  std::function<void()> on_data{};
 };
 
 /// Writes samples of one message type.

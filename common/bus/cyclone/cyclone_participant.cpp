@@ -287,7 +287,7 @@ template <typename T>
 class CycloneReader final : public Reader<T> {
  public:
   CycloneReader(std::shared_ptr<Context> context, const EndpointOptions& options)
-      : context_(std::move(context)), filter_(options.durability), queue_(options.signal) {
+      : context_(std::move(context)), filter_(options.durability), queue_(options.signal, options.on_data) {
     check_options(options);
     const dds_entity_t topic = context_->template topic<T>();
     Qos sub_qos;

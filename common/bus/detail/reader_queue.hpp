@@ -1,9 +1,11 @@
 #pragma once
 // The part of a DDS reader both backends share: samples converted on the vendor's listener thread are queued
-// here until take(), and the endpoint's Signal is notified on data and on writer liveliness or match changes.
+// here until take(); the endpoint's on_data handler is called on that thread when samples come (else its Signal is
+// notified), and its Signal on writer liveliness or match changes.
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <utility>
@@ -41,9 +43,11 @@ class VolatileFilter {
 template <typename T>
 class ReaderQueue {
  public:
-  explicit ReaderQueue(std::shared_ptr<Signal> signal) : signal_(std::move(signal)) {}
+  explicit ReaderQueue(std::shared_ptr<Signal> signal, std::function<void()> on_data = {})
+      : signal_(std::move(signal)), on_data_(std::move(on_data)) {}
 
-  /// Appends samples in arrival order and wakes the waiter (nothing to append = no wake-up).
+  /// Appends samples in arrival order, then calls the on_data handler, or else wakes the waiter (nothing to append =
+  /// neither). The queue is not locked while the handler runs: it may take().
   void push(std::vector<Received<T>>&& samples) {
     if (samples.empty()) return;
     {
@@ -54,7 +58,10 @@ class ReaderQueue {
         for (Received<T>& s : samples) queue_.push_back(std::move(s));
       }
     }
-    notify();
+    if (on_data_)
+      on_data_();
+    else
+      notify();
   }
   /// Everything queued since the last take.
   std::vector<Received<T>> take() {
@@ -70,6 +77,7 @@ class ReaderQueue {
 
  private:
   std::shared_ptr<Signal> signal_;
+  std::function<void()> on_data_;
   std::mutex mutex_;
   std::vector<Received<T>> queue_;
 };

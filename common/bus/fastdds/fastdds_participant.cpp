@@ -446,7 +446,8 @@ class FastDdsReader final : public Reader<T> {
   /// Converts and queues samples on Fast DDS's thread; nothing may escape into it.
   class Listener final : public dds::DataReaderListener {
    public:
-    explicit Listener(const EndpointOptions& options) : filter(options.durability), queue(options.signal) {}
+    explicit Listener(const EndpointOptions& options)
+        : filter(options.durability), queue(options.signal, options.on_data) {}
 
     void on_data_available(dds::DataReader* reader) override {
       try {

@@ -37,7 +37,10 @@ class InProcessReader final : public Reader<T> {
       std::lock_guard<std::mutex> lock(mutex_);
       queue_.push_back(sample);
     }
-    notify();
+    if (options_.on_data)
+      options_.on_data();  // on the writer's thread, as a DDS backend calls it on its own
+    else
+      notify();
   }
   void notify() const {
     if (options_.signal) options_.signal->notify();

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <thread>
+#include <vector>
 
 #include "marsala/bus/bus.hpp"
 #include "marsala/core/error.hpp"
@@ -73,6 +74,31 @@ TEST(InProcessBus, WriterLivelinessAndWakeUps) {
   EXPECT_TRUE(signal->wait_for(5s));  // woken when the writer goes
   killer.join();
   EXPECT_EQ(reader->alive_writers(), 0);
+}
+
+// A reader with an on_data handler: the handler runs when a sample comes (on the writing thread here, on the DDS
+// backend's own thread there) and can take it at once; the Signal is then left for writers coming and going.
+TEST(InProcessBus, AnOnDataHandlerTakesSamplesInPlaceOfTheSignal) {
+  auto participant = make_participant({Vendor::kInProcess, 16});
+  auto signal = std::make_shared<Signal>();
+  std::vector<std::uint64_t> taken;
+  std::vector<std::thread::id> threads;
+  std::unique_ptr<Reader<SensorFrame>> reader;
+  reader = participant->create_reader<SensorFrame>({"run/agent-4", signal, Durability::kVolatile, 64, [&] {
+                                                      threads.push_back(std::this_thread::get_id());
+                                                      for (const SensorFrame& f : reader->take()) taken.push_back(f.step);
+                                                    }});
+  auto writer = participant->create_writer<SensorFrame>({"run/agent-4", nullptr});
+  EXPECT_TRUE(signal->wait_for(0ms));  // a writer came: still signalled
+  for (std::uint64_t step = 0; step < 3; ++step) {
+    SensorFrame f;
+    f.step = step;
+    writer->write(f);
+    ASSERT_EQ(taken.size(), step + 1) << "taken before write() returned";
+  }
+  EXPECT_EQ(taken, (std::vector<std::uint64_t>{0, 1, 2}));
+  EXPECT_EQ(threads, std::vector<std::thread::id>(3, std::this_thread::get_id()));
+  EXPECT_FALSE(signal->wait_for(0ms));  // data alone does not signal
 }
 
 TEST(Bus, NamesAndErrors) {

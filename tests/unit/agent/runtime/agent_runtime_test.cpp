@@ -73,6 +73,8 @@ struct ScriptedWorld {
   std::uint64_t hellos_seen = 0;
   /// Called before the frame of each step is written, with the agent's partition and the world's frame writer.
   std::function<void(int step, const std::string& partition, bus::Writer<protocol::SensorFrame>& frames)> before_frame;
+  /// Steps whose request was there as soon as the frame's write() returned [count].
+  int answered_within_write = 0;
 
   protocol::AgentHello wait_hello(bus::Reader<protocol::AgentHello>& hellos, bus::Signal& signal) {
     const auto deadline = Clock::now() + 5s;
@@ -127,6 +129,12 @@ struct ScriptedWorld {
       if (f.run_over) break;
       const auto deadline = Clock::now() + 5s;
       bool answered = false;
+      // The in-process bus delivers on the writing thread, where the agent answers (on_data): before write() returned.
+      for (auto& q : requests->take()) {
+        answered = answered || q.step == f.step;
+        answered_within_write += q.step == f.step ? 1 : 0;
+        got.push_back(std::move(q));
+      }
       while (!answered && Clock::now() < deadline) {
         signal->wait_for(50ms);
         for (auto& q : requests->take()) {
@@ -165,6 +173,9 @@ TEST(AgentRuntime, HelloAdmissionLockstepAndRunOver) {
   }
   EXPECT_NE(agent.config().session, 0u);
   EXPECT_EQ(agent.config().name, "agent-4");
+  // Every frame after the first (which may come before the lockstep is ready, and is then taken by the loop) is
+  // decided and answered on the thread that delivered it, without waking the agent's own thread.
+  EXPECT_GE(world.answered_within_write, 4);
 }
 
 /// A ramp builder (agent 4) dumping its map into `dir`, run against the scripted world of `domain` admitting it to
