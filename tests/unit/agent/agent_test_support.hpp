@@ -142,4 +142,18 @@ inline protocol::SensorFrame keep_tile_at(protocol::SensorFrame f, const GridGeo
   return f;
 }
 
+/// A scanning robot's frame of `step` for agent `id` at `robot` [m] (z_m [m] under it), with 1 m^3 on board and no
+/// points yet.
+inline protocol::SensorFrame scan_frame(std::uint32_t id, std::uint64_t step, Position robot, double z_m = 0.0) {
+  protocol::SensorFrame f;
+  f.agent_id = id;
+  f.step = step;
+  f.x_m = robot.x;
+  f.y_m = robot.y;
+  f.z_m = z_m;
+  f.material_m3 = 1.0;
+  f.scanned = true;
+  return f;
+}
+
 }  // namespace marsala::agent::test

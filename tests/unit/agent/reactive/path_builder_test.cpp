@@ -539,8 +539,7 @@ TEST(PathBuilder, AScanningFrontFillsTheUnseenFootOfACliffUnderItsRays) {
   Heightmap h({40, 80, 0.0, 0.0, 0.25}, 0.0);
   for (int r = 0; r < h.rows(); ++r)
     for (int c = 0; c < 32; ++c) h(r, c) = 3.0;  // the top: x < 8 m
-  RobotBody body;
-  body.navigability = {0.3, 1.0, 0.05};
+  RobotBody body = test::husky(0.3);  // a Husky on 0.25 m cells: longer steps and reach, 0.1 m cubes
   body.max_step_m = 0.25;
   body.max_deposit_m3 = 0.05;
   body.material_capacity_m3 = 1.0;
@@ -565,14 +564,7 @@ TEST(PathBuilder, AScanningFrontFillsTheUnseenFootOfACliffUnderItsRays) {
   };
   std::vector<Deposition> unseen;
   for (std::uint64_t step = 0; step < 6 && unseen.empty(); ++step) {
-    protocol::SensorFrame f;
-    f.agent_id = 1;
-    f.step = step;
-    f.x_m = robot.x;
-    f.y_m = robot.y;
-    f.z_m = 3.0;
-    f.material_m3 = 1.0;
-    f.scanned = true;
+    protocol::SensorFrame f = test::scan_frame(1, step, robot, 3.0);
     f.points = cast_scan(h, origin, 0.0, c.type.sensor, step + 1);  // looking east
     const protocol::ActionRequest q = b.decide(f);
     for (const Deposition& d : q.depositions) {

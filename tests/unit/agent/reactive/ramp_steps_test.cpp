@@ -737,16 +737,7 @@ std::unique_ptr<RampSteps> laser_steps(const Heightmap& h) {
 }
 
 /// A scanning robot's frame of `step` at `robot` [m], with 1 m^3 on board and no points yet.
-protocol::SensorFrame scan_frame(std::uint64_t step, Position robot) {
-  protocol::SensorFrame f;
-  f.agent_id = 3;
-  f.step = step;
-  f.x_m = robot.x;
-  f.y_m = robot.y;
-  f.material_m3 = 1.0;
-  f.scanned = true;
-  return f;
-}
+protocol::SensorFrame scan_frame(std::uint64_t step, Position robot) { return test::scan_frame(3, step, robot); }
 
 // A laser robot before a 0.3 m step: the MARS gap in front of it is real, but it fills it only once its last 3 scans
 // in a row all showed it on cells they hit (kConfirmScans): one scan's misread step is no gap. Each frame here
