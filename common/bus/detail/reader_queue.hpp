@@ -1,7 +1,7 @@
 #pragma once
-// The part of a DDS reader both backends share: samples converted on the vendor's listener thread are queued
-// here until take(); the endpoint's on_data handler is called on that thread when samples come (else its Signal is
-// notified), and its Signal on writer liveliness or match changes.
+// The part of a reader every backend shares: samples delivered on the vendor's listener thread (the writer's thread
+// in process) are queued here until take(); the endpoint's on_data handler is called on that thread when samples come
+// (else its Signal is notified), and its Signal on writer liveliness or match changes.
 
 #include <chrono>
 #include <cstdint>

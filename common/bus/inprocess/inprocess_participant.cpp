@@ -11,6 +11,7 @@
 
 #include "marsala/bus/detail/backends.hpp"
 #include "marsala/bus/detail/participant_base.hpp"
+#include "marsala/bus/detail/reader_queue.hpp"
 
 namespace marsala::bus::detail {
 namespace {
@@ -21,37 +22,23 @@ class Hub;
 template <typename T>
 class InProcessReader final : public Reader<T> {
  public:
-  InProcessReader(std::shared_ptr<Hub<T>> hub, EndpointOptions options) : hub_(std::move(hub)), options_(options) {}
+  InProcessReader(std::shared_ptr<Hub<T>> hub, EndpointOptions options)
+      : hub_(std::move(hub)), options_(options), queue_(options_.signal, options_.on_data) {}
   ~InProcessReader() override { hub_->remove_reader(this); }
 
-  std::vector<Received<T>> take_received() override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    std::vector<Received<T>> out;
-    out.swap(queue_);
-    return out;
-  }
+  std::vector<Received<T>> take_received() override { return queue_.take(); }
   int alive_writers() const override { return hub_->writers_in(options_.partition); }
 
-  void deliver(const Received<T>& sample) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      queue_.push_back(sample);
-    }
-    if (options_.on_data)
-      options_.on_data();  // on the writer's thread, as a DDS backend calls it on its own
-    else
-      notify();
-  }
-  void notify() const {
-    if (options_.signal) options_.signal->notify();
-  }
+  /// Queues the sample and calls the on_data handler on the writer's thread, as a DDS backend calls it on its own
+  /// (else wakes the reader's Signal).
+  void deliver(const Received<T>& sample) { queue_.push({sample}); }
+  void notify() const { queue_.notify(); }
   const EndpointOptions& options() const { return options_; }
 
  private:
   std::shared_ptr<Hub<T>> hub_;
   EndpointOptions options_;
-  std::mutex mutex_;
-  std::vector<Received<T>> queue_;
+  ReaderQueue<T> queue_;
 };
 
 template <typename T>
