@@ -18,6 +18,7 @@ WorldWatch::WorldWatch(Clock::time_point now, std::chrono::milliseconds world_ti
                        std::chrono::milliseconds hello_period)
     : world_timeout_(world_timeout),
       hello_period_(hello_period),
+      hello_gap_(hello_period),
       deadline_(limit_from(now, world_timeout)),
       last_frame_at_(now),
       next_hello_(now + kRehelloAfter),
@@ -52,25 +53,42 @@ WatchTurn WorldWatch::turn(Clock::time_point now, const std::function<bool()>& w
     turn.paused_s = seconds(now - last_turn_);
     turn.hello = true;
     asked_ = true;
+    hello_gap_ = hello_period_;
     next_hello_ = now + hello_period_;
   }
   last_turn_ = now;
-  if (now - last_frame_at_ >= kRehelloAfter && now >= next_hello_) {
+  if (now - last_frame_at_ >= quiet_limit() && now >= next_hello_) {
     if (!asked_) turn.no_frame_s = seconds(now - last_frame_at_);
     turn.hello = true;
     asked_ = true;
-    next_hello_ = now + hello_period_;
+    next_hello_ = now + hello_gap_;
   }
   return turn;
 }
 
 bool WorldWatch::frame(Clock::time_point now) {
   sign_since_turn_ = true;
+  if (framed_) gaps_[gap_count_++ % kPaceFrames] = now - last_frame_at_;
+  framed_ = true;
   last_frame_at_ = now;
   deadline_ = limit_from(now, world_timeout_);
   const bool was_asking = asked_;
   asked_ = false;
+  hello_gap_ = hello_period_;
+  next_hello_ = now;  // the next silence asks after quiet_limit()
   return was_asking;
+}
+
+void WorldWatch::answered() {
+  sign_since_turn_ = true;
+  hello_gap_ = std::max<std::chrono::milliseconds>(hello_period_,
+                                                  std::min<std::chrono::milliseconds>(hello_gap_ * 2, kStillInRecheck));
+}
+
+WorldWatch::Clock::duration WorldWatch::quiet_limit() const {
+  Clock::duration longest{0};
+  for (std::size_t i = 0; i < std::min(gap_count_, kPaceFrames); ++i) longest = std::max(longest, gaps_[i]);
+  return std::clamp<Clock::duration>(kPaceMultiple * longest, kRehelloAfter, kLongestPace);
 }
 
 WorldWatch::Clock::time_point WorldWatch::wake_by() const {

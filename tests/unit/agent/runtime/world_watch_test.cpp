@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <vector>
+
 namespace marsala::agent::runtime {
 namespace {
 
@@ -121,6 +123,59 @@ TEST(WorldWatch, ASilenceAsksEveryHelloPeriodUntilAFrame) {
   EXPECT_FALSE(watch.frame(kT0 + 2400ms));
   for (auto t = 2500ms; t < 4400ms; t += 100ms) EXPECT_FALSE(watch.turn(kT0 + t, kAlive).hello) << t.count() << " ms";
   EXPECT_TRUE(watch.turn(kT0 + 4400ms, kAlive).hello);
+}
+
+/// The times (from kT0) of the hellos `watch` asks for on turns every 100 ms in [from, to), the world answering each
+/// one at once when `answer` (a world still admitting its team: it counts this agent in and sends no frame yet).
+std::vector<Clock::duration> hellos_between(WorldWatch& watch, Clock::duration from, Clock::duration to, bool answer) {
+  std::vector<Clock::duration> at;
+  for (Clock::duration t = from; t < to; t += 100ms) {
+    if (!watch.turn(kT0 + t, kAlive).hello) continue;
+    at.push_back(t);
+    if (answer) watch.answered();
+  }
+  return at;
+}
+
+TEST(WorldWatch, EachAnswerThatTheWorldStillCountsTheAgentInDoublesTheGapUpToTheRecheck) {
+  WorldWatch watch(kT0, 60s, 200ms);  // a silence limit beyond the test's minute
+  // First hello at 2 s, then gaps 0.2, 0.4, 0.8, 1.6, 3.2, 6.4 s, then kStillInRecheck (8 s).
+  const std::vector<Clock::duration> expected = {2000ms, 2200ms, 2600ms, 3400ms, 5000ms,
+                                                 8200ms, 14600ms, 22600ms, 30600ms};
+  EXPECT_EQ(hellos_between(watch, 100ms, 31s, true), expected);
+  // A frame ends the silence: the next one starts over at the hello period.
+  watch.frame(kT0 + 31s);
+  const std::vector<Clock::duration> again = {33000ms, 33200ms};  // 2 s after the frame, then the hello period
+  EXPECT_EQ(hellos_between(watch, 31100ms, 33500ms, true), again);
+  // Unanswered hellos (the world silent) keep the hello period.
+  WorldWatch unanswered = watch_from_t0();
+  EXPECT_EQ(hellos_between(unanswered, 100ms, 3s, false).size(), 5u);  // 2.0, 2.2, 2.4, 2.6, 2.8 s
+}
+
+TEST(WorldWatch, AWorldSteppingSlowlyIsAskedOnlyAfterThreeTimesItsRecentPace) {
+  WorldWatch watch = watch_from_t0();
+  // Frames 3 s apart (a crowd on a loaded host): no hello between them; before, one went 2 s after each frame. The
+  // pace needs a gap first: 1 s, then 2.5 s (under 3 x 1 s), then 3 s (under 3 x 2.5 s).
+  const std::vector<Clock::duration> frames = {1000ms, 2000ms, 4500ms, 7500ms, 10500ms, 13500ms};
+  Clock::duration last{0};
+  for (const Clock::duration f : frames) {
+    EXPECT_TRUE(hellos_between(watch, last + 100ms, f, true).empty()) << "before the frame at " << f.count();
+    watch.frame(kT0 + f);
+    last = f;
+  }
+  EXPECT_EQ(watch.quiet_limit(), Clock::duration(kPaceMultiple * 3s));
+  // Silent after the frame at 13.5 s: asked at 13.5 + 9 s.
+  const std::vector<Clock::duration> first = hellos_between(watch, 13600ms, 25s, true);
+  ASSERT_FALSE(first.empty());
+  EXPECT_EQ(first.front(), 22500ms);
+  // The pace follows the latest kPaceFrames gaps: fast frames again bring it back to kRehelloAfter.
+  for (std::size_t k = 1; k <= kPaceFrames + 1; ++k) watch.frame(kT0 + 25s + 100ms * k);
+  EXPECT_EQ(watch.quiet_limit(), Clock::duration(kRehelloAfter));
+  // And a world pausing for minutes is still asked after kLongestPace at the latest.
+  WorldWatch paused = watch_from_t0();
+  paused.frame(kT0 + 1s);
+  paused.frame(kT0 + 1s + 10min);
+  EXPECT_EQ(paused.quiet_limit(), Clock::duration(kLongestPace));
 }
 
 TEST(WorldWatch, AFrameRestartsTheSilenceLimit) {
