@@ -23,8 +23,8 @@ void fast_repair(eprosima::fastrtps::rtps::ReaderTimes& times);
 
 /// A writer that serves one reader heartbeats this many times as often as the profile's period [count]: the
 /// profile's period is the one of a writer that serves the team (the world's status, events and admissions, read by
-/// every agent and monitor); an agent's writers serve the world alone, and the world's writers in an agent's
-/// partition (its frames, the critical path of every step) serve that agent alone.
+/// every agent and monitor, and an agent's hellos); the writers in an agent's partition serve one reader: the agent's
+/// requests the world, the world's frames (the critical path of every step) that agent.
 inline constexpr int kOneReaderHeartbeatDivisor = 10;
 /// The shortest heartbeat period follow_team() gives [ms].
 inline constexpr std::chrono::milliseconds kShortestHeartbeat{5};
