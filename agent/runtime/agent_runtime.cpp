@@ -8,6 +8,7 @@
 #include <mutex>
 #include <optional>
 #include <random>
+#include <set>
 #include <vector>
 
 #include "marsala/agent/runtime/frame_gate.hpp"
@@ -131,14 +132,25 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
   spdlog::info("agent {} ({}, {}): saying hello, session {:016x}", config_.agent_id, config_.name,
                config_.type.behaviour, config_.session);
 
-  const Clock::time_point deadline = Clock::now() + config_.admit_timeout;
+  // The admit timeout counts from the latest agent the world admitted for the first time: a world admitting a crowd
+  // one by one is not gone (docs/runtime.md#admission); kAdmitProgressCap timeouts at the most.
+  const Clock::time_point started = Clock::now();
+  const Clock::time_point latest_deadline = started + kAdmitProgressCap * config_.admit_timeout;
+  Clock::time_point deadline = started + config_.admit_timeout;
+  std::set<std::uint32_t> others_admitted;
   Clock::time_point next_hello = Clock::now();
   while (!stop.load()) {
     const Clock::time_point now = Clock::now();
     if (now >= deadline) {
       result.outcome = RunOutcome::kAdmitTimeout;
-      result.message = fmt::format("not admitted within {} s (is marsala-world running on this DDS domain?)",
-                                   config_.admit_timeout.count() / 1000.0);
+      result.message =
+          others_admitted.empty()
+              ? fmt::format("not admitted within {} s (is marsala-world running on this DDS domain?)",
+                            config_.admit_timeout.count() / 1000.0)
+              : fmt::format("not admitted within {} s, while the world admitted {} other agents (the last more than "
+                            "{} s ago)",
+                            std::chrono::duration<double>(now - started).count(), others_admitted.size(),
+                            config_.admit_timeout.count() / 1000.0);
       return false;
     }
     if (now >= next_hello) {
@@ -149,7 +161,11 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
     for (const bus::Received<protocol::Admission>& received : admissions->take_received()) {
       const protocol::Admission& a = received.sample;
       const bool any_slot = config_.agent_id == 0;
-      if (a.session != config_.session || (!any_slot && a.agent_id != config_.agent_id)) continue;  // not ours
+      if (a.session != config_.session || (!any_slot && a.agent_id != config_.agent_id)) {  // not ours
+        if (a.accepted && a.agent_id != config_.agent_id && others_admitted.insert(a.agent_id).second)
+          deadline = std::min(latest_deadline, std::max(deadline, Clock::now() + config_.admit_timeout));
+        continue;
+      }
       if (!from_world(a, received.from, result)) continue;
       if (!a.accepted) {
         result.outcome = RunOutcome::kRefused;

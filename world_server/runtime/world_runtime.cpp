@@ -381,7 +381,12 @@ struct WorldRuntime::Impl {
   /// Waits for the expected agents: until all are admitted and ready, the admit timeout or `stop`. Throws Error when
   /// none was admitted.
   void admit_agents(const std::atomic<bool>& stop) {
-    const Clock::time_point deadline = Clock::now() + seconds(options.admit_timeout_s);
+    // The timeout counts from the latest admission: a crowd admitted one by one is still coming
+    // (docs/runtime.md#start-of-the-run); kAdmitProgressCap timeouts at the most.
+    const Clock::time_point started = Clock::now();
+    const Clock::time_point latest_deadline = started + kAdmitProgressCap * seconds(options.admit_timeout_s);
+    Clock::time_point deadline = started + seconds(options.admit_timeout_s);
+    std::size_t admitted_before = 0;
     const std::size_t expected = state.agents.size() - late_slots().size();
     for (;;) {
       service_hellos(true);
@@ -395,6 +400,9 @@ struct WorldRuntime::Impl {
       }
       if (admitted == expected && all_ready) return;
       const Clock::time_point now = Clock::now();
+      if (admitted > admitted_before)
+        deadline = std::min(latest_deadline, std::max(deadline, now + seconds(options.admit_timeout_s)));
+      admitted_before = admitted;
       if (stop || now >= deadline) break;
       signal->wait_until(std::min(
           deadline, now + (admitted == expected ? kReadyPollInterval

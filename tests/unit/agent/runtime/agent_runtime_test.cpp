@@ -390,6 +390,44 @@ TEST(AgentRuntime, RepeatsHellosAndIgnoresOtherSessions) {
   EXPECT_EQ(got[0].body.reach_m, 1.5);
 }
 
+// The admit timeout counts from the latest agent the world admitted for the first time, up to kAdmitProgressCap
+// timeouts: a world admitting a crowd one by one is not gone.
+TEST(AgentRuntime, WaitsWhileTheWorldAdmitsOtherAgentsUpToTheCap) {
+  for (const bool endless : {false, true}) {
+    const int domain = endless ? 111 : 110;
+    auto participant = bus::make_participant({bus::Vendor::kInProcess, domain});
+    RuntimeConfig c = config(6);
+    c.admit_timeout = 400ms;
+    AgentRuntime agent(*participant, c);
+    auto world_participant = bus::make_participant({bus::Vendor::kInProcess, domain});
+    auto admissions = world_participant->create_writer<protocol::Admission>();
+    std::atomic<bool> stop{false};
+    const auto t0 = Clock::now();
+    auto running = std::async(std::launch::async, [&] { return agent.run(stop); });
+    // Another agent admitted every 250 ms: for 1 s (agents 10..13), or for as long as the agent waits.
+    std::uint32_t other = 10;
+    while (running.wait_for(250ms) != std::future_status::ready && (endless || Clock::now() - t0 < 1000ms)) {
+      protocol::Admission a;
+      a.agent_id = other++;
+      a.session = 77;
+      a.accepted = true;
+      a.run_id = "crowd";
+      admissions->write(a);
+    }
+    const RunResult r = running.get();
+    const double waited_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    EXPECT_EQ(r.outcome, RunOutcome::kAdmitTimeout);
+    if (endless) {  // the cap: kAdmitProgressCap x 0.4 s
+      EXPECT_GE(waited_s, kAdmitProgressCap * 0.4 - 0.01);
+      EXPECT_LT(waited_s, kAdmitProgressCap * 0.4 + 1.0);
+    } else {  // 0.4 s after the last admission (at 0.75-1 s): well past 0.4 s, before the cap
+      EXPECT_GE(waited_s, 1.1);
+      EXPECT_LT(waited_s, kAdmitProgressCap * 0.4 - 0.01);
+    }
+    EXPECT_NE(r.message.find("while the world admitted"), std::string::npos) << r.message;
+  }
+}
+
 // --id auto: the hello asks for any slot (agent_id 0) under the name "<type>-any"; the agent takes the admission
 // of its own session whatever slot it names, and from then on is that slot: partition, frames, requests, name.
 TEST(AgentRuntime, AnySlotTakesTheAssignedIdFromItsAdmission) {

@@ -381,6 +381,31 @@ TEST_F(RuntimeTest, ALevelSiteRunPublishesItsLevelFractionAsProgress) {
   EXPECT_NE(summary.find("\"completion\": \"level_site\""), std::string::npos) << summary;
 }
 
+TEST_F(RuntimeTest, TheAdmitTimeoutCountsFromTheLatestAdmission) {
+  // Admit timeout 2 s: agent 1 comes at 1.2 s, agent 2 at 2.6 s, past the 2 s from the start but within 2 s of agent
+  // 1's admission: a team admitted one by one is waited for (before, the run started at 2 s with agent 1 alone).
+  constexpr int kDomain = 48;
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, kDomain});
+  RuntimeOptions o = options(2, 10.0);
+  o.admit_timeout_s = 2.0;
+  WorldRuntime runtime(scenario_, testing::flat_terrain(), o, *participant);
+  std::atomic<bool> stop{false};
+  RunResult result;
+  std::thread world([&] { result = runtime.run(stop); });
+  std::this_thread::sleep_for(1200ms);
+  FakeAgent a1(agent(kDomain, 1));
+  std::this_thread::sleep_for(1400ms);
+  FakeAgent a2(agent(kDomain, 2));
+  world.join();
+  a1.join();
+  a2.join();
+  EXPECT_TRUE(result.completed);
+  for (std::uint32_t id : {1u, 2u}) {
+    EXPECT_TRUE(runtime.state().agent(id).admitted) << "agent " << id;
+    EXPECT_EQ(runtime.state().agent(id).missed, 0u) << "agent " << id;  // both there from step 0
+  }
+}
+
 TEST_F(RuntimeTest, NoAgentWithinTheAdmitTimeoutIsAnError) {
   auto participant = bus::make_participant({bus::Vendor::kInProcess, 46});
   RuntimeOptions o = options(2, 1.0);
