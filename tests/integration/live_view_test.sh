@@ -92,10 +92,13 @@ rc=0; "$monitor" serve --bogus >"$work/usage.out" 2>&1 || rc=$?
 [ "$rc" -eq 2 ] && grep -q -- "--bogus" "$work/usage.out" || fail "unknown option: exit $rc, $(cat "$work/usage.out")"
 rc=0; "$monitor" serve --port 70000 >"$work/usage.out" 2>&1 || rc=$?
 [ "$rc" -eq 2 ] && grep -q -- "--port" "$work/usage.out" || fail "bad port: exit $rc, $(cat "$work/usage.out")"
-python3 -c 'import socket,sys,time; s=socket.socket(); s.bind(("127.0.0.1", int(sys.argv[1]))); s.listen(1); time.sleep(60)' \
-  "$busy_port" & pids+=("$!")
-sleep 0.5
-rc=0; "$monitor" serve --port "$busy_port" --domain "$domain" >"$work/usage.out" 2>&1 || rc=$?
+# The port is taken before the monitor starts (a loaded machine may take seconds to start python: a fixed sleep let
+# the monitor take the port itself and serve until the test's timeout); the monitor gets 30 s to say so.
+python3 -c 'import socket,sys,time; s=socket.socket(); s.bind(("127.0.0.1", int(sys.argv[1]))); s.listen(1); open(sys.argv[2], "w").close(); time.sleep(120)' \
+  "$busy_port" "$work/busy.ready" & pids+=("$!")
+for _ in $(seq 1 240); do [ -f "$work/busy.ready" ] && break; sleep 0.25; done
+[ -f "$work/busy.ready" ] || fail "could not take port $busy_port for the port-in-use case"
+rc=0; timeout 30 "$monitor" serve --port "$busy_port" --domain "$domain" >"$work/usage.out" 2>&1 || rc=$?
 [ "$rc" -eq 2 ] && grep -q "port $busy_port" "$work/usage.out" && grep -q "in use" "$work/usage.out" ||
   fail "port in use: exit $rc, $(cat "$work/usage.out")"
 echo "ok: usage errors exit 2 naming what ($(tail -1 "$work/usage.out"))"
