@@ -72,7 +72,9 @@ int main(int argc, char** argv) {
                  "marsala-world must get the same)")
       ->type_name("FIELD=VALUE");
   marsala::cli::add_log_options(app, log_options);
-  app.add_option("--admit-timeout", admit_timeout_s, "give up when not admitted within this [s]")
+  app.add_option("--admit-timeout", admit_timeout_s,
+                 "give up when not admitted within this [s] of the first hello or of the latest agent seen admitted\n"
+                 "(five times this from the first hello at the most)")
       ->check(marsala::cli::seconds_within(1e-3, 1e9));
   app.add_option("--world-timeout", world_timeout_s,
                  "give up when no frame comes for this long [s] (0: never); a silent world (paused, cut off,\n"

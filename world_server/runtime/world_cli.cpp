@@ -305,7 +305,9 @@ int run_world_cli(int argc, const char* const* argv, const std::atomic<bool>& st
   cli::add_dds_options(app, dds);
   app.add_option("--out", options.out_dir, "output folder")->capture_default_str();
   app.add_option("--run-id", options.run_id, "run id, the prefix of every agent partition");
-  app.add_option("--admit-timeout", options.admit_timeout_s, "seconds to wait for all agents")
+  app.add_option("--admit-timeout", options.admit_timeout_s,
+                 "seconds to wait for all agents, from the start or the latest admission (five times this at\n"
+                 "the most)")
       ->check(CLI::Range(0.0, 86400.0))
       ->capture_default_str();
   app.add_option("--max-steps", options.max_steps, "override the scenario's max_steps")
