@@ -18,6 +18,7 @@
 #include "marsala/core/error.hpp"
 #include "marsala/core/log_pacing.hpp"
 #include "marsala/core/statistics.hpp"
+#include "marsala/protocol/admit_deadline.hpp"
 #include "marsala/protocol/world_proof.hpp"
 
 namespace marsala::agent::runtime {
@@ -132,16 +133,14 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
   spdlog::info("agent {} ({}, {}): saying hello, session {:016x}", config_.agent_id, config_.name,
                config_.type.behaviour, config_.session);
 
-  // The admit timeout counts from the latest agent the world admitted for the first time: a world admitting a crowd
-  // one by one is not gone (docs/runtime.md#admission); kAdmitProgressCap timeouts at the most.
+  // The admit timeout counts from the latest agent the world admitted for the first time (protocol::AdmitDeadline).
   const Clock::time_point started = Clock::now();
-  const Clock::time_point latest_deadline = started + kAdmitProgressCap * config_.admit_timeout;
-  Clock::time_point deadline = started + config_.admit_timeout;
+  protocol::AdmitDeadline wait(started, config_.admit_timeout);
   std::set<std::uint32_t> others_admitted;
   Clock::time_point next_hello = Clock::now();
   while (!stop.load()) {
     const Clock::time_point now = Clock::now();
-    if (now >= deadline) {
+    if (now >= wait.deadline()) {
       result.outcome = RunOutcome::kAdmitTimeout;
       result.message =
           others_admitted.empty()
@@ -157,13 +156,13 @@ bool AgentRuntime::admit(const std::atomic<bool>& stop, RunResult& result, proto
       hellos->write(hello);
       next_hello = now + config_.hello_period;
     }
-    signal->wait_until(std::min({next_hello, deadline, now + kStopPoll}));
+    signal->wait_until(std::min({next_hello, wait.deadline(), now + kStopPoll}));
     for (const bus::Received<protocol::Admission>& received : admissions->take_received()) {
       const protocol::Admission& a = received.sample;
       const bool any_slot = config_.agent_id == 0;
       if (a.session != config_.session || (!any_slot && a.agent_id != config_.agent_id)) {  // not ours
         if (a.accepted && a.agent_id != config_.agent_id && others_admitted.insert(a.agent_id).second)
-          deadline = std::min(latest_deadline, std::max(deadline, Clock::now() + config_.admit_timeout));
+          wait.progress(Clock::now());
         continue;
       }
       if (!from_world(a, received.from, result)) continue;

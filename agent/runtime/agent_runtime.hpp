@@ -31,10 +31,6 @@ namespace marsala::agent::runtime {
 class AgentRuntime;
 struct RunResult;
 
-/// The admit timeout restarts at each agent the world admits for the first time, up to this many times its length
-/// from the first hello [count].
-inline constexpr int kAdmitProgressCap = 5;
-
 /// Who the agent is and how patient it is.
 struct RuntimeConfig {
   std::uint32_t agent_id = 0;                        ///< the scenario slot; 0: any free slot of `type` (--id auto)
@@ -47,7 +43,7 @@ struct RuntimeConfig {
   bool right_of_way = true;                          ///< the scenario's: keep the right-of-way protocol
   std::chrono::milliseconds hello_period{200};       ///< between hellos until admitted
   std::chrono::milliseconds admit_timeout{60000};    ///< give up when not admitted by then, counted from the latest
-                                                     ///< agent the world admitted (kAdmitProgressCap at the most)
+                                                     ///< agent the world admitted (protocol::AdmitDeadline)
   std::chrono::milliseconds world_timeout{600000};   ///< give up when no frame comes for this long; 0: never
   /// The run's public key (protocol::world_key_of() of --run-key): only a world that proves it is believed. Empty:
   /// the key of the first world that proves itself is pinned (docs/runtime.md#who-wrote-it).

@@ -15,6 +15,7 @@
 #include "marsala/core/format.hpp"
 #include "marsala/core/log_pacing.hpp"
 #include "marsala/core/statistics.hpp"
+#include "marsala/protocol/admit_deadline.hpp"
 #include "marsala/protocol/world_proof.hpp"
 #include "marsala/runlog/sha256.hpp"
 #include "marsala/world_server/records/persistence.hpp"
@@ -381,11 +382,8 @@ struct WorldRuntime::Impl {
   /// Waits for the expected agents: until all are admitted and ready, the admit timeout or `stop`. Throws Error when
   /// none was admitted.
   void admit_agents(const std::atomic<bool>& stop) {
-    // The timeout counts from the latest admission: a crowd admitted one by one is still coming
-    // (docs/runtime.md#start-of-the-run); kAdmitProgressCap timeouts at the most.
-    const Clock::time_point started = Clock::now();
-    const Clock::time_point latest_deadline = started + kAdmitProgressCap * seconds(options.admit_timeout_s);
-    Clock::time_point deadline = started + seconds(options.admit_timeout_s);
+    // The timeout counts from the latest admission (protocol::AdmitDeadline).
+    protocol::AdmitDeadline wait(Clock::now(), seconds(options.admit_timeout_s));
     std::size_t admitted_before = 0;
     const std::size_t expected = state.agents.size() - late_slots().size();
     for (;;) {
@@ -400,12 +398,11 @@ struct WorldRuntime::Impl {
       }
       if (admitted == expected && all_ready) return;
       const Clock::time_point now = Clock::now();
-      if (admitted > admitted_before)
-        deadline = std::min(latest_deadline, std::max(deadline, now + seconds(options.admit_timeout_s)));
+      if (admitted > admitted_before) wait.progress(now);
       admitted_before = admitted;
-      if (stop || now >= deadline) break;
+      if (stop || now >= wait.deadline()) break;
       signal->wait_until(std::min(
-          deadline, now + (admitted == expected ? kReadyPollInterval
+          wait.deadline(), now + (admitted == expected ? kReadyPollInterval
                                                 : std::chrono::duration_cast<Clock::duration>(kHelloInterval))));
     }
     std::size_t admitted = 0, ready_count = 0;

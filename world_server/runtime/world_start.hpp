@@ -17,14 +17,11 @@
 namespace marsala::world_server {
 
 /// How to run.
-/// The admit timeout restarts at each admission, up to this many times its length from the start [count].
-inline constexpr int kAdmitProgressCap = 5;
-
 struct RuntimeOptions {
   std::uint32_t agents = 0;             ///< expected agents, ids 1..agents; 0 = every slot of the scenario
   std::string run_id;                   ///< names the run's partitions; empty = default_run_id(scenario, domain)
   double admit_timeout_s = 60.0;        ///< how long to wait for all agents before starting with those admitted,
-                                        ///< counted from the latest admission (kAdmitProgressCap at the most) [s]
+                                        ///< counted from the latest admission (protocol::AdmitDeadline) [s]
   std::uint64_t max_steps = 0;          ///< 0 = the scenario's max_steps
   double step_deadline_s = 0.0;         ///< 0 = the scenario's step_deadline_s [s]
   std::string out_dir = "out/run";      ///< summary.json, terrain_*.asc, final*.png, goal_vector_map.png, events.log

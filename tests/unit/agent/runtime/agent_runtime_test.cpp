@@ -1,6 +1,7 @@
 // The agent's runtime edge over the in-process bus, against a scripted world on a thread of the test.
 
 #include "marsala/agent/runtime/agent_runtime.hpp"
+#include "marsala/protocol/admit_deadline.hpp"
 
 #include <gtest/gtest.h>
 
@@ -390,8 +391,8 @@ TEST(AgentRuntime, RepeatsHellosAndIgnoresOtherSessions) {
   EXPECT_EQ(got[0].body.reach_m, 1.5);
 }
 
-// The admit timeout counts from the latest agent the world admitted for the first time, up to kAdmitProgressCap
-// timeouts: a world admitting a crowd one by one is not gone.
+// The admit timeout counts from the latest agent the world admitted for the first time, up to
+// protocol::kAdmitProgressCap timeouts: a world admitting a crowd one by one is not gone.
 TEST(AgentRuntime, WaitsWhileTheWorldAdmitsOtherAgentsUpToTheCap) {
   for (const bool endless : {false, true}) {
     const int domain = endless ? 111 : 110;
@@ -417,12 +418,12 @@ TEST(AgentRuntime, WaitsWhileTheWorldAdmitsOtherAgentsUpToTheCap) {
     const RunResult r = running.get();
     const double waited_s = std::chrono::duration<double>(Clock::now() - t0).count();
     EXPECT_EQ(r.outcome, RunOutcome::kAdmitTimeout);
-    if (endless) {  // the cap: kAdmitProgressCap x 0.4 s
-      EXPECT_GE(waited_s, kAdmitProgressCap * 0.4 - 0.01);
-      EXPECT_LT(waited_s, kAdmitProgressCap * 0.4 + 1.0);
+    if (endless) {  // the cap: protocol::kAdmitProgressCap x 0.4 s
+      EXPECT_GE(waited_s, protocol::kAdmitProgressCap * 0.4 - 0.01);
+      EXPECT_LT(waited_s, protocol::kAdmitProgressCap * 0.4 + 1.0);
     } else {  // 0.4 s after the last admission (at 0.75-1 s): well past 0.4 s, before the cap
       EXPECT_GE(waited_s, 1.1);
-      EXPECT_LT(waited_s, kAdmitProgressCap * 0.4 - 0.01);
+      EXPECT_LT(waited_s, protocol::kAdmitProgressCap * 0.4 - 0.01);
     }
     EXPECT_NE(r.message.find("while the world admitted"), std::string::npos) << r.message;
   }
