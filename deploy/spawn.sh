@@ -45,7 +45,9 @@
 #                 unsecured unless --secure), lan (a subnet, multicast discovery) or unicast (no multicast: every
 #                 process finds the world at --peers); lan and unicast run secured unless --insecure. Fast DDS on lo
 #                 with 48 agents or more: fastdds-crowd.xml (slower heartbeats and announcements; 120 agents
-#                 were not admitted in 60 s with fastdds-lo.xml on two cores, README "Idle robots up to 120")
+#                 were not admitted in 60 s with fastdds-lo.xml on two cores, README "Idle robots up to 120"); on
+#                 unicast with 48 or more: fastdds-unicast-crowd.xml, the same timing (README "240 robots over four
+#                 hosts")
 #   --peers       unicast discovery at these hosts, given as --peers to the world, every agent and the monitor
 #                 (docs/runtime.md#peers): the world's address is enough; implies --profile unicast; default with
 #                 --profile unicast: $MARSALA_PEERS, else this host's first address, else 127.0.0.1
@@ -67,7 +69,7 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
-crowd_agents=48  # from this team size on, Fast DDS on loopback takes fastdds-crowd.xml
+crowd_agents=48  # from this team size on, Fast DDS takes fastdds-crowd.xml on loopback, fastdds-unicast-crowd.xml on unicast
 scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0 frames_every=""
 replace=0 secure=0 insecure=0 dump_maps=0 set_args=() observe_args=() profile="" peers="" identities=""
 fork="" fork_at="" fork_set_args=()
@@ -195,7 +197,9 @@ done
 # from the command line of every process (--peers, through MARSALA_PEERS: the binaries check it, exit 2 when malformed).
 export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-$profile.xml"
 fastdds_profile="$profile"
-[ "$profile" = lo ] && [ "$agents" -ge "$crowd_agents" ] && fastdds_profile=crowd
+if [ "$agents" -ge "$crowd_agents" ]; then
+  case "$profile" in lo) fastdds_profile=crowd ;; unicast) fastdds_profile=unicast-crowd ;; esac
+fi
 export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-$fastdds_profile.xml"
 if [ -n "$peers" ]; then export MARSALA_PEERS="$peers"; else unset MARSALA_PEERS; fi
 
@@ -291,7 +295,7 @@ for id in $(seq 1 "$agents"); do
     "${seed_args[@]}" "${set_args[@]}" "${sec_args[@]}" "${agent_args[@]}" "${key_args[@]}" >"$out/logs/agent-$id.log" 2>&1 &
   pids+=("$!")
 done
-[ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain, profile $profile$([ "$fastdds_profile" = crowd ] && [ "$dds$agent_dds" != cyclonecyclone ] && echo " (Fast DDS: crowd)")$([ -n "$peers" ] && echo " (peers $peers)"), $([ "$secure" -eq 1 ] && echo "secured with $identities" || echo unsecured); logs in $out/logs"
+[ "$quiet" -eq 1 ] || echo "spawn.sh: world (pid $world_pid, $dds) and $agents agents ($agent_dds) on domain $domain, profile $profile$([ "$fastdds_profile" != "$profile" ] && [ "$dds$agent_dds" != cyclonecyclone ] && echo " (Fast DDS: $fastdds_profile)")$([ -n "$peers" ] && echo " (peers $peers)"), $([ "$secure" -eq 1 ] && echo "secured with $identities" || echo unsecured); logs in $out/logs"
 
 progress_pid=""
 if [ "$monitor" -eq 1 ] && [ -x "$bin/marsala-monitor" ]; then
