@@ -2,7 +2,8 @@
 # Four-host benchmark: deploy/scenarios/crowd_240.pbtxt over five network-namespace hosts on one bridge
 # (tests/integration/lib.sh bridge_hosts and no_multicast: h1..h5 at 10.78.0.1-5, multicast off and dropped), the
 # world on h1, --per-host N agents on each of h2..h5 (ids 1..N on h2, N+1..2N on h3, ...), every process with the
-# unicast profile of its vendor and --peers 10.78.0.1 (the world's address), insecure, --steps steps (default 200).
+# unicast profile of its vendor (Fast DDS from 48 agents in all: fastdds-unicast-crowd.xml, as deploy/spawn.sh picks
+# it) and --peers 10.78.0.1 (the world's address), insecure, --steps steps (default 200).
 # One run per vendor, one after the other. Per run it reports (table on stdout, one CSV row per run in --csv FILE):
 #   admit s        from the world's start of admission to its first frame (summary.json admit_seconds)
 #   adm/conn/drop  agents admitted, connected at the first frame, dropped at the end (summary.json)
@@ -14,6 +15,7 @@
 #                  7400 + 250 d + 10 + 2 i) each host sent and received during the whole run, by nftables counters
 #                  on the host's eth0 (loopback traffic left out) [kB]
 #   eth0 kB h1..h5 all bytes each host's interface sent and received during the run (/sys/class/net statistics) [kB]
+#   profile        the DDS profile every process had (deploy/dds/)
 # Needs root for namespaces, a bridge and nftables; makes its own private namespaces (nothing outside is touched).
 # Usage: bench/multihost_bench.sh [--dds "cyclone fastdds"] [--per-host N] [--steps S] [--csv FILE] [--domain D]
 #        [--keep DIR]   (keep each run's folder, logs and summary.json, in DIR/VENDOR)
@@ -29,7 +31,7 @@ while [ $# -gt 0 ]; do
     --csv) csv="$2"; shift 2 ;;
     --domain) domain="$2"; shift 2 ;;
     --keep) keep="$2"; shift 2 ;;
-    -h|--help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "multihost_bench.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -57,6 +59,7 @@ bridge_hosts 10.78.0 5
 no_multicast 5
 unset CYCLONEDDS_URI FASTRTPS_DEFAULT_PROFILES_FILE MARSALA_DDS_CONFIG MARSALA_PEERS
 team=$((4 * per_host))
+crowd_agents=48  # as in deploy/spawn.sh: from this team size on, Fast DDS takes the crowd's timing
 
 # discovery_counters D: on every host a table `disc` counting UDP to domain D's metatraffic unicast ports (participant
 # indices 0..127), in and out.
@@ -82,9 +85,9 @@ eth0_bytes() {
   ip netns exec "$1" sh -c 'echo $(( $(cat /sys/class/net/eth0/statistics/rx_bytes) + $(cat /sys/class/net/eth0/statistics/tx_bytes) ))'
 }
 
-printf '%-8s %6s %7s %-13s %6s %8s %8s %9s %10s  %-29s %s\n' vendor agents "admit s" adm/conn/drop missed "step med" \
-  "step p90" "world CPU" "agents CPU" "disc kB h1/h2/h3/h4/h5" "eth0 kB h1/h2/h3/h4/h5"
-[ -z "$csv" ] || [ -s "$csv" ] || echo "vendor,per_host,agents,admitted,connected,dropped,missed_deadlines,admit_s,steps,end_reason,step_median_ms,step_p90_ms,world_cpu_ms_per_step,agents_cpu_ms_per_step,disc_kb_h1,disc_kb_h2,disc_kb_h3,disc_kb_h4,disc_kb_h5,eth0_kb_h1,eth0_kb_h2,eth0_kb_h3,eth0_kb_h4,eth0_kb_h5" >"$csv"
+printf '%-8s %6s %7s %-13s %6s %8s %8s %9s %10s  %-29s %-34s %s\n' vendor agents "admit s" adm/conn/drop missed "step med" \
+  "step p90" "world CPU" "agents CPU" "disc kB h1/h2/h3/h4/h5" "eth0 kB h1/h2/h3/h4/h5" profile
+[ -z "$csv" ] || [ -s "$csv" ] || echo "vendor,per_host,agents,admitted,connected,dropped,missed_deadlines,admit_s,steps,end_reason,step_median_ms,step_p90_ms,world_cpu_ms_per_step,agents_cpu_ms_per_step,disc_kb_h1,disc_kb_h2,disc_kb_h3,disc_kb_h4,disc_kb_h5,eth0_kb_h1,eth0_kb_h2,eth0_kb_h3,eth0_kb_h4,eth0_kb_h5,profile" >"$csv"
 for dds in $vendors; do
   domain=$((domain + 1))
   out="$work/$dds"
@@ -92,7 +95,9 @@ for dds in $vendors; do
   discovery_counters "$domain"
   declare -A eth0_start=()
   for h in 1 2 3 4 5; do eth0_start[$h]=$(eth0_bytes "h$h"); done
-  peers=(--peers 10.78.0.1 --domain "$domain" --dds "$dds")
+  profile="$dds-unicast.xml"
+  [ "$dds" = fastdds ] && [ "$team" -ge "$crowd_agents" ] && profile=fastdds-unicast-crowd.xml
+  peers=(--peers 10.78.0.1 --domain "$domain" --dds "$dds" --dds-config "$root/deploy/dds/$profile")
   ip netns exec h1 "$bin/marsala-world" --scenario "$scenario" --agents "$team" "${peers[@]}" --max-steps "$steps" \
     --admit-timeout 600 --out "$out" >"$out/logs/world.log" 2>&1 &
   world=$!
@@ -121,10 +126,10 @@ for dds in $vendors; do
   s="$out/summary.json"
   num() { jq -r ".$1 // 0" "$s"; }
   agents_cpu=$(grep -ho 'process CPU [0-9.]* ms per step' "$out"/logs/agent-*.log | awk '{ t += $3 } END { printf "%.1f", t }')
-  printf '%-8s %6s %7.2f %-13s %6s %8.1f %8.1f %9.2f %10s  %-29s %s\n' "$dds" "$team" "$(num admit_seconds)" \
+  printf '%-8s %6s %7.2f %-13s %6s %8.1f %8.1f %9.2f %10s  %-29s %-34s %s\n' "$dds" "$team" "$(num admit_seconds)" \
     "$(num admitted)/$(num connected)/$(num dropped)" "$(num missed_deadlines)" "$(num step_wall_median_ms)" \
     "$(num step_wall_p90_ms)" "$(num world_cpu_ms_per_step)" "$agents_cpu" "$(IFS=/; echo "${disc[*]}")" \
-    "$(IFS=/; echo "${eth[*]}")"
-  [ -z "$csv" ] || echo "$dds,$per_host,$team,$(num admitted),$(num connected),$(num dropped),$(num missed_deadlines),$(num admit_seconds),$(num steps),$(num end_reason),$(num step_wall_median_ms),$(num step_wall_p90_ms),$(num world_cpu_ms_per_step),$agents_cpu,$(IFS=,; echo "${disc[*]}"),$(IFS=,; echo "${eth[*]}")" >>"$csv"
+    "$(IFS=/; echo "${eth[*]}")" "$profile"
+  [ -z "$csv" ] || echo "$dds,$per_host,$team,$(num admitted),$(num connected),$(num dropped),$(num missed_deadlines),$(num admit_seconds),$(num steps),$(num end_reason),$(num step_wall_median_ms),$(num step_wall_p90_ms),$(num world_cpu_ms_per_step),$agents_cpu,$(IFS=,; echo "${disc[*]}"),$(IFS=,; echo "${eth[*]}"),$profile" >>"$csv"
   [ -z "$keep" ] || { mkdir -p "$keep" && rm -rf "${keep:?}/$dds" && cp -a "$out" "$keep/$dds"; }
 done
