@@ -61,6 +61,15 @@ TEST(FastDdsTimingTest, ShippedProfilesAndTheFallbackRepairWithinFiftyMillisecon
     EXPECT_EQ(timing.heartbeat_response_delay_ns, 0) << shipped;
     EXPECT_TRUE(timing.from_profile) << shipped << " leaves the timing to the bus";
   }
+  // The crowd's profiles (48 agents or more, deploy/spawn.sh): ten times as slow.
+  for (const char* crowd : {"deploy/dds/fastdds-crowd.xml", "deploy/dds/fastdds-unicast-crowd.xml"}) {
+    const RepairTiming timing = repair_timing_of_profile(source(crowd));
+    EXPECT_EQ(timing.heartbeat_period_ns, 10 * kShippedHeartbeatNs) << crowd;
+    EXPECT_EQ(timing.one_reader_heartbeat_ns, 10 * kAgentHeartbeatNs) << crowd;
+    EXPECT_EQ(timing.nack_response_delay_ns, 0) << crowd;
+    EXPECT_EQ(timing.heartbeat_response_delay_ns, 0) << crowd;
+    EXPECT_TRUE(timing.from_profile) << crowd << " leaves the timing to the bus";
+  }
 
   const RepairTiming kept = timing_of("own", R"(<?xml version="1.0" encoding="UTF-8"?>
 <dds xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"><profiles>
