@@ -243,7 +243,7 @@ class AgentRuntime::Lockstep {
       lock.lock();
       if (over_) break;
       const Clock::time_point now = Clock::now();
-      if (!world_still_there(now, writer_alive) || !still_counted_in() || take_frames()) return;
+      if (!world_still_there(now, writer_alive) || !still_counted_in(now) || take_frames()) return;
       const Clock::time_point wake_by = std::min(watch_.wake_by(), now + kStopPoll);
       lock.unlock();
       signal_->wait_until(wake_by);
@@ -287,11 +287,17 @@ class AgentRuntime::Lockstep {
     return true;
   }
 
-  /// The world's answers to this agent's hellos: false (and the outcome) when it no longer counts the agent in.
-  bool still_counted_in() {
+  /// The world's answers to this agent's hellos: false (and the outcome) when it no longer counts the agent in. Its
+  /// admissions and answers to other agents of the run are signs of life (WorldWatch::answered_another()).
+  bool still_counted_in(Clock::time_point now) {
     const RuntimeConfig& config = agent_.config_;
     for (const bus::Received<protocol::Admission>& received : agent_.admissions_->take_received()) {
       const protocol::Admission& a = received.sample;
+      if (a.agent_id != config.agent_id && a.accepted && a.run_id == admission_.run_id &&
+          received.from == gate_.world()) {
+        watch_.answered_another(now, admitting_stagger(config.agent_id));
+        continue;
+      }
       if (a.agent_id != config.agent_id || a.session != config.session || !watch_.asked()) continue;
       // Another participant answering: the world was restarted from its log (docs/runtime.md#resume) and proves the
       // run's key; frames now come from it. A stranger cannot prove it (docs/runtime.md#who-wrote-it).

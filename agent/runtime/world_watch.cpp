@@ -85,6 +85,11 @@ void WorldWatch::answered() {
                                                   std::min<std::chrono::milliseconds>(hello_gap_ * 2, kStillInRecheck));
 }
 
+void WorldWatch::answered_another(Clock::time_point now, Clock::duration stagger) {
+  sign_since_turn_ = true;
+  if (!framed_) next_hello_ = std::max(next_hello_, now + kRehelloAfter + stagger);
+}
+
 WorldWatch::Clock::duration WorldWatch::quiet_limit() const {
   Clock::duration longest{0};
   for (std::size_t i = 0; i < std::min(gap_count_, kPaceFrames); ++i) longest = std::max(longest, gaps_[i]);

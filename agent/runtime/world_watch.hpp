@@ -13,10 +13,16 @@
 //                     each answer that the world still counts the agent in doubles the gap, up to kStillInRecheck.
 //                     The world answers every hello to every agent: 120 agents of a team stepping at 2 s asked after
 //                     every step and at 5 Hz while the world admitted (60,000 deliveries a second) and kept it slow.
+//   admitting         before the first frame, an admission or answer the world gives another agent of the run is a
+//                     sign of life and puts the agent's own question off (kRehelloAfter and the agent's stagger after
+//                     it): while the world admits the rest of the team, the team asks about once per quiet spell of
+//                     the world's, not each agent every kStillInRecheck (240 agents: 30 questions a second, each
+//                     answer delivered to all 240).
 
 #include <array>
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <optional>
 
@@ -40,6 +46,16 @@ inline constexpr int kPaceMultiple = 3;
 inline constexpr std::size_t kPaceFrames = 8;
 /// The longest the pace waits before asking [s].
 inline constexpr std::chrono::seconds kLongestPace{30};
+/// Agents waiting for their first frame put their question off by kRehelloAfter after the world's latest admission or
+/// answer to another agent, plus (agent id mod kAdmittingStaggers) x kAdmittingStagger, so that the first to ask after
+/// a quiet spell of the world's are few: about one in kAdmittingStaggers.
+inline constexpr std::chrono::milliseconds kAdmittingStagger{250};
+inline constexpr int kAdmittingStaggers = 16;
+
+/// The stagger of agent `agent_id` (see kAdmittingStagger).
+inline std::chrono::milliseconds admitting_stagger(std::uint32_t agent_id) {
+  return kAdmittingStagger * static_cast<int>(agent_id % kAdmittingStaggers);
+}
 
 /// What the watch concluded on one turn.
 enum class WorldState { kWatching, kWorldTimeout };
@@ -70,6 +86,9 @@ class WorldWatch {
   bool asked() const { return asked_; }
   /// The world answered a hello: a sign of life; the next hellos of this silence go twice as far apart.
   void answered();
+  /// The world admitted or answered another agent of the run at `now`: a sign of life; before the first frame the
+  /// next hello waits until kRehelloAfter + `stagger` after it (the world is admitting the rest of the team).
+  void answered_another(Clock::time_point now, Clock::duration stagger);
   /// A frame was taken at `now`: a sign of life, the silence limit starts again. True when a hello had gone out since
   /// the last frame (frames are back).
   bool frame(Clock::time_point now);

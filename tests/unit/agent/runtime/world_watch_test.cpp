@@ -178,6 +178,32 @@ TEST(WorldWatch, AWorldSteppingSlowlyIsAskedOnlyAfterThreeTimesItsRecentPace) {
   EXPECT_EQ(paused.quiet_limit(), Clock::duration(kLongestPace));
 }
 
+TEST(WorldWatch, BeforeTheFirstFrameTheWorldAdmittingOthersPutsTheQuestionOffByTheAgentsStagger) {
+  EXPECT_EQ(admitting_stagger(16), 0ms);
+  EXPECT_EQ(admitting_stagger(1), 250ms);
+  EXPECT_EQ(admitting_stagger(15), 3750ms);
+  // Admitted at kT0, no frame yet; the world admits or answers another agent every 1.5 s until 9 s: this agent (stagger
+  // 500 ms) does not ask meanwhile, where it asked at 2 s before; then it asks 2.5 s after the last of them.
+  WorldWatch watch = watch_from_t0();
+  std::vector<Clock::duration> hellos;
+  for (Clock::duration t = 100ms; t < 15s; t += 100ms) {
+    if (t <= 9s && t % 1500ms == 0ms) watch.answered_another(kT0 + t, 500ms);
+    const WatchTurn turn = watch.turn(kT0 + t, kNotAlive);
+    EXPECT_FALSE(turn.silent_s.has_value()) << "the world admitting others is heard, at " << t.count() << " ms";
+    if (turn.hello) hellos.push_back(t);
+  }
+  ASSERT_FALSE(hellos.empty());
+  EXPECT_EQ(hellos.front(), 11500ms);  // the last admission of another at 9 s, + kRehelloAfter + 500 ms
+  // Once frames come, the world admitting others puts nothing off: asked kRehelloAfter after the last frame.
+  WorldWatch running = watch_from_t0();
+  for (Clock::duration t = 100ms; t < 3s; t += 100ms) {
+    if (t == 1s) running.frame(kT0 + t);
+    if (t == 2500ms) running.answered_another(kT0 + t, 500ms);
+    EXPECT_FALSE(running.turn(kT0 + t, kAlive).hello) << t.count() << " ms";
+  }
+  EXPECT_TRUE(running.turn(kT0 + 3s, kAlive).hello);
+}
+
 TEST(WorldWatch, AFrameRestartsTheSilenceLimit) {
   WorldWatch watch = watch_from_t0();
   watch.frame(kT0 + 15s);
