@@ -119,6 +119,15 @@ bool AgentLinks::resend(std::uint32_t id, std::uint64_t step, ResendPolicy::Cloc
   return true;
 }
 
+void AgentLinks::answer_with_frame(std::uint32_t id, ResendPolicy::Clock::time_point now) {
+  AgentLink& link = links_[id - 1];
+  if (!link.frame || !link.frames) return;
+  const CopyState copy = copy_state(link);
+  if (world_server::in_flight(copy)) return;
+  write_logged(*link.frames, *link.frame, "a sensor frame");
+  link.resends.copied(Resend::kAsked, now, copy.readers);
+}
+
 bool AgentLinks::in_flight(std::uint32_t id) const { return world_server::in_flight(copy_state(links_[id - 1])); }
 
 }  // namespace marsala::world_server

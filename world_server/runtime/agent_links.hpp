@@ -77,6 +77,12 @@ class AgentLinks {
   /// Slot `id`'s agent said hello again (ResendPolicy::asked()): its unanswered frame is written once more at the
   /// next look unless a copy is in flight.
   void asked(std::uint32_t id) { links_[id - 1].resends.asked(); }
+  /// True when slot `id`'s link holds a frame it sent (and its writer): answer_with_frame() can answer it.
+  bool has_frame(std::uint32_t id) const { return links_[id - 1].frame && links_[id - 1].frames; }
+  /// Answers slot `id`'s agent, which asked whether it is still counted in, on its own partition: its latest frame
+  /// again at `now` (answered or not), unless a copy is in flight, which answers it when it arrives. Needs has_frame();
+  /// a link without a frame is answered by an admission (docs/runtime.md#re-admission).
+  void answer_with_frame(std::uint32_t id, ResendPolicy::Clock::time_point now);
   /// Copies of slot `id`'s current frame written besides the first [count].
   std::uint32_t resends(std::uint32_t id) const { return links_[id - 1].resends.resends(); }
 

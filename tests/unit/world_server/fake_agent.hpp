@@ -31,6 +31,8 @@ struct FakeAgentConfig {
   std::uint64_t quit_at_step = 0;
   bool deposit_first = false;  ///< at step 0, also deposit two cube layers on the cell centred at (0.55, 1.95)
   double timeout_s = 30.0;     ///< gives up after this long
+  bool ask = false;               ///< after answering the frame of step ask_at_step, says hello once more (is it still
+  std::uint64_t ask_at_step = 1;  ///< counted in?)
 };
 
 class FakeAgent {
@@ -53,6 +55,8 @@ class FakeAgent {
   /// Copies of an already taken frame received so far [count].
   int copies() const { return copies_; }
   bool admitted() const { return admitted_; }
+  /// Admissions for this agent received after it asked again (ask) [count].
+  int answers_after_ask() const { return answers_after_ask_; }
   /// The refusal reason, when refused (read after join()).
   const std::string& refusal() const { return refusal_; }
 
@@ -89,8 +93,11 @@ class FakeAgent {
     const std::string partition = protocol::partition_for(admission.run_id, config_.id, admission.session);
     auto frames = participant->create_reader<protocol::SensorFrame>({partition, signal});
     auto requests = participant->create_writer<protocol::ActionRequest>({partition, nullptr});
+    bool asked = false;
     while (!stop_ && std::chrono::steady_clock::now() < give_up) {
       signal->wait_for(20ms);
+      for (const protocol::Admission& a : admissions->take())
+        if (asked && a.agent_id == config_.id && a.session == config_.session) ++answers_after_ask_;
       for (const protocol::SensorFrame& f : frames->take()) {
         {
           std::lock_guard<std::mutex> lock(mutex_);
@@ -103,6 +110,10 @@ class FakeAgent {
         if (config_.mode == FakeMode::kSilent) continue;
         if (config_.mode == FakeMode::kQuitter && f.step >= config_.quit_at_step) return;  // as if the process died
         requests->write(decide(f, admission));
+        if (config_.ask && !asked && f.step >= config_.ask_at_step) {
+          hellos->write(hello);
+          asked = true;
+        }
       }
     }
   }
@@ -137,6 +148,7 @@ class FakeAgent {
   std::atomic<bool> stop_{false};
   std::atomic<bool> admitted_{false};
   std::atomic<int> copies_{0};
+  std::atomic<int> answers_after_ask_{0};
   std::string refusal_;
   mutable std::mutex mutex_;
   std::vector<protocol::SensorFrame> frames_;

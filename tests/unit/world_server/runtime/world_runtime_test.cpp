@@ -267,6 +267,30 @@ TEST_F(RuntimeTest, AnAgentThatMissesThreeDeadlinesIsDroppedTheOthersContinue) {
   EXPECT_NE(summary.find("\"dropped\": true"), std::string::npos) << summary;
 }
 
+// docs/runtime.md#re-admission: a live agent that asks during the run whether it is still counted in is answered on its
+// own partition with its frame again (its watch takes a frame as the answer), not with an admission, which goes to
+// every agent of the team.
+TEST_F(RuntimeTest, ALiveAgentAskingDuringTheRunIsAnsweredWithItsFrameNotAnAdmission) {
+  constexpr int kDomain = 49;
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, kDomain});
+  WorldRuntime runtime(scenario_, testing::flat_terrain(), options(2, 1.0), *participant);
+  std::atomic<bool> stop{false};
+  RunResult result;
+  std::thread world([&] { result = runtime.run(stop); });
+  FakeAgentConfig asker = agent(kDomain, 1);
+  asker.ask = true;  // after answering step 1's frame (its admission was answered long before)
+  // Agent 2 never answers: each of its first three steps waits the 1 s deadline, time for agent 1's question.
+  FakeAgent a1(asker), a2(agent(kDomain, 2, FakeMode::kSilent));
+  world.join();
+  a1.join();
+  a2.join();
+
+  EXPECT_TRUE(result.completed);
+  EXPECT_GE(a1.copies(), 1) << "the question is answered by a copy of the frame it already answered";
+  EXPECT_EQ(a1.answers_after_ask(), 0) << "no admission on the team's topic";
+  EXPECT_EQ(runtime.state().agent(1).missed, 0u);
+}
+
 TEST_F(RuntimeTest, AnAgentWhoseWriterGoesAwayIsDroppedAtOnce) {
   constexpr int kDomain = 43;
   auto participant = bus::make_participant({bus::Vendor::kInProcess, kDomain});
