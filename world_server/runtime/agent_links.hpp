@@ -29,6 +29,7 @@ struct AgentLink {
   std::optional<protocol::SensorFrame> frame;  ///< the current step's frame, for resends
   ResendPolicy resends;                        ///< when its frame is written again
   bus::WriterId owner;                         ///< the participant the session belongs to; unknown until bound
+  bool accepted_here = false;  ///< this world process answered the session with an acceptance: the agent takes its frames
   std::uint64_t foreign = 0;                   ///< requests from other participants ignored [count]
 };
 
@@ -77,11 +78,20 @@ class AgentLinks {
   /// Slot `id`'s agent said hello again (ResendPolicy::asked()): its unanswered frame is written once more at the
   /// next look unless a copy is in flight.
   void asked(std::uint32_t id) { links_[id - 1].resends.asked(); }
-  /// True when slot `id`'s link holds a frame it sent (and its writer): answer_with_frame() can answer it.
-  bool has_frame(std::uint32_t id) const { return links_[id - 1].frame && links_[id - 1].frames; }
+  /// This world process answered `session` of slot `id` with an acceptance (nothing for another session's link).
+  void accepted(std::uint32_t id, std::uint64_t session) {
+    AgentLink& link = links_[id - 1];
+    if (link.requests && link.session == session) link.accepted_here = true;
+  }
+  /// True when answer_with_frame() can answer slot `id`'s agent: its link holds a frame it sent, and this process
+  /// answered the session with an acceptance (after a resume the agent takes the new world's frames only then).
+  bool answers_with_frame(std::uint32_t id) const {
+    const AgentLink& link = links_[id - 1];
+    return link.accepted_here && link.frame && link.frames;
+  }
   /// Answers slot `id`'s agent, which asked whether it is still counted in, on its own partition: its latest frame
-  /// again at `now` (answered or not), unless a copy is in flight, which answers it when it arrives. Needs has_frame();
-  /// a link without a frame is answered by an admission (docs/runtime.md#re-admission).
+  /// again at `now` (answered or not), unless a copy is in flight, which answers it when it arrives. Needs
+  /// answers_with_frame(); otherwise an admission answers (docs/runtime.md#re-admission).
   void answer_with_frame(std::uint32_t id, ResendPolicy::Clock::time_point now);
   /// Copies of slot `id`'s current frame written besides the first [count].
   std::uint32_t resends(std::uint32_t id) const { return links_[id - 1].resends.resends(); }

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <map>
 #include <optional>
 #include <random>
 #include <utility>
@@ -320,8 +319,7 @@ struct WorldRuntime::Impl {
       // the team, and a crowd asking during slow steps kept the world sending those instead of taking requests.
       if (decision.accepted && decision.kind == AdmissionKind::kRepeat && run_started) {
         const std::uint32_t id = slot_hello(state, hello, decision).agent_id;  // "any slot": the one it holds
-        if (state.has_agent(id) && links->has(id) && state.agent(id).alive && links->has_frame(id) &&
-            answered_session(id) == hello.session) {
+        if (state.has_agent(id) && links->has(id) && state.agent(id).alive && links->answers_with_frame(id)) {
           if (gate.may_answer(sender, now)) links->answer_with_frame(id, now);
           continue;
         }
@@ -338,15 +336,9 @@ struct WorldRuntime::Impl {
       if (!decision.accepted && !gate.may_answer_refusal()) continue;
       if (gate.may_answer(sender, now)) {
         write_logged(*admissions, signed_admission(hello, decision), "an admission");
-        if (decision.accepted) answered_sessions[slot_hello(state, hello, decision).agent_id] = hello.session;
+        if (decision.accepted) links->accepted(slot_hello(state, hello, decision).agent_id, hello.session);
       }
     }
-  }
-
-  /// The session of slot `id` this process last answered with an acceptance (0: none).
-  std::uint64_t answered_session(std::uint32_t id) const {
-    const auto it = answered_sessions.find(id);
-    return it == answered_sessions.end() ? 0 : it->second;
   }
 
   /// The team-silence rule (team_silence.hpp, docs/runtime.md#silence): true while the step is held because no live
@@ -807,7 +799,6 @@ struct WorldRuntime::Impl {
   std::string world_key, world_proof;  ///< the run key's public half, its signature of (run, this participant)
   Clock::time_point next_admitting_status{};
   Clock::time_point next_hello_service{};
-  std::map<std::uint32_t, std::uint64_t> answered_sessions;  // slot -> session this process answered with an acceptance
   bool run_started = false;
   std::vector<std::string> last_rejection;  ///< [id - 1]: the rejection reason last logged at info level
   std::vector<double> step_ms;              ///< wall time of each lockstep step [ms]

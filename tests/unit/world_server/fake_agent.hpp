@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -31,8 +32,7 @@ struct FakeAgentConfig {
   std::uint64_t quit_at_step = 0;
   bool deposit_first = false;  ///< at step 0, also deposit two cube layers on the cell centred at (0.55, 1.95)
   double timeout_s = 30.0;     ///< gives up after this long
-  bool ask = false;               ///< after answering the frame of step ask_at_step, says hello once more (is it still
-  std::uint64_t ask_at_step = 1;  ///< counted in?)
+  std::optional<std::uint64_t> ask_at_step;  ///< after answering this step's frame, hello once more (still counted in?)
 };
 
 class FakeAgent {
@@ -55,7 +55,7 @@ class FakeAgent {
   /// Copies of an already taken frame received so far [count].
   int copies() const { return copies_; }
   bool admitted() const { return admitted_; }
-  /// Admissions for this agent received after it asked again (ask) [count].
+  /// Admissions for this agent received after it asked again (ask_at_step) [count].
   int answers_after_ask() const { return answers_after_ask_; }
   /// The refusal reason, when refused (read after join()).
   const std::string& refusal() const { return refusal_; }
@@ -110,7 +110,7 @@ class FakeAgent {
         if (config_.mode == FakeMode::kSilent) continue;
         if (config_.mode == FakeMode::kQuitter && f.step >= config_.quit_at_step) return;  // as if the process died
         requests->write(decide(f, admission));
-        if (config_.ask && !asked && f.step >= config_.ask_at_step) {
+        if (config_.ask_at_step && !asked && f.step >= *config_.ask_at_step) {
           hellos->write(hello);
           asked = true;
         }

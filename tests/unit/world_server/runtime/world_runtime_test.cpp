@@ -278,7 +278,7 @@ TEST_F(RuntimeTest, ALiveAgentAskingDuringTheRunIsAnsweredWithItsFrameNotAnAdmis
   RunResult result;
   std::thread world([&] { result = runtime.run(stop); });
   FakeAgentConfig asker = agent(kDomain, 1);
-  asker.ask = true;  // after answering step 1's frame (its admission was answered long before)
+  asker.ask_at_step = 1;  // after answering step 1's frame (its admission was answered long before)
   // Agent 2 never answers: each of its first three steps waits the 1 s deadline, time for agent 1's question.
   FakeAgent a1(asker), a2(agent(kDomain, 2, FakeMode::kSilent));
   world.join();
