@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Lockstep benchmark: the wall time of one world step with 1, 4 and 12 (--teams: up to 120) idle agent processes
-# (behaviour "idle": an empty request per frame), beside the raw DDS round trip measured in the same run, as a ratio.
-# Reports the world's per-step median and 90th percentile (summary.json) over --steps steps.
+# (behaviour "idle": an empty request, which stands), beside the raw DDS round trip measured in the same run, as a
+# ratio. Each team runs twice: with standing answers (the world writes an idle robot no frame while nothing around it
+# changes: docs/runtime.md#standing-answers) and with a frame and a request every step (standing_answers: false: the
+# lockstep's round trip). Reports the world's per-step median and 90th percentile (summary.json) over --steps steps.
 # Usage: bench/lockstep_bench.sh [--dds cyclone|fastdds] [--steps N] [--teams "1 4 12"] [--dds-config FILE]
 #   --dds-config  a profile of the vendor for every process (default deploy/dds/<vendor>-lo.xml), e.g.
 #                 deploy/dds/fastdds-crowd.xml for Fast DDS with many agents
@@ -15,7 +17,7 @@ while [ $# -gt 0 ]; do
     --steps) steps="$2"; shift 2 ;;
     --teams) teams="$2"; shift 2 ;;
     --dds-config) profile="$2"; shift 2 ;;
-    -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
     *) echo "lockstep_bench.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -46,6 +48,8 @@ scenario="$work/idle.pbtxt"
   echo 'goal { x0_m: 18 y0_m: 18 x1_m: 19 y1_m: 19 min_height_m: 0 }'
   echo "base { x_m: 3.05 y_m: 3.05 radius_m: 1.0 } max_steps: $steps step_deadline_s: 10 tile_size: 16 seed: 1"
 } >"$scenario"
+every="$work/idle-every.pbtxt"  # the same robots answering a frame every step
+{ cat "$scenario"; echo 'standing_answers: false'; } >"$every"
 
 export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-lo.xml"
 export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-lo.xml"
@@ -60,24 +64,30 @@ field() { grep -o "\"$1\": *[^,}]*" "$2" | head -1 | sed 's/^[^:]*: *//; s/"//g'
 raw_us=$("$build/bench/bus_pingpong_bench" --benchmark_filter="BM_BusPingPong/$dds/" --benchmark_repetitions=3 \
   --benchmark_report_aggregates_only=true 2>/dev/null | grep median | grep -o 'p50_us=[0-9.]*' | head -1 | cut -d= -f2)
 echo "raw DDS round trip ($dds, median of p50): ${raw_us} us"
-printf '%-7s %-16s %-14s %-8s %s\n' agents "step median ms" "step p90 ms" ratio "idle agent RSS (MB)"
-for n in $teams; do
-  out="$work/run-$n"
-  "$root/deploy/spawn.sh" --scenario "$scenario" --agents "$n" --dds "$dds" --out "$out" --quiet --timeout 600 &
+printf '%-7s %-18s %-18s %-10s %s\n' agents "standing med/p90" "every frame m/p90" ratio "idle agent RSS (MB)"
+# One run of `$2` with $1 agents: sets median, p90 [ms] and rss (the largest agent resident set seen) [kB].
+run_team() {
+  local n=$1 file=$2 out="$work/run-$1-$(basename "$2" .pbtxt)" spawn rc=0 now
+  "$root/deploy/spawn.sh" --scenario "$file" --agents "$n" --dds "$dds" --out "$out" --quiet --timeout 600 &
   spawn=$!
-  rss=0  # largest agent resident set seen while the run lasts [kB]
+  rss=0
   while kill -0 "$spawn" 2>/dev/null; do
     now=$( (ps -C marsala-agent -o rss= || true) | sort -n | tail -1)
     [ -n "$now" ] && [ "$now" -gt "$rss" ] && rss=$now
     sleep 0.05
   done
-  rc=0
   wait "$spawn" || rc=$?
   # spawn.sh passes the world's exit code on: 0 completed, 3 max_steps (the idle scenario's end) both measured a run.
   [ "$rc" -eq 0 ] || [ "$rc" -eq 3 ] ||
     { echo "lockstep_bench.sh: the run with $n agents failed (exit $rc); world log:" >&2; tail -5 "$out/logs/world.log" >&2; exit 1; }
   median=$(field step_wall_median_ms "$out/summary.json")
   p90=$(field step_wall_p90_ms "$out/summary.json")
+}
+for n in $teams; do
+  run_team "$n" "$scenario"
+  standing=$(printf '%.3f / %.3f' "$median" "$p90")
+  run_team "$n" "$every"
   ratio=$(awk -v m="$median" -v r="$raw_us" 'BEGIN { if (r > 0) printf "%.1f", m * 1000 / r; else print "-" }')
-  printf '%-7s %-16.3f %-14.3f %-8s %s\n' "$n" "$median" "$p90" "$ratio" "$(awk -v k="${rss:-0}" 'BEGIN{printf "%.1f", k/1024}')"
+  printf '%-7s %-18s %-18s %-10s %s\n' "$n" "$standing" "$(printf '%.3f / %.3f' "$median" "$p90")" "$ratio" \
+    "$(awk -v k="${rss:-0}" 'BEGIN{printf "%.1f", k/1024}')"
 done

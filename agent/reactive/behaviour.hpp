@@ -37,6 +37,12 @@ class Behaviour {
   /// What the last decision waits for, in a few words ("front neighbour 7 at 1.4 m (hold)"); "" when nothing holds it
   /// up. Sent in every request (ActionRequest::waiting_for) for the world's stall account.
   virtual std::string waiting_for() const { return ""; }
+  /// True when the last decision's (empty) request is this behaviour's answer to every later frame that tells it nothing
+  /// new (the same pose, material, last result and neighbours; no terrain, no scan): deciding such a frame would
+  /// return the same request and leave the behaviour as it is. The runtime then says the answer stands
+  /// (ActionRequest::standing) and the world writes no frame until one tells something new
+  /// (docs/runtime.md#standing-answers). A behaviour that counts steps or draws randomness per frame must say false.
+  virtual bool answer_stands() const { return false; }
   /// Where the robot believes the terrain of its next frames lies (executive::MappingSystem::set_registration);
   /// behaviours without a map ignore it.
   virtual void set_registration(CellIndex /*offset*/) {}

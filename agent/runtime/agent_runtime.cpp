@@ -388,6 +388,8 @@ class AgentRuntime::Lockstep {
     reactive::Behaviour& behaviour = *agent_.behaviour_;
     const std::string before = behaviour.state_name();
     protocol::ActionRequest request = costs_.measure([&] { return behaviour.decide(frame); });
+    request.standing = behaviour.answer_stands();
+    watch_.standing(request.standing);
     requests_->write(request);
     ++result_.requests;
     result_.last_answered = frame.step;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <utility>
 
 #include "marsala/agent/executive/mapping_system.hpp"
@@ -68,10 +69,17 @@ void FrameGate::answered(std::uint64_t step, protocol::ActionRequest request) {
   answered_world_ = world_;
 }
 
-const protocol::ActionRequest* FrameGate::request_for(std::uint64_t step) const {
-  const auto it = std::lower_bound(sent_.begin(), sent_.end(), step,
-                                   [](const auto& sent, std::uint64_t s) { return sent.first < s; });
-  return it != sent_.end() && it->first == step ? &it->second : nullptr;
+std::optional<protocol::ActionRequest> FrameGate::request_for(std::uint64_t step) const {
+  // The first kept request after `step`; the one before it answered `step` or, standing, the steps up to the next.
+  const auto after = std::upper_bound(sent_.begin(), sent_.end(), step,
+                                      [](std::uint64_t s, const auto& sent) { return s < sent.first; });
+  if (after == sent_.begin()) return std::nullopt;
+  const auto& [answered, request] = *std::prev(after);
+  if (answered == step) return request;
+  if (!request.standing || step > last_answered_) return std::nullopt;
+  protocol::ActionRequest stood = request;
+  stood.step = step;
+  return stood;
 }
 
 }  // namespace marsala::agent::runtime

@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -68,8 +69,10 @@ class FrameGate {
   /// The request sent for the frame of `step`, repeated when that frame comes again; forgets the requests of `step`
   /// and later ones (a world that went back decides again from there) and the oldest beyond kRequestHistory.
   void answered(std::uint64_t step, protocol::ActionRequest request);
-  /// The request sent for the frame of `step`, when it is kept; nullptr otherwise.
-  const protocol::ActionRequest* request_for(std::uint64_t step) const;
+  /// The request sent for the frame of `step`, when it is kept: the one answering `step`, or a standing one sent for
+  /// an earlier step and not followed by another before `step` (the world held its frames back), for `step`;
+  /// nullopt otherwise.
+  std::optional<protocol::ActionRequest> request_for(std::uint64_t step) const;
 
  private:
   std::uint32_t agent_id_;

@@ -40,6 +40,10 @@ WatchTurn WorldWatch::turn(Clock::time_point now, const std::function<bool()>& w
     sign_since_turn_ = false;
     world_seen_ = true;
     last_sign_ = now;
+    if (standing_) {  // the frames the world holds back would tell nothing new
+      last_frame_at_ = now;
+      deadline_ = limit_from(now, world_timeout_);
+    }
   } else if (world_seen_ && !silence_said_ && now - last_sign_ >= kWorldGrace) {
     // Said once; the agent keeps its state and keeps asking (docs/runtime.md#silence).
     turn.silent_s = seconds(now - last_sign_);

@@ -13,6 +13,9 @@
 //                     each answer that the world still counts the agent in doubles the gap, up to kStillInRecheck.
 //                     The world answers every hello to every agent: 120 agents of a team stepping at 2 s asked after
 //                     every step and at 5 Hz while the world admitted (60,000 deliveries a second) and kept it slow.
+//   standing          the last request sent stands (docs/runtime.md#standing-answers): the world writes no frame
+//                     until one tells something new, so while it stands a sign of life counts as a frame with nothing
+//                     new (no hello for the missing frames, the silence limit from the latest sign)
 //   admitting         before the first frame, an admission or answer the world gives another agent of the run is a
 //                     sign of life and puts the agent's own question off (kRehelloAfter and the agent's stagger after
 //                     it): while the world admits the rest of the team, the team asks about once per quiet spell of
@@ -92,6 +95,8 @@ class WorldWatch {
   /// A frame was taken at `now`: a sign of life, the silence limit starts again. True when a hello had gone out since
   /// the last frame (frames are back).
   bool frame(Clock::time_point now);
+  /// Whether the request just sent stands: while it does, the world's signs of life stand for frames.
+  void standing(bool stands) { standing_ = stands; }
   /// The latest time the loop may wait until before its next turn: the silence limit, or the next hello while asking.
   Clock::time_point wake_by() const;
   /// How long without a frame before asking: kRehelloAfter, or kPaceMultiple times the longest recent gap between
@@ -114,6 +119,7 @@ class WorldWatch {
   bool world_seen_ = false;          // some sign of life came once
   bool sign_since_turn_ = false;     // a frame or an answer came since the last turn
   bool silence_said_ = false;        // the current silence was said (silent_s)
+  bool standing_ = false;            // the last request sent stands
 };
 
 }  // namespace marsala::agent::runtime

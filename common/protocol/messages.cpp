@@ -29,8 +29,8 @@ bool same_request(const ActionRequest& a, const ActionRequest& b) {
   const auto same = [](double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; };
   if (a.agent_id != b.agent_id || a.session != b.session || a.step != b.step || a.move != b.move ||
       !same(a.target_x_m, b.target_x_m) || !same(a.target_y_m, b.target_y_m) || a.refill != b.refill ||
-      a.state != b.state || a.waiting_for != b.waiting_for || a.depositions.size() != b.depositions.size() ||
-      a.deposits.size() != b.deposits.size())
+      a.state != b.state || a.waiting_for != b.waiting_for || a.standing != b.standing ||
+      a.depositions.size() != b.depositions.size() || a.deposits.size() != b.deposits.size())
     return false;
   for (std::size_t i = 0; i < a.deposits.size(); ++i) {
     const Deposit &p = a.deposits[i], &q = b.deposits[i];

@@ -87,6 +87,9 @@ struct ActionRequest {
   /// For the step trace only: never part of the request's meaning, so same_request() and the run log ignore them.
   std::uint32_t decision_us = 0;
   std::uint32_t decision_cpu_us = 0;  ///< [us]
+  /// This (empty) request is the agent's answer to every later frame that tells it nothing new: the world writes it
+  /// no frame meanwhile and takes this answer for it (docs/runtime.md#standing-answers).
+  bool standing = false;
 };
 
 /// One agent as the world sees it, for status and the monitor.

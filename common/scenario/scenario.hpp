@@ -105,6 +105,9 @@ struct Scenario {
   std::uint64_t stall_steps = kDefaultStallSteps;
   /// Builders keep the right-of-way protocol (docs/runtime.md#right-of-way); on by default, false turns it off.
   bool right_of_way = true;
+  /// The world takes an agent's standing answer for it until a frame would tell it something new, writing it no frame
+  /// meanwhile (docs/runtime.md#standing-answers); false: every live agent gets a frame every step.
+  bool standing_answers = true;
   double step_deadline_s = 10.0;
   std::int32_t tile_size = 16;
   std::uint64_t seed = 1;

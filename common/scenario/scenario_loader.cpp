@@ -421,6 +421,7 @@ void read_run_settings(const proto::Scenario& p, Scenario& s, const Validator& c
   if (s.tile_size < 1 || s.tile_size > 4096) check.fail("tile_size", fmt::format("{} must be in 1..4096", s.tile_size));
   if (p.has_seed()) s.seed = p.seed();
   if (p.has_right_of_way()) s.right_of_way = p.right_of_way();
+  if (p.has_standing_answers()) s.standing_answers = p.standing_answers();
 }
 
 Scenario to_scenario(const proto::Scenario& p, const std::string& source) {

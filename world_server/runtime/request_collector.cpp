@@ -12,8 +12,10 @@ void RequestCollector::read_partitions(const WorldState& state, RequestSelection
     for (protocol::ActionRequest& r : received) {
       const bool answers = r.step == state.step && carries_identity_of(a, r);
       const RequestTake take = selection.take(a.id, answers);
-      if (take == RequestTake::kAnswer)
+      if (take == RequestTake::kAnswer) {
         into.answered_at.push_back({a.id, Clock::now(), r.decision_us, r.decision_cpu_us});
+        into.answers.push_back(into.submissions.size());
+      }
       if (take != RequestTake::kSurplus) into.submissions.push_back({a.id, std::move(r)});
     }
   }
@@ -33,7 +35,7 @@ bool RequestCollector::look(const WorldState& state, const RequestSelection& sel
 }
 
 Collected RequestCollector::collect(const WorldState& state, double deadline_s, const std::atomic<bool>& stop,
-                                    const CollectDuties& duties) {
+                                    const CollectDuties& duties, std::vector<Submission> standing) {
   Clock::time_point deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(deadline_s));
   Clock::time_point last_wake = Clock::now();
@@ -42,6 +44,10 @@ Collected RequestCollector::collect(const WorldState& state, double deadline_s, 
   bool delivering = false;      // at the latest look, a frame of an agent that has not answered was in flight
   RequestSelection selection(state.agents.size());
   Collected collected;
+  for (Submission& s : standing) {
+    selection.take(s.channel_id, true);
+    collected.submissions.push_back(std::move(s));
+  }
   for (;;) {
     duties.on_wake();
     read_partitions(state, selection, collected);

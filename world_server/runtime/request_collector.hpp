@@ -54,6 +54,8 @@ struct Collected {
   std::chrono::steady_clock::duration waited{};  ///< time spent waiting for requests
   /// Each agent whose answer was taken, when it was read and its reported decision time (the step trace).
   std::vector<AgentAnswer> answered_at;
+  /// Where in `submissions` each answer read this step lies (standing answers not included).
+  std::vector<std::size_t> answers;
 };
 
 /// Collects the requests of each step from the agents' links.
@@ -68,9 +70,10 @@ class RequestCollector {
   /// The requests of state.step's live agents until all answered, `deadline_s` passes, or `stop`; the time the
   /// world's process did not run (kWorldPause), the time the step is held and the time a frame of an agent that has
   /// not answered is in flight (up to kMaxDeliveryStretch) are not counted. Requests of a dropped
-  /// agent's partition are read and discarded.
+  /// agent's partition are read and discarded. `standing` holds the answers that stand for this step
+  /// (standing_answers.hpp): their agents count as answered from the start.
   Collected collect(const WorldState& state, double deadline_s, const std::atomic<bool>& stop,
-                    const CollectDuties& duties);
+                    const CollectDuties& duties, std::vector<Submission> standing = {});
 
  private:
   /// Reads every partition once into `into`.

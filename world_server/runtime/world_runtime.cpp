@@ -29,6 +29,7 @@
 #include "marsala/world_server/runtime/agent_links.hpp"
 #include "marsala/world_server/runtime/metrics_server.hpp"
 #include "marsala/world_server/runtime/request_collector.hpp"
+#include "marsala/world_server/runtime/standing_answers.hpp"
 #include "marsala/world_server/runtime/step_trace.hpp"
 #include "marsala/world_server/runtime/team_silence.hpp"
 
@@ -150,6 +151,7 @@ struct WorldRuntime::Impl {
         recorder(recorder_setup(options, resume)),
         silence(std::chrono::milliseconds(static_cast<long long>(options.silence_timeout_s * 1000.0))) {
     sensing.emplace(state);
+    standing.emplace(state.agents.size(), scenario.standing_answers);
     last_rejection.resize(state.agents.size());
   }
 
@@ -283,6 +285,7 @@ struct WorldRuntime::Impl {
     recorder.record(admitted_record(state, slot.agent_id, kind));
     const AgentRecord& a = state.agent(slot.agent_id);
     if (kind != AdmissionKind::kFirst && a.session != previous) sensing->forget(slot.agent_id);
+    standing->forget(slot.agent_id);
     links->open(a, from);
     links->forgive(slot.agent_id);
     std::string detail = a.name;
@@ -453,7 +456,14 @@ struct WorldRuntime::Impl {
 
   // ---- the lockstep
 
-  void send_frame(std::uint32_t id, bool run_over) { links->send(id, sensing->frame_for(state, id, run_over)); }
+  /// Writes agent `id` its frame of this step.
+  void send_frame(std::uint32_t id, bool run_over) { tell(sensing->frame_for(state, id, run_over)); }
+
+  /// Writes `frame` to its agent; what the agent was told ends its standing answer (standing_answers.hpp).
+  void tell(protocol::SensorFrame frame) {
+    standing->told(frame);
+    links->send(frame.agent_id, std::move(frame));
+  }
 
   /// Logs a rejection at info level, or at debug level when it repeats the agent's previous one (a stuck agent would
   /// otherwise fill the log; events.log keeps every one).
@@ -504,9 +514,35 @@ struct WorldRuntime::Impl {
     return std::nullopt;
   }
 
-  /// Frames: each live agent's frame of this step.
-  void send_frames() {
-    for (std::uint32_t id : state.live_ids()) send_frame(id, false);
+  /// Frames: each live agent's frame of this step, unless its answer stands (the frame tells it nothing new): those
+  /// answers, for the collector.
+  std::vector<Submission> send_frames() {
+    std::vector<Submission> stood;
+    for (std::uint32_t id : state.live_ids()) {
+      protocol::SensorFrame frame = sensing->frame_for(state, id, false);
+      if (std::optional<protocol::ActionRequest> answer = standing->stands_for(id, frame))
+        stood.push_back({id, std::move(*answer)});
+      else
+        tell(std::move(frame));
+    }
+    return stood;
+  }
+
+  /// The answers read this step that were applied: each stands from now on when it says so and may (standing_answers
+  /// .hpp); one that says so but asks for something is taken for its step only, and the operator is told.
+  void keep_standing_answers(const Collected& collected, const StepOutcome& outcome) {
+    for (std::size_t i : collected.answers) {
+      const Submission& s = collected.submissions[i];
+      if (!outcome.accepted_submissions[i]) {
+        standing->forget(s.channel_id);
+        continue;
+      }
+      if (!standing->answered(s.channel_id, s.request) && power_of_ten(++unstandable_answers))
+        spdlog::warn(
+            "step {}: agent {} said its request stands, but it asks for something (a motion, deposition or refill): "
+            "taken for this step only ({} so far)",
+            state.step, s.channel_id, unstandable_answers);
+    }
   }
 
   /// Record: the step in run.log before anything of it is published (a crash never loses a step an agent has seen
@@ -541,13 +577,14 @@ struct WorldRuntime::Impl {
       StepTimes times;  // the phases' ends, for the step time and the trace
       times.step = state.step;
       times.start = Clock::now();
-      send_frames();
+      std::vector<Submission> stood = send_frames();
       times.frames_out = Clock::now();
-      Collected collected = collector->collect(state, options.step_deadline_s, stop, duties);
+      Collected collected = collector->collect(state, options.step_deadline_s, stop, duties, std::move(stood));
       if (stop) return protocol::EndReason::kSignal;  // the interrupted step is not applied
       if (fork && fork->replaying(state.step)) replay_fork_step(collected);
       times.collected = Clock::now();
       const StepOutcome outcome = apply_step(state, collected.submissions);
+      keep_standing_answers(collected, outcome);
       times.applied = Clock::now();
       state.surplus_requests += collected.surplus;
       record_step(collected, outcome);
@@ -568,6 +605,7 @@ struct WorldRuntime::Impl {
       throw ForkMismatch(fmt::format("fork of {} at step {}: {}", fork->origin().parent_dir, fork->origin().at_step,
                                      problem));
     collected.submissions = fork->recorded(state.step, state);
+    collected.answers.clear();  // they named the live submissions; no answer stands while the parent's steps replay
   }
 
   /// True for a fork's late slot (above the parent's team, docs/runtime.md#fork): not admitted before K.
@@ -786,6 +824,8 @@ struct WorldRuntime::Impl {
   RunRecorder recorder;           ///< run.log, snapshots, events.log, frames, final outputs
   TeamSilence silence;            ///< whether the step is held for a silent team
   std::optional<SensingService> sensing;
+  std::optional<StandingAnswers> standing;  ///< the agents' standing answers and what each was last told
+  std::uint64_t unstandable_answers = 0;    ///< answers that said they stand but asked for something [count]
   AdmissionGate gate;
   std::shared_ptr<bus::Signal> signal;
   std::optional<AgentLinks> links;

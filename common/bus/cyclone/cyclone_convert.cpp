@@ -249,6 +249,7 @@ marsala_wire_ActionRequest to_msg(const ActionRequest& in, Storage& storage) {
   out.waiting_for = borrow(in.waiting_for);
   out.decision_us = in.decision_us;
   out.decision_cpu_us = in.decision_cpu_us;
+  out.standing = in.standing;
   return out;
 }
 
@@ -282,6 +283,7 @@ ActionRequest from_msg(const marsala_wire_ActionRequest& in) {
   out.waiting_for = copy(in.waiting_for);
   out.decision_us = in.decision_us;
   out.decision_cpu_us = in.decision_cpu_us;
+  out.standing = in.standing;
   return out;
 }
 

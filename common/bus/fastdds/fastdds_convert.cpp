@@ -222,6 +222,7 @@ wire::ActionRequest to_msg(const ActionRequest& in) {
   out.waiting_for(in.waiting_for);
   out.decision_us(in.decision_us);
   out.decision_cpu_us(in.decision_cpu_us);
+  out.standing(in.standing);
   return out;
 }
 
@@ -253,6 +254,7 @@ ActionRequest from_msg(const wire::ActionRequest& in) {
   out.waiting_for = in.waiting_for();
   out.decision_us = in.decision_us();
   out.decision_cpu_us = in.decision_cpu_us();
+  out.standing = in.standing();
   return out;
 }
 

@@ -157,6 +157,7 @@ void expect_same(const ActionRequest& a, const ActionRequest& b) {
   }
   EXPECT_EQ(a.refill, b.refill);
   EXPECT_EQ(a.state, b.state);
+  EXPECT_EQ(a.standing, b.standing);
 }
 
 void expect_same(const WorldStatus& a, const WorldStatus& b) {
@@ -302,6 +303,7 @@ ActionRequest filled_request(Filler& f) {
   for (int i = 0; i < 5; ++i) r.deposits.push_back({f.real(), f.real(), f.real()});
   r.refill = true;
   r.state = "climb_" + kUtf8;
+  r.standing = true;
   return r;
 }
 

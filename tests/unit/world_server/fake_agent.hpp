@@ -21,6 +21,7 @@ enum class FakeMode {
   kWalker,   ///< walks straight to its target, at most max_step_m per step
   kSilent,   ///< is admitted, then never answers
   kQuitter,  ///< walks, then vanishes (endpoints destroyed) when the frame of `quit_at_step` arrives
+  kStander,  ///< stays where it is: answers every frame with an empty request that stands
 };
 
 struct FakeAgentConfig {
@@ -125,6 +126,11 @@ class FakeAgent {
     r.step = f.step;
     r.state = "walking";
     r.waiting_for = "its target\n";  // the world keeps it printable
+    if (config_.mode == FakeMode::kStander) {
+      r.state = "standing";
+      r.standing = true;
+      return r;
+    }
     const double dx = a.assignment.target.x - f.x_m, dy = a.assignment.target.y - f.y_m;
     const double d = std::sqrt(dx * dx + dy * dy);
     if (d > 0.0) {

@@ -67,7 +67,7 @@ TEST(FrameGate, RepeatsEveryAnsweredStepItKeeps) {
   };
   for (std::uint64_t step = 3; step <= 5; ++step) g.answered(step, request_of(step));
   EXPECT_EQ(g.judge(frame(5), writer(1)).call, FrameCall::kRepeat);
-  ASSERT_NE(g.request_for(5), nullptr);
+  ASSERT_TRUE(g.request_for(5));
   EXPECT_EQ(g.request_for(5)->target_x_m, 1.25);
   // A late copy of an earlier frame from the same world: stale.
   EXPECT_EQ(g.judge(frame(4), writer(1)).call, FrameCall::kStale);
@@ -75,11 +75,11 @@ TEST(FrameGate, RepeatsEveryAnsweredStepItKeeps) {
   // decisions.
   g.set_world(writer(2));
   EXPECT_EQ(g.judge(frame(4), writer(2)).call, FrameCall::kRepeat);
-  ASSERT_NE(g.request_for(3), nullptr);
+  ASSERT_TRUE(g.request_for(3));
   EXPECT_EQ(g.request_for(3)->target_x_m, 0.75);
   // A step before any kept is decided anew; so is the next step.
   EXPECT_EQ(g.judge(frame(2), writer(2)).call, FrameCall::kDecide);
-  EXPECT_EQ(g.request_for(2), nullptr);
+  EXPECT_FALSE(g.request_for(2));
   EXPECT_EQ(g.judge(frame(6), writer(2)).call, FrameCall::kDecide);
   // The run-over frame ends the run whatever its step.
   protocol::SensorFrame over = frame(3);
@@ -88,17 +88,55 @@ TEST(FrameGate, RepeatsEveryAnsweredStepItKeeps) {
   // Deciding step 4 again forgets the requests of 4 and 5: they were never applied in this world's history.
   g.answered(4, request_of(40));
   EXPECT_EQ(g.request_for(4)->step, 40u);
-  EXPECT_EQ(g.request_for(5), nullptr);
+  EXPECT_FALSE(g.request_for(5));
   EXPECT_EQ(g.judge(frame(5), writer(2)).call, FrameCall::kDecide);
   EXPECT_EQ(g.judge(frame(3), writer(2)).call, FrameCall::kStale);  // answered since by this world: a late copy
   EXPECT_EQ(g.request_for(3)->target_x_m, 0.75);
 }
 
+// docs/runtime.md#standing-answers: a standing request answered the steps whose frames the world held back, up to the
+// next request; a world that went back to one of them gets it again for that step, never a new decision.
+TEST(FrameGate, AStandingRequestIsRepeatedForTheStepsItStoodFor) {
+  FrameGate g = gate();
+  protocol::ActionRequest stands;
+  stands.agent_id = 7;
+  stands.step = 3;
+  stands.state = "idle";
+  stands.standing = true;
+  g.answered(3, stands);
+  protocol::ActionRequest moves;
+  moves.agent_id = 7;
+  moves.step = 9;
+  moves.move = true;
+  g.answered(9, moves);
+  g.set_world(writer(2));
+  for (std::uint64_t step = 4; step <= 8; ++step) {
+    EXPECT_EQ(g.judge(frame(step), writer(2)).call, FrameCall::kRepeat) << step;
+    const std::optional<protocol::ActionRequest> r = g.request_for(step);
+    ASSERT_TRUE(r) << step;
+    EXPECT_EQ(r->step, step);
+    EXPECT_EQ(r->state, "idle");
+    EXPECT_FALSE(r->move);
+  }
+  EXPECT_EQ(g.request_for(9)->step, 9u);
+  EXPECT_TRUE(g.request_for(9)->move);
+  EXPECT_EQ(g.judge(frame(10), writer(2)).call, FrameCall::kDecide);
+  EXPECT_FALSE(g.request_for(10)) << "a new step is decided";
+  // A request that did not stand answered its own step only.
+  FrameGate h = gate();
+  stands.standing = false;
+  h.answered(3, stands);
+  h.answered(9, moves);
+  h.set_world(writer(2));
+  EXPECT_FALSE(h.request_for(5));
+  EXPECT_EQ(h.judge(frame(5), writer(2)).call, FrameCall::kDecide);
+}
+
 TEST(FrameGate, KeepsTheLastRequestsOnly) {
   FrameGate g = gate();
   for (std::uint64_t step = 1; step <= kRequestHistory + 10; ++step) g.answered(step, {});
-  EXPECT_EQ(g.request_for(10), nullptr);
-  EXPECT_NE(g.request_for(11), nullptr);  // the oldest of the kRequestHistory kept
+  EXPECT_FALSE(g.request_for(10));
+  EXPECT_TRUE(g.request_for(11));  // the oldest of the kRequestHistory kept
   g.set_world(writer(2));
   EXPECT_EQ(g.judge(frame(10), writer(2)).call, FrameCall::kDecide);
   EXPECT_EQ(g.judge(frame(11), writer(2)).call, FrameCall::kRepeat);

@@ -204,6 +204,40 @@ TEST(WorldWatch, BeforeTheFirstFrameTheWorldAdmittingOthersPutsTheQuestionOffByT
   EXPECT_TRUE(running.turn(kT0 + 3s, kAlive).hello);
 }
 
+// docs/runtime.md#standing-answers: while the agent's answer stands the world writes no frame; a live world's signs
+// stand for frames with nothing new: no hello and no silence limit however long; a world whose writer is gone is asked
+// after the run's pace as usual, and the limit counts from its last sign.
+TEST(WorldWatch, WhileTheAnswerStandsALiveWorldIsNeitherAskedNorTimedOut) {
+  WorldWatch watch = watch_from_t0();
+  watch.frame(kT0 + 100ms);
+  watch.standing(true);
+  for (auto t = 200ms; t < 60s; t += 100ms) {
+    const WatchTurn turn = watch.turn(kT0 + t, kAlive);
+    ASSERT_EQ(turn.state, WorldState::kWatching) << t.count() << " ms";
+    ASSERT_FALSE(turn.hello) << t.count() << " ms";
+  }
+  // The world's writer goes at 60 s: asked kRehelloAfter after its last sign, timed out 20 s after it.
+  std::vector<Clock::duration> hellos;
+  WorldState end = WorldState::kWatching;
+  Clock::duration ended{};
+  for (Clock::duration t = 60s; t <= 90s && end == WorldState::kWatching; t += 100ms) {
+    const WatchTurn turn = watch.turn(kT0 + t, kNotAlive);
+    if (turn.hello) hellos.push_back(t);
+    end = turn.state;
+    ended = t;
+  }
+  ASSERT_FALSE(hellos.empty());
+  EXPECT_EQ(hellos.front(), 59900ms + kRehelloAfter);
+  EXPECT_EQ(end, WorldState::kWorldTimeout);
+  EXPECT_EQ(ended, 59900ms + 20s);
+  // Not standing: the same live world is asked after the pace once frames stop.
+  WorldWatch answering = watch_from_t0();
+  answering.frame(kT0 + 100ms);
+  int asked = 0;
+  for (auto t = 200ms; t < 10s; t += 100ms) asked += answering.turn(kT0 + t, kAlive).hello;
+  EXPECT_GT(asked, 0);
+}
+
 TEST(WorldWatch, AFrameRestartsTheSilenceLimit) {
   WorldWatch watch = watch_from_t0();
   watch.frame(kT0 + 15s);

@@ -291,6 +291,93 @@ TEST_F(RuntimeTest, ALiveAgentAskingDuringTheRunIsAnsweredWithItsFrameNotAnAdmis
   EXPECT_EQ(runtime.state().agent(1).missed, 0u);
 }
 
+// docs/runtime.md#standing-answers: a robot whose empty answer stands gets a frame only when the frame tells it something
+// new (here: a walker passing within its proximity range), the world taking its answer for every other step; the run
+// is the same as with a frame every step (standing_answers: false): every step accepted for both robots, none missed,
+// the same end, and every frame held back told nothing its predecessor had not.
+TEST_F(RuntimeTest, AStandingAnswerIsTakenWhileFramesWouldTellNothingNew) {
+  struct Run {
+    RunResult result;
+    std::vector<protocol::SensorFrame> frames;  // the stander's
+    std::uint32_t accepted[2] = {0, 0};
+    std::uint32_t rejected[2] = {0, 0};
+    std::uint32_t missed[2] = {0, 0};
+    Position walker;
+  };
+  const auto run = [&](int domain, bool standing) {
+    scenario_ = scenario::parse_scenario(
+        testing::small_scenario_text_completing(
+            kTwoBodyGoal, std::string("max_steps: 30") + (standing ? "" : " standing_answers: false")),
+        "small.pbtxt");
+    auto participant = bus::make_participant({bus::Vendor::kInProcess, domain});
+    RuntimeOptions o = options(2, 10.0);
+    o.max_steps = 30;
+    o.out_dir = (out_ / std::to_string(domain)).string();
+    WorldRuntime runtime(scenario_, testing::flat_terrain(), o, *participant);
+    std::atomic<bool> stop{false};
+    Run r;
+    std::thread world([&] { r.result = runtime.run(stop); });
+    // Agent 2 stands at (2.55, 1.05), 1.5 m from agent 1's start: the walker is its neighbour from step 0 and moves
+    // within its range until the stander's body stops it (its motions refused); then nothing changes around agent 2.
+    FakeAgent a1(agent(domain, 1)), a2(agent(domain, 2, FakeMode::kStander));
+    world.join();
+    a1.join();
+    a2.join();
+    r.frames = a2.frames();
+    for (std::uint32_t id : {1u, 2u}) {
+      r.accepted[id - 1] = runtime.state().agent(id).accepted;
+      r.rejected[id - 1] = runtime.state().agent(id).rejected;
+      r.missed[id - 1] = runtime.state().agent(id).missed;
+    }
+    r.walker = runtime.state().agent(1).position;
+    return r;
+  };
+  const Run every = run(52, false);
+  const Run stood = run(53, true);
+
+  for (const Run* r : {&every, &stood}) {
+    EXPECT_EQ(r->result.end_reason, protocol::EndReason::kMaxSteps);
+    EXPECT_EQ(r->result.steps, 30u);
+    EXPECT_EQ(r->accepted[0] + r->rejected[0], 30u);  // the walker's way passes the stander's body
+    EXPECT_EQ(r->accepted[1], 30u);
+    EXPECT_EQ(r->missed[0] + r->missed[1], 0u);
+  }
+  EXPECT_EQ(stood.accepted[0], every.accepted[0]);
+  EXPECT_EQ(stood.walker.x, every.walker.x);
+  EXPECT_EQ(stood.walker.y, every.walker.y);
+  ASSERT_EQ(every.frames.size(), 31u) << "30 steps and the run-over frame";
+  ASSERT_GE(stood.frames.size(), 3u);
+  EXPECT_TRUE(stood.frames.back().run_over);
+  EXPECT_LT(stood.frames.size(), 20u) << "no frame for the steps after the walker stopped";
+  // Every frame the stander got is the one of that step with a frame every step; every frame held back repeats the
+  // last one it got in pose, material, result and neighbours.
+  std::size_t next = 0;
+  for (const protocol::SensorFrame& f : every.frames) {
+    if (next < stood.frames.size() && stood.frames[next].step == f.step && stood.frames[next].run_over == f.run_over) {
+      const protocol::SensorFrame& got = stood.frames[next++];
+      ASSERT_EQ(got.neighbours.size(), f.neighbours.size()) << f.step;
+      for (std::size_t i = 0; i < f.neighbours.size(); ++i) {
+        EXPECT_EQ(got.neighbours[i].position.x, f.neighbours[i].position.x) << f.step;
+        EXPECT_EQ(got.neighbours[i].position.y, f.neighbours[i].position.y) << f.step;
+      }
+      EXPECT_EQ(got.last_result, f.last_result) << f.step;
+      continue;
+    }
+    ASSERT_GT(next, 0u) << "the frame of step 0 goes out";
+    const protocol::SensorFrame& last = stood.frames[next - 1];
+    EXPECT_FALSE(f.run_over);
+    EXPECT_EQ(f.x_m, last.x_m) << f.step;
+    EXPECT_EQ(f.y_m, last.y_m) << f.step;
+    EXPECT_EQ(f.last_result, last.last_result) << f.step;
+    ASSERT_EQ(f.neighbours.size(), last.neighbours.size()) << f.step;
+    for (std::size_t i = 0; i < f.neighbours.size(); ++i) {
+      EXPECT_EQ(f.neighbours[i].position.x, last.neighbours[i].position.x) << f.step;
+      EXPECT_EQ(f.neighbours[i].position.y, last.neighbours[i].position.y) << f.step;
+    }
+  }
+  EXPECT_EQ(next, stood.frames.size()) << "every frame the stander got was one of the run's";
+}
+
 TEST_F(RuntimeTest, AnAgentWhoseWriterGoesAwayIsDroppedAtOnce) {
   constexpr int kDomain = 43;
   auto participant = bus::make_participant({bus::Vendor::kInProcess, kDomain});
