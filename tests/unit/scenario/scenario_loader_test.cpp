@@ -428,6 +428,13 @@ TEST(ScenarioLoader, StallStepsDefaultsAndRange) {
   EXPECT_NE(invalid_override({"stall_steps=-1"}).find("stall_steps: -1 must be 0 (never)"), std::string::npos);
 }
 
+TEST(ScenarioLoader, StandingAnswersOnUnlessTurnedOff) {
+  EXPECT_TRUE(parse_scenario(kMinimal, "t.pbtxt").standing_answers);
+  EXPECT_FALSE(parse_scenario(std::string(kMinimal) + "standing_answers: false", "t.pbtxt").standing_answers);
+  EXPECT_FALSE(parse_scenario(kMinimal, "t.pbtxt", {"standing_answers=false"}).standing_answers);
+  EXPECT_NE(invalid_override({"standing_answers=maybe"}).find("standing_answers"), std::string::npos);
+}
+
 TEST(ScenarioLoader, RightOfWayOnUnlessTurnedOff) {
   EXPECT_TRUE(parse_scenario(kMinimal, "t.pbtxt").right_of_way);
   EXPECT_FALSE(parse_scenario(std::string(kMinimal) + "right_of_way: false", "t.pbtxt").right_of_way);
