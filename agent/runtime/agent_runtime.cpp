@@ -48,10 +48,10 @@ class DecisionCosts {
   }
   /// The median decision [ms]; 0 before the first.
   double median_ms() const { return median(decision_ms_); }
-  /// The process's CPU time since the first decision, per request sent [ms]; 0 when none was sent.
-  double process_ms_per(std::uint64_t requests) const {
-    if (requests == 0 || !process_at_first_ms_) return 0.0;
-    return (process_cpu_ms() - *process_at_first_ms_) / static_cast<double>(requests);
+  /// The process's CPU time since the first decision, per step of the run since [ms]; 0 before any.
+  double process_ms_per(std::uint64_t steps) const {
+    if (steps == 0 || !process_at_first_ms_) return 0.0;
+    return (process_cpu_ms() - *process_at_first_ms_) / static_cast<double>(steps);
   }
 
  private:
@@ -392,6 +392,7 @@ class AgentRuntime::Lockstep {
     watch_.standing(request.standing);
     requests_->write(request);
     ++result_.requests;
+    if (!first_decided_) first_decided_ = frame.step;
     result_.last_answered = frame.step;
     gate_.answered(frame.step, std::move(request));
     if (behaviour.state_name() != before)
@@ -404,7 +405,10 @@ class AgentRuntime::Lockstep {
     result_.outcome = RunOutcome::kRunOver;
     result_.message = fmt::format("run over at step {}", frame.step);
     result_.decision_cpu_median_ms = costs_.median_ms();
-    result_.cpu_ms_per_step = costs_.process_ms_per(result_.requests);
+    // Per step of the run, not per request: while its answer stands the agent sends none (docs/runtime.md#standing-
+    // answers), and its process still runs.
+    const std::uint64_t steps = first_decided_ && frame.step > *first_decided_ ? frame.step - *first_decided_ : 0;
+    result_.cpu_ms_per_step = costs_.process_ms_per(std::max(steps, result_.requests));
     spdlog::info(
         "agent {}: {} ({} requests, {} rejected, {} frames ignored, {} admissions ignored; decision CPU median "
         "{:.3f} ms, process CPU {:.3f} ms per step)",
@@ -425,6 +429,7 @@ class AgentRuntime::Lockstep {
   FrameGate gate_;
   WorldWatch watch_;
   DecisionCosts costs_;
+  std::optional<std::uint64_t> first_decided_;  // the step of the first decision
   // Last: made once everything on_frames() uses exists, and gone (its callbacks over) before any of it goes.
   std::unique_ptr<bus::Reader<protocol::SensorFrame>> frames_;
 };

@@ -78,7 +78,7 @@ struct RunResult {
   std::string final_state;           ///< the behaviour's state at the end
   double decision_cpu_median_ms = 0.0;  ///< median CPU time of the behaviour's decision of one step [ms]
   double cpu_ms_per_step = 0.0;  ///< the process's CPU time (all threads, DDS's too) from its first decision to the
-                                 ///< run-over frame, per request sent [ms]
+                                 ///< run-over frame, per step of the run since (or per decision when more) [ms]
 };
 
 /// A non-zero random session id (std::random_device): tells a restarted agent process apart.

@@ -46,7 +46,9 @@ FrameJudgement FrameGate::judge(const protocol::SensorFrame& frame, const bus::W
             fmt::format("written by participant {}, not by the world this agent was admitted to ({})", from.to_string(),
                         world_.to_string())};
   if (frame.agent_id != agent_id_) return {FrameCall::kIgnored, fmt::format("addressed to agent {}", frame.agent_id)};
-  if (answered_any_ && frame.step > last_answered_ && frame.step - last_answered_ > kMaxStepsAhead)
+  // A standing request answers any number of steps the world holds back (docs/runtime.md#standing-answers).
+  const bool stood = !sent_.empty() && sent_.back().second.standing;
+  if (answered_any_ && !stood && frame.step > last_answered_ && frame.step - last_answered_ > kMaxStepsAhead)
     return {FrameCall::kIgnored, fmt::format("step {} is more than {} steps ahead of the last one answered ({})",
                                              frame.step, kMaxStepsAhead, last_answered_)};
   std::string problem = frame_problem(frame, assignment_, sensor_);

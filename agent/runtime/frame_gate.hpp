@@ -25,7 +25,7 @@
 namespace marsala::agent::runtime {
 
 /// A frame further ahead of the last step answered is not the world's: no run goes on for a million steps while an
-/// agent waits for its next frame [steps].
+/// agent waits for its next frame [steps], unless the agent's last request stood (docs/runtime.md#standing-answers).
 inline constexpr std::uint64_t kMaxStepsAhead = 1000000;
 /// How many of its last requests an agent keeps, to repeat them when the world goes back to their steps [steps]: a
 /// world resumed from a log whose damaged tail was cut replays those steps with the same requests, so the run ends as

@@ -122,6 +122,11 @@ TEST(FrameGate, AStandingRequestIsRepeatedForTheStepsItStoodFor) {
   EXPECT_TRUE(g.request_for(9)->move);
   EXPECT_EQ(g.judge(frame(10), writer(2)).call, FrameCall::kDecide);
   EXPECT_FALSE(g.request_for(10)) << "a new step is decided";
+  // However far the world held its frames back after a standing request, the next frame is decided.
+  EXPECT_EQ(g.judge(frame(9 + kMaxStepsAhead + 1), writer(2)).call, FrameCall::kIgnored) << "the last did not stand";
+  stands.step = 10;
+  g.answered(10, stands);
+  EXPECT_EQ(g.judge(frame(10 + 5 * kMaxStepsAhead), writer(2)).call, FrameCall::kDecide);
   // A request that did not stand answered its own step only.
   FrameGate h = gate();
   stands.standing = false;
