@@ -40,10 +40,7 @@ WatchTurn WorldWatch::turn(Clock::time_point now, const std::function<bool()>& w
     sign_since_turn_ = false;
     world_seen_ = true;
     last_sign_ = now;
-    if (standing_) {  // the frames the world holds back would tell nothing new
-      last_frame_at_ = now;
-      deadline_ = limit_from(now, world_timeout_);
-    }
+    if (standing_) deadline_ = limit_from(now, world_timeout_);  // the frames held back would tell nothing new
   } else if (world_seen_ && !silence_said_ && now - last_sign_ >= kWorldGrace) {
     // Said once; the agent keeps its state and keeps asking (docs/runtime.md#silence).
     turn.silent_s = seconds(now - last_sign_);
@@ -72,7 +69,7 @@ WatchTurn WorldWatch::turn(Clock::time_point now, const std::function<bool()>& w
 
 bool WorldWatch::frame(Clock::time_point now) {
   sign_since_turn_ = true;
-  if (framed_) gaps_[gap_count_++ % kPaceFrames] = now - last_frame_at_;
+  if (framed_ && !standing_) gaps_[gap_count_++ % kPaceFrames] = now - last_frame_at_;  // a held-back gap sets no pace
   framed_ = true;
   last_frame_at_ = now;
   deadline_ = limit_from(now, world_timeout_);
@@ -95,6 +92,7 @@ void WorldWatch::answered_another(Clock::time_point now, Clock::duration stagger
 }
 
 WorldWatch::Clock::duration WorldWatch::quiet_limit() const {
+  if (standing_) return kStandingRecheck;
   Clock::duration longest{0};
   for (std::size_t i = 0; i < std::min(gap_count_, kPaceFrames); ++i) longest = std::max(longest, gaps_[i]);
   return std::clamp<Clock::duration>(kPaceMultiple * longest, kRehelloAfter, kLongestPace);

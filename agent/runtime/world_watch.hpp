@@ -14,8 +14,9 @@
 //                     The world answers every hello to every agent: 120 agents of a team stepping at 2 s asked after
 //                     every step and at 5 Hz while the world admitted (60,000 deliveries a second) and kept it slow.
 //   standing          the last request sent stands (docs/runtime.md#standing-answers): the world writes no frame
-//                     until one tells something new, so while it stands a sign of life counts as a frame with nothing
-//                     new (no hello for the missing frames, the silence limit from the latest sign)
+//                     until one tells something new, so while it stands the silence limit counts from the latest sign
+//                     of life and the agent asks whether it is still counted in only kStandingRecheck after its last
+//                     frame (a world that dropped it meanwhile says so; one that counts it in writes the next frame)
 //   admitting         before the first frame, an admission or answer the world gives another agent of the run is a
 //                     sign of life and puts the agent's own question off (kRehelloAfter and the agent's stagger after
 //                     it): while the world admits the rest of the team, the team asks about once per quiet spell of
@@ -43,6 +44,8 @@ inline constexpr std::chrono::seconds kRehelloAfter{2};
 /// The longest gap between two hellos of a silence that the world answers [s]: an agent it counts in asks again this
 /// often at the least, so one it dropped meanwhile learns it this late at the most (a pause asks at once).
 inline constexpr std::chrono::seconds kStillInRecheck{8};
+/// While the agent's answer stands, how long after its last frame it asks whether the world still counts it in [s].
+inline constexpr std::chrono::seconds kStandingRecheck{30};
 /// A world whose steps came this many times as far apart as now is not yet silent [count].
 inline constexpr int kPaceMultiple = 3;
 /// How many of the latest gaps between frames set the run's pace [count].
@@ -95,12 +98,12 @@ class WorldWatch {
   /// A frame was taken at `now`: a sign of life, the silence limit starts again. True when a hello had gone out since
   /// the last frame (frames are back).
   bool frame(Clock::time_point now);
-  /// Whether the request just sent stands: while it does, the world's signs of life stand for frames.
+  /// Whether the request just sent stands: while it does, the world holds its frames back (see the header).
   void standing(bool stands) { standing_ = stands; }
   /// The latest time the loop may wait until before its next turn: the silence limit, or the next hello while asking.
   Clock::time_point wake_by() const;
   /// How long without a frame before asking: kRehelloAfter, or kPaceMultiple times the longest recent gap between
-  /// frames when longer, kLongestPace at the most.
+  /// frames when longer, kLongestPace at the most; kStandingRecheck while the last answer stands.
   Clock::duration quiet_limit() const;
 
  private:

@@ -82,6 +82,13 @@ void StandingAnswers::forget(std::uint32_t id) {
   if (Slot* s = slot(id)) *s = Slot{};
 }
 
+bool StandingAnswers::asked(std::uint32_t id) {
+  Slot* s = slot(id);
+  if (s == nullptr || !s->standing) return false;
+  s->standing.reset();
+  return true;
+}
+
 std::size_t StandingAnswers::standing() const {
   std::size_t n = 0;
   for (const Slot& s : slots_) n += s.standing ? 1 : 0;

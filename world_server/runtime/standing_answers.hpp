@@ -37,6 +37,9 @@ class StandingAnswers {
   std::optional<protocol::ActionRequest> stands_for(std::uint32_t id, const protocol::SensorFrame& frame) const;
   /// Agent `id` starts afresh (admitted again, dropped): no answer stands, nothing was told.
   void forget(std::uint32_t id);
+  /// Agent `id` asked whether it is still counted in: its answer no longer stands, so its next frame goes out and
+  /// answers it. True when an answer stood.
+  bool asked(std::uint32_t id);
   /// How many agents hold a standing answer now [count].
   std::size_t standing() const;
 

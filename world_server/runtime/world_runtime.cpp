@@ -322,6 +322,8 @@ struct WorldRuntime::Impl {
       // the team, and a crowd asking during slow steps kept the world sending those instead of taking requests.
       if (decision.accepted && decision.kind == AdmissionKind::kRepeat && run_started) {
         const std::uint32_t id = slot_hello(state, hello, decision).agent_id;  // "any slot": the one it holds
+        // An agent whose answer stood: its frame of the next step goes out and answers (standing_answers.hpp).
+        if (state.has_agent(id) && state.agent(id).alive && standing->asked(id)) continue;
         if (state.has_agent(id) && links->has(id) && state.agent(id).alive && links->answers_with_frame(id)) {
           if (gate.may_answer(sender, now)) links->answer_with_frame(id, now);
           continue;

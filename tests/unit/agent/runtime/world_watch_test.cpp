@@ -204,38 +204,51 @@ TEST(WorldWatch, BeforeTheFirstFrameTheWorldAdmittingOthersPutsTheQuestionOffByT
   EXPECT_TRUE(running.turn(kT0 + 3s, kAlive).hello);
 }
 
-// docs/runtime.md#standing-answers: while the agent's answer stands the world writes no frame; a live world's signs
-// stand for frames with nothing new: no hello and no silence limit however long; a world whose writer is gone is asked
-// after the run's pace as usual, and the limit counts from its last sign.
-TEST(WorldWatch, WhileTheAnswerStandsALiveWorldIsNeitherAskedNorTimedOut) {
+// docs/runtime.md#standing-answers: while the agent's answer stands the world writes no frame. A live world's signs
+// keep the silence limit away however long; the agent asks whether it is still counted in only kStandingRecheck after
+// its last frame (and again after the next frame, which answers); a world whose writer is gone times out 20 s after
+// its last sign; the held-back gap sets no pace for the frames after.
+TEST(WorldWatch, WhileTheAnswerStandsALiveWorldIsAskedOnlyAtTheRecheckAndNeverTimedOut) {
   WorldWatch watch = watch_from_t0();
   watch.frame(kT0 + 100ms);
   watch.standing(true);
-  for (auto t = 200ms; t < 60s; t += 100ms) {
-    const WatchTurn turn = watch.turn(kT0 + t, kAlive);
-    ASSERT_EQ(turn.state, WorldState::kWatching) << t.count() << " ms";
-    ASSERT_FALSE(turn.hello) << t.count() << " ms";
-  }
-  // The world's writer goes at 60 s: asked kRehelloAfter after its last sign, timed out 20 s after it.
   std::vector<Clock::duration> hellos;
+  for (Clock::duration t = 200ms; t < 100ms + kStandingRecheck + 1s; t += 100ms) {
+    const WatchTurn turn = watch.turn(kT0 + t, kAlive);
+    ASSERT_EQ(turn.state, WorldState::kWatching) << t.count();
+    if (turn.hello) hellos.push_back(t);
+  }
+  ASSERT_EQ(hellos.size(), 5u) << "from the recheck on, every hello period (200 ms) until answered";
+  EXPECT_EQ(hellos.front(), 100ms + kStandingRecheck);
+  // The world answers with the next frame; the answer stands again: no question for another kStandingRecheck, and
+  // a live world is not timed out (20 s) in between.
+  EXPECT_TRUE(watch.frame(kT0 + 31200ms));
+  for (Clock::duration t = 31300ms; t < 31200ms + kStandingRecheck; t += 100ms) {
+    const WatchTurn turn = watch.turn(kT0 + t, kAlive);
+    ASSERT_EQ(turn.state, WorldState::kWatching) << t.count();
+    ASSERT_FALSE(turn.hello) << t.count();
+  }
+  // The world's writer goes: timed out 20 s after its last sign.
   WorldState end = WorldState::kWatching;
   Clock::duration ended{};
-  for (Clock::duration t = 60s; t <= 90s && end == WorldState::kWatching; t += 100ms) {
-    const WatchTurn turn = watch.turn(kT0 + t, kNotAlive);
-    if (turn.hello) hellos.push_back(t);
-    end = turn.state;
+  for (Clock::duration t = 61200ms; t <= 90s && end == WorldState::kWatching; t += 100ms) {
+    end = watch.turn(kT0 + t, kNotAlive).state;
     ended = t;
   }
-  ASSERT_FALSE(hellos.empty());
-  EXPECT_EQ(hellos.front(), 59900ms + kRehelloAfter);
   EXPECT_EQ(end, WorldState::kWorldTimeout);
-  EXPECT_EQ(ended, 59900ms + 20s);
-  // Not standing: the same live world is asked after the pace once frames stop.
-  WorldWatch answering = watch_from_t0();
-  answering.frame(kT0 + 100ms);
-  int asked = 0;
-  for (auto t = 200ms; t < 10s; t += 100ms) asked += answering.turn(kT0 + t, kAlive).hello;
-  EXPECT_GT(asked, 0);
+  EXPECT_EQ(ended, 61100ms + 20s);
+  // Frames every 100 ms after the answer stood no longer: the long gap set no pace (asked kRehelloAfter after them).
+  WorldWatch after = watch_from_t0();
+  after.frame(kT0 + 100ms);
+  after.standing(true);
+  for (Clock::duration t = 200ms; t < 20s; t += 100ms) (void)after.turn(kT0 + t, kAlive);
+  after.frame(kT0 + 20s);
+  after.standing(false);
+  after.frame(kT0 + 20100ms);
+  Clock::duration asked{};
+  for (Clock::duration t = 20200ms; t < 40s && asked == Clock::duration{}; t += 100ms)
+    if (after.turn(kT0 + t, kAlive).hello) asked = t;
+  EXPECT_EQ(asked, 20100ms + kRehelloAfter);
 }
 
 TEST(WorldWatch, AFrameRestartsTheSilenceLimit) {

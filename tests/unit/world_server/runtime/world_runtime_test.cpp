@@ -378,6 +378,41 @@ TEST_F(RuntimeTest, AStandingAnswerIsTakenWhileFramesWouldTellNothingNew) {
   EXPECT_EQ(next, stood.frames.size()) << "every frame the stander got was one of the run's";
 }
 
+// docs/runtime.md#standing-answers: an agent whose answer stands and asks whether it is still counted in is answered
+// by its frame of the next step (then its answer stands again), neither by a copy of an old frame nor by an admission.
+TEST_F(RuntimeTest, AStandingAgentAskingIsAnsweredByItsNextFrame) {
+  constexpr int kDomain = 54;
+  constexpr std::uint64_t kSteps = 20000;
+  auto participant = bus::make_participant({bus::Vendor::kInProcess, kDomain});
+  RuntimeOptions o = options(1, 10.0);
+  o.max_steps = kSteps;
+  scenario_ = scenario::parse_scenario(
+      testing::small_scenario_text_completing(kTwoBodyGoal, "max_steps: 20000 stall_steps: 0"), "small.pbtxt");
+  WorldRuntime runtime(scenario_, testing::flat_terrain(), o, *participant);
+  std::atomic<bool> stop{false};
+  RunResult result;
+  std::thread world([&] { result = runtime.run(stop); });
+  FakeAgentConfig asker = agent(kDomain, 1, FakeMode::kStander);
+  asker.ask_at_step = 1;  // after answering the frame of step 1, whose answer stands
+  FakeAgent a1(asker);
+  world.join();
+  a1.join();
+
+  EXPECT_EQ(result.end_reason, protocol::EndReason::kMaxSteps);
+  EXPECT_EQ(runtime.state().agent(1).accepted, kSteps);
+  EXPECT_EQ(runtime.state().agent(1).missed, 0u);
+  const std::vector<protocol::SensorFrame> frames = a1.frames();
+  ASSERT_EQ(frames.size(), 4u) << "steps 0 and 1 (its first result is news), the answer to its question, run over";
+  EXPECT_EQ(frames[0].step, 0u);
+  EXPECT_EQ(frames[1].step, 1u);
+  EXPECT_GT(frames[2].step, 1u);
+  EXPECT_LT(frames[2].step, kSteps) << "answered during the run, by the frame of a step";
+  EXPECT_FALSE(frames[2].run_over);
+  EXPECT_TRUE(frames[3].run_over);
+  EXPECT_EQ(a1.copies(), 0) << "no copy of an old frame";
+  EXPECT_EQ(a1.answers_after_ask(), 0) << "no admission on the team's topic";
+}
+
 TEST_F(RuntimeTest, AnAgentWhoseWriterGoesAwayIsDroppedAtOnce) {
   constexpr int kDomain = 43;
   auto participant = bus::make_participant({bus::Vendor::kInProcess, kDomain});
