@@ -543,7 +543,7 @@ struct WorldRuntime::Impl {
         spdlog::warn(
             "step {}: agent {} said its request stands, but it asks for something (a motion, deposition or refill): "
             "taken for this step only ({} so far)",
-            state.step, s.channel_id, unstandable_answers);
+            outcome.step, s.channel_id, unstandable_answers);
     }
   }
 
