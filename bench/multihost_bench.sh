@@ -59,7 +59,8 @@ bridge_hosts 10.78.0 5
 no_multicast 5
 unset CYCLONEDDS_URI FASTRTPS_DEFAULT_PROFILES_FILE MARSALA_DDS_CONFIG MARSALA_PEERS
 team=$((4 * per_host))
-crowd_agents=48  # as in deploy/spawn.sh: from this team size on, Fast DDS takes the crowd's timing
+# shellcheck source=deploy/dds/crowd.sh
+source "$root/deploy/dds/crowd.sh"  # as deploy/spawn.sh: from marsala_crowd_agents on, Fast DDS takes the crowd's timing
 
 # discovery_counters D: on every host a table `disc` counting UDP to domain D's metatraffic unicast ports (participant
 # indices 0..127), in and out.
@@ -95,9 +96,10 @@ for dds in $vendors; do
   discovery_counters "$domain"
   declare -A eth0_start=()
   for h in 1 2 3 4 5; do eth0_start[$h]=$(eth0_bytes "h$h"); done
-  profile="$dds-unicast.xml"
-  [ "$dds" = fastdds ] && [ "$team" -ge "$crowd_agents" ] && profile=fastdds-unicast-crowd.xml
-  peers=(--peers 10.78.0.1 --domain "$domain" --dds "$dds" --dds-config "$root/deploy/dds/$profile")
+  config="$root/deploy/dds/$dds-unicast.xml"
+  [ "$dds" = fastdds ] && config=$(marsala_crowd_profile "$config" "$team")
+  profile=${config##*/}
+  peers=(--peers 10.78.0.1 --domain "$domain" --dds "$dds" --dds-config "$config")
   ip netns exec h1 "$bin/marsala-world" --scenario "$scenario" --agents "$team" "${peers[@]}" --max-steps "$steps" \
     --admit-timeout 600 --out "$out" >"$out/logs/world.log" 2>&1 &
   world=$!

@@ -69,7 +69,9 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MARSALA_BUILD_DIR:-$root/build}/bin"
 
-crowd_agents=48  # from this team size on, Fast DDS takes fastdds-crowd.xml on loopback, fastdds-unicast-crowd.xml on unicast
+# From marsala_crowd_agents on, Fast DDS takes fastdds-crowd.xml on loopback, fastdds-unicast-crowd.xml on unicast.
+# shellcheck source=deploy/dds/crowd.sh
+source "$root/deploy/dds/crowd.sh"
 scenario="" agents="" dds="${MARSALA_DDS:-cyclone}" agent_dds="" out="" domain="${MARSALA_DOMAIN:-}" monitor=0 max_steps="" timeout_s=1800 seed="" quiet=0 frames_every=""
 replace=0 secure=0 insecure=0 dump_maps=0 set_args=() observe_args=() profile="" peers="" identities=""
 fork="" fork_at="" fork_set_args=()
@@ -196,11 +198,10 @@ done
 # The profile: loopback by default, DDS traffic never leaves this host's lo interface. The unicast one gets the peers
 # from the command line of every process (--peers, through MARSALA_PEERS: the binaries check it, exit 2 when malformed).
 export CYCLONEDDS_URI="file://$root/deploy/dds/cyclone-$profile.xml"
-fastdds_profile="$profile"
-if [ "$agents" -ge "$crowd_agents" ]; then
-  case "$profile" in lo) fastdds_profile=crowd ;; unicast) fastdds_profile=unicast-crowd ;; esac
-fi
-export FASTRTPS_DEFAULT_PROFILES_FILE="$root/deploy/dds/fastdds-$fastdds_profile.xml"
+FASTRTPS_DEFAULT_PROFILES_FILE=$(marsala_crowd_profile "$root/deploy/dds/fastdds-$profile.xml" "$agents")
+export FASTRTPS_DEFAULT_PROFILES_FILE
+fastdds_profile=$(basename "$FASTRTPS_DEFAULT_PROFILES_FILE" .xml)
+fastdds_profile=${fastdds_profile#fastdds-}  # lo, crowd, unicast, unicast-crowd, lan: said on the start line
 if [ -n "$peers" ]; then export MARSALA_PEERS="$peers"; else unset MARSALA_PEERS; fi
 
 # Without --domain: a random one (not derived from the PID, whose values repeat) on which no world answers

@@ -14,9 +14,10 @@
 # volume), MARSALA_AGENTS (the team size), MARSALA_INSECURE (1: no DDS Security; anyone on the network can read and
 # write the run), and the programs' own MARSALA_DDS, MARSALA_DDS_CONFIG and MARSALA_PEERS (unicast discovery at
 # those hosts, no multicast: docker/docker-compose.agents.yml sets the world's address; docs/runtime.md#peers).
-# Fast DDS teams of 48 agents or more take the crowd's timing as deploy/spawn.sh gives it: a MARSALA_DDS_CONFIG naming
-# the shipped fastdds-lo.xml or fastdds-unicast.xml becomes fastdds-crowd.xml or fastdds-unicast-crowd.xml beside it
-# (one line says so; README "240 robots over four hosts").
+# Fast DDS teams of 48 agents or more take the crowd's timing as deploy/spawn.sh gives it (deploy/dds/crowd.sh, read
+# from the folder of the profile): a MARSALA_DDS_CONFIG naming the shipped fastdds-lo.xml or fastdds-unicast.xml
+# becomes fastdds-crowd.xml or fastdds-unicast-crowd.xml beside it (one line says so; README "240 robots over four
+# hosts").
 set -euo pipefail
 role="${1:-}"
 [ $# -gt 0 ] && shift
@@ -34,14 +35,13 @@ slots="${MARSALA_SLOTS:-all}"
   { echo "marsala-entrypoint: MARSALA_SLOTS must be A-B with 1 <= A <= B <= MARSALA_AGENTS ($agents), got '$slots'" >&2
     exit 2; }
 first_slot="${BASH_REMATCH[1]}" last_slot="${BASH_REMATCH[2]}"
-crowd_agents=48  # as in deploy/spawn.sh
 config="${MARSALA_DDS_CONFIG:-}"
-if [ "${MARSALA_DDS:-cyclone}" = fastdds ] && [ "$agents" -ge "$crowd_agents" ]; then
-  case "${config##*/}" in
-    fastdds-lo.xml) config="${config%/*}/fastdds-crowd.xml" ;;
-    fastdds-unicast.xml) config="${config%/*}/fastdds-unicast-crowd.xml" ;;
-  esac
-  if [ "$config" != "${MARSALA_DDS_CONFIG:-}" ] && [ -f "$config" ]; then
+# The rule lies beside the shipped profiles (deploy/dds/crowd.sh); a profile in a folder without it is taken as given.
+if [ "${MARSALA_DDS:-cyclone}" = fastdds ] && [ -n "$config" ] && [ -f "$(dirname -- "$config")/crowd.sh" ]; then
+  # shellcheck source=deploy/dds/crowd.sh
+  source "$(dirname -- "$config")/crowd.sh"
+  config=$(marsala_crowd_profile "$config" "$agents")
+  if [ "$config" != "$MARSALA_DDS_CONFIG" ]; then
     echo "marsala-entrypoint: $agents Fast DDS agents: the crowd's timing, $config (MARSALA_DDS_CONFIG)" >&2
     export MARSALA_DDS_CONFIG="$config"
   fi

@@ -10,7 +10,7 @@ for p in marsala-world marsala-agent marsala-monitor; do
   printf '#!/bin/sh\necho "%s ${MARSALA_DDS_CONFIG:-none}"\n' "$p" >"$work/bin/$p"
   chmod +x "$work/bin/$p"
 done
-cp "$root"/deploy/dds/*.xml "$work/dds/"
+cp "$root"/deploy/dds/*.xml "$root"/deploy/dds/crowd.sh "$work/dds/"
 fail=0
 # check ROLE DDS AGENTS CONFIG EXPECTED: the profile ROLE runs with, unsecured
 check() {
@@ -32,6 +32,8 @@ check agent cyclone 60 "$d/cyclone-unicast.xml" "$d/cyclone-unicast.xml"       #
 check agent fastdds 60 "$d/fastdds-lan.xml" "$d/fastdds-lan.xml"               # no crowd twin: as given
 cp "$d/fastdds-unicast.xml" "$work/mine.xml"
 check agent fastdds 60 "$work/mine.xml" "$work/mine.xml"                       # a user's own profile: as given
+mkdir "$work/other" && cp "$d/fastdds-unicast.xml" "$d/fastdds-unicast-crowd.xml" "$work/other/"
+check agent fastdds 60 "$work/other/fastdds-unicast.xml" "$work/other/fastdds-unicast.xml"  # no rule (crowd.sh) beside
 rm "$d/fastdds-unicast-crowd.xml"
 check agent fastdds 60 "$d/fastdds-unicast.xml" "$d/fastdds-unicast.xml"       # an image without the twin: as given
 [ "$fail" -eq 0 ] && echo "ok: the entrypoint gives Fast DDS teams of 48 or more the crowd's profiles, nothing else"
