@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <initializer_list>
 #include <limits>
 #include <string>
@@ -229,8 +230,111 @@ void LocalMapSynthesizer::gap_and_occupiable(LocalMap& local) const {
     return;
   }
   local.gap = mars_.gap(local.heights);
-  local.occupiable = navigability_.occupiable(local.heights);
+  local.occupiable = occupiable_after_memo(local);
   memo_ = Memo{local.offset, local.rows(), local.cols(), std::vector<double>(first, last), local.gap, local.occupiable};
+}
+
+CellMask LocalMapSynthesizer::occupiable_after_memo(const LocalMap& local) const {
+  const int rows = local.rows(), cols = local.cols();
+  if (memo_.rows <= 0 || memo_.cols <= 0 || rows <= 0 || cols <= 0) return navigability_.occupiable(local.heights);
+  const double cs = local.geometry().cell_size_m;
+  const double radius_cells = params().delta_m / (2.0 * cs);
+  const NavigabilityParams& p = params();
+  if (radius_cells != ball_radius_cells_) {
+    ball_ = disc_offsets(radius_cells);
+    ball_radius_cells_ = radius_cells;
+    ball_reach_ = 0;
+    for (const CellIndex& o : ball_) ball_reach_ = std::max({ball_reach_, std::abs(o.row), std::abs(o.col)});
+    // Each pair of the ball with the threshold cell_occupiable_in_ball() gives it (the processor's expression).
+    ball_pairs_.clear();
+    for (std::size_t a = 0; a < ball_.size(); ++a)
+      for (std::size_t b = a + 1; b < ball_.size(); ++b) {
+        const long long dr = ball_[a].row - ball_[b].row, dc = ball_[a].col - ball_[b].col;
+        ball_pairs_.push_back({a, b, p.eps_m + p.kappa * (cs * std::sqrt(static_cast<double>(dr * dr + dc * dc))) +
+                                         tolerance::kHeightM});
+      }
+  }
+  const int reach = ball_reach_;
+  // Both windows in world indices: [first, last] rows and columns.
+  const int new_r0 = local.offset.row, new_c0 = local.offset.col;
+  const int new_r1 = new_r0 + rows - 1, new_c1 = new_c0 + cols - 1;
+  const int old_r0 = memo_.offset.row, old_c0 = memo_.offset.col;
+  const int old_r1 = old_r0 + memo_.rows - 1, old_c1 = old_c0 + memo_.cols - 1;
+  // A cell's ball rows clipped by the new window and by the old one are the same rows (likewise columns).
+  const auto clipped_alike = [reach](int g, int new_lo, int new_hi, int old_lo, int old_hi) {
+    return std::max(g - reach, new_lo) == std::max(g - reach, old_lo) &&
+           std::min(g + reach, new_hi) == std::min(g + reach, old_hi);
+  };
+  std::vector<std::uint8_t> col_alike(static_cast<std::size_t>(cols));
+  for (int c = 0; c < cols; ++c) col_alike[c] = clipped_alike(new_c0 + c, new_c0, new_c1, old_c0, old_c1);
+  // near[r][c]: the square of side 2 reach + 1 around the cell holds a cell the old window did not hold at the same
+  // height: the changed cells widened along rows, then along columns.
+  const std::size_t n = static_cast<std::size_t>(rows) * cols;
+  std::vector<std::uint8_t> along(n, 0), near(n, 0);
+  for (int r = 0; r < rows; ++r) {
+    const int g_row = new_r0 + r;
+    const bool row_held = g_row >= old_r0 && g_row <= old_r1;
+    const double* before =
+        row_held ? memo_.heights.data() + static_cast<std::size_t>(g_row - old_r0) * memo_.cols : nullptr;
+    for (int c = 0; c < cols; ++c) {
+      const int g_col = new_c0 + c;
+      if (row_held && g_col >= old_c0 && g_col <= old_c1 && before[g_col - old_c0] == local.heights(r, c)) continue;
+      std::uint8_t* row = along.data() + static_cast<std::size_t>(r) * cols;
+      std::fill(row + std::max(c - reach, 0), row + std::min(c + reach, cols - 1) + 1, std::uint8_t{1});
+    }
+  }
+  for (int r = 0; r < rows; ++r) {
+    const std::uint8_t* from = along.data() + static_cast<std::size_t>(r) * cols;
+    for (int t = std::max(r - reach, 0); t <= std::min(r + reach, rows - 1); ++t) {
+      std::uint8_t* to = near.data() + static_cast<std::size_t>(t) * cols;
+      for (int c = 0; c < cols; ++c) to[c] |= from[c];
+    }
+  }
+  CellMask out(rows, cols);
+  std::vector<CellIndex> judge;
+  for (int r = 0; r < rows; ++r) {
+    const int g_row = new_r0 + r;
+    const bool row_alike = clipped_alike(g_row, new_r0, new_r1, old_r0, old_r1);
+    const std::uint8_t* near_row = near.data() + static_cast<std::size_t>(r) * cols;
+    for (int c = 0; c < cols; ++c) {
+      if (row_alike && col_alike[c] && near_row[c] == 0) {
+        // The ball's square lies in both windows (clipped alike) with the old heights: the old answer.
+        out(r, c) = memo_.occupiable(g_row - old_r0, new_c0 + c - old_c0);
+        continue;
+      }
+      judge.push_back({r, c});
+    }
+  }
+  // Judged one by one, a cell costs up to its ball's pairs; the whole window costs about a few of them per cell.
+  if (judge.size() * 3 > n) return navigability_.occupiable(local.heights);
+  // A ball whose heights spread by no more than the threshold of the nearest pair (one cell apart) passes every pair:
+  // |h(a) - h(b)| <= max - min <= eps + kappa cs + tol <= each pair's threshold, each rounded alike (rounding is
+  // monotone), so this is cell_occupiable_in_ball()'s answer without its pairs.
+  const double nearest_threshold_m = p.eps_m + p.kappa * (cs * std::sqrt(1.0)) + tolerance::kHeightM;
+  std::vector<double> hs(ball_.size());
+  // Cells of a ball off the window are ignored, as the processor ignores cells off its grid: NaN there, which no
+  // min, max or pair test below takes (every comparison with NaN is false).
+  const double off = std::numeric_limits<double>::quiet_NaN();
+  for (const CellIndex cell : judge) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (std::size_t k = 0; k < ball_.size(); ++k) {
+      const CellIndex b{cell.row + ball_[k].row, cell.col + ball_[k].col};
+      hs[k] = local.heights.contains(b) ? local.heights(b) : off;
+      lo = std::min(lo, hs[k]);
+      hi = std::max(hi, hs[k]);
+    }
+    bool occupiable = hi - lo <= nearest_threshold_m;
+    if (!occupiable) {  // every pair of cells on the window, as cell_occupiable_in_ball() checks them
+      occupiable = true;
+      for (const BallPair& q : ball_pairs_)
+        if (std::abs(hs[q.a] - hs[q.b]) > q.threshold_m) {
+          occupiable = false;
+          break;
+        }
+    }
+    out(cell.row, cell.col) = occupiable ? 1 : 0;
+  }
+  return out;
 }
 
 std::optional<CellIndex> LocalMapSynthesizer::local_origin(const LocalMap& local,

@@ -159,6 +159,11 @@ class LocalMapSynthesizer {
   };
   /// Fills local.gap and local.occupiable from local.heights, from the memo when the window is the last one.
   void gap_and_occupiable(LocalMap& local) const;
+  /// NavigabilityProcessor::occupiable() of local.heights, taking from the memo's window every cell whose ball the
+  /// windows' edges clip alike and whose ball's bounding square holds the same heights in both: the rule reads only
+  /// the ball. The other cells (a moved window's edges, the balls around changed heights) are judged one by one by the
+  /// pair rule on the ball, as cell_occupiable_in_ball() judges them, or the whole window again when they are many.
+  CellMask occupiable_after_memo(const LocalMap& local) const;
   // The cells of `map.stood` in the window whose balls read as when the robot stood there become occupiable.
   static void open_stood_cells(LocalMap& local, const KnownMap& map);
 
@@ -166,6 +171,14 @@ class LocalMapSynthesizer {
   NavigabilityProcessor navigability_;
   double sensing_range_m_;
   mutable Memo memo_;
+  mutable double ball_radius_cells_ = -1.0;  // the body ball below is disc_offsets() of this radius [cells]
+  mutable std::vector<CellIndex> ball_;
+  mutable int ball_reach_ = 0;  // largest |row| or |col| offset of the ball [cells]
+  struct BallPair {
+    std::size_t a, b;    // indices into ball_
+    double threshold_m;  // eps + kappa |a - b| + tolerance [m]
+  };
+  mutable std::vector<BallPair> ball_pairs_;
 };
 
 }  // namespace marsala::agent::deliberative

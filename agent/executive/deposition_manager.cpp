@@ -255,6 +255,7 @@ void DepositionManager::prepare(WayBack& w) const {
     for (int r = 0; r < map.rows(); ++r)
       for (int c = 0; c < map.cols(); ++c)
         if (map.occupiable(r, c) != 0 && map.heights_occupiable(r, c) == 0) w.occupiable(r, c) = 1;
+  w.occupiable_is_map = w.occupiable == map.occupiable;
   w.after = map.heights;
   w.ball = disc_offsets(params_.navigability.delta_m / (2.0 * cs));
   w.touched.assign(static_cast<std::size_t>(map.rows()) * map.cols(), 0);
@@ -303,7 +304,8 @@ CellMask DepositionManager::occupiable_after(WayBack& w, const std::vector<Depos
 }
 
 CellMask DepositionManager::raised_occupiable(WayBack& w, const std::vector<DepositionCandidate>& depositions,
-                                              const NavigabilityProcessor& rule, const CellMask& before) const {
+                                              const NavigabilityProcessor& rule, const CellMask& before,
+                                              bool* unchanged) const {
   const deliberative::LocalMap& map = *w.map;
   for (const auto& d : depositions) w.after(d.cell) += d.height_m;
   // A cell's occupiability reads only the heights in its body ball: the cells whose ball holds a raised cell.
@@ -333,6 +335,10 @@ CellMask DepositionManager::raised_occupiable(WayBack& w, const std::vector<Depo
           map.blind(p.row, p.col) == 0 && cell_occupiable_in_ball(w.after, p, rule.params(), w.ball) ? 1 : 0;
   }
   for (const auto& d : depositions) w.after(d.cell) = map.heights(d.cell);
+  if (unchanged) {
+    *unchanged = true;
+    for (const CellIndex p : changed) *unchanged = *unchanged && occupiable(p.row, p.col) == before(p.row, p.col);
+  }
   return occupiable;
 }
 
@@ -342,7 +348,11 @@ bool DepositionManager::keeps_way_back(WayBack& w, const std::vector<DepositionC
   if (!w.ready) prepare(w);
   const deliberative::LocalMap& map = *w.map;
   const CellIndex cell = *w.cell;
-  const CellMask occupiable = occupiable_after(w, depositions);
+  bool unchanged = false;
+  const CellMask occupiable = raised_occupiable(w, depositions, navigability_, w.occupiable, &unchanged);
+  // Depositions that change no cell's occupiability leave every reach below as it was: the robot's own cell, its way
+  // out (had_way_out was read on these cells) and the reach from the origin (`before`) stay.
+  if (unchanged && w.occupiable_is_map && w.reach.size() == 0) return true;
   // This robot's own cell must stay occupiable if it was (the world checks only motion targets, but a robot on a
   // cell it cannot occupy has no navigable move).
   if (map.occupiable(cell.row, cell.col) != 0 && occupiable(cell.row, cell.col) == 0) return false;

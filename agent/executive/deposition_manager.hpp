@@ -158,6 +158,7 @@ class DepositionManager {
     /// (eps widened by it), 0 on blind cells, 1 on the robot's cell; empty otherwise.
     CellMask within_noise;
     CellMask occupiable;            ///< NavigabilityProcessor::occupiable(map.heights), 0 on blind cells
+    bool occupiable_is_map = false;  ///< `occupiable` is map.occupiable, cell for cell
     Heightmap after;                ///< scratch: map.heights with the depositions tried, restored after each try
     std::vector<CellIndex> ball;    ///< the body ball's offsets (delta / 2)
     std::vector<std::uint8_t> touched;  ///< scratch: 0 per window cell between tries
@@ -172,9 +173,11 @@ class DepositionManager {
 
  private:
   void prepare(WayBack& context) const;
-  // occupiable_after() by `rule` from its mask `before` the depositions (blind cells never occupiable).
+  // occupiable_after() by `rule` from its mask `before` the depositions (blind cells never occupiable); `unchanged`,
+  // when given, is set to whether the mask is `before`, cell for cell.
   CellMask raised_occupiable(WayBack& context, const std::vector<DepositionCandidate>& depositions,
-                             const NavigabilityProcessor& rule, const CellMask& before) const;
+                             const NavigabilityProcessor& rule, const CellMask& before,
+                             bool* unchanged = nullptr) const;
   bool in_territory(const deliberative::LocalMap& map, CellIndex cell, Position centre, const Neighbourhood& neighbours,
                     std::optional<CellIndex> self_cell) const;
   DepositionParams params_;

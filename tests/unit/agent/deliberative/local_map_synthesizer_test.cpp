@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <random>
+
 #include "marsala/core/cell_occupancy.hpp"
 #include "marsala/core/error.hpp"
 #include "marsala/core/iterators.hpp"
@@ -99,6 +102,45 @@ TEST(LocalMapSynthesizer, AWindowAskedAgainGivesItsOwnGapAfterADepositOrAMove) {
   check(h, kRobot, "after a deposit");
   check(h, {4.15, 2.95}, "moved one cell east");
   check(bumpy_terrain(), {4.15, 2.95}, "the deposit gone, same place");
+}
+
+// A robot's synthesizer keeps the occupiable cells of its last window and judges again only the cells whose balls
+// moved across a window edge or hold a changed height. Along a random walk (steps of one cell, jumps, the grid's
+// corners, where the window is clipped) on terrain full of ties (ramps at exactly slope kappa with steps of exactly
+// eps) with random deposits, every window's mask is the processor's on that window alone.
+TEST(LocalMapSynthesizer, OccupiableAfterAMoveOrADepositIsTheProcessorsOnTheNewWindow) {
+  std::mt19937 rng(5);
+  Heightmap h = bumpy_terrain();
+  for (int r = 0; r < h.rows(); ++r)
+    for (int c = 0; c < h.cols(); ++c)
+      if ((r / 10 + c / 10) % 3 == 0)  // ramps east at slope kappa, a step of eps every 5 columns
+        h(r, c) = kBody.kappa * 0.1 * (c % 10) + ((c % 10) >= 5 ? kBody.eps_m : 0.0);
+  const LocalMapSynthesizer synthesizer(kBody, 1.0);
+  int row = 30, col = 40, not_occupiable = 0;
+  for (int step = 0; step < 400; ++step) {
+    const int move = static_cast<int>(rng() % 10);
+    if (move < 6) {  // a step to one of the 8 neighbours
+      row = std::clamp(row + static_cast<int>(rng() % 3) - 1, 0, h.rows() - 1);
+      col = std::clamp(col + static_cast<int>(rng() % 3) - 1, 0, h.cols() - 1);
+    } else if (move == 6) {  // a jump, now and then to a corner
+      row = rng() % 2 ? static_cast<int>(rng() % h.rows()) : (rng() % 2 ? 0 : h.rows() - 1);
+      col = rng() % 2 ? static_cast<int>(rng() % h.cols()) : (rng() % 2 ? 0 : h.cols() - 1);
+    }
+    if (rng() % 3 == 0) {  // a deposit near the robot: one cube layer, or a kappa step
+      const int r = std::clamp(row + static_cast<int>(rng() % 7) - 3, 0, h.rows() - 1);
+      const int c = std::clamp(col + static_cast<int>(rng() % 7) - 3, 0, h.cols() - 1);
+      h(r, c) += rng() % 2 ? 0.1 : kBody.kappa * 0.1;
+    }
+    const Position robot = kWorld.cell_center({row, col});
+    executive::MappingSystem map = test::full_map(h);
+    map.record_pose(robot);
+    const LocalMap local = synthesizer.synthesize(map.known_map(), robot, {4.55, 2.95});
+    const Heightmap window = h.window(local.offset, local.rows(), local.cols());
+    const CellMask expected = NavigabilityProcessor(kBody).occupiable(window);
+    ASSERT_TRUE(local.heights_occupiable == expected) << "step " << step << " at row " << row << ", col " << col;
+    not_occupiable += static_cast<int>(expected.size() - expected.cast<int>().sum());
+  }
+  EXPECT_GT(not_occupiable, 4000);  // many cells along the way were not occupiable: not only flat ground
 }
 
 TEST(LocalMapSynthesizer, OccupiableIsTheWorldsSingleCellAnswer) {
