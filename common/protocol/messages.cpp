@@ -24,22 +24,24 @@ std::string partition_for(const std::string& run_id, std::uint32_t agent_id, std
   return fmt::format("{}/agent-{}-{:016x}", run_id, agent_id, session);
 }
 
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
 bool same_request(const ActionRequest& a, const ActionRequest& b) {
   // Bitwise on the doubles, so that a repeated request is recognised even when it carries a NaN.
-  const auto same = [](double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; };
   if (a.agent_id != b.agent_id || a.session != b.session || a.step != b.step || a.move != b.move ||
-      !same(a.target_x_m, b.target_x_m) || !same(a.target_y_m, b.target_y_m) || a.refill != b.refill ||
+      !same_bits(a.target_x_m, b.target_x_m) || !same_bits(a.target_y_m, b.target_y_m) || a.refill != b.refill ||
       a.state != b.state || a.waiting_for != b.waiting_for || a.standing != b.standing ||
       a.depositions.size() != b.depositions.size() || a.deposits.size() != b.deposits.size())
     return false;
   for (std::size_t i = 0; i < a.deposits.size(); ++i) {
     const Deposit &p = a.deposits[i], &q = b.deposits[i];
-    if (!same(p.centre.x, q.centre.x) || !same(p.centre.y, q.centre.y) || !same(p.volume_m3, q.volume_m3))
+    if (!same_bits(p.centre.x, q.centre.x) || !same_bits(p.centre.y, q.centre.y) ||
+        !same_bits(p.volume_m3, q.volume_m3))
       return false;
   }
   for (std::size_t i = 0; i < a.depositions.size(); ++i) {
     const Deposition &p = a.depositions[i], &q = b.depositions[i];
-    if (p.row != q.row || p.col != q.col || !same(p.height_m, q.height_m)) return false;
+    if (p.row != q.row || p.col != q.col || !same_bits(p.height_m, q.height_m)) return false;
   }
   return true;
 }

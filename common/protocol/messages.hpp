@@ -157,6 +157,8 @@ std::string partition_for(const std::string& run_id, std::uint32_t agent_id, std
 
 /// True when the two requests are the same in every field (an agent that repeats a request it already sent).
 bool same_request(const ActionRequest& a, const ActionRequest& b);
+/// True when `a` and `b` are the same bits: how the contract compares its doubles (a NaN equals itself).
+bool same_bits(double a, double b);
 
 /// Names of the enums, for logs and the monitor; from_string throws InvalidArgument listing valid names.
 std::string to_string(ActionResult r);

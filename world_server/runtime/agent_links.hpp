@@ -93,6 +93,11 @@ class AgentLinks {
   /// again at `now` (answered or not), unless a copy is in flight, which answers it when it arrives. Needs
   /// answers_with_frame(); otherwise an admission answers (docs/runtime.md#re-admission).
   void answer_with_frame(std::uint32_t id, ResendPolicy::Clock::time_point now);
+  /// The frame last written to slot `id`'s agent (what it was told), nullptr when none (no link, or none yet).
+  const protocol::SensorFrame* last_frame(std::uint32_t id) const {
+    const AgentLink& link = links_[id - 1];
+    return link.frame ? &*link.frame : nullptr;
+  }
   /// Copies of slot `id`'s current frame written besides the first [count].
   std::uint32_t resends(std::uint32_t id) const { return links_[id - 1].resends.resends(); }
 

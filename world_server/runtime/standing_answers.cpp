@@ -1,15 +1,12 @@
 #include "marsala/world_server/runtime/standing_answers.hpp"
 
-#include <cstring>
-
 namespace marsala::world_server {
 namespace {
-
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 /// True when `frame` tells its agent nothing that `told` did not: no terrain, no scan, not run over, and the same pose,
 /// material, last result and reason and neighbours (bit for bit).
 bool nothing_new(const protocol::SensorFrame& frame, const protocol::SensorFrame& told) {
+  using protocol::same_bits;
   if (frame.run_over || frame.scanned || !frame.tiles.empty() || !frame.points.empty()) return false;
   if (!same_bits(frame.x_m, told.x_m) || !same_bits(frame.y_m, told.y_m) || !same_bits(frame.z_m, told.z_m) ||
       !same_bits(frame.material_m3, told.material_m3) || frame.last_result != told.last_result ||
@@ -30,69 +27,31 @@ bool empty_request(const protocol::ActionRequest& r) {
   return !r.move && r.depositions.empty() && r.deposits.empty() && !r.refill;
 }
 
-StandingAnswers::StandingAnswers(std::size_t slots, bool allowed) : allowed_(allowed), slots_(slots) {}
-
-StandingAnswers::Slot* StandingAnswers::slot(std::uint32_t id) {
-  return id >= 1 && id <= slots_.size() ? &slots_[id - 1] : nullptr;
-}
-
-const StandingAnswers::Slot* StandingAnswers::slot(std::uint32_t id) const {
-  return id >= 1 && id <= slots_.size() ? &slots_[id - 1] : nullptr;
-}
-
-void StandingAnswers::told(const protocol::SensorFrame& frame) {
-  Slot* s = slot(frame.agent_id);
-  if (s == nullptr) return;
-  s->standing.reset();
-  protocol::SensorFrame kept;  // what nothing_new() compares: the frame without its terrain and scan
-  kept.agent_id = frame.agent_id;
-  kept.step = frame.step;
-  kept.x_m = frame.x_m;
-  kept.y_m = frame.y_m;
-  kept.z_m = frame.z_m;
-  kept.material_m3 = frame.material_m3;
-  kept.last_result = frame.last_result;
-  kept.last_reason = frame.last_reason;
-  kept.neighbours = frame.neighbours;
-  s->told = std::move(kept);
-}
+StandingAnswers::StandingAnswers(std::size_t slots, bool allowed) : allowed_(allowed), standing_(slots) {}
 
 bool StandingAnswers::answered(std::uint32_t id, const protocol::ActionRequest& r) {
-  Slot* s = slot(id);
-  if (s == nullptr) return true;
-  s->standing.reset();
-  if (!r.standing || !allowed_) return true;
-  if (!empty_request(r) || !s->told) return false;
-  s->standing = r;
+  end(id);
+  if (!r.standing || !allowed_ || id < 1 || id > standing_.size()) return true;
+  if (!empty_request(r)) return false;
+  standing_[id - 1] = r;
   return true;
 }
 
-std::optional<protocol::ActionRequest> StandingAnswers::stands_for(std::uint32_t id,
-                                                                   const protocol::SensorFrame& frame) const {
-  const Slot* s = slot(id);
-  if (s == nullptr || !s->standing || !s->told || !nothing_new(frame, *s->told)) return std::nullopt;
-  protocol::ActionRequest r = *s->standing;
+std::optional<protocol::ActionRequest> StandingAnswers::stands_for(std::uint32_t id, const protocol::SensorFrame& frame,
+                                                                   const protocol::SensorFrame* told) const {
+  if (id < 1 || id > standing_.size() || !standing_[id - 1] || told == nullptr || !nothing_new(frame, *told))
+    return std::nullopt;
+  protocol::ActionRequest r = *standing_[id - 1];
   r.step = frame.step;
   r.decision_us = 0;  // no decision was made for this step
   r.decision_cpu_us = 0;
   return r;
 }
 
-void StandingAnswers::forget(std::uint32_t id) {
-  if (Slot* s = slot(id)) *s = Slot{};
-}
-
-bool StandingAnswers::asked(std::uint32_t id) {
-  Slot* s = slot(id);
-  if (s == nullptr || !s->standing) return false;
-  s->standing.reset();
+bool StandingAnswers::end(std::uint32_t id) {
+  if (id < 1 || id > standing_.size() || !standing_[id - 1]) return false;
+  standing_[id - 1].reset();
   return true;
-}
-
-std::size_t StandingAnswers::standing() const {
-  std::size_t n = 0;
-  for (const Slot& s : slots_) n += s.standing ? 1 : 0;
-  return n;
 }
 
 }  // namespace marsala::world_server

@@ -149,9 +149,9 @@ struct WorldRuntime::Impl {
         resume_step(state.step),
         fork(std::move(start.fork)),
         recorder(recorder_setup(options, resume)),
-        silence(std::chrono::milliseconds(static_cast<long long>(options.silence_timeout_s * 1000.0))) {
+        silence(std::chrono::milliseconds(static_cast<long long>(options.silence_timeout_s * 1000.0))),
+        standing(state.agents.size(), scenario.standing_answers) {
     sensing.emplace(state);
-    standing.emplace(state.agents.size(), scenario.standing_answers);
     last_rejection.resize(state.agents.size());
   }
 
@@ -285,7 +285,7 @@ struct WorldRuntime::Impl {
     recorder.record(admitted_record(state, slot.agent_id, kind));
     const AgentRecord& a = state.agent(slot.agent_id);
     if (kind != AdmissionKind::kFirst && a.session != previous) sensing->forget(slot.agent_id);
-    standing->forget(slot.agent_id);
+    standing.end(slot.agent_id);
     links->open(a, from);
     links->forgive(slot.agent_id);
     std::string detail = a.name;
@@ -323,7 +323,7 @@ struct WorldRuntime::Impl {
       if (decision.accepted && decision.kind == AdmissionKind::kRepeat && run_started) {
         const std::uint32_t id = slot_hello(state, hello, decision).agent_id;  // "any slot": the one it holds
         // An agent whose answer stood: its frame of the next step goes out and answers (standing_answers.hpp).
-        if (state.has_agent(id) && state.agent(id).alive && standing->asked(id)) continue;
+        if (state.has_agent(id) && state.agent(id).alive && standing.end(id)) continue;
         if (state.has_agent(id) && links->has(id) && state.agent(id).alive && links->answers_with_frame(id)) {
           if (gate.may_answer(sender, now)) links->answer_with_frame(id, now);
           continue;
@@ -463,7 +463,7 @@ struct WorldRuntime::Impl {
 
   /// Writes `frame` to its agent; what the agent was told ends its standing answer (standing_answers.hpp).
   void tell(protocol::SensorFrame frame) {
-    standing->told(frame);
+    standing.end(frame.agent_id);
     links->send(frame.agent_id, std::move(frame));
   }
 
@@ -522,7 +522,7 @@ struct WorldRuntime::Impl {
     std::vector<Submission> stood;
     for (std::uint32_t id : state.live_ids()) {
       protocol::SensorFrame frame = sensing->frame_for(state, id, false);
-      if (std::optional<protocol::ActionRequest> answer = standing->stands_for(id, frame))
+      if (std::optional<protocol::ActionRequest> answer = standing.stands_for(id, frame, links->last_frame(id)))
         stood.push_back({id, std::move(*answer)});
       else
         tell(std::move(frame));
@@ -535,11 +535,8 @@ struct WorldRuntime::Impl {
   void keep_standing_answers(const Collected& collected, const StepOutcome& outcome) {
     for (std::size_t i : collected.answers) {
       const Submission& s = collected.submissions[i];
-      if (!outcome.accepted_submissions[i]) {
-        standing->forget(s.channel_id);
-        continue;
-      }
-      if (!standing->answered(s.channel_id, s.request) && power_of_ten(++unstandable_answers))
+      if (!outcome.accepted_submissions[i]) continue;  // its frame, written this step, ended any standing answer
+      if (!standing.answered(s.channel_id, s.request) && power_of_ten(++unstandable_answers))
         spdlog::warn(
             "step {}: agent {} said its request stands, but it asks for something (a motion, deposition or refill): "
             "taken for this step only ({} so far)",
@@ -826,8 +823,8 @@ struct WorldRuntime::Impl {
   RunRecorder recorder;           ///< run.log, snapshots, events.log, frames, final outputs
   TeamSilence silence;            ///< whether the step is held for a silent team
   std::optional<SensingService> sensing;
-  std::optional<StandingAnswers> standing;  ///< the agents' standing answers and what each was last told
-  std::uint64_t unstandable_answers = 0;    ///< answers that said they stand but asked for something [count]
+  StandingAnswers standing;               ///< the agents' standing answers
+  std::uint64_t unstandable_answers = 0;  ///< answers that said they stand but asked for something [count]
   AdmissionGate gate;
   std::shared_ptr<bus::Signal> signal;
   std::optional<AgentLinks> links;

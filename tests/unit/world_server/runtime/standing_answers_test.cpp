@@ -46,11 +46,10 @@ protocol::ActionRequest answer(std::uint64_t step, bool standing = true) {
 
 TEST(StandingAnswers, AnEmptyAnswerThatSaysItStandsAnswersFramesWithNothingNewForTheirStep) {
   StandingAnswers answers(3, true);
-  answers.told(frame(4));
+  const protocol::SensorFrame told = frame(4);
   ASSERT_TRUE(answers.answered(2, answer(4)));
-  EXPECT_EQ(answers.standing(), 1u);
   for (std::uint64_t step : {5u, 6u, 500u}) {
-    const std::optional<protocol::ActionRequest> r = answers.stands_for(2, frame(step));
+    const std::optional<protocol::ActionRequest> r = answers.stands_for(2, frame(step), &told);
     ASSERT_TRUE(r) << step;
     EXPECT_EQ(r->step, step);
     EXPECT_EQ(r->state, "idle");
@@ -60,8 +59,8 @@ TEST(StandingAnswers, AnEmptyAnswerThatSaysItStandsAnswersFramesWithNothingNewFo
     EXPECT_EQ(r->decision_us, 0u) << "no decision was made for a held step";
     EXPECT_EQ(r->decision_cpu_us, 0u);
   }
-  EXPECT_FALSE(answers.stands_for(1, frame(5))) << "another agent holds no answer";
-  EXPECT_FALSE(answers.stands_for(7, frame(5))) << "no such slot";
+  EXPECT_FALSE(answers.stands_for(1, frame(5), &told)) << "another agent holds no answer";
+  EXPECT_FALSE(answers.stands_for(7, frame(5), &told)) << "no such slot";
 }
 
 TEST(StandingAnswers, AnyNewsInTheFrameEndsIt) {
@@ -82,34 +81,35 @@ TEST(StandingAnswers, AnyNewsInTheFrameEndsIt) {
       {"a neighbour came", [](protocol::SensorFrame& f) { f.neighbours.push_back(f.neighbours[0]); }},
       {"the neighbour went", [](protocol::SensorFrame& f) { f.neighbours.clear(); }},
   };
+  const protocol::SensorFrame told = frame(4);
   for (const auto& [what, change] : news) {
     StandingAnswers answers(3, true);
-    answers.told(frame(4));
     ASSERT_TRUE(answers.answered(2, answer(4)));
     protocol::SensorFrame next = frame(5);
     change(next);
-    EXPECT_FALSE(answers.stands_for(2, next)) << what;
+    EXPECT_FALSE(answers.stands_for(2, next, &told)) << what;
   }
 }
 
 TEST(StandingAnswers, AFrameWrittenEndsItAndTheNextAnswerDecides) {
   StandingAnswers answers(3, true);
-  answers.told(frame(4));
+  const protocol::SensorFrame first = frame(4);
   ASSERT_TRUE(answers.answered(2, answer(4)));
   protocol::SensorFrame moved = frame(5);
   moved.x_m = 1.15;
-  answers.told(moved);
-  EXPECT_EQ(answers.standing(), 0u);
-  EXPECT_FALSE(answers.stands_for(2, moved)) << "told, then not answered yet";
+  EXPECT_TRUE(answers.end(2)) << "the moved frame is written: the answer stood until then";
+  EXPECT_FALSE(answers.stands_for(2, moved, &moved)) << "told, then not answered yet";
+  EXPECT_FALSE(answers.end(2)) << "nothing stands any more";
   ASSERT_TRUE(answers.answered(2, answer(5, false)));
-  EXPECT_FALSE(answers.stands_for(2, moved)) << "an answer for its step only";
+  EXPECT_FALSE(answers.stands_for(2, moved, &moved)) << "an answer for its step only";
   ASSERT_TRUE(answers.answered(2, answer(5)));
   protocol::SensorFrame later = moved;
   later.step = 6;
-  EXPECT_TRUE(answers.stands_for(2, later)) << "compared with the frame told last, not the first";
-  EXPECT_FALSE(answers.stands_for(2, frame(6)));
-  answers.forget(2);
-  EXPECT_FALSE(answers.stands_for(2, later));
+  EXPECT_TRUE(answers.stands_for(2, later, &moved)) << "compared with the frame told last";
+  EXPECT_FALSE(answers.stands_for(2, later, &first)) << "not with an earlier one";
+  EXPECT_FALSE(answers.stands_for(2, frame(6), &moved));
+  answers.end(2);
+  EXPECT_FALSE(answers.stands_for(2, later, &moved));
 }
 
 TEST(StandingAnswers, AnAnswerThatAsksForSomethingNeverStands) {
@@ -119,25 +119,25 @@ TEST(StandingAnswers, AnAnswerThatAsksForSomethingNeverStands) {
       {"a deposit", [](protocol::ActionRequest& r) { r.deposits.push_back({{1.0, 2.0}, 0.001}); }},
       {"a refill", [](protocol::ActionRequest& r) { r.refill = true; }},
   };
+  const protocol::SensorFrame told = frame(4);
   for (const auto& [what, change] : asks) {
     StandingAnswers answers(3, true);
-    answers.told(frame(4));
     protocol::ActionRequest r = answer(4);
     change(r);
     EXPECT_FALSE(answers.answered(2, r)) << what;
-    EXPECT_FALSE(answers.stands_for(2, frame(5))) << what;
+    EXPECT_FALSE(answers.stands_for(2, frame(5), &told)) << what;
   }
   StandingAnswers untold(3, true);
-  EXPECT_FALSE(untold.answered(2, answer(4))) << "an answer to no frame written";
-  EXPECT_FALSE(untold.stands_for(2, frame(5)));
+  ASSERT_TRUE(untold.answered(2, answer(4)));
+  EXPECT_FALSE(untold.stands_for(2, frame(5), nullptr)) << "no frame written to the agent yet";
 }
 
 TEST(StandingAnswers, AScenarioWithoutStandingAnswersGetsAFrameEveryStep) {
   StandingAnswers answers(3, false);
-  answers.told(frame(4));
+  const protocol::SensorFrame told = frame(4);
   EXPECT_TRUE(answers.answered(2, answer(4))) << "not a fault of the agent's";
-  EXPECT_FALSE(answers.stands_for(2, frame(5)));
-  EXPECT_EQ(answers.standing(), 0u);
+  EXPECT_FALSE(answers.stands_for(2, frame(5), &told));
+  EXPECT_FALSE(answers.end(2)) << "nothing stood";
 }
 
 }  // namespace
