@@ -54,7 +54,8 @@ struct Collected {
   std::chrono::steady_clock::duration waited{};  ///< time spent waiting for requests
   /// Each agent whose answer was taken, when it was read and its reported decision time (the step trace).
   std::vector<AgentAnswer> answered_at;
-  /// Where in `submissions` each answer read this step lies (standing answers not included).
+  /// Where in `submissions` each answer read this step lies. Standing answers are not among them: a question during the
+  /// step ends an agent's standing answer (StandingAnswers::end()), and taking its held answer again would undo that.
   std::vector<std::size_t> answers;
 };
 
